@@ -1,0 +1,27 @@
+//! The command-line interface: argument definitions and one module per sub-command. `main.rs` only
+//! parses and dispatches; everything a command does lives here so it can be tested.
+
+pub mod part;
+
+use clap::{Parser, Subcommand};
+
+/// pinfeed: orient planar parts on a conveyor with overhead pins and fences.
+#[derive(Debug, Parser)]
+#[command(name = "pinfeed", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Describe a part: area, centroid, a, convexity, stable states; optionally plot it.
+    Part(part::PartArgs),
+}
+
+/// Run a parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Part(a) => part::run(&a),
+    }
+}

@@ -1,0 +1,203 @@
+//! Named parts (SPEC §1) and the textual part specifications the CLI and scenarios accept.
+//!
+//! | spec | shape |
+//! |---|---|
+//! | `tripoly1` | right isosceles triangle, hypotenuse down: (−1.5,−0.5), (1.5,−0.5), (0,1) |
+//! | `tripoly2` | right triangle, legs 2:1, long leg down: (−2/3,−1/3), (4/3,−1/3), (−2/3,2/3) |
+//! | `square` | unit square |
+//! | `rect:W:H` | W × H rectangle |
+//! | `ngon:N` | regular N-gon of circumradius 1 with a flat bottom edge (3 ≤ N ≤ 1000) |
+//! | `lshape` | concave L made of three unit squares |
+//! | `vertices:x1,y1 x2,y2 …` | any simple polygon (also accepted by `--vertices`) |
+
+use super::polygon::{Polygon, PolygonError};
+use super::vec2::Vec2;
+use thiserror::Error;
+
+/// Why a part specification could not be turned into a polygon.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PartSpecError {
+    #[error("unknown part '{0}'; expected one of tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, vertices:\"x1,y1 x2,y2 ...\"")]
+    Unknown(String),
+    #[error("bad part '{spec}': {reason}")]
+    BadParameter { spec: String, reason: String },
+    #[error("bad vertex list: {0}")]
+    BadVertexList(String),
+    #[error(transparent)]
+    Polygon(#[from] PolygonError),
+}
+
+/// Names accepted by [`part_from_spec`] (for help texts).
+pub const PART_NAMES: &[&str] = &[
+    "tripoly1", "tripoly2", "square", "rect:W:H", "ngon:N", "lshape",
+];
+
+fn positive(spec: &str, what: &str, s: &str) -> Result<f64, PartSpecError> {
+    let v: f64 = s.trim().parse().map_err(|_| PartSpecError::BadParameter {
+        spec: spec.into(),
+        reason: format!("{what} '{s}' is not a number"),
+    })?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(PartSpecError::BadParameter {
+            spec: spec.into(),
+            reason: format!("{what} must be a positive finite number, got {s}"),
+        });
+    }
+    Ok(v)
+}
+
+/// Vertex list of a named part (before validation), or `None` when the name is unknown.
+pub fn named_vertices(spec: &str) -> Result<Vec<Vec2>, PartSpecError> {
+    let s = spec.trim();
+    let lower = s.to_ascii_lowercase();
+    let v = |pts: &[(f64, f64)]| {
+        pts.iter()
+            .map(|&(x, y)| Vec2::new(x, y))
+            .collect::<Vec<_>>()
+    };
+    match lower.as_str() {
+        "tripoly1" => return Ok(v(&[(-1.5, -0.5), (1.5, -0.5), (0.0, 1.0)])),
+        "tripoly2" => {
+            return Ok(v(&[
+                (-2.0 / 3.0, -1.0 / 3.0),
+                (4.0 / 3.0, -1.0 / 3.0),
+                (-2.0 / 3.0, 2.0 / 3.0),
+            ]))
+        }
+        "square" => return Ok(v(&[(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)])),
+        "lshape" => {
+            return Ok(v(&[
+                (0.0, 0.0),
+                (2.0, 0.0),
+                (2.0, 1.0),
+                (1.0, 1.0),
+                (1.0, 2.0),
+                (0.0, 2.0),
+            ]))
+        }
+        _ => {}
+    }
+    if let Some(rest) = lower.strip_prefix("rect:") {
+        let parts: Vec<&str> = rest.split(':').collect();
+        if parts.len() != 2 {
+            return Err(PartSpecError::BadParameter {
+                spec: s.into(),
+                reason: "expected rect:W:H".into(),
+            });
+        }
+        let w = positive(s, "width", parts[0])?;
+        let h = positive(s, "height", parts[1])?;
+        return Ok(v(&[
+            (-w / 2.0, -h / 2.0),
+            (w / 2.0, -h / 2.0),
+            (w / 2.0, h / 2.0),
+            (-w / 2.0, h / 2.0),
+        ]));
+    }
+    if let Some(rest) = lower.strip_prefix("ngon:") {
+        let n: usize = rest
+            .trim()
+            .parse()
+            .map_err(|_| PartSpecError::BadParameter {
+                spec: s.into(),
+                reason: format!("'{rest}' is not a whole number of sides"),
+            })?;
+        if !(3..=1000).contains(&n) {
+            return Err(PartSpecError::BadParameter {
+                spec: s.into(),
+                reason: format!("number of sides must be between 3 and 1000, got {n}"),
+            });
+        }
+        let step = std::f64::consts::TAU / n as f64;
+        let start = -std::f64::consts::FRAC_PI_2 - step / 2.0;
+        return Ok((0..n)
+            .map(|k| Vec2::from_angle(start + step * k as f64))
+            .collect());
+    }
+    if let Some(rest) = s.strip_prefix("vertices:") {
+        return parse_vertex_list(rest);
+    }
+    Err(PartSpecError::Unknown(s.into()))
+}
+
+/// Parse `"x1,y1 x2,y2 ..."` (pairs separated by whitespace or semicolons).
+pub fn parse_vertex_list(text: &str) -> Result<Vec<Vec2>, PartSpecError> {
+    let mut out = Vec::new();
+    for (k, tok) in text
+        .split(|c: char| c.is_whitespace() || c == ';')
+        .filter(|t| !t.is_empty())
+        .enumerate()
+    {
+        let xy: Vec<&str> = tok.split(',').collect();
+        if xy.len() != 2 {
+            return Err(PartSpecError::BadVertexList(format!(
+                "vertex {k} '{tok}' is not of the form x,y"
+            )));
+        }
+        let parse = |s: &str| -> Result<f64, PartSpecError> {
+            s.trim().parse::<f64>().map_err(|_| {
+                PartSpecError::BadVertexList(format!("vertex {k}: '{s}' is not a number"))
+            })
+        };
+        out.push(Vec2::new(parse(xy[0])?, parse(xy[1])?));
+    }
+    Ok(out)
+}
+
+/// Build a validated part from a specification (see the module table).
+pub fn part_from_spec(spec: &str) -> Result<Polygon, PartSpecError> {
+    let v = named_vertices(spec)?;
+    Ok(Polygon::new(&v)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn named_parts_are_valid() {
+        for n in [
+            "tripoly1",
+            "tripoly2",
+            "square",
+            "lshape",
+            "rect:2:1",
+            "ngon:7",
+            "ngon:1000",
+        ] {
+            let p = part_from_spec(n).unwrap();
+            assert!(p.area() > 0.0, "{n}");
+        }
+        assert!(!part_from_spec("lshape").unwrap().is_convex());
+        let tri = part_from_spec("tripoly2").unwrap();
+        assert!(tri.offset().norm() < 1e-15);
+    }
+
+    #[test]
+    fn ngon_has_flat_bottom() {
+        let p = part_from_spec("ngon:5").unwrap();
+        let s = p.stable_states();
+        assert_eq!(s.len(), 5);
+        assert!(s[0].theta.abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_specs() {
+        assert!(matches!(
+            part_from_spec("blob"),
+            Err(PartSpecError::Unknown(_))
+        ));
+        assert!(matches!(
+            part_from_spec("rect:2:-1"),
+            Err(PartSpecError::BadParameter { .. })
+        ));
+        assert!(matches!(
+            part_from_spec("ngon:2"),
+            Err(PartSpecError::BadParameter { .. })
+        ));
+        assert!(matches!(
+            part_from_spec("vertices:0,0 1,x 0,1"),
+            Err(PartSpecError::BadVertexList(_))
+        ));
+    }
+}

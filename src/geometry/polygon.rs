@@ -1,0 +1,524 @@
+//! Simple polygons: validation, mass properties, convex hull, radius function and stable states.
+//!
+//! A part is a simple polygon (convex or concave) stored counter-clockwise in its own frame with the
+//! origin at its area centroid (SPEC §1). Construction validates the input and normalises it:
+//!
+//! * at least three vertices, all finite, no vertex repeating its predecessor (within 1e-12 of the
+//!   part's size — an edge of 1e-9 of the size is kept), non-zero area, no self-intersection;
+//! * clockwise input is reversed to counter-clockwise;
+//! * a vertex lying *exactly* on the straight line through its neighbours (turn below 1e-15 of the
+//!   edge lengths, so floating-point collinear) is dropped: it does not change the shape, and keeping
+//!   it would split a flat side into two edges. Nearly collinear vertices are kept.
+//!
+//! Mass properties use the shoelace formulas; `a` is the largest centroid-to-vertex distance.
+//! Stable states (SPEC §1) are the orientations θ at which an edge of the convex hull has its outward
+//! normal along −y and the foot of the perpendicular from the centroid lies strictly inside that edge:
+//! the local minima of the radius function ρ(φ) = max_v v·(cos φ, sin φ).
+
+use super::vec2::{wrap_2pi, Vec2};
+use serde::Serialize;
+use thiserror::Error;
+
+/// Why a vertex list is not a valid part.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PolygonError {
+    #[error("a polygon needs at least 3 vertices, got {count}")]
+    TooFewVertices { count: usize },
+    #[error("vertex {index} has a non-finite coordinate ({x}, {y}); every coordinate must be a finite number")]
+    NonFinite { index: usize, x: f64, y: f64 },
+    #[error("vertex {index} repeats vertex {previous} (zero-length edge){hint}")]
+    RepeatedVertex {
+        index: usize,
+        previous: usize,
+        hint: &'static str,
+    },
+    #[error("the polygon has zero area (all vertices are collinear or it folds onto itself)")]
+    ZeroArea,
+    #[error("the polygon is not simple: edge {edge_a} ({a0} -> {a1}) and edge {edge_b} ({b0} -> {b1}) intersect")]
+    SelfIntersecting {
+        edge_a: usize,
+        edge_b: usize,
+        a0: usize,
+        a1: usize,
+        b0: usize,
+        b1: usize,
+    },
+}
+
+/// A validated simple polygon in its own frame: counter-clockwise, centroid at the origin.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polygon {
+    vertices: Vec<Vec2>,
+    /// Where the centroid was in the caller's coordinates (the part frame is the input translated by −offset).
+    offset: Vec2,
+    area: f64,
+    polar_moment: f64,
+    radius: f64,
+    convex: bool,
+    hull: Vec<Vec2>,
+}
+
+/// A stable state of a part: orientation and the hull edge it rests on.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StableState {
+    /// Orientation θ in radians, in [0, 2π).
+    pub theta: f64,
+    /// Index of the hull edge (into [`Polygon::hull`]) whose outward normal points along −y.
+    pub hull_edge: usize,
+    /// Distance from the centroid to that edge (the radius function's local minimum).
+    pub height: f64,
+}
+
+fn orient(a: Vec2, b: Vec2, c: Vec2) -> f64 {
+    (b - a).cross(c - a)
+}
+
+fn on_segment(a: Vec2, b: Vec2, p: Vec2) -> bool {
+    p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
+}
+
+/// Do the closed segments [p1,p2] and [q1,q2] share a point?
+fn segments_intersect(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> bool {
+    let d1 = orient(q1, q2, p1);
+    let d2 = orient(q1, q2, p2);
+    let d3 = orient(p1, p2, q1);
+    let d4 = orient(p1, p2, q2);
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    (d1 == 0.0 && on_segment(q1, q2, p1))
+        || (d2 == 0.0 && on_segment(q1, q2, p2))
+        || (d3 == 0.0 && on_segment(p1, p2, q1))
+        || (d4 == 0.0 && on_segment(p1, p2, q2))
+}
+
+/// Signed area (positive for counter-clockwise) computed relative to the first vertex.
+fn signed_area(v: &[Vec2]) -> f64 {
+    let o = v[0];
+    let mut s = 0.0;
+    for i in 1..v.len() - 1 {
+        s += (v[i] - o).cross(v[i + 1] - o);
+    }
+    0.5 * s
+}
+
+impl Polygon {
+    /// Build a part from a vertex list in any orientation and any unit.
+    pub fn new(points: &[Vec2]) -> Result<Polygon, PolygonError> {
+        let n = points.len();
+        if n < 3 {
+            return Err(PolygonError::TooFewVertices { count: n });
+        }
+        for (i, p) in points.iter().enumerate() {
+            if !p.is_finite() {
+                return Err(PolygonError::NonFinite {
+                    index: i,
+                    x: p.x,
+                    y: p.y,
+                });
+            }
+        }
+        // Size of the part, for relative tolerances.
+        let (mut lo, mut hi) = (points[0], points[0]);
+        for p in points {
+            lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Vec2::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        let size = (hi - lo).norm();
+        for i in 0..n {
+            let j = (i + 1) % n;
+            if (points[j] - points[i]).norm() <= 1e-12 * size {
+                let (index, previous) = if j == 0 { (n - 1, 0) } else { (j, i) };
+                return Err(PolygonError::RepeatedVertex {
+                    index,
+                    previous,
+                    hint: if j == 0 {
+                        " — the ring closes itself; do not repeat the first vertex at the end"
+                    } else {
+                        ""
+                    },
+                });
+            }
+        }
+        let area = signed_area(points);
+        // All vertices on one line: say so before any talk of self-intersection.
+        if convex_hull(points).len() < 3 {
+            return Err(PolygonError::ZeroArea);
+        }
+        // Simplicity: non-adjacent edges must not touch; adjacent edges must not fold back.
+        for i in 0..n {
+            let (a0, a1) = (points[i], points[(i + 1) % n]);
+            for j in i + 1..n {
+                let (b0, b1) = (points[j], points[(j + 1) % n]);
+                let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+                let hit = if adjacent {
+                    // Shared vertex: they intersect elsewhere only if collinear and overlapping.
+                    let (shared, p, q) = if j == i + 1 {
+                        (a1, a0, b1)
+                    } else {
+                        (a0, a1, b0)
+                    };
+                    let u = p - shared;
+                    let w = q - shared;
+                    u.cross(w).abs() <= 1e-15 * u.norm() * w.norm() && u.dot(w) > 0.0
+                } else {
+                    segments_intersect(a0, a1, b0, b1)
+                };
+                if hit {
+                    return Err(PolygonError::SelfIntersecting {
+                        edge_a: i,
+                        edge_b: j,
+                        a0: i,
+                        a1: (i + 1) % n,
+                        b0: j,
+                        b1: (j + 1) % n,
+                    });
+                }
+            }
+        }
+        if area.abs() <= 1e-12 * size * size {
+            return Err(PolygonError::ZeroArea);
+        }
+        let mut v: Vec<Vec2> = points.to_vec();
+        if area < 0.0 {
+            v.reverse();
+        }
+        // Drop vertices that are exactly collinear with their neighbours.
+        let mut k = 0;
+        while k < v.len() && v.len() > 3 {
+            let m = v.len();
+            let prev = v[(k + m - 1) % m];
+            let next = v[(k + 1) % m];
+            let e1 = v[k] - prev;
+            let e2 = next - v[k];
+            if e1.cross(e2).abs() <= 1e-15 * e1.norm() * e2.norm() && e1.dot(e2) > 0.0 {
+                v.remove(k);
+                k = k.saturating_sub(1);
+            } else {
+                k += 1;
+            }
+        }
+        // Centroid (relative to the first vertex for accuracy).
+        let o = v[0];
+        let mut a2 = 0.0;
+        let mut cx = Vec2::ZERO;
+        for i in 1..v.len() - 1 {
+            let p = v[i] - o;
+            let q = v[i + 1] - o;
+            let c = p.cross(q);
+            a2 += c;
+            cx += (p + q) * c;
+        }
+        let centroid = o + cx / (3.0 * a2);
+        for p in v.iter_mut() {
+            *p -= centroid;
+        }
+        let m = v.len();
+        let mut polar = 0.0;
+        let mut radius: f64 = 0.0;
+        let mut convex = true;
+        for i in 0..m {
+            let p = v[i];
+            let q = v[(i + 1) % m];
+            let r = v[(i + 2) % m];
+            let c = p.cross(q);
+            polar += c * (p.dot(p) + p.dot(q) + q.dot(q));
+            radius = radius.max(p.norm());
+            if (q - p).cross(r - q) < 0.0 {
+                convex = false;
+            }
+        }
+        polar /= 12.0;
+        let hull = convex_hull(&v);
+        Ok(Polygon {
+            vertices: v,
+            offset: centroid,
+            area: area.abs(),
+            polar_moment: polar,
+            radius,
+            convex,
+            hull,
+        })
+    }
+
+    /// Build from `(x, y)` pairs.
+    pub fn from_xy(points: &[(f64, f64)]) -> Result<Polygon, PolygonError> {
+        let v: Vec<Vec2> = points.iter().map(|&(x, y)| Vec2::new(x, y)).collect();
+        Polygon::new(&v)
+    }
+
+    /// Vertices, counter-clockwise, in the part frame (centroid at the origin).
+    pub fn vertices(&self) -> &[Vec2] {
+        &self.vertices
+    }
+    pub fn len(&self) -> usize {
+        self.vertices.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.vertices.is_empty()
+    }
+    /// Vertex `i` (indices wrap around).
+    #[inline]
+    pub fn vertex(&self, i: usize) -> Vec2 {
+        self.vertices[i % self.vertices.len()]
+    }
+    /// Edge `i` runs from vertex `i` to vertex `i + 1`.
+    #[inline]
+    pub fn edge(&self, i: usize) -> (Vec2, Vec2) {
+        (self.vertex(i), self.vertex(i + 1))
+    }
+    /// Unit inward normal of edge `i` (part frame): the edge direction rotated by +90°.
+    #[inline]
+    pub fn inward_normal(&self, i: usize) -> Vec2 {
+        let (a, b) = self.edge(i);
+        (b - a).normalized().perp()
+    }
+    /// Is vertex `i` convex (interior angle < 180°)?
+    pub fn vertex_is_convex(&self, i: usize) -> bool {
+        let m = self.vertices.len();
+        let prev = self.vertex(i + m - 1);
+        let p = self.vertex(i);
+        let next = self.vertex(i + 1);
+        (p - prev).cross(next - p) > 0.0
+    }
+    /// Centroid of the input vertex list in the caller's coordinates.
+    pub fn offset(&self) -> Vec2 {
+        self.offset
+    }
+    /// Area (input units²).
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+    /// Polar second moment of area about the centroid, ∫|x|² dA (input units⁴).
+    pub fn polar_moment(&self) -> f64 {
+        self.polar_moment
+    }
+    /// `a`: the largest centroid-to-vertex distance.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+    pub fn is_convex(&self) -> bool {
+        self.convex
+    }
+    /// Convex hull, counter-clockwise, part frame.
+    pub fn hull(&self) -> &[Vec2] {
+        &self.hull
+    }
+
+    /// The same polygon scaled by `k > 0` about its centroid.
+    pub fn scaled(&self, k: f64) -> Polygon {
+        let v: Vec<Vec2> = self.vertices.iter().map(|&p| p * k).collect();
+        Polygon::new(&v).expect("scaling a valid polygon by a positive factor keeps it valid")
+    }
+
+    /// The mirror image about the part frame's x axis (y → −y), re-normalised counter-clockwise.
+    pub fn mirrored_y(&self) -> Polygon {
+        let v: Vec<Vec2> = self
+            .vertices
+            .iter()
+            .map(|&p| Vec2::new(p.x, -p.y))
+            .collect();
+        Polygon::new(&v).expect("mirroring a valid polygon keeps it valid")
+    }
+
+    /// Vertices of the part placed at a pose, in world coordinates.
+    pub fn world_vertices(&self, pose: &super::vec2::Pose) -> Vec<Vec2> {
+        self.vertices.iter().map(|&p| pose.apply(p)).collect()
+    }
+
+    /// Radius (support) function: the extent of the part along the unit direction at angle `phi`.
+    pub fn radius_function(&self, phi: f64) -> f64 {
+        let u = Vec2::from_angle(phi);
+        self.hull
+            .iter()
+            .map(|p| p.dot(u))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Extent of the part along −y at orientation θ, i.e. −min_v y(v): how far the part reaches below its centroid.
+    pub fn depth_below(&self, theta: f64) -> f64 {
+        self.radius_function(-std::f64::consts::FRAC_PI_2 - theta)
+    }
+
+    /// Stable states (SPEC §1), sorted by θ ascending in [0, 2π).
+    pub fn stable_states(&self) -> Vec<StableState> {
+        let h = &self.hull;
+        let m = h.len();
+        let mut out = Vec::new();
+        for i in 0..m {
+            let a = h[i];
+            let b = h[(i + 1) % m];
+            let e = b - a;
+            let len2 = e.norm2();
+            // Foot of the perpendicular from the centroid (origin) onto the edge line.
+            let t = -a.dot(e) / len2;
+            let tol = 1e-12;
+            if t <= tol || t >= 1.0 - tol {
+                continue;
+            }
+            let outward = Vec2::new(e.y, -e.x).normalized();
+            // Rotate the outward normal onto −y: θ + angle(outward) = −π/2.
+            let theta = wrap_2pi(-std::f64::consts::FRAC_PI_2 - outward.angle());
+            let height = a.dot(outward);
+            out.push(StableState {
+                theta,
+                hull_edge: i,
+                height,
+            });
+        }
+        out.sort_by(|x, y| x.theta.total_cmp(&y.theta));
+        out
+    }
+
+    /// Does the part-frame point `p` lie strictly inside the polygon (crossing-number test)?
+    pub fn contains(&self, p: Vec2) -> bool {
+        let v = &self.vertices;
+        let m = v.len();
+        let mut inside = false;
+        for i in 0..m {
+            let a = v[i];
+            let b = v[(i + 1) % m];
+            if (a.y > p.y) != (b.y > p.y) {
+                let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                if p.x < x {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+
+    /// Distance from a part-frame point to the polygon's boundary, with the nearest edge.
+    pub fn distance_to_boundary(&self, p: Vec2) -> (f64, usize) {
+        let m = self.vertices.len();
+        let mut best = (f64::INFINITY, 0);
+        for i in 0..m {
+            let (a, b) = self.edge(i);
+            let e = b - a;
+            let t = ((p - a).dot(e) / e.norm2()).clamp(0.0, 1.0);
+            let d = (a + e * t - p).norm();
+            if d < best.0 {
+                best = (d, i);
+            }
+        }
+        best
+    }
+}
+
+/// Convex hull by Andrew's monotone chain, counter-clockwise, collinear points removed.
+pub fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
+    let mut p: Vec<Vec2> = points.to_vec();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let mut lower: Vec<Vec2> = Vec::new();
+    for &q in &p {
+        while lower.len() >= 2 && orient(lower[lower.len() - 2], lower[lower.len() - 1], q) <= 0.0 {
+            lower.pop();
+        }
+        lower.push(q);
+    }
+    let mut upper: Vec<Vec2> = Vec::new();
+    for &q in p.iter().rev() {
+        while upper.len() >= 2 && orient(upper[upper.len() - 2], upper[upper.len() - 1], q) <= 0.0 {
+            upper.pop();
+        }
+        upper.push(q);
+    }
+    lower.pop();
+    upper.pop();
+    lower.extend(upper);
+    lower
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn deg(x: f64) -> f64 {
+        x.to_degrees()
+    }
+
+    #[test]
+    fn triangle_properties() {
+        let p = Polygon::from_xy(&[(-1.5, -0.5), (1.5, -0.5), (0.0, 1.0)]).unwrap();
+        assert!((p.area() - 2.25).abs() < 1e-12);
+        assert!(p.offset().norm() < 1e-12);
+        assert!(p.is_convex());
+        assert!((p.radius() - (1.5f64.powi(2) + 0.25).sqrt()).abs() < 1e-12);
+        let s: Vec<f64> = p.stable_states().iter().map(|s| deg(s.theta)).collect();
+        assert_eq!(s.len(), 3);
+        for (got, want) in s.iter().zip([0.0, 135.0, 225.0]) {
+            assert!((got - want).abs() < 1e-9, "{got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn clockwise_input_is_normalised() {
+        let p = Polygon::from_xy(&[(0.0, 1.0), (1.5, -0.5), (-1.5, -0.5)]).unwrap();
+        assert!(signed_area(p.vertices()) > 0.0);
+    }
+
+    #[test]
+    fn polar_moment_of_square() {
+        let p = Polygon::from_xy(&[(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]).unwrap();
+        // ∫(x²+y²) over a 2x2 square about its centre = 2 * (2*2^3/12) = 8/3 * 2 = 5.333..
+        assert!((p.polar_moment() - 2.0 * 2.0 * 8.0 / 12.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn collinear_middle_vertex_dropped() {
+        let p = Polygon::from_xy(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)])
+            .unwrap();
+        assert_eq!(p.len(), 4);
+    }
+
+    #[test]
+    fn rejections() {
+        assert!(matches!(
+            Polygon::from_xy(&[(0.0, 0.0), (1.0, 0.0)]),
+            Err(PolygonError::TooFewVertices { count: 2 })
+        ));
+        assert!(matches!(
+            Polygon::from_xy(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)]),
+            Err(PolygonError::ZeroArea)
+        ));
+        assert!(matches!(
+            Polygon::from_xy(&[(0.0, 0.0), (1.0, 1.0), (1.0, 0.0), (0.0, 1.0)]),
+            Err(PolygonError::SelfIntersecting { .. })
+        ));
+        assert!(matches!(
+            Polygon::from_xy(&[(0.0, 0.0), (f64::NAN, 1.0), (1.0, 0.0)]),
+            Err(PolygonError::NonFinite { index: 1, .. })
+        ));
+        assert!(matches!(
+            Polygon::from_xy(&[(0.0, 0.0), (1.0, 0.0), (1.0, 0.0), (0.0, 1.0)]),
+            Err(PolygonError::RepeatedVertex { .. })
+        ));
+        // A spike: the ring runs out and straight back along the same line.
+        assert!(Polygon::from_xy(&[(0.0, 0.0), (2.0, 0.0), (1.0, 0.0), (1.0, 1.0)]).is_err());
+    }
+
+    #[test]
+    fn concave_hull() {
+        let l = Polygon::from_xy(&[
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ])
+        .unwrap();
+        assert!(!l.is_convex());
+        assert_eq!(l.hull().len(), 5);
+        assert!((l.area() - 3.0).abs() < 1e-12);
+        assert!(!l.vertex_is_convex(3));
+        assert!(l.contains(Vec2::ZERO - l.offset() + Vec2::new(0.5, 0.5)));
+        assert!(!l.contains(Vec2::ZERO - l.offset() + Vec2::new(1.5, 1.5)));
+    }
+}

@@ -1,0 +1,16 @@
+//! # pinfeed
+//!
+//! A simulator and planner for orienting planar parts on a conveyor belt with overhead pins and
+//! fences. Data flows one way: a scenario is compiled into an immutable scene (part geometry with its
+//! limit-surface data, obstacles, settings); a seeded stream of randomly posed parts runs through a
+//! discrete-event engine, which calls the contact model — a pure function from (part, pose, obstacle,
+//! settings) to a `ContactOutcome` — for each pin or fence encounter; metrics and reports come out
+//! the other end. Physics and conventions follow `SPEC.md` (quasi-static pushing with Coulomb
+//! friction; x along belt travel, y to the left, angles counter-clockwise, degrees at interfaces).
+//!
+//! Modules: [`geometry`] (polygons, stable states, first contact), [`report`] (tables and figures),
+//! [`cli`] (the `pinfeed` command).
+
+pub mod cli;
+pub mod geometry;
+pub mod report;

@@ -1,0 +1,3 @@
+//! Reports for people and programs: terminal tables, JSON/CSV, and SVG figures.
+
+pub mod plot_part;
