@@ -13,4 +13,6 @@
 
 pub mod cli;
 pub mod geometry;
+pub mod mechanics;
+pub mod random;
 pub mod report;

@@ -1,6 +1,7 @@
 //! The command-line interface: argument definitions and one module per sub-command. `main.rs` only
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
+pub mod contact;
 pub mod part;
 
 use clap::{Parser, Subcommand};
@@ -17,11 +18,14 @@ pub struct Cli {
 pub enum Command {
     /// Describe a part: area, centroid, a, convexity, stable states; optionally plot it.
     Part(part::PartArgs),
+    /// One pin pass over one part (or a batch from CSV): final pose, rotation, contact segments.
+    Contact(contact::ContactArgs),
 }
 
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Part(a) => part::run(&a),
+        Command::Contact(a) => contact::run(&a),
     }
 }

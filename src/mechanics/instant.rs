@@ -1,0 +1,328 @@
+//! One instant of one contact: which mode (stick, slide left, slide right, separate) is consistent,
+//! and the part's twist in it (SPEC §2, "Solving one instant robustly").
+//!
+//! Inputs are in the part frame, normalised units: contact point `p` (relative to the centroid), unit
+//! normal `n` pointing into the part, and the pin's velocity `v_pin` relative to the belt.
+//!
+//! 1. n·v_pin ≤ 0: the pin is not pushing; the contact separates.
+//! 2. The friction-cone edges f_L = R(+atan μc) n, f_R = R(−atan μc) n give edge twists ξ_L, ξ_R
+//!    (normal to the limit surface at the edge wrenches) with contact velocities v_L, v_R.
+//! 3. Stick iff v_pin lies in the cone spanned by v_R and v_L; then v_c(ξ) = v_pin.
+//! 4. Otherwise slide on the violated side b with ξ = κ ξ_b, κ = (n·v_pin)/(n·v_b); a side with
+//!    n·v_b ≤ ε can never slide and counts as stick.
+//! 5. μc = 0: one force direction (the normal), always slide.
+//!
+//! Sliding left means the contact force is f_L: the pin slides along +t = ẑ×n relative to the part.
+//!
+//! Each mode also reports *margins*, continuous functions that are positive while the mode stays
+//! consistent: for stick, μc λn ∓ λt (normalised by |f|), for slide-left/right the signed sine between
+//! v_b and v_pin. The integrator locates the zero crossings of these as mode-switch events.
+
+use super::part_model::{point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist};
+use crate::geometry::Vec2;
+use serde::Serialize;
+
+/// Contact mode at one instant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// No relative sliding at the contact.
+    Stick,
+    /// Sliding with the force on the counter-clockwise cone edge (pin moves along +ẑ×n relative to the part).
+    SlideLeft,
+    /// Sliding with the force on the clockwise cone edge.
+    SlideRight,
+    /// Frictionless contact (μc = 0): the force is along the normal.
+    Slide,
+}
+
+impl Mode {
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Stick => "stick",
+            Mode::SlideLeft => "slide_left",
+            Mode::SlideRight => "slide_right",
+            Mode::Slide => "slide",
+        }
+    }
+}
+
+/// Contact geometry at one instant (part frame, normalised units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactGeom {
+    pub p: Vec2,
+    pub n: Vec2,
+    pub v_pin: Vec2,
+}
+
+/// The solved instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Instant {
+    pub mode: Mode,
+    /// Part twist (part frame) scaled so that the normal velocity at the contact matches the pin's.
+    pub twist: Twist,
+    /// Contact force on the part (part frame), in units of μs m g.
+    pub force: Vec2,
+    /// Margins of the mode (positive while consistent): stick: [μcλn − λt, μcλn + λt]/|f|;
+    /// slide-left: [sine(v_L, v_pin), 1]; slide-right: [1, sine(v_pin, v_R)]; slide: [1, 1].
+    pub margins: [f64; 2],
+}
+
+/// Warm starts carried from instant to instant.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Warm {
+    pub left: Option<Twist>,
+    pub right: Option<Twist>,
+    pub normal: Option<Twist>,
+    pub stick_omega: Option<f64>,
+}
+
+/// Friction settings of the contact.
+#[derive(Debug, Clone, Copy)]
+pub struct Friction {
+    pub mu_c: f64,
+}
+
+const GUARD: f64 = 1e-9;
+
+/// Separation margin: the sine between the normal and the pin's velocity (positive while pushing).
+#[inline]
+pub fn push_margin(g: &ContactGeom) -> f64 {
+    g.n.dot(g.v_pin) / g.v_pin.norm()
+}
+
+fn slide_instant(
+    model: &PartModel,
+    fid: Fidelity,
+    g: &ContactGeom,
+    f_dir: Vec2,
+    warm: &mut Option<Twist>,
+    evals: &mut u64,
+) -> Result<(Twist, Vec2, Vec2), SolveFailure> {
+    let s = model.twist_for_wrench(fid, wrench_of(f_dir, g.p), *warm, evals)?;
+    *warm = Some(s.twist);
+    let vb = point_velocity(s.twist, g.p);
+    Ok((s.twist, vb, Vec2::new(s.wrench[0], s.wrench[1])))
+}
+
+fn scaled_slide(g: &ContactGeom, xi: Twist, vb: Vec2) -> Twist {
+    let k = g.n.dot(g.v_pin) / g.n.dot(vb);
+    [xi[0] * k, xi[1] * k, xi[2] * k]
+}
+
+fn sine(a: Vec2, b: Vec2) -> f64 {
+    a.cross(b) / (a.norm() * b.norm())
+}
+
+fn stick_instant(
+    model: &PartModel,
+    fid: Fidelity,
+    g: &ContactGeom,
+    fr: Friction,
+    warm: &mut Warm,
+    evals: &mut u64,
+) -> Result<Instant, SolveFailure> {
+    let s = model.stick_twist(fid, g.p, g.v_pin, warm.stick_omega, evals)?;
+    warm.stick_omega = Some(s.twist[2]);
+    let f = Vec2::new(s.wrench[0], s.wrench[1]);
+    let t = g.n.perp();
+    let (ln, lt) = (f.dot(g.n), f.dot(t));
+    let fn_ = f.norm().max(1e-300);
+    Ok(Instant {
+        mode: Mode::Stick,
+        twist: s.twist,
+        force: f,
+        margins: [(fr.mu_c * ln - lt) / fn_, (fr.mu_c * ln + lt) / fn_],
+    })
+}
+
+/// Solve the instant assuming `mode` (no consistency decision), returning margins for event location.
+pub fn solve_in_mode(
+    model: &PartModel,
+    fid: Fidelity,
+    g: &ContactGeom,
+    fr: Friction,
+    mode: Mode,
+    warm: &mut Warm,
+    evals: &mut u64,
+) -> Result<Instant, SolveFailure> {
+    let phi = fr.mu_c.atan();
+    match mode {
+        Mode::Stick => stick_instant(model, fid, g, fr, warm, evals),
+        Mode::Slide => {
+            let (xi, vb, f) = slide_instant(model, fid, g, g.n, &mut warm.normal, evals)?;
+            Ok(Instant {
+                mode,
+                twist: scaled_slide(g, xi, vb),
+                force: f,
+                margins: [1.0, 1.0],
+            })
+        }
+        Mode::SlideLeft => {
+            let (xi, vb, f) = slide_instant(model, fid, g, g.n.rotate(phi), &mut warm.left, evals)?;
+            let mut m = sine(vb, g.v_pin);
+            if g.n.dot(vb) <= GUARD * vb.norm() {
+                m = m.min(-1e-3);
+            }
+            Ok(Instant {
+                mode,
+                twist: scaled_slide(g, xi, vb),
+                force: f,
+                margins: [m, 1.0],
+            })
+        }
+        Mode::SlideRight => {
+            let (xi, vb, f) =
+                slide_instant(model, fid, g, g.n.rotate(-phi), &mut warm.right, evals)?;
+            let mut m = -sine(vb, g.v_pin);
+            if g.n.dot(vb) <= GUARD * vb.norm() {
+                m = m.min(-1e-3);
+            }
+            Ok(Instant {
+                mode,
+                twist: scaled_slide(g, xi, vb),
+                force: f,
+                margins: [1.0, m],
+            })
+        }
+    }
+}
+
+/// Decide the consistent mode at an instant and solve it; `None` when the contact separates.
+pub fn classify(
+    model: &PartModel,
+    fid: Fidelity,
+    g: &ContactGeom,
+    fr: Friction,
+    warm: &mut Warm,
+    evals: &mut u64,
+) -> Result<Option<Instant>, SolveFailure> {
+    if push_margin(g) <= 1e-12 {
+        return Ok(None);
+    }
+    if fr.mu_c == 0.0 {
+        return solve_in_mode(model, fid, g, fr, Mode::Slide, warm, evals).map(Some);
+    }
+    let left = solve_in_mode(model, fid, g, fr, Mode::SlideLeft, warm, evals)?;
+    let right = solve_in_mode(model, fid, g, fr, Mode::SlideRight, warm, evals)?;
+    let ml = left.margins[0];
+    let mr = right.margins[1];
+    if ml > 0.0 && (mr <= 0.0 || ml >= mr) {
+        return Ok(Some(left));
+    }
+    if mr > 0.0 {
+        return Ok(Some(right));
+    }
+    stick_instant(model, fid, g, fr, warm, evals).map(Some)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::part_from_spec;
+    use crate::mechanics::part_model::Support;
+
+    fn model(name: &str) -> PartModel {
+        PartModel::new(&part_from_spec(name).unwrap(), &Support::Uniform).unwrap()
+    }
+
+    /// Lynch, Maekawa & Tanie (1992), the ellipsoid's stick motion written out independently:
+    /// vx = ((c²+x²)vpx + x y vpy)/(c²+x²+y²), vy = (x y vpx + (c²+y²)vpy)/(c²+x²+y²), ω = (x vy − y vx)/c².
+    fn lynch_stick(c: f64, p: Vec2, vp: Vec2) -> [f64; 3] {
+        let (x, y) = (p.x, p.y);
+        let c2 = c * c;
+        let den = c2 + x * x + y * y;
+        let vx = ((c2 + x * x) * vp.x + x * y * vp.y) / den;
+        let vy = (x * y * vp.x + (c2 + y * y) * vp.y) / den;
+        [vx, vy, (x * vy - y * vx) / c2]
+    }
+
+    #[test]
+    fn ellipsoid_matches_lynch_closed_form() {
+        let m = model("tripoly2");
+        let c = m.ellipsoid_c();
+        let mut ev = 0;
+        for (p, n, vp, mu) in [
+            (
+                Vec2::new(0.5, -0.2),
+                Vec2::new(-0.6, 0.8),
+                Vec2::new(-1.0, 0.0),
+                0.5,
+            ),
+            (
+                Vec2::new(-0.3, 0.4),
+                Vec2::new(0.0, -1.0),
+                Vec2::new(-0.2, -1.0),
+                0.3,
+            ),
+            (
+                Vec2::new(0.7, 0.1),
+                Vec2::new(-1.0, 0.0),
+                Vec2::new(-1.0, 0.6),
+                0.05,
+            ),
+        ] {
+            let n = n.normalized();
+            let g = ContactGeom { p, n, v_pin: vp };
+            let mut warm = Warm::default();
+            let inst = classify(
+                &m,
+                Fidelity::Ellipsoid,
+                &g,
+                Friction { mu_c: mu },
+                &mut warm,
+                &mut ev,
+            )
+            .unwrap()
+            .unwrap();
+            // Lynch: stick if v_pin inside the motion cone; else slide with v_b in place of v_pin.
+            let phi = f64::atan(mu);
+            let edge_vel = |f: Vec2| {
+                // For a force f at p the ellipsoid twist is (c² f, p×f): contact velocity.
+                let xi = [c * c * f.x, c * c * f.y, p.cross(f)];
+                point_velocity(xi, p)
+            };
+            let vl = edge_vel(n.rotate(phi));
+            let vr = edge_vel(n.rotate(-phi));
+            let expected = if vl.cross(vp) > 0.0 {
+                let k = n.dot(vp) / n.dot(vl);
+                lynch_stick(c, p, vl * k)
+            } else if vr.cross(vp) < 0.0 {
+                let k = n.dot(vp) / n.dot(vr);
+                lynch_stick(c, p, vr * k)
+            } else {
+                lynch_stick(c, p, vp)
+            };
+            for i in 0..3 {
+                assert!(
+                    (inst.twist[i] - expected[i]).abs() < 1e-10,
+                    "{:?} vs {:?} ({:?})",
+                    inst.twist,
+                    expected,
+                    inst.mode
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn separation_when_not_pushing() {
+        let m = model("square");
+        let g = ContactGeom {
+            p: Vec2::new(0.5, 0.0),
+            n: Vec2::new(1.0, 0.0),
+            v_pin: Vec2::new(-1.0, 0.0),
+        };
+        let mut ev = 0;
+        assert!(classify(
+            &m,
+            Fidelity::Tip,
+            &g,
+            Friction { mu_c: 0.5 },
+            &mut Warm::default(),
+            &mut ev
+        )
+        .unwrap()
+        .is_none());
+    }
+}

@@ -1,0 +1,1016 @@
+//! Integration of one pin pass over a part: from first touch to separation, with error control and
+//! precise event location (SPEC §2, "Integration over a contact").
+//!
+//! Work happens in the belt frame, in normalised units (the part's `a` = 1, belt speed 1). The pin
+//! moves along v_pin = (−1, w) (w = lateral speed / belt speed) and its travel `s` relative to the belt
+//! parametrises the motion (time = s / V). A contact is held in reduced coordinates so the contact
+//! constraint never drifts:
+//!
+//! * on edge k: y = (θ, ℓ), ℓ the distance of the contact point from vertex k along the edge;
+//! * on vertex k: y = (θ, φ), φ the part-frame angle of the normal from the pin centre to the vertex
+//!   (a disc pin rides round the vertex; for a point pin φ is frozen while the vertex sticks — the
+//!   ρ → 0 limit of the disc).
+//!
+//! The pose follows from (s, θ, contact): c = P(s) + R(θ)(ρ n − p). The rates are
+//! dθ/ds = ω, dℓ/ds = ê·(v_pin + ρ ω ẑ×n − v_p) and dφ/ds = (ẑ×n)·(v_p − v_pin)/ρ − ω, with v_p the
+//! material velocity of the contact point (all in part axes); the twist comes from [`super::instant`].
+//!
+//! Steps: Dormand–Prince 5(4) with absolute tolerance `tol` on θ (radians) and on ℓ, φ (units of a).
+//! Events, located with a cubic Hermite interpolant and the Illinois method and then landed on with a
+//! real step: separation (n·v_pin = 0), mode margins (stick ↔ slide), edge ends and, for a disc on a
+//! vertex, the edges of the vertex's normal cone. At a convex vertex a point pin passes onto the next
+//! edge in its direction of sliding (or separates if that edge faces away); a reflex vertex means a
+//! second contact in a notch, which is reported as [`ContactStatus::MultiContact`], not simulated.
+//! After separation the pin's path is cast again, so a concave part can be struck more than once.
+
+use super::instant::{
+    classify, push_margin, solve_in_mode, ContactGeom, Friction, Instant, Mode, Warm,
+};
+use super::outcome::{
+    ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, TraceSample,
+};
+use super::part_model::{Fidelity, PartModel, SolveFailure};
+use crate::geometry::{first_contact, Feature, Polygon, Pose, Vec2};
+use serde::Serialize;
+
+/// A pin as the contact model sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Pin {
+    /// Radius in the caller's units (0: the thesis's point pin).
+    pub radius: f64,
+    /// Lateral velocity as a fraction of the belt speed (0 for a fixed pin): v_pin = (−V, w·V).
+    pub lateral_speed: f64,
+}
+
+impl Pin {
+    pub fn point() -> Pin {
+        Pin {
+            radius: 0.0,
+            lateral_speed: 0.0,
+        }
+    }
+}
+
+/// Settings of the contact model.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ContactSettings {
+    pub fidelity: Fidelity,
+    /// Pin–part (contact) friction coefficient μc ≥ 0.
+    pub mu_c: f64,
+    /// Part–belt (support) friction coefficient μs > 0: scales forces only.
+    pub mu_s: f64,
+    /// Absolute local error tolerance per step on θ (radians) and on contact coordinates (units of a).
+    pub tol: f64,
+    /// Largest pin travel in contact, in units of a, before reporting [`ContactStatus::TravelLimit`].
+    pub max_travel: f64,
+    /// Evaluation budget per pass.
+    pub max_evaluations: u64,
+    /// Event budget per pass.
+    pub max_events: u32,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        ContactSettings {
+            fidelity: Fidelity::Exact,
+            mu_c: 0.5,
+            mu_s: 0.3,
+            tol: 1e-6,
+            max_travel: 50.0,
+            max_evaluations: 2_000_000,
+            max_events: 200,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Feat {
+    Edge(usize),
+    Vertex(usize),
+}
+
+impl Feat {
+    fn public(self) -> ContactFeature {
+        match self {
+            Feat::Edge(k) => ContactFeature::Edge(k),
+            Feat::Vertex(k) => ContactFeature::Vertex(k),
+        }
+    }
+}
+
+struct Ctx<'a, 'r> {
+    model: &'a PartModel,
+    poly: &'a Polygon,
+    fid: Fidelity,
+    fr: Friction,
+    rho: f64,
+    vdir: Vec2,
+    start: Vec2,
+    tol: f64,
+    scale: f64,
+    evals: u64,
+    warm: Warm,
+    recorder: Option<&'r mut dyn Recorder>,
+}
+
+enum End {
+    Separated,
+    Stop(ContactStatus),
+}
+
+const N_EVENTS: usize = 5;
+
+impl Ctx<'_, '_> {
+    fn pin_at(&self, s: f64) -> Vec2 {
+        self.start + self.vdir * s
+    }
+
+    fn geom(&self, feat: Feat, y: [f64; 2]) -> ContactGeom {
+        let v_pin = self.vdir.rotate(-y[0]);
+        match feat {
+            Feat::Edge(k) => {
+                let (a, b) = self.poly.edge(k);
+                let e = (b - a).normalized();
+                ContactGeom {
+                    p: a + e * y[1],
+                    n: e.perp(),
+                    v_pin,
+                }
+            }
+            Feat::Vertex(k) => ContactGeom {
+                p: self.poly.vertex(k),
+                n: Vec2::from_angle(y[1]),
+                v_pin,
+            },
+        }
+    }
+
+    fn pose(&self, s: f64, feat: Feat, y: [f64; 2]) -> Pose {
+        let g = self.geom(feat, y);
+        let c = self.pin_at(s) + (g.n * self.rho - g.p).rotate(y[0]);
+        Pose::new(c.x, c.y, y[0])
+    }
+
+    fn rates(&self, feat: Feat, y: [f64; 2], g: &ContactGeom, inst: &Instant) -> [f64; 2] {
+        let xi = inst.twist;
+        let om = xi[2];
+        let vp = Vec2::new(xi[0], xi[1]) + g.p.perp() * om;
+        let dq = match feat {
+            Feat::Edge(k) => {
+                let (a, b) = self.poly.edge(k);
+                let e = (b - a).normalized();
+                e.dot(g.v_pin + g.n.perp() * (self.rho * om) - vp)
+            }
+            Feat::Vertex(_) => {
+                if self.rho > 0.0 {
+                    g.n.perp().dot(vp - g.v_pin) / self.rho - om
+                } else {
+                    0.0
+                }
+            }
+        };
+        let _ = y;
+        [om, dq]
+    }
+
+    fn rhs(
+        &mut self,
+        feat: Feat,
+        mode: Mode,
+        y: [f64; 2],
+    ) -> Result<([f64; 2], Instant), SolveFailure> {
+        let g = self.geom(feat, y);
+        let inst = solve_in_mode(
+            self.model,
+            self.fid,
+            &g,
+            self.fr,
+            mode,
+            &mut self.warm,
+            &mut self.evals,
+        )?;
+        let d = self.rates(feat, y, &g, &inst);
+        if !(d[0].is_finite() && d[1].is_finite()) {
+            return Err(SolveFailure::NonFinite);
+        }
+        Ok((d, inst))
+    }
+
+    /// Event functions (positive while nothing happens).
+    fn events(&self, feat: Feat, y: [f64; 2], inst: &Instant) -> [f64; N_EVENTS] {
+        let g = self.geom(feat, y);
+        let (e3, e4) = match feat {
+            Feat::Edge(k) => {
+                let (a, b) = self.poly.edge(k);
+                (y[1], (b - a).norm() - y[1])
+            }
+            Feat::Vertex(k) => {
+                if self.rho > 0.0 {
+                    let m = self.poly.len();
+                    let na = self.poly.inward_normal(k + m - 1);
+                    let nb = self.poly.inward_normal(k);
+                    (na.cross(g.n), g.n.cross(nb))
+                } else {
+                    (1.0, 1.0)
+                }
+            }
+        };
+        [push_margin(&g), inst.margins[0], inst.margins[1], e3, e4]
+    }
+
+    fn record(&mut self, s: f64, feat: Feat, y: [f64; 2], inst: &Instant) {
+        if self.recorder.is_none() {
+            return;
+        }
+        let pose = self.pose(s, feat, y);
+        let g = self.geom(feat, y);
+        let k = self.scale;
+        let sample = TraceSample {
+            s: s * k,
+            pose: Pose::new(pose.x * k, pose.y * k, pose.theta),
+            pin_centre: self.pin_at(s) * k,
+            contact_point: pose.apply(g.p) * k,
+            force: inst.force.rotate(y[0]),
+            mode: inst.mode,
+            feature: feat.public(),
+        };
+        if let Some(r) = self.recorder.as_deref_mut() {
+            r.record(&sample);
+        }
+    }
+}
+
+// Dormand–Prince 5(4) tableau.
+const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+
+struct StepResult {
+    y1: [f64; 2],
+    f1: [f64; 2],
+    inst1: Instant,
+    err: f64,
+}
+
+/// One Dormand–Prince step of size h from (y0, f0).
+fn dp_step(
+    ctx: &mut Ctx,
+    feat: Feat,
+    mode: Mode,
+    y0: [f64; 2],
+    f0: [f64; 2],
+    h: f64,
+) -> Result<StepResult, SolveFailure> {
+    let mut k = [[0.0f64; 2]; 7];
+    k[0] = f0;
+    let mut inst_last = None;
+    for i in 1..7 {
+        let mut yi = y0;
+        for (j, kj) in k.iter().enumerate().take(i) {
+            let a = A[i][j];
+            if a != 0.0 {
+                yi[0] += h * a * kj[0];
+                yi[1] += h * a * kj[1];
+            }
+        }
+        let _ = C[i];
+        let (d, inst) = ctx.rhs(feat, mode, yi)?;
+        k[i] = d;
+        inst_last = Some(inst);
+    }
+    // Stage 7 is evaluated at y1 (FSAL).
+    let mut y1 = y0;
+    for (j, kj) in k.iter().enumerate().take(6) {
+        y1[0] += h * A[6][j] * kj[0];
+        y1[1] += h * A[6][j] * kj[1];
+    }
+    let mut err: f64 = 0.0;
+    for c in 0..2 {
+        let mut e = 0.0;
+        for (j, kj) in k.iter().enumerate() {
+            e += E[j] * kj[c];
+        }
+        err = err.max((h * e).abs() / ctx.tol);
+    }
+    if !(y1[0].is_finite() && y1[1].is_finite() && err.is_finite()) {
+        return Err(SolveFailure::NonFinite);
+    }
+    Ok(StepResult {
+        y1,
+        f1: k[6],
+        inst1: inst_last.expect("six stages ran"),
+        err,
+    })
+}
+
+fn hermite(y0: [f64; 2], f0: [f64; 2], y1: [f64; 2], f1: [f64; 2], h: f64, t: f64) -> [f64; 2] {
+    let t2 = t * t;
+    let t3 = t2 * t;
+    let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+    let h10 = t3 - 2.0 * t2 + t;
+    let h01 = -2.0 * t3 + 3.0 * t2;
+    let h11 = t3 - t2;
+    let mut out = [0.0; 2];
+    for c in 0..2 {
+        out[c] = h00 * y0[c] + h10 * h * f0[c] + h01 * y1[c] + h11 * h * f1[c];
+    }
+    out
+}
+
+/// Illinois root of g on [0, 1] with g(0) = ga > 0 ≥ g(1) = gb.
+fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64) -> f64 {
+    let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, ga, gb);
+    let mut side = 0;
+    let mut c = 1.0;
+    for _ in 0..80 {
+        c = (a * fb - b * fa) / (fb - fa);
+        if !c.is_finite() || c <= a || c >= b {
+            c = 0.5 * (a + b);
+        }
+        let fc = g(c);
+        if fc.abs() <= 1e-15 || b - a <= 1e-14 {
+            break;
+        }
+        if fc < 0.0 {
+            b = c;
+            fb = fc;
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        } else {
+            a = c;
+            fa = fc;
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    c
+}
+
+/// The state after a point pin's instantaneous sweep round convex vertex `k`: onto the incoming edge
+/// (direction left) or the outgoing edge (right), or separation if that edge faces away from the pin.
+fn sweep(ctx: &Ctx, k: usize, left: bool, theta: f64) -> Option<(Feat, [f64; 2])> {
+    let m = ctx.poly.len();
+    let (edge, ell) = if left {
+        let e = (k + m - 1) % m;
+        let (a, b) = ctx.poly.edge(e);
+        (e, (b - a).norm())
+    } else {
+        (k % m, 0.0)
+    };
+    let n = ctx.poly.inward_normal(edge);
+    let v_pin = ctx.vdir.rotate(-theta);
+    if n.dot(v_pin) / v_pin.norm() <= 1e-12 {
+        None
+    } else {
+        Some((Feat::Edge(edge), [theta, ell]))
+    }
+}
+
+/// Outcome of settling the mode at a new contact state: continue, or the contact ends.
+enum Settle {
+    Go(Feat, [f64; 2], Instant),
+    Separate,
+    Stop(ContactStatus),
+}
+
+/// Decide the mode at a (possibly new) contact state, resolving point-pin vertex sweeps.
+fn settle(ctx: &mut Ctx, s: f64, mut feat: Feat, mut y: [f64; 2]) -> Settle {
+    for _ in 0..4 {
+        let g = ctx.geom(feat, y);
+        let inst = match classify(
+            ctx.model,
+            ctx.fid,
+            &g,
+            ctx.fr,
+            &mut ctx.warm,
+            &mut ctx.evals,
+        ) {
+            Ok(Some(i)) => i,
+            Ok(None) => return Settle::Separate,
+            Err(failure) => {
+                return Settle::Stop(ContactStatus::Solver {
+                    failure,
+                    s: s * ctx.scale,
+                })
+            }
+        };
+        match (feat, ctx.rho > 0.0, inst.mode) {
+            (Feat::Vertex(k), false, Mode::SlideLeft | Mode::SlideRight | Mode::Slide) => {
+                // A point pin cannot slide on a vertex: it passes onto the edge it slides towards.
+                let left = match inst.mode {
+                    Mode::SlideLeft => true,
+                    Mode::SlideRight => false,
+                    _ => g.v_pin.dot(g.n.perp()) > 0.0,
+                };
+                match sweep(ctx, k, left, y[0]) {
+                    Some((f, yy)) => {
+                        feat = f;
+                        y = yy;
+                        continue;
+                    }
+                    None => return Settle::Separate,
+                }
+            }
+            _ => return Settle::Go(feat, y, inst),
+        }
+    }
+    Settle::Stop(ContactStatus::EventLimit { events: 4 })
+}
+
+/// The starting contact state for a first touch.
+fn initial_state(ctx: &Ctx, pose: &Pose, feature: Feature, normal_world: Vec2) -> (Feat, [f64; 2]) {
+    let theta = pose.theta;
+    match feature {
+        Feature::Edge { index, t } => {
+            let (a, b) = ctx.poly.edge(index);
+            (Feat::Edge(index), [theta, t * (b - a).norm()])
+        }
+        Feature::Vertex { index } => {
+            let n_part = if ctx.rho > 0.0 {
+                normal_world.rotate(-theta)
+            } else {
+                // Point pin: the ρ → 0 limit of a disc arriving along its path: the normal is the
+                // direction of travel, clamped into the vertex's normal cone.
+                let m = ctx.poly.len();
+                let na = ctx.poly.inward_normal(index + m - 1);
+                let nb = ctx.poly.inward_normal(index);
+                let d = ctx.vdir.rotate(-theta).normalized();
+                if na.cross(d) >= 0.0 && d.cross(nb) >= 0.0 {
+                    d
+                } else if d.dot(na) >= d.dot(nb) {
+                    na
+                } else {
+                    nb
+                }
+            };
+            (Feat::Vertex(index), [theta, n_part.angle()])
+        }
+    }
+}
+
+/// Minimum distance from the pin centre to edges not adjacent to the current feature (disc pins on
+/// concave parts): negative margin means a second contact.
+fn second_contact(ctx: &Ctx, feat: Feat, pose: &Pose, s: f64) -> bool {
+    if ctx.poly.is_convex() || ctx.rho == 0.0 {
+        return false;
+    }
+    let m = ctx.poly.len();
+    let centre = pose.apply_inverse(ctx.pin_at(s));
+    let (skip_a, skip_b) = match feat {
+        Feat::Edge(k) => (k, k),
+        Feat::Vertex(k) => ((k + m - 1) % m, k),
+    };
+    for i in 0..m {
+        if i == skip_a || i == skip_b {
+            continue;
+        }
+        let (a, b) = ctx.poly.edge(i);
+        let e = b - a;
+        let t = ((centre - a).dot(e) / e.norm2()).clamp(0.0, 1.0);
+        if (a + e * t - centre).norm() < ctx.rho * (1.0 - 1e-9) {
+            return true;
+        }
+    }
+    false
+}
+
+struct Segments {
+    list: Vec<Segment>,
+    open: Option<(Feat, Mode, f64, f64)>,
+}
+
+impl Segments {
+    fn open(&mut self, feat: Feat, mode: Mode, s: f64, theta: f64) {
+        self.open = Some((feat, mode, s, theta));
+    }
+    fn close(&mut self, s: f64, theta: f64, scale: f64) {
+        if let Some((f, m, s0, t0)) = self.open.take() {
+            self.list.push(Segment {
+                feature: f.public(),
+                mode: m,
+                s_begin: s0 * scale,
+                s_end: s * scale,
+                theta_begin: t0,
+                theta_end: theta,
+            });
+        }
+    }
+}
+
+/// Integrate one contact from its first touch until separation. Returns the end and the final state.
+fn integrate_contact(
+    ctx: &mut Ctx,
+    settings: &ContactSettings,
+    s_start: f64,
+    feat0: Feat,
+    y_start: [f64; 2],
+    segs: &mut Segments,
+    events_used: &mut u32,
+    steps: &mut u32,
+) -> (End, f64, Pose) {
+    let mut s = s_start;
+    let (mut feat, mut y, mut inst) = match settle(ctx, s, feat0, y_start) {
+        Settle::Go(f, yy, i) => (f, yy, i),
+        Settle::Separate => {
+            let p = ctx.pose(s, feat0, y_start);
+            return (End::Separated, s, p);
+        }
+        Settle::Stop(st) => {
+            let p = ctx.pose(s, feat0, y_start);
+            return (End::Stop(st), s, p);
+        }
+    };
+    let mut mode = inst.mode;
+    segs.open(feat, mode, s, y[0]);
+    ctx.record(s, feat, y, &inst);
+    let mut f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
+    let mut ev0 = ctx.events(feat, y, &inst);
+    let h_max = 0.25;
+    let h_min = 1e-13;
+    let mut h = (0.2 * ctx.tol.powf(0.2)).clamp(1e-6, h_max);
+    loop {
+        if ctx.evals > settings.max_evaluations {
+            let p = ctx.pose(s, feat, y);
+            return (
+                End::Stop(ContactStatus::EvaluationLimit {
+                    evaluations: ctx.evals,
+                }),
+                s,
+                p,
+            );
+        }
+        if s - s_start > settings.max_travel {
+            let p = ctx.pose(s, feat, y);
+            return (
+                End::Stop(ContactStatus::TravelLimit {
+                    travel: (s - s_start) * ctx.scale,
+                }),
+                s,
+                p,
+            );
+        }
+        // An event function already negative at the start of a step: the state is at an event.
+        let pending = (0..N_EVENTS).find(|&i| ev0[i] < -1e-9);
+        let (event, s_ev, y_ev, inst_ev) = if let Some(i) = pending {
+            (Some(i), s, y, inst)
+        } else {
+            let step = match dp_step(ctx, feat, mode, y, f0, h) {
+                Ok(r) => r,
+                Err(failure) => {
+                    h *= 0.25;
+                    if h < h_min {
+                        let p = ctx.pose(s, feat, y);
+                        return (
+                            End::Stop(ContactStatus::Solver {
+                                failure,
+                                s: s * ctx.scale,
+                            }),
+                            s,
+                            p,
+                        );
+                    }
+                    continue;
+                }
+            };
+            if step.err > 1.0 {
+                h *= (0.9 * step.err.powf(-0.2)).max(0.2);
+                if h < h_min {
+                    let p = ctx.pose(s, feat, y);
+                    return (
+                        End::Stop(ContactStatus::StepTooSmall { s: s * ctx.scale }),
+                        s,
+                        p,
+                    );
+                }
+                continue;
+            }
+            let ev1 = ctx.events(feat, step.y1, &step.inst1);
+            let crossed: Vec<usize> = (0..N_EVENTS)
+                .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -1e-9)
+                .collect();
+            let factor = (0.9 * step.err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
+            if crossed.is_empty() {
+                s += h;
+                y = step.y1;
+                inst = step.inst1;
+                f0 = step.f1;
+                ev0 = ev1;
+                *steps += 1;
+                ctx.record(s, feat, y, &inst);
+                let pose = ctx.pose(s, feat, y);
+                if second_contact(ctx, feat, &pose, s) {
+                    return (
+                        End::Stop(ContactStatus::MultiContact { s: s * ctx.scale }),
+                        s,
+                        pose,
+                    );
+                }
+                h = (h * factor).min(h_max);
+                continue;
+            }
+            // Locate the earliest crossing on the interpolant.
+            let (y0c, f0c, y1c, f1c, hc) = (y, f0, step.y1, step.f1, h);
+            let mut best = (2.0, 0usize);
+            let warm_saved = ctx.warm;
+            for &i in &crossed {
+                let g0 = ev0[i].max(0.0);
+                let t = if g0 == 0.0 {
+                    0.0
+                } else {
+                    illinois(
+                        |t| {
+                            let yt = hermite(y0c, f0c, y1c, f1c, hc, t);
+                            if i == 0 || i >= 3 {
+                                let dummy = inst;
+                                ctx.events(feat, yt, &dummy)[i]
+                            } else {
+                                let g = ctx.geom(feat, yt);
+                                match solve_in_mode(
+                                    ctx.model,
+                                    ctx.fid,
+                                    &g,
+                                    ctx.fr,
+                                    mode,
+                                    &mut ctx.warm,
+                                    &mut ctx.evals,
+                                ) {
+                                    Ok(it) => it.margins[i - 1],
+                                    Err(_) => -1.0,
+                                }
+                            }
+                        },
+                        g0,
+                        ev1[i],
+                    )
+                };
+                if t < best.0 {
+                    best = (t, i);
+                }
+            }
+            ctx.warm = warm_saved;
+            let (t_est, i) = best;
+            // Refine on real steps: g(t) = event i after a Dormand–Prince step of t·h from (s, y).
+            let real = |t: f64, ctx: &mut Ctx| -> Option<StepResult> {
+                if t * h <= 1e-15 {
+                    return None;
+                }
+                dp_step(ctx, feat, mode, y, f0, t * h).ok()
+            };
+            let g_of = |r: &Option<StepResult>, ctx: &Ctx| -> f64 {
+                match r {
+                    Some(r) => ctx.events(feat, r.y1, &r.inst1)[i],
+                    None => ev0[i].max(0.0),
+                }
+            };
+            let (mut a, mut b) = (0.0f64, 1.0f64);
+            let (mut ga, mut gb) = (ev0[i].max(0.0), ev1[i]);
+            let mut best_step: Option<StepResult> = None;
+            let mut best_t = 0.0;
+            let mut t = t_est.clamp(0.0, 1.0);
+            let mut side = 0;
+            for _ in 0..40 {
+                let r = real(t, ctx);
+                let gt = g_of(&r, ctx);
+                if gt < 0.0 {
+                    b = t;
+                    gb = gt;
+                    if side == -1 {
+                        ga *= 0.5;
+                    }
+                    side = -1;
+                } else {
+                    a = t;
+                    ga = gt;
+                    best_step = r;
+                    best_t = t;
+                    if side == 1 {
+                        gb *= 0.5;
+                    }
+                    side = 1;
+                }
+                if gt.abs() <= 1e-12 || (b - a) * h <= 1e-13 {
+                    if gt < 0.0 && gt.abs() <= 1e-12 {
+                        best_step = real(t, ctx);
+                        best_t = t;
+                    }
+                    break;
+                }
+                t = (a * gb - b * ga) / (gb - ga);
+                if !t.is_finite() || t <= a || t >= b {
+                    t = 0.5 * (a + b);
+                }
+            }
+            match best_step {
+                Some(r) => {
+                    *steps += 1;
+                    (Some(i), s + best_t * h, r.y1, r.inst1)
+                }
+                None => (Some(i), s, y, inst),
+            }
+        };
+        let i = event.expect("an event was found");
+        if std::env::var("PINFEED_DEBUG").is_ok() {
+            eprintln!("event {i} at s={s_ev} mode={mode:?} feat={feat:?} y={y_ev:?} margins={:?} ev0={ev0:?}", inst_ev.margins);
+        }
+        *events_used += 1;
+        if *events_used > settings.max_events {
+            let p = ctx.pose(s_ev, feat, y_ev);
+            return (
+                End::Stop(ContactStatus::EventLimit {
+                    events: *events_used,
+                }),
+                s_ev,
+                p,
+            );
+        }
+        s = s_ev;
+        y = y_ev;
+        ctx.record(s, feat, y, &inst_ev);
+        segs.close(s, y[0], ctx.scale);
+        // Apply the event.
+        let m = ctx.poly.len();
+        let next: Option<(Feat, [f64; 2], Option<Mode>)> = match (i, feat) {
+            (0, _) => None,
+            (1 | 2, _) => {
+                let new_mode = match (mode, i) {
+                    (Mode::Stick, 1) => Mode::SlideLeft,
+                    (Mode::Stick, _) => Mode::SlideRight,
+                    _ => Mode::Stick,
+                };
+                if let (Feat::Vertex(k), false) = (feat, ctx.rho > 0.0) {
+                    // Hooked point pin lets go: it sweeps onto the edge it now slides towards.
+                    match sweep(ctx, k, new_mode == Mode::SlideLeft, y[0]) {
+                        Some((f, yy)) => Some((f, yy, None)),
+                        None => None,
+                    }
+                } else {
+                    Some((feat, y, Some(new_mode)))
+                }
+            }
+            (3, Feat::Edge(k)) | (4, Feat::Edge(k)) => {
+                let v = if i == 3 { k } else { (k + 1) % m };
+                if !ctx.poly.vertex_is_convex(v) {
+                    let p = ctx.pose(s, feat, y);
+                    return (
+                        End::Stop(ContactStatus::MultiContact { s: s * ctx.scale }),
+                        s,
+                        p,
+                    );
+                }
+                if ctx.rho > 0.0 {
+                    let n = ctx.poly.inward_normal(k);
+                    Some((Feat::Vertex(v), [y[0], n.angle()], None))
+                } else {
+                    match sweep(ctx, v, i == 3, y[0]) {
+                        Some((f, yy)) => Some((f, yy, None)),
+                        None => None,
+                    }
+                }
+            }
+            (3, Feat::Vertex(k)) => {
+                let e = (k + m - 1) % m;
+                let (a, b) = ctx.poly.edge(e);
+                Some((Feat::Edge(e), [y[0], (b - a).norm()], None))
+            }
+            (4, Feat::Vertex(k)) => Some((Feat::Edge(k), [y[0], 0.0], None)),
+            _ => unreachable!("event index out of range"),
+        };
+        let Some((nf, ny, forced)) = next else {
+            let p = ctx.pose(s, feat, y);
+            return (End::Separated, s, p);
+        };
+        let settled = match forced {
+            Some(md) => {
+                let g = ctx.geom(nf, ny);
+                match solve_in_mode(
+                    ctx.model,
+                    ctx.fid,
+                    &g,
+                    ctx.fr,
+                    md,
+                    &mut ctx.warm,
+                    &mut ctx.evals,
+                ) {
+                    Ok(it) => Settle::Go(nf, ny, it),
+                    Err(failure) => Settle::Stop(ContactStatus::Solver {
+                        failure,
+                        s: s * ctx.scale,
+                    }),
+                }
+            }
+            None => settle(ctx, s, nf, ny),
+        };
+        match settled {
+            Settle::Go(f, yy, it) => {
+                feat = f;
+                y = yy;
+                inst = it;
+                mode = it.mode;
+            }
+            Settle::Separate => {
+                let p = ctx.pose(s, nf, ny);
+                return (End::Separated, s, p);
+            }
+            Settle::Stop(st) => {
+                let p = ctx.pose(s, nf, ny);
+                return (End::Stop(st), s, p);
+            }
+        }
+        segs.open(feat, mode, s, y[0]);
+        f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
+        ev0 = ctx.events(feat, y, &inst);
+        // Freshly started segments begin at their boundary: do not re-trigger on rounding.
+        for e in ev0.iter_mut() {
+            if e.abs() <= 1e-8 {
+                *e = 0.0;
+            }
+        }
+        h = h.max(1e-6);
+    }
+}
+
+/// Push a part with one pin: the pin starts at `pin_start` (world, caller's units) and travels along
+/// (−1, w) relative to the belt past the part resting at `pose`. Pure function of its inputs.
+pub fn push(
+    model: &PartModel,
+    pose: Pose,
+    pin_start: Vec2,
+    pin: &Pin,
+    settings: &ContactSettings,
+    recorder: Option<&mut dyn Recorder>,
+) -> ContactOutcome {
+    let k = model.scale();
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let mut ctx = Ctx {
+        model,
+        poly: model.polygon(),
+        fid: settings.fidelity,
+        fr: Friction {
+            mu_c: settings.mu_c,
+        },
+        rho: pin.radius / k,
+        vdir: Vec2::new(-1.0, pin.lateral_speed),
+        start: pin_start / k,
+        tol: settings.tol,
+        scale: k,
+        evals: 0,
+        warm: Warm::default(),
+        recorder,
+    };
+    let mut out = ContactOutcome {
+        contact: false,
+        pose_initial: pose,
+        pose_final: pose,
+        rotation: 0.0,
+        travel_to_contact: 0.0,
+        contact_length: 0.0,
+        contacts: 0,
+        segments: Vec::new(),
+        evaluations: 0,
+        steps: 0,
+        status: ContactStatus::Ok,
+    };
+    // The pin must start clear of the part.
+    let local = pose_n.apply_inverse(ctx.start);
+    if ctx.poly.contains(local) || ctx.poly.distance_to_boundary(local).0 < ctx.rho * (1.0 - 1e-12)
+    {
+        out.status = ContactStatus::PinInsidePart;
+        return out;
+    }
+    let dir_len = ctx.vdir.norm();
+    let dir = ctx.vdir / dir_len;
+    let mut s = 0.0;
+    let mut cur = pose_n;
+    let mut segs = Segments {
+        list: Vec::new(),
+        open: None,
+    };
+    let mut events_used = 0u32;
+    let mut steps = 0u32;
+    let mut min_travel = 0.0;
+    for _pass in 0..16 {
+        let hit = first_contact(ctx.poly, &cur, ctx.pin_at(s), dir, ctx.rho, min_travel);
+        let Some(hit) = hit else { break };
+        if hit.grazing {
+            // A touch that pushes nothing: continue along the path past it.
+            min_travel = hit.travel + 1e-9;
+            continue;
+        }
+        let s_touch = s + hit.travel / dir_len;
+        if out.contacts == 0 {
+            out.travel_to_contact = s_touch * k;
+        }
+        out.contacts += 1;
+        let (feat, y) = initial_state(&ctx, &cur, hit.feature, hit.normal);
+        // The pose at touch: the part has not moved; the state reconstructs it exactly.
+        let (end, s_end, pose_end) = integrate_contact(
+            &mut ctx,
+            settings,
+            s_touch,
+            feat,
+            y,
+            &mut segs,
+            &mut events_used,
+            &mut steps,
+        );
+        segs.close(s_end, pose_end.theta, k);
+        out.contact_length += (s_end - s_touch) * k;
+        s = s_end;
+        cur = pose_end;
+        match end {
+            End::Separated => {
+                min_travel = 1e-9;
+            }
+            End::Stop(st) => {
+                out.status = st;
+                break;
+            }
+        }
+    }
+    out.contact = out.contacts > 0;
+    out.segments = segs.list;
+    out.pose_final = Pose::new(cur.x * k, cur.y * k, cur.theta);
+    out.rotation = cur.theta - pose.theta;
+    out.evaluations = ctx.evals;
+    out.steps = steps;
+    out
+}
+
+/// The mode and twist at the first instant of contact (for Mason's-vote checks and sensors).
+/// Returns (contact geometry in the part frame, the instant) or `None` without a pushing contact.
+pub fn first_instant(
+    model: &PartModel,
+    pose: Pose,
+    pin_start: Vec2,
+    pin: &Pin,
+    settings: &ContactSettings,
+) -> Option<(ContactGeom, Instant)> {
+    let k = model.scale();
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let mut ctx = Ctx {
+        model,
+        poly: model.polygon(),
+        fid: settings.fidelity,
+        fr: Friction {
+            mu_c: settings.mu_c,
+        },
+        rho: pin.radius / k,
+        vdir: Vec2::new(-1.0, pin.lateral_speed),
+        start: pin_start / k,
+        tol: settings.tol,
+        scale: k,
+        evals: 0,
+        warm: Warm::default(),
+        recorder: None,
+    };
+    let dir = ctx.vdir.normalized();
+    let hit = first_contact(ctx.poly, &pose_n, ctx.start, dir, ctx.rho, 0.0)?;
+    if hit.grazing {
+        return None;
+    }
+    let (feat, y) = initial_state(&ctx, &pose_n, hit.feature, hit.normal);
+    let g = ctx.geom(feat, y);
+    let inst = classify(model, ctx.fid, &g, ctx.fr, &mut ctx.warm, &mut ctx.evals).ok()??;
+    Some((g, inst))
+}

@@ -1,0 +1,26 @@
+//! The contact model: what happens to a part carried by the belt into one pin (SPEC §2).
+//!
+//! * [`limit_surface`]: dissipation D(ξ), its gradient (the support load) and Hessian for uniform
+//!   pressure (closed form per edge, with a far-field quadrature) and for weighted support points.
+//! * [`part_model`]: the compiled part (normalised geometry + support) and the two convex
+//!   sub-problems, at three fidelity levels (`tip`, `ellipsoid`, `exact`).
+//! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
+//! * [`integrate`]: one pin pass, integrated in pin travel with error control and event location.
+//! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
+//! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
+//!
+//! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
+//! → [`ContactOutcome`].
+
+pub mod instant;
+pub mod integrate;
+pub mod limit_surface;
+pub mod outcome;
+pub mod part_model;
+pub mod vote;
+
+pub use instant::Mode;
+pub use integrate::{first_instant, push, ContactSettings, Pin};
+pub use outcome::{ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, TraceSample};
+pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
+pub use vote::mason_vote;

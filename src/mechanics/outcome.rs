@@ -1,0 +1,121 @@
+//! What one pass of a pin past a part produces: [`ContactOutcome`], its segments and status, and the
+//! optional [`Recorder`] that receives the trajectory and contact force per step.
+
+use super::instant::Mode;
+use super::part_model::SolveFailure;
+use crate::geometry::{Pose, Vec2};
+use serde::Serialize;
+
+/// The feature of the part in contact during a segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", content = "index", rename_all = "snake_case")]
+pub enum ContactFeature {
+    Edge(usize),
+    Vertex(usize),
+}
+
+/// A stretch of contact with one feature in one mode.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Segment {
+    pub feature: ContactFeature,
+    pub mode: Mode,
+    /// Pin travel (belt frame, caller's units) at the start and end of the segment.
+    pub s_begin: f64,
+    pub s_end: f64,
+    /// Part orientation (radians, unwrapped) at the start and end.
+    pub theta_begin: f64,
+    pub theta_end: f64,
+}
+
+/// How a contact computation ended.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ContactStatus {
+    /// The pin passed the part; the result is trustworthy to the requested tolerance.
+    Ok,
+    /// The pin touches the part at two places at once (a concave notch): the single-contact model
+    /// stops here rather than mis-simulate; `pose_final` is the pose at that moment.
+    MultiContact { s: f64 },
+    /// The pin started inside the part.
+    PinInsidePart,
+    /// The part was still being pushed after the travel limit (e.g. a metastable push through the
+    /// centroid that never turns): the part rides on the pin.
+    TravelLimit { travel: f64 },
+    /// Too many model evaluations (the budget is a setting).
+    EvaluationLimit { evaluations: u64 },
+    /// Too many contact events (mode chattering).
+    EventLimit { events: u32 },
+    /// The integrator's step fell below its floor (a non-smooth spot it cannot resolve).
+    StepTooSmall { s: f64 },
+    /// A limit-surface sub-problem failed.
+    Solver { failure: SolveFailure, s: f64 },
+}
+
+impl ContactStatus {
+    pub fn is_ok(&self) -> bool {
+        matches!(self, ContactStatus::Ok)
+    }
+    /// Short machine-readable name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ContactStatus::Ok => "ok",
+            ContactStatus::MultiContact { .. } => "multi_contact",
+            ContactStatus::PinInsidePart => "pin_inside_part",
+            ContactStatus::TravelLimit { .. } => "travel_limit",
+            ContactStatus::EvaluationLimit { .. } => "evaluation_limit",
+            ContactStatus::EventLimit { .. } => "event_limit",
+            ContactStatus::StepTooSmall { .. } => "step_too_small",
+            ContactStatus::Solver { .. } => "solver",
+        }
+    }
+}
+
+/// The result of pushing one part with one pin (SPEC §2): a pure function of its inputs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ContactOutcome {
+    /// Did the pin push the part at all?
+    pub contact: bool,
+    /// Pose before (belt frame, caller's units, radians).
+    pub pose_initial: Pose,
+    /// Pose after the pin has passed (or at the moment a non-ok status stopped the computation).
+    pub pose_final: Pose,
+    /// Signed total rotation θ_final − θ_initial (radians, not wrapped).
+    pub rotation: f64,
+    /// Pin travel relative to the belt before the first touch (caller's units).
+    pub travel_to_contact: f64,
+    /// Pin travel while in contact (caller's units); time in contact = contact_length / V.
+    pub contact_length: f64,
+    /// Number of separate contacts during the pass (a concave part may be struck twice).
+    pub contacts: u32,
+    pub segments: Vec<Segment>,
+    /// Limit-surface evaluations (exact model: dissipation evaluations; closed forms: solves).
+    pub evaluations: u64,
+    /// Accepted integration steps.
+    pub steps: u32,
+    pub status: ContactStatus,
+}
+
+/// One recorded instant of a contact (belt frame, caller's units).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TraceSample {
+    /// Pin travel relative to the belt.
+    pub s: f64,
+    pub pose: Pose,
+    pub pin_centre: Vec2,
+    pub contact_point: Vec2,
+    /// Force the pin applies to the part (world axes), in units of μs m g.
+    pub force: Vec2,
+    pub mode: Mode,
+    pub feature: ContactFeature,
+}
+
+/// Receives the trajectory of a contact. With no recorder attached nothing is collected.
+pub trait Recorder {
+    fn record(&mut self, sample: &TraceSample);
+}
+
+impl Recorder for Vec<TraceSample> {
+    fn record(&mut self, sample: &TraceSample) {
+        self.push(*sample);
+    }
+}

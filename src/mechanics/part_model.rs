@@ -1,0 +1,709 @@
+//! The part as the contact model sees it: geometry normalised to unit size plus its support
+//! (friction) model, and the two convex sub-problems every instant reduces to (SPEC §2, "Solving one
+//! instant robustly"):
+//!
+//! * [`PartModel::twist_for_wrench`]: the twist ξ normal to the limit surface at a contact wrench w,
+//!   ξ = argmin D(ξ) subject to w·ξ = 1;
+//! * [`PartModel::stick_twist`]: the twist whose velocity at a contact point p equals a given v,
+//!   ξ(ω) = (v − ω ẑ×p, ω) with ω minimising D (zero support moment about p).
+//!
+//! Units: the polygon is scaled so that `a` (largest centroid-to-vertex distance) is 1, the support
+//! load is normalised to μs m g = 1, and twists are in the part frame (centroid origin, part axes).
+//! Lengths are converted back by [`PartModel::scale`]. μs only scales forces and never enters a
+//! motion, so μs invariance holds by construction (and is tested).
+//!
+//! Fidelity levels:
+//! * `exact`: the dissipation D(ξ) = ∫ p|u| dA of the real pressure distribution (uniform: closed
+//!   form per edge; points: exact sums), minimised by Newton's method with the analytic Hessian and
+//!   a backtracking line search, warm-started from the previous instant.
+//! * `ellipsoid`: H(w) = |f|²/f_max² + m²/m_max² (Lynch, Maekawa & Tanie 1992), normal map
+//!   ξ ∝ (c² f, m) with c = m_max/f_max = (1/mg)∫p|x|dA: closed forms.
+//! * `tip`: Peshkin & Sanderson's COR-locus tip. For a force line at distance q from the centroid the
+//!   COR sits on the perpendicular through the centroid at a²/q on the far side; this is exactly the
+//!   normal map ξ ∝ (a² f, m), i.e. the ellipsoid formulas with c = a. It is the slowest-rotating
+//!   motion any pressure distribution allows, kept as the thesis's baseline.
+
+use super::limit_surface::points::PointSupport;
+use super::limit_surface::uniform::UniformSurface;
+use super::limit_surface::Dissipation;
+use crate::geometry::{Polygon, Vec2};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// A twist (vx, vy, ω) in the part frame: centroid velocity and angular rate.
+pub type Twist = [f64; 3];
+/// A wrench (fx, fy, m) in the part frame: force and moment about the centroid.
+pub type Wrench = [f64; 3];
+
+#[inline]
+pub(crate) fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+#[inline]
+fn scale3(a: [f64; 3], k: f64) -> [f64; 3] {
+    [a[0] * k, a[1] * k, a[2] * k]
+}
+#[inline]
+fn axpy3(a: [f64; 3], k: f64, b: [f64; 3]) -> [f64; 3] {
+    [a[0] + k * b[0], a[1] + k * b[1], a[2] + k * b[2]]
+}
+#[inline]
+fn norm3(a: [f64; 3]) -> f64 {
+    dot3(a, a).sqrt()
+}
+#[inline]
+fn quad3(h: &[[f64; 3]; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let mut s = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            s += a[i] * h[i][j] * b[j];
+        }
+    }
+    s
+}
+
+/// Contact wrench of a force `f` applied at part-frame point `p`.
+#[inline]
+pub fn wrench_of(f: Vec2, p: Vec2) -> Wrench {
+    [f.x, f.y, p.cross(f)]
+}
+
+/// Velocity of the material point `p` (part frame) under twist `xi`.
+#[inline]
+pub fn point_velocity(xi: Twist, p: Vec2) -> Vec2 {
+    Vec2::new(xi[0], xi[1]) + p.perp() * xi[2]
+}
+
+/// Which model of the support friction to use (SPEC §2, "Fidelity levels").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Fidelity {
+    /// The thesis's COR-locus tip (Peshkin & Sanderson): slowest possible rotation.
+    Tip,
+    /// Ellipsoidal limit surface (Lynch et al. 1992).
+    Ellipsoid,
+    /// The limit surface of the actual pressure distribution.
+    #[default]
+    Exact,
+}
+
+impl Fidelity {
+    pub fn name(self) -> &'static str {
+        match self {
+            Fidelity::Tip => "tip",
+            Fidelity::Ellipsoid => "ellipsoid",
+            Fidelity::Exact => "exact",
+        }
+    }
+    pub fn parse(s: &str) -> Option<Fidelity> {
+        match s {
+            "tip" => Some(Fidelity::Tip),
+            "ellipsoid" => Some(Fidelity::Ellipsoid),
+            "exact" => Some(Fidelity::Exact),
+            _ => None,
+        }
+    }
+}
+
+impl fmt::Display for Fidelity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How the part's weight is carried by the belt.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Support {
+    /// Uniform pressure over the footprint (the thesis's assumption).
+    Uniform,
+    /// Weighted support points in the part frame of the *caller's* units (e.g. a tripod).
+    Points {
+        points: Vec<Vec2>,
+        weights: Vec<f64>,
+    },
+}
+
+impl Support {
+    /// A random tripod (SPEC §2): three points drawn uniformly inside the part whose triangle
+    /// contains the centroid; each carries the centroid's barycentric weight (static equilibrium).
+    /// Points are in the polygon's part frame (centroid origin). Each weight is at least 2%, so the
+    /// tripod is never degenerate.
+    pub fn random_tripod(poly: &Polygon, rng: &mut impl rand::Rng) -> Result<Support, String> {
+        use rand::RngExt;
+        let v = poly.vertices();
+        let (mut lo, mut hi) = (v[0], v[0]);
+        for p in v {
+            lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Vec2::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        let draw = |rng: &mut dyn FnMut() -> f64| -> Option<Vec2> {
+            for _ in 0..10_000 {
+                let p = Vec2::new(lo.x + (hi.x - lo.x) * rng(), lo.y + (hi.y - lo.y) * rng());
+                if poly.contains(p) {
+                    return Some(p);
+                }
+            }
+            None
+        };
+        let mut uni = || rng.random::<f64>();
+        for _ in 0..100_000 {
+            let (Some(a), Some(b), Some(c)) = (draw(&mut uni), draw(&mut uni), draw(&mut uni))
+            else {
+                break;
+            };
+            let area = (b - a).cross(c - a);
+            if area.abs() < 1e-12 {
+                continue;
+            }
+            // Barycentric coordinates of the centroid (origin).
+            let o = Vec2::ZERO;
+            let wa = (b - o).cross(c - o) / area;
+            let wb = (c - o).cross(a - o) / area;
+            let wc = (a - o).cross(b - o) / area;
+            if wa >= 0.02 && wb >= 0.02 && wc >= 0.02 {
+                return Ok(Support::Points {
+                    points: vec![a, b, c],
+                    weights: vec![wa, wb, wc],
+                });
+            }
+        }
+        Err("could not draw a tripod inside the part that carries its centroid".into())
+    }
+
+    /// Parse a support specification: `uniform` or `tripod:SEED`.
+    pub fn parse(spec: &str, poly: &Polygon) -> Result<Support, String> {
+        let s = spec.trim();
+        if s == "uniform" {
+            return Ok(Support::Uniform);
+        }
+        if let Some(seed) = s.strip_prefix("tripod:") {
+            let seed: u64 = seed
+                .trim()
+                .parse()
+                .map_err(|_| format!("support '{s}': the tripod seed must be a whole number"))?;
+            let mut rng = crate::random::stream(seed, 0);
+            return Support::random_tripod(poly, &mut rng);
+        }
+        Err(format!(
+            "unknown support '{s}'; expected 'uniform' or 'tripod:SEED'"
+        ))
+    }
+}
+
+enum SupportData {
+    Uniform(UniformSurface),
+    Points(PointSupport),
+}
+
+/// Why a convex sub-problem could not be solved.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SolveFailure {
+    /// Newton's method stopped before reaching the tolerance; `residual` is the relative optimality gap.
+    NoConvergence { iterations: u32, residual: f64 },
+    /// A non-finite number appeared.
+    NonFinite,
+}
+
+impl fmt::Display for SolveFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SolveFailure::NoConvergence {
+                iterations,
+                residual,
+            } => write!(
+                f,
+                "limit-surface solve did not converge ({iterations} iterations, residual {residual:.2e})"
+            ),
+            SolveFailure::NonFinite => write!(f, "limit-surface solve produced a non-finite number"),
+        }
+    }
+}
+
+/// A solved twist with the contact wrench on the limit surface it corresponds to
+/// (in units of μs m g; the friction load on the part is its negative).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Solved {
+    pub twist: Twist,
+    pub wrench: Wrench,
+}
+
+/// The compiled part: normalised geometry and support data. Immutable; shared by all contacts.
+pub struct PartModel {
+    poly: Polygon,
+    scale: f64,
+    support: SupportData,
+    /// m_max / f_max of the ellipsoid approximation (normalised units).
+    c_ellipsoid: f64,
+}
+
+impl fmt::Debug for PartModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("PartModel")
+            .field("vertices", &self.poly.len())
+            .field("scale", &self.scale)
+            .field("c_ellipsoid", &self.c_ellipsoid)
+            .finish()
+    }
+}
+
+const NEWTON_TOL: f64 = 1e-13;
+const NEWTON_MAX: u32 = 60;
+
+impl PartModel {
+    /// Compile a part: normalise to a = 1 and precompute the support's limit-surface data.
+    pub fn new(poly: &Polygon, support: &Support) -> Result<PartModel, String> {
+        let scale = poly.radius();
+        let unit = poly.scaled(1.0 / scale);
+        let data = match support {
+            Support::Uniform => SupportData::Uniform(UniformSurface::new(&unit)),
+            Support::Points { points, weights } => {
+                let pts: Vec<Vec2> = points.iter().map(|&p| p / scale).collect();
+                SupportData::Points(PointSupport::new(pts, weights.clone())?)
+            }
+        };
+        let c = match &data {
+            SupportData::Uniform(u) => u.ellipsoid_c(),
+            SupportData::Points(p) => p.ellipsoid_c(),
+        };
+        Ok(PartModel {
+            poly: unit,
+            scale,
+            support: data,
+            c_ellipsoid: c,
+        })
+    }
+
+    /// The polygon in normalised units (a = 1).
+    pub fn polygon(&self) -> &Polygon {
+        &self.poly
+    }
+    /// Length of one normalised unit in the caller's units (the part's `a`).
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+    /// m_max/f_max of the ellipsoidal approximation (normalised units).
+    pub fn ellipsoid_c(&self) -> f64 {
+        self.c_ellipsoid
+    }
+
+    /// The c of the closed-form normal map for a non-exact fidelity.
+    fn closed_form_c(&self, fid: Fidelity) -> f64 {
+        match fid {
+            Fidelity::Tip => 1.0,
+            _ => self.c_ellipsoid,
+        }
+    }
+
+    /// Exact dissipation, gradient and optionally Hessian at twist `xi`.
+    #[inline]
+    pub fn dissipation(&self, xi: Twist, hessian: bool) -> Dissipation {
+        match &self.support {
+            SupportData::Uniform(u) => u.eval(xi, hessian),
+            SupportData::Points(p) => p.eval(xi, hessian),
+        }
+    }
+
+    /// Contact wrench on the limit surface whose normal is `xi` (units of μs m g).
+    pub fn wrench_for_twist(&self, fid: Fidelity, xi: Twist, evals: &mut u64) -> Wrench {
+        match fid {
+            Fidelity::Exact => {
+                *evals += 1;
+                self.dissipation(xi, false).grad
+            }
+            _ => {
+                let c = self.closed_form_c(fid);
+                // On H(w) = |f|² + m²/c² = 1 with normal ∝ (f, m/c²) ∝ ξ: f = kξv, m = k c² ξω.
+                let k = 1.0 / (xi[0] * xi[0] + xi[1] * xi[1] + c * c * xi[2] * xi[2]).sqrt();
+                [k * xi[0], k * xi[1], k * c * c * xi[2]]
+            }
+        }
+    }
+
+    /// ξ normal to the limit surface at wrench direction `w`, normalised so that w·ξ = 1.
+    pub fn twist_for_wrench(
+        &self,
+        fid: Fidelity,
+        w: Wrench,
+        warm: Option<Twist>,
+        evals: &mut u64,
+    ) -> Result<Solved, SolveFailure> {
+        match fid {
+            Fidelity::Exact => self.exact_twist_for_wrench(w, warm, evals),
+            _ => {
+                *evals += 1;
+                let c2 = self.closed_form_c(fid).powi(2);
+                let xi = [c2 * w[0], c2 * w[1], w[2]];
+                let d = dot3(w, xi);
+                if !(d > 0.0) || !d.is_finite() {
+                    return Err(SolveFailure::NonFinite);
+                }
+                let xi = scale3(xi, 1.0 / d);
+                Ok(Solved {
+                    twist: xi,
+                    wrench: self.wrench_for_twist(fid, xi, evals),
+                })
+            }
+        }
+    }
+
+    /// The twist whose velocity at part-frame point `p` equals `v`, minimising D (stick at p).
+    pub fn stick_twist(
+        &self,
+        fid: Fidelity,
+        p: Vec2,
+        v: Vec2,
+        warm_omega: Option<f64>,
+        evals: &mut u64,
+    ) -> Result<Solved, SolveFailure> {
+        match fid {
+            Fidelity::Exact => self.exact_stick(p, v, warm_omega, evals),
+            _ => {
+                // ξ = A w(f) with A = diag(c², c², 1); v_c = B f, B = c² I + q qᵀ, q = ẑ×p (Lynch 1992).
+                *evals += 1;
+                let c2 = self.closed_form_c(fid).powi(2);
+                let q = p.perp();
+                let denom = c2 + q.norm2();
+                // B⁻¹ v = (v − q (q·v)/(c²+|q|²)) / c²
+                let f = (v - q * (q.dot(v) / denom)) / c2;
+                let w = wrench_of(f, p);
+                let xi = [c2 * w[0], c2 * w[1], w[2]];
+                if !norm3(xi).is_finite() {
+                    return Err(SolveFailure::NonFinite);
+                }
+                Ok(Solved {
+                    twist: xi,
+                    wrench: self.wrench_for_twist(fid, xi, evals),
+                })
+            }
+        }
+    }
+
+    fn ellipsoid_guess(&self, w: Wrench) -> Twist {
+        let c2 = self.c_ellipsoid * self.c_ellipsoid;
+        [c2 * w[0], c2 * w[1], w[2]]
+    }
+
+    /// Pivot candidates of a point support: a twist rotating about support point j is optimal iff
+    /// 0 ∈ ∂D restricted to the plane, i.e. ∇D_rest + w_j Jⱼᵀ b = λ w for some |b| ≤ 1.
+    fn pivot_candidate(&self, w: Wrench, evals: &mut u64) -> Option<Solved> {
+        let SupportData::Points(ps) = &self.support else {
+            return None;
+        };
+        for (j, (&r, &wj)) in ps.points.iter().zip(&ps.weights).enumerate() {
+            if wj <= 0.0 {
+                continue;
+            }
+            let dir = [r.y, -r.x, 1.0];
+            let wd = dot3(w, dir);
+            if wd.abs() < 1e-300 {
+                continue;
+            }
+            let xi = scale3(dir, 1.0 / wd);
+            // Gradient of the other points at xi.
+            *evals += 1;
+            let mut g = [0.0; 3];
+            for (i, (&x, &wi)) in ps.points.iter().zip(&ps.weights).enumerate() {
+                if i == j {
+                    continue;
+                }
+                let u = point_velocity(xi, x);
+                let n = u.norm();
+                if n > 0.0 {
+                    let uh = u / n;
+                    g[0] += wi * uh.x;
+                    g[1] += wi * uh.y;
+                    g[2] += wi * x.cross(uh);
+                }
+            }
+            // Solve [wj*Jᵀ | −w] [b1 b2 λ]ᵀ = −g with Jᵀ columns (1,0,−ry), (0,1,rx).
+            let m = [
+                [wj, 0.0, -w[0]],
+                [0.0, wj, -w[1]],
+                [-wj * r.y, wj * r.x, -w[2]],
+            ];
+            if let Some(sol) = solve3(m, [-g[0], -g[1], -g[2]]) {
+                let b = Vec2::new(sol[0], sol[1]);
+                if b.norm() <= 1.0 + 1e-12 && sol[2] > 0.0 {
+                    let mut wr = g;
+                    wr[0] += wj * b.x;
+                    wr[1] += wj * b.y;
+                    wr[2] += wj * r.cross(b);
+                    return Some(Solved {
+                        twist: xi,
+                        wrench: wr,
+                    });
+                }
+            }
+        }
+        None
+    }
+
+    fn exact_twist_for_wrench(
+        &self,
+        w: Wrench,
+        warm: Option<Twist>,
+        evals: &mut u64,
+    ) -> Result<Solved, SolveFailure> {
+        if let Some(s) = self.pivot_candidate(w, evals) {
+            return Ok(s);
+        }
+        let wn = norm3(w);
+        if !(wn > 0.0) || !wn.is_finite() {
+            return Err(SolveFailure::NonFinite);
+        }
+        let wh = scale3(w, 1.0 / wn);
+        let (e1, e2) = orthonormal_complement(wh);
+        let xi0 = scale3(wh, 1.0 / wn);
+        let start = match warm {
+            Some(x) if dot3(w, x) > 0.0 => scale3(x, 1.0 / dot3(w, x)),
+            _ => {
+                let g = self.ellipsoid_guess(w);
+                scale3(g, 1.0 / dot3(w, g))
+            }
+        };
+        let mut z = [dot3(e1, start), dot3(e2, start)];
+        let at = |z: [f64; 2]| axpy3(axpy3(xi0, z[0], e1), z[1], e2);
+        let mut xi = at(z);
+        *evals += 1;
+        let mut d = self.dissipation(xi, true);
+        let mut residual = f64::INFINITY;
+        for it in 0..NEWTON_MAX {
+            let gr = [dot3(e1, d.grad), dot3(e2, d.grad)];
+            let gnorm = norm3(d.grad);
+            residual = (gr[0] * gr[0] + gr[1] * gr[1]).sqrt() / gnorm.max(1e-300);
+            if !residual.is_finite() {
+                return Err(SolveFailure::NonFinite);
+            }
+            if residual <= NEWTON_TOL {
+                return Ok(Solved {
+                    twist: xi,
+                    wrench: d.grad,
+                });
+            }
+            let h11 = quad3(&d.hess, e1, e1);
+            let h12 = quad3(&d.hess, e1, e2);
+            let h22 = quad3(&d.hess, e2, e2);
+            let det = h11 * h22 - h12 * h12;
+            let mut dz = if det > 0.0 && h11 > 0.0 && det.is_finite() {
+                [
+                    -(h22 * gr[0] - h12 * gr[1]) / det,
+                    -(-h12 * gr[0] + h11 * gr[1]) / det,
+                ]
+            } else {
+                [-gr[0], -gr[1]]
+            };
+            let slope = gr[0] * dz[0] + gr[1] * dz[1];
+            if slope >= 0.0 {
+                dz = [-gr[0], -gr[1]];
+            }
+            let slope = gr[0] * dz[0] + gr[1] * dz[1];
+            let mut t = 1.0;
+            let mut accepted = false;
+            for _ in 0..40 {
+                let zn = [z[0] + t * dz[0], z[1] + t * dz[1]];
+                let xin = at(zn);
+                *evals += 1;
+                let dn = self.dissipation(xin, true);
+                if dn.value.is_finite() && dn.value <= d.value + 1e-4 * t * slope {
+                    z = zn;
+                    xi = xin;
+                    d = dn;
+                    accepted = true;
+                    break;
+                }
+                // Near the optimum D is flat to rounding: accept a step that does not increase it.
+                if dn.value.is_finite() && dn.value <= d.value * (1.0 + 4.0 * f64::EPSILON) {
+                    z = zn;
+                    xi = xin;
+                    d = dn;
+                    accepted = true;
+                    break;
+                }
+                t *= 0.5;
+            }
+            if !accepted {
+                if residual <= 1e-9 {
+                    return Ok(Solved {
+                        twist: xi,
+                        wrench: d.grad,
+                    });
+                }
+                return Err(SolveFailure::NoConvergence {
+                    iterations: it + 1,
+                    residual,
+                });
+            }
+        }
+        if residual <= 1e-9 {
+            return Ok(Solved {
+                twist: xi,
+                wrench: d.grad,
+            });
+        }
+        Err(SolveFailure::NoConvergence {
+            iterations: NEWTON_MAX,
+            residual,
+        })
+    }
+
+    fn exact_stick(
+        &self,
+        p: Vec2,
+        v: Vec2,
+        warm: Option<f64>,
+        evals: &mut u64,
+    ) -> Result<Solved, SolveFailure> {
+        // ξ(ω) = (v + ω q, ω), q = −ẑ×p, so that the velocity at p is v for every ω.
+        let q = -p.perp();
+        let e = [q.x, q.y, 1.0];
+        let xi_of = |om: f64| [v.x + om * q.x, v.y + om * q.y, om];
+        let mut om = match warm {
+            Some(o) if o.is_finite() => o,
+            _ => {
+                let mut dummy = 0;
+                self.stick_twist(Fidelity::Ellipsoid, p, v, None, &mut dummy)
+                    .map(|s| s.twist[2] / point_velocity(s.twist, p).norm().max(1e-300) * v.norm())
+                    .unwrap_or(0.0)
+            }
+        };
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        let vscale = v.norm() / (1.0 + q.norm());
+        let mut residual = f64::INFINITY;
+        for it in 0..200u32 {
+            let xi = xi_of(om);
+            *evals += 1;
+            let d = self.dissipation(xi, true);
+            let g = dot3(e, d.grad);
+            let hss = quad3(&d.hess, e, e);
+            if !g.is_finite() {
+                return Err(SolveFailure::NonFinite);
+            }
+            let solved = Solved {
+                twist: xi,
+                wrench: d.grad,
+            };
+            residual = g.abs() / (norm3(d.grad) * norm3(e)).max(1e-300);
+            if residual <= NEWTON_TOL {
+                return Ok(solved);
+            }
+            if g > 0.0 {
+                hi = hi.min(om);
+            } else {
+                lo = lo.max(om);
+            }
+            // A bracket closed to rounding: the minimum sits on a kink (a point support) or is found.
+            if hi - lo <= 1e-15 * (1.0 + om.abs()) {
+                return Ok(solved);
+            }
+            let mut next = if hss > 0.0 && hss.is_finite() {
+                om - g / hss
+            } else {
+                f64::NAN
+            };
+            if !(next > lo && next < hi) || !next.is_finite() {
+                next = if lo.is_finite() && hi.is_finite() {
+                    0.5 * (lo + hi)
+                } else if lo.is_finite() {
+                    lo + vscale.max(1.0) * 2f64.powi(it as i32)
+                } else {
+                    hi - vscale.max(1.0) * 2f64.powi(it as i32)
+                };
+            }
+            om = next;
+        }
+        Err(SolveFailure::NoConvergence {
+            iterations: 200,
+            residual,
+        })
+    }
+}
+
+/// Two unit vectors orthogonal to the unit vector `w` and to each other.
+fn orthonormal_complement(w: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    // Pick the coordinate axis least aligned with w.
+    let a = if w[0].abs() <= w[1].abs() && w[0].abs() <= w[2].abs() {
+        [1.0, 0.0, 0.0]
+    } else if w[1].abs() <= w[2].abs() {
+        [0.0, 1.0, 0.0]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    let e1 = axpy3(a, -dot3(a, w), w);
+    let e1 = scale3(e1, 1.0 / norm3(e1));
+    let e2 = [
+        w[1] * e1[2] - w[2] * e1[1],
+        w[2] * e1[0] - w[0] * e1[2],
+        w[0] * e1[1] - w[1] * e1[0],
+    ];
+    (e1, e2)
+}
+
+/// Solve a 3×3 linear system by Cramer's rule (None if singular).
+fn solve3(m: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
+    let det = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let d = det(m);
+    if d.abs() < 1e-300 || !d.is_finite() {
+        return None;
+    }
+    let mut out = [0.0; 3];
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut mk = m;
+        for i in 0..3 {
+            mk[i][k] = b[i];
+        }
+        *o = det(mk) / d;
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::part_from_spec;
+
+    #[test]
+    fn ellipsoid_normal_map_is_linear() {
+        let poly = part_from_spec("tripoly2").unwrap();
+        let m = PartModel::new(&poly, &Support::Uniform).unwrap();
+        let mut ev = 0;
+        let w = [0.3, -1.0, 0.2];
+        let s = m
+            .twist_for_wrench(Fidelity::Ellipsoid, w, None, &mut ev)
+            .unwrap();
+        assert!((dot3(w, s.twist) - 1.0).abs() < 1e-14);
+        let c2 = m.ellipsoid_c().powi(2);
+        assert!((s.twist[0] / s.twist[2] - c2 * w[0] / w[2]).abs() < 1e-12);
+        // The wrench returned lies on the ellipsoid.
+        let wr = s.wrench;
+        let h = wr[0] * wr[0] + wr[1] * wr[1] + wr[2] * wr[2] / c2;
+        assert!((h - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn closed_form_stick_matches_target_velocity() {
+        let poly = part_from_spec("square").unwrap();
+        let m = PartModel::new(&poly, &Support::Uniform).unwrap();
+        let mut ev = 0;
+        let p = Vec2::new(0.7, 0.2);
+        let v = Vec2::new(-1.0, 0.3);
+        for fid in [Fidelity::Tip, Fidelity::Ellipsoid] {
+            let s = m.stick_twist(fid, p, v, None, &mut ev).unwrap();
+            assert!((point_velocity(s.twist, p) - v).norm() < 1e-13);
+        }
+    }
+
+    #[test]
+    fn orthonormal_basis() {
+        let w = [0.2, -0.5, 0.84];
+        let n = norm3(w);
+        let w = scale3(w, 1.0 / n);
+        let (a, b) = orthonormal_complement(w);
+        assert!(dot3(a, w).abs() < 1e-15 && dot3(b, w).abs() < 1e-15 && dot3(a, b).abs() < 1e-15);
+        assert!((norm3(a) - 1.0).abs() < 1e-15 && (norm3(b) - 1.0).abs() < 1e-15);
+    }
+}
