@@ -12,7 +12,9 @@ pub struct PartArgs {
     /// Named part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape.
     pub name: Option<String>,
     /// Vertex list instead of a name: "x1,y1 x2,y2 ..." (any orientation, any unit).
-    #[arg(long, conflicts_with = "name")]
+    // allow_hyphen_values: a list that starts with a negative coordinate ("-1.5,-0.5 ...") is a
+    // value, not an unknown flag.
+    #[arg(long, conflicts_with = "name", allow_hyphen_values = true)]
     pub vertices: Option<String>,
     /// Print one JSON object instead of a table.
     #[arg(long)]

@@ -11,7 +11,8 @@
 //! A touch is *grazing* when the pin's direction of travel does not enter the part there (the pin
 //! slides past an extreme vertex or along an edge): such a touch pushes nothing, and the caller
 //! decides whether to continue past it (`min_travel`). Tolerances are relative to the part's size:
-//! a hit within 1e-12·a of an edge end is reported as that vertex.
+//! a hit within 1e-12·a of an edge end is reported as that vertex, and a disc whose swept edge
+//! passes within 1e-12·a of a vertex it touches is grazing it.
 
 use super::polygon::Polygon;
 use super::vec2::{Pose, Vec2};
@@ -106,10 +107,9 @@ pub fn first_contact(
         if s < -eps || s > 1.0 + eps {
             continue;
         }
-        if radius > 0.0 {
-            let s = s.clamp(0.0, 1.0);
-            consider((t, Feature::Edge { index: i, t: s }, a + e * s, n_in, 0));
-        } else if s <= eps {
+        // A touch within the tolerance of an edge end is that vertex, for point and disc pins alike
+        // (for a disc the edge's inward normal is then the centre-to-vertex direction).
+        if s <= eps {
             consider((t, Feature::Vertex { index: i }, a, n_in, 1));
         } else if s >= 1.0 - eps {
             consider((t, Feature::Vertex { index: (i + 1) % m }, b, n_in, 1));
@@ -125,7 +125,9 @@ pub fn first_contact(
             let v = poly.vertex(i);
             let w = v - p;
             let tc = w.dot(d);
-            let perp2 = w.norm2() - tc * tc;
+            // Squared distance from the vertex to the centre's path. From the cross product, not as
+            // |w|² − tc², which cancels catastrophically when the pin starts far away.
+            let perp2 = w.cross(d).powi(2);
             if perp2 > radius * radius {
                 continue;
             }
@@ -147,7 +149,11 @@ pub fn first_contact(
         Feature::Edge { .. } => false,
         Feature::Vertex { index } => {
             if radius > 0.0 {
-                d.dot(normal) <= 1e-12
+                // Tangent within tolerance: the vertex lies within 1e-12·a of the disc's swept
+                // edge. (Near tangency d·n ~ √(2δ/ρ) for an offset δ, so an angle test alone would
+                // call an f64-rounded tangent touch an entering push.)
+                let miss = radius - (point - p).cross(d).abs();
+                d.dot(normal) <= 1e-12 || miss <= tol_t
             } else {
                 !enters_at_vertex(poly, index, d)
             }
