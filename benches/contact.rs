@@ -14,7 +14,12 @@ fn bench_contacts(c: &mut Criterion) {
         let a = poly.radius();
         // 24 contacts spread over orientations and offsets (all of them make contact or pass).
         let cases: Vec<(f64, f64)> = (0..24)
-            .map(|k| (k as f64 * 15.0 + 2.0, -0.7 + 1.4 * ((k * 7 % 24) as f64) / 23.0))
+            .map(|k| {
+                (
+                    k as f64 * 15.0 + 2.0,
+                    -0.7 + 1.4 * ((k * 7 % 24) as f64) / 23.0,
+                )
+            })
             .collect();
         for fid in [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact] {
             let settings = ContactSettings {
@@ -26,7 +31,14 @@ fn bench_contacts(c: &mut Criterion) {
                     let mut acc = 0.0;
                     for &(th, d) in cases {
                         let pose = Pose::new(0.0, 0.0, th.to_radians());
-                        let o = push(&model, pose, Vec2::new(1.01 * a, d * a), &Pin::point(), &settings, None);
+                        let o = push(
+                            &model,
+                            pose,
+                            Vec2::new(1.01 * a, d * a),
+                            &Pin::point(),
+                            &settings,
+                            None,
+                        );
                         acc += o.pose_final.theta;
                     }
                     black_box(acc)

@@ -92,7 +92,9 @@ fn mirror_symmetry() {
 fn mason_vote_agrees() {
     let mut checked = 0;
     for fid in FIDELITIES {
-        for name in ["tripoly1", "tripoly2", "square", "lshape", "ngon:5", "rect:3:1"] {
+        for name in [
+            "tripoly1", "tripoly2", "square", "lshape", "ngon:5", "rect:3:1",
+        ] {
             let p = poly(name);
             let m = model(&p);
             let a = p.radius();
@@ -137,9 +139,15 @@ fn self_convergence_under_tolerance() {
             let a = run(&m, &p, th, d, Pin::point(), &s);
             s.tol *= 0.01;
             let b = run(&m, &p, th, d, Pin::point(), &s);
-            let diff = ang_diff_deg(a.pose_final.theta.to_degrees(), b.pose_final.theta.to_degrees());
+            let diff = ang_diff_deg(
+                a.pose_final.theta.to_degrees(),
+                b.pose_final.theta.to_degrees(),
+            );
             assert!(diff.abs() < 0.01, "{fid} {name} θ0={th} d={d}: {diff}°");
-            assert!(b.evaluations >= a.evaluations, "a tighter tolerance cannot be cheaper");
+            assert!(
+                b.evaluations >= a.evaluations,
+                "a tighter tolerance cannot be cheaper"
+            );
         }
     }
 }
@@ -168,10 +176,16 @@ fn disc_pin_converges_to_point_pin() {
                     point.pose_final.theta.to_degrees(),
                 )
                 .abs();
-                assert!(diff <= last + 1e-6, "{fid} {name}: ρ={rho} diff {diff} after {last}");
+                assert!(
+                    diff <= last + 1e-6,
+                    "{fid} {name}: ρ={rho} diff {diff} after {last}"
+                );
                 last = diff;
             }
-            assert!(last < 0.05, "{fid} {name} θ0={th} d={d}: ρ=1e-4a still {last}° off");
+            assert!(
+                last < 0.05,
+                "{fid} {name} θ0={th} d={d}: ρ=1e-4a still {last}° off"
+            );
         }
     }
 }
@@ -207,7 +221,10 @@ fn tip_rotates_slowest_initially() {
                 .map(|(g, i)| i.twist[2].abs() / g.v_pin.norm())
         };
         if let (Some(t), Some(e)) = (rate(Fidelity::Tip), rate(Fidelity::Exact)) {
-            assert!(t <= e * (1.0 + 1e-9), "{name} θ0={th} d={d}: tip {t} > exact {e}");
+            assert!(
+                t <= e * (1.0 + 1e-9),
+                "{name} θ0={th} d={d}: tip {t} > exact {e}"
+            );
         }
     }
 }

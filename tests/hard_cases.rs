@@ -6,8 +6,8 @@ mod common;
 use common::*;
 use pinfeed::geometry::{Polygon, Pose, Vec2};
 use pinfeed::mechanics::{
-    push, ContactFeature, ContactOutcome, ContactSettings, ContactStatus, Fidelity, PartModel,
-    Pin, Support, TraceSample,
+    push, ContactFeature, ContactOutcome, ContactSettings, ContactStatus, Fidelity, PartModel, Pin,
+    Support, TraceSample,
 };
 use proptest::prelude::*;
 
@@ -15,7 +15,11 @@ const EVAL_BOUND: u64 = 200_000;
 
 fn check(o: &ContactOutcome, what: &str) {
     assert_finite(o, what);
-    assert!(o.evaluations < EVAL_BOUND, "{what}: {} evaluations", o.evaluations);
+    assert!(
+        o.evaluations < EVAL_BOUND,
+        "{what}: {} evaluations",
+        o.evaluations
+    );
 }
 
 /// A push through the centroid: Mason's vote is a tie and the COR is at infinity (pure translation).
@@ -29,7 +33,11 @@ fn push_through_centroid() {
             let o = run(&model(&p), &p, 0.0, 0.0, Pin::point(), &settings(fid, mu));
             check(&o, "central push");
             assert!(o.rotation.abs() < 1e-9, "{fid}: rotation {}", o.rotation);
-            assert!(matches!(o.status, ContactStatus::TravelLimit { .. }), "{:?}", o.status);
+            assert!(
+                matches!(o.status, ContactStatus::TravelLimit { .. }),
+                "{:?}",
+                o.status
+            );
         }
     }
 }
@@ -118,11 +126,20 @@ fn pin_level_with_a_vertex() {
                 let start = Vec2::new(3.0, v.y);
                 let o = push(&m, pose, start, &pin, &settings(fid, 0.5), None);
                 check(&o, "level with vertex");
-                assert!(o.contact, "{name} {fid}: the pin strikes the vertex head on");
+                assert!(
+                    o.contact,
+                    "{name} {fid}: the pin strikes the vertex head on"
+                );
                 assert!(o.status.is_ok(), "{name} {fid} ρ={rho}: {:?}", o.status);
                 if rho == 0.0 {
-                    assert!((o.segments[0].s_begin - (3.0 - v.x)).abs() < 1e-12, "{name}: touch at the vertex");
-                    assert!(matches!(o.segments[0].feature, ContactFeature::Vertex(_) | ContactFeature::Edge(_)));
+                    assert!(
+                        (o.segments[0].s_begin - (3.0 - v.x)).abs() < 1e-12,
+                        "{name}: touch at the vertex"
+                    );
+                    assert!(matches!(
+                        o.segments[0].feature,
+                        ContactFeature::Vertex(_) | ContactFeature::Edge(_)
+                    ));
                 }
             }
         }
@@ -162,8 +179,14 @@ fn pin_grazing_the_extreme_y() {
 /// An edge 1e-9 of the part's size (a nearly-sharp corner cut off).
 #[test]
 fn tiny_edge() {
-    let p = Polygon::from_xy(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0 - 1e-9), (2.0 - 1e-9, 1.0), (0.0, 1.0)])
-        .unwrap();
+    let p = Polygon::from_xy(&[
+        (0.0, 0.0),
+        (2.0, 0.0),
+        (2.0, 1.0 - 1e-9),
+        (2.0 - 1e-9, 1.0),
+        (0.0, 1.0),
+    ])
+    .unwrap();
     assert_eq!(p.len(), 5);
     let m = model(&p);
     for fid in FIDELITIES {
@@ -179,7 +202,14 @@ fn tiny_edge() {
 /// Nearly collinear vertices: a pentagon whose extra vertex sits 1e-10 off a straight side.
 #[test]
 fn nearly_collinear_vertices() {
-    let p = Polygon::from_xy(&[(0.0, 0.0), (1.0, -1e-10), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)]).unwrap();
+    let p = Polygon::from_xy(&[
+        (0.0, 0.0),
+        (1.0, -1e-10),
+        (2.0, 0.0),
+        (2.0, 1.0),
+        (0.0, 1.0),
+    ])
+    .unwrap();
     assert_eq!(p.len(), 5);
     let m = model(&p);
     for fid in FIDELITIES {
@@ -236,10 +266,24 @@ fn needle() {
 fn extreme_scales() {
     let p = poly("tripoly2");
     for fid in FIDELITIES {
-        let base = run(&model(&p), &p, 40.0, 0.25, Pin::point(), &settings(fid, 0.5));
+        let base = run(
+            &model(&p),
+            &p,
+            40.0,
+            0.25,
+            Pin::point(),
+            &settings(fid, 0.5),
+        );
         for k in [1e-6, 1e6] {
             let q = p.scaled(k);
-            let o = run(&model(&q), &q, 40.0, 0.25, Pin::point(), &settings(fid, 0.5));
+            let o = run(
+                &model(&q),
+                &q,
+                40.0,
+                0.25,
+                Pin::point(),
+                &settings(fid, 0.5),
+            );
             check(&o, "scaled");
             assert!((o.rotation - base.rotation).abs() < 1e-9);
         }
@@ -295,9 +339,34 @@ fn moving_pin() {
         // Opposite lateral speeds on a mirrored part mirror the result.
         let q = p.mirrored_y();
         let mq = model(&q);
-        let a = run(&m, &p, 60.0, 0.1, Pin { radius: 0.0, lateral_speed: 0.3 }, &settings(fid, 0.4));
-        let b = run(&mq, &q, -60.0, -0.1, Pin { radius: 0.0, lateral_speed: -0.3 }, &settings(fid, 0.4));
-        assert!((a.rotation + b.rotation).abs() < 1e-7, "{fid}: {} vs {}", a.rotation, b.rotation);
+        let a = run(
+            &m,
+            &p,
+            60.0,
+            0.1,
+            Pin {
+                radius: 0.0,
+                lateral_speed: 0.3,
+            },
+            &settings(fid, 0.4),
+        );
+        let b = run(
+            &mq,
+            &q,
+            -60.0,
+            -0.1,
+            Pin {
+                radius: 0.0,
+                lateral_speed: -0.3,
+            },
+            &settings(fid, 0.4),
+        );
+        assert!(
+            (a.rotation + b.rotation).abs() < 1e-7,
+            "{fid}: {} vs {}",
+            a.rotation,
+            b.rotation
+        );
     }
 }
 
@@ -312,7 +381,11 @@ fn tripod_supports() {
             for d in [-0.4, 0.1, 0.5] {
                 let o = run(&m, &p, th, d, Pin::point(), &settings(Fidelity::Exact, 0.5));
                 check(&o, "tripod");
-                assert!(o.status.is_ok(), "seed {seed} θ0={th} d={d}: {:?}", o.status);
+                assert!(
+                    o.status.is_ok(),
+                    "seed {seed} θ0={th} d={d}: {:?}",
+                    o.status
+                );
             }
         }
     }

@@ -46,7 +46,7 @@ fn positive(spec: &str, what: &str, s: &str) -> Result<f64, PartSpecError> {
     Ok(v)
 }
 
-/// Vertex list of a named part (before validation), or `None` when the name is unknown.
+/// Vertex list of a part specification (before validation); an error for an unknown name or bad parameters.
 pub fn named_vertices(spec: &str) -> Result<Vec<Vec2>, PartSpecError> {
     let s = spec.trim();
     let lower = s.to_ascii_lowercase();
@@ -114,8 +114,8 @@ pub fn named_vertices(spec: &str) -> Result<Vec<Vec2>, PartSpecError> {
             .map(|k| Vec2::from_angle(start + step * k as f64))
             .collect());
     }
-    if let Some(rest) = s.strip_prefix("vertices:") {
-        return parse_vertex_list(rest);
+    if lower.starts_with("vertices:") {
+        return parse_vertex_list(&s["vertices:".len()..]);
     }
     Err(PartSpecError::Unknown(s.into()))
 }

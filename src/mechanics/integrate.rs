@@ -942,6 +942,14 @@ pub fn push(
             out.travel_to_contact = s_touch * k;
         }
         out.contacts += 1;
+        if let Feature::Vertex { index } = hit.feature {
+            if !ctx.poly.vertex_is_convex(index) {
+                // The pin strikes a reflex corner: it touches both edges of the notch at once.
+                out.status = ContactStatus::MultiContact { s: s_touch * k };
+                s = s_touch;
+                break;
+            }
+        }
         let (feat, y) = initial_state(&ctx, &cur, hit.feature, hit.normal);
         // The pose at touch: the part has not moved; the state reconstructs it exactly.
         let (end, s_end, pose_end) = integrate_contact(

@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 use pinfeed::geometry::{part_from_spec, Polygon, Pose, Vec2};
-use pinfeed::mechanics::{push, ContactOutcome, ContactSettings, Fidelity, PartModel, Pin, Support};
+use pinfeed::mechanics::{
+    push, ContactOutcome, ContactSettings, Fidelity, PartModel, Pin, Support,
+};
 
 pub const FIDELITIES: [Fidelity; 2] = [Fidelity::Tip, Fidelity::Ellipsoid];
 
@@ -45,7 +47,10 @@ pub fn assert_finite(o: &ContactOutcome, what: &str) {
         "{what}: non-finite pose {p:?}"
     );
     assert!(o.rotation.is_finite(), "{what}: rotation");
-    assert!(o.contact_length.is_finite() && o.contact_length >= 0.0, "{what}: length");
+    assert!(
+        o.contact_length.is_finite() && o.contact_length >= 0.0,
+        "{what}: length"
+    );
     for s in &o.segments {
         assert!(s.s_begin.is_finite() && s.s_end.is_finite() && s.s_end >= s.s_begin - 1e-12);
     }
