@@ -946,7 +946,6 @@ pub fn push(
             if !ctx.poly.vertex_is_convex(index) {
                 // The pin strikes a reflex corner: it touches both edges of the notch at once.
                 out.status = ContactStatus::MultiContact { s: s_touch * k };
-                s = s_touch;
                 break;
             }
         }
