@@ -16,3 +16,4 @@ pub mod geometry;
 pub mod mechanics;
 pub mod random;
 pub mod report;
+pub mod study;

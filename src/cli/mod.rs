@@ -1,6 +1,7 @@
 //! The command-line interface: argument definitions and one module per sub-command. `main.rs` only
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
+pub mod bench;
 pub mod contact;
 pub mod part;
 
@@ -20,6 +21,8 @@ pub enum Command {
     Part(part::PartArgs),
     /// One pin pass over one part (or a batch from CSV): final pose, rotation, contact segments.
     Contact(contact::ContactArgs),
+    /// Measurements that write the reports in results/ (e.g. `bench contact`).
+    Bench(bench::BenchArgs),
 }
 
 /// Run a parsed command line.
@@ -27,5 +30,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
+        Command::Bench(a) => bench::run(&a),
     }
 }
