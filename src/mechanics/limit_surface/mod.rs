@@ -10,9 +10,12 @@
 //! * [`uniform`] — uniform pressure over a simple polygon (convex or concave): closed form per edge
 //!   near the part, Gauss quadrature of the twist-form integrand far from it (and at pure
 //!   translation).
+//! * [`points`] — a finite set of weighted support points (e.g. a tripod): exact sums.
 
+pub mod points;
 pub mod uniform;
 
+pub use points::PointSupport;
 pub use uniform::UniformSurface;
 
 /// Dissipation D(ξ) and its derivatives for normalised load (total load 1, μs = 1).
