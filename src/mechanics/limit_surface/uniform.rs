@@ -73,8 +73,8 @@
 //! than 20–40 a.
 //!
 //! Cost (release build, shared 2-core machine, value + gradient / with Hessian): triangle near
-//! field 85–110 ns / 115–135 ns, far field (64 nodes) 240–320 ns / 400–480 ns; far-field cost grows
-//! with the node count (L-shape: 256 nodes ≈ 1 µs; 12-gon: 640 nodes ≈ 2.6 µs). A compressed
+//! field 85–110 ns / 100–135 ns, far field (64 nodes) 250–320 ns / 385–480 ns; far-field cost
+//! grows with the node count (L-shape: 256 nodes ≈ 0.9–1.1 µs; 12-gon: 640 nodes ≈ 2.3–2.6 µs). A compressed
 //! (Tchakaloff) rule would cut that for many-sided parts. No heap allocation in any evaluation.
 
 use super::Dissipation;
