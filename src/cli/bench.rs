@@ -14,6 +14,18 @@ pub struct BenchArgs {
 
 #[derive(Debug, Subcommand)]
 pub enum BenchWhat {
+    /// What accuracy costs in time: every fidelity tier against a tight exact reference; writes
+    /// results/accuracy-vs-time.{md,csv,svg}.
+    Accuracy {
+        /// Random contacts (split evenly over tripoly1, tripoly2, square, lshape).
+        #[arg(long, default_value_t = 1200)]
+        contacts: usize,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Output path without extension.
+        #[arg(long, default_value = "results/accuracy-vs-time")]
+        out: PathBuf,
+    },
     /// Time, evaluations and self-accuracy per contact for each fidelity on the reference parts;
     /// writes results/contact-model.md.
     Contact {
@@ -33,6 +45,41 @@ pub enum BenchWhat {
 
 pub fn run(args: &BenchArgs) -> Result<()> {
     match &args.what {
+        BenchWhat::Accuracy {
+            contacts,
+            seed,
+            out,
+        } => {
+            if *contacts < 4 || *contacts > 1_000_000 {
+                anyhow::bail!("--contacts must be between 4 and 1000000, got {contacts}");
+            }
+            let parts = ["tripoly1", "tripoly2", "square", "lshape"];
+            let st = crate::study::accuracy::run(&parts, *contacts, *seed)?;
+            let cmd = format!(
+                "cargo run --release -- bench accuracy --contacts {contacts} --seed {seed} --out {}",
+                out.display()
+            );
+            if let Some(dir) = out.parent() {
+                std::fs::create_dir_all(dir).ok();
+            }
+            let md = crate::study::accuracy::report_markdown(&st, &cmd);
+            let p_md = out.with_extension("md");
+            let p_csv = out.with_extension("csv");
+            let p_svg = out.with_extension("svg");
+            std::fs::write(&p_md, md).with_context(|| format!("writing {}", p_md.display()))?;
+            std::fs::write(&p_csv, crate::study::accuracy::csv(&st))
+                .with_context(|| format!("writing {}", p_csv.display()))?;
+            crate::report::plot_accuracy::plot_accuracy(&st, &p_svg)
+                .with_context(|| format!("writing {}", p_svg.display()))?;
+            print!("{}", crate::study::accuracy::markdown_table(&st));
+            eprintln!(
+                "wrote {}, {}, {}",
+                p_md.display(),
+                p_csv.display(),
+                p_svg.display()
+            );
+            Ok(())
+        }
         BenchWhat::Contact {
             contacts,
             tol,

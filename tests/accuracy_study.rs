@@ -1,0 +1,40 @@
+//! The accuracy-vs-time study orders the tiers the way the physics says it must.
+
+use pinfeed::study::accuracy;
+
+/// Exact integration error shrinks with the tolerance and stays far below 0.01° at the default; the
+/// COR-tip baseline is worse than the ellipsoid, which is worse than exact; the map tier is fastest.
+#[test]
+fn tiers_are_ordered() {
+    let st = accuracy::run(&["tripoly2"], 60, 3).unwrap();
+    let row = |p: &str| st.rows.iter().find(|r| r.tier.starts_with(p)).unwrap();
+    let (tip, ell) = (row("tip"), row("ellipsoid"));
+    let (loose, default, tight) = (
+        row("exact tol=1e-3"),
+        row("exact tol=1e-6"),
+        row("exact tol=1e-8"),
+    );
+    assert!(default.error_max_deg < 0.01, "{}", default.error_max_deg);
+    assert!(tight.error_mean_deg < default.error_mean_deg);
+    assert!(default.error_mean_deg < loose.error_mean_deg);
+    assert!(ell.error_mean_deg < tip.error_mean_deg);
+    assert!(loose.error_mean_deg < ell.error_mean_deg);
+    assert!(
+        tip.different_band_share > 0.2,
+        "the tip model under-rotates badly"
+    );
+    let map = row("map");
+    assert!(map.median_us < default.median_us);
+    assert!(st.rows.iter().all(|r| r.contacts == st.contacts));
+}
+
+/// The ellipsoid's near-central gap matches the closed form c²/((1/A)∫x∥² dA) to 1%.
+#[test]
+fn central_gap_matches_closed_form() {
+    for (name, th, measured, formula) in accuracy::central_push_gap() {
+        assert!(
+            (measured - formula).abs() < 0.01 * formula,
+            "{name} {th}: {measured} vs {formula}"
+        );
+    }
+}
