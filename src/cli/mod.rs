@@ -2,6 +2,7 @@
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
 pub mod contact;
+pub mod map;
 pub mod part;
 
 use clap::{Parser, Subcommand};
@@ -20,6 +21,8 @@ pub enum Command {
     Part(part::PartArgs),
     /// One pin pass over one part (or a batch from CSV): final pose, rotation, contact segments.
     Contact(contact::ContactArgs),
+    /// Configuration maps θ0 → θf for several d: bands, no-contact runs, figures, report files.
+    Map(map::MapArgs),
 }
 
 /// Run a parsed command line.
@@ -27,5 +30,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
+        Command::Map(a) => map::run(&a),
     }
 }
