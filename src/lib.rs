@@ -18,3 +18,4 @@ pub mod maps;
 pub mod mechanics;
 pub mod random;
 pub mod report;
+pub mod study;

@@ -1,6 +1,7 @@
 //! The command-line interface: argument definitions and one module per sub-command. `main.rs` only
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
+pub mod bench;
 pub mod contact;
 pub mod map;
 pub mod part;
@@ -23,6 +24,8 @@ pub enum Command {
     Contact(contact::ContactArgs),
     /// Configuration maps θ0 → θf for several d: bands, no-contact runs, figures, report files.
     Map(map::MapArgs),
+    /// Measurements that write the reports in results/ (e.g. `bench contact`).
+    Bench(bench::BenchArgs),
 }
 
 /// Run a parsed command line.
@@ -31,5 +34,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
         Command::Map(a) => map::run(&a),
+        Command::Bench(a) => bench::run(&a),
     }
 }
