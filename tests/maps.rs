@@ -6,21 +6,12 @@
 use pinfeed::geometry::{part_from_spec, wrap_deg, Polygon};
 use pinfeed::maps::runs::{circular_runs, run_indices};
 use pinfeed::maps::{compute_maps, ConfigurationMap, MapSample, MapSettings};
-use pinfeed::mechanics::{ContactSettings, ContactStatus, Fidelity, PartModel, Pin, Support};
+use pinfeed::mechanics::{ContactStatus, Fidelity, PartModel, Support};
 use serde_json::Value;
 use std::process::{Command, Output};
 
 fn settings(fidelity: Fidelity, step: f64) -> MapSettings {
-    MapSettings {
-        theta_step_deg: step,
-        threshold_deg: 5.0,
-        contact: ContactSettings {
-            fidelity,
-            mu_c: 0.5,
-            ..ContactSettings::default()
-        },
-        pin: Pin::point(),
-    }
+    MapSettings::point_pin(fidelity, 0.5, step, 5.0)
 }
 
 fn maps_of(part: &str, ds: &[f64], s: &MapSettings) -> Vec<ConfigurationMap> {
@@ -29,11 +20,11 @@ fn maps_of(part: &str, ds: &[f64], s: &MapSettings) -> Vec<ConfigurationMap> {
     compute_maps(&poly, &model, ds, s).unwrap()
 }
 
-/// A few maps of both thesis parts, at both cheap fidelities.
+/// A few maps of both thesis parts, at every fidelity.
 fn sample_maps() -> Vec<(String, ConfigurationMap)> {
     let mut out = Vec::new();
     for part in ["tripoly1", "tripoly2"] {
-        for fid in [Fidelity::Ellipsoid, Fidelity::Tip] {
+        for fid in [Fidelity::Exact, Fidelity::Ellipsoid, Fidelity::Tip] {
             for m in maps_of(part, &[-0.9, -0.3, 0.1, 0.7], &settings(fid, 2.0)) {
                 out.push((format!("{part} {fid} d={}", m.d), m));
             }
@@ -186,7 +177,7 @@ fn a_real_band_straddling_zero_is_one_band() {
         })
         .collect();
     let spec = format!("vertices:{}", turned.join(" "));
-    let s = settings(Fidelity::Ellipsoid, 1.0);
+    let s = settings(Fidelity::Exact, 1.0);
     let plain = &maps_of("tripoly1", &[-0.3], &s)[0];
     let rotated = &maps_of(&spec, &[-0.3], &s)[0];
     assert_eq!(plain.bands.len(), rotated.bands.len());
@@ -254,7 +245,7 @@ fn adjusted_bands_are_mean_plus_minus_sd() {
 fn the_same_map_at_one_and_two_threads_is_identical() {
     let poly: Polygon = part_from_spec("tripoly2").unwrap();
     let model = PartModel::new(&poly, &Support::Uniform).unwrap();
-    let s = settings(Fidelity::Ellipsoid, 3.0);
+    let s = settings(Fidelity::Exact, 3.0);
     let ds = [-0.7, -0.2, 0.4];
     let run = |threads: usize| -> Vec<ConfigurationMap> {
         rayon::ThreadPoolBuilder::new()
@@ -277,7 +268,7 @@ fn tripoly2_at_d_minus_0_3_misses_the_pin_at_theta0_zero() {
     // At θ0 = 0 tripoly2's lowest point is y = −1/3 while the pin runs at y = −0.3·a ≈ −0.412.
     let poly = part_from_spec("tripoly2").unwrap();
     assert!(-0.3 * poly.radius() < -1.0 / 3.0);
-    for fid in [Fidelity::Ellipsoid, Fidelity::Tip] {
+    for fid in [Fidelity::Exact, Fidelity::Ellipsoid, Fidelity::Tip] {
         let m = &maps_of("tripoly2", &[-0.3], &settings(fid, 1.0))[0];
         assert!(!m.samples[0].contact);
         let inside = |r: &[f64; 2]| {
@@ -294,6 +285,29 @@ fn tripoly2_at_d_minus_0_3_misses_the_pin_at_theta0_zero() {
         );
         assert!(m.bands.iter().all(|b| b.samples > 0));
     }
+}
+
+#[test]
+fn tripoly1_maps_at_plus_and_minus_d_are_mirror_images() {
+    // tripoly1 is symmetric about its own y axis, so mirroring the world in the belt's axis maps
+    // (θ0, d) to (180° − θ0, −d) and θf to 180° − θf, with the final centroid y negated.
+    let ms = maps_of("tripoly1", &[-0.4, 0.4], &settings(Fidelity::Exact, 2.0));
+    let (minus, plus) = (&ms[0], &ms[1]);
+    let n = plus.samples.len();
+    for (k, s) in plus.samples.iter().enumerate() {
+        let mirror = &minus.samples[(n + n / 2 - k) % n];
+        assert_eq!(wrap_deg(180.0 - s.theta0_deg), mirror.theta0_deg);
+        assert_eq!(s.contact, mirror.contact, "θ0 = {}", s.theta0_deg);
+        let diff = wrap_deg(180.0 - s.theta_final_deg - mirror.theta_final_deg + 180.0) - 180.0;
+        assert!(diff.abs() < 1e-6, "θ0 = {}: {diff}", s.theta0_deg);
+        assert!((s.com_final_y + mirror.com_final_y).abs() < 1e-6);
+    }
+    let mut w0: Vec<f64> = plus.bands.iter().map(|b| b.width_deg).collect();
+    let mut w1: Vec<f64> = minus.bands.iter().map(|b| b.width_deg).collect();
+    w0.sort_by(f64::total_cmp);
+    w1.sort_by(f64::total_cmp);
+    assert_eq!(w0.len(), w1.len());
+    assert!(w0.iter().zip(&w1).all(|(a, b)| (a - b).abs() < 1e-6));
 }
 
 // ---- the command line ----

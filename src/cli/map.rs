@@ -277,7 +277,8 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     let json_path = out_dir.join("map.json");
-    std::fs::write(&json_path, serde_json::to_string_pretty(report)? + "\n")
+    // Compact: the document holds every sample (README.md is the readable summary).
+    std::fs::write(&json_path, serde_json::to_string(report)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     let csv_path = out_dir.join("samples.csv");
     let f = std::fs::File::create(&csv_path)

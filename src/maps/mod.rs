@@ -29,7 +29,7 @@ pub use sample::{sample_maps, theta_grid};
 pub use start::pass_start;
 
 use crate::geometry::Polygon;
-use crate::mechanics::{ContactSettings, ContactStatus, PartModel, Pin};
+use crate::mechanics::{ContactSettings, ContactStatus, Fidelity, PartModel, Pin};
 use serde::{Serialize, Serializer};
 
 /// Bad input to a map computation.
@@ -58,6 +58,27 @@ pub struct MapSettings {
     pub threshold_deg: f64,
     pub contact: ContactSettings,
     pub pin: Pin,
+}
+
+impl MapSettings {
+    /// A point pin with contact friction `mu_c` and otherwise default contact settings.
+    pub fn point_pin(
+        fidelity: Fidelity,
+        mu_c: f64,
+        theta_step_deg: f64,
+        threshold_deg: f64,
+    ) -> Self {
+        MapSettings {
+            theta_step_deg,
+            threshold_deg,
+            contact: ContactSettings {
+                fidelity,
+                mu_c,
+                ..ContactSettings::default()
+            },
+            pin: Pin::point(),
+        }
+    }
 }
 
 /// One sample of a map: a pin pass at one initial orientation.

@@ -275,7 +275,7 @@ pub fn plot_band_intervals(
     ch.draw_series(means)?
         .label("band mean")
         .legend(|(x, y)| Circle::new((x + 8, y), 3, RED.filled()));
-    draw_legend(&mut ch, SeriesLabelPosition::UpperRight)?;
+    draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
     root.present()?;
     Ok(())
 }
