@@ -432,6 +432,7 @@ fn cli_refuses_bad_input() {
     for (extra, words) in [
         (vec!["--d=nan"], "d"),
         (vec!["--d=1.5"], "out of range"),
+        (vec!["--d=0.3,-0.2,0.3"], "twice"),
         (vec!["--d=0.3", "--theta-step", "0"], "theta step"),
         (vec!["--d=0.3", "--theta-step", "-1"], "theta step"),
         (vec!["--d=0.3", "--theta-step", "7"], "does not divide"),

@@ -47,6 +47,8 @@ pub enum MapError {
     ContactParameter { d: f64, limit: f64 },
     #[error("no contact parameter d given")]
     NoContactParameter,
+    #[error("contact parameter d = {0} is given twice")]
+    RepeatedContactParameter(f64),
 }
 
 /// What a map is computed with.
@@ -189,8 +191,11 @@ pub fn compute_maps(
         return Err(MapError::NoContactParameter);
     }
     check_threshold(settings.threshold_deg)?;
-    for &d in ds {
+    for (i, &d) in ds.iter().enumerate() {
         sample::check_contact_parameter(poly, d, settings.pin.radius)?;
+        if ds[..i].contains(&d) {
+            return Err(MapError::RepeatedContactParameter(d));
+        }
     }
     let grid = theta_grid(settings.theta_step_deg)?;
     let rows = sample_maps(poly, model, ds, &grid, &settings.contact, &settings.pin);
