@@ -59,11 +59,12 @@ fn adjusted_arc(b: &Band) -> Vec<(f64, f64)> {
 
 type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
-/// A white chart with a title, `x` across and orientations 0°…360° up.
+/// A white chart with a title, `x` across and orientations 0°…`y_top` up.
 fn degree_chart<'a, 'b>(
     root: &'a DrawingArea<SVGBackend<'b>, Shift>,
     title: &str,
     x: std::ops::Range<f64>,
+    y_top: f64,
 ) -> anyhow::Result<Chart<'a, 'b>> {
     root.fill(&WHITE)?;
     Ok(ChartBuilder::on(root)
@@ -71,7 +72,7 @@ fn degree_chart<'a, 'b>(
         .margin(14)
         .x_label_area_size(40)
         .y_label_area_size(50)
-        .build_cartesian_2d(x, 0.0..360.0)?)
+        .build_cartesian_2d(x, 0.0..y_top)?)
 }
 
 fn draw_legend<'a, 'b: 'a>(
@@ -95,7 +96,7 @@ pub fn plot_map(
     path: &Path,
 ) -> anyhow::Result<()> {
     let root = SVGBackend::new(path, (760, 680)).into_drawing_area();
-    let mut ch = degree_chart(&root, title, 0.0..360.0)?;
+    let mut ch = degree_chart(&root, title, 0.0..360.0, 360.0)?;
     ch.configure_mesh()
         .x_labels(13)
         .y_labels(13)
@@ -213,10 +214,17 @@ pub fn plot_band_intervals(
     }
     let pad = ((dmax - dmin) * 0.06).max(0.1);
     let root = SVGBackend::new(path, (900, 620)).into_drawing_area();
-    let mut ch = degree_chart(&root, title, (dmin - pad)..(dmax + pad))?;
+    // Room above 360° for the legend, so it never hides an interval.
+    let mut ch = degree_chart(&root, title, (dmin - pad)..(dmax + pad), 420.0)?;
     ch.configure_mesh()
-        .y_labels(13)
-        .y_label_formatter(&|v| format!("{v:.0}"))
+        .y_labels(15)
+        .y_label_formatter(&|v| {
+            if *v <= 360.0 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        })
         .light_line_style(WHITE)
         .x_desc("contact parameter d")
         .y_desc(if adjusted {
@@ -227,6 +235,11 @@ pub fn plot_band_intervals(
         .draw()?;
     let blue = PALETTE[0];
     let grey = RGBColor(185, 185, 185);
+    // The top of the circle: intervals above it continue from 0°.
+    ch.draw_series(LineSeries::new(
+        vec![(dmin - pad, 360.0), (dmax + pad, 360.0)],
+        BLACK.mix(0.6),
+    ))?;
     for m in maps {
         for b in &m.bands {
             for (y0, y1) in raw_arc(b) {
