@@ -111,6 +111,9 @@ struct Ctx<'a, 'r> {
     evals: u64,
     warm: Warm,
     recorder: Option<&'r mut dyn Recorder>,
+    /// Per-event tolerance band: event i fires when its function drops below −band[i]. Zero except
+    /// for a mode margin that just bounced (see the ping-pong rule in `integrate_contact`).
+    band: [f64; N_EVENTS],
 }
 
 enum End {
@@ -119,6 +122,8 @@ enum End {
 }
 
 const N_EVENTS: usize = 5;
+/// Tolerance band of a mode margin after a ping-pong (a sine: about 0.006°).
+const BOUNCE_BAND: f64 = 1e-4;
 
 impl Ctx<'_, '_> {
     fn pin_at(&self, s: f64) -> Vec2 {
@@ -215,7 +220,14 @@ impl Ctx<'_, '_> {
                 }
             }
         };
-        [push_margin(&g), inst.margins[0], inst.margins[1], e3, e4]
+        let b = &self.band;
+        [
+            push_margin(&g) + b[0],
+            inst.margins[0] + b[1],
+            inst.margins[1] + b[2],
+            e3 + b[3],
+            e4 + b[4],
+        ]
     }
 
     fn record(&mut self, s: f64, feat: Feat, y: [f64; 2], inst: &Instant) {
@@ -287,6 +299,8 @@ struct StepResult {
     f1: [f64; 2],
     inst1: Instant,
     err: f64,
+    /// The seven stage derivatives (for the dense output).
+    k: [[f64; 2]; 7],
 }
 
 /// One Dormand–Prince step of size h from (y0, f0).
@@ -337,25 +351,40 @@ fn dp_step(
         f1: k[6],
         inst1: inst_last.expect("six stages ran"),
         err,
+        k,
     })
 }
 
-fn hermite(y0: [f64; 2], f0: [f64; 2], y1: [f64; 2], f1: [f64; 2], h: f64, t: f64) -> [f64; 2] {
-    let t2 = t * t;
-    let t3 = t2 * t;
-    let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
-    let h10 = t3 - 2.0 * t2 + t;
-    let h01 = -2.0 * t3 + 3.0 * t2;
-    let h11 = t3 - t2;
+// Dormand–Prince continuous extension (Hairer, Nørsett & Wanner, dopri5 `contd5`): 4th order.
+const D: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+/// State at fraction `t` ∈ [0, 1] of a step of size `h` from `y0` that ended at `y1` with stages `k`.
+fn dense(y0: [f64; 2], y1: [f64; 2], k: &[[f64; 2]; 7], h: f64, t: f64) -> [f64; 2] {
     let mut out = [0.0; 2];
     for c in 0..2 {
-        out[c] = h00 * y0[c] + h10 * h * f0[c] + h01 * y1[c] + h11 * h * f1[c];
+        let ydiff = y1[c] - y0[c];
+        let bspl = h * k[0][c] - ydiff;
+        let r4 = ydiff - h * k[6][c] - bspl;
+        let mut r5 = 0.0;
+        for (j, kj) in k.iter().enumerate() {
+            r5 += D[j] * kj[c];
+        }
+        r5 *= h;
+        out[c] = y0[c] + t * (ydiff + (1.0 - t) * (bspl + t * (r4 + (1.0 - t) * r5)));
     }
     out
 }
 
 /// Illinois root of g on [0, 1] with g(0) = ga > 0 ≥ g(1) = gb.
-fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64) -> f64 {
+fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64, tol: f64) -> f64 {
     let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, ga, gb);
     let mut side = 0;
     let mut c = 1.0;
@@ -365,7 +394,7 @@ fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64) -> f64 {
             c = 0.5 * (a + b);
         }
         let fc = g(c);
-        if fc.abs() <= 1e-15 || b - a <= 1e-14 {
+        if fc.abs() <= tol || b - a <= 1e-12 {
             break;
         }
         if fc < 0.0 {
@@ -515,12 +544,26 @@ fn second_contact(ctx: &Ctx, feat: Feat, pose: &Pose, s: f64) -> bool {
     false
 }
 
-struct Segments {
+/// Book-keeping of one pass: segments, events and steps so far.
+struct Tally {
     list: Vec<Segment>,
     open: Option<(Feat, Mode, f64, f64)>,
+    events: u32,
+    steps: u32,
 }
 
-impl Segments {
+impl Tally {
+    /// Reopen the segment just closed if it had this feature and mode (no zero-length split).
+    /// Closed segments are in the caller's units, open ones in normalised units: `scale` converts.
+    fn reopen(&mut self, feat: Feat, mode: Mode, s: f64, theta: f64, scale: f64) {
+        match self.list.last() {
+            Some(last) if last.feature == feat.public() && last.mode == mode => {
+                let last = self.list.pop().expect("checked above");
+                self.open = Some((feat, mode, last.s_begin / scale, last.theta_begin));
+            }
+            _ => self.open(feat, mode, s, theta),
+        }
+    }
     fn open(&mut self, feat: Feat, mode: Mode, s: f64, theta: f64) {
         self.open = Some((feat, mode, s, theta));
     }
@@ -545,9 +588,7 @@ fn integrate_contact(
     s_start: f64,
     feat0: Feat,
     y_start: [f64; 2],
-    segs: &mut Segments,
-    events_used: &mut u32,
-    steps: &mut u32,
+    segs: &mut Tally,
 ) -> (End, f64, Pose) {
     let mut s = s_start;
     let (mut feat, mut y, mut inst) = match settle(ctx, s, feat0, y_start) {
@@ -566,9 +607,17 @@ fn integrate_contact(
     ctx.record(s, feat, y, &inst);
     let mut f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
     let mut ev0 = ctx.events(feat, y, &inst);
-    let h_max = 0.25;
+    let h_max = 2.0;
     let h_min = 1e-13;
-    let mut h = (0.2 * ctx.tol.powf(0.2)).clamp(1e-6, h_max);
+    // First step: a tenth of a, shrunk by the error control if the motion is fast.
+    let mut h = 0.1;
+    // Events are landed to |g| ≤ land_tol; a fresh segment treats |g| ≤ slack as "at the boundary"
+    // (the new mode's margin starts at zero up to the landing error), and only g < −slack at a
+    // segment start means the state is already past an event.
+    let land_tol = 1e-2 * ctx.tol;
+    let slack = 100.0 * land_tol;
+    let mut last_switch: Option<(f64, Mode)> = None;
+    ctx.band = [0.0; N_EVENTS];
     loop {
         if ctx.evals > settings.max_evaluations {
             let p = ctx.pose(s, feat, y);
@@ -591,7 +640,7 @@ fn integrate_contact(
             );
         }
         // An event function already negative at the start of a step: the state is at an event.
-        let pending = (0..N_EVENTS).find(|&i| ev0[i] < -1e-9);
+        let pending = (0..N_EVENTS).find(|&i| ev0[i] < -slack);
         let (event, s_ev, y_ev, inst_ev) = if let Some(i) = pending {
             (Some(i), s, y, inst)
         } else {
@@ -627,16 +676,22 @@ fn integrate_contact(
             }
             let ev1 = ctx.events(feat, step.y1, &step.inst1);
             let crossed: Vec<usize> = (0..N_EVENTS)
-                .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -1e-9)
+                .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -slack)
                 .collect();
             let factor = (0.9 * step.err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
             if crossed.is_empty() {
+                // A bounced margin that has recovered gets its ordinary zero threshold back.
+                for (b, e) in ctx.band.iter_mut().zip(ev1) {
+                    if *b > 0.0 && e - *b > slack {
+                        *b = 0.0;
+                    }
+                }
                 s += h;
                 y = step.y1;
                 inst = step.inst1;
                 f0 = step.f1;
                 ev0 = ev1;
-                *steps += 1;
+                segs.steps += 1;
                 ctx.record(s, feat, y, &inst);
                 let pose = ctx.pose(s, feat, y);
                 if second_contact(ctx, feat, &pose, s) {
@@ -650,9 +705,11 @@ fn integrate_contact(
                 continue;
             }
             // Locate the earliest crossing on the interpolant.
-            let (y0c, f0c, y1c, f1c, hc) = (y, f0, step.y1, step.f1, h);
+            let (y0c, y1c, kc, hc) = (y, step.y1, step.k, h);
             let mut best = (2.0, 0usize);
             let warm_saved = ctx.warm;
+            let root_tol = 1e-3 * ctx.tol;
+            let band = ctx.band;
             for &i in &crossed {
                 let g0 = ev0[i].max(0.0);
                 let t = if g0 == 0.0 {
@@ -660,7 +717,7 @@ fn integrate_contact(
                 } else {
                     illinois(
                         |t| {
-                            let yt = hermite(y0c, f0c, y1c, f1c, hc, t);
+                            let yt = dense(y0c, y1c, &kc, hc, t);
                             if i == 0 || i >= 3 {
                                 let dummy = inst;
                                 ctx.events(feat, yt, &dummy)[i]
@@ -675,13 +732,14 @@ fn integrate_contact(
                                     &mut ctx.warm,
                                     &mut ctx.evals,
                                 ) {
-                                    Ok(it) => it.margins[i - 1],
+                                    Ok(it) => it.margins[i - 1] + band[i],
                                     Err(_) => -1.0,
                                 }
                             }
                         },
                         g0,
                         ev1[i],
+                        root_tol,
                     )
                 };
                 if t < best.0 {
@@ -729,8 +787,10 @@ fn integrate_contact(
                     }
                     side = 1;
                 }
-                if gt.abs() <= 1e-12 || (b - a) * h <= 1e-13 {
-                    if gt < 0.0 && gt.abs() <= 1e-12 {
+                // Landing tolerance: far below the integration tolerance, far above rounding.
+                let g_tol = land_tol;
+                if gt.abs() <= g_tol || (b - a) * h <= 1e-13 {
+                    if gt < 0.0 && gt.abs() <= g_tol {
                         best_step = real(t, ctx);
                         best_t = t;
                     }
@@ -743,22 +803,23 @@ fn integrate_contact(
             }
             match best_step {
                 Some(r) => {
-                    *steps += 1;
+                    segs.steps += 1;
                     (Some(i), s + best_t * h, r.y1, r.inst1)
                 }
                 None => (Some(i), s, y, inst),
             }
         };
         let i = event.expect("an event was found");
+
         if std::env::var("PINFEED_DEBUG").is_ok() {
             eprintln!("event {i} at s={s_ev} mode={mode:?} feat={feat:?} y={y_ev:?} margins={:?} ev0={ev0:?}", inst_ev.margins);
         }
-        *events_used += 1;
-        if *events_used > settings.max_events {
+        segs.events += 1;
+        if segs.events > settings.max_events {
             let p = ctx.pose(s_ev, feat, y_ev);
             return (
                 End::Stop(ContactStatus::EventLimit {
-                    events: *events_used,
+                    events: segs.events,
                 }),
                 s_ev,
                 p,
@@ -778,12 +839,24 @@ fn integrate_contact(
                     (Mode::Stick, _) => Mode::SlideRight,
                     _ => Mode::Stick,
                 };
+                // Ping-pong: switching straight back to the mode we left at this very point means the
+                // state sits on the stick/slide boundary, where both modes give the same motion and
+                // their margins differ only by solver rounding. Stay, and let this margin run down to
+                // −BOUNCE_BAND before it counts (a real, sustained violation still switches).
+                if let Some((s_prev, from)) = last_switch {
+                    if (s - s_prev).abs() <= 1e-12 && from == new_mode && ctx.band[i] == 0.0 {
+                        ctx.band[i] = BOUNCE_BAND;
+                        segs.reopen(feat, mode, s, y[0], ctx.scale);
+                        ev0 = ctx.events(feat, y, &inst_ev);
+                        inst = inst_ev;
+                        f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
+                        continue;
+                    }
+                }
+                last_switch = Some((s, mode));
                 if let (Feat::Vertex(k), false) = (feat, ctx.rho > 0.0) {
                     // Hooked point pin lets go: it sweeps onto the edge it now slides towards.
-                    match sweep(ctx, k, new_mode == Mode::SlideLeft, y[0]) {
-                        Some((f, yy)) => Some((f, yy, None)),
-                        None => None,
-                    }
+                    sweep(ctx, k, new_mode == Mode::SlideLeft, y[0]).map(|(f, yy)| (f, yy, None))
                 } else {
                     Some((feat, y, Some(new_mode)))
                 }
@@ -802,10 +875,7 @@ fn integrate_contact(
                     let n = ctx.poly.inward_normal(k);
                     Some((Feat::Vertex(v), [y[0], n.angle()], None))
                 } else {
-                    match sweep(ctx, v, i == 3, y[0]) {
-                        Some((f, yy)) => Some((f, yy, None)),
-                        None => None,
-                    }
+                    sweep(ctx, v, i == 3, y[0]).map(|(f, yy)| (f, yy, None))
                 }
             }
             (3, Feat::Vertex(k)) => {
@@ -862,7 +932,7 @@ fn integrate_contact(
         ev0 = ctx.events(feat, y, &inst);
         // Freshly started segments begin at their boundary: do not re-trigger on rounding.
         for e in ev0.iter_mut() {
-            if e.abs() <= 1e-8 {
+            if e.abs() <= slack {
                 *e = 0.0;
             }
         }
@@ -886,9 +956,7 @@ pub fn push(
         model,
         poly: model.polygon(),
         fid: settings.fidelity,
-        fr: Friction {
-            mu_c: settings.mu_c,
-        },
+        fr: Friction::new(settings.mu_c),
         rho: pin.radius / k,
         vdir: Vec2::new(-1.0, pin.lateral_speed),
         start: pin_start / k,
@@ -897,6 +965,7 @@ pub fn push(
         evals: 0,
         warm: Warm::default(),
         recorder,
+        band: [0.0; N_EVENTS],
     };
     let mut out = ContactOutcome {
         contact: false,
@@ -922,12 +991,12 @@ pub fn push(
     let dir = ctx.vdir / dir_len;
     let mut s = 0.0;
     let mut cur = pose_n;
-    let mut segs = Segments {
+    let mut segs = Tally {
         list: Vec::new(),
         open: None,
+        events: 0,
+        steps: 0,
     };
-    let mut events_used = 0u32;
-    let mut steps = 0u32;
     let mut min_travel = 0.0;
     for _pass in 0..16 {
         let hit = first_contact(ctx.poly, &cur, ctx.pin_at(s), dir, ctx.rho, min_travel);
@@ -951,16 +1020,8 @@ pub fn push(
         }
         let (feat, y) = initial_state(&ctx, &cur, hit.feature, hit.normal);
         // The pose at touch: the part has not moved; the state reconstructs it exactly.
-        let (end, s_end, pose_end) = integrate_contact(
-            &mut ctx,
-            settings,
-            s_touch,
-            feat,
-            y,
-            &mut segs,
-            &mut events_used,
-            &mut steps,
-        );
+        let (end, s_end, pose_end) =
+            integrate_contact(&mut ctx, settings, s_touch, feat, y, &mut segs);
         segs.close(s_end, pose_end.theta, k);
         out.contact_length += (s_end - s_touch) * k;
         s = s_end;
@@ -980,7 +1041,7 @@ pub fn push(
     out.pose_final = Pose::new(cur.x * k, cur.y * k, cur.theta);
     out.rotation = cur.theta - pose.theta;
     out.evaluations = ctx.evals;
-    out.steps = steps;
+    out.steps = segs.steps;
     out
 }
 
@@ -999,9 +1060,7 @@ pub fn first_instant(
         model,
         poly: model.polygon(),
         fid: settings.fidelity,
-        fr: Friction {
-            mu_c: settings.mu_c,
-        },
+        fr: Friction::new(settings.mu_c),
         rho: pin.radius / k,
         vdir: Vec2::new(-1.0, pin.lateral_speed),
         start: pin_start / k,
@@ -1010,6 +1069,7 @@ pub fn first_instant(
         evals: 0,
         warm: Warm::default(),
         recorder: None,
+        band: [0.0; N_EVENTS],
     };
     let dir = ctx.vdir.normalized();
     let hit = first_contact(ctx.poly, &pose_n, ctx.start, dir, ctx.rho, 0.0)?;

@@ -2,16 +2,21 @@
 //! points"; a tripod is the case N = 3 with barycentric loads).
 //!
 //! Part frame, centroid at the origin; weights are the normalised loads (sum 1, μs = 1). For a
-//! twist ξ = [vx, vy, ω] the point x_i slides at u_i = v + ω ẑ×x_i and, exactly,
+//! twist ξ = [vx, vy, ω] the point x_i slides at u_i = v + ω ẑ×x_i.
 //!
-//! * D(ξ) = Σ w_i |u_i|,
-//! * ∇D(ξ) = Σ w_i J(x_i)ᵀ û_i, J(x) = [[1, 0, −y], [0, 1, x]] (the load on the part is −∇D),
-//! * H(ξ) = Σ w_i J(x_i)ᵀ (I − û_i û_iᵀ) J(x_i) / |u_i|.
+//! Ideal points make D non-differentiable wherever the centre of rotation sits on a loaded point
+//! (the limit surface has facets, and at such a pivot the contact force is indeterminate). Real
+//! supports are small contact patches, so each point is modelled as a uniform disc patch of radius
+//! ε = 1e-3 × (largest |x_i|): its dissipation is √(|u_i|² + (c ω)²) with c = 2ε/3, exact when the
+//! patch spins about its own centre (the mean distance over a disc is 2ε/3) and within O(ε²ω²/|u|)
+//! of |u_i| otherwise. Then, with g_i = (u_i, c ω) and A_i ξ = g_i,
 //!
-//! D is not differentiable where a loaded point is at rest (the centre of rotation sits on it):
-//! such a point (|u_i| ≤ 1e-300 (|v_x| + |v_y| + |ω| (|x_i| + |y_i|))) contributes nothing to
-//! ∇D and H; its contribution to ∇D is then one element of the subdifferential (the point's static
-//! friction is undetermined).
+//! * D(ξ) = Σ w_i |g_i|,
+//! * ∇D(ξ) = Σ w_i A_iᵀ ĝ_i, A_iᵀ(a, b, e) = (a, b, x_i b − y_i a + c e) (the load on the part is −∇D),
+//! * H(ξ) = Σ w_i A_iᵀ (I − ĝ_i ĝ_iᵀ) A_i / |g_i|,
+//!
+//! smooth and convex for every ξ ≠ 0, so the same Newton solver serves uniform and point supports.
+//! Results differ from ideal points by O(ε) in the pivoting phases and not at all elsewhere.
 
 use super::Dissipation;
 use crate::geometry::Vec2;
@@ -23,11 +28,12 @@ pub struct PointSupport {
     pub points: Vec<Vec2>,
     /// Normalised loads: non-negative, summing to 1.
     pub weights: Vec<f64>,
+    /// Effective spin radius c = 2ε/3 of each contact patch (see the module docs).
+    pub spin_radius: f64,
 }
 
-/// A point whose speed is at most this fraction of the twist's scale at that point counts as at
-/// rest.
-const AT_REST: f64 = 1e-300;
+/// Patch radius as a fraction of the largest support-point radius.
+pub const PATCH_FRACTION: f64 = 1e-3;
 
 impl PointSupport {
     /// Build from points and non-negative loads (any positive total; they are normalised to sum 1).
@@ -63,34 +69,50 @@ impl PointSupport {
             ));
         }
         let weights = weights.into_iter().map(|w| w / total).collect();
-        Ok(PointSupport { points, weights })
+        let reach = points.iter().map(|p| p.norm()).fold(0.0, f64::max);
+        let eps = PATCH_FRACTION * if reach > 0.0 { reach } else { 1.0 };
+        Ok(PointSupport {
+            points,
+            weights,
+            spin_radius: 2.0 * eps / 3.0,
+        })
     }
 
-    /// D, ∇D and (if `hessian`) H at twist ξ = [vx, vy, ω] (part frame), exact sums.
+    /// D, ∇D and (if `hessian`) H at twist ξ = [vx, vy, ω] (part frame); see the module docs.
     pub fn eval(&self, xi: [f64; 3], hessian: bool) -> Dissipation {
         let (vx, vy, om) = (xi[0], xi[1], xi[2]);
-        let vscale = vx.abs() + vy.abs();
+        let c = self.spin_radius;
         let mut out = Dissipation::ZERO;
         for (p, &w) in self.points.iter().zip(&self.weights) {
-            let (x, y) = (p.x, p.y);
-            let ux = vx - om * y;
-            let uy = vy + om * x;
-            let speed = ux.hypot(uy);
-            out.value += w * speed;
-            if speed <= AT_REST * (vscale + om.abs() * (x.abs() + y.abs())) || w == 0.0 {
+            if w == 0.0 {
                 continue;
             }
+            let (x, y) = (p.x, p.y);
+            let g = [vx - om * y, vy + om * x, c * om];
+            let speed = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+            if speed == 0.0 {
+                continue;
+            }
+            out.value += w * speed;
             let ws = w / speed;
-            out.grad[0] += ws * ux;
-            out.grad[1] += ws * uy;
-            out.grad[2] += ws * (x * uy - y * ux);
+            let at = |a: [f64; 3]| [a[0], a[1], x * a[1] - y * a[0] + c * a[2]];
+            let grad = at(g);
+            for (o, g) in out.grad.iter_mut().zip(grad) {
+                *o += ws * g;
+            }
             if hessian {
-                // Jᵀ u⊥ with u⊥ = ẑ×u; H += w/|u|³ (Jᵀu⊥)(Jᵀu⊥)ᵀ.
-                let a = [-uy, ux, x * ux + y * uy];
-                let wh = ws / (speed * speed);
-                for (i, ai) in a.iter().enumerate() {
-                    for (j, aj) in a.iter().enumerate() {
-                        out.hess[i][j] += wh * ai * aj;
+                // Aᵀ(I − ĝĝᵀ)A / |g| = (AᵀA − (Aᵀĝ)(Aᵀĝ)ᵀ) / |g|, with AᵀA from the columns of A.
+                let cols = [
+                    at([1.0, 0.0, 0.0]),
+                    at([0.0, 1.0, 0.0]),
+                    at([0.0, 0.0, 1.0]),
+                ];
+                for i in 0..3 {
+                    for j in 0..3 {
+                        let ata = cols[0][i] * cols[0][j]
+                            + cols[1][i] * cols[1][j]
+                            + cols[2][i] * cols[2][j];
+                        out.hess[i][j] += ws * (ata - grad[i] * grad[j] / (speed * speed));
                     }
                 }
             }
@@ -125,12 +147,13 @@ mod tests {
 
     #[test]
     fn a_point_at_rest_contributes_no_gradient() {
-        // Rotation about the support point itself: D = 0 there, and the other point carries all.
-        let s = PointSupport::new(
+        // Ideal points: rotation about the support point itself: D = 0 there, the other carries all.
+        let mut s = PointSupport::new(
             vec![Vec2::new(0.5, 0.5), Vec2::new(-0.5, 0.5)],
             vec![1.0, 1.0],
         )
         .unwrap();
+        s.spin_radius = 0.0;
         // COR at (0.5, 0.5) with ω = 1: v = −ω ẑ×r = (0.5, −0.5).
         let d = s.eval([0.5, -0.5, 1.0], true);
         assert!(d.grad.iter().all(|g| g.is_finite()));
@@ -141,8 +164,35 @@ mod tests {
         // x × û = (−0.5, 0.5) × (0, −1) = 0.5, times the weight 0.5.
         assert!((d.grad[2] - 0.25).abs() < 1e-15);
         // A zero weight point is ignored entirely.
-        let z = PointSupport::new(vec![Vec2::ZERO, Vec2::new(1.0, 0.0)], vec![0.0, 1.0]).unwrap();
+        let mut z =
+            PointSupport::new(vec![Vec2::ZERO, Vec2::new(1.0, 0.0)], vec![0.0, 1.0]).unwrap();
+        z.spin_radius = 0.0;
         let d = z.eval([0.0, 0.0, 1.0], true);
         assert!((d.value - 1.0).abs() < 1e-15 && (d.grad[2] - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_pivoting_patch_spins() {
+        // With the default patch, a point at the centre of rotation dissipates w·c|ω| and resists
+        // with a moment w·c·sgn(ω): the limit surface is smooth there, not a facet.
+        let s = PointSupport::new(
+            vec![Vec2::new(0.5, 0.5), Vec2::new(-0.5, 0.5)],
+            vec![1.0, 1.0],
+        )
+        .unwrap();
+        let c = s.spin_radius;
+        assert!((c - 2.0 / 3.0 * PATCH_FRACTION * 0.5f64.sqrt()).abs() < 1e-18);
+        let d = s.eval([1.0, -1.0, 2.0], true); // COR at (0.5, 0.5)
+        let moving = (1.0f64 * 4.0 + (c * 2.0).powi(2)).sqrt(); // |(0, −2, 2c)|
+        assert!((d.value - 0.5 * (2.0 * c + moving)).abs() < 1e-15);
+        // The resting patch adds 0.5·c to the moment (its g = (0, 0, 2c), Aᵀĝ = (0, 0, c)).
+        let moving_moment = 0.5 * ((-0.5) * (-2.0) - 0.5 * 0.0 + c * 2.0 * c) / moving;
+        assert!((d.grad[2] - (0.5 * c + moving_moment)).abs() < 1e-15);
+        // The Hessian is finite and positive semidefinite with Hξ = 0.
+        let xi = [1.0, -1.0, 2.0];
+        for i in 0..3 {
+            let hx: f64 = (0..3).map(|j| d.hess[i][j] * xi[j]).sum();
+            assert!(hx.abs() < 1e-9, "row {i}: {hx}");
+        }
     }
 }
