@@ -349,3 +349,74 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
     std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    fn parse(args: &[&str]) -> MapArgs {
+        let cli =
+            crate::cli::Cli::parse_from(std::iter::once("pinfeed").chain(args.iter().copied()));
+        match cli.command {
+            crate::cli::Command::Map(a) => a,
+            other => panic!("not a map command: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn the_recorded_command_parses_back_to_the_same_settings() {
+        let a = parse(&[
+            "map",
+            "--part",
+            "vertices:0,0 2,0 0,1",
+            "--d",
+            "-0.5,0.25",
+            "--mu-c",
+            "0.7",
+            "--theta-step",
+            "2",
+            "--out-dir",
+            "out dir",
+        ]);
+        let cmd = command_line(&a);
+        assert!(cmd.contains("--part 'vertices:0,0 2,0 0,1'"), "{cmd}");
+        assert!(cmd.contains("--out-dir 'out dir'"), "{cmd}");
+        // Split the shell words back (single quotes only) and parse them again.
+        let mut words: Vec<String> = Vec::new();
+        let mut quoted = false;
+        let mut cur = String::new();
+        for c in cmd.chars() {
+            match c {
+                '\'' => quoted = !quoted,
+                ' ' if !quoted => words.push(std::mem::take(&mut cur)),
+                _ => cur.push(c),
+            }
+        }
+        words.push(cur);
+        let refs: Vec<&str> = words.iter().skip(1).map(String::as_str).collect();
+        let b = parse(&refs);
+        assert_eq!(
+            (b.part, b.d, b.mu_c, b.theta_step),
+            (a.part, a.d, a.mu_c, a.theta_step)
+        );
+        assert_eq!(b.out_dir, a.out_dir);
+        assert_eq!(command_line(&parse(&refs)), cmd);
+    }
+
+    #[test]
+    fn default_report_directory_is_per_part() {
+        assert_eq!(
+            default_out_dir("tripoly1"),
+            Path::new("results/maps/tripoly1")
+        );
+        assert_eq!(
+            default_out_dir("rect:2:1"),
+            Path::new("results/maps/rect_2_1")
+        );
+        assert_eq!(
+            default_out_dir("vertices:0,0 1,0 0,1"),
+            Path::new("results/maps/custom")
+        );
+    }
+}
