@@ -97,12 +97,23 @@ fn bench_maps(repeats: usize, out: &std::path::Path) -> Result<()> {
     threads.sort_unstable();
     threads.dedup();
     let fids = [Fidelity::Exact, Fidelity::Ellipsoid, Fidelity::Tip];
+    // Other work on the machine slows every row: say how busy it was (Linux only).
+    let load = || {
+        std::fs::read_to_string("/proc/loadavg")
+            .ok()
+            .and_then(|l| l.split_whitespace().next().map(str::to_string))
+            .unwrap_or_else(|| "unknown".into())
+    };
+    let load_before = load();
     let rows = map_cost::measure(&["tripoly1", "tripoly2"], &fids, &threads, 1.0, repeats)?;
+    let load_after = load();
     let table = map_cost::markdown(&rows);
     let doc = format!(
         "# Configuration maps: wall time\n\n\
          Regenerate with:\n\n```\ncargo run --release -- bench maps --repeats {repeats} --out {}\n```\n\n\
-         Machine: {cores} cores (shared with other work: compare rows of one run, not runs). Each row \
+         Machine: {cores} cores, shared with other work (1-minute load average {load_before} before, \
+         {load_after} after this run; with a load near the core count the 2-thread rows cannot \
+         show their speed-up). Each row \
          times `maps::compute_maps` for the 18 thesis maps d = ±0.1 … ±0.9 with θ0 every 1° \
          (6480 contacts: sampling, bands and runs; no printing, files or figures), point pin, \
          μc = 0.5, uniform pressure, tolerance 1e-6: median, min and max of {repeats} runs after \
