@@ -179,6 +179,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         pin_speed: 0.0,
         support: args.support.clone(),
         tol: args.tol,
+        fence: None,
     };
     check_inputs(&template)?;
     let (poly, part_model) = compile_part(&args.part, &args.support)?;
