@@ -8,11 +8,13 @@
 //! the other end. Physics and conventions follow `SPEC.md` (quasi-static pushing with Coulomb
 //! friction; x along belt travel, y to the left, angles counter-clockwise, degrees at interfaces).
 //!
-//! Modules: [`geometry`] (polygons, stable states, first contact), [`report`] (tables and figures),
+//! Modules: [`geometry`] (polygons, stable states, first contact), [`mechanics`] (the contact
+//! model), [`maps`] (configuration maps and their bands), [`report`] (tables and figures),
 //! [`cli`] (the `pinfeed` command).
 
 pub mod cli;
 pub mod geometry;
+pub mod maps;
 pub mod mechanics;
 pub mod random;
 pub mod report;

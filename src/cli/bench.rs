@@ -1,7 +1,7 @@
 //! `pinfeed bench`: measurements that produce the reports in `results/`.
 
 use crate::mechanics::Fidelity;
-use crate::study::contact_cost;
+use crate::study::{contact_cost, map_cost};
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
@@ -39,6 +39,16 @@ pub enum BenchWhat {
         seed: u64,
         /// Output Markdown file.
         #[arg(long, default_value = "results/contact-model.md")]
+        out: PathBuf,
+    },
+    /// Wall time of the 18 thesis configuration maps (d = ±0.1 … ±0.9, 360 θ0 each) per part,
+    /// model and thread count; writes results/maps/timing.md.
+    Maps {
+        /// Timed repeats per row (after one warm-up).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Output Markdown file.
+        #[arg(long, default_value = "results/maps/timing.md")]
         out: PathBuf,
     },
 }
@@ -121,5 +131,48 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             eprintln!("wrote {}", out.display());
             Ok(())
         }
+        BenchWhat::Maps { repeats, out } => bench_maps(*repeats, out),
     }
+}
+
+fn bench_maps(repeats: usize, out: &std::path::Path) -> Result<()> {
+    if repeats == 0 || repeats > 1000 {
+        anyhow::bail!("--repeats must be between 1 and 1000, got {repeats}");
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut threads = vec![1, 2, cores];
+    threads.sort_unstable();
+    threads.dedup();
+    let fids = [Fidelity::Exact, Fidelity::Ellipsoid, Fidelity::Tip];
+    // Other work on the machine slows every row: say how busy it was (Linux only).
+    let load = || {
+        std::fs::read_to_string("/proc/loadavg")
+            .ok()
+            .and_then(|l| l.split_whitespace().next().map(str::to_string))
+            .unwrap_or_else(|| "unknown".into())
+    };
+    let load_before = load();
+    let rows = map_cost::measure(&["tripoly1", "tripoly2"], &fids, &threads, 1.0, repeats)?;
+    let load_after = load();
+    let table = map_cost::markdown(&rows);
+    let doc = format!(
+        "# Configuration maps: wall time\n\n\
+         Regenerate with:\n\n```\ncargo run --release -- bench maps --repeats {repeats} --out {}\n```\n\n\
+         Machine: {cores} cores, shared with other work (1-minute load average {load_before} before, \
+         {load_after} after this run; with a load near the core count the 2-thread rows cannot \
+         show their speed-up). Each row \
+         times `maps::compute_maps` for the 18 thesis maps d = ±0.1 … ±0.9 with θ0 every 1° \
+         (6480 contacts: sampling, bands and runs; no printing, files or figures), point pin, \
+         μc = 0.5, uniform pressure, tolerance 1e-6: median, min and max of {repeats} runs after \
+         one warm-up. *µs per contact* is thread-time per contact (median × threads / contacts). \
+         Target (issue 4): under 0.5 s with the exact model on 2 cores.\n\n{table}",
+        out.display()
+    );
+    if let Some(dir) = out.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(out, &doc).with_context(|| format!("writing {}", out.display()))?;
+    print!("{table}");
+    eprintln!("wrote {}", out.display());
+    Ok(())
 }

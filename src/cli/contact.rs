@@ -167,7 +167,8 @@ pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>)
     }
 }
 
-fn check_inputs(c: &Case) -> Result<()> {
+/// Refuse non-finite or out-of-range settings of a case with a message naming the option.
+pub(crate) fn check_inputs(c: &Case) -> Result<()> {
     let finite = |name: &str, v: f64| -> Result<()> {
         if !v.is_finite() {
             bail!("{name} must be a finite number, got {v}");
@@ -202,20 +203,22 @@ fn check_inputs(c: &Case) -> Result<()> {
     Ok(())
 }
 
-/// The initial pose and pin start for a case (part centred at the origin, pin just clear of it).
+/// The initial pose and pin start for a case (part centred at the origin, pin just clear of it):
+/// the convention of [`crate::maps::pass_start`], shared with configuration maps.
 pub fn case_geometry(poly: &Polygon, c: &Case) -> (Pose, Vec2) {
-    let a = poly.radius();
-    let pose = Pose::new(0.0, 0.0, c.theta0_deg.to_radians());
-    let start = Vec2::new(a * 1.01 + c.pin_radius, c.d * a);
-    (pose, start)
+    crate::maps::pass_start(poly, c.theta0_deg, c.d, c.pin_radius)
 }
 
-/// Run one case; returns the polygon, the outcome and (if asked) the trace.
-pub fn run_case(c: &Case, want_trace: bool) -> Result<(Polygon, ContactOutcome, Vec<TraceSample>)> {
-    check_inputs(c)?;
-    let poly = named::part_from_spec(&c.part).with_context(|| format!("part '{}'", c.part))?;
-    let support = Support::parse(&c.support, &poly).map_err(anyhow::Error::msg)?;
+/// Resolve a part spec and a support spec into the polygon and its compiled contact model.
+pub(crate) fn compile_part(part: &str, support: &str) -> Result<(Polygon, PartModel)> {
+    let poly = named::part_from_spec(part).with_context(|| format!("part '{part}'"))?;
+    let support = Support::parse(support, &poly).map_err(anyhow::Error::msg)?;
     let model = PartModel::new(&poly, &support).map_err(anyhow::Error::msg)?;
+    Ok((poly, model))
+}
+
+/// The contact-model settings and the pin of a case.
+pub(crate) fn settings_and_pin(c: &Case) -> (ContactSettings, Pin) {
     let settings = ContactSettings {
         fidelity: c.model,
         mu_c: c.mu_c,
@@ -227,6 +230,14 @@ pub fn run_case(c: &Case, want_trace: bool) -> Result<(Polygon, ContactOutcome, 
         radius: c.pin_radius,
         lateral_speed: c.pin_speed,
     };
+    (settings, pin)
+}
+
+/// Run one case; returns the polygon, the outcome and (if asked) the trace.
+pub fn run_case(c: &Case, want_trace: bool) -> Result<(Polygon, ContactOutcome, Vec<TraceSample>)> {
+    check_inputs(c)?;
+    let (poly, model) = compile_part(&c.part, &c.support)?;
+    let (settings, pin) = settings_and_pin(c);
     let (pose, start) = case_geometry(&poly, c);
     let mut trace: Vec<TraceSample> = Vec::new();
     let recorder: Option<&mut dyn crate::mechanics::Recorder> =
@@ -266,7 +277,8 @@ fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
     }
 }
 
-fn parse_model(s: &str) -> Result<Fidelity> {
+/// Parse `--model`: exact, ellipsoid or tip.
+pub(crate) fn parse_model(s: &str) -> Result<Fidelity> {
     Fidelity::parse(s.trim())
         .with_context(|| format!("unknown model '{s}'; expected exact, ellipsoid or tip"))
 }

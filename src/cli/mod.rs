@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod contact;
+pub mod map;
 pub mod part;
 
 use clap::{Parser, Subcommand};
@@ -21,6 +22,8 @@ pub enum Command {
     Part(part::PartArgs),
     /// One pin pass over one part (or a batch from CSV): final pose, rotation, contact segments.
     Contact(contact::ContactArgs),
+    /// Configuration maps θ0 → θf for several d: bands, no-contact runs, figures, report files.
+    Map(map::MapArgs),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
 }
@@ -30,6 +33,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
+        Command::Map(a) => map::run(&a),
         Command::Bench(a) => bench::run(&a),
     }
 }

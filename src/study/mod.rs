@@ -1,5 +1,6 @@
 //! Studies built on the contact model and the line: what a contact costs and how accurate it is
-//! (`contact_cost`); later Monte Carlo robustness and accuracy-vs-time.
+//! (`contact_cost`), what a set of configuration maps costs (`map_cost`); later Monte Carlo robustness and accuracy-vs-time.
 
 pub mod accuracy;
 pub mod contact_cost;
+pub mod map_cost;

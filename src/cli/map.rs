@@ -1,0 +1,423 @@
+//! `pinfeed map`: configuration maps θ0 → θf for a list of contact parameters d (SPEC §3, thesis
+//! chapter 3), their bands, and the figures and report files under `results/maps/<part>/`.
+//!
+//! Each map samples θ0 over [0°, 360°) with the start convention of `pinfeed contact`
+//! ([`crate::maps::pass_start`]). Standard output gets a band table (default), the JSON document
+//! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
+//! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
+//! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
+
+use super::contact::{check_inputs, compile_part, parse_model, settings_and_pin, Case};
+use crate::maps::{compute_maps, ConfigurationMap, MapSettings};
+use crate::report::{map_table, plot_map};
+use anyhow::{Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `pinfeed map`.
+#[derive(Debug, Args)]
+pub struct MapArgs {
+    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, or vertices:"x,y x,y ...".
+    #[arg(long)]
+    pub part: String,
+    /// Contact parameters d = (y_pin − y_com)/a, comma-separated (e.g. -0.9,-0.5,0.3).
+    #[arg(
+        long,
+        required = true,
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub d: Vec<f64>,
+    /// Spacing of the initial orientations θ0 (degrees; must divide 360).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    pub theta_step: f64,
+    /// Fidelity: exact, ellipsoid or tip.
+    #[arg(long, default_value = "exact")]
+    pub model: String,
+    /// Pin–part friction coefficient μc (≥ 0).
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub mu_c: f64,
+    /// Pin radius in part units (0: point pin).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub pin_radius: f64,
+    /// Support: uniform or tripod:SEED.
+    #[arg(long, default_value = "uniform")]
+    pub support: String,
+    /// Band threshold T (degrees): neighbouring final angles at least T apart start a new band.
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    pub threshold: f64,
+    /// Integration tolerance (absolute, radians / units of a, per step).
+    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
+    pub tol: f64,
+    /// Print the maps as one JSON document.
+    #[arg(long, conflicts_with = "csv")]
+    pub json: bool,
+    /// Print the samples as CSV.
+    #[arg(long)]
+    pub csv: bool,
+    /// Report directory (README.md, map.json, samples.csv, figures) [default: results/maps/<part>].
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
+    /// Directory for the SVG figures [default: the report directory].
+    #[arg(long, value_name = "DIR")]
+    pub plot_dir: Option<PathBuf>,
+    /// Print only; write no files.
+    #[arg(long, conflicts_with_all = ["out_dir", "plot_dir"])]
+    pub no_write: bool,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+/// The JSON document of `pinfeed map --json` (and `map.json`).
+#[derive(Debug, Serialize)]
+pub struct MapReport<'a> {
+    /// The command that regenerates this report.
+    pub command: String,
+    pub part: &'a str,
+    pub model: &'a str,
+    pub mu_c: f64,
+    pub pin_radius: f64,
+    pub support: &'a str,
+    pub theta_step_deg: f64,
+    pub threshold_deg: f64,
+    pub tol: f64,
+    pub maps: &'a [ConfigurationMap],
+}
+
+/// One CSV row: a sample of one map.
+#[derive(Debug, Serialize)]
+struct SampleRow {
+    d: f64,
+    theta0_deg: f64,
+    theta_final_deg: f64,
+    rotation_deg: f64,
+    contact: bool,
+    com_final_y: f64,
+    contact_length: f64,
+    band: Option<usize>,
+    status: &'static str,
+}
+
+/// Quote a shell word if it needs it.
+fn shell_word(s: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
+    if !s.is_empty() && s.chars().all(plain) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// The command line that regenerates a report, every setting explicit.
+pub fn command_line(args: &MapArgs) -> String {
+    let ds: Vec<String> = args.d.iter().map(|d| d.to_string()).collect();
+    let mut words = vec![
+        "pinfeed".to_string(),
+        "map".into(),
+        "--part".into(),
+        shell_word(&args.part),
+        format!("--d={}", ds.join(",")),
+        "--theta-step".into(),
+        args.theta_step.to_string(),
+        "--model".into(),
+        shell_word(&args.model),
+        "--mu-c".into(),
+        args.mu_c.to_string(),
+        "--pin-radius".into(),
+        args.pin_radius.to_string(),
+        "--support".into(),
+        shell_word(&args.support),
+        "--threshold".into(),
+        args.threshold.to_string(),
+        "--tol".into(),
+        args.tol.to_string(),
+    ];
+    for (flag, dir) in [("--out-dir", &args.out_dir), ("--plot-dir", &args.plot_dir)] {
+        if let Some(dir) = dir {
+            words.push(flag.into());
+            words.push(shell_word(&dir.display().to_string()));
+        }
+    }
+    words.join(" ")
+}
+
+/// The default report directory of a part: `results/maps/<part>` (a vertex list is `custom`).
+pub fn default_out_dir(part: &str) -> PathBuf {
+    let name = if part.trim().to_lowercase().starts_with("vertices:") {
+        "custom".to_string()
+    } else {
+        part.trim()
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect()
+    };
+    Path::new("results").join("maps").join(name)
+}
+
+fn figure_name(d: f64) -> String {
+    format!("map_d{d:+}.svg")
+}
+
+pub fn run(args: &MapArgs) -> Result<()> {
+    let model = parse_model(&args.model)?;
+    let template = Case {
+        part: args.part.clone(),
+        theta0_deg: 0.0,
+        d: 0.0,
+        mu_c: args.mu_c,
+        mu_s: crate::mechanics::ContactSettings::default().mu_s,
+        model,
+        pin_radius: args.pin_radius,
+        pin_speed: 0.0,
+        support: args.support.clone(),
+        tol: args.tol,
+        fence: None,
+    };
+    check_inputs(&template)?;
+    let (poly, part_model) = compile_part(&args.part, &args.support)?;
+    let (contact, pin) = settings_and_pin(&template);
+    let settings = MapSettings {
+        theta_step_deg: args.theta_step,
+        threshold_deg: args.threshold,
+        contact,
+        pin,
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads)
+        .build()
+        .context("starting the worker threads")?;
+    let started = std::time::Instant::now();
+    let maps = pool.install(|| compute_maps(&poly, &part_model, &args.d, &settings))?;
+    let elapsed = started.elapsed().as_secs_f64();
+    let contacts: usize = maps.iter().map(|m| m.samples.len()).sum();
+    eprintln!(
+        "computed {} maps × {} θ0 = {contacts} contacts ({}) in {elapsed:.3} s on {} threads",
+        maps.len(),
+        maps.first().map_or(0, |m| m.samples.len()),
+        model.name(),
+        pool.current_num_threads()
+    );
+    let non_ok: usize = maps.iter().map(|m| m.non_ok_samples()).sum();
+    if non_ok > 0 {
+        eprintln!("warning: {non_ok} contacts ended with a status other than ok (see the samples' status)");
+    }
+
+    let report = MapReport {
+        command: command_line(args),
+        part: &args.part,
+        model: model.name(),
+        mu_c: args.mu_c,
+        pin_radius: args.pin_radius,
+        support: &args.support,
+        theta_step_deg: args.theta_step,
+        threshold_deg: args.threshold,
+        tol: args.tol,
+        maps: &maps,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else if args.csv {
+        write_csv(std::io::stdout().lock(), &maps)?;
+    } else {
+        println!(
+            "{}  model {}  μc {}  pin radius {}  support {}  θ0 step {}°  threshold {}°",
+            args.part,
+            report.model,
+            args.mu_c,
+            args.pin_radius,
+            args.support,
+            args.theta_step,
+            args.threshold
+        );
+        print!("{}", map_table::bands_text(&maps));
+    }
+    if !args.no_write {
+        let out_dir = args
+            .out_dir
+            .clone()
+            .unwrap_or_else(|| default_out_dir(&args.part));
+        write_report(&report, &out_dir, args.plot_dir.as_deref())?;
+        eprintln!("report written to {}", out_dir.display());
+    }
+    Ok(())
+}
+
+fn write_csv<W: std::io::Write>(w: W, maps: &[ConfigurationMap]) -> Result<()> {
+    let mut wtr = csv::Writer::from_writer(w);
+    for m in maps {
+        for s in &m.samples {
+            wtr.serialize(SampleRow {
+                d: m.d,
+                theta0_deg: s.theta0_deg,
+                theta_final_deg: s.theta_final_deg,
+                rotation_deg: s.rotation_deg,
+                contact: s.contact,
+                com_final_y: s.com_final_y,
+                contact_length: s.contact_length,
+                band: s.band,
+                status: s.status.name(),
+            })?;
+        }
+    }
+    wtr.flush()?;
+    Ok(())
+}
+
+/// Write README.md, map.json, samples.csv and the figures.
+fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> Result<()> {
+    let plot_dir = plot_dir.unwrap_or(out_dir);
+    for dir in [out_dir, plot_dir] {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let json_path = out_dir.join("map.json");
+    // Compact: the document holds every sample (README.md is the readable summary).
+    std::fs::write(&json_path, serde_json::to_string(report)? + "\n")
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    let csv_path = out_dir.join("samples.csv");
+    let f = std::fs::File::create(&csv_path)
+        .with_context(|| format!("writing {}", csv_path.display()))?;
+    write_csv(std::io::BufWriter::new(f), report.maps)?;
+
+    let describe = format!("{} ({}, μc {})", report.part, report.model, report.mu_c);
+    let mut figures: Vec<(String, PathBuf)> = Vec::new();
+    for (adjusted, file, what) in [
+        (false, "band_intervals.svg", "Band intervals against d"),
+        (
+            true,
+            "band_intervals_adjusted.svg",
+            "Adjusted band intervals (mean ± sd) against d",
+        ),
+    ] {
+        let path = plot_dir.join(file);
+        plot_map::plot_band_intervals(report.maps, adjusted, &format!("{what}: {describe}"), &path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        figures.push((what.to_string(), path));
+    }
+    for m in report.maps {
+        let path = plot_dir.join(figure_name(m.d));
+        let title = format!("{describe}, d = {:+}: θ0 → θf", m.d);
+        plot_map::plot_map(m, &title, report.theta_step_deg, &path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        figures.push((format!("d = {:+}", m.d), path));
+    }
+
+    let link = |p: &Path| -> String {
+        if plot_dir == out_dir {
+            p.file_name()
+                .map_or_else(String::new, |f| f.to_string_lossy().into_owned())
+        } else {
+            p.display().to_string()
+        }
+    };
+    let samples = report.maps.first().map_or(0, |m| m.samples.len());
+    let non_ok: usize = report.maps.iter().map(|m| m.non_ok_samples()).sum();
+    let mut md = format!(
+        "# Configuration maps: {part}\n\nRegenerate from the repository root with\n\n    cargo run --release -- {cmd}\n\n",
+        part = report.part,
+        cmd = report.command.trim_start_matches("pinfeed "),
+    );
+    md += &format!(
+        "Part `{}`, model `{}`, contact friction μc = {}, pin radius {} (part units), support `{}`, \
+         θ0 every {}° ({samples} samples per map), band threshold T = {}°, integration tolerance {}. \
+         Conventions: SPEC §3 and the module docs of `src/maps/` (bands group neighbours in sorted \
+         final angle, circularly; an interval [a, b] with b < a straddles 0°/360°; sd uses n − 1; \
+         adjusted band = mean ± sd, thesis eq. 3-2). Contacts that did not end `ok`: {non_ok}.\n\n",
+        report.part,
+        report.model,
+        report.mu_c,
+        report.pin_radius,
+        report.support,
+        report.theta_step_deg,
+        report.threshold_deg,
+        report.tol
+    );
+    md += "Files: `map.json` (every sample, band and no-contact interval), `samples.csv` \
+           (one row per sample), and the figures below.\n\n## Bands per d\n\n";
+    md += &map_table::bands_markdown(report.maps);
+    md += "\n## Figures\n\n";
+    for (what, path) in &figures {
+        md += &format!("### {what}\n\n![{what}]({})\n\n", link(path));
+    }
+    let readme = out_dir.join("README.md");
+    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    fn parse(args: &[&str]) -> MapArgs {
+        let cli =
+            crate::cli::Cli::parse_from(std::iter::once("pinfeed").chain(args.iter().copied()));
+        match cli.command {
+            crate::cli::Command::Map(a) => a,
+            other => panic!("not a map command: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn the_recorded_command_parses_back_to_the_same_settings() {
+        let a = parse(&[
+            "map",
+            "--part",
+            "vertices:0,0 2,0 0,1",
+            "--d",
+            "-0.5,0.25",
+            "--mu-c",
+            "0.7",
+            "--theta-step",
+            "2",
+            "--out-dir",
+            "out dir",
+        ]);
+        let cmd = command_line(&a);
+        assert!(cmd.contains("--part 'vertices:0,0 2,0 0,1'"), "{cmd}");
+        assert!(cmd.contains("--out-dir 'out dir'"), "{cmd}");
+        // Split the shell words back (single quotes only) and parse them again.
+        let mut words: Vec<String> = Vec::new();
+        let mut quoted = false;
+        let mut cur = String::new();
+        for c in cmd.chars() {
+            match c {
+                '\'' => quoted = !quoted,
+                ' ' if !quoted => words.push(std::mem::take(&mut cur)),
+                _ => cur.push(c),
+            }
+        }
+        words.push(cur);
+        let refs: Vec<&str> = words.iter().skip(1).map(String::as_str).collect();
+        let b = parse(&refs);
+        assert_eq!(
+            (b.part, b.d, b.mu_c, b.theta_step),
+            (a.part, a.d, a.mu_c, a.theta_step)
+        );
+        assert_eq!(b.out_dir, a.out_dir);
+        assert_eq!(command_line(&parse(&refs)), cmd);
+    }
+
+    #[test]
+    fn default_report_directory_is_per_part() {
+        assert_eq!(
+            default_out_dir("tripoly1"),
+            Path::new("results/maps/tripoly1")
+        );
+        assert_eq!(
+            default_out_dir("rect:2:1"),
+            Path::new("results/maps/rect_2_1")
+        );
+        assert_eq!(
+            default_out_dir("vertices:0,0 1,0 0,1"),
+            Path::new("results/maps/custom")
+        );
+    }
+}

@@ -1,0 +1,206 @@
+//! Configuration maps (thesis §2.17 and chapter 3; SPEC §3): initial orientation θ0 → final
+//! orientation θf of a part after one pass of a pin at contact parameter d, and what the thesis
+//! reads off them.
+//!
+//! * [`sample`]: θ0 on a regular grid over [0°, 360°), one contact per sample (pure, parallel,
+//!   independent of the thread count), from the start convention of [`start`].
+//! * [`bands`]: bands B_j of final angles (eq. 2-15/2-16, circular-aware), their mean, standard
+//!   deviation and adjusted interval mean ± sd (eq. 3-2), and COM_j ranges (eq. 2-18).
+//! * [`runs`]: maximal circular runs of θ0 samples: the initial-angle sets K_j of each band
+//!   (eq. 2-17, possibly several runs) and the no-contact intervals NC_j (eq. 3-1).
+//!
+//! A no-contact sample is one where the pin never touches the part (θf = θ0 by definition). NC
+//! intervals are the maximal runs of consecutive no-contact samples on the θ0 grid (read
+//! circularly); this is the thesis's grouping of eq. 3-1 with neighbours taken along the grid, so
+//! the union of the NC intervals is exactly the set of no-contact samples, no more. Samples whose
+//! contact ended with a non-ok status (e.g. the part still riding the pin at the travel limit) keep
+//! the pose where the computation stopped, are grouped like the others and carry their status.
+//!
+//! Angles are degrees, wrapped to [0°, 360°); an interval [a, b] with b < a straddles 0°/360°.
+//! Lengths (final centroid y, contact length) are in the part's units, belt frame.
+
+pub mod bands;
+pub mod runs;
+pub mod sample;
+pub mod start;
+
+pub use bands::{circular_clusters, find_bands};
+pub use sample::{sample_maps, theta_grid};
+pub use start::pass_start;
+
+use crate::geometry::Polygon;
+use crate::mechanics::{ContactSettings, ContactStatus, Fidelity, PartModel, Pin};
+use serde::{Serialize, Serializer};
+
+/// Bad input to a map computation.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MapError {
+    #[error("theta step must be a finite number of degrees in (0, 360], got {0}")]
+    ThetaStep(f64),
+    #[error("theta step {0}° does not divide 360° into a whole number of samples")]
+    ThetaStepNotDividing(f64),
+    #[error("theta step gives {0} samples per map; at most {max} are allowed", max = sample::MAX_SAMPLES)]
+    TooManySamples(usize),
+    #[error("band threshold must be a finite number of degrees in (0, 360], got {0}")]
+    Threshold(f64),
+    #[error("contact parameter d = {d} is out of range: |d| must be at most {limit:.4} (beyond it the pin cannot touch the part)")]
+    ContactParameter { d: f64, limit: f64 },
+    #[error("no contact parameter d given")]
+    NoContactParameter,
+    #[error("contact parameter d = {0} is given twice")]
+    RepeatedContactParameter(f64),
+}
+
+/// What a map is computed with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapSettings {
+    /// Spacing of the θ0 grid (degrees); must divide 360.
+    pub theta_step_deg: f64,
+    /// Band threshold T (degrees): neighbouring final angles at least T apart start a new band.
+    pub threshold_deg: f64,
+    pub contact: ContactSettings,
+    pub pin: Pin,
+}
+
+impl MapSettings {
+    /// A point pin with contact friction `mu_c` and otherwise default contact settings.
+    pub fn point_pin(
+        fidelity: Fidelity,
+        mu_c: f64,
+        theta_step_deg: f64,
+        threshold_deg: f64,
+    ) -> Self {
+        MapSettings {
+            theta_step_deg,
+            threshold_deg,
+            contact: ContactSettings {
+                fidelity,
+                mu_c,
+                ..ContactSettings::default()
+            },
+            pin: Pin::point(),
+        }
+    }
+}
+
+/// One sample of a map: a pin pass at one initial orientation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MapSample {
+    /// Initial orientation θ0 (degrees, on the grid).
+    pub theta0_deg: f64,
+    /// Final orientation θf (degrees, [0, 360)); exactly θ0 when there is no contact.
+    pub theta_final_deg: f64,
+    /// Signed total rotation (degrees, not wrapped).
+    pub rotation_deg: f64,
+    /// Did the pin touch the part?
+    pub contact: bool,
+    /// Final centroid y (belt frame, part units; 0 without contact).
+    pub com_final_y: f64,
+    /// Pin travel in contact (part units).
+    pub contact_length: f64,
+    /// Index of the band holding this sample (None for no contact).
+    pub band: Option<usize>,
+    /// How the contact computation ended.
+    #[serde(serialize_with = "status_name")]
+    pub status: ContactStatus,
+}
+
+fn status_name<S: Serializer>(status: &ContactStatus, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(status.name())
+}
+
+/// One band B_j with its statistics (see [`bands`] for the definitions).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Band {
+    /// Lower and upper end of the final-angle arc (degrees; max < min when it straddles 0°).
+    pub final_min_deg: f64,
+    pub final_max_deg: f64,
+    /// Arc length from min to max (degrees).
+    pub width_deg: f64,
+    pub mean_deg: f64,
+    pub sd_deg: f64,
+    /// The thesis's adjusted band, mean ± sd (eq. 3-2), wrapped.
+    pub adjusted_min_deg: f64,
+    pub adjusted_max_deg: f64,
+    /// K_j: the θ0 runs feeding this band, [first, last] (degrees, on the grid).
+    pub initial_ranges_deg: Vec<[f64; 2]>,
+    /// COM_j: range of the final centroid y (part units).
+    pub com_y_min: f64,
+    pub com_y_max: f64,
+    /// Number of samples in the band.
+    pub samples: usize,
+}
+
+/// The configuration map for one contact parameter d.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConfigurationMap {
+    pub d: f64,
+    /// One sample per grid θ0, in grid order.
+    pub samples: Vec<MapSample>,
+    /// Bands ordered by their lower end.
+    pub bands: Vec<Band>,
+    /// NC_j: runs of no-contact θ0, [first, last] (degrees, on the grid).
+    pub no_contact_ranges_deg: Vec<[f64; 2]>,
+}
+
+impl ConfigurationMap {
+    /// Derive bands and NC intervals from a full grid of samples (in grid order).
+    pub fn from_samples(
+        d: f64,
+        mut samples: Vec<MapSample>,
+        threshold_deg: f64,
+    ) -> Result<ConfigurationMap, MapError> {
+        check_threshold(threshold_deg)?;
+        let (bands, band_of) = find_bands(&samples, threshold_deg);
+        for (s, b) in samples.iter_mut().zip(band_of) {
+            s.band = b;
+        }
+        let grid: Vec<f64> = samples.iter().map(|s| s.theta0_deg).collect();
+        let no_contact: Vec<bool> = samples.iter().map(|s| !s.contact).collect();
+        let no_contact_ranges_deg = runs::circular_ranges(&no_contact, &grid);
+        Ok(ConfigurationMap {
+            d,
+            samples,
+            bands,
+            no_contact_ranges_deg,
+        })
+    }
+
+    /// Number of samples whose contact computation did not end `ok`.
+    pub fn non_ok_samples(&self) -> usize {
+        self.samples.iter().filter(|s| !s.status.is_ok()).count()
+    }
+}
+
+fn check_threshold(threshold_deg: f64) -> Result<(), MapError> {
+    if !(threshold_deg.is_finite() && threshold_deg > 0.0 && threshold_deg <= 360.0) {
+        return Err(MapError::Threshold(threshold_deg));
+    }
+    Ok(())
+}
+
+/// Compute the configuration maps of `poly` (compiled as `model`) for each d in `ds`, in order.
+/// Validates every input before any contact is computed. Runs on the current rayon pool.
+pub fn compute_maps(
+    poly: &Polygon,
+    model: &PartModel,
+    ds: &[f64],
+    settings: &MapSettings,
+) -> Result<Vec<ConfigurationMap>, MapError> {
+    if ds.is_empty() {
+        return Err(MapError::NoContactParameter);
+    }
+    check_threshold(settings.threshold_deg)?;
+    for (i, &d) in ds.iter().enumerate() {
+        sample::check_contact_parameter(poly, d, settings.pin.radius)?;
+        if ds[..i].contains(&d) {
+            return Err(MapError::RepeatedContactParameter(d));
+        }
+    }
+    let grid = theta_grid(settings.theta_step_deg)?;
+    let rows = sample_maps(poly, model, ds, &grid, &settings.contact, &settings.pin);
+    ds.iter()
+        .zip(rows)
+        .map(|(&d, row)| ConfigurationMap::from_samples(d, row, settings.threshold_deg))
+        .collect()
+}

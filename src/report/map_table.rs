@@ -1,0 +1,110 @@
+//! Tables of configuration-map bands for people: one row per band B_j (final-angle interval, width,
+//! mean, sd, adjusted interval mean ± sd, the θ0 runs K_j that feed it, the COM_j range and the sample
+//! count) and one row per d for its no-contact runs NC_j. Rendered as aligned plain text for the
+//! terminal or as a Markdown table for results files. Intervals [a, b] with b < a straddle 0°/360°.
+
+use crate::maps::ConfigurationMap;
+
+const HEADER: [&str; 10] = [
+    "d",
+    "band",
+    "final [min, max] °",
+    "width °",
+    "mean °",
+    "sd °",
+    "adjusted [min, max] °",
+    "θ0 runs (K / NC) °",
+    "COM y [min, max]",
+    "n",
+];
+
+fn interval(lo: f64, hi: f64, digits: usize) -> String {
+    format!("[{lo:.digits$}, {hi:.digits$}]")
+}
+
+fn ranges(r: &[[f64; 2]]) -> String {
+    if r.is_empty() {
+        return "—".into();
+    }
+    r.iter()
+        .map(|x| interval(x[0], x[1], 1))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The table's cells: a row per band and a row per map with no-contact runs.
+fn rows(maps: &[ConfigurationMap]) -> Vec<[String; 10]> {
+    let mut out = Vec::new();
+    for m in maps {
+        for (j, b) in m.bands.iter().enumerate() {
+            out.push([
+                format!("{:+}", m.d),
+                format!("B{}", j + 1),
+                interval(b.final_min_deg, b.final_max_deg, 2),
+                format!("{:.2}", b.width_deg),
+                format!("{:.2}", b.mean_deg),
+                format!("{:.2}", b.sd_deg),
+                interval(b.adjusted_min_deg, b.adjusted_max_deg, 2),
+                ranges(&b.initial_ranges_deg),
+                interval(b.com_y_min, b.com_y_max, 3),
+                b.samples.to_string(),
+            ]);
+        }
+        let nc = m.samples.iter().filter(|s| !s.contact).count();
+        if nc > 0 {
+            let dash = || "—".to_string();
+            out.push([
+                format!("{:+}", m.d),
+                "NC".into(),
+                dash(),
+                dash(),
+                dash(),
+                dash(),
+                dash(),
+                ranges(&m.no_contact_ranges_deg),
+                dash(),
+                nc.to_string(),
+            ]);
+        }
+    }
+    out
+}
+
+/// Aligned plain-text table for the terminal.
+pub fn bands_text(maps: &[ConfigurationMap]) -> String {
+    let rows = rows(maps);
+    let mut width: Vec<usize> = HEADER.iter().map(|h| h.chars().count()).collect();
+    for r in &rows {
+        for (w, c) in width.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |cells: Vec<&str>| -> String {
+        let padded: Vec<String> = cells
+            .iter()
+            .zip(&width)
+            .map(|(c, &w)| format!("{c}{}", " ".repeat(w - c.chars().count())))
+            .collect();
+        padded.join("  ").trim_end().to_string() + "\n"
+    };
+    let mut s = line(HEADER.to_vec());
+    let mut last_d: Option<&str> = None;
+    for r in &rows {
+        if last_d.is_some_and(|d| d != r[0]) {
+            s.push('\n');
+        }
+        last_d = Some(&r[0]);
+        s += &line(r.iter().map(String::as_str).collect());
+    }
+    s
+}
+
+/// Markdown table for results files.
+pub fn bands_markdown(maps: &[ConfigurationMap]) -> String {
+    let mut s = format!("| {} |\n", HEADER.join(" | "));
+    s += &format!("|{}\n", "---|".repeat(HEADER.len()));
+    for r in rows(maps) {
+        s += &format!("| {} |\n", r.join(" | "));
+    }
+    s
+}

@@ -1,0 +1,310 @@
+//! SVG figures of configuration maps (thesis chapter 3):
+//!
+//! * [`plot_map`]: one map as θ0 against θf (the thesis's Figure 3-3): samples coloured by band,
+//!   each band B_j shaded over the θ0 runs K_j that feed it, its adjusted interval (mean ± sd) as
+//!   dashed lines, no-contact samples as red crosses on the diagonal with their runs NC_j drawn along
+//!   it, and samples whose contact did not end `ok` ringed in black.
+//! * [`plot_band_intervals`]: band intervals against d for every map given (Figure 3-6), with "+"
+//!   at the ends and a dot at the mean; with `adjusted` the intervals are mean ± sd (Figure 3-8),
+//!   drawn over the raw ones in grey.
+//!
+//! Intervals straddling 0°/360° are drawn as two pieces.
+
+use crate::geometry::wrap_deg;
+use crate::maps::{Band, ConfigurationMap};
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::element::ComposedElement;
+use plotters::prelude::*;
+use std::path::Path;
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+    RGBColor(140, 86, 75),
+    RGBColor(188, 189, 34),
+    RGBColor(227, 119, 194),
+];
+
+/// The arc that starts at `start` (degrees) and runs `width` degrees counter-clockwise, as pieces
+/// inside [0, 360].
+fn arc_pieces(start: f64, width: f64) -> Vec<(f64, f64)> {
+    if width >= 360.0 {
+        return vec![(0.0, 360.0)];
+    }
+    let lo = wrap_deg(start);
+    let hi = lo + width;
+    if hi <= 360.0 {
+        vec![(lo, hi)]
+    } else {
+        vec![(lo, 360.0), (0.0, hi - 360.0)]
+    }
+}
+
+/// A θ0 run [first, last] on a grid of spacing `step`, widened by half a step each side.
+fn run_pieces(run: [f64; 2], step: f64) -> Vec<(f64, f64)> {
+    arc_pieces(run[0] - step / 2.0, wrap_deg(run[1] - run[0]) + step)
+}
+
+fn raw_arc(b: &Band) -> Vec<(f64, f64)> {
+    arc_pieces(b.final_min_deg, b.width_deg)
+}
+
+fn adjusted_arc(b: &Band) -> Vec<(f64, f64)> {
+    arc_pieces(b.mean_deg - b.sd_deg, 2.0 * b.sd_deg)
+}
+
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A white chart with a title, `x` across and orientations 0°…`y_top` up.
+fn degree_chart<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, Shift>,
+    title: &str,
+    x: std::ops::Range<f64>,
+    y_top: f64,
+) -> anyhow::Result<Chart<'a, 'b>> {
+    root.fill(&WHITE)?;
+    Ok(ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 18))
+        .margin(14)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(x, 0.0..y_top)?)
+}
+
+fn draw_legend<'a, 'b: 'a>(
+    ch: &mut Chart<'a, 'b>,
+    position: SeriesLabelPosition,
+) -> anyhow::Result<()> {
+    ch.configure_series_labels()
+        .position(position)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.85))
+        .label_font(("sans-serif", 12))
+        .draw()?;
+    Ok(())
+}
+
+/// Draw one configuration map (θ0 against θf) into an SVG file; `step_deg` is the θ0 grid spacing.
+pub fn plot_map(
+    map: &ConfigurationMap,
+    title: &str,
+    step_deg: f64,
+    path: &Path,
+) -> anyhow::Result<()> {
+    let root = SVGBackend::new(path, (760, 680)).into_drawing_area();
+    let mut ch = degree_chart(&root, title, 0.0..360.0, 360.0)?;
+    ch.configure_mesh()
+        .x_labels(13)
+        .y_labels(13)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .light_line_style(WHITE)
+        .x_desc("initial orientation θ0 (deg)")
+        .y_desc("final orientation θf (deg)")
+        .draw()?;
+    for (j, band) in map.bands.iter().enumerate() {
+        let colour = PALETTE[j % PALETTE.len()];
+        let runs: Vec<(f64, f64)> = band
+            .initial_ranges_deg
+            .iter()
+            .flat_map(|&r| run_pieces(r, step_deg))
+            .collect();
+        let mut shades = Vec::new();
+        for &(x0, x1) in &runs {
+            for (y0, y1) in raw_arc(band) {
+                shades.push(Rectangle::new(
+                    [(x0, y0), (x1, y1)],
+                    colour.mix(0.18).filled(),
+                ));
+            }
+        }
+        ch.draw_series(shades)?;
+        for &(x0, x1) in &runs {
+            for y in [band.adjusted_min_deg, band.adjusted_max_deg] {
+                ch.draw_series(DashedLineSeries::new(
+                    vec![(x0, y), (x1, y)],
+                    4,
+                    3,
+                    colour.stroke_width(1),
+                ))?;
+            }
+        }
+        let points = map
+            .samples
+            .iter()
+            .filter(|s| s.band == Some(j))
+            .map(|s| Circle::new((s.theta0_deg, s.theta_final_deg), 2, colour.filled()));
+        ch.draw_series(points)?
+            .label(format!(
+                "B{} [{:.1}°, {:.1}°], mean ± sd {:.1}° ± {:.1}°",
+                j + 1,
+                band.final_min_deg,
+                band.final_max_deg,
+                band.mean_deg,
+                band.sd_deg
+            ))
+            .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
+    }
+    for r in &map.no_contact_ranges_deg {
+        for (x0, x1) in run_pieces(*r, step_deg) {
+            ch.draw_series(LineSeries::new(
+                vec![(x0, x0), (x1, x1)],
+                RED.mix(0.35).stroke_width(6),
+            ))?;
+        }
+    }
+    if map.samples.iter().any(|s| !s.contact) {
+        let crosses = map
+            .samples
+            .iter()
+            .filter(|s| !s.contact)
+            .map(|s| Cross::new((s.theta0_deg, s.theta_final_deg), 3, RED));
+        ch.draw_series(crosses)?
+            .label("no contact (θf = θ0), runs NC_j shaded")
+            .legend(|(x, y)| Cross::new((x + 8, y), 4, RED));
+    }
+    if map.non_ok_samples() > 0 {
+        let rings = map
+            .samples
+            .iter()
+            .filter(|s| !s.status.is_ok())
+            .map(|s| Circle::new((s.theta0_deg, s.theta_final_deg), 5, BLACK));
+        ch.draw_series(rings)?
+            .label("contact status not ok")
+            .legend(|(x, y)| Circle::new((x + 8, y), 5, BLACK));
+    }
+    ch.draw_series(std::iter::once(PathElement::new(
+        vec![(0.0, 0.0), (0.0, 0.0)],
+        WHITE,
+    )))?
+    .label("dashed: adjusted band mean ± sd (eq. 3-2)")
+    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
+    draw_legend(&mut ch, SeriesLabelPosition::UpperLeft)?;
+    root.present()?;
+    Ok(())
+}
+
+/// A "+" marker of half-size `r` pixels at `at` (any coordinate system).
+type Plus<C, DB> = ComposedElement<C, DB, PathElement<(i32, i32)>, PathElement<(i32, i32)>>;
+
+fn plus<C, DB: DrawingBackend>(at: C, r: i32, style: ShapeStyle) -> Plus<C, DB> {
+    EmptyElement::at(at)
+        + PathElement::new(vec![(-r, 0), (r, 0)], style)
+        + PathElement::new(vec![(0, -r), (0, r)], style)
+}
+
+/// Draw the band intervals of all maps against d (Figure 3-6; with `adjusted`, Figure 3-8).
+pub fn plot_band_intervals(
+    maps: &[ConfigurationMap],
+    adjusted: bool,
+    title: &str,
+    path: &Path,
+) -> anyhow::Result<()> {
+    let (mut dmin, mut dmax) = maps
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), m| {
+            (lo.min(m.d), hi.max(m.d))
+        });
+    if !(dmin.is_finite() && dmax.is_finite()) {
+        (dmin, dmax) = (-1.0, 1.0);
+    }
+    let pad = ((dmax - dmin) * 0.06).max(0.1);
+    let root = SVGBackend::new(path, (900, 620)).into_drawing_area();
+    // Room above 360° for the legend, so it never hides an interval.
+    let mut ch = degree_chart(&root, title, (dmin - pad)..(dmax + pad), 420.0)?;
+    ch.configure_mesh()
+        .y_labels(15)
+        .y_label_formatter(&|v| {
+            if *v <= 360.0 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        })
+        .light_line_style(WHITE)
+        .x_desc("contact parameter d")
+        .y_desc(if adjusted {
+            "adjusted band mean ± sd (deg)"
+        } else {
+            "final orientation band (deg)"
+        })
+        .draw()?;
+    let blue = PALETTE[0];
+    let grey = RGBColor(185, 185, 185);
+    // The top of the circle: intervals above it continue from 0°.
+    ch.draw_series(LineSeries::new(
+        vec![(dmin - pad, 360.0), (dmax + pad, 360.0)],
+        BLACK.mix(0.6),
+    ))?;
+    for m in maps {
+        for b in &m.bands {
+            for (y0, y1) in raw_arc(b) {
+                let style = if adjusted {
+                    grey.stroke_width(5)
+                } else {
+                    blue.stroke_width(2)
+                };
+                ch.draw_series(LineSeries::new(vec![(m.d, y0), (m.d, y1)], style))?;
+            }
+            if adjusted {
+                for (y0, y1) in adjusted_arc(b) {
+                    ch.draw_series(LineSeries::new(
+                        vec![(m.d, y0), (m.d, y1)],
+                        blue.stroke_width(2),
+                    ))?;
+                }
+            }
+        }
+    }
+    let ends = maps.iter().flat_map(|m| {
+        m.bands.iter().flat_map(move |b| {
+            let (lo, hi) = if adjusted {
+                (b.adjusted_min_deg, b.adjusted_max_deg)
+            } else {
+                (b.final_min_deg, b.final_max_deg)
+            };
+            [
+                plus((m.d, lo), 5, BLACK.into()),
+                plus((m.d, hi), 5, BLACK.into()),
+            ]
+        })
+    });
+    ch.draw_series(ends)?
+        .label(if adjusted {
+            "adjusted band ends (mean ± sd); grey: raw band"
+        } else {
+            "band ends [min, max]"
+        })
+        .legend(|(x, y)| plus((x + 8, y), 5, BLACK.into()));
+    let means = maps.iter().flat_map(|m| {
+        m.bands
+            .iter()
+            .map(move |b| Circle::new((m.d, b.mean_deg), 3, RED.filled()))
+    });
+    ch.draw_series(means)?
+        .label("band mean")
+        .legend(|(x, y)| Circle::new((x + 8, y), 3, RED.filled()));
+    draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
+    root.present()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arcs_through_zero_are_split_in_two() {
+        assert_eq!(arc_pieces(350.0, 20.0), vec![(350.0, 360.0), (0.0, 10.0)]);
+        assert_eq!(arc_pieces(-5.0, 3.0), vec![(355.0, 358.0)]);
+        assert_eq!(arc_pieces(10.0, 400.0), vec![(0.0, 360.0)]);
+        assert_eq!(
+            run_pieces([359.0, 1.0], 1.0),
+            vec![(358.5, 360.0), (0.0, 1.5)]
+        );
+    }
+}

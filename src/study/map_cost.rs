@@ -1,0 +1,96 @@
+//! What a set of configuration maps costs: wall time of [`compute_maps`] (sampling, bands, runs; no
+//! output) for the thesis's set of 18 contact parameters d = ±0.1 … ±0.9 at 360 θ0 each, per part,
+//! fidelity and thread count. Each figure is the median (with min and max) of several repeats after
+//! one warm-up run; the pool is built once per thread count, outside the timed region.
+
+use crate::geometry::part_from_spec;
+use crate::maps::{compute_maps, MapSettings};
+use crate::mechanics::{Fidelity, PartModel, Support};
+use std::time::Instant;
+
+/// The thesis's contact parameters: ±0.1 … ±0.9.
+pub const THESIS_DS: [f64; 18] = [
+    -0.9, -0.8, -0.7, -0.6, -0.5, -0.4, -0.3, -0.2, -0.1, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8,
+    0.9,
+];
+
+/// One (part, fidelity, threads) row.
+#[derive(Debug, Clone)]
+pub struct MapCostRow {
+    pub part: String,
+    pub fidelity: Fidelity,
+    pub threads: usize,
+    pub contacts: usize,
+    pub median_s: f64,
+    pub min_s: f64,
+    pub max_s: f64,
+}
+
+/// Time `repeats` computations of the maps at `THESIS_DS` for each part, fidelity and thread count
+/// (μc = 0.5, point pin, uniform pressure, θ0 step `theta_step_deg`, threshold 5°).
+pub fn measure(
+    parts: &[&str],
+    fidelities: &[Fidelity],
+    thread_counts: &[usize],
+    theta_step_deg: f64,
+    repeats: usize,
+) -> anyhow::Result<Vec<MapCostRow>> {
+    let mut rows = Vec::new();
+    for part in parts {
+        let poly = part_from_spec(part)?;
+        let model = PartModel::new(&poly, &Support::Uniform).map_err(anyhow::Error::msg)?;
+        for &fidelity in fidelities {
+            let settings = MapSettings::point_pin(fidelity, 0.5, theta_step_deg, 5.0);
+            for &threads in thread_counts {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()?;
+                let mut times = Vec::with_capacity(repeats);
+                let mut contacts = 0;
+                for r in 0..=repeats {
+                    let t0 = Instant::now();
+                    let maps =
+                        pool.install(|| compute_maps(&poly, &model, &THESIS_DS, &settings))?;
+                    let dt = t0.elapsed().as_secs_f64();
+                    contacts = maps.iter().map(|m| m.samples.len()).sum();
+                    if r > 0 {
+                        times.push(dt);
+                    }
+                }
+                times.sort_by(f64::total_cmp);
+                rows.push(MapCostRow {
+                    part: part.to_string(),
+                    fidelity,
+                    threads,
+                    contacts,
+                    median_s: times[times.len() / 2],
+                    min_s: times[0],
+                    max_s: times[times.len() - 1],
+                });
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// Render the rows as a Markdown table.
+pub fn markdown(rows: &[MapCostRow]) -> String {
+    let mut s = String::from(
+        "| part | model | threads | contacts | median s | min s | max s | µs per contact |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        s += &format!(
+            "| {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.1} |\n",
+            r.part,
+            r.fidelity,
+            r.threads,
+            r.contacts,
+            r.median_s,
+            r.min_s,
+            r.max_s,
+            r.median_s * 1e6 * r.threads as f64 / r.contacts.max(1) as f64
+        );
+    }
+    s
+}
