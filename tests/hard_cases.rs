@@ -484,3 +484,62 @@ fn broad_sweep_has_no_numerical_failures() {
         failures.join("\n")
     );
 }
+
+/// Regressions found by map sweeps: a stiff tripod patch made the 1-D stick solve bounce between
+/// its bracket's ends (solver failure); a tripod with the COR near a support and a μc = 3 contact
+/// that once flapped between stick and slide at zero length.
+#[test]
+fn map_sweep_regressions() {
+    for (name, th, d, support, mu) in [
+        ("tripoly1", 335.0, 0.3, "tripod:1", 0.5),
+        ("tripoly2", 90.0, 0.1, "tripod:0", 0.5),
+        ("tripoly1", 1.0, -0.3, "uniform", 3.0),
+    ] {
+        let p = poly(name);
+        let m = PartModel::new(&p, &Support::parse(support, &p).unwrap()).unwrap();
+        let o = run(&m, &p, th, d, Pin::point(), &settings(Fidelity::Exact, mu));
+        check(&o, name);
+        assert!(
+            o.status.is_ok(),
+            "{name} θ0={th} d={d} {support} μc={mu}: {:?}",
+            o.status
+        );
+        assert!(o.segments.len() < 10, "{:?}", o.segments);
+    }
+}
+
+/// Tripod supports over whole maps (every 5°, three offsets, five random tripods, two triangles):
+/// no numerical status at all.
+#[test]
+fn tripod_map_sweep() {
+    let mut bad = Vec::new();
+    for name in ["tripoly1", "tripoly2"] {
+        let p = poly(name);
+        for seed in 0..5u64 {
+            let m = PartModel::new(&p, &Support::parse(&format!("tripod:{seed}"), &p).unwrap())
+                .unwrap();
+            for k in 0..72 {
+                let th = 5.0 * k as f64;
+                for d in [-0.3, 0.1, 0.3] {
+                    let o = run(&m, &p, th, d, Pin::point(), &settings(Fidelity::Exact, 0.5));
+                    check(&o, name);
+                    if !matches!(
+                        o.status,
+                        ContactStatus::Ok | ContactStatus::TravelLimit { .. }
+                    ) {
+                        bad.push(format!(
+                            "{name} tripod:{seed} θ0={th} d={d}: {:?}",
+                            o.status
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "{} failures:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
+}

@@ -532,6 +532,7 @@ impl PartModel {
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         let vscale = v.norm() / (1.0 + q.norm());
         let mut residual = f64::INFINITY;
+        let mut last_step = f64::INFINITY;
         for it in 0..200u32 {
             let xi = xi_of(om);
             *evals += 1;
@@ -563,6 +564,19 @@ impl PartModel {
             } else {
                 f64::NAN
             };
+            // Safeguard (as in Numerical Recipes' rtsafe): bisect when the Newton step leaves the
+            // bracket or fails to halve the step before it (a stiff, kink-like minimum, e.g. a
+            // support patch, makes Newton bounce between the bracket's ends).
+            let newton_step = (next - om).abs();
+            let slow = newton_step > 0.5 * last_step && lo.is_finite() && hi.is_finite();
+            last_step = if newton_step.is_finite() {
+                newton_step
+            } else {
+                f64::INFINITY
+            };
+            if slow {
+                next = f64::NAN;
+            }
             if !(next > lo && next < hi && next.is_finite()) {
                 next = if lo.is_finite() && hi.is_finite() {
                     0.5 * (lo + hi)
