@@ -12,7 +12,9 @@
 //! [`cli`] (the `pinfeed` command).
 
 pub mod cli;
+pub mod engine;
 pub mod geometry;
 pub mod mechanics;
 pub mod random;
 pub mod report;
+pub mod scenario;

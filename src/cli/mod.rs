@@ -3,6 +3,7 @@
 
 pub mod contact;
 pub mod part;
+pub mod run;
 
 use clap::{Parser, Subcommand};
 
@@ -20,6 +21,8 @@ pub enum Command {
     Part(part::PartArgs),
     /// One pin pass over one part (or a batch from CSV): final pose, rotation, contact segments.
     Contact(contact::ContactArgs),
+    /// Simulate a feeder line from a scenario file: throughput and orientation success.
+    Run(run::RunArgs),
 }
 
 /// Run a parsed command line.
@@ -27,5 +30,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
+        Command::Run(a) => run::run(&a),
     }
 }
