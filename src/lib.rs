@@ -18,3 +18,4 @@ pub mod mechanics;
 pub mod random;
 pub mod report;
 pub mod scenario;
+pub mod study;

@@ -28,16 +28,16 @@ pub struct ContactArgs {
     #[arg(long, allow_hyphen_values = true, required_unless_present = "cases")]
     pub d: Option<f64>,
     /// Pin–part friction coefficient μc (≥ 0).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
     /// Part–belt friction coefficient μs (> 0; scales forces only).
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub mu_s: f64,
     /// Fidelity: exact, ellipsoid or tip.
     #[arg(long, default_value = "exact")]
     pub model: String,
     /// Pin radius in part units (0: point pin).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Lateral pin speed as a fraction of the belt speed (moving pin).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -46,7 +46,7 @@ pub struct ContactArgs {
     #[arg(long, default_value = "uniform")]
     pub support: String,
     /// Integration tolerance (absolute, radians / units of a, per step).
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub tol: f64,
     /// Print one JSON object.
     #[arg(long)]

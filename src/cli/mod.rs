@@ -1,6 +1,7 @@
 //! The command-line interface: argument definitions and one module per sub-command. `main.rs` only
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
+pub mod bench;
 pub mod contact;
 pub mod part;
 pub mod run;
@@ -23,6 +24,8 @@ pub enum Command {
     Contact(contact::ContactArgs),
     /// Simulate a feeder line from a scenario file: throughput and orientation success.
     Run(run::RunArgs),
+    /// Measurements that write the reports in results/ (e.g. `bench contact`).
+    Bench(bench::BenchArgs),
 }
 
 /// Run a parsed command line.
@@ -31,5 +34,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
         Command::Run(a) => run::run(&a),
+        Command::Bench(a) => bench::run(&a),
     }
 }

@@ -515,12 +515,15 @@ fn second_contact(ctx: &Ctx, feat: Feat, pose: &Pose, s: f64) -> bool {
     false
 }
 
-struct Segments {
+/// Book-keeping of one pass: segments, events and steps so far.
+struct Tally {
     list: Vec<Segment>,
     open: Option<(Feat, Mode, f64, f64)>,
+    events: u32,
+    steps: u32,
 }
 
-impl Segments {
+impl Tally {
     fn open(&mut self, feat: Feat, mode: Mode, s: f64, theta: f64) {
         self.open = Some((feat, mode, s, theta));
     }
@@ -545,9 +548,7 @@ fn integrate_contact(
     s_start: f64,
     feat0: Feat,
     y_start: [f64; 2],
-    segs: &mut Segments,
-    events_used: &mut u32,
-    steps: &mut u32,
+    segs: &mut Tally,
 ) -> (End, f64, Pose) {
     let mut s = s_start;
     let (mut feat, mut y, mut inst) = match settle(ctx, s, feat0, y_start) {
@@ -636,7 +637,7 @@ fn integrate_contact(
                 inst = step.inst1;
                 f0 = step.f1;
                 ev0 = ev1;
-                *steps += 1;
+                segs.steps += 1;
                 ctx.record(s, feat, y, &inst);
                 let pose = ctx.pose(s, feat, y);
                 if second_contact(ctx, feat, &pose, s) {
@@ -743,7 +744,7 @@ fn integrate_contact(
             }
             match best_step {
                 Some(r) => {
-                    *steps += 1;
+                    segs.steps += 1;
                     (Some(i), s + best_t * h, r.y1, r.inst1)
                 }
                 None => (Some(i), s, y, inst),
@@ -753,12 +754,12 @@ fn integrate_contact(
         if std::env::var("PINFEED_DEBUG").is_ok() {
             eprintln!("event {i} at s={s_ev} mode={mode:?} feat={feat:?} y={y_ev:?} margins={:?} ev0={ev0:?}", inst_ev.margins);
         }
-        *events_used += 1;
-        if *events_used > settings.max_events {
+        segs.events += 1;
+        if segs.events > settings.max_events {
             let p = ctx.pose(s_ev, feat, y_ev);
             return (
                 End::Stop(ContactStatus::EventLimit {
-                    events: *events_used,
+                    events: segs.events,
                 }),
                 s_ev,
                 p,
@@ -780,10 +781,7 @@ fn integrate_contact(
                 };
                 if let (Feat::Vertex(k), false) = (feat, ctx.rho > 0.0) {
                     // Hooked point pin lets go: it sweeps onto the edge it now slides towards.
-                    match sweep(ctx, k, new_mode == Mode::SlideLeft, y[0]) {
-                        Some((f, yy)) => Some((f, yy, None)),
-                        None => None,
-                    }
+                    sweep(ctx, k, new_mode == Mode::SlideLeft, y[0]).map(|(f, yy)| (f, yy, None))
                 } else {
                     Some((feat, y, Some(new_mode)))
                 }
@@ -802,10 +800,7 @@ fn integrate_contact(
                     let n = ctx.poly.inward_normal(k);
                     Some((Feat::Vertex(v), [y[0], n.angle()], None))
                 } else {
-                    match sweep(ctx, v, i == 3, y[0]) {
-                        Some((f, yy)) => Some((f, yy, None)),
-                        None => None,
-                    }
+                    sweep(ctx, v, i == 3, y[0]).map(|(f, yy)| (f, yy, None))
                 }
             }
             (3, Feat::Vertex(k)) => {
@@ -922,12 +917,12 @@ pub fn push(
     let dir = ctx.vdir / dir_len;
     let mut s = 0.0;
     let mut cur = pose_n;
-    let mut segs = Segments {
+    let mut segs = Tally {
         list: Vec::new(),
         open: None,
+        events: 0,
+        steps: 0,
     };
-    let mut events_used = 0u32;
-    let mut steps = 0u32;
     let mut min_travel = 0.0;
     for _pass in 0..16 {
         let hit = first_contact(ctx.poly, &cur, ctx.pin_at(s), dir, ctx.rho, min_travel);
@@ -951,16 +946,8 @@ pub fn push(
         }
         let (feat, y) = initial_state(&ctx, &cur, hit.feature, hit.normal);
         // The pose at touch: the part has not moved; the state reconstructs it exactly.
-        let (end, s_end, pose_end) = integrate_contact(
-            &mut ctx,
-            settings,
-            s_touch,
-            feat,
-            y,
-            &mut segs,
-            &mut events_used,
-            &mut steps,
-        );
+        let (end, s_end, pose_end) =
+            integrate_contact(&mut ctx, settings, s_touch, feat, y, &mut segs);
         segs.close(s_end, pose_end.theta, k);
         out.contact_length += (s_end - s_touch) * k;
         s = s_end;
@@ -980,7 +967,7 @@ pub fn push(
     out.pose_final = Pose::new(cur.x * k, cur.y * k, cur.theta);
     out.rotation = cur.theta - pose.theta;
     out.evaluations = ctx.evals;
-    out.steps = steps;
+    out.steps = segs.steps;
     out
 }
 

@@ -6,7 +6,7 @@ use pinfeed::mechanics::{
     push, ContactOutcome, ContactSettings, Fidelity, PartModel, Pin, Support,
 };
 
-pub const FIDELITIES: [Fidelity; 2] = [Fidelity::Tip, Fidelity::Ellipsoid];
+pub const FIDELITIES: [Fidelity; 3] = [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact];
 
 pub fn poly(name: &str) -> Polygon {
     part_from_spec(name).unwrap()

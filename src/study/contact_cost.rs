@@ -1,0 +1,166 @@
+//! What one contact costs and how accurate it is at a given tolerance, per fidelity and part.
+//!
+//! For each part and fidelity, `n` random contacts (θ0 uniform in [0°, 360°), d uniform in
+//! [−0.9, 0.9], from the reproducible stream (seed, part index)) are run at the tolerance under test
+//! and again at a 1000× tighter one with the same fidelity. The *self-accuracy* is the difference in
+//! final orientation between the two (it measures integration error, not model error: how far each
+//! fidelity is from the exact model is the accuracy-vs-time study's business). Times are wall-clock
+//! per contact on the calling thread, reported as median and 90th percentile.
+
+use crate::geometry::{part_from_spec, wrap_deg, Pose, Vec2};
+use crate::mechanics::{push, ContactSettings, Fidelity, PartModel, Pin, Support};
+use rand::RngExt;
+use serde::Serialize;
+use std::time::Instant;
+
+/// One (part, fidelity) row of the contact-cost table.
+#[derive(Debug, Clone, Serialize)]
+pub struct ContactCostRow {
+    pub part: String,
+    pub fidelity: String,
+    pub contacts: usize,
+    /// Contacts that touched the part (the rest passed it).
+    pub touching: usize,
+    pub median_us: f64,
+    pub p90_us: f64,
+    pub mean_evaluations: f64,
+    pub mean_steps: f64,
+    /// |θf(tol) − θf(tol/1000)| in degrees: mean, 95th percentile, max.
+    pub self_error_mean_deg: f64,
+    pub self_error_p95_deg: f64,
+    pub self_error_max_deg: f64,
+    /// Contacts whose status was not ok, by status name.
+    pub non_ok: Vec<(String, usize)>,
+}
+
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let idx = ((sorted.len() - 1) as f64 * q).round() as usize;
+    sorted[idx]
+}
+
+/// Measure the contact cost table.
+pub fn measure(
+    parts: &[&str],
+    fidelities: &[Fidelity],
+    n: usize,
+    tol: f64,
+    seed: u64,
+) -> anyhow::Result<Vec<ContactCostRow>> {
+    let mut rows = Vec::new();
+    for (pi, part) in parts.iter().enumerate() {
+        let poly = part_from_spec(part)?;
+        let model = PartModel::new(&poly, &Support::Uniform).map_err(anyhow::Error::msg)?;
+        let a = poly.radius();
+        let mut rng = crate::random::stream(seed, pi as u64);
+        let cases: Vec<(f64, f64)> = (0..n)
+            .map(|_| {
+                (
+                    rng.random::<f64>() * 360.0,
+                    -0.9 + 1.8 * rng.random::<f64>(),
+                )
+            })
+            .collect();
+        for &fid in fidelities {
+            let s = ContactSettings {
+                fidelity: fid,
+                tol,
+                ..ContactSettings::default()
+            };
+            let tight = ContactSettings {
+                tol: tol * 1e-3,
+                ..s
+            };
+            let run = |st: &ContactSettings, th: f64, d: f64| {
+                let pose = Pose::new(0.0, 0.0, th.to_radians());
+                push(
+                    &model,
+                    pose,
+                    Vec2::new(1.01 * a, d * a),
+                    &Pin::point(),
+                    st,
+                    None,
+                )
+            };
+            // Warm up caches and the branch predictor.
+            for &(th, d) in cases.iter().take(20) {
+                std::hint::black_box(run(&s, th, d));
+            }
+            let mut times = Vec::with_capacity(n);
+            let mut evals = 0u64;
+            let mut steps = 0u64;
+            let mut errors = Vec::with_capacity(n);
+            let mut touching = 0;
+            let mut non_ok: std::collections::BTreeMap<String, usize> = Default::default();
+            for &(th, d) in &cases {
+                let t0 = Instant::now();
+                let o = std::hint::black_box(run(&s, th, d));
+                times.push(t0.elapsed().as_secs_f64() * 1e6);
+                if !o.status.is_ok() {
+                    *non_ok.entry(o.status.name().to_string()).or_default() += 1;
+                }
+                if !o.contact {
+                    continue;
+                }
+                touching += 1;
+                evals += o.evaluations;
+                steps += o.steps as u64;
+                let r = run(&tight, th, d);
+                let e = wrap_deg(
+                    o.pose_final.theta.to_degrees() - r.pose_final.theta.to_degrees() + 180.0,
+                ) - 180.0;
+                errors.push(e.abs());
+            }
+            times.sort_by(f64::total_cmp);
+            errors.sort_by(f64::total_cmp);
+            let k = touching.max(1) as f64;
+            rows.push(ContactCostRow {
+                part: part.to_string(),
+                fidelity: fid.name().into(),
+                contacts: n,
+                touching,
+                median_us: percentile(&times, 0.5),
+                p90_us: percentile(&times, 0.9),
+                mean_evaluations: evals as f64 / k,
+                mean_steps: steps as f64 / k,
+                self_error_mean_deg: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
+                self_error_p95_deg: percentile(&errors, 0.95),
+                self_error_max_deg: errors.last().copied().unwrap_or(0.0),
+                non_ok: non_ok.into_iter().collect(),
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// Render the table as Markdown.
+pub fn markdown(rows: &[ContactCostRow]) -> String {
+    let mut s = String::new();
+    s.push_str("| part | model | touching / contacts | median µs | p90 µs | evaluations | steps | self-error mean ° | p95 ° | max ° | not ok |\n");
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for r in rows {
+        let bad: Vec<String> = r.non_ok.iter().map(|(k, v)| format!("{k}: {v}")).collect();
+        s.push_str(&format!(
+            "| {} | {} | {}/{} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2e} | {:.2e} | {:.2e} | {} |\n",
+            r.part,
+            r.fidelity,
+            r.touching,
+            r.contacts,
+            r.median_us,
+            r.p90_us,
+            r.mean_evaluations,
+            r.mean_steps,
+            r.self_error_mean_deg,
+            r.self_error_p95_deg,
+            r.self_error_max_deg,
+            if bad.is_empty() {
+                "—".into()
+            } else {
+                bad.join(", ")
+            }
+        ));
+    }
+    s
+}
