@@ -104,13 +104,15 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         (Some(_), Some(_)) => {
             return Err(c.err("part.vertices", "give either shape or vertices, not both"))
         }
-        (None, None) => return Err(c.err(
-            "part",
-            format!(
+        (None, None) => {
+            return Err(c.err(
+                "part",
+                format!(
                 "the part needs shape = one of {} (e.g. \"tripoly2\"), or vertices = [[x, y], ...]",
                 named::PART_NAMES.join(", ")
             ),
-        )),
+            ))
+        }
         (Some(shape), None) => {
             if shape.trim_start().starts_with("vertices") {
                 return Err(c.err(
@@ -285,33 +287,24 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
                 }
                 Ok(())
             };
+            let on_belt = |key: &str, v: Option<f64>| {
+                c.within(
+                    &format!("feed.lateral.{key}"),
+                    v.unwrap_or(0.0),
+                    -reach,
+                    reach,
+                    &range,
+                )
+            };
             match l.distribution {
                 LateralKind::Fixed => {
                     allowed(&["value"])?;
-                    Lateral::Fixed(c.within(
-                        "feed.lateral.value",
-                        l.value.unwrap_or(0.0),
-                        -reach,
-                        reach,
-                        &range,
-                    )?)
+                    Lateral::Fixed(on_belt("value", l.value)?)
                 }
                 LateralKind::Uniform => {
                     allowed(&["min", "max"])?;
-                    let min = c.within(
-                        "feed.lateral.min",
-                        l.min.unwrap_or(0.0),
-                        -reach,
-                        reach,
-                        &range,
-                    )?;
-                    let max = c.within(
-                        "feed.lateral.max",
-                        l.max.unwrap_or(0.0),
-                        -reach,
-                        reach,
-                        &range,
-                    )?;
+                    let min = on_belt("min", l.min)?;
+                    let max = on_belt("max", l.max)?;
                     if min > max {
                         return Err(c.err(
                             "feed.lateral.max",
@@ -322,13 +315,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
                 }
                 LateralKind::Normal => {
                     allowed(&["mean", "sd"])?;
-                    let mean = c.within(
-                        "feed.lateral.mean",
-                        l.mean.unwrap_or(0.0),
-                        -reach,
-                        reach,
-                        &range,
-                    )?;
+                    let mean = on_belt("mean", l.mean)?;
                     let sd = c.non_negative("feed.lateral.sd", l.sd.unwrap_or(0.0), "m")?;
                     Lateral::Normal {
                         mean,

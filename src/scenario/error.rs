@@ -92,7 +92,7 @@ impl<'a> Locator<'a> {
             .unwrap_or(0)
             .max(1);
         let gutter = line.to_string().len();
-        let excerpt = if text_line.is_empty() && span.is_empty() && line == 1 {
+        let excerpt = if span == (0..0) {
             String::new()
         } else {
             format!(
@@ -124,6 +124,13 @@ impl<'a> Locator<'a> {
     pub fn from_toml(&self, e: &toml::de::Error) -> ScenarioError {
         let span = e.span().unwrap_or(0..0);
         let message = e.message().trim().to_string();
+        if !self.doc.is_toml() {
+            return self.at_span(
+                span,
+                &KeyPath::parse("(TOML syntax)"),
+                format!("{message} (the file is not valid TOML)"),
+            );
+        }
         let mut key = self.doc.path_at(&span);
         if let Some(field) = backticked_after(&message, "missing field ") {
             key = key.key(&field);

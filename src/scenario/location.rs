@@ -97,6 +97,11 @@ impl<'a> SpannedDoc<'a> {
         }
     }
 
+    /// Did the file parse as TOML?
+    pub fn is_toml(&self) -> bool {
+        self.root.is_some()
+    }
+
     /// Span of the value at `path`, or of its nearest existing ancestor (for a missing key: the
     /// table that should hold it). The root maps to the start of the file.
     pub fn span_of(&self, path: &KeyPath) -> Range<usize> {
@@ -112,9 +117,7 @@ impl<'a> SpannedDoc<'a> {
                     .iter()
                     .find(|(key, _)| key.get_ref().as_ref() == k.as_str())
                     .map(|(_, v)| v),
-                (PathStep::Index(i), _, Some(v)) => {
-                    v.get_ref().as_array().and_then(|a| a.get(*i))
-                }
+                (PathStep::Index(i), _, Some(v)) => v.get_ref().as_array().and_then(|a| a.get(*i)),
                 _ => None,
             };
             let Some(v) = next else { break };
@@ -125,50 +128,65 @@ impl<'a> SpannedDoc<'a> {
         best
     }
 
-    /// The deepest key path whose key or value span contains `offset` (for errors reported by
-    /// serde with a span but no key).
+    /// The key path of the tightest key or value span that contains `span` (for errors reported
+    /// by serde with a span but no key). Table headers' spans do not cover their bodies, so the
+    /// whole tree is searched.
     pub fn path_at(&self, span: &Range<usize>) -> KeyPath {
         let Some(root) = &self.root else {
             return KeyPath::root();
         };
-        let mut path = KeyPath::root();
-        let mut table: Option<&DeTable> = Some(root.get_ref());
-        let mut array: Option<&Spanned<DeValue>> = None;
-        let inside = |r: &Range<usize>| r.start <= span.start && span.end <= r.end.max(r.start + 1);
-        loop {
-            let mut next: Option<&Spanned<DeValue>> = None;
-            if let Some(t) = table {
-                for (k, v) in t.iter() {
-                    if inside(&k.span()) || inside(&v.span()) {
-                        path = path.key(k.get_ref());
-                        next = Some(v);
-                        break;
-                    }
-                }
-            } else if let Some(a) = array.and_then(|v| v.get_ref().as_array()) {
-                for (i, v) in a.iter().enumerate() {
-                    if inside(&v.span()) {
-                        path = path.index(i);
-                        next = Some(v);
-                        break;
-                    }
-                }
-            }
-            let Some(v) = next else { break };
-            if v.span() == *span {
-                break;
-            }
-            table = v.get_ref().as_table();
-            array = if table.is_none() && v.get_ref().as_array().is_some() {
-                Some(v)
-            } else {
-                None
-            };
-            if table.is_none() && array.is_none() {
-                break;
-            }
+        let mut best: Option<(usize, KeyPath)> = None;
+        walk_table(root.get_ref(), &KeyPath::root(), span, &mut best);
+        best.map(|(_, p)| p).unwrap_or_default()
+    }
+}
+
+fn consider(
+    r: &Range<usize>,
+    span: &Range<usize>,
+    path: &KeyPath,
+    best: &mut Option<(usize, KeyPath)>,
+) {
+    let contains = r.start <= span.start && span.end <= r.end.max(r.start + 1);
+    if !contains {
+        return;
+    }
+    let size = r.end - r.start;
+    let better = match best {
+        None => true,
+        Some((s, p)) => size < *s || (size == *s && path.0.len() > p.0.len()),
+    };
+    if better {
+        *best = Some((size, path.clone()));
+    }
+}
+
+fn walk_value(
+    v: &Spanned<DeValue>,
+    path: &KeyPath,
+    span: &Range<usize>,
+    best: &mut Option<(usize, KeyPath)>,
+) {
+    consider(&v.span(), span, path, best);
+    if let Some(t) = v.get_ref().as_table() {
+        walk_table(t, path, span, best);
+    } else if let Some(a) = v.get_ref().as_array() {
+        for (i, item) in a.iter().enumerate() {
+            walk_value(item, &path.index(i), span, best);
         }
-        path
+    }
+}
+
+fn walk_table(
+    t: &DeTable,
+    path: &KeyPath,
+    span: &Range<usize>,
+    best: &mut Option<(usize, KeyPath)>,
+) {
+    for (k, v) in t.iter() {
+        let p = path.key(k.get_ref());
+        consider(&k.span(), span, &p, best);
+        walk_value(v, &p, span, best);
     }
 }
 
