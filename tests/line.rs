@@ -487,3 +487,24 @@ fn run_command_writes_results_and_draws_the_line() {
     ]);
     assert!(q.status.success() && q.stdout.is_empty());
 }
+
+#[test]
+fn a_part_the_pin_never_releases_is_a_jam() {
+    // tripoly2 lying on its short leg (90°), pushed exactly through its centroid: the push never
+    // turns it, so it rides on the pin until the travel limit.
+    let s = scene(&scenario_text(
+        &[
+            ("weights = [1, 0, 0]", "weights = [0, 1, 0]"),
+            ("headway = 12.0", "headway = 40.0"),
+            ("parts = 40", "parts = 3"),
+            (
+                "distribution = \"uniform\"\nmin = -0.002\nmax = 0.002",
+                "distribution = \"fixed\"\nvalue = 0.0",
+            ),
+        ],
+        "[model]\nmax_travel = 20\n",
+    ));
+    let r = run(&s);
+    assert_eq!(r.summary.outcomes.jam, 3, "{:?}", r.summary.outcomes);
+    assert!(r.summary.latency_s.is_none(), "no part reached the end");
+}

@@ -8,6 +8,7 @@ use crate::report::{line_table, parts_csv, plot_line, plot_orientations};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -103,16 +104,28 @@ pub fn run(args: &RunArgs) -> Result<()> {
             .with_context(|| format!("writing {}", p.display()))?;
     }
 
+    let mut text = String::new();
     if args.json {
-        print!("{json}");
+        text = json;
     } else if !args.quiet {
-        print!("{}", line_table::table(summary));
+        text.push_str(&line_table::table(summary));
         let parts_per_s = summary.parts_in as f64 / wall.max(1e-9);
         let contacts_per_s = summary.work.contact_solves as f64 / wall.max(1e-9);
-        println!(
-            "simulator speed           {parts_per_s:.0} parts/s, {contacts_per_s:.0} contacts/s ({wall:.2} s wall)"
-        );
-        println!("results                   {}", dir.display());
+        text.push_str(&format!(
+            "simulator speed           {parts_per_s:.0} parts/s, {contacts_per_s:.0} contacts/s ({wall:.2} s wall)\n"
+        ));
+        text.push_str(&format!("results                   {}\n", dir.display()));
+    }
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|_| stdout.flush())
+    {
+        // A closed pipe (`| head`) is the reader's choice, not an error.
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            return Err(e).context("writing to stdout")
+        }
+        _ => {}
     }
     Ok(())
 }
