@@ -34,7 +34,7 @@ use super::outcome::PartOutcome;
 use super::overlap::{disc_clearance, first_touch, polygon_clearance, segment_distance};
 use super::part_stream::{arrival_gap, draw_part};
 use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
-use crate::mechanics::{push, ContactSettings, ContactStatus, PartModel, Pin};
+use crate::mechanics::{push, ContactSettings, ContactStatus, PartModel, Pin, SolveFailure};
 use crate::scenario::{Arrival, Obstacle, Scene};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -368,6 +368,12 @@ impl Line<'_> {
             ContactStatus::Ok => None,
             ContactStatus::MultiContact { .. } => Some(Stop::MultiContact { cause: "notch" }),
             ContactStatus::TravelLimit { .. } => Some(Stop::Jam),
+            ContactStatus::Solver { failure, .. } => Some(Stop::Solver {
+                cause: match failure {
+                    SolveFailure::NoConvergence { .. } => "no_convergence",
+                    SolveFailure::NonFinite => "non_finite",
+                },
+            }),
             other => Some(Stop::Solver {
                 cause: other.name(),
             }),

@@ -23,7 +23,8 @@ pub enum Stop {
     MultiContact { cause: &'static str },
     /// The pin never released the part within the travel limit.
     Jam,
-    /// The contact model failed; `cause` is the contact status name.
+    /// The contact model failed; `cause` is the contact status name (`evaluation_limit`,
+    /// `event_limit`, `step_too_small`), or for a failed sub-problem `no_convergence` / `non_finite`.
     Solver { cause: &'static str },
 }
 
