@@ -427,3 +427,60 @@ proptest! {
         );
     }
 }
+
+/// A broad sweep (4 parts × 3 fidelities × 3 friction values × 40 seeded poses, plus random tripods):
+/// no contact may end in a numerical status (solver, step, event or evaluation limit).
+#[test]
+fn broad_sweep_has_no_numerical_failures() {
+    use rand::RngExt;
+    let mut rng = pinfeed::random::stream(2026, 0);
+    let mut failures = Vec::new();
+    for name in ["tripoly1", "tripoly2", "square", "lshape"] {
+        let p = poly(name);
+        let uniform = model(&p);
+        for fid in FIDELITIES {
+            for mu in [0.0, 0.3, 1.0] {
+                for _ in 0..40 {
+                    let th = rng.random::<f64>() * 360.0;
+                    let d = -0.95 + 1.9 * rng.random::<f64>();
+                    let o = run(&uniform, &p, th, d, Pin::point(), &settings(fid, mu));
+                    check(&o, name);
+                    if !matches!(
+                        o.status,
+                        ContactStatus::Ok | ContactStatus::MultiContact { .. }
+                    ) {
+                        failures.push(format!(
+                            "{name} {fid} μc={mu} θ0={th} d={d}: {:?}",
+                            o.status
+                        ));
+                    }
+                }
+            }
+        }
+        for seed in 0..6u64 {
+            let sup = Support::parse(&format!("tripod:{seed}"), &p).unwrap();
+            let m = PartModel::new(&p, &sup).unwrap();
+            for _ in 0..10 {
+                let th = rng.random::<f64>() * 360.0;
+                let d = -0.95 + 1.9 * rng.random::<f64>();
+                let o = run(&m, &p, th, d, Pin::point(), &settings(Fidelity::Exact, 0.5));
+                check(&o, name);
+                if !matches!(
+                    o.status,
+                    ContactStatus::Ok | ContactStatus::MultiContact { .. }
+                ) {
+                    failures.push(format!(
+                        "{name} tripod:{seed} θ0={th} d={d}: {:?}",
+                        o.status
+                    ));
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}

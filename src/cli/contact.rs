@@ -7,7 +7,8 @@
 
 use crate::geometry::{named, wrap_deg, Polygon, Pose, Vec2};
 use crate::mechanics::{
-    push, ContactOutcome, ContactSettings, Fidelity, PartModel, Pin, Support, TraceSample,
+    push, push_fence, ContactOutcome, ContactSettings, FenceSpec, Fidelity, PartModel, Pin,
+    Support, TraceSample,
 };
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -57,6 +58,11 @@ pub struct ContactArgs {
     /// Draw the part's successive poses against the pin into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
+    /// Push with a fence instead of a pin: angle from the belt direction in degrees (−90 < α < 90;
+    /// positive fences deflect parts to the left) and optional length in part units (default 20a).
+    /// The fence line crosses the part's path at y = d·a; `--mu-c` is the fence friction μf.
+    #[arg(long, value_name = "ANGLE_DEG[:LENGTH]", allow_hyphen_values = true)]
+    pub fence: Option<String>,
     /// Batch mode: a CSV with columns part,theta0,d,mu_c (+ optional model,pin_radius,mu_s); one
     /// output row per case goes to stdout.
     #[arg(long, value_name = "FILE.csv", conflicts_with_all = ["part", "theta0", "d", "json", "trace", "plot"])]
@@ -101,6 +107,64 @@ pub struct Case {
     pub pin_speed: f64,
     pub support: String,
     pub tol: f64,
+    /// A fence (angle in degrees, length in part units; None = default length) instead of a pin.
+    pub fence: Option<(f64, Option<f64>)>,
+}
+
+/// Parse `ANGLE_DEG[:LENGTH]`.
+pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>)> {
+    let mut it = spec.splitn(2, ':');
+    let angle: f64 = it
+        .next()
+        .unwrap_or("")
+        .trim()
+        .parse()
+        .with_context(|| format!("--fence '{spec}': the angle is not a number"))?;
+    if !(angle.is_finite() && angle.abs() < 90.0) {
+        bail!("--fence '{spec}': the angle must be strictly between -90 and 90 degrees");
+    }
+    let length = match it.next() {
+        None => None,
+        Some(l) => {
+            let l: f64 = l
+                .trim()
+                .parse()
+                .with_context(|| format!("--fence '{spec}': the length is not a number"))?;
+            if !(l.is_finite() && l > 0.0) {
+                bail!("--fence '{spec}': the length must be a positive number");
+            }
+            Some(l)
+        }
+    };
+    Ok((angle, length))
+}
+
+/// The fence of a case: its line crosses the part's path at y = d·a, clear of the part (the part's
+/// circumscribed circle lies on the upstream side), and it starts 1.5a beyond the part's band on the
+/// side it comes from.
+pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>) -> FenceSpec {
+    let a = poly.radius();
+    let angle = angle_deg.to_radians();
+    let e = Vec2::from_angle(angle);
+    let mut n = e.perp();
+    if n.x > 0.0 {
+        n = -n;
+    }
+    let y = c.d * a;
+    let x = (1.01 * a + y * n.y) / (-n.x);
+    let cross = Vec2::new(x, y);
+    let sin = angle.sin();
+    let back = if sin.abs() > 1e-12 {
+        (y + sin.signum() * 1.5 * a) / sin
+    } else {
+        0.0
+    };
+    FenceSpec {
+        start: cross - e * back,
+        angle,
+        length: length.unwrap_or(20.0 * a),
+        mu_f: c.mu_c,
+    }
 }
 
 fn check_inputs(c: &Case) -> Result<()> {
@@ -165,10 +229,14 @@ pub fn run_case(c: &Case, want_trace: bool) -> Result<(Polygon, ContactOutcome, 
     };
     let (pose, start) = case_geometry(&poly, c);
     let mut trace: Vec<TraceSample> = Vec::new();
-    let out = if want_trace {
-        push(&model, pose, start, &pin, &settings, Some(&mut trace))
-    } else {
-        push(&model, pose, start, &pin, &settings, None)
+    let recorder: Option<&mut dyn crate::mechanics::Recorder> =
+        if want_trace { Some(&mut trace) } else { None };
+    let out = match c.fence {
+        Some((angle, length)) => {
+            let fence = case_fence(&poly, c, angle, length);
+            push_fence(&model, pose, &fence, &settings, recorder)
+        }
+        None => push(&model, pose, start, &pin, &settings, recorder),
     };
     Ok((poly, out, trace))
 }
@@ -218,6 +286,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         pin_speed: args.pin_speed,
         support: args.support.clone(),
         tol: args.tol,
+        fence: args.fence.as_deref().map(parse_fence).transpose()?,
     };
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
@@ -251,11 +320,12 @@ pub fn run(args: &ContactArgs) -> Result<()> {
                 .segments
                 .iter()
                 .map(|s| {
-                    let f = match s.feature {
-                        crate::mechanics::ContactFeature::Edge(k) => format!("edge {k}"),
-                        crate::mechanics::ContactFeature::Vertex(k) => format!("vertex {k}"),
-                    };
-                    format!("{f} {}", s.mode.name())
+                    format!(
+                        "{} {} {}",
+                        s.feature.kind(),
+                        s.feature.index(),
+                        s.mode.name()
+                    )
                 })
                 .collect();
             println!("segments            {}", segs.join(" → "));
@@ -276,10 +346,7 @@ fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
         "s,x,y,theta_deg,pin_x,pin_y,contact_x,contact_y,force_x,force_y,mode,feature,index"
     )?;
     for t in trace {
-        let (kind, idx) = match t.feature {
-            crate::mechanics::ContactFeature::Edge(k) => ("edge", k),
-            crate::mechanics::ContactFeature::Vertex(k) => ("vertex", k),
-        };
+        let (kind, idx) = (t.feature.kind(), t.feature.index());
         writeln!(
             f,
             "{},{},{},{},{},{},{},{},{},{},{},{},{}",
@@ -361,6 +428,7 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
             pin_speed: args.pin_speed,
             support: args.support.clone(),
             tol: args.tol,
+            fence: None,
         };
         let (_, out, _) =
             run_case(&c, false).with_context(|| format!("{}:{line}", path.display()))?;

@@ -45,9 +45,11 @@ impl Vec2 {
             y: self.x,
         }
     }
+    /// Euclidean length (plain √(x²+y²): `hypot` is several times slower and pinfeed's lengths are
+    /// far from overflow).
     #[inline]
     pub fn norm(self) -> f64 {
-        self.x.hypot(self.y)
+        (self.x * self.x + self.y * self.y).sqrt()
     }
     #[inline]
     pub fn norm2(self) -> f64 {

@@ -77,10 +77,34 @@ pub struct Warm {
     pub stick_omega: Option<f64>,
 }
 
-/// Friction settings of the contact.
+/// Friction settings of the contact: μc and the friction-cone half-angle's sine and cosine
+/// (precomputed: the cone edges are needed at every instant).
 #[derive(Debug, Clone, Copy)]
 pub struct Friction {
     pub mu_c: f64,
+    sin_phi: f64,
+    cos_phi: f64,
+}
+
+impl Friction {
+    pub fn new(mu_c: f64) -> Friction {
+        let c = 1.0 / (1.0 + mu_c * mu_c).sqrt();
+        Friction {
+            mu_c,
+            sin_phi: mu_c * c,
+            cos_phi: c,
+        }
+    }
+    /// The counter-clockwise friction-cone edge R(+atan μc) n.
+    #[inline]
+    pub fn left_edge(&self, n: Vec2) -> Vec2 {
+        n.rotate_sc(self.sin_phi, self.cos_phi)
+    }
+    /// The clockwise friction-cone edge R(−atan μc) n.
+    #[inline]
+    pub fn right_edge(&self, n: Vec2) -> Vec2 {
+        n.rotate_sc(-self.sin_phi, self.cos_phi)
+    }
 }
 
 const GUARD: f64 = 1e-9;
@@ -146,7 +170,6 @@ pub fn solve_in_mode(
     warm: &mut Warm,
     evals: &mut u64,
 ) -> Result<Instant, SolveFailure> {
-    let phi = fr.mu_c.atan();
     match mode {
         Mode::Stick => stick_instant(model, fid, g, fr, warm, evals),
         Mode::Slide => {
@@ -159,7 +182,8 @@ pub fn solve_in_mode(
             })
         }
         Mode::SlideLeft => {
-            let (xi, vb, f) = slide_instant(model, fid, g, g.n.rotate(phi), &mut warm.left, evals)?;
+            let (xi, vb, f) =
+                slide_instant(model, fid, g, fr.left_edge(g.n), &mut warm.left, evals)?;
             let mut m = sine(vb, g.v_pin);
             if g.n.dot(vb) <= GUARD * vb.norm() {
                 m = m.min(-1e-3);
@@ -173,7 +197,7 @@ pub fn solve_in_mode(
         }
         Mode::SlideRight => {
             let (xi, vb, f) =
-                slide_instant(model, fid, g, g.n.rotate(-phi), &mut warm.right, evals)?;
+                slide_instant(model, fid, g, fr.right_edge(g.n), &mut warm.right, evals)?;
             let mut m = -sine(vb, g.v_pin);
             if g.n.dot(vb) <= GUARD * vb.norm() {
                 m = m.min(-1e-3);
@@ -269,7 +293,7 @@ mod tests {
                 &m,
                 Fidelity::Ellipsoid,
                 &g,
-                Friction { mu_c: mu },
+                Friction::new(mu),
                 &mut warm,
                 &mut ev,
             )
@@ -318,7 +342,7 @@ mod tests {
             &m,
             Fidelity::Tip,
             &g,
-            Friction { mu_c: 0.5 },
+            Friction::new(0.5),
             &mut Warm::default(),
             &mut ev
         )

@@ -23,6 +23,7 @@
 //! second contact in a notch, which is reported as [`ContactStatus::MultiContact`], not simulated.
 //! After separation the pin's path is cast again, so a concave part can be struck more than once.
 
+use super::fence::{first_touch, FenceGeom, FenceSpec, FenceTouch};
 use super::instant::{
     classify, push_margin, solve_in_mode, ContactGeom, Friction, Instant, Mode, Warm,
 };
@@ -85,8 +86,14 @@ impl Default for ContactSettings {
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Feat {
+    /// Pin on polygon edge k; y = (θ, ℓ).
     Edge(usize),
+    /// Pin on polygon vertex k; y = (θ, φ).
     Vertex(usize),
+    /// Hull vertex k on the fence line; y = (θ, σ), σ the vertex's fence coordinate.
+    FenceVertex(usize),
+    /// Hull edge k flush on the fence line; y = (θ, σ), σ the fence coordinate of hull vertex k.
+    FenceEdge(usize),
 }
 
 impl Feat {
@@ -94,6 +101,8 @@ impl Feat {
         match self {
             Feat::Edge(k) => ContactFeature::Edge(k),
             Feat::Vertex(k) => ContactFeature::Vertex(k),
+            Feat::FenceVertex(k) => ContactFeature::FenceVertex(k),
+            Feat::FenceEdge(k) => ContactFeature::FenceEdge(k),
         }
     }
 }
@@ -105,12 +114,18 @@ struct Ctx<'a, 'r> {
     fr: Friction,
     rho: f64,
     vdir: Vec2,
+    /// Where the pin (or the fence end acting as one) is at travel 0.
     start: Vec2,
+    /// The fence, when the obstacle is one (`poly` is then the part's hull).
+    fence: Option<FenceGeom>,
     tol: f64,
     scale: f64,
     evals: u64,
     warm: Warm,
     recorder: Option<&'r mut dyn Recorder>,
+    /// Per-event tolerance band: event i fires when its function drops below −band[i]. Zero except
+    /// for a mode margin that just bounced (see the ping-pong rule in `integrate_contact`).
+    band: [f64; N_EVENTS],
 }
 
 enum End {
@@ -118,7 +133,9 @@ enum End {
     Stop(ContactStatus),
 }
 
-const N_EVENTS: usize = 5;
+const N_EVENTS: usize = 7;
+/// Tolerance band of a mode margin after a ping-pong (a sine: about 0.006°).
+const BOUNCE_BAND: f64 = 1e-4;
 
 impl Ctx<'_, '_> {
     fn pin_at(&self, s: f64) -> Vec2 {
@@ -142,12 +159,29 @@ impl Ctx<'_, '_> {
                 n: Vec2::from_angle(y[1]),
                 v_pin,
             },
+            Feat::FenceVertex(k) | Feat::FenceEdge(k) => ContactGeom {
+                p: self.poly.vertex(k),
+                n: self.fence_geom().n.rotate(-y[0]),
+                v_pin,
+            },
         }
+    }
+
+    fn fence_geom(&self) -> &FenceGeom {
+        self.fence
+            .as_ref()
+            .expect("fence features only arise with a fence")
     }
 
     fn pose(&self, s: f64, feat: Feat, y: [f64; 2]) -> Pose {
         let g = self.geom(feat, y);
-        let c = self.pin_at(s) + (g.n * self.rho - g.p).rotate(y[0]);
+        let c = match feat {
+            Feat::FenceVertex(_) | Feat::FenceEdge(_) => {
+                let f = self.fence_geom();
+                f.p0 + self.vdir * s + f.e * y[1] - g.p.rotate(y[0])
+            }
+            _ => self.pin_at(s) + (g.n * self.rho - g.p).rotate(y[0]),
+        };
         Pose::new(c.x, c.y, y[0])
     }
 
@@ -168,8 +202,11 @@ impl Ctx<'_, '_> {
                     0.0
                 }
             }
+            // dσ/ds: the contact point's velocity relative to the fence, along the fence.
+            Feat::FenceVertex(_) | Feat::FenceEdge(_) => {
+                self.fence_geom().e.dot(vp.rotate(y[0]) - self.vdir)
+            }
         };
-        let _ = y;
         [om, dq]
     }
 
@@ -180,15 +217,18 @@ impl Ctx<'_, '_> {
         y: [f64; 2],
     ) -> Result<([f64; 2], Instant), SolveFailure> {
         let g = self.geom(feat, y);
-        let inst = solve_in_mode(
-            self.model,
-            self.fid,
-            &g,
-            self.fr,
-            mode,
-            &mut self.warm,
-            &mut self.evals,
-        )?;
+        let inst = match feat {
+            Feat::FenceEdge(k) => self.flush_instant(k, y, mode),
+            _ => solve_in_mode(
+                self.model,
+                self.fid,
+                &g,
+                self.fr,
+                mode,
+                &mut self.warm,
+                &mut self.evals,
+            )?,
+        };
         let d = self.rates(feat, y, &g, &inst);
         if !(d[0].is_finite() && d[1].is_finite()) {
             return Err(SolveFailure::NonFinite);
@@ -199,6 +239,7 @@ impl Ctx<'_, '_> {
     /// Event functions (positive while nothing happens).
     fn events(&self, feat: Feat, y: [f64; 2], inst: &Instant) -> [f64; N_EVENTS] {
         let g = self.geom(feat, y);
+        let (mut e5, mut e6) = (1.0, 1.0);
         let (e3, e4) = match feat {
             Feat::Edge(k) => {
                 let (a, b) = self.poly.edge(k);
@@ -214,8 +255,118 @@ impl Ctx<'_, '_> {
                     (1.0, 1.0)
                 }
             }
+            Feat::FenceVertex(k) => {
+                // Neighbouring hull vertices stay off the line (an edge turns flush at zero), and
+                // the vertex stays between the fence's ends.
+                let f = self.fence_geom();
+                let m = self.poly.len();
+                let v = self.poly.vertex(k);
+                let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
+                e5 = y[1];
+                e6 = f.len - y[1];
+                (dist(k + m - 1), dist(k + 1))
+            }
+            Feat::FenceEdge(_) => (1.0, 1.0),
         };
-        [push_margin(&g), inst.margins[0], inst.margins[1], e3, e4]
+        let b = &self.band;
+        [
+            push_margin(&g) + b[0],
+            inst.margins[0] + b[1],
+            inst.margins[1] + b[2],
+            e3 + b[3],
+            e4 + b[4],
+            e5 + b[5],
+            e6 + b[6],
+        ]
+    }
+
+    /// The flush edge k's supported interval and the point where the force line through the
+    /// centroid meets the fence, all as fence coordinates relative to hull vertex k:
+    /// (lo, hi, where the force line meets the fence).
+    fn flush_interval(&self, k: usize, y: [f64; 2], force_dir: Vec2) -> (f64, f64, f64) {
+        let f = self.fence_geom();
+        let vk = self.poly.vertex(k).rotate(y[0]);
+        let other = (self.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
+        let lo = other.min(0.0).max(-y[1]);
+        let hi = other.max(0.0).min(f.len - y[1]);
+        // Centroid relative to vertex k is −vk; the line c + λ·dir meets the fence line (through
+        // vertex k, normal n) at λ = vk·n / (dir·n).
+        let lambda = vk.dot(f.n) / force_dir.dot(f.n);
+        let meet = (-vk + force_dir * lambda).dot(f.e);
+        (lo, hi, meet)
+    }
+
+    /// A flush edge translates (SPEC §6): sliding with the force on a friction-cone edge, or, in
+    /// `Stick` mode, jammed (moving with the fence). The force passes through the centroid; the
+    /// margins say how far inside the supported interval it meets the fence.
+    fn flush_instant(&self, k: usize, y: [f64; 2], mode: Mode) -> Instant {
+        let f = self.fence_geom();
+        let (dir, v_world) = match mode {
+            Mode::SlideLeft | Mode::SlideRight | Mode::Slide => {
+                let dir = match mode {
+                    Mode::SlideLeft => self.fr.left_edge(f.n),
+                    Mode::SlideRight => self.fr.right_edge(f.n),
+                    _ => f.n,
+                };
+                (dir, dir * (f.n.dot(self.vdir) / f.n.dot(dir)))
+            }
+            Mode::Stick => (self.vdir.normalized(), self.vdir),
+        };
+        let (lo, hi, meet) = self.flush_interval(k, y, dir);
+        let v = v_world.rotate(-y[0]);
+        Instant {
+            mode,
+            twist: [v.x, v.y, 0.0],
+            force: dir.rotate(-y[0]),
+            margins: [meet - lo, hi - meet],
+        }
+    }
+
+    /// The hull edge adjacent to vertex k that is flush to rounding (its other end within 1e-9 a of
+    /// the fence line), if any.
+    fn flush_neighbour(&self, k: usize, y: [f64; 2]) -> Option<usize> {
+        let f = self.fence_geom();
+        let m = self.poly.len();
+        let v = self.poly.vertex(k);
+        let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
+        if dist(k + m - 1).abs() <= 1e-9 {
+            Some((k + m - 1) % m)
+        } else if dist(k + 1).abs() <= 1e-9 {
+            Some(k)
+        } else {
+            None
+        }
+    }
+
+    /// The orientation nearest `theta` at which hull edge k lies exactly flush on the fence (its
+    /// outward normal against the fence normal). Flush is a geometric fact at the event that finds
+    /// it; snapping removes the event's landing error (≤ 1e-2·tol).
+    fn flush_angle(&self, k: usize, theta: f64) -> f64 {
+        let f = self.fence_geom();
+        let out = -self.poly.inward_normal(k);
+        let target = (-f.n).angle() - out.angle();
+        theta + crate::geometry::wrap_pi(target - theta)
+    }
+
+    /// The consistent translation mode of a flush edge: slide towards the side the belt's motion
+    /// leaves the friction cone on, or `Stick` (a jam) when it lies inside the cone (inclusive:
+    /// α + atan μf ≥ 90° jams).
+    fn flush_mode(&self) -> Mode {
+        let f = self.fence_geom();
+        if self.fr.mu_c == 0.0 {
+            return Mode::Slide;
+        }
+        let (fl, fr) = (self.fr.left_edge(f.n), self.fr.right_edge(f.n));
+        // The cone boundary itself jams (α + atan μf = 90° exactly); 1e-12 absorbs the rounding
+        // of the angles so that the condition holds at exactly the predicted angle.
+        let v = self.vdir.normalized();
+        if fl.cross(v) > 1e-12 {
+            Mode::SlideLeft
+        } else if fr.cross(v) < -1e-12 {
+            Mode::SlideRight
+        } else {
+            Mode::Stick
+        }
     }
 
     fn record(&mut self, s: f64, feat: Feat, y: [f64; 2], inst: &Instant) {
@@ -287,6 +438,8 @@ struct StepResult {
     f1: [f64; 2],
     inst1: Instant,
     err: f64,
+    /// The seven stage derivatives (for the dense output).
+    k: [[f64; 2]; 7],
 }
 
 /// One Dormand–Prince step of size h from (y0, f0).
@@ -337,25 +490,40 @@ fn dp_step(
         f1: k[6],
         inst1: inst_last.expect("six stages ran"),
         err,
+        k,
     })
 }
 
-fn hermite(y0: [f64; 2], f0: [f64; 2], y1: [f64; 2], f1: [f64; 2], h: f64, t: f64) -> [f64; 2] {
-    let t2 = t * t;
-    let t3 = t2 * t;
-    let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
-    let h10 = t3 - 2.0 * t2 + t;
-    let h01 = -2.0 * t3 + 3.0 * t2;
-    let h11 = t3 - t2;
+// Dormand–Prince continuous extension (Hairer, Nørsett & Wanner, dopri5 `contd5`): 4th order.
+const D: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+/// State at fraction `t` ∈ [0, 1] of a step of size `h` from `y0` that ended at `y1` with stages `k`.
+fn dense(y0: [f64; 2], y1: [f64; 2], k: &[[f64; 2]; 7], h: f64, t: f64) -> [f64; 2] {
     let mut out = [0.0; 2];
     for c in 0..2 {
-        out[c] = h00 * y0[c] + h10 * h * f0[c] + h01 * y1[c] + h11 * h * f1[c];
+        let ydiff = y1[c] - y0[c];
+        let bspl = h * k[0][c] - ydiff;
+        let r4 = ydiff - h * k[6][c] - bspl;
+        let mut r5 = 0.0;
+        for (j, kj) in k.iter().enumerate() {
+            r5 += D[j] * kj[c];
+        }
+        r5 *= h;
+        out[c] = y0[c] + t * (ydiff + (1.0 - t) * (bspl + t * (r4 + (1.0 - t) * r5)));
     }
     out
 }
 
 /// Illinois root of g on [0, 1] with g(0) = ga > 0 ≥ g(1) = gb.
-fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64) -> f64 {
+fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64, tol: f64) -> f64 {
     let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, ga, gb);
     let mut side = 0;
     let mut c = 1.0;
@@ -365,7 +533,7 @@ fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64) -> f64 {
             c = 0.5 * (a + b);
         }
         let fc = g(c);
-        if fc.abs() <= 1e-15 || b - a <= 1e-14 {
+        if fc.abs() <= tol || b - a <= 1e-12 {
             break;
         }
         if fc < 0.0 {
@@ -416,7 +584,26 @@ enum Settle {
 
 /// Decide the mode at a (possibly new) contact state, resolving point-pin vertex sweeps.
 fn settle(ctx: &mut Ctx, s: f64, mut feat: Feat, mut y: [f64; 2]) -> Settle {
-    for _ in 0..4 {
+    for _ in 0..6 {
+        if let Feat::FenceEdge(k) = feat {
+            let mode = ctx.flush_mode();
+            let inst = ctx.flush_instant(k, y, mode);
+            // The supported interval is closed (the force may act at an end vertex): rounding-level
+            // negatives count as inside.
+            let (m0, m1) = (inst.margins[0] + ctx.band[1], inst.margins[1] + ctx.band[2]);
+            if m0 < -1e-12 || m1 < -1e-12 {
+                // The force line misses the supported interval: pivot about the nearer end.
+                ctx.band = [0.0; N_EVENTS];
+                let (f, yy) = flush_pivot(ctx, k, y, m1 < m0);
+                feat = f;
+                y = yy;
+                continue;
+            }
+            if mode == Mode::Stick {
+                return Settle::Stop(ContactStatus::Jam { s: s * ctx.scale });
+            }
+            return Settle::Go(feat, y, inst);
+        }
         let g = ctx.geom(feat, y);
         let inst = match classify(
             ctx.model,
@@ -455,7 +642,27 @@ fn settle(ctx: &mut Ctx, s: f64, mut feat: Feat, mut y: [f64; 2]) -> Settle {
             _ => return Settle::Go(feat, y, inst),
         }
     }
-    Settle::Stop(ContactStatus::EventLimit { events: 4 })
+    Settle::Stop(ContactStatus::EventLimit { events: 6 })
+}
+
+/// A flush edge whose force line leaves its supported interval pivots about that end: a hull vertex
+/// (vertex on the fence line) or the fence's own end (which then acts as a point pin on the edge).
+fn flush_pivot(ctx: &mut Ctx, k: usize, y: [f64; 2], hi_end: bool) -> (Feat, [f64; 2]) {
+    let f = *ctx.fence_geom();
+    let m = ctx.poly.len();
+    let vk = ctx.poly.vertex(k).rotate(y[0]);
+    let other = (ctx.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
+    let (lo, hi, _) = ctx.flush_interval(k, y, f.n);
+    let end = if hi_end { hi } else { lo };
+    if end == 0.0 {
+        (Feat::FenceVertex(k), y)
+    } else if end == other {
+        (Feat::FenceVertex((k + 1) % m), [y[0], y[1] + other])
+    } else {
+        // A fence end inside the edge: that end pushes the edge like a point pin.
+        ctx.start = if end <= -y[1] + 1e-12 { f.p0 } else { f.p1() };
+        (Feat::Edge(k), [y[0], end.abs()])
+    }
 }
 
 /// The starting contact state for a first touch.
@@ -492,14 +699,14 @@ fn initial_state(ctx: &Ctx, pose: &Pose, feature: Feature, normal_world: Vec2) -
 /// Minimum distance from the pin centre to edges not adjacent to the current feature (disc pins on
 /// concave parts): negative margin means a second contact.
 fn second_contact(ctx: &Ctx, feat: Feat, pose: &Pose, s: f64) -> bool {
-    if ctx.poly.is_convex() || ctx.rho == 0.0 {
+    if ctx.poly.is_convex() || ctx.rho == 0.0 || ctx.fence.is_some() {
         return false;
     }
     let m = ctx.poly.len();
     let centre = pose.apply_inverse(ctx.pin_at(s));
     let (skip_a, skip_b) = match feat {
-        Feat::Edge(k) => (k, k),
-        Feat::Vertex(k) => ((k + m - 1) % m, k),
+        Feat::Edge(k) | Feat::FenceEdge(k) => (k, k),
+        Feat::Vertex(k) | Feat::FenceVertex(k) => ((k + m - 1) % m, k),
     };
     for i in 0..m {
         if i == skip_a || i == skip_b {
@@ -524,6 +731,17 @@ struct Tally {
 }
 
 impl Tally {
+    /// Reopen the segment just closed if it had this feature and mode (no zero-length split).
+    /// Closed segments are in the caller's units, open ones in normalised units: `scale` converts.
+    fn reopen(&mut self, feat: Feat, mode: Mode, s: f64, theta: f64, scale: f64) {
+        match self.list.last() {
+            Some(last) if last.feature == feat.public() && last.mode == mode => {
+                let last = self.list.pop().expect("checked above");
+                self.open = Some((feat, mode, last.s_begin / scale, last.theta_begin));
+            }
+            _ => self.open(feat, mode, s, theta),
+        }
+    }
     fn open(&mut self, feat: Feat, mode: Mode, s: f64, theta: f64) {
         self.open = Some((feat, mode, s, theta));
     }
@@ -567,9 +785,19 @@ fn integrate_contact(
     ctx.record(s, feat, y, &inst);
     let mut f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
     let mut ev0 = ctx.events(feat, y, &inst);
-    let h_max = 0.25;
+    let h_max = 2.0;
     let h_min = 1e-13;
-    let mut h = (0.2 * ctx.tol.powf(0.2)).clamp(1e-6, h_max);
+    // First step: a tenth of a, shrunk by the error control if the motion is fast.
+    let mut h = 0.1;
+    // Events are landed to |g| ≤ land_tol; a fresh segment treats |g| ≤ slack as "at the boundary"
+    // (the new mode's margin starts at zero up to the landing error), and only g < −slack at a
+    // segment start means the state is already past an event.
+    let land_tol = 1e-2 * ctx.tol;
+    let slack = 100.0 * land_tol;
+    let mut last_switch: Option<(f64, Mode)> = None;
+    // (travel, feature left, event index) of the last change of contact feature.
+    let mut last_feature_change: Option<(f64, Feat, usize)> = None;
+    ctx.band = [0.0; N_EVENTS];
     loop {
         if ctx.evals > settings.max_evaluations {
             let p = ctx.pose(s, feat, y);
@@ -592,7 +820,7 @@ fn integrate_contact(
             );
         }
         // An event function already negative at the start of a step: the state is at an event.
-        let pending = (0..N_EVENTS).find(|&i| ev0[i] < -1e-9);
+        let pending = (0..N_EVENTS).find(|&i| ev0[i] < -slack);
         let (event, s_ev, y_ev, inst_ev) = if let Some(i) = pending {
             (Some(i), s, y, inst)
         } else {
@@ -628,10 +856,16 @@ fn integrate_contact(
             }
             let ev1 = ctx.events(feat, step.y1, &step.inst1);
             let crossed: Vec<usize> = (0..N_EVENTS)
-                .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -1e-9)
+                .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -slack)
                 .collect();
             let factor = (0.9 * step.err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
             if crossed.is_empty() {
+                // A bounced margin that has recovered gets its ordinary zero threshold back.
+                for (b, e) in ctx.band.iter_mut().zip(ev1) {
+                    if *b > 0.0 && e - *b > slack {
+                        *b = 0.0;
+                    }
+                }
                 s += h;
                 y = step.y1;
                 inst = step.inst1;
@@ -651,9 +885,11 @@ fn integrate_contact(
                 continue;
             }
             // Locate the earliest crossing on the interpolant.
-            let (y0c, f0c, y1c, f1c, hc) = (y, f0, step.y1, step.f1, h);
+            let (y0c, y1c, kc, hc) = (y, step.y1, step.k, h);
             let mut best = (2.0, 0usize);
             let warm_saved = ctx.warm;
+            let root_tol = 1e-3 * ctx.tol;
+            let band = ctx.band;
             for &i in &crossed {
                 let g0 = ev0[i].max(0.0);
                 let t = if g0 == 0.0 {
@@ -661,7 +897,7 @@ fn integrate_contact(
                 } else {
                     illinois(
                         |t| {
-                            let yt = hermite(y0c, f0c, y1c, f1c, hc, t);
+                            let yt = dense(y0c, y1c, &kc, hc, t);
                             if i == 0 || i >= 3 {
                                 let dummy = inst;
                                 ctx.events(feat, yt, &dummy)[i]
@@ -676,13 +912,14 @@ fn integrate_contact(
                                     &mut ctx.warm,
                                     &mut ctx.evals,
                                 ) {
-                                    Ok(it) => it.margins[i - 1],
+                                    Ok(it) => it.margins[i - 1] + band[i],
                                     Err(_) => -1.0,
                                 }
                             }
                         },
                         g0,
                         ev1[i],
+                        root_tol,
                     )
                 };
                 if t < best.0 {
@@ -730,8 +967,10 @@ fn integrate_contact(
                     }
                     side = 1;
                 }
-                if gt.abs() <= 1e-12 || (b - a) * h <= 1e-13 {
-                    if gt < 0.0 && gt.abs() <= 1e-12 {
+                // Landing tolerance: far below the integration tolerance, far above rounding.
+                let g_tol = land_tol;
+                if gt.abs() <= g_tol || (b - a) * h <= 1e-13 {
+                    if gt < 0.0 && gt.abs() <= g_tol {
                         best_step = real(t, ctx);
                         best_t = t;
                     }
@@ -751,6 +990,7 @@ fn integrate_contact(
             }
         };
         let i = event.expect("an event was found");
+
         if std::env::var("PINFEED_DEBUG").is_ok() {
             eprintln!("event {i} at s={s_ev} mode={mode:?} feat={feat:?} y={y_ev:?} margins={:?} ev0={ev0:?}", inst_ev.margins);
         }
@@ -773,12 +1013,42 @@ fn integrate_contact(
         let m = ctx.poly.len();
         let next: Option<(Feat, [f64; 2], Option<Mode>)> = match (i, feat) {
             (0, _) => None,
+            (1 | 2, Feat::FenceEdge(k)) => {
+                let (f, yy) = flush_pivot(ctx, k, y, i == 2);
+                Some((f, yy, None))
+            }
+            (1 | 2, Feat::FenceVertex(k)) if ctx.flush_neighbour(k, y).is_some() => {
+                // The mode changes just as an adjacent edge turns flush (the two events coincide,
+                // e.g. at exactly the jam angle): the edge's arrival decides.
+                let j = ctx.flush_neighbour(k, y).expect("checked by the guard");
+                let f = *ctx.fence_geom();
+                let th = ctx.flush_angle(j, y[0]);
+                let d = (ctx.poly.vertex(j) - ctx.poly.vertex(k))
+                    .rotate(th)
+                    .dot(f.e);
+                Some((Feat::FenceEdge(j), [th, y[1] + d], None))
+            }
             (1 | 2, _) => {
                 let new_mode = match (mode, i) {
                     (Mode::Stick, 1) => Mode::SlideLeft,
                     (Mode::Stick, _) => Mode::SlideRight,
                     _ => Mode::Stick,
                 };
+                // Ping-pong: switching straight back to the mode we left at this very point means the
+                // state sits on the stick/slide boundary, where both modes give the same motion and
+                // their margins differ only by solver rounding. Stay, and let this margin run down to
+                // −BOUNCE_BAND before it counts (a real, sustained violation still switches).
+                if let Some((s_prev, from)) = last_switch {
+                    if (s - s_prev).abs() <= 1e-12 && from == new_mode && ctx.band[i] == 0.0 {
+                        ctx.band[i] = BOUNCE_BAND;
+                        segs.reopen(feat, mode, s, y[0], ctx.scale);
+                        ev0 = ctx.events(feat, y, &inst_ev);
+                        inst = inst_ev;
+                        f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
+                        continue;
+                    }
+                }
+                last_switch = Some((s, mode));
                 if let (Feat::Vertex(k), false) = (feat, ctx.rho > 0.0) {
                     // Hooked point pin lets go: it sweeps onto the edge it now slides towards.
                     sweep(ctx, k, new_mode == Mode::SlideLeft, y[0]).map(|(f, yy)| (f, yy, None))
@@ -809,12 +1079,46 @@ fn integrate_contact(
                 Some((Feat::Edge(e), [y[0], (b - a).norm()], None))
             }
             (4, Feat::Vertex(k)) => Some((Feat::Edge(k), [y[0], 0.0], None)),
+            (3, Feat::FenceVertex(k)) => {
+                // The edge before vertex k turns flush: its start vertex k−1 reached the line.
+                let f = *ctx.fence_geom();
+                let j = (k + m - 1) % m;
+                let th = ctx.flush_angle(j, y[0]);
+                let d = (ctx.poly.vertex(j) - ctx.poly.vertex(k))
+                    .rotate(th)
+                    .dot(f.e);
+                Some((Feat::FenceEdge(j), [th, y[1] + d], None))
+            }
+            (4, Feat::FenceVertex(k)) => {
+                Some((Feat::FenceEdge(k), [ctx.flush_angle(k, y[0]), y[1]], None))
+            }
+            (5 | 6, Feat::FenceVertex(k)) => {
+                // The vertex slides off a fence end; that end now acts as a point pin on the part.
+                let f = *ctx.fence_geom();
+                ctx.start = if i == 5 { f.p0 } else { f.p1() };
+                Some((Feat::Vertex(k), [y[0], f.n.rotate(-y[0]).angle()], None))
+            }
             _ => unreachable!("event index out of range"),
         };
         let Some((nf, ny, forced)) = next else {
             let p = ctx.pose(s, feat, y);
             return (End::Separated, s, p);
         };
+        if nf != feat {
+            // Event indices mean different things on the new feature: start with no bands, except
+            // when this transition merely returns, at the same point, to the feature just left (a
+            // marginal geometry, e.g. a force line through an edge's end): then stay there and let
+            // the event that ejected it run down to −BOUNCE_BAND before it counts.
+            let cycle = matches!(last_feature_change, Some((s0, f0, _)) if (s - s0).abs() <= 1e-12 && f0 == nf);
+            let ejected_by = last_feature_change.map(|(_, _, i)| i);
+            ctx.band = [0.0; N_EVENTS];
+            if cycle {
+                if let Some(j) = ejected_by {
+                    ctx.band[j] = BOUNCE_BAND;
+                }
+            }
+            last_feature_change = Some((s, feat, i));
+        }
         let settled = match forced {
             Some(md) => {
                 let g = ctx.geom(nf, ny);
@@ -857,7 +1161,7 @@ fn integrate_contact(
         ev0 = ctx.events(feat, y, &inst);
         // Freshly started segments begin at their boundary: do not re-trigger on rounding.
         for e in ev0.iter_mut() {
-            if e.abs() <= 1e-8 {
+            if e.abs() <= slack {
                 *e = 0.0;
             }
         }
@@ -865,35 +1169,63 @@ fn integrate_contact(
     }
 }
 
-/// Push a part with one pin: the pin starts at `pin_start` (world, caller's units) and travels along
-/// (−1, w) relative to the belt past the part resting at `pose`. Pure function of its inputs.
-pub fn push(
-    model: &PartModel,
-    pose: Pose,
-    pin_start: Vec2,
-    pin: &Pin,
-    settings: &ContactSettings,
-    recorder: Option<&mut dyn Recorder>,
-) -> ContactOutcome {
-    let k = model.scale();
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    let mut ctx = Ctx {
-        model,
-        poly: model.polygon(),
-        fid: settings.fidelity,
-        fr: Friction {
-            mu_c: settings.mu_c,
-        },
-        rho: pin.radius / k,
-        vdir: Vec2::new(-1.0, pin.lateral_speed),
-        start: pin_start / k,
-        tol: settings.tol,
-        scale: k,
-        evals: 0,
-        warm: Warm::default(),
-        recorder,
-    };
-    let mut out = ContactOutcome {
+/// How the next contact of a pass begins.
+enum Touch {
+    None,
+    At(f64, Feat, [f64; 2]),
+    Stop(ContactStatus),
+}
+
+/// The next touch between the obstacle and the part resting at `cur`, after travel `s`.
+fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touch {
+    let k = ctx.scale;
+    if let Some(f) = ctx.fence {
+        let s_from = if after_separation { s + 1e-9 } else { s };
+        return match first_touch(ctx.poly, cur, &f, ctx.vdir, s_from) {
+            None => Touch::None,
+            Some((t, FenceTouch::LineVertex { k, sigma })) => {
+                Touch::At(t, Feat::FenceVertex(k), [cur.theta, sigma])
+            }
+            Some((t, FenceTouch::LineEdge { k, sigma })) => {
+                Touch::At(t, Feat::FenceEdge(k), [cur.theta, sigma])
+            }
+            Some((t, FenceTouch::End { end, feature })) => {
+                ctx.start = if end == 0 { f.p0 } else { f.p1() };
+                let n = ctx.vdir.normalized();
+                let (feat, y) = initial_state(ctx, cur, feature, n);
+                Touch::At(t, feat, y)
+            }
+        };
+    }
+    let dir_len = ctx.vdir.norm();
+    let dir = ctx.vdir / dir_len;
+    let mut min_travel = if after_separation { 1e-9 } else { 0.0 };
+    for _ in 0..8 {
+        let Some(hit) = first_contact(ctx.poly, cur, ctx.pin_at(s), dir, ctx.rho, min_travel)
+        else {
+            return Touch::None;
+        };
+        if hit.grazing {
+            // A touch that pushes nothing: continue along the path past it.
+            min_travel = hit.travel + 1e-9;
+            continue;
+        }
+        let s_touch = s + hit.travel / dir_len;
+        if let Feature::Vertex { index } = hit.feature {
+            if !ctx.poly.vertex_is_convex(index) {
+                // The pin strikes a reflex corner: it touches both edges of the notch at once.
+                return Touch::Stop(ContactStatus::MultiContact { s: s_touch * k });
+            }
+        }
+        let (feat, y) = initial_state(ctx, cur, hit.feature, hit.normal);
+        return Touch::At(s_touch, feat, y);
+    }
+    Touch::None
+}
+
+/// The outcome of a pass that never touched the part.
+fn untouched(pose: Pose, status: ContactStatus) -> ContactOutcome {
+    ContactOutcome {
         contact: false,
         pose_initial: pose,
         pose_final: pose,
@@ -904,17 +1236,15 @@ pub fn push(
         segments: Vec::new(),
         evaluations: 0,
         steps: 0,
-        status: ContactStatus::Ok,
-    };
-    // The pin must start clear of the part.
-    let local = pose_n.apply_inverse(ctx.start);
-    if ctx.poly.contains(local) || ctx.poly.distance_to_boundary(local).0 < ctx.rho * (1.0 - 1e-12)
-    {
-        out.status = ContactStatus::PinInsidePart;
-        return out;
+        status,
     }
-    let dir_len = ctx.vdir.norm();
-    let dir = ctx.vdir / dir_len;
+}
+
+/// Run the passes of one obstacle over the part until it no longer touches it.
+fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactOutcome {
+    let k = ctx.scale;
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let mut out = untouched(pose, ContactStatus::Ok);
     let mut s = 0.0;
     let mut cur = pose_n;
     let mut segs = Tally {
@@ -923,39 +1253,27 @@ pub fn push(
         events: 0,
         steps: 0,
     };
-    let mut min_travel = 0.0;
+    let mut after_separation = false;
     for _pass in 0..16 {
-        let hit = first_contact(ctx.poly, &cur, ctx.pin_at(s), dir, ctx.rho, min_travel);
-        let Some(hit) = hit else { break };
-        if hit.grazing {
-            // A touch that pushes nothing: continue along the path past it.
-            min_travel = hit.travel + 1e-9;
-            continue;
-        }
-        let s_touch = s + hit.travel / dir_len;
+        let (s_touch, feat, y) = match next_touch(ctx, &cur, s, after_separation) {
+            Touch::None => break,
+            Touch::Stop(st) => {
+                out.status = st;
+                break;
+            }
+            Touch::At(t, f, y) => (t, f, y),
+        };
         if out.contacts == 0 {
             out.travel_to_contact = s_touch * k;
         }
         out.contacts += 1;
-        if let Feature::Vertex { index } = hit.feature {
-            if !ctx.poly.vertex_is_convex(index) {
-                // The pin strikes a reflex corner: it touches both edges of the notch at once.
-                out.status = ContactStatus::MultiContact { s: s_touch * k };
-                break;
-            }
-        }
-        let (feat, y) = initial_state(&ctx, &cur, hit.feature, hit.normal);
-        // The pose at touch: the part has not moved; the state reconstructs it exactly.
-        let (end, s_end, pose_end) =
-            integrate_contact(&mut ctx, settings, s_touch, feat, y, &mut segs);
+        let (end, s_end, pose_end) = integrate_contact(ctx, settings, s_touch, feat, y, &mut segs);
         segs.close(s_end, pose_end.theta, k);
         out.contact_length += (s_end - s_touch) * k;
         s = s_end;
         cur = pose_end;
         match end {
-            End::Separated => {
-                min_travel = 1e-9;
-            }
+            End::Separated => after_separation = true,
             End::Stop(st) => {
                 out.status = st;
                 break;
@@ -969,6 +1287,80 @@ pub fn push(
     out.evaluations = ctx.evals;
     out.steps = segs.steps;
     out
+}
+
+/// Push a part with one pin: the pin starts at `pin_start` (world, caller's units) and travels along
+/// (−1, w) relative to the belt past the part resting at `pose`. Pure function of its inputs.
+pub fn push(
+    model: &PartModel,
+    pose: Pose,
+    pin_start: Vec2,
+    pin: &Pin,
+    settings: &ContactSettings,
+    recorder: Option<&mut dyn Recorder>,
+) -> ContactOutcome {
+    let k = model.scale();
+    let mut ctx = Ctx {
+        model,
+        poly: model.polygon(),
+        fid: settings.fidelity,
+        fr: Friction::new(settings.mu_c),
+        rho: pin.radius / k,
+        vdir: Vec2::new(-1.0, pin.lateral_speed),
+        start: pin_start / k,
+        fence: None,
+        tol: settings.tol,
+        scale: k,
+        evals: 0,
+        warm: Warm::default(),
+        recorder,
+        band: [0.0; N_EVENTS],
+    };
+    // The pin must start clear of the part.
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let local = pose_n.apply_inverse(ctx.start);
+    if ctx.poly.contains(local) || ctx.poly.distance_to_boundary(local).0 < ctx.rho * (1.0 - 1e-12)
+    {
+        return untouched(pose, ContactStatus::PinInsidePart);
+    }
+    run_passes(&mut ctx, settings, pose)
+}
+
+/// Push a part resting at `pose` with a fence (SPEC §6; see [`super::fence`]): the fence travels at
+/// (−V, 0) relative to the belt past the part; its friction μf replaces μc in `settings`.
+/// Fence-contact features index the part's convex hull.
+pub fn push_fence(
+    model: &PartModel,
+    pose: Pose,
+    fence: &FenceSpec,
+    settings: &ContactSettings,
+    recorder: Option<&mut dyn Recorder>,
+) -> ContactOutcome {
+    let k = model.scale();
+    let geom = FenceGeom::new(fence, k);
+    let mut ctx = Ctx {
+        model,
+        poly: model.hull(),
+        fid: settings.fidelity,
+        fr: Friction::new(fence.mu_f),
+        rho: 0.0,
+        vdir: Vec2::new(-1.0, 0.0),
+        start: geom.p1(),
+        fence: Some(geom),
+        tol: settings.tol,
+        scale: k,
+        evals: 0,
+        warm: Warm::default(),
+        recorder,
+        band: [0.0; N_EVENTS],
+    };
+    // Sliding along a steep fence is slow (it stops altogether at the jam angle): allow the belt
+    // travel a fence of this length can take before calling the part held.
+    let settings = ContactSettings {
+        max_travel: settings.max_travel + 50.0 * geom.len,
+        ..*settings
+    };
+    run_passes(&mut ctx, &settings, pose)
 }
 
 /// The mode and twist at the first instant of contact (for Mason's-vote checks and sensors).
@@ -986,17 +1378,17 @@ pub fn first_instant(
         model,
         poly: model.polygon(),
         fid: settings.fidelity,
-        fr: Friction {
-            mu_c: settings.mu_c,
-        },
+        fr: Friction::new(settings.mu_c),
         rho: pin.radius / k,
         vdir: Vec2::new(-1.0, pin.lateral_speed),
         start: pin_start / k,
+        fence: None,
         tol: settings.tol,
         scale: k,
         evals: 0,
         warm: Warm::default(),
         recorder: None,
+        band: [0.0; N_EVENTS],
     };
     let dir = ctx.vdir.normalized();
     let hit = first_contact(ctx.poly, &pose_n, ctx.start, dir, ctx.rho, 0.0)?;

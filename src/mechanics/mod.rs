@@ -7,11 +7,13 @@
 //! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
 //! * [`integrate`]: one pin pass, integrated in pin travel with error control and event location.
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
+//! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!
 //! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
 //! → [`ContactOutcome`].
 
+pub mod fence;
 pub mod instant;
 pub mod integrate;
 pub mod limit_surface;
@@ -19,8 +21,9 @@ pub mod outcome;
 pub mod part_model;
 pub mod vote;
 
+pub use fence::FenceSpec;
 pub use instant::Mode;
-pub use integrate::{first_instant, push, ContactSettings, Pin};
+pub use integrate::{first_instant, push, push_fence, ContactSettings, Pin};
 pub use outcome::{ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, TraceSample};
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
 pub use vote::mason_vote;

@@ -12,6 +12,31 @@ use serde::Serialize;
 pub enum ContactFeature {
     Edge(usize),
     Vertex(usize),
+    /// A vertex of the part's convex hull sliding or sticking on a fence line (hull index).
+    FenceVertex(usize),
+    /// An edge of the part's convex hull flush against a fence line (hull index).
+    FenceEdge(usize),
+}
+
+impl ContactFeature {
+    /// Machine-readable kind: `edge`, `vertex`, `fence_vertex` or `fence_edge`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ContactFeature::Edge(_) => "edge",
+            ContactFeature::Vertex(_) => "vertex",
+            ContactFeature::FenceVertex(_) => "fence_vertex",
+            ContactFeature::FenceEdge(_) => "fence_edge",
+        }
+    }
+    /// Index of the vertex or edge (of the polygon, or of its hull for fence features).
+    pub fn index(&self) -> usize {
+        match *self {
+            ContactFeature::Edge(k)
+            | ContactFeature::Vertex(k)
+            | ContactFeature::FenceVertex(k)
+            | ContactFeature::FenceEdge(k) => k,
+        }
+    }
 }
 
 /// A stretch of contact with one feature in one mode.
@@ -49,6 +74,9 @@ pub enum ContactStatus {
     StepTooSmall { s: f64 },
     /// A limit-surface sub-problem failed.
     Solver { failure: SolveFailure, s: f64 },
+    /// The part jammed against a fence (α + atan μf ≥ 90°): it stops in the world while the belt
+    /// slips under it, and would stay there for ever. `pose_final` is where it stopped.
+    Jam { s: f64 },
 }
 
 impl ContactStatus {
@@ -66,6 +94,7 @@ impl ContactStatus {
             ContactStatus::EventLimit { .. } => "event_limit",
             ContactStatus::StepTooSmall { .. } => "step_too_small",
             ContactStatus::Solver { .. } => "solver",
+            ContactStatus::Jam { .. } => "jam",
         }
     }
 }

@@ -231,6 +231,8 @@ pub struct Solved {
 /// The compiled part: normalised geometry and support data. Immutable; shared by all contacts.
 pub struct PartModel {
     poly: Polygon,
+    /// The convex hull as a polygon (what a straight fence can touch), normalised units.
+    hull: Polygon,
     scale: f64,
     support: SupportData,
     /// m_max / f_max of the ellipsoid approximation (normalised units).
@@ -267,7 +269,9 @@ impl PartModel {
             SupportData::Uniform(u) => u.ellipsoid_c(),
             SupportData::Points(p) => p.ellipsoid_c(),
         };
+        let hull = Polygon::new(unit.hull()).map_err(|e| e.to_string())?;
         Ok(PartModel {
+            hull,
             poly: unit,
             scale,
             support: data,
@@ -278,6 +282,10 @@ impl PartModel {
     /// The polygon in normalised units (a = 1).
     pub fn polygon(&self) -> &Polygon {
         &self.poly
+    }
+    /// The convex hull in normalised units (fence contacts index its vertices and edges).
+    pub fn hull(&self) -> &Polygon {
+        &self.hull
     }
     /// Length of one normalised unit in the caller's units (the part's `a`).
     pub fn scale(&self) -> f64 {

@@ -353,7 +353,7 @@ impl UniformSurface {
     /// D, ∇D and (if `hessian`) H at twist ξ = [vx, vy, ω] (part frame), normalised pressure.
     /// ξ must not be zero (a zero twist returns [`Dissipation::ZERO`]).
     pub fn eval(&self, xi: [f64; 3], hessian: bool) -> Dissipation {
-        let speed = xi[0].hypot(xi[1]);
+        let speed = (xi[0] * xi[0] + xi[1] * xi[1]).sqrt();
         let omega = xi[2];
         if speed > self.switch_radius * omega.abs() {
             self.eval_quadrature(xi, hessian)

@@ -1,0 +1,325 @@
+//! Fences (SPEC §6): flush stable orientations, the jam angle, the COR-tip bound, μs invariance,
+//! short fences, mirror symmetry — for the contact model's fence path.
+
+mod common;
+use common::*;
+use pinfeed::geometry::{wrap_deg, Polygon, Pose, Vec2};
+use pinfeed::mechanics::{
+    push_fence, ContactFeature, ContactOutcome, ContactSettings, ContactStatus, FenceSpec,
+    Fidelity, Mode, PartModel,
+};
+
+/// A fence whose line crosses the part's path at y = d·a, clear of the part, starting 1.5a beyond
+/// the part's band (the CLI's convention), of length `len` (units of a).
+fn fence(p: &Polygon, angle_deg: f64, d: f64, len: f64, mu_f: f64) -> FenceSpec {
+    let a = p.radius();
+    let angle = angle_deg.to_radians();
+    let e = Vec2::from_angle(angle);
+    let mut n = e.perp();
+    if n.x > 0.0 {
+        n = -n;
+    }
+    let y = d * a;
+    let cross = Vec2::new((1.01 * a + y * n.y) / (-n.x), y);
+    let sin = angle.sin();
+    let back = (y + sin.signum() * 1.5 * a) / sin;
+    FenceSpec {
+        start: cross - e * back,
+        angle,
+        length: len * a,
+        mu_f,
+    }
+}
+
+fn run_fence(m: &PartModel, p: &Polygon, th: f64, f: &FenceSpec, fid: Fidelity) -> ContactOutcome {
+    let s = ContactSettings {
+        fidelity: fid,
+        ..ContactSettings::default()
+    };
+    let _ = p;
+    push_fence(m, Pose::new(0.0, 0.0, th.to_radians()), f, &s, None)
+}
+
+/// Orientations at which hull edge j lies flush on a fence at angle α: its outward normal points at
+/// α − 90° (against the fence normal).
+fn flush_orientations(m: &PartModel, angle_deg: f64) -> Vec<f64> {
+    let h = m.hull();
+    (0..h.len())
+        .map(|j| {
+            let out = -h.inward_normal(j);
+            wrap_deg(angle_deg - 90.0 - out.angle().to_degrees())
+        })
+        .collect()
+}
+
+/// A long fence at 30–60° leaves every tripoly2 with an edge flush: while it translates along the
+/// fence its orientation is exactly one of the fence's flush orientations.
+#[test]
+fn long_fence_leaves_an_edge_flush() {
+    let p = poly("tripoly2");
+    let m = model(&p);
+    for fid in FIDELITIES {
+        for angle in [30.0, 40.0, 50.0, 60.0] {
+            let flush = flush_orientations(&m, angle);
+            let f = fence(&p, angle, 0.0, 20.0, 0.3);
+            for k in 0..24 {
+                let th = k as f64 * 15.0 + 1.0;
+                let o = run_fence(&m, &p, th, &f, fid);
+                assert_finite(&o, "fence");
+                assert!(o.status.is_ok(), "{fid} α={angle} θ0={th}: {:?}", o.status);
+                let seg = o
+                    .segments
+                    .iter()
+                    .rev()
+                    .find(|s| matches!(s.feature, ContactFeature::FenceEdge(_)))
+                    .unwrap_or_else(|| panic!("{fid} α={angle} θ0={th}: never flush"));
+                assert!(seg.s_end > seg.s_begin, "the flush edge translates");
+                assert_eq!(seg.theta_begin, seg.theta_end, "a flush edge does not turn");
+                let th_f = wrap_deg(seg.theta_end.to_degrees());
+                let best = flush
+                    .iter()
+                    .map(|&q| ang_diff_deg(q, th_f).abs())
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    best < 1e-9,
+                    "{fid} α={angle} θ0={th}: flush at {th_f}°, set {flush:?}"
+                );
+            }
+        }
+    }
+}
+
+/// The jam condition holds exactly at α + atan μf = 90°: just below the part slides along the fence;
+/// at the angle and above it jams (reported, never integrated for ever).
+#[test]
+fn jam_exactly_at_the_predicted_angle() {
+    let p = poly("tripoly2");
+    let m = model(&p);
+    for mu in [0.2, 0.5, 1.0] {
+        let critical = 90.0 - f64::atan(mu).to_degrees();
+        for fid in FIDELITIES {
+            for th in [10.0, 200.0] {
+                let below = run_fence(&m, &p, th, &fence(&p, critical - 0.05, 0.0, 20.0, mu), fid);
+                assert!(
+                    !matches!(below.status, ContactStatus::Jam { .. }),
+                    "{fid} μf={mu} θ0={th}: jammed below the critical angle"
+                );
+                for angle in [critical, critical + 1e-6, critical + 2.0] {
+                    let o = run_fence(&m, &p, th, &fence(&p, angle, 0.0, 20.0, mu), fid);
+                    assert!(
+                        matches!(o.status, ContactStatus::Jam { .. }),
+                        "{fid} μf={mu} α={angle} θ0={th}: {:?}",
+                        o.status
+                    );
+                    assert_finite(&o, "jam");
+                }
+            }
+        }
+    }
+}
+
+/// Peshkin & Sanderson's COR-locus tip is the slowest rotation: the exact model turns an edge flush
+/// in no more belt travel than the tip model does.
+#[test]
+fn exact_aligns_no_later_than_the_cor_tip_bound() {
+    let mut compared = 0;
+    for name in ["tripoly1", "tripoly2", "square"] {
+        let p = poly(name);
+        let m = model(&p);
+        for angle in [30.0, 45.0] {
+            let f = fence(&p, angle, 0.0, 30.0, 0.0);
+            for k in 0..12 {
+                let th = k as f64 * 30.0 + 7.0;
+                let first_flush = |fid| {
+                    run_fence(&m, &p, th, &f, fid)
+                        .segments
+                        .iter()
+                        .find(|s| matches!(s.feature, ContactFeature::FenceEdge(_)))
+                        .map(|s| (s.s_begin, s.theta_begin))
+                };
+                let (Some(exact), Some(tip)) =
+                    (first_flush(Fidelity::Exact), first_flush(Fidelity::Tip))
+                else {
+                    continue;
+                };
+                if ang_diff_deg(exact.1.to_degrees(), tip.1.to_degrees()).abs() > 1e-6 {
+                    continue; // they reached different edges: no common yardstick
+                }
+                assert!(
+                    exact.0 <= tip.0 + 1e-9,
+                    "{name} α={angle} θ0={th}: exact flush at travel {} after tip {}",
+                    exact.0,
+                    tip.0
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 20, "only {compared} comparable pushes");
+}
+
+/// μs scales forces only: fence contacts are bit-identical for any μs.
+#[test]
+fn fence_mu_s_invariance() {
+    let p = poly("tripoly1");
+    let m = model(&p);
+    let f = fence(&p, 40.0, 0.2, 15.0, 0.4);
+    for fid in FIDELITIES {
+        let mut s = ContactSettings {
+            fidelity: fid,
+            mu_s: 0.05,
+            ..ContactSettings::default()
+        };
+        let a = push_fence(&m, Pose::new(0.0, 0.0, 1.0), &f, &s, None);
+        s.mu_s = 2.0;
+        let b = push_fence(&m, Pose::new(0.0, 0.0, 1.0), &f, &s, None);
+        assert_eq!(a, b, "{fid}");
+    }
+}
+
+/// A fence shorter than needed leaves parts in intermediate orientations (not flush).
+#[test]
+fn short_fence_leaves_intermediate_orientations() {
+    let p = poly("tripoly2");
+    let m = model(&p);
+    let angle = 45.0;
+    let flush = flush_orientations(&m, angle);
+    let mut intermediate = 0;
+    for k in 0..24 {
+        let th = k as f64 * 15.0 + 1.0;
+        let f = fence(&p, angle, 0.0, 1.6, 0.3);
+        let o = run_fence(&m, &p, th, &f, Fidelity::Exact);
+        assert!(o.status.is_ok(), "θ0={th}: {:?}", o.status);
+        let th_f = wrap_deg(o.pose_final.theta.to_degrees());
+        if flush.iter().all(|&q| ang_diff_deg(q, th_f).abs() > 0.5) {
+            intermediate += 1;
+        }
+    }
+    assert!(
+        intermediate >= 6,
+        "only {intermediate} of 24 parts left unaligned by a short fence"
+    );
+}
+
+/// A frictionless fence never sticks or jams, and slides with the force along the normal.
+#[test]
+fn frictionless_fence_always_slides() {
+    let p = poly("square");
+    let m = model(&p);
+    for angle in [20.0, 70.0, 85.0] {
+        let o = run_fence(
+            &m,
+            &p,
+            10.0,
+            &fence(&p, angle, 0.1, 20.0, 0.0),
+            Fidelity::Exact,
+        );
+        assert!(o.status.is_ok(), "α={angle}: {:?}", o.status);
+        for s in &o.segments {
+            if matches!(
+                s.feature,
+                ContactFeature::FenceVertex(_) | ContactFeature::FenceEdge(_)
+            ) {
+                assert_eq!(s.mode, Mode::Slide);
+            }
+        }
+    }
+}
+
+/// Mirror symmetry: reflecting the part about the belt axis, the fence angle, θ0 and d negates the
+/// rotation.
+#[test]
+fn fence_mirror_symmetry() {
+    let p = poly("tripoly2");
+    let q = p.mirrored_y();
+    let (mp, mq) = (model(&p), model(&q));
+    for fid in FIDELITIES {
+        for th in [20.0, 140.0, 250.0] {
+            let a = run_fence(&mp, &p, th, &fence(&p, 35.0, 0.1, 12.0, 0.3), fid);
+            let b = run_fence(&mq, &q, -th, &fence(&q, -35.0, -0.1, 12.0, 0.3), fid);
+            assert!(
+                (a.rotation + b.rotation).abs() < 1e-7,
+                "{fid} θ0={th}: {} vs {}",
+                a.rotation.to_degrees(),
+                b.rotation.to_degrees()
+            );
+        }
+    }
+}
+
+/// `pinfeed contact --fence` runs through the CLI with the same JSON as pins.
+#[test]
+fn cli_fence_contact() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args([
+            "contact", "--part", "tripoly2", "--theta0", "0", "--d", "0", "--fence", "30", "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["status"], "ok");
+    let kinds: Vec<String> = v["segments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["feature"]["kind"].as_str().unwrap().to_string())
+        .collect();
+    assert!(kinds.iter().any(|k| k == "fence_edge"), "{kinds:?}");
+    for bad in ["90", "-95", "abc", "30:-2"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+            .args([
+                "contact", "--part", "tripoly2", "--theta0", "0", "--d", "0", "--fence", bad,
+            ])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "--fence {bad} accepted");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--fence"));
+    }
+}
+
+/// A seeded sweep of fences (angle 5–85°, either side, μf 0–1.2, length 0.5–25a) over four parts and
+/// all fidelities: every contact ends ok, jammed or held — never in a numerical status.
+#[test]
+fn fence_sweep_has_no_numerical_failures() {
+    use rand::RngExt;
+    let mut rng = pinfeed::random::stream(77, 0);
+    let mut failures = Vec::new();
+    for name in ["tripoly1", "tripoly2", "square", "lshape"] {
+        let p = poly(name);
+        let m = model(&p);
+        for fid in FIDELITIES {
+            for _ in 0..40 {
+                let side = if rng.random::<bool>() { 1.0 } else { -1.0 };
+                let angle = side * (5.0 + 80.0 * rng.random::<f64>());
+                let mu = 1.2 * rng.random::<f64>();
+                let len = 0.5 + 24.5 * rng.random::<f64>();
+                let d = -0.8 + 1.6 * rng.random::<f64>();
+                let th = 360.0 * rng.random::<f64>();
+                let o = run_fence(&m, &p, th, &fence(&p, angle, d, len, mu), fid);
+                assert_finite(&o, name);
+                if !matches!(
+                    o.status,
+                    ContactStatus::Ok
+                        | ContactStatus::Jam { .. }
+                        | ContactStatus::TravelLimit { .. }
+                ) {
+                    failures.push(format!(
+                        "{name} {fid} α={angle} μf={mu} L={len} d={d} θ0={th}: {:?}",
+                        o.status
+                    ));
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
