@@ -8,8 +8,10 @@
 //! the other end. Physics and conventions follow `SPEC.md` (quasi-static pushing with Coulomb
 //! friction; x along belt travel, y to the left, angles counter-clockwise, degrees at interfaces).
 //!
-//! Modules: [`geometry`] (polygons, stable states, first contact), [`report`] (tables and figures),
-//! [`cli`] (the `pinfeed` command).
+//! Modules: [`geometry`] (polygons, stable states, first contact), [`mechanics`] (the contact
+//! model), [`scenario`] (TOML scenarios compiled to an immutable scene), [`engine`] (the
+//! discrete-event feeder line and its metrics), [`report`] (tables and figures), [`cli`] (the
+//! `pinfeed` command).
 
 pub mod cli;
 pub mod engine;
