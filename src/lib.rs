@@ -9,13 +9,16 @@
 //! friction; x along belt travel, y to the left, angles counter-clockwise, degrees at interfaces).
 //!
 //! Modules: [`geometry`] (polygons, stable states, first contact), [`mechanics`] (the contact
-//! model), [`maps`] (configuration maps and their bands), [`report`] (tables and figures),
-//! [`cli`] (the `pinfeed` command).
+//! model), [`maps`] (configuration maps and their bands), [`scenario`] (TOML scenarios compiled to
+//! an immutable scene), [`engine`] (the discrete-event feeder line and its metrics), [`report`]
+//! (tables and figures), [`cli`] (the `pinfeed` command).
 
 pub mod cli;
+pub mod engine;
 pub mod geometry;
 pub mod maps;
 pub mod mechanics;
 pub mod random;
 pub mod report;
+pub mod scenario;
 pub mod study;

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod contact;
 pub mod map;
 pub mod part;
+pub mod run;
 
 use clap::{Parser, Subcommand};
 
@@ -24,6 +25,8 @@ pub enum Command {
     Contact(contact::ContactArgs),
     /// Configuration maps θ0 → θf for several d: bands, no-contact runs, figures, report files.
     Map(map::MapArgs),
+    /// Simulate a feeder line from a scenario file: throughput and orientation success.
+    Run(run::RunArgs),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
 }
@@ -34,6 +37,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
         Command::Map(a) => map::run(&a),
+        Command::Run(a) => run::run(&a),
         Command::Bench(a) => bench::run(&a),
     }
 }

@@ -1,7 +1,11 @@
 //! Reports for people and programs: terminal tables, JSON/CSV, and SVG figures.
 
+pub mod line_table;
 pub mod map_table;
+pub mod parts_csv;
 pub mod plot_accuracy;
 pub mod plot_contact;
+pub mod plot_line;
 pub mod plot_map;
+pub mod plot_orientations;
 pub mod plot_part;

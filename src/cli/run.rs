@@ -1,0 +1,131 @@
+//! `pinfeed run SCENARIO.toml`: simulate a feeder line (SPEC §7) and report throughput and
+//! orientation success. Writes `summary.json` (and, as the scenario's `[output]` asks, the
+//! per-part CSV, the orientation histogram SVG and the event log) under
+//! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`.
+
+use crate::engine::{self, RunOptions};
+use crate::report::{line_table, parts_csv, plot_line, plot_orientations};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `pinfeed run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scenario file (TOML; see README "Scenario format").
+    pub scenario: PathBuf,
+    /// Number of parts (overrides [feed] parts).
+    #[arg(long)]
+    pub parts: Option<u64>,
+    /// Random seed (overrides the scenario's seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Print the summary as JSON instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Folder for results (default: the scenario's [output] dir, "results").
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// No table and no progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Draw the line from above, to scale, with a few sample parts, into this SVG file.
+    #[arg(long, value_name = "FILE.svg")]
+    pub draw: Option<PathBuf>,
+}
+
+/// How many of the first parts have their paths recorded when drawing.
+const SAMPLE_POOL: usize = 64;
+
+pub fn run(args: &RunArgs) -> Result<()> {
+    let scene = crate::scenario::load(&args.scenario)?;
+    let mut opts = RunOptions::from_scene(&scene);
+    if let Some(n) = args.parts {
+        if !(1..=1_000_000_000).contains(&n) {
+            bail!("--parts must lie in [1, 1000000000], got {n}");
+        }
+        opts.parts = n;
+    }
+    if let Some(s) = args.seed {
+        opts.seed = s;
+    }
+    opts.keep_records = scene.output.parts_csv;
+    if args.draw.is_some() {
+        opts.sample_paths = SAMPLE_POOL;
+    }
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::with_draw_target(Some(opts.parts), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} parts  {per_sec}  eta {eta}")
+                .expect("valid progress template"),
+        );
+        b
+    };
+    let started = Instant::now();
+    let result = engine::run(&scene, &opts, &mut |done| bar.set_position(done))
+        .with_context(|| format!("running {}", args.scenario.display()))?;
+    let wall = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let summary = &result.summary;
+
+    let dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(&scene.output.dir))
+        .join(&scene.name);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let json = serde_json::to_string_pretty(summary)? + "\n";
+    let summary_path = dir.join("summary.json");
+    std::fs::write(&summary_path, &json)
+        .with_context(|| format!("writing {}", summary_path.display()))?;
+    if scene.output.parts_csv {
+        let p = dir.join("parts.csv");
+        parts_csv::write_parts_csv(&p, &result.records)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    if scene.output.histogram_svg {
+        let p = dir.join("orientation_histogram.svg");
+        plot_orientations::plot_orientation_histogram(&scene, summary, &p)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    if scene.effects.event_log {
+        let p = dir.join("events.json");
+        std::fs::write(&p, serde_json::to_string(&result.events)? + "\n")
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    if let Some(p) = &args.draw {
+        let samples = plot_line::choose_samples(&result.paths, scene.output.draw_parts as usize);
+        plot_line::plot_line(&scene, &samples, p)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+
+    let mut text = String::new();
+    if args.json {
+        text = json;
+    } else if !args.quiet {
+        text.push_str(&line_table::table(summary));
+        let parts_per_s = summary.parts_in as f64 / wall.max(1e-9);
+        let contacts_per_s = summary.work.contact_solves as f64 / wall.max(1e-9);
+        text.push_str(&format!(
+            "simulator speed           {parts_per_s:.0} parts/s, {contacts_per_s:.0} contacts/s ({wall:.2} s wall)\n"
+        ));
+        text.push_str(&format!("results                   {}\n", dir.display()));
+    }
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|_| stdout.flush())
+    {
+        // A closed pipe (`| head`) is the reader's choice, not an error.
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            return Err(e).context("writing to stdout")
+        }
+        _ => {}
+    }
+    Ok(())
+}

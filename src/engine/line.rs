@@ -1,0 +1,649 @@
+//! The feeder line as a discrete-event simulation (SPEC §7; DESIGN.md "the shape of the program").
+//!
+//! Parts arrive (periodic or Poisson, at x = 0 with a random orientation and lateral offset), ride
+//! the belt, are pushed by pins and leave at x = belt length. Each part is, at any time, either
+//! free (riding the belt) or held (being pushed); see [`super::motion`]. Its next event is always
+//! known: from a free state the first-contact ray cast (belt frame) over every obstacle gives the
+//! next contact begin, else the exit; at contact begin the contact model ([`crate::mechanics::push`])
+//! gives the whole push and so the contact end. Events are processed in time order, ties by
+//! sequence number ([`super::event_queue`]).
+//!
+//! Detection (never silent mis-simulation):
+//! * **two obstacles at once**: when a push starts, each obstacle close enough to the pushing pin
+//!   to be reached (centre distance ≤ 2a + both radii, precomputed per scene) is checked against the
+//!   part's recorded path during the push; a touch ends the push there as `multi_contact`. The
+//!   contact model itself reports a pin in a concave notch (also `multi_contact`).
+//! * **part–part overlap**: whenever a part's motion changes (arrival, contact begin, contact end),
+//!   its new motion is checked against every other part on the belt over the time both motions are
+//!   known (until the earlier of their next events). Every interval of time in which two parts
+//!   coexist starts at such a change of one of them, so every overlap is found. A broad phase
+//!   (bounding capsules in the belt frame) skips distant pairs; close pairs are resolved in time
+//!   with [`super::overlap::first_touch`]. The first overlap schedules a collision event; both
+//!   parts are taken off the line then, unless one of them has already gone.
+//!   Only while two or more parts share the belt does this run (`work.part_part_checks`).
+//! * **off the belt**: after a push, a centroid outside |y| ≤ width/2 means the part falls off.
+//! * **jam**: a push that never releases the part (the contact model's travel limit).
+//! * **solver**: any other failure of the contact model, with its cause.
+//!
+//! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it.
+
+use super::event_queue::{Event, EventKind, EventQueue};
+use super::metrics::{Metrics, Summary};
+use super::motion::{ContactPlan, Motion, Stop};
+use super::outcome::PartOutcome;
+use super::overlap::{disc_clearance, first_touch, polygon_clearance, segment_distance};
+use super::part_stream::{arrival_gap, draw_part};
+use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
+use crate::mechanics::{push, ContactSettings, ContactStatus, PartModel, Pin, SolveFailure};
+use crate::scenario::{Arrival, Obstacle, Scene};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use thiserror::Error;
+
+/// What a run needs beyond the scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOptions {
+    /// Number of parts (default: the scene's).
+    pub parts: u64,
+    /// Seed (default: the scene's).
+    pub seed: u64,
+    /// Record the paths of the first `sample_paths` parts (for drawing).
+    pub sample_paths: usize,
+    /// Keep one record per part (for the per-part CSV).
+    pub keep_records: bool,
+}
+
+impl RunOptions {
+    /// The scene's own settings: its number of parts and seed, nothing recorded.
+    pub fn from_scene(scene: &Scene) -> RunOptions {
+        RunOptions {
+            parts: scene.feed.parts,
+            seed: scene.seed,
+            sample_paths: 0,
+            keep_records: false,
+        }
+    }
+}
+
+/// Why a run could not be carried out.
+#[derive(Debug, Error)]
+pub enum EngineError {
+    #[error("part {index}: {reason}")]
+    PartDraw { index: u64, reason: String },
+}
+
+/// One finished part.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PartRecord {
+    pub part: u64,
+    pub arrival_s: f64,
+    pub end_s: f64,
+    pub outcome: &'static str,
+    /// Cause behind multi_contact or solver, else empty.
+    pub cause: &'static str,
+    pub contacts: u32,
+    pub theta_in_deg: f64,
+    pub theta_out_deg: f64,
+    pub y_in_m: f64,
+    pub y_out_m: f64,
+}
+
+/// The path of a sample part: world poses at successive instants (s, pose).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SamplePath {
+    pub part: u64,
+    pub outcome: PartOutcome,
+    pub poses: Vec<(f64, Pose)>,
+}
+
+/// Everything a run produces.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    pub summary: Summary,
+    pub metrics: Metrics,
+    /// Per-part records, if asked for.
+    pub records: Vec<PartRecord>,
+    /// Every event taken off the queue, if the scene's event log is on.
+    pub events: Vec<Event>,
+    pub paths: Vec<SamplePath>,
+}
+
+struct ActivePart {
+    arrival: f64,
+    theta_in: f64,
+    y_in: f64,
+    motion: Motion,
+    /// The obstacle whose push ended last (its pin has passed; it cannot touch the part again).
+    last_obstacle: Option<usize>,
+    contacts: u32,
+    /// Own contact model (random tripod), else the scene's.
+    model: Option<PartModel>,
+    path: Option<Vec<(f64, Pose)>>,
+}
+
+struct Line<'a> {
+    scene: &'a Scene,
+    opts: &'a RunOptions,
+    queue: EventQueue,
+    active: BTreeMap<u64, ActivePart>,
+    metrics: Metrics,
+    records: Vec<PartRecord>,
+    events: Vec<Event>,
+    paths: Vec<SamplePath>,
+    finished: u64,
+}
+
+/// Run the line: a pure function of (scene, options). `progress` is called with the number of
+/// finished parts from time to time.
+pub fn run(
+    scene: &Scene,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunResult, EngineError> {
+    let names = scene
+        .obstacles
+        .iter()
+        .map(|o| o.name().to_string())
+        .collect();
+    let mut line = Line {
+        scene,
+        opts,
+        queue: EventQueue::new(),
+        active: BTreeMap::new(),
+        metrics: Metrics::new(names, scene.output.histogram_bin_deg),
+        records: Vec::new(),
+        events: Vec::new(),
+        paths: Vec::new(),
+        finished: 0,
+    };
+    if opts.parts > 0 {
+        line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
+    }
+    while let Some(ev) = line.queue.pop() {
+        line.handle(ev)?;
+        if line.finished % 256 == 0 {
+            progress(line.finished);
+        }
+    }
+    progress(line.finished);
+    assert!(
+        line.active.is_empty(),
+        "parts left on the belt after the last event"
+    );
+    assert_eq!(
+        line.metrics.outcomes.total(),
+        line.metrics.parts_in,
+        "conservation: every part that enters ends in exactly one class"
+    );
+    assert_eq!(line.metrics.parts_in, opts.parts);
+    let summary = line
+        .metrics
+        .summary(&scene.name, opts.seed, scene.contact.fidelity.name());
+    Ok(RunResult {
+        summary,
+        metrics: line.metrics,
+        records: line.records,
+        events: line.events,
+        paths: line.paths,
+    })
+}
+
+impl Line<'_> {
+    fn speed(&self) -> f64 {
+        self.scene.belt.speed
+    }
+
+    fn handle(&mut self, ev: Event) -> Result<(), EngineError> {
+        self.metrics.work.events += 1;
+        self.metrics.last_event = self.metrics.last_event.max(ev.time);
+        if self.scene.effects.event_log {
+            self.events.push(ev);
+        }
+        let t = ev.time;
+        match ev.kind {
+            EventKind::Arrival { part } => self.arrival(t, part)?,
+            EventKind::ContactBegin { part, obstacle } => {
+                self.contact_begin(t, part, obstacle as usize)
+            }
+            EventKind::ContactEnd { part, obstacle } => {
+                self.contact_end(t, part, obstacle as usize)
+            }
+            EventKind::Exit { part } => self.exit(t, part),
+            EventKind::Collision { first, second } => {
+                if self.active.contains_key(&first) && self.active.contains_key(&second) {
+                    self.finish(first, t, PartOutcome::Collision, "");
+                    self.finish(second, t, PartOutcome::Collision, "");
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn arrival(&mut self, t: f64, index: u64) -> Result<(), EngineError> {
+        let d = draw_part(self.scene, self.opts.seed, index)
+            .map_err(|reason| EngineError::PartDraw { index, reason })?;
+        if d.model.is_some() {
+            self.metrics.work.tripods_drawn += 1;
+        }
+        self.metrics.arrival(t);
+        if index + 1 < self.opts.parts {
+            let next = match self.scene.feed.arrival {
+                Arrival::Periodic { headway } => (index + 1) as f64 * headway,
+                Arrival::Poisson { .. } => t + arrival_gap(self.scene, self.opts.seed, index + 1),
+            };
+            self.queue
+                .schedule(next, EventKind::Arrival { part: index + 1 });
+        }
+        let pose = Pose::new(0.0, d.y, d.theta);
+        let mut part = ActivePart {
+            arrival: t,
+            theta_in: d.theta,
+            y_in: d.y,
+            motion: Motion::Free {
+                t0: t,
+                pose,
+                until: t,
+            },
+            last_obstacle: None,
+            contacts: 0,
+            model: d.model,
+            path: ((index as usize) < self.opts.sample_paths).then(|| vec![(t, pose)]),
+        };
+        self.plan_next(index, &mut part, t);
+        self.active.insert(index, part);
+        self.check_pairs(index, t);
+        Ok(())
+    }
+
+    /// From a free state, find the next event: the first obstacle the part will touch (first-contact
+    /// ray cast in the belt frame, exactly as the contact model casts it), or the exit.
+    fn plan_next(&mut self, index: u64, part: &mut ActivePart, now: f64) {
+        let Motion::Free { t0, pose, .. } = part.motion else {
+            unreachable!("plan_next on a held part");
+        };
+        let v = self.speed();
+        let a = self.scene.part.radius;
+        let model = part.model.as_ref().unwrap_or(&self.scene.part.model);
+        let k = model.scale();
+        let poly = model.polygon();
+        let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+        let mut best: Option<(f64, usize)> = None;
+        for (j, ob) in self.scene.obstacles.iter().enumerate() {
+            if Some(j) == part.last_obstacle {
+                continue;
+            }
+            let Obstacle::Pin(pin) = ob;
+            // Out of lateral reach, or already behind the part: the pin's path misses it.
+            if (pin.centre.y - pose.y).abs() > a + pin.radius
+                || pin.centre.x + pin.radius < pose.x - a
+            {
+                continue;
+            }
+            self.metrics.work.ray_casts += 1;
+            let start = pin.centre / k;
+            let rho = pin.radius / k;
+            let mut min_travel = 0.0;
+            let travel = loop {
+                match first_contact(poly, &pose_n, start, Vec2::new(-1.0, 0.0), rho, min_travel) {
+                    None => break None,
+                    Some(h) if h.grazing => min_travel = h.travel + 1e-9,
+                    Some(h) => break Some(h.travel * k),
+                }
+            };
+            if let Some(tr) = travel {
+                if best.is_none_or(|(b, _)| tr < b) {
+                    best = Some((tr, j));
+                }
+            }
+        }
+        let length = self.scene.belt.length;
+        let t_exit = if pose.x >= length {
+            now
+        } else {
+            (t0 + (length - pose.x) / v).max(now)
+        };
+        let until = match best {
+            Some((travel, j)) if t0 + travel / v < t_exit => {
+                let tb = (t0 + travel / v).max(now);
+                self.queue.schedule(
+                    tb,
+                    EventKind::ContactBegin {
+                        part: index,
+                        obstacle: j as u32,
+                    },
+                );
+                tb
+            }
+            _ => {
+                self.queue.schedule(t_exit, EventKind::Exit { part: index });
+                t_exit
+            }
+        };
+        part.motion = Motion::Free { t0, pose, until };
+    }
+
+    fn contact_begin(&mut self, t: f64, index: u64, j: usize) {
+        let scene = self.scene;
+        let v = self.speed();
+        let Some(mut part) = self.active.remove(&index) else {
+            return; // the part has already left the line
+        };
+        let Motion::Free { t0, pose, .. } = part.motion else {
+            unreachable!("contact begin for a held part");
+        };
+        let Obstacle::Pin(pin) = &scene.obstacles[j];
+        let settings = ContactSettings {
+            mu_c: pin.mu_c,
+            ..scene.contact
+        };
+        let pin_model = Pin {
+            radius: pin.radius,
+            lateral_speed: 0.0,
+        };
+        let model = part.model.as_ref().unwrap_or(&scene.part.model);
+        let out = push(model, pose, pin.centre, &pin_model, &settings, None);
+        self.metrics.work.contact_solves += 1;
+        self.metrics.work.model_evaluations += out.evaluations;
+        if matches!(out.status, ContactStatus::PinInsidePart) {
+            self.active.insert(index, part);
+            self.finish(index, t, PartOutcome::MultiContact, "pin_inside_part");
+            return;
+        }
+        if !out.contact {
+            // The model found only a grazing touch: the pin passes without pushing.
+            part.last_obstacle = Some(j);
+            self.plan_next(index, &mut part, t);
+            self.active.insert(index, part);
+            self.check_pairs(index, t);
+            return;
+        }
+        let s_touch = out.travel_to_contact;
+        let s_end = out
+            .segments
+            .last()
+            .map(|s| s.s_end)
+            .unwrap_or(s_touch + out.contact_length)
+            .max(s_touch);
+        let stop = match out.status {
+            ContactStatus::Ok => None,
+            ContactStatus::MultiContact { .. } => Some(Stop::MultiContact { cause: "notch" }),
+            ContactStatus::TravelLimit { .. } => Some(Stop::Jam),
+            ContactStatus::Solver { failure, .. } => Some(Stop::Solver {
+                cause: match failure {
+                    SolveFailure::NoConvergence { .. } => "no_convergence",
+                    SolveFailure::NonFinite => "non_finite",
+                },
+            }),
+            other => Some(Stop::Solver {
+                cause: other.name(),
+            }),
+        };
+        let mut plan = ContactPlan {
+            obstacle: j,
+            t_ref: t0,
+            pose_ref: pose,
+            pin_centre: pin.centre,
+            pin: pin_model,
+            settings,
+            outcome: out,
+            s_touch,
+            s_end,
+            t_begin: t,
+            t_end: (t0 + s_end / v).max(t),
+            stop,
+            trace: None,
+        };
+        // Another obstacle within reach of this push?
+        if scene.effects.obstacle_sweeps && !scene.neighbours[j].is_empty() {
+            if plan.ensure_trace(model) {
+                self.metrics.work.traces_recorded += 1;
+            }
+            let held = Motion::Held(Box::new(plan.clone()));
+            let poly = &scene.part.polygon;
+            let a = scene.part.radius;
+            let breaks = plan.step_times(v);
+            let mut earliest: Option<f64> = None;
+            for &nb in &scene.neighbours[j] {
+                self.metrics.work.obstacle_sweep_checks += 1;
+                let (centre, radius) = scene.obstacles[nb].bounding_disc();
+                let end = earliest.unwrap_or(plan.t_end);
+                let mut evals = 0;
+                let hit = first_touch(
+                    plan.t_begin,
+                    end,
+                    &breaks,
+                    &mut |tau| {
+                        let p = held.world_pose(tau, v);
+                        disc_clearance(centre, radius, &poly.world_vertices(&p))
+                    },
+                    &|ta, tb| {
+                        let (p, q) = (held.world_pose(ta, v), held.world_pose(tb, v));
+                        (q.position() - p.position()).norm() + a * (q.theta - p.theta).abs()
+                    },
+                    1e-6 * a,
+                    &mut evals,
+                );
+                self.metrics.work.clearance_evaluations += evals;
+                if let Some(tm) = hit {
+                    earliest = Some(earliest.map_or(tm, |e: f64| e.min(tm)));
+                }
+            }
+            if let Some(tm) = earliest {
+                plan.t_end = tm.max(t);
+                plan.stop = Some(Stop::MultiContact {
+                    cause: "second_obstacle",
+                });
+            }
+        }
+        part.contacts += 1;
+        self.metrics.contacts += 1;
+        self.metrics.obstacles[j].contacts += 1;
+        if part.path.is_some() {
+            if plan.ensure_trace(model) {
+                self.metrics.work.traces_recorded += 1;
+            }
+            let held = Motion::Held(Box::new(plan.clone()));
+            let mut times = vec![plan.t_begin];
+            times.extend(plan.step_times(v));
+            times.push(plan.t_end);
+            if let Some(path) = part.path.as_mut() {
+                path.extend(times.iter().map(|&tau| (tau, held.world_pose(tau, v))));
+            }
+        }
+        let t_end = plan.t_end;
+        part.motion = Motion::Held(Box::new(plan));
+        self.queue.schedule(
+            t_end,
+            EventKind::ContactEnd {
+                part: index,
+                obstacle: j as u32,
+            },
+        );
+        self.active.insert(index, part);
+        self.check_pairs(index, t);
+    }
+
+    fn contact_end(&mut self, t: f64, index: u64, j: usize) {
+        let Some(mut part) = self.active.remove(&index) else {
+            return;
+        };
+        let Motion::Held(plan) = &part.motion else {
+            unreachable!("contact end for a free part");
+        };
+        self.metrics.obstacles[j].busy_s += (plan.t_end - plan.t_begin).max(0.0);
+        if let Some(stop) = plan.stop.clone() {
+            self.active.insert(index, part);
+            let (outcome, cause) = match stop {
+                Stop::MultiContact { cause } => (PartOutcome::MultiContact, cause),
+                Stop::Jam => (PartOutcome::Jam, ""),
+                Stop::Solver { cause } => (PartOutcome::Solver, cause),
+            };
+            self.finish(index, t, outcome, cause);
+            return;
+        }
+        let end = plan.outcome.pose_final;
+        let pose = Pose::new(end.x + plan.s_end, end.y, end.theta);
+        if let Some(path) = part.path.as_mut() {
+            path.push((t, pose));
+        }
+        part.motion = Motion::Free {
+            t0: t,
+            pose,
+            until: t,
+        };
+        part.last_obstacle = Some(j);
+        if pose.y.abs() > self.scene.belt.width / 2.0 {
+            self.active.insert(index, part);
+            self.finish(index, t, PartOutcome::OffBelt, "");
+            return;
+        }
+        self.plan_next(index, &mut part, t);
+        self.active.insert(index, part);
+        self.check_pairs(index, t);
+    }
+
+    fn exit(&mut self, t: f64, index: u64) {
+        let Some(part) = self.active.get(&index) else {
+            return;
+        };
+        let pose = part.motion.world_pose(t, self.speed());
+        let outcome = if self.scene.goal.matching_set(pose.theta).is_some() {
+            PartOutcome::Success
+        } else {
+            PartOutcome::WrongOrientation
+        };
+        self.finish(index, t, outcome, "");
+    }
+
+    /// Take part `index` off the line at time `t` with `outcome`.
+    fn finish(&mut self, index: u64, t: f64, outcome: PartOutcome, cause: &'static str) {
+        let Some(part) = self.active.remove(&index) else {
+            return;
+        };
+        let pose = part.motion.world_pose(t, self.speed());
+        let theta_deg = wrap_deg(pose.theta.to_degrees());
+        self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
+        self.metrics.cause(outcome, cause);
+        if self.opts.keep_records {
+            self.records.push(PartRecord {
+                part: index,
+                arrival_s: part.arrival,
+                end_s: t,
+                outcome: outcome.name(),
+                cause,
+                contacts: part.contacts,
+                theta_in_deg: wrap_deg(part.theta_in.to_degrees()),
+                theta_out_deg: theta_deg,
+                y_in_m: part.y_in,
+                y_out_m: pose.y,
+            });
+        }
+        if let Some(mut poses) = part.path {
+            if poses.last().is_none_or(|&(tl, _)| tl < t) {
+                poses.push((t, pose));
+            }
+            self.paths.push(SamplePath {
+                part: index,
+                outcome,
+                poses,
+            });
+        }
+        self.finished += 1;
+    }
+
+    /// Check the motion part `index` has just started against every other part on the belt.
+    fn check_pairs(&mut self, index: u64, now: f64) {
+        if !self.scene.effects.collisions || self.active.len() < 2 {
+            return;
+        }
+        let scene = self.scene;
+        let v = self.speed();
+        let a = scene.part.radius;
+        let others: Vec<u64> = self
+            .active
+            .keys()
+            .copied()
+            .filter(|&k| k != index)
+            .collect();
+        for other in others {
+            self.metrics.work.part_part_checks += 1;
+            let end = self.active[&index]
+                .motion
+                .until()
+                .min(self.active[&other].motion.until());
+            if end < now {
+                continue;
+            }
+            // Broad phase in the belt frame that is the world at `now`: a free part is a disc of
+            // radius a at rest; a held part stays within 2a + ρ of its pin, whose belt-frame path
+            // runs from its centre back along −x.
+            let capsule = |p: &ActivePart| -> (Vec2, Vec2, f64) {
+                match &p.motion {
+                    Motion::Free { .. } => {
+                        let c = p.motion.world_pose(now, v).position();
+                        (c, c, a)
+                    }
+                    Motion::Held(plan) => {
+                        let Obstacle::Pin(pin) = &scene.obstacles[plan.obstacle];
+                        let x = pin.centre;
+                        (x, x - Vec2::new(v * (end - now), 0.0), 2.0 * a + pin.radius)
+                    }
+                }
+            };
+            let (p0, p1, r1) = capsule(&self.active[&index]);
+            let (q0, q1, r2) = capsule(&self.active[&other]);
+            if segment_distance(p0, p1, q0, q1) > r1 + r2 {
+                continue;
+            }
+            self.metrics.work.part_part_narrow_checks += 1;
+            for k in [index, other] {
+                let part = self.active.get_mut(&k).expect("active part");
+                if let Motion::Held(plan) = &mut part.motion {
+                    let model = part.model.as_ref().unwrap_or(&scene.part.model);
+                    if plan.ensure_trace(model) {
+                        self.metrics.work.traces_recorded += 1;
+                    }
+                }
+            }
+            let (pi, pj) = (&self.active[&index], &self.active[&other]);
+            let mut breaks: Vec<f64> = Vec::new();
+            for p in [pi, pj] {
+                if let Motion::Held(plan) = &p.motion {
+                    breaks.extend(plan.step_times(v));
+                }
+            }
+            breaks.sort_by(f64::total_cmp);
+            let poly = &scene.part.polygon;
+            let belt_motion = |m: &Motion, ta: f64, tb: f64| -> f64 {
+                let (p, q) = (m.world_pose(ta, v), m.world_pose(tb, v));
+                let d = q.position() - p.position() - Vec2::new(v * (tb - ta), 0.0);
+                d.norm() + a * (q.theta - p.theta).abs()
+            };
+            let mut evals = 0;
+            let hit = first_touch(
+                now,
+                end,
+                &breaks,
+                &mut |tau| {
+                    polygon_clearance(
+                        &poly.world_vertices(&pi.motion.world_pose(tau, v)),
+                        &poly.world_vertices(&pj.motion.world_pose(tau, v)),
+                    )
+                },
+                &|ta, tb| belt_motion(&pi.motion, ta, tb) + belt_motion(&pj.motion, ta, tb),
+                1e-6 * a,
+                &mut evals,
+            );
+            self.metrics.work.clearance_evaluations += evals;
+            if let Some(tc) = hit {
+                self.queue.schedule(
+                    tc,
+                    EventKind::Collision {
+                        first: index.min(other),
+                        second: index.max(other),
+                    },
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,346 @@
+//! What a run measures, accumulated as events happen (SPEC §7; issue 7 "Metrics"), and the
+//! deterministic [`Summary`] built from it.
+//!
+//! Definitions:
+//! * **throughput** (parts/min): a rate over a window [t_a, t_b] counts the events in [t_a, t_b)
+//!   and divides by t_b − t_a, so N periodic events h apart give exactly 1/h. `throughput_in`
+//!   uses the arrivals (first to last arrival). The **steady window** for the output side runs from
+//!   the first to the last exit (success or wrong orientation): it leaves out the time the belt
+//!   takes to fill and to empty. `throughput_out` counts all exits in it, `throughput_ok` the
+//!   successes.
+//! * **success rate**: successes / parts in, with the 95% Wilson score interval.
+//! * **latency**: exit time − arrival time of the parts that exit, in an HDR histogram of
+//!   microseconds (3 significant digits), reported in seconds.
+//! * **contacts per part**: pin encounters (pushes) / parts in.
+//! * **busy fraction** of a pin: total time it is pushing a part / simulated time (first arrival to
+//!   last event).
+//! * **work**: counters of the work each optional effect did, so a test can show that an effect a
+//!   scene does not use costs nothing. Wall-clock speed is not part of the summary (it would make
+//!   runs differ); the CLI prints it beside the table.
+
+use super::outcome::{OutcomeCounts, PartOutcome};
+use hdrhistogram::Histogram;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Work done, by kind.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct WorkCounters {
+    /// Events taken off the queue.
+    pub events: u64,
+    /// Calls of the contact model (pushes), excluding re-runs for traces.
+    pub contact_solves: u64,
+    /// Limit-surface evaluations reported by those calls.
+    pub model_evaluations: u64,
+    /// First-contact ray casts to find a part's next obstacle.
+    pub ray_casts: u64,
+    /// Pushes re-run with a recorder because something needed intermediate poses.
+    pub traces_recorded: u64,
+    /// Pairs of parts considered for overlap (only while two or more parts share the belt).
+    pub part_part_checks: u64,
+    /// Of those, pairs close enough to need a time-resolved check.
+    pub part_part_narrow_checks: u64,
+    /// Neighbouring obstacles checked against a push.
+    pub obstacle_sweep_checks: u64,
+    /// Clearance evaluations in time-resolved checks.
+    pub clearance_evaluations: u64,
+    /// Random tripods drawn (support = "tripod").
+    pub tripods_drawn: u64,
+}
+
+/// Per-obstacle statistics.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ObstacleStats {
+    pub name: String,
+    pub contacts: u64,
+    /// Seconds spent pushing parts.
+    pub busy_s: f64,
+}
+
+/// Accumulators of a run.
+#[derive(Debug, Clone)]
+pub struct Metrics {
+    pub parts_in: u64,
+    pub outcomes: OutcomeCounts,
+    pub multi_contact_causes: BTreeMap<String, u64>,
+    pub solver_causes: BTreeMap<String, u64>,
+    pub first_arrival: Option<f64>,
+    pub last_arrival: f64,
+    pub first_exit: Option<f64>,
+    pub last_exit: f64,
+    pub exits_at_last: u64,
+    pub successes_at_last: u64,
+    pub exits: u64,
+    pub last_event: f64,
+    /// Entry → exit, microseconds.
+    pub latency_us: Histogram<u64>,
+    /// Largest latency (s), exact.
+    pub latency_max: f64,
+    pub contacts: u64,
+    pub obstacles: Vec<ObstacleStats>,
+    /// Final orientations of exiting parts, counts per bin of `bin_deg`.
+    pub orientation_bins: Vec<u64>,
+    pub bin_deg: f64,
+    pub work: WorkCounters,
+}
+
+impl Metrics {
+    pub fn new(obstacle_names: Vec<String>, bin_deg: f64) -> Metrics {
+        let bins = (360.0 / bin_deg).round() as usize;
+        Metrics {
+            parts_in: 0,
+            outcomes: OutcomeCounts::default(),
+            multi_contact_causes: BTreeMap::new(),
+            solver_causes: BTreeMap::new(),
+            first_arrival: None,
+            last_arrival: 0.0,
+            first_exit: None,
+            last_exit: 0.0,
+            exits_at_last: 0,
+            successes_at_last: 0,
+            exits: 0,
+            last_event: 0.0,
+            latency_us: Histogram::new_with_bounds(1, 1_000_000_000_000, 3)
+                .expect("valid histogram bounds: 1 µs to 10⁶ s, 3 significant digits"),
+            latency_max: 0.0,
+            contacts: 0,
+            obstacles: obstacle_names
+                .into_iter()
+                .map(|name| ObstacleStats {
+                    name,
+                    ..ObstacleStats::default()
+                })
+                .collect(),
+            orientation_bins: vec![0; bins],
+            bin_deg,
+            work: WorkCounters::default(),
+        }
+    }
+
+    pub fn arrival(&mut self, t: f64) {
+        self.parts_in += 1;
+        if self.first_arrival.is_none() {
+            self.first_arrival = Some(t);
+        }
+        self.last_arrival = t;
+    }
+
+    /// A part has finished with `outcome` at time `t`; `theta_deg` is its final orientation in
+    /// [0, 360) and `latency` its time on the belt.
+    pub fn finish(&mut self, outcome: PartOutcome, t: f64, theta_deg: f64, latency: f64) {
+        self.outcomes.add(outcome);
+        if !outcome.exited() {
+            return;
+        }
+        if self.first_exit.is_none() {
+            self.first_exit = Some(t);
+        }
+        if t > self.last_exit || self.exits == 0 {
+            self.last_exit = t;
+            self.exits_at_last = 0;
+            self.successes_at_last = 0;
+        }
+        self.exits += 1;
+        self.exits_at_last += 1;
+        if outcome == PartOutcome::Success {
+            self.successes_at_last += 1;
+        }
+        let us = (latency * 1e6).round().max(1.0) as u64;
+        self.latency_us.saturating_record(us);
+        self.latency_max = self.latency_max.max(latency);
+        let n = self.orientation_bins.len();
+        let bin = ((theta_deg / self.bin_deg).floor() as usize).min(n - 1);
+        self.orientation_bins[bin] += 1;
+    }
+
+    pub fn cause(&mut self, outcome: PartOutcome, cause: &str) {
+        let map = match outcome {
+            PartOutcome::MultiContact => &mut self.multi_contact_causes,
+            PartOutcome::Solver => &mut self.solver_causes,
+            _ => return,
+        };
+        *map.entry(cause.to_string()).or_insert(0) += 1;
+    }
+}
+
+/// Latency quantiles (seconds; the quantiles to the histogram's 3 significant digits, the
+/// maximum exact).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LatencySummary {
+    pub p50: f64,
+    pub p90: f64,
+    pub p99: f64,
+    pub max: f64,
+}
+
+/// Per-obstacle line of the summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObstacleSummary {
+    pub name: String,
+    pub contacts: u64,
+    pub busy_fraction: f64,
+}
+
+/// Final-orientation histogram of the exiting parts.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OrientationHistogram {
+    pub bin_deg: f64,
+    /// counts[k] = parts with final θ in [k·bin, (k+1)·bin) degrees.
+    pub counts: Vec<u64>,
+}
+
+/// Causes behind the multi_contact and solver classes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Causes {
+    pub multi_contact: BTreeMap<String, u64>,
+    pub solver: BTreeMap<String, u64>,
+}
+
+/// The deterministic result of a run: a pure function of (scene, seed, parts).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    pub scenario: String,
+    pub seed: u64,
+    pub fidelity: String,
+    pub parts_in: u64,
+    pub outcomes: OutcomeCounts,
+    pub success_rate: f64,
+    pub success_ci95: [f64; 2],
+    pub throughput_in_per_min: Option<f64>,
+    pub throughput_out_per_min: Option<f64>,
+    pub throughput_ok_per_min: Option<f64>,
+    /// [first exit, last exit] (s).
+    pub steady_window_s: Option<[f64; 2]>,
+    pub latency_s: Option<LatencySummary>,
+    pub contacts_per_part: f64,
+    pub obstacles: Vec<ObstacleSummary>,
+    pub orientation_histogram: OrientationHistogram,
+    pub causes: Causes,
+    /// First arrival to last event (s).
+    pub simulated_time_s: f64,
+    pub work: WorkCounters,
+}
+
+/// The 95% Wilson score interval for `k` successes in `n` trials.
+pub fn wilson_interval(k: u64, n: u64) -> [f64; 2] {
+    if n == 0 {
+        return [0.0, 1.0];
+    }
+    let z = 1.959_963_984_540_054_f64;
+    let n = n as f64;
+    let p = k as f64 / n;
+    let z2 = z * z;
+    let denom = 1.0 + z2 / n;
+    let centre = (p + z2 / (2.0 * n)) / denom;
+    let half = z / denom * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
+    [(centre - half).max(0.0), (centre + half).min(1.0)]
+}
+
+impl Metrics {
+    /// Build the summary.
+    pub fn summary(&self, scenario: &str, seed: u64, fidelity: &str) -> Summary {
+        let n = self.parts_in;
+        let per_min = |count: u64, a: f64, b: f64| -> Option<f64> {
+            (b > a).then(|| count as f64 / (b - a) * 60.0)
+        };
+        let first_arrival = self.first_arrival.unwrap_or(0.0);
+        let throughput_in = per_min(n.saturating_sub(1), first_arrival, self.last_arrival);
+        let (throughput_out, throughput_ok, window) = match self.first_exit {
+            Some(a) => (
+                per_min(self.exits - self.exits_at_last, a, self.last_exit),
+                per_min(
+                    self.outcomes.success - self.successes_at_last,
+                    a,
+                    self.last_exit,
+                ),
+                Some([a, self.last_exit]),
+            ),
+            None => (None, None, None),
+        };
+        let latency = (!self.latency_us.is_empty()).then(|| {
+            let q = |p: f64| self.latency_us.value_at_quantile(p) as f64 * 1e-6;
+            LatencySummary {
+                p50: q(0.5),
+                p90: q(0.9),
+                p99: q(0.99),
+                max: self.latency_max,
+            }
+        });
+        let span = self.last_event - first_arrival;
+        Summary {
+            scenario: scenario.to_string(),
+            seed,
+            fidelity: fidelity.to_string(),
+            parts_in: n,
+            outcomes: self.outcomes,
+            success_rate: if n > 0 {
+                self.outcomes.success as f64 / n as f64
+            } else {
+                0.0
+            },
+            success_ci95: wilson_interval(self.outcomes.success, n),
+            throughput_in_per_min: throughput_in,
+            throughput_out_per_min: throughput_out,
+            throughput_ok_per_min: throughput_ok,
+            steady_window_s: window,
+            latency_s: latency,
+            contacts_per_part: if n > 0 {
+                self.contacts as f64 / n as f64
+            } else {
+                0.0
+            },
+            obstacles: self
+                .obstacles
+                .iter()
+                .map(|o| ObstacleSummary {
+                    name: o.name.clone(),
+                    contacts: o.contacts,
+                    busy_fraction: if span > 0.0 { o.busy_s / span } else { 0.0 },
+                })
+                .collect(),
+            orientation_histogram: OrientationHistogram {
+                bin_deg: self.bin_deg,
+                counts: self.orientation_bins.clone(),
+            },
+            causes: Causes {
+                multi_contact: self.multi_contact_causes.clone(),
+                solver: self.solver_causes.clone(),
+            },
+            simulated_time_s: span,
+            work: self.work,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wilson_matches_reference_values() {
+        // 8 of 10: Wilson 95% interval (0.4902, 0.9433).
+        let [lo, hi] = wilson_interval(8, 10);
+        assert!(
+            (lo - 0.4902).abs() < 1e-4 && (hi - 0.9433).abs() < 1e-4,
+            "{lo} {hi}"
+        );
+        let [lo, hi] = wilson_interval(0, 20);
+        assert_eq!(lo, 0.0);
+        assert!((hi - 0.1611).abs() < 1e-4);
+    }
+
+    #[test]
+    fn periodic_rate_is_exact() {
+        let mut m = Metrics::new(vec![], 5.0);
+        for i in 0..11 {
+            m.arrival(2.0 * i as f64);
+            m.finish(PartOutcome::Success, 10.0 + 2.0 * i as f64, 0.0, 10.0);
+        }
+        m.last_event = 30.0;
+        let s = m.summary("t", 1, "exact");
+        assert_eq!(s.throughput_in_per_min, Some(30.0));
+        assert_eq!(s.throughput_ok_per_min, Some(30.0));
+        let lat = s.latency_s.unwrap();
+        assert!((lat.p50 - 10.0).abs() < 0.01 && lat.max == 10.0, "{lat:?}");
+    }
+}

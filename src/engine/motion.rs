@@ -1,0 +1,186 @@
+//! How a part moves on the line between events (SPEC §7).
+//!
+//! * Free: the part rides the belt: its world pose at time t is its pose at the anchor time t₀
+//!   translated by V·(t − t₀) along x.
+//! * Held: a pin is pushing it. The contact model works in the belt frame that coincides with the
+//!   world at the anchor time t_ref (SPEC §2): the pin, fixed in the world at X, starts at X and
+//!   travels along −x relative to the belt, its travel s = V·(t − t_ref). The push outcome gives the
+//!   belt-frame pose after the pin has passed; the world pose at time t is the belt-frame pose
+//!   translated by s along x. The part therefore lags the belt while it is held.
+//!
+//! Intermediate poses of a push are only needed when something may touch the part during it (a
+//! neighbouring obstacle or another part) or when it is drawn. Then the push is run again with a
+//! recorder (it is a pure function, so the outcome is the same) and the trace is kept; between
+//! recorded steps the pose is interpolated linearly in (centroid, θ).
+
+use crate::geometry::{Pose, Vec2};
+use crate::mechanics::{push, ContactOutcome, ContactSettings, PartModel, Pin, TraceSample};
+
+/// Why a part leaves the line at the end of a push instead of riding on.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stop {
+    /// Two obstacles at once; `cause` names how (`notch`, `second_obstacle`, `pin_inside_part`).
+    MultiContact { cause: &'static str },
+    /// The pin never released the part within the travel limit.
+    Jam,
+    /// The contact model failed; `cause` is the contact status name (`evaluation_limit`,
+    /// `event_limit`, `step_too_small`), or for a failed sub-problem `no_convergence` / `non_finite`.
+    Solver { cause: &'static str },
+}
+
+/// A push in progress: its inputs (to re-run it with a recorder) and its outcome.
+#[derive(Debug, Clone)]
+pub struct ContactPlan {
+    pub obstacle: usize,
+    /// Anchor: the world and belt frames coincide at this time.
+    pub t_ref: f64,
+    /// World pose of the part at `t_ref` (= its belt-frame pose throughout the push, before touch).
+    pub pose_ref: Pose,
+    /// Pin centre, world frame.
+    pub pin_centre: Vec2,
+    pub pin: Pin,
+    pub settings: ContactSettings,
+    pub outcome: ContactOutcome,
+    /// Pin travel at first touch and at the end of the last contact of the pass.
+    pub s_touch: f64,
+    pub s_end: f64,
+    /// World times of first touch and of the end of the push (or of an earlier stop).
+    pub t_begin: f64,
+    pub t_end: f64,
+    pub stop: Option<Stop>,
+    /// Recorded poses (pin travel, belt-frame pose), sorted by travel, once recorded.
+    pub trace: Option<Vec<(f64, Pose)>>,
+}
+
+impl ContactPlan {
+    /// Belt speed implied by the plan's times (travel / time).
+    fn travel_at(&self, t: f64, speed: f64) -> f64 {
+        speed * (t - self.t_ref)
+    }
+
+    /// Record the push's trace (if not yet recorded). Returns true if work was done.
+    pub fn ensure_trace(&mut self, model: &PartModel) -> bool {
+        if self.trace.is_some() {
+            return false;
+        }
+        let mut samples: Vec<TraceSample> = Vec::new();
+        let again = push(
+            model,
+            self.pose_ref,
+            self.pin_centre,
+            &self.pin,
+            &self.settings,
+            Some(&mut samples),
+        );
+        debug_assert_eq!(
+            again.pose_final, self.outcome.pose_final,
+            "push is not pure"
+        );
+        let mut trace = Vec::with_capacity(samples.len() + 2);
+        trace.push((self.s_touch, self.pose_ref));
+        for s in &samples {
+            if s.s
+                > trace
+                    .last()
+                    .map(|l: &(f64, Pose)| l.0)
+                    .unwrap_or(f64::NEG_INFINITY)
+                && s.s < self.s_end
+            {
+                trace.push((s.s, s.pose));
+            }
+        }
+        if self.s_end > self.s_touch {
+            trace.push((self.s_end, self.outcome.pose_final));
+        }
+        self.trace = Some(trace);
+        true
+    }
+
+    /// Belt-frame pose at pin travel `s` (inside the contact: from the trace, if recorded).
+    fn belt_pose(&self, s: f64) -> Pose {
+        if s <= self.s_touch {
+            return self.pose_ref;
+        }
+        if s >= self.s_end {
+            return self.outcome.pose_final;
+        }
+        let Some(tr) = self.trace.as_ref() else {
+            // Without a trace only the ends are known: interpolate between them (callers that
+            // need the real path record the trace first).
+            let u = (s - self.s_touch) / (self.s_end - self.s_touch);
+            let (p0, p1) = (self.pose_ref, self.outcome.pose_final);
+            return Pose::new(
+                p0.x + u * (p1.x - p0.x),
+                p0.y + u * (p1.y - p0.y),
+                p0.theta + u * (p1.theta - p0.theta),
+            );
+        };
+        let i = tr.partition_point(|(si, _)| *si <= s);
+        if i == 0 {
+            return tr[0].1;
+        }
+        if i >= tr.len() {
+            return tr[tr.len() - 1].1;
+        }
+        let (s0, p0) = tr[i - 1];
+        let (s1, p1) = tr[i];
+        let u = if s1 > s0 { (s - s0) / (s1 - s0) } else { 1.0 };
+        Pose::new(
+            p0.x + u * (p1.x - p0.x),
+            p0.y + u * (p1.y - p0.y),
+            p0.theta + u * (p1.theta - p0.theta),
+        )
+    }
+
+    /// World times of the recorded steps inside (t_begin, t_end).
+    pub fn step_times(&self, speed: f64) -> Vec<f64> {
+        match &self.trace {
+            Some(tr) => tr
+                .iter()
+                .map(|(s, _)| self.t_ref + s / speed)
+                .filter(|&t| t > self.t_begin && t < self.t_end)
+                .collect(),
+            None => Vec::new(),
+        }
+    }
+}
+
+/// The motion of a part between two of its events.
+#[derive(Debug, Clone)]
+pub enum Motion {
+    /// Riding the belt from world pose `pose` at time `t0`, until its next event at `until`.
+    Free { t0: f64, pose: Pose, until: f64 },
+    /// Being pushed by a pin.
+    Held(Box<ContactPlan>),
+}
+
+impl Motion {
+    /// The time this motion ends (the part's next event).
+    pub fn until(&self) -> f64 {
+        match self {
+            Motion::Free { until, .. } => *until,
+            Motion::Held(p) => p.t_end,
+        }
+    }
+
+    /// World pose at time `t` within the motion.
+    pub fn world_pose(&self, t: f64, speed: f64) -> Pose {
+        match self {
+            Motion::Free { t0, pose, .. } => {
+                Pose::new(pose.x + speed * (t - t0), pose.y, pose.theta)
+            }
+            Motion::Held(p) => {
+                let s = p.travel_at(t, speed);
+                let b = p.belt_pose(s);
+                Pose::new(b.x + s, b.y, b.theta)
+            }
+        }
+    }
+
+    /// Belt-frame pose at time `t` (the belt frame anchored at world time 0 is not used: only
+    /// differences matter). Free parts are still in it; held parts move.
+    pub fn belt_pose(&self, t: f64, speed: f64) -> Pose {
+        let w = self.world_pose(t, speed);
+        Pose::new(w.x - speed * t, w.y, w.theta)
+    }
+}

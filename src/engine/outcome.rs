@@ -1,0 +1,98 @@
+//! How a part leaves the line. Every part that enters ends in exactly one class (SPEC §7):
+//!
+//! | class | meaning |
+//! |---|---|
+//! | `success` | reached x = belt length with its orientation in the goal |
+//! | `wrong_orientation` | reached x = belt length, orientation not in the goal |
+//! | `collision` | overlapped another part (both parts are taken off the line at that instant) |
+//! | `multi_contact` | touched two obstacles at once (another obstacle during a push), or the pin met a concave notch (two contact points) |
+//! | `off_belt` | its centroid left the belt's width after a push (it falls off) |
+//! | `jam` | a pin never released it: it rides on the pin beyond `model.max_travel` (a real line would stop here; the part is counted and removed) |
+//! | `solver` | the contact model could not finish the push (evaluation/event limits, step too small, a sub-problem failed); the cause is counted |
+
+use serde::Serialize;
+
+/// The class of a finished part.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PartOutcome {
+    Success,
+    WrongOrientation,
+    Collision,
+    MultiContact,
+    OffBelt,
+    Jam,
+    Solver,
+}
+
+impl PartOutcome {
+    pub const ALL: [PartOutcome; 7] = [
+        PartOutcome::Success,
+        PartOutcome::WrongOrientation,
+        PartOutcome::Collision,
+        PartOutcome::MultiContact,
+        PartOutcome::OffBelt,
+        PartOutcome::Jam,
+        PartOutcome::Solver,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            PartOutcome::Success => "success",
+            PartOutcome::WrongOrientation => "wrong_orientation",
+            PartOutcome::Collision => "collision",
+            PartOutcome::MultiContact => "multi_contact",
+            PartOutcome::OffBelt => "off_belt",
+            PartOutcome::Jam => "jam",
+            PartOutcome::Solver => "solver",
+        }
+    }
+
+    /// Did the part reach the end of the belt?
+    pub fn exited(self) -> bool {
+        matches!(self, PartOutcome::Success | PartOutcome::WrongOrientation)
+    }
+}
+
+/// Counts per class, serialised as an object with the classes in a fixed order.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct OutcomeCounts {
+    pub success: u64,
+    pub wrong_orientation: u64,
+    pub collision: u64,
+    pub multi_contact: u64,
+    pub off_belt: u64,
+    pub jam: u64,
+    pub solver: u64,
+}
+
+impl OutcomeCounts {
+    pub fn add(&mut self, o: PartOutcome) {
+        *self.get_mut(o) += 1;
+    }
+    pub fn get(&self, o: PartOutcome) -> u64 {
+        match o {
+            PartOutcome::Success => self.success,
+            PartOutcome::WrongOrientation => self.wrong_orientation,
+            PartOutcome::Collision => self.collision,
+            PartOutcome::MultiContact => self.multi_contact,
+            PartOutcome::OffBelt => self.off_belt,
+            PartOutcome::Jam => self.jam,
+            PartOutcome::Solver => self.solver,
+        }
+    }
+    fn get_mut(&mut self, o: PartOutcome) -> &mut u64 {
+        match o {
+            PartOutcome::Success => &mut self.success,
+            PartOutcome::WrongOrientation => &mut self.wrong_orientation,
+            PartOutcome::Collision => &mut self.collision,
+            PartOutcome::MultiContact => &mut self.multi_contact,
+            PartOutcome::OffBelt => &mut self.off_belt,
+            PartOutcome::Jam => &mut self.jam,
+            PartOutcome::Solver => &mut self.solver,
+        }
+    }
+    pub fn total(&self) -> u64 {
+        PartOutcome::ALL.iter().map(|&o| self.get(o)).sum()
+    }
+}

@@ -1,0 +1,118 @@
+//! The terminal summary of a line run: outcomes, success rate with its 95% interval, throughput,
+//! latency, contacts and per-pin statistics (definitions in [`crate::engine::metrics`]).
+
+use crate::engine::{PartOutcome, Summary};
+use std::fmt::Write;
+
+fn opt(v: Option<f64>, digits: usize) -> String {
+    match v {
+        Some(x) => format!("{x:.digits$}"),
+        None => "n/a".into(),
+    }
+}
+
+/// A readable multi-line summary.
+pub fn table(s: &Summary) -> String {
+    let mut o = String::new();
+    let pct = |k: u64| {
+        if s.parts_in > 0 {
+            100.0 * k as f64 / s.parts_in as f64
+        } else {
+            0.0
+        }
+    };
+    let _ = writeln!(
+        o,
+        "scenario {}  seed {}  fidelity {}",
+        s.scenario, s.seed, s.fidelity
+    );
+    let _ = writeln!(o, "parts in                  {}", s.parts_in);
+    for outcome in PartOutcome::ALL {
+        let k = s.outcomes.get(outcome);
+        let _ = writeln!(o, "  {:<22}  {:>8}  {:5.1}%", outcome.name(), k, pct(k));
+    }
+    let _ = writeln!(
+        o,
+        "success rate              {:.4}  (95% CI {:.4}–{:.4})",
+        s.success_rate, s.success_ci95[0], s.success_ci95[1]
+    );
+    let _ = writeln!(
+        o,
+        "throughput in             {} parts/min",
+        opt(s.throughput_in_per_min, 2)
+    );
+    let window = match s.steady_window_s {
+        Some([a, b]) => format!("  (steady window {a:.1}–{b:.1} s)"),
+        None => String::new(),
+    };
+    let _ = writeln!(
+        o,
+        "throughput out / ok       {} / {} parts/min{window}",
+        opt(s.throughput_out_per_min, 2),
+        opt(s.throughput_ok_per_min, 2)
+    );
+    match &s.latency_s {
+        Some(l) => {
+            let _ = writeln!(
+                o,
+                "latency p50/p90/p99/max   {:.2} / {:.2} / {:.2} / {:.2} s",
+                l.p50, l.p90, l.p99, l.max
+            );
+        }
+        None => {
+            let _ = writeln!(o, "latency                   n/a (no part exited)");
+        }
+    }
+    let _ = writeln!(o, "contacts per part         {:.3}", s.contacts_per_part);
+    if !s.obstacles.is_empty() {
+        let _ = writeln!(o, "obstacles                 contacts    busy");
+        for ob in &s.obstacles {
+            let _ = writeln!(
+                o,
+                "  {:<22}  {:>8}  {:5.1}%",
+                ob.name,
+                ob.contacts,
+                100.0 * ob.busy_fraction
+            );
+        }
+    }
+    for (label, map) in [
+        ("multi_contact causes", &s.causes.multi_contact),
+        ("solver causes", &s.causes.solver),
+    ] {
+        if !map.is_empty() {
+            let list: Vec<String> = map.iter().map(|(k, v)| format!("{k} {v}")).collect();
+            let _ = writeln!(o, "{label:<26}{}", list.join(", "));
+        }
+    }
+    // The most populated orientation bins.
+    let h = &s.orientation_histogram;
+    let mut bins: Vec<(usize, u64)> = h
+        .counts
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|&(_, c)| c > 0)
+        .collect();
+    bins.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    if !bins.is_empty() {
+        let top: Vec<String> = bins
+            .iter()
+            .take(4)
+            .map(|&(i, c)| {
+                format!(
+                    "[{:.0}°, {:.0}°) {c}",
+                    i as f64 * h.bin_deg,
+                    (i + 1) as f64 * h.bin_deg
+                )
+            })
+            .collect();
+        let _ = writeln!(o, "final orientations        {}", top.join(", "));
+    }
+    let _ = writeln!(
+        o,
+        "simulated time            {:.1} s ({} events, {} contact solves)",
+        s.simulated_time_s, s.work.events, s.work.contact_solves
+    );
+    o
+}

@@ -1,0 +1,17 @@
+//! One CSV row per finished part (`[output] parts_csv = true`): arrival and end times, class,
+//! cause, contacts, entry and final orientation and lateral position.
+
+use crate::engine::PartRecord;
+use std::path::Path;
+
+/// Write the records, sorted by part index.
+pub fn write_parts_csv(path: &Path, records: &[PartRecord]) -> anyhow::Result<()> {
+    let mut sorted: Vec<&PartRecord> = records.iter().collect();
+    sorted.sort_by_key(|r| r.part);
+    let mut w = csv::Writer::from_path(path)?;
+    for r in sorted {
+        w.serialize(r)?;
+    }
+    w.flush()?;
+    Ok(())
+}

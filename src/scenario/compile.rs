@@ -1,0 +1,549 @@
+//! Validation and compilation: [`RawScenario`] → [`Scene`]. Every check names the key and the
+//! allowed range (SPEC §1 units: m, s, degrees in the file; radians inside).
+//!
+//! Geometry rules that keep a run well defined:
+//! * a part enters with its centroid at x = 0 and must fit on the belt: the lateral offsets lie
+//!   within [−width/2 + a, width/2 − a];
+//! * a pin lies over the belt, downstream of the entry by more than a + radius (so no part enters
+//!   touching it) and before the exit (x < length).
+
+use super::error::{Locator, ScenarioError};
+use super::location::KeyPath;
+use super::raw::*;
+use super::scene::*;
+use crate::geometry::{named, Polygon, Vec2};
+use crate::mechanics::{ContactSettings, PartModel, Support};
+
+type R<T> = Result<T, ScenarioError>;
+
+struct Checker<'a, 'b> {
+    loc: &'b Locator<'a>,
+}
+
+impl Checker<'_, '_> {
+    fn err(&self, path: &str, msg: impl Into<String>) -> ScenarioError {
+        self.loc.at_key(&KeyPath::parse(path), msg)
+    }
+    fn finite(&self, path: &str, v: f64) -> R<f64> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(path, format!("must be a finite number, got {v}")))
+        }
+    }
+    fn positive(&self, path: &str, v: f64, unit: &str) -> R<f64> {
+        self.finite(path, v)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(path, format!("must be greater than 0 ({unit}), got {v}")))
+        }
+    }
+    fn non_negative(&self, path: &str, v: f64, unit: &str) -> R<f64> {
+        self.finite(path, v)?;
+        if v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(path, format!("must be at least 0 ({unit}), got {v}")))
+        }
+    }
+    fn within(&self, path: &str, v: f64, lo: f64, hi: f64, unit: &str) -> R<f64> {
+        self.finite(path, v)?;
+        if v >= lo && v <= hi {
+            Ok(v)
+        } else {
+            Err(self.err(path, format!("must lie in [{lo}, {hi}] ({unit}), got {v}")))
+        }
+    }
+    fn missing(&self, section: &str, msg: &str) -> ScenarioError {
+        self.err(section, msg.to_string())
+    }
+}
+
+/// Compile a parsed scenario. `default_name` names the scene when the file does not.
+pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene> {
+    let c = Checker { loc };
+    let name = match &raw.name {
+        Some(n) => {
+            let ok = !n.is_empty()
+                && n.chars()
+                    .all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_');
+            if !ok {
+                return Err(c.err(
+                    "name",
+                    format!("'{n}' must be non-empty and use only letters, digits, '-' and '_' (it names the results folder)"),
+                ));
+            }
+            n.clone()
+        }
+        None => default_name.to_string(),
+    };
+    let seed = raw.seed.unwrap_or(1);
+
+    // [belt]
+    let Some(rb) = &raw.belt else {
+        return Err(c.missing(
+            "belt",
+            "missing section [belt]: give speed (m/s), width (m) and length (m)",
+        ));
+    };
+    let belt = Belt {
+        speed: c.positive("belt.speed", rb.speed, "m/s")?,
+        width: c.positive("belt.width", rb.width, "m")?,
+        length: c.positive("belt.length", rb.length, "m")?,
+    };
+
+    // [part]
+    let Some(rp) = &raw.part else {
+        return Err(c.missing(
+            "part",
+            "missing section [part]: give shape = \"tripoly2\" (or vertices = [[x, y], ...]) and scale (m per unit)",
+        ));
+    };
+    let (label, poly) = match (&rp.shape, &rp.vertices) {
+        (Some(_), Some(_)) => {
+            return Err(c.err("part.vertices", "give either shape or vertices, not both"))
+        }
+        (None, None) => {
+            return Err(c.err(
+                "part",
+                format!(
+                "the part needs shape = one of {} (e.g. \"tripoly2\"), or vertices = [[x, y], ...]",
+                named::PART_NAMES.join(", ")
+            ),
+            ))
+        }
+        (Some(shape), None) => {
+            if shape.trim_start().starts_with("vertices") {
+                return Err(c.err(
+                    "part.shape",
+                    "write a vertex list as vertices = [[x, y], ...], not as a shape",
+                ));
+            }
+            let p = named::part_from_spec(shape).map_err(|e| c.err("part.shape", e.to_string()))?;
+            (shape.trim().to_string(), p)
+        }
+        (None, Some(vs)) => {
+            let pts: Vec<Vec2> = vs.iter().map(|v| Vec2::new(v[0], v[1])).collect();
+            let p = Polygon::new(&pts).map_err(|e| {
+                c.err(
+                    "part.vertices",
+                    format!("not a valid part: {e} (a part is a simple polygon with at least 3 vertices and non-zero area)"),
+                )
+            })?;
+            ("vertices".to_string(), p)
+        }
+    };
+    let scale = c.positive("part.scale", rp.scale.unwrap_or(1.0), "m per unit")?;
+    let polygon = poly.scaled(scale);
+    let radius = polygon.radius();
+    let mu_c = c.non_negative("part.mu_c", rp.mu_c.unwrap_or(0.5), "friction coefficient")?;
+    let mu_s = c.positive("part.mu_s", rp.mu_s.unwrap_or(0.3), "friction coefficient")?;
+    let model = PartModel::new(&polygon, &Support::Uniform).map_err(|e| {
+        c.err(
+            "part",
+            format!("cannot compile the part's contact model: {e}"),
+        )
+    })?;
+    let stable_states = polygon.stable_states();
+
+    // [feed]
+    let Some(rf) = &raw.feed else {
+        return Err(c.missing(
+            "feed",
+            "missing section [feed]: give parts, arrival (periodic | poisson), headway (s) or rate (1/s), orientation (uniform | stable)",
+        ));
+    };
+    if rf.parts == 0 || rf.parts > 1_000_000_000 {
+        return Err(c.err(
+            "feed.parts",
+            format!("must lie in [1, 1000000000], got {}", rf.parts),
+        ));
+    }
+    let headway = match (rf.headway, rf.rate) {
+        (Some(_), Some(_)) => {
+            return Err(c.err(
+                "feed.rate",
+                "give either headway (s) or rate (1/s), not both",
+            ))
+        }
+        (None, None) => {
+            return Err(c.err(
+                "feed",
+                "give headway (seconds between arrivals) or rate (arrivals per second)",
+            ))
+        }
+        (Some(h), None) => c.positive("feed.headway", h, "s")?,
+        (None, Some(r)) => 1.0 / c.positive("feed.rate", r, "arrivals per second")?,
+    };
+    let arrival = match rf.arrival {
+        ArrivalKind::Periodic => Arrival::Periodic { headway },
+        ArrivalKind::Poisson => Arrival::Poisson { headway },
+    };
+    let jitter = c
+        .non_negative("feed.jitter", rf.jitter.unwrap_or(0.0), "degrees")?
+        .to_radians();
+    let orientation = match rf.orientation {
+        OrientationKind::Uniform => {
+            if rf.weights.is_some() {
+                return Err(c.err(
+                    "feed.weights",
+                    "weights apply only to orientation = \"stable\"",
+                ));
+            }
+            if rf.jitter.is_some() {
+                return Err(c.err(
+                    "feed.jitter",
+                    "jitter applies only to orientation = \"stable\"",
+                ));
+            }
+            Orientation::Uniform
+        }
+        OrientationKind::Stable => {
+            let thetas: Vec<f64> = stable_states.iter().map(|s| s.theta).collect();
+            if thetas.is_empty() {
+                return Err(c.err(
+                    "feed.orientation",
+                    "this part has no stable state; use orientation = \"uniform\"",
+                ));
+            }
+            let list = thetas
+                .iter()
+                .map(|t| format!("{:.3}°", t.to_degrees()))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let weights = match &rf.weights {
+                None => vec![1.0; thetas.len()],
+                Some(w) => {
+                    if w.len() != thetas.len() {
+                        return Err(c.err(
+                            "feed.weights",
+                            format!(
+                                "needs one weight per stable state: {} ({list}), got {}",
+                                thetas.len(),
+                                w.len()
+                            ),
+                        ));
+                    }
+                    for (i, &x) in w.iter().enumerate() {
+                        c.non_negative(&format!("feed.weights[{i}]"), x, "relative weight")?;
+                    }
+                    w.clone()
+                }
+            };
+            let total: f64 = weights.iter().sum();
+            if total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return Err(c.err("feed.weights", "at least one weight must be positive"));
+            }
+            Orientation::Stable {
+                thetas,
+                weights: weights.iter().map(|w| w / total).collect(),
+                jitter,
+            }
+        }
+    };
+    let reach = belt.width / 2.0 - radius;
+    if reach < 0.0 {
+        return Err(c.err(
+            "belt.width",
+            format!(
+                "the belt ({} m) is narrower than the part (2a = {:.6} m)",
+                belt.width,
+                2.0 * radius
+            ),
+        ));
+    }
+    let range = format!("m; the belt half-width minus the part's a = {radius:.6} m");
+    let lateral = match &rf.lateral {
+        None => Lateral::Fixed(0.0),
+        Some(l) => {
+            let allowed = |keys: &[&str]| -> R<()> {
+                let given = [
+                    ("value", l.value.is_some()),
+                    ("min", l.min.is_some()),
+                    ("max", l.max.is_some()),
+                    ("mean", l.mean.is_some()),
+                    ("sd", l.sd.is_some()),
+                ];
+                for (k, present) in given {
+                    if present && !keys.contains(&k) {
+                        return Err(c.err(
+                            &format!("feed.lateral.{k}"),
+                            format!(
+                                "does not apply to this distribution, which takes {}",
+                                keys.join(", ")
+                            ),
+                        ));
+                    }
+                }
+                for k in keys {
+                    let present = given.iter().any(|(g, p)| g == k && *p);
+                    if !present {
+                        return Err(c.err(
+                            "feed.lateral",
+                            format!("this distribution needs {}", keys.join(", ")),
+                        ));
+                    }
+                }
+                Ok(())
+            };
+            let on_belt = |key: &str, v: Option<f64>| {
+                c.within(
+                    &format!("feed.lateral.{key}"),
+                    v.unwrap_or(0.0),
+                    -reach,
+                    reach,
+                    &range,
+                )
+            };
+            match l.distribution {
+                LateralKind::Fixed => {
+                    allowed(&["value"])?;
+                    Lateral::Fixed(on_belt("value", l.value)?)
+                }
+                LateralKind::Uniform => {
+                    allowed(&["min", "max"])?;
+                    let min = on_belt("min", l.min)?;
+                    let max = on_belt("max", l.max)?;
+                    if min > max {
+                        return Err(c.err(
+                            "feed.lateral.max",
+                            format!("must be at least min ({min}), got {max}"),
+                        ));
+                    }
+                    Lateral::Uniform { min, max }
+                }
+                LateralKind::Normal => {
+                    allowed(&["mean", "sd"])?;
+                    let mean = on_belt("mean", l.mean)?;
+                    let sd = c.non_negative("feed.lateral.sd", l.sd.unwrap_or(0.0), "m")?;
+                    Lateral::Normal {
+                        mean,
+                        sd,
+                        lo: -reach,
+                        hi: reach,
+                    }
+                }
+            }
+        }
+    };
+    let feed = Feed {
+        parts: rf.parts,
+        arrival,
+        orientation,
+        lateral,
+    };
+
+    // [[obstacles]]
+    let mut obstacles = Vec::new();
+    for (i, ro) in raw.obstacles.iter().enumerate() {
+        let p = |k: &str| format!("obstacles[{i}].{k}");
+        match ro.kind {
+            ObstacleKind::Pin => {}
+            other => {
+                let name = match other {
+                    ObstacleKind::SensorPin => "sensor_pin",
+                    ObstacleKind::MovingPin => "moving_pin",
+                    _ => "fence",
+                };
+                return Err(c.err(
+                    &p("kind"),
+                    format!("obstacle kind \"{name}\" is not yet supported; this version simulates kind = \"pin\""),
+                ));
+            }
+        }
+        let need = |k: &str, v: Option<f64>| -> R<f64> {
+            v.ok_or_else(|| {
+                c.err(
+                    &format!("obstacles[{i}]"),
+                    format!("a pin needs x, y and radius (m); `{k}` is missing"),
+                )
+            })
+        };
+        let radius = c.non_negative(&p("radius"), need("radius", ro.radius)?, "m")?;
+        let x_min = radius + polygon.radius();
+        let x = c.finite(&p("x"), need("x", ro.x)?)?;
+        if !(x > x_min && x < belt.length) {
+            return Err(c.err(
+                &p("x"),
+                format!(
+                    "must lie in ({x_min:.6}, {}) m: beyond a + radius from the entry at x = 0 and before the exit at belt.length, got {x}",
+                    belt.length
+                ),
+            ));
+        }
+        let half = belt.width / 2.0;
+        let y = c.within(&p("y"), need("y", ro.y)?, -half, half, "m; over the belt")?;
+        let mu = match ro.mu_c {
+            Some(m) => c.non_negative(&p("mu_c"), m, "friction coefficient")?,
+            None => mu_c,
+        };
+        let name = match &ro.name {
+            Some(n) if !n.is_empty() => n.clone(),
+            Some(_) => return Err(c.err(&p("name"), "must not be empty")),
+            None => format!("pin{}", i + 1),
+        };
+        if obstacles.iter().any(|o: &Obstacle| o.name() == name) {
+            return Err(c.err(
+                &p("name"),
+                format!("'{name}' is used by another obstacle; names must be unique"),
+            ));
+        }
+        obstacles.push(Obstacle::Pin(PinObstacle {
+            name,
+            centre: Vec2::new(x, y),
+            radius,
+            mu_c: mu,
+        }));
+    }
+    let neighbours = obstacles
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            let (ca, ra) = a.bounding_disc();
+            obstacles
+                .iter()
+                .enumerate()
+                .filter(|&(j, b)| {
+                    let (cb, rb) = b.bounding_disc();
+                    j != i && (ca - cb).norm() <= 2.0 * radius + ra + rb
+                })
+                .map(|(j, _)| j)
+                .collect()
+        })
+        .collect();
+
+    // [goal]
+    let Some(rg) = &raw.goal else {
+        return Err(c.missing(
+            "goal",
+            "missing section [goal]: give any = true, or one or more [[goal.sets]] with orientations (degrees)",
+        ));
+    };
+    let goal =
+        match (rg.any, rg.sets.is_empty()) {
+            (true, false) => {
+                return Err(c.err("goal.sets", "give either any = true or goal sets, not both"))
+            }
+            (false, true) => return Err(c.err(
+                "goal",
+                "give any = true, or one or more [[goal.sets]] with orientations = [degrees, ...]",
+            )),
+            (true, true) => Goal::Any,
+            (false, false) => {
+                let mut sets = Vec::new();
+                for (i, s) in rg.sets.iter().enumerate() {
+                    if s.orientations.is_empty() {
+                        return Err(c.err(
+                            &format!("goal.sets[{i}].orientations"),
+                            "needs at least one orientation (degrees)",
+                        ));
+                    }
+                    let mut os = Vec::new();
+                    for (j, &o) in s.orientations.iter().enumerate() {
+                        os.push(
+                            c.finite(&format!("goal.sets[{i}].orientations[{j}]"), o)?
+                                .to_radians(),
+                        );
+                    }
+                    let tol = s.tolerance.unwrap_or(5.0);
+                    let tol = c.within(
+                        &format!("goal.sets[{i}].tolerance"),
+                        tol,
+                        0.0,
+                        180.0,
+                        "degrees",
+                    )?;
+                    let name = s.name.clone().unwrap_or_else(|| format!("set{}", i + 1));
+                    if sets.iter().any(|g: &GoalSet| g.name == name) {
+                        return Err(c.err(
+                            &format!("goal.sets[{i}].name"),
+                            format!("'{name}' is used twice"),
+                        ));
+                    }
+                    sets.push(GoalSet {
+                        name,
+                        orientations: os,
+                        tolerance: tol.to_radians(),
+                    });
+                }
+                Goal::Sets(sets)
+            }
+        };
+
+    // [model]
+    let defaults = ContactSettings::default();
+    let tol = raw.model.tol.unwrap_or(defaults.tol);
+    let tol = c.finite("model.tol", tol)?;
+    if !(tol > 0.0 && tol <= 1e-2) {
+        return Err(c.err("model.tol", format!("must lie in (0, 0.01], got {tol}")));
+    }
+    let max_travel = c.within(
+        "model.max_travel",
+        raw.model.max_travel.unwrap_or(defaults.max_travel),
+        1.0,
+        1e4,
+        "units of a",
+    )?;
+    let contact = ContactSettings {
+        fidelity: raw.model.fidelity.unwrap_or_default(),
+        mu_c,
+        mu_s,
+        tol,
+        max_travel,
+        ..defaults
+    };
+
+    let effects = Effects {
+        collisions: raw.effects.collisions.unwrap_or(true),
+        obstacle_sweeps: raw.effects.obstacle_sweeps.unwrap_or(true),
+        event_log: raw.effects.event_log.unwrap_or(false),
+    };
+    let ro = &raw.output;
+    let output = OutputOptions {
+        dir: ro.dir.clone().unwrap_or_else(|| "results".into()),
+        parts_csv: ro.parts_csv.unwrap_or(false),
+        histogram_svg: ro.histogram_svg.unwrap_or(true),
+        histogram_bin_deg: {
+            let b = ro.histogram_bin.unwrap_or(5.0);
+            c.finite("output.histogram_bin", b)?;
+            if !(b > 0.0 && b <= 90.0 && (360.0 / b - (360.0 / b).round()).abs() < 1e-9) {
+                return Err(c.err(
+                    "output.histogram_bin",
+                    format!("must divide 360 and lie in (0, 90] degrees, got {b}"),
+                ));
+            }
+            b
+        },
+        draw_parts: {
+            let n = ro.draw_parts.unwrap_or(4);
+            if !(1..=20).contains(&n) {
+                return Err(c.err("output.draw_parts", format!("must lie in [1, 20], got {n}")));
+            }
+            n
+        },
+    };
+
+    Ok(Scene {
+        name,
+        seed,
+        belt,
+        part: PartSpec {
+            label,
+            polygon,
+            radius,
+            model,
+            support: rp.support,
+            mu_c,
+            mu_s,
+            stable_states,
+        },
+        feed,
+        obstacles,
+        neighbours,
+        goal,
+        contact,
+        effects,
+        output,
+    })
+}

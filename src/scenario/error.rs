@@ -1,0 +1,159 @@
+//! The error a bad scenario file produces: file, line, column, the key at fault and what is
+//! allowed there, followed by the offending source line with a caret (like a compiler).
+
+use super::location::{line_column, KeyPath, SpannedDoc};
+use std::fmt;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Why a scenario could not be loaded.
+#[derive(Debug, Error)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("{}: cannot read the scenario: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML, or a key or value is wrong.
+    #[error("{0}")]
+    Invalid(Box<InvalidScenario>),
+}
+
+/// A located problem in a scenario file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InvalidScenario {
+    pub file: PathBuf,
+    /// 1-based line and column of the key or value at fault.
+    pub line: usize,
+    pub column: usize,
+    /// The key path at fault, e.g. `belt.speed` or `obstacles[1].kind`.
+    pub key: String,
+    /// What is wrong and what is allowed.
+    pub message: String,
+    /// The source line and a caret under the fault.
+    pub excerpt: String,
+}
+
+impl fmt::Display for InvalidScenario {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}:{}:{}: key `{}`: {}",
+            self.file.display(),
+            self.line,
+            self.column,
+            self.key,
+            self.message
+        )?;
+        if !self.excerpt.is_empty() {
+            write!(f, "\n{}", self.excerpt)?;
+        }
+        Ok(())
+    }
+}
+
+impl ScenarioError {
+    /// The located details (None for I/O errors).
+    pub fn invalid(&self) -> Option<&InvalidScenario> {
+        match self {
+            ScenarioError::Invalid(i) => Some(i),
+            ScenarioError::Io { .. } => None,
+        }
+    }
+}
+
+/// Builds located errors for one source file.
+pub struct Locator<'a> {
+    pub file: &'a Path,
+    pub source: &'a str,
+    pub doc: SpannedDoc<'a>,
+}
+
+impl<'a> Locator<'a> {
+    pub fn new(file: &'a Path, source: &'a str) -> Locator<'a> {
+        Locator {
+            file,
+            source,
+            doc: SpannedDoc::parse(source),
+        }
+    }
+
+    /// An error at a byte span, with an explicit key path.
+    pub fn at_span(&self, span: Range<usize>, key: &KeyPath, message: String) -> ScenarioError {
+        let (line, column) = line_column(self.source, span.start);
+        let text_line = self.source.lines().nth(line - 1).unwrap_or("");
+        let width = self.source[span.start.min(self.source.len())..span.end.min(self.source.len())]
+            .lines()
+            .next()
+            .map(|s| s.chars().count())
+            .unwrap_or(0)
+            .max(1);
+        let gutter = line.to_string().len();
+        let excerpt = if span == (0..0) {
+            String::new()
+        } else {
+            format!(
+                "{:gutter$} |\n{line} | {text_line}\n{:gutter$} | {}{}",
+                "",
+                "",
+                " ".repeat(column - 1),
+                "^".repeat(width)
+            )
+        };
+        ScenarioError::Invalid(Box::new(InvalidScenario {
+            file: self.file.to_path_buf(),
+            line,
+            column,
+            key: key.to_string(),
+            message,
+            excerpt,
+        }))
+    }
+
+    /// An error about the value at `path` (or, if it is missing, about the table that should hold it).
+    pub fn at_key(&self, path: &KeyPath, message: impl Into<String>) -> ScenarioError {
+        let span = self.doc.span_of(path);
+        self.at_span(span, path, message.into())
+    }
+
+    /// Turn a toml/serde error into a located error: the key comes from the span, plus the field
+    /// a "missing field" or "unknown field" message names.
+    pub fn from_toml(&self, e: &toml::de::Error) -> ScenarioError {
+        let span = e.span().unwrap_or(0..0);
+        let message = e.message().trim().to_string();
+        if !self.doc.is_toml() {
+            return self.at_span(
+                span,
+                &KeyPath::parse("(TOML syntax)"),
+                format!("{message} (the file is not valid TOML)"),
+            );
+        }
+        let mut key = self.doc.path_at(&span);
+        if let Some(field) = backticked_after(&message, "missing field ") {
+            key = key.key(&field);
+            let message = if key.0.len() == 1 {
+                format!("{message}: the scenario needs a [{field}] section or `{field} = ...` key")
+            } else {
+                message
+            };
+            return self.at_span(span, &key, message);
+        }
+        if let Some(field) = backticked_after(&message, "unknown field ") {
+            if key.0.last() != Some(&super::location::PathStep::Key(field.clone())) {
+                key = key.key(&field);
+            }
+        }
+        self.at_span(span, &key, message)
+    }
+}
+
+/// The text between backticks right after `prefix` in `message`.
+fn backticked_after(message: &str, prefix: &str) -> Option<String> {
+    let rest = message.strip_prefix(prefix)?;
+    let rest = rest.strip_prefix('`')?;
+    let end = rest.find('`')?;
+    Some(rest[..end].to_string())
+}

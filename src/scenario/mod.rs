@@ -1,0 +1,128 @@
+//! Scenario files: the TOML a user writes to describe a feeder line (belt, part, feed, obstacles,
+//! goal, model, effects, output; README "Scenario format"), parsed with `deny_unknown_fields`,
+//! validated with errors that name file, line, column, key and the allowed values, and compiled
+//! into an immutable [`Scene`] (DESIGN.md "model vs state"; SPEC §1 units and frames, §7 the line).
+//!
+//! * [`raw`]: serde structs mirroring the file;
+//! * [`compile`]: checks and conversion to [`Scene`];
+//! * [`scene`]: the compiled types the engine reads;
+//! * [`location`], [`error`]: spans → line/column and key paths, and the located error.
+
+pub mod compile;
+pub mod error;
+pub mod location;
+pub mod raw;
+pub mod scene;
+
+pub use error::{InvalidScenario, ScenarioError};
+pub use scene::*;
+
+use std::path::Path;
+
+/// Parse and compile scenario text; `file` is only used in messages and for the default name.
+pub fn parse(file: &Path, source: &str) -> Result<Scene, ScenarioError> {
+    let loc = error::Locator::new(file, source);
+    let raw: raw::RawScenario = toml::from_str(source).map_err(|e| loc.from_toml(&e))?;
+    let default_name = file
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scenario")
+        .to_string();
+    compile::compile(&raw, &loc, &default_name)
+}
+
+/// Read, parse and compile a scenario file.
+pub fn load(path: &Path) -> Result<Scene, ScenarioError> {
+    let source = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(path, &source)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+[belt]
+speed = 0.05
+width = 0.2
+length = 1.0
+
+[part]
+shape = "tripoly2"
+scale = 0.02
+
+[feed]
+parts = 10
+arrival = "periodic"
+headway = 2.0
+orientation = "stable"
+
+[[obstacles]]
+kind = "pin"
+x = 0.3
+y = 0.0
+radius = 0.002
+
+[goal]
+any = true
+"#;
+
+    fn err(src: &str) -> InvalidScenario {
+        match parse(Path::new("t.toml"), src) {
+            Ok(_) => panic!("accepted:\n{src}"),
+            Err(e) => e.invalid().expect("located error").clone(),
+        }
+    }
+
+    #[test]
+    fn good_scenario_compiles() {
+        let s = parse(Path::new("dir/good.toml"), GOOD).unwrap();
+        assert_eq!(s.name, "good");
+        assert_eq!(s.obstacles.len(), 1);
+        assert_eq!(s.obstacles[0].name(), "pin1");
+        assert!((s.part.radius - 0.02 * 1.374368).abs() < 1e-6);
+        assert_eq!(s.feed.arrival, Arrival::Periodic { headway: 2.0 });
+        assert_eq!(s.goal, Goal::Any);
+    }
+
+    #[test]
+    fn unknown_key_is_located() {
+        let e = err(&GOOD.replace("speed = 0.05", "sped = 0.05"));
+        assert_eq!((e.line, e.column, e.key.as_str()), (3, 1, "belt.sped"));
+        assert!(e.message.contains("`speed`"), "{}", e.message);
+    }
+
+    #[test]
+    fn validation_errors_name_key_and_range() {
+        let e = err(&GOOD.replace("speed = 0.05", "speed = -0.05"));
+        assert_eq!((e.line, e.column, e.key.as_str()), (3, 9, "belt.speed"));
+        assert!(e.message.contains("greater than 0"));
+        let e = err(&GOOD.replace("radius = 0.002", "radius = 0.002\nmu_c = -1"));
+        assert_eq!(e.key, "obstacles[0].mu_c");
+        let e = err(&GOOD.replace("kind = \"pin\"", "kind = \"fence\""));
+        assert_eq!(e.key, "obstacles[0].kind");
+        assert!(e.message.contains("not yet supported"));
+        let e = err(&GOOD.replace("x = 0.3", "x = 0.01"));
+        assert_eq!(e.key, "obstacles[0].x");
+        let e = err(&GOOD.replace(
+            "orientation = \"stable\"",
+            "orientation = \"stable\"\nweights = [1, 2]",
+        ));
+        assert!(
+            e.message.contains("3 (0.000°, 90.000°, 206.565°)"),
+            "{}",
+            e.message
+        );
+    }
+
+    #[test]
+    fn missing_part_is_reported() {
+        let src = GOOD.replace("[part]\nshape = \"tripoly2\"\nscale = 0.02\n", "");
+        let e = err(&src);
+        assert_eq!(e.key, "part");
+        assert!(e.message.contains("missing section [part]"));
+    }
+}

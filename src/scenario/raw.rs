@@ -1,0 +1,205 @@
+//! The scenario file as written: serde structs mirroring the TOML, one per section, each with
+//! `deny_unknown_fields` so a misspelt key is an error (no `flatten`, which would defeat it).
+//! Values are checked and converted in [`super::compile`]; this layer only fixes names and types.
+//! Units are SI (m, s) and degrees, as documented in README.md's "Scenario format".
+
+use crate::mechanics::Fidelity;
+use serde::Deserialize;
+
+/// The whole file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScenario {
+    /// Name used for the results folder (default: the file name without `.toml`).
+    pub name: Option<String>,
+    /// Seed of the run (default 1).
+    pub seed: Option<u64>,
+    pub belt: Option<RawBelt>,
+    pub part: Option<RawPart>,
+    pub feed: Option<RawFeed>,
+    #[serde(default)]
+    pub obstacles: Vec<RawObstacle>,
+    pub goal: Option<RawGoal>,
+    #[serde(default)]
+    pub model: RawModel,
+    #[serde(default)]
+    pub effects: RawEffects,
+    #[serde(default)]
+    pub output: RawOutput,
+}
+
+/// `[belt]`: speed (m/s), width (m, the belt spans y ∈ [−width/2, width/2]) and usable length (m,
+/// parts enter at x = 0 and leave at x = length).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBelt {
+    pub speed: f64,
+    pub width: f64,
+    pub length: f64,
+}
+
+/// How the part's weight rests on the belt.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SupportKind {
+    /// Uniform pressure over the footprint.
+    #[default]
+    Uniform,
+    /// A random tripod per part, drawn from the part's own random stream.
+    Tripod,
+}
+
+/// `[part]`: a named shape or a vertex list, scaled to metres.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPart {
+    pub shape: Option<String>,
+    pub vertices: Option<Vec<[f64; 2]>>,
+    /// Metres per unit of the shape's coordinates.
+    pub scale: Option<f64>,
+    /// Pin–part friction coefficient (default 0.5; a pin may override it).
+    pub mu_c: Option<f64>,
+    /// Part–belt friction coefficient (default 0.3; scales forces only).
+    pub mu_s: Option<f64>,
+    #[serde(default)]
+    pub support: SupportKind,
+}
+
+/// Arrival process.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ArrivalKind {
+    Periodic,
+    Poisson,
+}
+
+/// Distribution of the initial orientation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OrientationKind {
+    Uniform,
+    Stable,
+}
+
+/// Distribution of the lateral offset of the centroid at entry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LateralKind {
+    Fixed,
+    Uniform,
+    Normal,
+}
+
+/// `[feed]`: how many parts, when and how they arrive.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFeed {
+    pub parts: u64,
+    pub arrival: ArrivalKind,
+    /// Seconds between arrivals (the mean, for Poisson).
+    pub headway: Option<f64>,
+    /// Arrivals per second (alternative to headway).
+    pub rate: Option<f64>,
+    pub orientation: OrientationKind,
+    /// Relative weights of the stable states (orientation = "stable"), in the order `pinfeed part` lists them.
+    pub weights: Option<Vec<f64>>,
+    /// Standard deviation of a normal perturbation of the orientation (degrees).
+    pub jitter: Option<f64>,
+    pub lateral: Option<RawLateral>,
+}
+
+/// `[feed.lateral]`: the centroid's y at entry (m).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLateral {
+    pub distribution: LateralKind,
+    pub value: Option<f64>,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub mean: Option<f64>,
+    pub sd: Option<f64>,
+}
+
+/// Kinds of obstacle. Only `pin` is simulated so far; the others are reserved names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObstacleKind {
+    Pin,
+    SensorPin,
+    MovingPin,
+    Fence,
+}
+
+/// `[[obstacles]]`: one element over the belt.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawObstacle {
+    pub kind: ObstacleKind,
+    pub name: Option<String>,
+    /// Position of the pin's centre (m, world frame).
+    pub x: Option<f64>,
+    pub y: Option<f64>,
+    /// Pin radius (m; 0 is a point pin).
+    pub radius: Option<f64>,
+    /// Pin–part friction for this pin (default: the part's mu_c).
+    pub mu_c: Option<f64>,
+}
+
+/// `[goal]`: which final orientations count as correct.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawGoal {
+    /// Every exiting part counts as correctly oriented.
+    #[serde(default)]
+    pub any: bool,
+    #[serde(default)]
+    pub sets: Vec<RawGoalSet>,
+}
+
+/// `[[goal.sets]]`: a named set of target orientations (degrees) with a tolerance (degrees).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawGoalSet {
+    pub name: Option<String>,
+    pub orientations: Vec<f64>,
+    pub tolerance: Option<f64>,
+}
+
+/// `[model]`: the contact model's fidelity and accuracy.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawModel {
+    pub fidelity: Option<Fidelity>,
+    pub tol: Option<f64>,
+    /// Largest pin travel in contact, in units of a, before a part counts as jammed.
+    pub max_travel: Option<f64>,
+}
+
+/// `[effects]`: optional work the engine does only when switched on.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawEffects {
+    /// Detect part–part overlap (default true; only ever runs while two parts share the belt).
+    pub collisions: Option<bool>,
+    /// Check that a part pushed by one obstacle does not touch another (default true; only runs
+    /// for obstacles close enough to interact).
+    pub obstacle_sweeps: Option<bool>,
+    /// Keep a log of every event (default false; for debugging and tests).
+    pub event_log: Option<bool>,
+}
+
+/// `[output]`: what files a run writes.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawOutput {
+    /// Folder under which `<scenario name>/` is written (default "results").
+    pub dir: Option<String>,
+    /// Write one CSV row per part (default false).
+    pub parts_csv: Option<bool>,
+    /// Write the final-orientation histogram as SVG (default true).
+    pub histogram_svg: Option<bool>,
+    /// Histogram bin width, degrees (default 5).
+    pub histogram_bin: Option<f64>,
+    /// How many sample parts `--draw` shows (default 4).
+    pub draw_parts: Option<u32>,
+}
