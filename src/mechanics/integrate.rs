@@ -1400,3 +1400,12 @@ pub fn first_instant(
     let inst = classify(model, ctx.fid, &g, ctx.fr, &mut ctx.warm, &mut ctx.evals).ok()??;
     Some((g, inst))
 }
+
+/// Belt travel (caller's units) until a fence first touches the part resting at `pose`, or `None`
+/// if it never does (for scheduling fence contacts in the line).
+pub fn fence_first_touch(model: &PartModel, pose: Pose, fence: &FenceSpec) -> Option<f64> {
+    let k = model.scale();
+    let geom = FenceGeom::new(fence, k);
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    first_touch(model.hull(), &pose_n, &geom, Vec2::new(-1.0, 0.0), 0.0).map(|(s, _)| s * k)
+}

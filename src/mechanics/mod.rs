@@ -23,7 +23,7 @@ pub mod vote;
 
 pub use fence::FenceSpec;
 pub use instant::Mode;
-pub use integrate::{first_instant, push, push_fence, ContactSettings, Pin};
+pub use integrate::{fence_first_touch, first_instant, push, push_fence, ContactSettings, Pin};
 pub use outcome::{ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, TraceSample};
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
 pub use vote::mason_vote;
