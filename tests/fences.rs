@@ -3,32 +3,18 @@
 
 mod common;
 use common::*;
-use pinfeed::geometry::{wrap_deg, Polygon, Pose, Vec2};
+use pinfeed::geometry::{wrap_deg, Polygon, Pose};
+use pinfeed::maps::fence_pass_start;
 use pinfeed::mechanics::{
     push_fence, ContactFeature, ContactOutcome, ContactSettings, ContactStatus, FenceSpec,
     Fidelity, Mode, PartModel,
 };
 
 /// A fence whose line crosses the part's path at y = d·a, clear of the part, starting 1.5a beyond
-/// the part's band (the CLI's convention), of length `len` (units of a).
+/// the part's band (the CLI's convention, `pinfeed::maps::fence_pass_start`), of length `len`
+/// (units of a).
 fn fence(p: &Polygon, angle_deg: f64, d: f64, len: f64, mu_f: f64) -> FenceSpec {
-    let a = p.radius();
-    let angle = angle_deg.to_radians();
-    let e = Vec2::from_angle(angle);
-    let mut n = e.perp();
-    if n.x > 0.0 {
-        n = -n;
-    }
-    let y = d * a;
-    let cross = Vec2::new((1.01 * a + y * n.y) / (-n.x), y);
-    let sin = angle.sin();
-    let back = (y + sin.signum() * 1.5 * a) / sin;
-    FenceSpec {
-        start: cross - e * back,
-        angle,
-        length: len * a,
-        mu_f,
-    }
+    fence_pass_start(p, d, angle_deg, Some(len * p.radius()), mu_f)
 }
 
 fn run_fence(m: &PartModel, p: &Polygon, th: f64, f: &FenceSpec, fid: Fidelity) -> ContactOutcome {

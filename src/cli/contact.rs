@@ -139,32 +139,11 @@ pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>)> {
     Ok((angle, length))
 }
 
-/// The fence of a case: its line crosses the part's path at y = d·a, clear of the part (the part's
-/// circumscribed circle lies on the upstream side), and it starts 1.5a beyond the part's band on the
-/// side it comes from.
+/// The fence of a case: the convention of [`crate::maps::fence_pass_start`] (its line 1.01a clear of
+/// the centroid, crossing y = d·a; its upstream end 1.5a beyond the part's band on the side it
+/// comes from), with the case's μc as the fence friction μf.
 pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>) -> FenceSpec {
-    let a = poly.radius();
-    let angle = angle_deg.to_radians();
-    let e = Vec2::from_angle(angle);
-    let mut n = e.perp();
-    if n.x > 0.0 {
-        n = -n;
-    }
-    let y = c.d * a;
-    let x = (1.01 * a + y * n.y) / (-n.x);
-    let cross = Vec2::new(x, y);
-    let sin = angle.sin();
-    let back = if sin.abs() > 1e-12 {
-        (y + sin.signum() * 1.5 * a) / sin
-    } else {
-        0.0
-    };
-    FenceSpec {
-        start: cross - e * back,
-        angle,
-        length: length.unwrap_or(20.0 * a),
-        mu_f: c.mu_c,
-    }
+    crate::maps::fence_pass_start(poly, c.d, angle_deg, length, c.mu_c)
 }
 
 /// Refuse non-finite or out-of-range settings of a case with a message naming the option.

@@ -2,13 +2,18 @@
 //! chapter 3), their bands, and the figures and report files under `results/maps/<part>/`.
 //!
 //! Each map samples θ0 over [0°, 360°) with the start convention of `pinfeed contact`
-//! ([`crate::maps::pass_start`]). Standard output gets a band table (default), the JSON document
+//! ([`crate::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
+//! (SPEC §6), placed as `pinfeed contact --fence` places it ([`super::contact::case_fence`]);
+//! a fence map has no contact parameter, so `--d` is not taken, and its report goes to
+//! `results/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
 //! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
 //! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
 
-use super::contact::{check_inputs, compile_part, parse_model, settings_and_pin, Case};
-use crate::maps::{compute_maps, ConfigurationMap, MapSettings};
+use super::contact::{
+    case_fence, check_inputs, compile_part, parse_fence, parse_model, settings_and_pin, Case,
+};
+use crate::maps::{compute_maps, ConfigurationMap, MapFence, MapSettings};
 use crate::report::{map_table, plot_map};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -24,11 +29,17 @@ pub struct MapArgs {
     /// Contact parameters d = (y_pin − y_com)/a, comma-separated (e.g. -0.9,-0.5,0.3).
     #[arg(
         long,
-        required = true,
+        required_unless_present = "fence",
+        conflicts_with = "fence",
         value_delimiter = ',',
         allow_hyphen_values = true
     )]
     pub d: Vec<f64>,
+    /// Map a fence instead of a pin: angle from the belt direction in degrees (−90 < α < 90;
+    /// positive fences deflect parts to the left) and optional length in part units (default 20a),
+    /// placed as `pinfeed contact --fence` places it; `--mu-c` is the fence friction μf.
+    #[arg(long, value_name = "ANGLE_DEG[:LENGTH]", allow_hyphen_values = true)]
+    pub fence: Option<String>,
     /// Spacing of the initial orientations θ0 (degrees; must divide 360).
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub theta_step: f64,
@@ -39,7 +50,12 @@ pub struct MapArgs {
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
     /// Pin radius in part units (0: point pin).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        allow_hyphen_values = true,
+        conflicts_with = "fence"
+    )]
     pub pin_radius: f64,
     /// Support: uniform or tripod:SEED.
     #[arg(long, default_value = "uniform")]
@@ -83,6 +99,10 @@ pub struct MapReport<'a> {
     pub theta_step_deg: f64,
     pub threshold_deg: f64,
     pub tol: f64,
+    /// The fence of a fence map, placed as `pinfeed contact --fence` places it (part units at θ0 = 0,
+    /// the part's centroid at the origin).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fence: Option<crate::mechanics::FenceSpec>,
     pub maps: &'a [ConfigurationMap],
 }
 
@@ -118,22 +138,30 @@ pub fn command_line(args: &MapArgs) -> String {
         "map".into(),
         "--part".into(),
         shell_word(&args.part),
-        format!("--d={}", ds.join(",")),
+    ];
+    match &args.fence {
+        Some(f) => words.extend(["--fence".to_string(), shell_word(f)]),
+        None => words.push(format!("--d={}", ds.join(","))),
+    }
+    words.extend([
         "--theta-step".into(),
         args.theta_step.to_string(),
         "--model".into(),
         shell_word(&args.model),
         "--mu-c".into(),
         args.mu_c.to_string(),
-        "--pin-radius".into(),
-        args.pin_radius.to_string(),
+    ]);
+    if args.fence.is_none() {
+        words.extend(["--pin-radius".into(), args.pin_radius.to_string()]);
+    }
+    words.extend([
         "--support".into(),
         shell_word(&args.support),
         "--threshold".into(),
         args.threshold.to_string(),
         "--tol".into(),
         args.tol.to_string(),
-    ];
+    ]);
     for (flag, dir) in [("--out-dir", &args.out_dir), ("--plot-dir", &args.plot_dir)] {
         if let Some(dir) = dir {
             words.push(flag.into());
@@ -141,6 +169,24 @@ pub fn command_line(args: &MapArgs) -> String {
         }
     }
     words.join(" ")
+}
+
+/// The default report directory of a map command: `results/maps/<part>` (a vertex list is
+/// `custom`), and below it `fence_<angle>[_<length>]` for a fence map.
+pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
+    let dir = default_out_dir(&args.part);
+    match &args.fence {
+        None => dir,
+        Some(f) => {
+            let name: String = f
+                .trim()
+                .chars()
+                .map(|c| if c == ':' { '_' } else { c })
+                .filter(|c| c.is_ascii_alphanumeric() || "-_.".contains(*c))
+                .collect();
+            dir.join(format!("fence_{name}"))
+        }
+    }
 }
 
 /// The default report directory of a part: `results/maps/<part>` (a vertex list is `custom`).
@@ -162,12 +208,23 @@ pub fn default_out_dir(part: &str) -> PathBuf {
     Path::new("results").join("maps").join(name)
 }
 
-fn figure_name(d: f64) -> String {
-    format!("map_d{d:+}.svg")
+/// The angle of a fence map as the user gave it (degrees; 0 for pin maps).
+fn fence_angle_deg(maps: &[ConfigurationMap]) -> f64 {
+    maps.first()
+        .and_then(|m| m.fence)
+        .map_or(0.0, |f| f.angle_deg)
+}
+
+fn figure_name(m: &ConfigurationMap) -> String {
+    match m.fence {
+        None => format!("map_d{:+}.svg", m.d),
+        Some(_) => "map_fence.svg".into(),
+    }
 }
 
 pub fn run(args: &MapArgs) -> Result<()> {
     let model = parse_model(&args.model)?;
+    let fence = args.fence.as_deref().map(parse_fence).transpose()?;
     let template = Case {
         part: args.part.clone(),
         theta0_deg: 0.0,
@@ -179,7 +236,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         pin_speed: 0.0,
         support: args.support.clone(),
         tol: args.tol,
-        fence: None,
+        fence,
     };
     check_inputs(&template)?;
     let (poly, part_model) = compile_part(&args.part, &args.support)?;
@@ -189,13 +246,20 @@ pub fn run(args: &MapArgs) -> Result<()> {
         threshold_deg: args.threshold,
         contact,
         pin,
+        fence: fence.map(|(angle_deg, length)| MapFence { angle_deg, length }),
+    };
+    // A fence map has one map and no contact parameter (the fence's placement ignores d).
+    let ds: Vec<f64> = if fence.is_some() {
+        vec![0.0]
+    } else {
+        args.d.clone()
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
         .context("starting the worker threads")?;
     let started = std::time::Instant::now();
-    let maps = pool.install(|| compute_maps(&poly, &part_model, &args.d, &settings))?;
+    let maps = pool.install(|| compute_maps(&poly, &part_model, &ds, &settings))?;
     let elapsed = started.elapsed().as_secs_f64();
     let contacts: usize = maps.iter().map(|m| m.samples.len()).sum();
     eprintln!(
@@ -220,6 +284,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         theta_step_deg: args.theta_step,
         threshold_deg: args.threshold,
         tol: args.tol,
+        fence: fence.map(|(angle, length)| case_fence(&poly, &template, angle, length)),
         maps: &maps,
     };
     if args.json {
@@ -227,15 +292,18 @@ pub fn run(args: &MapArgs) -> Result<()> {
     } else if args.csv {
         write_csv(std::io::stdout().lock(), &maps)?;
     } else {
+        let obstacle = match &report.fence {
+            Some(f) => format!(
+                "fence {}° length {} μf {}",
+                fence_angle_deg(report.maps),
+                f.length,
+                f.mu_f
+            ),
+            None => format!("μc {}  pin radius {}", args.mu_c, args.pin_radius),
+        };
         println!(
-            "{}  model {}  μc {}  pin radius {}  support {}  θ0 step {}°  threshold {}°",
-            args.part,
-            report.model,
-            args.mu_c,
-            args.pin_radius,
-            args.support,
-            args.theta_step,
-            args.threshold
+            "{}  model {}  {obstacle}  support {}  θ0 step {}°  threshold {}°",
+            args.part, report.model, args.support, args.theta_step, args.threshold
         );
         print!("{}", map_table::bands_text(&maps));
     }
@@ -243,7 +311,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         let out_dir = args
             .out_dir
             .clone()
-            .unwrap_or_else(|| default_out_dir(&args.part));
+            .unwrap_or_else(|| default_out_dir_for(args));
         write_report(&report, &out_dir, args.plot_dir.as_deref())?;
         eprintln!("report written to {}", out_dir.display());
     }
@@ -286,27 +354,49 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
         .with_context(|| format!("writing {}", csv_path.display()))?;
     write_csv(std::io::BufWriter::new(f), report.maps)?;
 
-    let describe = format!("{} ({}, μc {})", report.part, report.model, report.mu_c);
-    let mut figures: Vec<(String, PathBuf)> = Vec::new();
-    for (adjusted, file, what) in [
-        (false, "band_intervals.svg", "Band intervals against d"),
-        (
-            true,
-            "band_intervals_adjusted.svg",
-            "Adjusted band intervals (mean ± sd) against d",
+    let describe = match &report.fence {
+        Some(f) => format!(
+            "{} ({}, fence {}° length {}, μf {})",
+            report.part,
+            report.model,
+            fence_angle_deg(report.maps),
+            f.length,
+            report.mu_c
         ),
-    ] {
+        None => format!("{} ({}, μc {})", report.part, report.model, report.mu_c),
+    };
+    let mut figures: Vec<(String, PathBuf)> = Vec::new();
+    // Band intervals against d: only pin maps have a d to plot against.
+    let against_d: &[(bool, &str, &str)] = if report.fence.is_some() {
+        &[]
+    } else {
+        &[
+            (false, "band_intervals.svg", "Band intervals against d"),
+            (
+                true,
+                "band_intervals_adjusted.svg",
+                "Adjusted band intervals (mean ± sd) against d",
+            ),
+        ]
+    };
+    for &(adjusted, file, what) in against_d {
         let path = plot_dir.join(file);
         plot_map::plot_band_intervals(report.maps, adjusted, &format!("{what}: {describe}"), &path)
             .with_context(|| format!("writing {}", path.display()))?;
         figures.push((what.to_string(), path));
     }
     for m in report.maps {
-        let path = plot_dir.join(figure_name(m.d));
-        let title = format!("{describe}, d = {:+}: θ0 → θf", m.d);
+        let path = plot_dir.join(figure_name(m));
+        let (title, what) = match m.fence {
+            Some(_) => (format!("{describe}: θ0 → θf"), "θ0 → θf".to_string()),
+            None => (
+                format!("{describe}, d = {:+}: θ0 → θf", m.d),
+                format!("d = {:+}", m.d),
+            ),
+        };
         plot_map::plot_map(m, &title, report.theta_step_deg, &path)
             .with_context(|| format!("writing {}", path.display()))?;
-        figures.push((format!("d = {:+}", m.d), path));
+        figures.push((what, path));
     }
 
     let link = |p: &Path| -> String {
@@ -324,23 +414,42 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
         part = report.part,
         cmd = report.command.trim_start_matches("pinfeed "),
     );
+    let obstacle = match &report.fence {
+        Some(f) => format!(
+            "a fence at {}° of length {} (part units) with friction μf = {}, its upstream end at \
+             ({:.4}, {:.4}) when the part's centroid is at the origin (the placement of \
+             `pinfeed contact --fence`, `src/maps/start.rs`)",
+            fence_angle_deg(report.maps),
+            f.length,
+            f.mu_f,
+            f.start.x,
+            f.start.y
+        ),
+        None => format!(
+            "contact friction μc = {}, pin radius {} (part units)",
+            report.mu_c, report.pin_radius
+        ),
+    };
     md += &format!(
-        "Part `{}`, model `{}`, contact friction μc = {}, pin radius {} (part units), support `{}`, \
+        "Part `{}`, model `{}`, {obstacle}, support `{}`, \
          θ0 every {}° ({samples} samples per map), band threshold T = {}°, integration tolerance {}. \
          Conventions: SPEC §3 and the module docs of `src/maps/` (bands group neighbours in sorted \
          final angle, circularly; an interval [a, b] with b < a straddles 0°/360°; sd uses n − 1; \
          adjusted band = mean ± sd, thesis eq. 3-2). Contacts that did not end `ok`: {non_ok}.\n\n",
         report.part,
         report.model,
-        report.mu_c,
-        report.pin_radius,
         report.support,
         report.theta_step_deg,
         report.threshold_deg,
         report.tol
     );
     md += "Files: `map.json` (every sample, band and no-contact interval), `samples.csv` \
-           (one row per sample), and the figures below.\n\n## Bands per d\n\n";
+           (one row per sample), and the figures below.\n\n";
+    md += if report.fence.is_some() {
+        "## Bands\n\n"
+    } else {
+        "## Bands per d\n\n"
+    };
     md += &map_table::bands_markdown(report.maps);
     md += "\n## Figures\n\n";
     for (what, path) in &figures {

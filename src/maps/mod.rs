@@ -1,6 +1,6 @@
 //! Configuration maps (thesis §2.17 and chapter 3; SPEC §3): initial orientation θ0 → final
-//! orientation θf of a part after one pass of a pin at contact parameter d, and what the thesis
-//! reads off them.
+//! orientation θf of a part after one pass of a pin at contact parameter d — or of a fence (SPEC §6,
+//! [`MapFence`]; placed by [`fence_pass_start`]) — and what the thesis reads off them.
 //!
 //! * [`sample`]: θ0 on a regular grid over [0°, 360°), one contact per sample (pure, parallel,
 //!   independent of the thread count), from the start convention of [`start`].
@@ -26,7 +26,7 @@ pub mod start;
 
 pub use bands::{circular_clusters, find_bands};
 pub use sample::{sample_maps, theta_grid};
-pub use start::pass_start;
+pub use start::{fence_pass_start, pass_start};
 
 use crate::geometry::Polygon;
 use crate::mechanics::{ContactSettings, ContactStatus, Fidelity, PartModel, Pin};
@@ -49,6 +49,20 @@ pub enum MapError {
     NoContactParameter,
     #[error("contact parameter d = {0} is given twice")]
     RepeatedContactParameter(f64),
+    #[error("fence angle must lie strictly between -90 and 90 degrees, got {0}")]
+    FenceAngle(f64),
+    #[error("fence length must be a positive number (part units), got {0}")]
+    FenceLength(f64),
+}
+
+/// A fence to map instead of a pin (SPEC §6): its friction is the settings' `mu_c`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MapFence {
+    /// Angle from the belt direction (degrees, strictly between −90 and 90; positive fences deflect
+    /// parts to the left).
+    pub angle_deg: f64,
+    /// Length in the part's units (default 20a).
+    pub length: Option<f64>,
 }
 
 /// What a map is computed with.
@@ -60,6 +74,8 @@ pub struct MapSettings {
     pub threshold_deg: f64,
     pub contact: ContactSettings,
     pub pin: Pin,
+    /// A fence instead of the pin (`pin` is then unused; `contact.mu_c` is the fence friction).
+    pub fence: Option<MapFence>,
 }
 
 impl MapSettings {
@@ -79,6 +95,7 @@ impl MapSettings {
                 ..ContactSettings::default()
             },
             pin: Pin::point(),
+            fence: None,
         }
     }
 }
@@ -141,6 +158,23 @@ pub struct ConfigurationMap {
     pub bands: Vec<Band>,
     /// NC_j: runs of no-contact θ0, [first, last] (degrees, on the grid).
     pub no_contact_ranges_deg: Vec<[f64; 2]>,
+    /// The fence of a fence map (its `d` is then 0: a fence map has no contact parameter).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fence: Option<MapFence>,
+}
+
+impl ConfigurationMap {
+    /// How the map is labelled in tables: `+0.3` for a pin map, `fence 45°` (`fence 45°:3`
+    /// with a length) for a fence map.
+    pub fn label(&self) -> String {
+        match self.fence {
+            None => format!("{:+}", self.d),
+            Some(f) => match f.length {
+                None => format!("fence {}°", f.angle_deg),
+                Some(l) => format!("fence {}°:{l}", f.angle_deg),
+            },
+        }
+    }
 }
 
 impl ConfigurationMap {
@@ -163,6 +197,7 @@ impl ConfigurationMap {
             samples,
             bands,
             no_contact_ranges_deg,
+            fence: None,
         })
     }
 
@@ -191,6 +226,16 @@ pub fn compute_maps(
         return Err(MapError::NoContactParameter);
     }
     check_threshold(settings.threshold_deg)?;
+    if let Some(f) = settings.fence {
+        if !(f.angle_deg.is_finite() && f.angle_deg.abs() < 90.0) {
+            return Err(MapError::FenceAngle(f.angle_deg));
+        }
+        if let Some(l) = f.length {
+            if !(l.is_finite() && l > 0.0) {
+                return Err(MapError::FenceLength(l));
+            }
+        }
+    }
     for (i, &d) in ds.iter().enumerate() {
         sample::check_contact_parameter(poly, d, settings.pin.radius)?;
         if ds[..i].contains(&d) {
@@ -198,9 +243,13 @@ pub fn compute_maps(
         }
     }
     let grid = theta_grid(settings.theta_step_deg)?;
-    let rows = sample_maps(poly, model, ds, &grid, &settings.contact, &settings.pin);
+    let rows = sample_maps(poly, model, ds, &grid, settings);
     ds.iter()
         .zip(rows)
-        .map(|(&d, row)| ConfigurationMap::from_samples(d, row, settings.threshold_deg))
+        .map(|(&d, row)| {
+            let mut m = ConfigurationMap::from_samples(d, row, settings.threshold_deg)?;
+            m.fence = settings.fence;
+            Ok(m)
+        })
         .collect()
 }

@@ -1,13 +1,13 @@
 //! Sampling a configuration map: one pin pass per initial orientation θ0 on a regular grid over
 //! [0°, 360°), for each contact parameter d (SPEC §3, thesis eq. 2-14: θf = f(θi, d; μc, pressure)).
 //!
-//! Every sample is an independent call of the pure contact model [`push`] from the standard start
-//! ([`super::pass_start`]). The (d, θ0) pairs are flattened into one list, computed with rayon and
+//! Every sample is an independent call of the pure contact model ([`push`], or [`push_fence`] for
+//! a fence map) from the standard start ([`super::pass_start`], [`super::fence_pass_start`]). The (d, θ0) pairs are flattened into one list, computed with rayon and
 //! collected in index order, so the result is the same bit for bit at any thread count.
 
-use super::{MapError, MapSample};
+use super::{MapError, MapSample, MapSettings};
 use crate::geometry::{wrap_deg, Polygon};
-use crate::mechanics::{push, ContactSettings, PartModel, Pin};
+use crate::mechanics::{push, push_fence, PartModel};
 use rayon::prelude::*;
 
 /// Largest number of θ0 samples per map (a step of 0.001°).
@@ -44,17 +44,23 @@ pub fn check_contact_parameter(poly: &Polygon, d: f64, pin_radius: f64) -> Resul
     Ok(())
 }
 
-/// One pin pass at (θ0, d) from the standard start. `band` is left empty.
+/// One pin (or fence) pass at (θ0, d) from the standard start. `band` is left empty.
 pub fn sample_one(
     poly: &Polygon,
     model: &PartModel,
     theta0_deg: f64,
     d: f64,
-    settings: &ContactSettings,
-    pin: &Pin,
+    settings: &MapSettings,
 ) -> MapSample {
+    let (pin, contact) = (&settings.pin, &settings.contact);
     let (pose, start) = super::pass_start(poly, theta0_deg, d, pin.radius);
-    let out = push(model, pose, start, pin, settings, None);
+    let out = match settings.fence {
+        None => push(model, pose, start, pin, contact, None),
+        Some(f) => {
+            let fence = super::fence_pass_start(poly, d, f.angle_deg, f.length, contact.mu_c);
+            push_fence(model, pose, &fence, contact, None)
+        }
+    };
     // Without contact the orientation is untouched by definition: θf = θ0 exactly.
     let theta_final_deg = if out.contact {
         wrap_deg(theta0_deg + out.rotation.to_degrees())
@@ -80,13 +86,12 @@ pub fn sample_maps(
     model: &PartModel,
     ds: &[f64],
     grid: &[f64],
-    settings: &ContactSettings,
-    pin: &Pin,
+    settings: &MapSettings,
 ) -> Vec<Vec<MapSample>> {
     let n = grid.len();
     let flat: Vec<MapSample> = (0..ds.len() * n)
         .into_par_iter()
-        .map(|i| sample_one(poly, model, grid[i % n], ds[i / n], settings, pin))
+        .map(|i| sample_one(poly, model, grid[i % n], ds[i / n], settings))
         .collect();
     let mut rows = Vec::with_capacity(ds.len());
     let mut it = flat.into_iter();

@@ -1,6 +1,6 @@
 //! Tables of configuration-map bands for people: one row per band B_j (final-angle interval, width,
 //! mean, sd, adjusted interval mean ± sd, the θ0 runs K_j that feed it, the COM_j range and the sample
-//! count) and one row per d for its no-contact runs NC_j. Rendered as aligned plain text for the
+//! count) and one row per map (per d, or the fence of a fence map) for its no-contact runs NC_j. Rendered as aligned plain text for the
 //! terminal or as a Markdown table for results files. Intervals [a, b] with b < a straddle 0°/360°.
 
 use crate::maps::ConfigurationMap;
@@ -38,7 +38,7 @@ fn rows(maps: &[ConfigurationMap]) -> Vec<[String; 10]> {
     for m in maps {
         for (j, b) in m.bands.iter().enumerate() {
             out.push([
-                format!("{:+}", m.d),
+                m.label(),
                 format!("B{}", j + 1),
                 interval(b.final_min_deg, b.final_max_deg, 2),
                 format!("{:.2}", b.width_deg),
@@ -54,7 +54,7 @@ fn rows(maps: &[ConfigurationMap]) -> Vec<[String; 10]> {
         if nc > 0 {
             let dash = || "—".to_string();
             out.push([
-                format!("{:+}", m.d),
+                m.label(),
                 "NC".into(),
                 dash(),
                 dash(),
@@ -70,10 +70,20 @@ fn rows(maps: &[ConfigurationMap]) -> Vec<[String; 10]> {
     out
 }
 
+/// The header: the first column names the pin maps' d, or the fence of fence maps.
+fn header(maps: &[ConfigurationMap]) -> [&'static str; 10] {
+    let mut h = HEADER;
+    if maps.iter().any(|m| m.fence.is_some()) {
+        h[0] = "map";
+    }
+    h
+}
+
 /// Aligned plain-text table for the terminal.
 pub fn bands_text(maps: &[ConfigurationMap]) -> String {
     let rows = rows(maps);
-    let mut width: Vec<usize> = HEADER.iter().map(|h| h.chars().count()).collect();
+    let head = header(maps);
+    let mut width: Vec<usize> = head.iter().map(|h| h.chars().count()).collect();
     for r in &rows {
         for (w, c) in width.iter_mut().zip(r) {
             *w = (*w).max(c.chars().count());
@@ -87,7 +97,7 @@ pub fn bands_text(maps: &[ConfigurationMap]) -> String {
             .collect();
         padded.join("  ").trim_end().to_string() + "\n"
     };
-    let mut s = line(HEADER.to_vec());
+    let mut s = line(head.to_vec());
     let mut last_d: Option<&str> = None;
     for r in &rows {
         if last_d.is_some_and(|d| d != r[0]) {
@@ -101,8 +111,9 @@ pub fn bands_text(maps: &[ConfigurationMap]) -> String {
 
 /// Markdown table for results files.
 pub fn bands_markdown(maps: &[ConfigurationMap]) -> String {
-    let mut s = format!("| {} |\n", HEADER.join(" | "));
-    s += &format!("|{}\n", "---|".repeat(HEADER.len()));
+    let head = header(maps);
+    let mut s = format!("| {} |\n", head.join(" | "));
+    s += &format!("|{}\n", "---|".repeat(head.len()));
     for r in rows(maps) {
         s += &format!("| {} |\n", r.join(" | "));
     }
