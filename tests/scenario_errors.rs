@@ -1,6 +1,6 @@
-//! Bad scenario files through the CLI (issue 7 acceptance): each is refused with a non-zero exit,
-//! no panic, no result on stdout, and a message naming the file, line, column, key and what is
-//! allowed. The files are under tests/fixtures/scenarios/.
+//! Bad scenario files through the CLI (issue 7 acceptance; bad fence fields, issue 5): each is
+//! refused with a non-zero exit, no panic, no result on stdout, and a message naming the file,
+//! line, column, key and what is allowed. The files are under tests/fixtures/scenarios/.
 
 use std::process::Command;
 
@@ -119,7 +119,79 @@ fn reserved_obstacle_kind_is_not_yet_supported() {
         18,
         8,
         "obstacles[0].kind",
-        &["\"fence\" is not yet supported", "kind = \"pin\""],
+        &[
+            "\"moving_pin\" is not yet supported",
+            "kind = \"pin\" and kind = \"fence\"",
+        ],
+    );
+}
+
+#[test]
+fn fence_angle_out_of_range() {
+    assert_error(
+        "fence_bad_angle.toml",
+        21,
+        9,
+        "obstacles[0].angle",
+        &["strictly between -90 and 90", "got 90"],
+    );
+}
+
+#[test]
+fn fence_end_off_the_belt() {
+    assert_error(
+        "fence_off_belt.toml",
+        22,
+        10,
+        "obstacles[0].length",
+        &[
+            "downstream end (0.500000, 0.256410) m lies off the belt",
+            "|y| ≤ width/2 = 0.1",
+        ],
+    );
+}
+
+#[test]
+fn fence_length_must_be_positive() {
+    assert_error(
+        "fence_bad_length.toml",
+        22,
+        10,
+        "obstacles[0].length",
+        &["must be greater than 0 (m), got -0.1"],
+    );
+}
+
+#[test]
+fn fence_friction_must_not_be_negative() {
+    assert_error(
+        "fence_bad_friction.toml",
+        23,
+        8,
+        "obstacles[0].mu_f",
+        &["must be at least 0", "got -0.2"],
+    );
+}
+
+#[test]
+fn fence_refuses_pin_keys() {
+    assert_error(
+        "fence_with_radius.toml",
+        23,
+        10,
+        "obstacles[0].radius",
+        &["does not apply to a fence", "x, y, angle, length, mu_f"],
+    );
+}
+
+#[test]
+fn fence_needs_its_angle() {
+    assert_error(
+        "fence_missing_angle.toml",
+        17,
+        1,
+        "obstacles[0]",
+        &["a fence needs x, y", "`angle` is missing"],
     );
 }
 

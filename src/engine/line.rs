@@ -1,18 +1,21 @@
 //! The feeder line as a discrete-event simulation (SPEC §7; DESIGN.md "the shape of the program").
 //!
 //! Parts arrive (periodic or Poisson, at x = 0 with a random orientation and lateral offset), ride
-//! the belt, are pushed by pins and leave at x = belt length. Each part is, at any time, either
-//! free (riding the belt) or held (being pushed); see [`super::motion`]. Its next event is always
-//! known: from a free state the first-contact ray cast (belt frame) over every obstacle gives the
-//! next contact begin, else the exit; at contact begin the contact model ([`crate::mechanics::push`])
-//! gives the whole push and so the contact end. Events are processed in time order, ties by
-//! sequence number ([`super::event_queue`]).
+//! the belt, are pushed by pins and fences and leave at x = belt length. Each part is, at any time,
+//! either free (riding the belt) or held (being pushed); see [`super::motion`]. Its next event is
+//! always known: from a free state the first touch (belt frame) over every obstacle gives the next
+//! contact begin, else the exit — for a pin the first-contact ray cast the contact model uses, for
+//! a fence [`crate::mechanics::fence_first_touch`]; the earliest obstacle wins. At contact begin the
+//! contact model ([`crate::mechanics::push`], [`crate::mechanics::push_fence`]) gives the whole
+//! push and so the contact end. Events are processed in time order, ties by sequence number
+//! ([`super::event_queue`]).
 //!
 //! Detection (never silent mis-simulation):
-//! * **two obstacles at once**: when a push starts, each obstacle close enough to the pushing pin
-//!   to be reached (centre distance ≤ 2a + both radii, precomputed per scene) is checked against the
-//!   part's recorded path during the push; a touch ends the push there as `multi_contact`. The
-//!   contact model itself reports a pin in a concave notch (also `multi_contact`).
+//! * **two obstacles at once**: when a push starts, each obstacle close enough to the pushing one
+//!   to be reached (distance between pin discs and fence segments ≤ 2a, precomputed per scene) is
+//!   checked against the part's recorded path during the push; a touch ends the push there as
+//!   `multi_contact`. The contact model itself reports a pin in a concave notch (also
+//!   `multi_contact`).
 //! * **part–part overlap**: whenever a part's motion changes (arrival, contact begin, contact end),
 //!   its new motion is checked against every other part on the belt over the time both motions are
 //!   known (until the earlier of their next events). Every interval of time in which two parts
@@ -21,20 +24,29 @@
 //!   with [`super::overlap::first_touch`]. The first overlap schedules a collision event; both
 //!   parts are taken off the line then, unless one of them has already gone.
 //!   Only while two or more parts share the belt does this run (`work.part_part_checks`).
-//! * **off the belt**: after a push, a centroid outside |y| ≤ width/2 means the part falls off.
-//! * **jam**: a push that never releases the part (the contact model's travel limit).
+//! * **off the belt**: after a push, a centroid outside |y| ≤ width/2 means the part falls off. A
+//!   fence carries parts across the belt, so during a fence push whose reach (the fence's lateral
+//!   extent plus a: the centroid stays within a of the contact on the fence) crosses an edge the
+//!   recorded path is checked too, and the part falls off where its centroid crosses the edge.
+//! * **jam**: an obstacle that holds the part for good: a pin still pushing it after the contact
+//!   model's travel limit (cause `travel_limit`), or a fence at α + atan μf ≥ 90° against which the
+//!   part stops in the world while the belt slips under it (cause `fence_angle`, SPEC §6). A real
+//!   line would stop there; the simulator counts the part and takes it off at that instant, so the
+//!   parts behind it are still measured.
 //! * **solver**: any other failure of the contact model, with its cause.
 //!
 //! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it.
 
 use super::event_queue::{Event, EventKind, EventQueue};
 use super::metrics::{Metrics, Summary};
-use super::motion::{ContactPlan, Motion, Stop};
+use super::motion::{ContactPlan, Motion, Pusher, Stop};
 use super::outcome::PartOutcome;
-use super::overlap::{disc_clearance, first_touch, polygon_clearance, segment_distance};
+use super::overlap::{capsule_clearance, first_touch, polygon_clearance, segment_distance};
 use super::part_stream::{arrival_gap, draw_part};
 use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
-use crate::mechanics::{push, ContactSettings, ContactStatus, PartModel, Pin, SolveFailure};
+use crate::mechanics::{
+    fence_first_touch, ContactSettings, ContactStatus, PartModel, Pin, SolveFailure,
+};
 use crate::scenario::{Arrival, Obstacle, Scene};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -256,7 +268,8 @@ impl Line<'_> {
     }
 
     /// From a free state, find the next event: the first obstacle the part will touch (first-contact
-    /// ray cast in the belt frame, exactly as the contact model casts it), or the exit.
+    /// ray cast for a pin, first touch of a fence, in the belt frame exactly as the contact model
+    /// finds them), or the exit.
     fn plan_next(&mut self, index: u64, part: &mut ActivePart, now: f64) {
         let Motion::Free { t0, pose, .. } = part.motion else {
             unreachable!("plan_next on a held part");
@@ -272,23 +285,33 @@ impl Line<'_> {
             if Some(j) == part.last_obstacle {
                 continue;
             }
-            let Obstacle::Pin(pin) = ob;
-            // Out of lateral reach, or already behind the part: the pin's path misses it.
-            if (pin.centre.y - pose.y).abs() > a + pin.radius
-                || pin.centre.x + pin.radius < pose.x - a
-            {
+            // Out of lateral reach, or already behind the part: the obstacle's path misses it.
+            let ([_, x_max], [y_min, y_max]) = (ob.x_range(), ob.y_range());
+            if y_min > pose.y + a || y_max < pose.y - a || x_max < pose.x - a {
                 continue;
             }
             self.metrics.work.ray_casts += 1;
-            let start = pin.centre / k;
-            let rho = pin.radius / k;
-            let mut min_travel = 0.0;
-            let travel = loop {
-                match first_contact(poly, &pose_n, start, Vec2::new(-1.0, 0.0), rho, min_travel) {
-                    None => break None,
-                    Some(h) if h.grazing => min_travel = h.travel + 1e-9,
-                    Some(h) => break Some(h.travel * k),
+            let travel = match ob {
+                Obstacle::Pin(pin) => {
+                    let start = pin.centre / k;
+                    let rho = pin.radius / k;
+                    let mut min_travel = 0.0;
+                    loop {
+                        match first_contact(
+                            poly,
+                            &pose_n,
+                            start,
+                            Vec2::new(-1.0, 0.0),
+                            rho,
+                            min_travel,
+                        ) {
+                            None => break None,
+                            Some(h) if h.grazing => min_travel = h.travel + 1e-9,
+                            Some(h) => break Some(h.travel * k),
+                        }
+                    }
                 }
+                Obstacle::Fence(fence) => fence_first_touch(model, pose, &fence.spec()),
             };
             if let Some(tr) = travel {
                 if best.is_none_or(|(b, _)| tr < b) {
@@ -331,17 +354,25 @@ impl Line<'_> {
         let Motion::Free { t0, pose, .. } = part.motion else {
             unreachable!("contact begin for a held part");
         };
-        let Obstacle::Pin(pin) = &scene.obstacles[j];
-        let settings = ContactSettings {
-            mu_c: pin.mu_c,
-            ..scene.contact
-        };
-        let pin_model = Pin {
-            radius: pin.radius,
-            lateral_speed: 0.0,
+        let (pusher, settings) = match &scene.obstacles[j] {
+            Obstacle::Pin(pin) => (
+                Pusher::Pin {
+                    centre: pin.centre,
+                    pin: Pin {
+                        radius: pin.radius,
+                        lateral_speed: 0.0,
+                    },
+                },
+                ContactSettings {
+                    mu_c: pin.mu_c,
+                    ..scene.contact
+                },
+            ),
+            // The fence's own μf replaces the contact friction inside `push_fence`.
+            Obstacle::Fence(fence) => (Pusher::Fence(fence.spec()), scene.contact),
         };
         let model = part.model.as_ref().unwrap_or(&scene.part.model);
-        let out = push(model, pose, pin.centre, &pin_model, &settings, None);
+        let out = pusher.push(model, pose, &settings, None);
         self.metrics.work.contact_solves += 1;
         self.metrics.work.model_evaluations += out.evaluations;
         if matches!(out.status, ContactStatus::PinInsidePart) {
@@ -367,7 +398,12 @@ impl Line<'_> {
         let stop = match out.status {
             ContactStatus::Ok => None,
             ContactStatus::MultiContact { .. } => Some(Stop::MultiContact { cause: "notch" }),
-            ContactStatus::TravelLimit { .. } => Some(Stop::Jam),
+            ContactStatus::TravelLimit { .. } => Some(Stop::Jam {
+                cause: "travel_limit",
+            }),
+            ContactStatus::Jam { .. } => Some(Stop::Jam {
+                cause: "fence_angle",
+            }),
             ContactStatus::Solver { failure, .. } => Some(Stop::Solver {
                 cause: match failure {
                     SolveFailure::NoConvergence { .. } => "no_convergence",
@@ -382,8 +418,7 @@ impl Line<'_> {
             obstacle: j,
             t_ref: t0,
             pose_ref: pose,
-            pin_centre: pin.centre,
-            pin: pin_model,
+            pusher,
             settings,
             outcome: out,
             s_touch,
@@ -405,7 +440,7 @@ impl Line<'_> {
             let mut earliest: Option<f64> = None;
             for &nb in &scene.neighbours[j] {
                 self.metrics.work.obstacle_sweep_checks += 1;
-                let (centre, radius) = scene.obstacles[nb].bounding_disc();
+                let (p, q, radius) = scene.obstacles[nb].capsule();
                 let end = earliest.unwrap_or(plan.t_end);
                 let mut evals = 0;
                 let hit = first_touch(
@@ -413,8 +448,8 @@ impl Line<'_> {
                     end,
                     &breaks,
                     &mut |tau| {
-                        let p = held.world_pose(tau, v);
-                        disc_clearance(centre, radius, &poly.world_vertices(&p))
+                        let pose = held.world_pose(tau, v);
+                        capsule_clearance(p, q, radius, &poly.world_vertices(&pose))
                     },
                     &|ta, tb| {
                         let (p, q) = (held.world_pose(ta, v), held.world_pose(tb, v));
@@ -433,6 +468,21 @@ impl Line<'_> {
                 plan.stop = Some(Stop::MultiContact {
                     cause: "second_obstacle",
                 });
+            }
+        }
+        // A fence carries the part across the belt: does its centroid cross an edge on the way?
+        if let Obstacle::Fence(_) = &scene.obstacles[j] {
+            let half = scene.belt.width / 2.0;
+            let [y_min, y_max] = scene.obstacles[j].y_range();
+            let a = scene.part.radius;
+            if y_min - a < -half || y_max + a > half {
+                if plan.ensure_trace(model) {
+                    self.metrics.work.traces_recorded += 1;
+                }
+                if let Some(tm) = edge_crossing(&plan, v, half) {
+                    plan.t_end = tm.max(t);
+                    plan.stop = Some(Stop::OffBelt);
+                }
             }
         }
         part.contacts += 1;
@@ -475,7 +525,8 @@ impl Line<'_> {
             self.active.insert(index, part);
             let (outcome, cause) = match stop {
                 Stop::MultiContact { cause } => (PartOutcome::MultiContact, cause),
-                Stop::Jam => (PartOutcome::Jam, ""),
+                Stop::Jam { cause } => (PartOutcome::Jam, cause),
+                Stop::OffBelt => (PartOutcome::OffBelt, ""),
                 Stop::Solver { cause } => (PartOutcome::Solver, cause),
             };
             self.finish(index, t, outcome, cause);
@@ -575,8 +626,9 @@ impl Line<'_> {
                 continue;
             }
             // Broad phase in the belt frame that is the world at `now`: a free part is a disc of
-            // radius a at rest; a held part stays within 2a + ρ of its pin, whose belt-frame path
-            // runs from its centre back along −x.
+            // radius a at rest; a held part stays within 2a of the obstacle holding it — within
+            // 2a + ρ of a pin's centre, within 2a + length/2 of a fence's midpoint — whose
+            // belt-frame path runs back along −x.
             let capsule = |p: &ActivePart| -> (Vec2, Vec2, f64) {
                 match &p.motion {
                     Motion::Free { .. } => {
@@ -584,9 +636,10 @@ impl Line<'_> {
                         (c, c, a)
                     }
                     Motion::Held(plan) => {
-                        let Obstacle::Pin(pin) = &scene.obstacles[plan.obstacle];
-                        let x = pin.centre;
-                        (x, x - Vec2::new(v * (end - now), 0.0), 2.0 * a + pin.radius)
+                        let (p, q, r) = scene.obstacles[plan.obstacle].capsule();
+                        let x = (p + q) * 0.5;
+                        let reach = 2.0 * a + r + (q - p).norm() / 2.0;
+                        (x, x - Vec2::new(v * (end - now), 0.0), reach)
                     }
                 }
             };
@@ -646,4 +699,29 @@ impl Line<'_> {
             }
         }
     }
+}
+
+/// The first time in (t_begin, t_end] at which the held part's centroid lies beyond |y| = `half`
+/// (the belt's edge), following the recorded path (linear between steps, as everywhere in the
+/// line).
+fn edge_crossing(plan: &ContactPlan, speed: f64, half: f64) -> Option<f64> {
+    let held = Motion::Held(Box::new(plan.clone()));
+    let mut times = vec![plan.t_begin];
+    times.extend(plan.step_times(speed));
+    times.push(plan.t_end);
+    let beyond = |t: f64| held.world_pose(t, speed).y.abs() - half;
+    let mut prev = (times[0], beyond(times[0]));
+    if prev.1 > 0.0 {
+        return Some(prev.0);
+    }
+    for &t in &times[1..] {
+        let g = beyond(t);
+        if g > 0.0 {
+            // Linear between the steps: the crossing of |y| = half (g ≤ 0 before, > 0 now).
+            let u = prev.1 / (prev.1 - g);
+            return Some(prev.0 + u * (t - prev.0));
+        }
+        prev = (t, g);
+    }
+    None
 }

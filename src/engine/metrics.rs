@@ -11,9 +11,9 @@
 //! * **success rate**: successes / parts in, with the 95% Wilson score interval.
 //! * **latency**: exit time − arrival time of the parts that exit, in an HDR histogram of
 //!   microseconds (3 significant digits), reported in seconds.
-//! * **contacts per part**: pin encounters (pushes) / parts in.
-//! * **busy fraction** of a pin: total time it is pushing a part / simulated time (first arrival to
-//!   last event).
+//! * **contacts per part**: obstacle encounters (pushes by pins and fences) / parts in.
+//! * **busy fraction** of an obstacle (pin or fence): total time it is pushing a part / simulated
+//!   time (first arrival to last event).
 //! * **work**: counters of the work each optional effect did, so a test can show that an effect a
 //!   scene does not use costs nothing. Wall-clock speed is not part of the summary (it would make
 //!   runs differ); the CLI prints it beside the table.
@@ -63,6 +63,7 @@ pub struct Metrics {
     pub parts_in: u64,
     pub outcomes: OutcomeCounts,
     pub multi_contact_causes: BTreeMap<String, u64>,
+    pub jam_causes: BTreeMap<String, u64>,
     pub solver_causes: BTreeMap<String, u64>,
     pub first_arrival: Option<f64>,
     pub last_arrival: f64,
@@ -91,6 +92,7 @@ impl Metrics {
             parts_in: 0,
             outcomes: OutcomeCounts::default(),
             multi_contact_causes: BTreeMap::new(),
+            jam_causes: BTreeMap::new(),
             solver_causes: BTreeMap::new(),
             first_arrival: None,
             last_arrival: 0.0,
@@ -156,6 +158,7 @@ impl Metrics {
     pub fn cause(&mut self, outcome: PartOutcome, cause: &str) {
         let map = match outcome {
             PartOutcome::MultiContact => &mut self.multi_contact_causes,
+            PartOutcome::Jam => &mut self.jam_causes,
             PartOutcome::Solver => &mut self.solver_causes,
             _ => return,
         };
@@ -189,10 +192,13 @@ pub struct OrientationHistogram {
     pub counts: Vec<u64>,
 }
 
-/// Causes behind the multi_contact and solver classes.
+/// Causes behind the multi_contact, jam and solver classes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Causes {
     pub multi_contact: BTreeMap<String, u64>,
+    /// `travel_limit` (a pin still pushing after `model.max_travel`) or `fence_angle` (stopped
+    /// against a fence at α + atan μf ≥ 90°).
+    pub jam: BTreeMap<String, u64>,
     pub solver: BTreeMap<String, u64>,
 }
 
@@ -304,6 +310,7 @@ impl Metrics {
             },
             causes: Causes {
                 multi_contact: self.multi_contact_causes.clone(),
+                jam: self.jam_causes.clone(),
                 solver: self.solver_causes.clone(),
             },
             simulated_time_s: span,

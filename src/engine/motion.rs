@@ -2,11 +2,12 @@
 //!
 //! * Free: the part rides the belt: its world pose at time t is its pose at the anchor time t₀
 //!   translated by V·(t − t₀) along x.
-//! * Held: a pin is pushing it. The contact model works in the belt frame that coincides with the
-//!   world at the anchor time t_ref (SPEC §2): the pin, fixed in the world at X, starts at X and
-//!   travels along −x relative to the belt, its travel s = V·(t − t_ref). The push outcome gives the
-//!   belt-frame pose after the pin has passed; the world pose at time t is the belt-frame pose
-//!   translated by s along x. The part therefore lags the belt while it is held.
+//! * Held: a pin or a fence is pushing it. The contact model works in the belt frame that coincides
+//!   with the world at the anchor time t_ref (SPEC §2, §6): the obstacle, fixed in the world, starts
+//!   where it stands and travels along −x relative to the belt, its travel s = V·(t − t_ref). The
+//!   push outcome gives the belt-frame pose after the obstacle has passed; the world pose at time t
+//!   is the belt-frame pose translated by s along x. The part therefore lags the belt while it is
+//!   held (a part sliding along a fence also moves across the belt).
 //!
 //! Intermediate poses of a push are only needed when something may touch the part during it (a
 //! neighbouring obstacle or another part) or when it is drawn. Then the push is run again with a
@@ -14,15 +15,47 @@
 //! recorded steps the pose is interpolated linearly in (centroid, θ).
 
 use crate::geometry::{Pose, Vec2};
-use crate::mechanics::{push, ContactOutcome, ContactSettings, PartModel, Pin, TraceSample};
+use crate::mechanics::{
+    push, push_fence, ContactOutcome, ContactSettings, FenceSpec, PartModel, Pin, Recorder,
+    TraceSample,
+};
+
+/// The obstacle pushing a held part, as the contact model takes it (world frame at t_ref, m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pusher {
+    /// A pin whose centre stands at `centre`.
+    Pin { centre: Vec2, pin: Pin },
+    /// A fence.
+    Fence(FenceSpec),
+}
+
+impl Pusher {
+    /// The push of a part resting at `pose` (belt frame = world at the anchor time): a pure
+    /// function, so calling it again with a recorder gives the same outcome.
+    pub fn push(
+        &self,
+        model: &PartModel,
+        pose: Pose,
+        settings: &ContactSettings,
+        recorder: Option<&mut dyn Recorder>,
+    ) -> ContactOutcome {
+        match self {
+            Pusher::Pin { centre, pin } => push(model, pose, *centre, pin, settings, recorder),
+            Pusher::Fence(fence) => push_fence(model, pose, fence, settings, recorder),
+        }
+    }
+}
 
 /// Why a part leaves the line at the end of a push instead of riding on.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Stop {
     /// Two obstacles at once; `cause` names how (`notch`, `second_obstacle`, `pin_inside_part`).
     MultiContact { cause: &'static str },
-    /// The pin never released the part within the travel limit.
-    Jam,
+    /// The obstacle holds the part for good; `cause` is `travel_limit` (still pushed after
+    /// `model.max_travel`) or `fence_angle` (stopped against a fence at α + atan μf ≥ 90°).
+    Jam { cause: &'static str },
+    /// The part's centroid crossed the belt's edge while it was pushed along a fence.
+    OffBelt,
     /// The contact model failed; `cause` is the contact status name (`evaluation_limit`,
     /// `event_limit`, `step_too_small`), or for a failed sub-problem `no_convergence` / `non_finite`.
     Solver { cause: &'static str },
@@ -36,9 +69,8 @@ pub struct ContactPlan {
     pub t_ref: f64,
     /// World pose of the part at `t_ref` (= its belt-frame pose throughout the push, before touch).
     pub pose_ref: Pose,
-    /// Pin centre, world frame.
-    pub pin_centre: Vec2,
-    pub pin: Pin,
+    /// The pushing obstacle.
+    pub pusher: Pusher,
     pub settings: ContactSettings,
     pub outcome: ContactOutcome,
     /// Pin travel at first touch and at the end of the last contact of the pass.
@@ -64,14 +96,9 @@ impl ContactPlan {
             return false;
         }
         let mut samples: Vec<TraceSample> = Vec::new();
-        let again = push(
-            model,
-            self.pose_ref,
-            self.pin_centre,
-            &self.pin,
-            &self.settings,
-            Some(&mut samples),
-        );
+        let again = self
+            .pusher
+            .push(model, self.pose_ref, &self.settings, Some(&mut samples));
         debug_assert_eq!(
             again.pose_final, self.outcome.pose_final,
             "push is not pure"

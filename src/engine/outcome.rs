@@ -6,8 +6,8 @@
 //! | `wrong_orientation` | reached x = belt length, orientation not in the goal |
 //! | `collision` | overlapped another part (both parts are taken off the line at that instant) |
 //! | `multi_contact` | touched two obstacles at once (another obstacle during a push), or the pin met a concave notch (two contact points) |
-//! | `off_belt` | its centroid left the belt's width after a push (it falls off) |
-//! | `jam` | a pin never released it: it rides on the pin beyond `model.max_travel` (a real line would stop here; the part is counted and removed) |
+//! | `off_belt` | its centroid left the belt's width after a push, or while a fence carried it across (it falls off) |
+//! | `jam` | an obstacle holds it for good: it rides on a pin beyond `model.max_travel` (cause `travel_limit`), or it stops against a fence at α + atan μf ≥ 90° while the belt slips under it (cause `fence_angle`, SPEC §6). A real line would stop here; the part is counted and removed at that instant |
 //! | `solver` | the contact model could not finish the push (evaluation/event limits, step too small, a sub-problem failed); the cause is counted |
 
 use serde::Serialize;

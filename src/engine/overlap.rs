@@ -4,6 +4,7 @@
 //! * [`polygon_clearance`]: the distance between two simple polygons (world vertices), 0 when they
 //!   intersect;
 //! * [`disc_clearance`]: the distance from a disc (a pin) to a polygon, ≤ 0 when they touch;
+//! * [`capsule_clearance`]: the same for a segment thickened by a radius (a fence, or a pin);
 //! * [`first_touch`]: the earliest time in a window at which a clearance that varies with time
 //!   reaches 0, given the clearance at any instant and a bound on how fast it can fall.
 //!
@@ -114,6 +115,19 @@ pub fn disc_clearance(centre: Vec2, radius: f64, v: &[Vec2]) -> f64 {
     d - radius
 }
 
+/// Distance from the capsule (the points within `radius` of the segment [p, q]: a pin's disc when
+/// p = q, a fence when radius = 0) to the polygon `v`, negative or 0 when they touch.
+pub fn capsule_clearance(p: Vec2, q: Vec2, radius: f64, v: &[Vec2]) -> f64 {
+    if point_in_polygon(p, v) {
+        return -radius;
+    }
+    let m = v.len();
+    let d = (0..m)
+        .map(|i| segment_distance(p, q, v[i], v[(i + 1) % m]))
+        .fold(f64::INFINITY, f64::min);
+    d - radius
+}
+
 /// The earliest time in [t0, t1] at which `clearance(t) ≤ 0`, or `None`.
 ///
 /// `breaks` are the times inside (t0, t1) at which the motion's linear pieces join (recorded
@@ -218,6 +232,20 @@ mod tests {
             (disc_clearance(Vec2::new(1.5, 0.0), 0.25, &square(0.0, 0.0)) - 0.75).abs() < 1e-12
         );
         assert!(disc_clearance(Vec2::new(0.0, 0.0), 0.25, &square(0.0, 0.0)) < 0.0);
+    }
+
+    #[test]
+    fn clearance_of_capsules() {
+        let sq = square(0.0, 0.0);
+        // A segment (fence) 1 above the square, crossing it, or inside it.
+        let d = capsule_clearance(Vec2::new(-3.0, 1.5), Vec2::new(3.0, 1.5), 0.0, &sq);
+        assert!((d - 1.0).abs() < 1e-12, "{d}");
+        let cross = capsule_clearance(Vec2::new(-3.0, 0.2), Vec2::new(3.0, 0.1), 0.0, &sq);
+        assert_eq!(cross, 0.0);
+        assert!(capsule_clearance(Vec2::new(-0.1, 0.0), Vec2::new(0.1, 0.0), 0.0, &sq) <= 0.0);
+        // A degenerate capsule is the disc.
+        let c = Vec2::new(1.5, 0.0);
+        assert!((capsule_clearance(c, c, 0.25, &sq) - disc_clearance(c, 0.25, &sq)).abs() < 1e-12);
     }
 
     #[test]

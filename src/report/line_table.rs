@@ -78,6 +78,7 @@ pub fn table(s: &Summary) -> String {
     }
     for (label, map) in [
         ("multi_contact causes", &s.causes.multi_contact),
+        ("jam causes", &s.causes.jam),
         ("solver causes", &s.causes.solver),
     ] {
         if !map.is_empty() {

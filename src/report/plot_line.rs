@@ -148,13 +148,23 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
             ))?;
         }
         for ob in &scene.obstacles {
-            let Obstacle::Pin(pin) = ob;
-            let r = ((pin.radius * px_per_m).round() as i32).max(2);
-            ch.draw_series(std::iter::once(Circle::new(
-                (pin.centre.x, pin.centre.y),
-                r,
-                RED.filled(),
-            )))?;
+            match ob {
+                Obstacle::Pin(pin) => {
+                    let r = ((pin.radius * px_per_m).round() as i32).max(2);
+                    ch.draw_series(std::iter::once(Circle::new(
+                        (pin.centre.x, pin.centre.y),
+                        r,
+                        RED.filled(),
+                    )))?;
+                }
+                Obstacle::Fence(fence) => {
+                    let (p, q) = (fence.start, fence.end());
+                    ch.draw_series(LineSeries::new(
+                        vec![(p.x, p.y), (q.x, q.y)],
+                        RED.stroke_width(3),
+                    ))?;
+                }
+            }
         }
         let Some(sample) = sample else { continue };
         let colour = outcome_colour(sample.outcome);

@@ -4,8 +4,7 @@
 //! Geometry rules that keep a run well defined:
 //! * a part enters with its centroid at x = 0 and must fit on the belt: the lateral offsets lie
 //!   within [−width/2 + a, width/2 − a];
-//! * a pin lies over the belt, downstream of the entry by more than a + radius (so no part enters
-//!   touching it) and before the exit (x < length).
+//! * obstacles (pins and fences) are checked in [`super::obstacles`].
 
 use super::error::{Locator, ScenarioError};
 use super::location::KeyPath;
@@ -16,22 +15,23 @@ use crate::mechanics::{ContactSettings, PartModel, Support};
 
 type R<T> = Result<T, ScenarioError>;
 
-struct Checker<'a, 'b> {
+/// Builds located errors and checks numbers against their allowed ranges.
+pub(super) struct Checker<'a, 'b> {
     loc: &'b Locator<'a>,
 }
 
 impl Checker<'_, '_> {
-    fn err(&self, path: &str, msg: impl Into<String>) -> ScenarioError {
+    pub(super) fn err(&self, path: &str, msg: impl Into<String>) -> ScenarioError {
         self.loc.at_key(&KeyPath::parse(path), msg)
     }
-    fn finite(&self, path: &str, v: f64) -> R<f64> {
+    pub(super) fn finite(&self, path: &str, v: f64) -> R<f64> {
         if v.is_finite() {
             Ok(v)
         } else {
             Err(self.err(path, format!("must be a finite number, got {v}")))
         }
     }
-    fn positive(&self, path: &str, v: f64, unit: &str) -> R<f64> {
+    pub(super) fn positive(&self, path: &str, v: f64, unit: &str) -> R<f64> {
         self.finite(path, v)?;
         if v > 0.0 {
             Ok(v)
@@ -39,7 +39,7 @@ impl Checker<'_, '_> {
             Err(self.err(path, format!("must be greater than 0 ({unit}), got {v}")))
         }
     }
-    fn non_negative(&self, path: &str, v: f64, unit: &str) -> R<f64> {
+    pub(super) fn non_negative(&self, path: &str, v: f64, unit: &str) -> R<f64> {
         self.finite(path, v)?;
         if v >= 0.0 {
             Ok(v)
@@ -47,7 +47,7 @@ impl Checker<'_, '_> {
             Err(self.err(path, format!("must be at least 0 ({unit}), got {v}")))
         }
     }
-    fn within(&self, path: &str, v: f64, lo: f64, hi: f64, unit: &str) -> R<f64> {
+    pub(super) fn within(&self, path: &str, v: f64, lo: f64, hi: f64, unit: &str) -> R<f64> {
         self.finite(path, v)?;
         if v >= lo && v <= hi {
             Ok(v)
@@ -335,83 +335,8 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
     };
 
     // [[obstacles]]
-    let mut obstacles = Vec::new();
-    for (i, ro) in raw.obstacles.iter().enumerate() {
-        let p = |k: &str| format!("obstacles[{i}].{k}");
-        match ro.kind {
-            ObstacleKind::Pin => {}
-            other => {
-                let name = match other {
-                    ObstacleKind::SensorPin => "sensor_pin",
-                    ObstacleKind::MovingPin => "moving_pin",
-                    _ => "fence",
-                };
-                return Err(c.err(
-                    &p("kind"),
-                    format!("obstacle kind \"{name}\" is not yet supported; this version simulates kind = \"pin\""),
-                ));
-            }
-        }
-        let need = |k: &str, v: Option<f64>| -> R<f64> {
-            v.ok_or_else(|| {
-                c.err(
-                    &format!("obstacles[{i}]"),
-                    format!("a pin needs x, y and radius (m); `{k}` is missing"),
-                )
-            })
-        };
-        let radius = c.non_negative(&p("radius"), need("radius", ro.radius)?, "m")?;
-        let x_min = radius + polygon.radius();
-        let x = c.finite(&p("x"), need("x", ro.x)?)?;
-        if !(x > x_min && x < belt.length) {
-            return Err(c.err(
-                &p("x"),
-                format!(
-                    "must lie in ({x_min:.6}, {}) m: beyond a + radius from the entry at x = 0 and before the exit at belt.length, got {x}",
-                    belt.length
-                ),
-            ));
-        }
-        let half = belt.width / 2.0;
-        let y = c.within(&p("y"), need("y", ro.y)?, -half, half, "m; over the belt")?;
-        let mu = match ro.mu_c {
-            Some(m) => c.non_negative(&p("mu_c"), m, "friction coefficient")?,
-            None => mu_c,
-        };
-        let name = match &ro.name {
-            Some(n) if !n.is_empty() => n.clone(),
-            Some(_) => return Err(c.err(&p("name"), "must not be empty")),
-            None => format!("pin{}", i + 1),
-        };
-        if obstacles.iter().any(|o: &Obstacle| o.name() == name) {
-            return Err(c.err(
-                &p("name"),
-                format!("'{name}' is used by another obstacle; names must be unique"),
-            ));
-        }
-        obstacles.push(Obstacle::Pin(PinObstacle {
-            name,
-            centre: Vec2::new(x, y),
-            radius,
-            mu_c: mu,
-        }));
-    }
-    let neighbours = obstacles
-        .iter()
-        .enumerate()
-        .map(|(i, a)| {
-            let (ca, ra) = a.bounding_disc();
-            obstacles
-                .iter()
-                .enumerate()
-                .filter(|&(j, b)| {
-                    let (cb, rb) = b.bounding_disc();
-                    j != i && (ca - cb).norm() <= 2.0 * radius + ra + rb
-                })
-                .map(|(j, _)| j)
-                .collect()
-        })
-        .collect();
+    let (obstacles, neighbours) =
+        super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, radius, mu_c)?;
 
     // [goal]
     let Some(rg) = &raw.goal else {

@@ -5,12 +5,14 @@
 //!
 //! * [`raw`]: serde structs mirroring the file;
 //! * [`compile`]: checks and conversion to [`Scene`];
+//! * [`obstacles`]: pins and fences, their checks and neighbour lists;
 //! * [`scene`]: the compiled types the engine reads;
 //! * [`location`], [`error`]: spans → line/column and key paths, and the located error.
 
 pub mod compile;
 pub mod error;
 pub mod location;
+pub mod obstacles;
 pub mod raw;
 pub mod scene;
 
@@ -102,7 +104,7 @@ any = true
         assert!(e.message.contains("greater than 0"));
         let e = err(&GOOD.replace("radius = 0.002", "radius = 0.002\nmu_c = -1"));
         assert_eq!(e.key, "obstacles[0].mu_c");
-        let e = err(&GOOD.replace("kind = \"pin\"", "kind = \"fence\""));
+        let e = err(&GOOD.replace("kind = \"pin\"", "kind = \"moving_pin\""));
         assert_eq!(e.key, "obstacles[0].kind");
         assert!(e.message.contains("not yet supported"));
         let e = err(&GOOD.replace("x = 0.3", "x = 0.01"));
@@ -116,6 +118,50 @@ any = true
             "{}",
             e.message
         );
+    }
+
+    #[test]
+    fn fences_compile_beside_pins() {
+        let fence =
+            "\n[[obstacles]]\nkind = \"fence\"\nx = 0.4\ny = -0.09\nangle = -30\nlength = 0.1\n";
+        // A fence at −30° from y = −0.09 runs to the right, off the belt: refused.
+        let e = err(&GOOD.replace("[goal]", &format!("{fence}\n[goal]")));
+        assert_eq!(e.key, "obstacles[1].length");
+        assert!(e.message.contains("downstream end"), "{}", e.message);
+        // At +30° it runs to the left, over the belt; μf defaults to the part's μc.
+        let text = GOOD.replace("[goal]", &format!("{}\n[goal]", fence.replace("-30", "30")));
+        let s = parse(Path::new("f.toml"), &text).unwrap();
+        let Obstacle::Fence(f) = &s.obstacles[1] else {
+            panic!("not a fence: {:?}", s.obstacles[1]);
+        };
+        assert_eq!(f.name, "fence2");
+        assert_eq!(
+            (f.start.x, f.start.y, f.length, f.mu_f),
+            (0.4, -0.09, 0.1, 0.5)
+        );
+        assert!((f.angle - 30f64.to_radians()).abs() < 1e-15);
+        assert!((f.end().y - (-0.09 + 0.05)).abs() < 1e-12);
+        assert_eq!(s.obstacles[1].x_range(), [0.4, f.end().x]);
+        // The pin at (0.3, 0) is 0.107 m from the fence: beyond 2a = 0.055 m, not a neighbour.
+        assert!(s.neighbours[0].is_empty() && s.neighbours[1].is_empty());
+        // A pin's key on a fence, and a fence's key on a pin, are refused by name.
+        let e = err(&text.replace("length = 0.1\n", "length = 0.1\nmu_c = 0.2\n"));
+        assert_eq!(e.key, "obstacles[1].mu_c");
+        assert!(
+            e.message.contains("does not apply to a fence"),
+            "{}",
+            e.message
+        );
+        let e = err(&GOOD.replace("radius = 0.002", "radius = 0.002\nangle = 10"));
+        assert_eq!(e.key, "obstacles[0].angle");
+        assert!(
+            e.message.contains("does not apply to a pin"),
+            "{}",
+            e.message
+        );
+        // Too close to the entry (x must exceed a = 0.0275 m).
+        let e = err(&text.replace("x = 0.4", "x = 0.02"));
+        assert_eq!(e.key, "obstacles[1].x");
     }
 
     #[test]

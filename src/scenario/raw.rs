@@ -120,7 +120,7 @@ pub struct RawLateral {
     pub sd: Option<f64>,
 }
 
-/// Kinds of obstacle. Only `pin` is simulated so far; the others are reserved names.
+/// Kinds of obstacle. `pin` and `fence` are simulated; the others are reserved names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ObstacleKind {
@@ -130,19 +130,28 @@ pub enum ObstacleKind {
     Fence,
 }
 
-/// `[[obstacles]]`: one element over the belt.
+/// `[[obstacles]]`: one element over the belt. A pin takes x, y, radius and mu_c; a fence takes
+/// x, y (its upstream end), angle, length and mu_f. Which keys apply is checked in
+/// [`super::compile`].
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawObstacle {
     pub kind: ObstacleKind,
     pub name: Option<String>,
-    /// Position of the pin's centre (m, world frame).
+    /// Position of the pin's centre, or of the fence's upstream end (m, world frame).
     pub x: Option<f64>,
     pub y: Option<f64>,
     /// Pin radius (m; 0 is a point pin).
     pub radius: Option<f64>,
     /// Pin–part friction for this pin (default: the part's mu_c).
     pub mu_c: Option<f64>,
+    /// Fence angle from the belt direction (degrees, strictly between −90 and 90; positive fences
+    /// run downstream to the left and deflect parts to the left).
+    pub angle: Option<f64>,
+    /// Fence length along the fence (m).
+    pub length: Option<f64>,
+    /// Fence–part friction (default: the part's mu_c).
+    pub mu_f: Option<f64>,
 }
 
 /// `[goal]`: which final orientations count as correct.

@@ -3,7 +3,7 @@
 
 pub use super::raw::SupportKind;
 use crate::geometry::{Polygon, StableState, Vec2};
-use crate::mechanics::{ContactSettings, PartModel};
+use crate::mechanics::{ContactSettings, FenceSpec, PartModel};
 
 /// The belt: parts enter at x = 0 and leave at x = `length`; it spans y ∈ [−width/2, width/2].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,24 +102,74 @@ pub struct PinObstacle {
     pub mu_c: f64,
 }
 
-/// An element over the belt. Only fixed pins exist so far; sensor pins, moving pins and fences
-/// are reserved kinds in the file format and will become variants here.
+/// A fixed fence over the belt (SPEC §6): the segment from `start` (its upstream end) along
+/// `angle` for `length`.
+///
+/// Side: parts meet the fence's upstream face. A positive angle runs downstream to the left (+y):
+/// parts arriving from its right slide along it to the left. A negative angle mirrors that: the
+/// fence runs downstream to the right and deflects parts to the right. The sign of the angle is the
+/// only "side" a fence has.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FenceObstacle {
+    pub name: String,
+    /// Upstream end, world frame (m).
+    pub start: Vec2,
+    /// Angle from the belt direction (radians, strictly inside (−π/2, π/2)).
+    pub angle: f64,
+    /// Length (m, > 0).
+    pub length: f64,
+    /// Fence–part friction μf.
+    pub mu_f: f64,
+}
+
+impl FenceObstacle {
+    /// Downstream end, world frame (m).
+    pub fn end(&self) -> Vec2 {
+        self.start + Vec2::from_angle(self.angle) * self.length
+    }
+    /// The fence as the contact model takes it (world frame, metres).
+    pub fn spec(&self) -> FenceSpec {
+        FenceSpec {
+            start: self.start,
+            angle: self.angle,
+            length: self.length,
+            mu_f: self.mu_f,
+        }
+    }
+}
+
+/// An element over the belt: a fixed pin or a fence. Sensor pins and moving pins are reserved
+/// kinds in the file format and will become variants here.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Obstacle {
     Pin(PinObstacle),
+    Fence(FenceObstacle),
 }
 
 impl Obstacle {
     pub fn name(&self) -> &str {
         match self {
             Obstacle::Pin(p) => &p.name,
+            Obstacle::Fence(f) => &f.name,
         }
     }
-    /// A disc containing the obstacle (centre, radius), for broad-phase tests.
-    pub fn bounding_disc(&self) -> (Vec2, f64) {
+    /// The obstacle as a capsule: the points within `radius` of the segment [p, q] (world, m). A
+    /// pin is a disc (p = q = its centre); a fence is its segment (radius 0).
+    pub fn capsule(&self) -> (Vec2, Vec2, f64) {
         match self {
-            Obstacle::Pin(p) => (p.centre, p.radius),
+            Obstacle::Pin(p) => (p.centre, p.centre, p.radius),
+            Obstacle::Fence(f) => (f.start, f.end(), 0.0),
         }
+    }
+    /// The obstacle's extent along the belt, [x_min, x_max] (m).
+    pub fn x_range(&self) -> [f64; 2] {
+        let (p, q, r) = self.capsule();
+        [p.x.min(q.x) - r, p.x.max(q.x) + r]
+    }
+    /// The obstacle's extent across the belt, [y_min, y_max] (m).
+    pub fn y_range(&self) -> [f64; 2] {
+        let (p, q, r) = self.capsule();
+        [p.y.min(q.y) - r, p.y.max(q.y) + r]
     }
 }
 
@@ -182,8 +232,8 @@ pub struct Scene {
     pub part: PartSpec,
     pub feed: Feed,
     pub obstacles: Vec<Obstacle>,
-    /// For each obstacle, the other obstacles a part in contact with it could touch
-    /// (centre distance ≤ 2a + both radii), ascending.
+    /// For each obstacle, the other obstacles a part in contact with it could touch (their
+    /// distance, between the pins' discs and the fences' segments, is at most 2a), ascending.
     pub neighbours: Vec<Vec<usize>>,
     pub goal: Goal,
     /// Contact-model settings; a pin's own μc replaces `mu_c` for its contacts.

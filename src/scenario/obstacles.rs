@@ -1,0 +1,228 @@
+//! Validation and compilation of `[[obstacles]]`: pins and fences (README "Scenario format";
+//! SPEC §6 fences, §7 the line), and the neighbour lists the engine uses to look for a second
+//! obstacle during a push.
+//!
+//! Rules that keep a run well defined:
+//! * a **pin** lies over the belt (|y| ≤ width/2), downstream of the entry by more than a + radius
+//!   (so no part enters touching it) and before the exit (x < length);
+//! * a **fence** is the segment from its upstream end (x, y) along `angle` (degrees from the belt
+//!   direction, strictly between −90 and 90: positive fences run downstream to the left and deflect
+//!   parts to the left, negative ones mirror that) for `length` (m > 0), with friction `mu_f` ≥ 0
+//!   (default: the part's `mu_c`). Both ends lie over the belt (|y| ≤ width/2), the upstream end
+//!   beyond a from the entry (x > a: since x grows along any allowed angle, no part enters touching
+//!   the fence) and the downstream end no further than the exit (x ≤ length);
+//! * each kind takes only its own keys: a pin's `radius`/`mu_c` on a fence (or a fence's
+//!   `angle`/`length`/`mu_f` on a pin) is refused, naming the keys that kind takes;
+//! * names are unique (default `pinN` / `fenceN`, N the 1-based position in the list).
+//!
+//! Two obstacles are neighbours when their distance (between the pins' discs and the fences'
+//! segments) is at most 2a: only then can a part touching one touch the other.
+
+use super::compile::Checker;
+use super::raw::{ObstacleKind, RawObstacle};
+use super::scene::{Belt, FenceObstacle, Obstacle, PinObstacle};
+use super::ScenarioError;
+use crate::engine::overlap::segment_distance;
+use crate::geometry::Vec2;
+
+type R<T> = Result<T, ScenarioError>;
+
+/// The obstacles of a scene and, for each, its neighbours (ascending indices).
+pub(super) fn compile_obstacles(
+    c: &Checker,
+    raw: &[RawObstacle],
+    belt: &Belt,
+    part_radius: f64,
+    part_mu_c: f64,
+) -> R<(Vec<Obstacle>, Vec<Vec<usize>>)> {
+    let mut obstacles: Vec<Obstacle> = Vec::new();
+    for (i, ro) in raw.iter().enumerate() {
+        let at = At {
+            c,
+            i,
+            belt,
+            part_radius,
+            part_mu_c,
+        };
+        let ob = match ro.kind {
+            ObstacleKind::Pin => Obstacle::Pin(pin(&at, ro)?),
+            ObstacleKind::Fence => Obstacle::Fence(fence(&at, ro)?),
+            other => {
+                let name = match other {
+                    ObstacleKind::SensorPin => "sensor_pin",
+                    _ => "moving_pin",
+                };
+                return Err(c.err(
+                    &format!("obstacles[{i}].kind"),
+                    format!("obstacle kind \"{name}\" is not yet supported; this version simulates kind = \"pin\" and kind = \"fence\""),
+                ));
+            }
+        };
+        if obstacles.iter().any(|o| o.name() == ob.name()) {
+            return Err(c.err(
+                &format!("obstacles[{i}].name"),
+                format!(
+                    "'{}' is used by another obstacle; names must be unique",
+                    ob.name()
+                ),
+            ));
+        }
+        obstacles.push(ob);
+    }
+    let neighbours = obstacles
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            obstacles
+                .iter()
+                .enumerate()
+                .filter(|&(j, b)| j != i && obstacle_distance(a, b) <= 2.0 * part_radius)
+                .map(|(j, _)| j)
+                .collect()
+        })
+        .collect();
+    Ok((obstacles, neighbours))
+}
+
+/// Distance between two obstacles (0 when they overlap), m.
+pub fn obstacle_distance(a: &Obstacle, b: &Obstacle) -> f64 {
+    let (p1, q1, r1) = a.capsule();
+    let (p2, q2, r2) = b.capsule();
+    (segment_distance(p1, q1, p2, q2) - r1 - r2).max(0.0)
+}
+
+/// Refuse the keys of the other kind.
+fn only_keys(c: &Checker, i: usize, ro: &RawObstacle, kind: &str, takes: &str) -> R<()> {
+    let given = [
+        ("radius", ro.radius.is_some()),
+        ("mu_c", ro.mu_c.is_some()),
+        ("angle", ro.angle.is_some()),
+        ("length", ro.length.is_some()),
+        ("mu_f", ro.mu_f.is_some()),
+    ];
+    for (k, present) in given {
+        if present && !takes.split(", ").any(|t| t == k) {
+            return Err(c.err(
+                &format!("obstacles[{i}].{k}"),
+                format!("does not apply to a {kind}, which takes {takes} (and name)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Obstacle `i` of a scene with this belt and part: checks on its keys.
+struct At<'c, 'a, 'b> {
+    c: &'c Checker<'a, 'b>,
+    i: usize,
+    belt: &'c Belt,
+    part_radius: f64,
+    part_mu_c: f64,
+}
+
+impl At<'_, '_, '_> {
+    fn path(&self, k: &str) -> String {
+        format!("obstacles[{}].{k}", self.i)
+    }
+    /// A required number; `needs` lists what this kind needs (for the missing-key message).
+    fn need(&self, k: &str, v: Option<f64>, needs: &str) -> R<f64> {
+        let v = v.ok_or_else(|| {
+            self.c.err(
+                &format!("obstacles[{}]", self.i),
+                format!("{needs}; `{k}` is missing"),
+            )
+        })?;
+        self.c.finite(&self.path(k), v)
+    }
+    /// x strictly inside (lo, belt.length): `what` names the point, `beyond` says what lo is.
+    fn x_within(&self, x: f64, lo: f64, what: &str, beyond: &str) -> R<f64> {
+        let length = self.belt.length;
+        if x > lo && x < length {
+            return Ok(x);
+        }
+        Err(self.c.err(
+            &self.path("x"),
+            format!(
+                "{what} must lie in ({lo:.6}, {length}) m: beyond {beyond} from the entry at x = 0 and before the exit at belt.length, got {x}",
+            ),
+        ))
+    }
+    /// y over the belt.
+    fn y_over(&self, y: f64) -> R<f64> {
+        let half = self.belt.width / 2.0;
+        self.c
+            .within(&self.path("y"), y, -half, half, "m; over the belt")
+    }
+    /// A friction coefficient, or the part's μc.
+    fn friction(&self, k: &str, v: Option<f64>) -> R<f64> {
+        match v {
+            Some(m) => self
+                .c
+                .non_negative(&self.path(k), m, "friction coefficient"),
+            None => Ok(self.part_mu_c),
+        }
+    }
+    /// The given name, or `<prefix>N`.
+    fn name(&self, given: &Option<String>, prefix: &str) -> R<String> {
+        match given {
+            Some(n) if !n.is_empty() => Ok(n.clone()),
+            Some(_) => Err(self.c.err(&self.path("name"), "must not be empty")),
+            None => Ok(format!("{prefix}{}", self.i + 1)),
+        }
+    }
+}
+
+fn pin(at: &At, ro: &RawObstacle) -> R<PinObstacle> {
+    only_keys(at.c, at.i, ro, "pin", "x, y, radius, mu_c")?;
+    let needs = "a pin needs x, y and radius (m)";
+    let radius = at.need("radius", ro.radius, needs)?;
+    let radius = at.c.non_negative(&at.path("radius"), radius, "m")?;
+    let x = at.need("x", ro.x, needs)?;
+    let x = at.x_within(x, radius + at.part_radius, "the pin's centre", "a + radius")?;
+    let y = at.y_over(at.need("y", ro.y, needs)?)?;
+    Ok(PinObstacle {
+        name: at.name(&ro.name, "pin")?,
+        centre: Vec2::new(x, y),
+        radius,
+        mu_c: at.friction("mu_c", ro.mu_c)?,
+    })
+}
+
+fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
+    let (c, belt) = (at.c, at.belt);
+    only_keys(c, at.i, ro, "fence", "x, y, angle, length, mu_f")?;
+    let needs = "a fence needs x, y (its upstream end, m), angle (degrees) and length (m)";
+    let x = at.need("x", ro.x, needs)?;
+    let x = at.x_within(x, at.part_radius, "the fence's upstream end", "a")?;
+    let y = at.y_over(at.need("y", ro.y, needs)?)?;
+    let angle = at.need("angle", ro.angle, needs)?;
+    if !(angle > -90.0 && angle < 90.0) {
+        return Err(c.err(
+            &at.path("angle"),
+            format!("must lie strictly between -90 and 90 (degrees from the belt direction; positive fences run downstream to the left and deflect parts to the left), got {angle}"),
+        ));
+    }
+    let length = at.need("length", ro.length, needs)?;
+    let length = c.positive(&at.path("length"), length, "m")?;
+    let f = FenceObstacle {
+        name: at.name(&ro.name, "fence")?,
+        start: Vec2::new(x, y),
+        angle: angle.to_radians(),
+        length,
+        mu_f: at.friction("mu_f", ro.mu_f)?,
+    };
+    let end = f.end();
+    let half = belt.width / 2.0;
+    // A little slack for ends placed exactly on an edge by trigonometry.
+    let slack = 1e-9 * (belt.width + belt.length);
+    if end.x > belt.length + slack || end.y.abs() > half + slack {
+        return Err(c.err(
+            &at.path("length"),
+            format!(
+                "the fence's downstream end ({:.6}, {:.6}) m lies off the belt (it must keep x ≤ belt.length = {} and |y| ≤ width/2 = {half}): shorten the fence or change its angle, got length {length}",
+                end.x, end.y, belt.length
+            ),
+        ));
+    }
+    Ok(f)
+}
