@@ -2,6 +2,7 @@
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
 pub mod bench;
+pub mod compare;
 pub mod contact;
 pub mod map;
 pub mod part;
@@ -27,6 +28,8 @@ pub enum Command {
     Map(map::MapArgs),
     /// Simulate a feeder line from a scenario file: throughput and orientation success.
     Run(run::RunArgs),
+    /// Run several line designs on the same part stream and print one table.
+    Compare(compare::CompareArgs),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
 }
@@ -38,6 +41,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Contact(a) => contact::run(&a),
         Command::Map(a) => map::run(&a),
         Command::Run(a) => run::run(&a),
+        Command::Compare(a) => compare::run(&a),
         Command::Bench(a) => bench::run(&a),
     }
 }

@@ -79,32 +79,16 @@ fn header(maps: &[ConfigurationMap]) -> [&'static str; 10] {
     h
 }
 
-/// Aligned plain-text table for the terminal.
+/// Aligned plain-text table for the terminal, a blank line between maps.
 pub fn bands_text(maps: &[ConfigurationMap]) -> String {
     let rows = rows(maps);
-    let head = header(maps);
-    let mut width: Vec<usize> = head.iter().map(|h| h.chars().count()).collect();
-    for r in &rows {
-        for (w, c) in width.iter_mut().zip(r) {
-            *w = (*w).max(c.chars().count());
-        }
-    }
-    let line = |cells: Vec<&str>| -> String {
-        let padded: Vec<String> = cells
-            .iter()
-            .zip(&width)
-            .map(|(c, &w)| format!("{c}{}", " ".repeat(w - c.chars().count())))
-            .collect();
-        padded.join("  ").trim_end().to_string() + "\n"
-    };
-    let mut s = line(head.to_vec());
-    let mut last_d: Option<&str> = None;
-    for r in &rows {
-        if last_d.is_some_and(|d| d != r[0]) {
+    let lines = super::aligned::aligned_lines(&header(maps), &rows);
+    let mut s = lines[0].clone();
+    for (i, (r, l)) in rows.iter().zip(&lines[1..]).enumerate() {
+        if i > 0 && rows[i - 1][0] != r[0] {
             s.push('\n');
         }
-        last_d = Some(&r[0]);
-        s += &line(r.iter().map(String::as_str).collect());
+        s += l;
     }
     s
 }

@@ -1,5 +1,7 @@
 //! Reports for people and programs: terminal tables, JSON/CSV, and SVG figures.
 
+pub mod aligned;
+pub mod compare_table;
 pub mod line_table;
 pub mod map_table;
 pub mod parts_csv;

@@ -7,7 +7,8 @@
 //! * [`compile`]: checks and conversion to [`Scene`];
 //! * [`obstacles`]: pins and fences, their checks and neighbour lists;
 //! * [`scene`]: the compiled types the engine reads;
-//! * [`location`], [`error`]: spans → line/column and key paths, and the located error.
+//! * [`location`], [`error`]: spans → line/column and key paths, and the located error;
+//! * [`shared_feed`]: one reference scene's part stream imposed on others (`pinfeed compare`).
 
 pub mod compile;
 pub mod error;
@@ -15,9 +16,11 @@ pub mod location;
 pub mod obstacles;
 pub mod raw;
 pub mod scene;
+pub mod shared_feed;
 
 pub use error::{InvalidScenario, ScenarioError};
 pub use scene::*;
+pub use shared_feed::{FeedMismatch, FeedSource};
 
 use std::path::Path;
 

@@ -1,0 +1,127 @@
+//! `pinfeed compare A.toml B.toml ...`: run line designs on the same part stream and print one
+//! table (issue 5: pin layouts measured against fence designs; [`crate::study::compare`]).
+//!
+//! The same part stream: the first scenario's feed (number of parts, arrivals, orientation and
+//! lateral distributions) and seed are imposed on every scenario ([`crate::scenario::FeedSource`]),
+//! so part i arrives at the same time with the same orientation and offset in every design. The
+//! part (shape, scale, support) must be the same in every file, and the first file's lateral
+//! offsets must fit on every belt; otherwise the scenario is refused with the reason. Each
+//! scenario keeps its own belt, obstacles, goal and model. `--parts` and `--seed` override the
+//! first file's; `--uniform-orientation` feeds every design parts at orientations uniform on
+//! [0°, 360°) instead of the first file's distribution. Nothing is written to disk.
+
+use crate::report::compare_table;
+use crate::scenario::{FeedSource, Lateral, Orientation};
+use crate::study::compare::compare;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `pinfeed compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// Scenario files; the first one's feed and seed are used for all.
+    #[arg(required = true, num_args = 1..)]
+    pub scenarios: Vec<PathBuf>,
+    /// Number of parts (overrides the first file's [feed] parts).
+    #[arg(long)]
+    pub parts: Option<u64>,
+    /// Random seed (overrides the first file's seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Feed orientations uniform on [0°, 360°) instead of the first file's distribution.
+    #[arg(long)]
+    pub uniform_orientation: bool,
+    /// Print the rows as a JSON array of objects.
+    #[arg(long, conflicts_with = "markdown")]
+    pub json: bool,
+    /// Print the table as Markdown.
+    #[arg(long)]
+    pub markdown: bool,
+}
+
+/// One line saying which part stream every design ran on.
+pub fn feed_line(file: &str, source: &FeedSource, parts: u64) -> String {
+    let feed = &source.feed;
+    let orientation = match &feed.orientation {
+        Orientation::Uniform => "uniform on [0°, 360°)".to_string(),
+        Orientation::Stable {
+            thetas,
+            weights,
+            jitter,
+        } => {
+            let states: Vec<String> = thetas
+                .iter()
+                .zip(weights)
+                .map(|(t, w)| format!("{:.3}° ×{w:.3}", t.to_degrees()))
+                .collect();
+            format!(
+                "stable states {} ± {:.3}° (sd)",
+                states.join(", "),
+                jitter.to_degrees()
+            )
+        }
+    };
+    let lateral = match feed.lateral {
+        Lateral::Fixed(y) => format!("at y = {y} m"),
+        Lateral::Uniform { min, max } => format!("y uniform on [{min}, {max}] m"),
+        Lateral::Normal { mean, sd, .. } => format!("y normal, mean {mean} m, sd {sd} m"),
+    };
+    let arrival = match feed.arrival {
+        crate::scenario::Arrival::Periodic { headway } => format!("one every {headway} s"),
+        crate::scenario::Arrival::Poisson { headway } => {
+            format!("Poisson, mean headway {headway} s")
+        }
+    };
+    format!(
+        "part stream of {file}: seed {}, {parts} parts, {arrival}, orientation {orientation}, {lateral}",
+        source.seed
+    )
+}
+
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let mut scenes = Vec::new();
+    let mut files = Vec::new();
+    for path in &args.scenarios {
+        scenes.push(crate::scenario::load(path)?);
+        files.push(path.display().to_string());
+    }
+    let mut source = FeedSource::from_scene(&scenes[0]);
+    if let Some(s) = args.seed {
+        source.seed = s;
+    }
+    if args.uniform_orientation {
+        source = source.with_uniform_orientation();
+    }
+    let parts = args.parts.unwrap_or(source.feed.parts);
+    if !(1..=1_000_000_000).contains(&parts) {
+        bail!("--parts must lie in [1, 1000000000], got {parts}");
+    }
+    source.feed.parts = parts;
+    for (scene, file) in scenes.iter_mut().zip(&files) {
+        source
+            .apply(scene)
+            .with_context(|| format!("{file} cannot run on the part stream of {}", files[0]))?;
+    }
+    let rows = compare(&scenes, &files, parts).context("running the comparison")?;
+    let text = if args.json {
+        serde_json::to_string_pretty(&rows)? + "\n"
+    } else {
+        let feed = feed_line(&files[0], &source, parts);
+        if args.markdown {
+            format!("{feed}\n\n{}", compare_table::markdown(&rows))
+        } else {
+            format!("{feed}\n{}", compare_table::text(&rows))
+        }
+    };
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|_| stdout.flush())
+    {
+        // A closed pipe (`| head`) is the reader's choice, not an error.
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e).context("writing to stdout"),
+        _ => Ok(()),
+    }
+}

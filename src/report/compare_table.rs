@@ -1,0 +1,64 @@
+//! The table of `pinfeed compare`: one row per line design run on the same part stream (definitions
+//! in [`crate::study::compare`]), as aligned plain text for the terminal or as Markdown.
+
+use crate::study::compare::ComparisonRow;
+
+const HEADER: [&str; 10] = [
+    "scenario",
+    "obstacles",
+    "parts",
+    "success (95% CI)",
+    "footprint m",
+    "across / belt m",
+    "oriented/min",
+    "latency mean / p99 s",
+    "contacts/part",
+    "jams",
+];
+
+fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or_else(|| "n/a".into(), |x| format!("{x:.digits$}"))
+}
+
+fn cells(r: &ComparisonRow) -> [String; 10] {
+    let obstacles = match (r.pins, r.fences) {
+        (0, 0) => "none".to_string(),
+        (p, 0) => format!("{p} pin{}", if p == 1 { "" } else { "s" }),
+        (0, f) => format!("{f} fence{}", if f == 1 { "" } else { "s" }),
+        (p, f) => format!("{p} pins + {f} fences"),
+    };
+    [
+        r.scenario.clone(),
+        obstacles,
+        r.parts_in.to_string(),
+        format!(
+            "{:.4} ({:.4}–{:.4})",
+            r.success_rate, r.success_ci95[0], r.success_ci95[1]
+        ),
+        opt(r.footprint_m, 3),
+        format!("{} / {}", opt(r.across_m, 3), r.belt_width_m),
+        opt(r.throughput_ok_per_min, 2),
+        format!("{} / {}", opt(r.latency_mean_s, 2), opt(r.latency_p99_s, 2)),
+        format!("{:.3}", r.contacts_per_part),
+        r.jams.to_string(),
+    ]
+}
+
+/// Aligned plain text.
+pub fn text(rows: &[ComparisonRow]) -> String {
+    let body: Vec<[String; 10]> = rows.iter().map(cells).collect();
+    super::aligned::aligned_lines(&HEADER, &body).concat()
+}
+
+/// A Markdown table.
+pub fn markdown(rows: &[ComparisonRow]) -> String {
+    let mut s = format!(
+        "| {} |\n|{}\n",
+        HEADER.join(" | "),
+        "---|".repeat(HEADER.len())
+    );
+    for r in rows {
+        s += &format!("| {} |\n", cells(r).join(" | "));
+    }
+    s
+}

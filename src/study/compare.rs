@@ -1,0 +1,144 @@
+//! Several line designs on one part stream (`pinfeed compare`, issue 5: pin layouts measured
+//! against fence designs). Each scene runs on the same parts ([`crate::scenario::FeedSource`]);
+//! the runs are independent and go in parallel, each a pure function of its scene, so the rows do
+//! not depend on the thread count.
+//!
+//! Per scene:
+//! * **success rate** with its 95% Wilson interval (as `pinfeed run`);
+//! * **footprint**: the belt length the design occupies — from the most upstream point of any
+//!   obstacle (a pin's disc, a fence's segment) to the most downstream one, plus the part's length
+//!   (its largest dimension, the greatest distance between two of its vertices), the room a part
+//!   needs to clear the last obstacle. None without obstacles. Beside it, the same across the belt
+//!   (**across**: the obstacles' y span plus the part's length) and the belt's width: fences trade
+//!   belt length for width;
+//! * **throughput of oriented parts** (successes per minute over the steady window, as `run`);
+//! * **latency**: mean and 99th percentile of entry → exit time of the parts that exit, from the
+//!   run's HDR histogram (3 significant digits);
+//! * **contacts per part** and the number of **jams**, with every outcome count beside them.
+
+use crate::engine::{self, EngineError, OutcomeCounts, RunOptions};
+use crate::geometry::Polygon;
+use crate::scenario::{Obstacle, Scene};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// One scene's line of the comparison.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComparisonRow {
+    /// The scene's name and the file it came from.
+    pub scenario: String,
+    pub file: String,
+    pub pins: usize,
+    pub fences: usize,
+    pub seed: u64,
+    pub parts_in: u64,
+    pub success_rate: f64,
+    pub success_ci95: [f64; 2],
+    /// [first, last] x of the obstacles (m).
+    pub obstacle_span_m: Option<[f64; 2]>,
+    /// The part's largest dimension (m).
+    pub part_length_m: f64,
+    /// Obstacle span plus the part's length (m).
+    pub footprint_m: Option<f64>,
+    /// [lowest, highest] y of the obstacles (m).
+    pub obstacle_y_span_m: Option<[f64; 2]>,
+    /// Obstacle y span plus the part's length (m).
+    pub across_m: Option<f64>,
+    pub belt_width_m: f64,
+    pub throughput_ok_per_min: Option<f64>,
+    pub latency_mean_s: Option<f64>,
+    pub latency_p99_s: Option<f64>,
+    pub contacts_per_part: f64,
+    pub jams: u64,
+    pub outcomes: OutcomeCounts,
+}
+
+/// The greatest distance between two vertices of a polygon (its units).
+pub fn part_length(poly: &Polygon) -> f64 {
+    let v = poly.vertices();
+    let mut best: f64 = 0.0;
+    for (i, &p) in v.iter().enumerate() {
+        for &q in &v[i + 1..] {
+            best = best.max((q - p).norm());
+        }
+    }
+    best
+}
+
+/// [first, last] x of a scene's obstacles (m), None without obstacles.
+pub fn obstacle_span(scene: &Scene) -> Option<[f64; 2]> {
+    span(scene, Obstacle::x_range)
+}
+
+fn span(scene: &Scene, range: fn(&Obstacle) -> [f64; 2]) -> Option<[f64; 2]> {
+    scene
+        .obstacles
+        .iter()
+        .map(range)
+        .reduce(|a, b| [a[0].min(b[0]), a[1].max(b[1])])
+}
+
+/// Run every scene (already on one part stream) with `parts` parts; one row per scene, in order.
+/// `files` names where each scene came from.
+pub fn compare(
+    scenes: &[Scene],
+    files: &[String],
+    parts: u64,
+) -> Result<Vec<ComparisonRow>, EngineError> {
+    scenes
+        .par_iter()
+        .zip(files.par_iter())
+        .map(|(scene, file)| {
+            let opts = RunOptions {
+                parts,
+                ..RunOptions::from_scene(scene)
+            };
+            let r = engine::run(scene, &opts, &mut |_| {})?;
+            let s = &r.summary;
+            let span = obstacle_span(scene);
+            let y_span = self::span(scene, Obstacle::y_range);
+            let length = part_length(&scene.part.polygon);
+            let hist = &r.metrics.latency_us;
+            let count = |f: fn(&Obstacle) -> bool| scene.obstacles.iter().filter(|o| f(o)).count();
+            Ok(ComparisonRow {
+                scenario: scene.name.clone(),
+                file: file.clone(),
+                pins: count(|o| matches!(o, Obstacle::Pin(_))),
+                fences: count(|o| matches!(o, Obstacle::Fence(_))),
+                seed: s.seed,
+                parts_in: s.parts_in,
+                success_rate: s.success_rate,
+                success_ci95: s.success_ci95,
+                obstacle_span_m: span,
+                part_length_m: length,
+                footprint_m: span.map(|[a, b]| b - a + length),
+                obstacle_y_span_m: y_span,
+                across_m: y_span.map(|[a, b]| b - a + length),
+                belt_width_m: scene.belt.width,
+                throughput_ok_per_min: s.throughput_ok_per_min,
+                latency_mean_s: (!hist.is_empty()).then(|| hist.mean() * 1e-6),
+                latency_p99_s: s.latency_s.map(|l| l.p99),
+                contacts_per_part: s.contacts_per_part,
+                jams: s.outcomes.jam,
+                outcomes: s.outcomes,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn part_length_is_the_largest_dimension() {
+        let p = crate::geometry::part_from_spec("tripoly2").unwrap();
+        // The hypotenuse of the 2 × 1 right triangle.
+        assert!((part_length(&p) - 5f64.sqrt()).abs() < 1e-12);
+        // A square's diagonal.
+        let sq = crate::geometry::part_from_spec("square").unwrap();
+        let v = sq.vertices();
+        assert!((part_length(&sq) - (v[2] - v[0]).norm()).abs() < 1e-12);
+        assert!(part_length(&sq) > (v[1] - v[0]).norm() * 1.4);
+    }
+}

@@ -1,0 +1,153 @@
+//! `pinfeed compare` (issue 5): several designs on the same part stream, one row each, the same
+//! JSON byte for byte on every run; scenarios that cannot share the stream are refused.
+
+use serde_json::Value;
+use std::process::Command;
+
+fn scenario(name: &str) -> String {
+    format!("{}/scenarios/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn pinfeed(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(args)
+        .output()
+        .expect("run pinfeed")
+}
+
+#[test]
+fn pins_and_fences_on_one_part_stream() {
+    let (pins, fences) = (
+        scenario("quickstart.toml"),
+        scenario("tripoly2_fences.toml"),
+    );
+    let args = ["compare", &pins, &fences, "--parts", "40", "--json"];
+    let a = pinfeed(&args);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    let b = pinfeed(&args);
+    assert_eq!(a.stdout, b.stdout, "compare --json differs between runs");
+    let rows: Value = serde_json::from_slice(&a.stdout).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["scenario"], "quickstart");
+    assert_eq!(rows[1]["scenario"], "tripoly2_fences");
+    assert_eq!(
+        (rows[0]["pins"].clone(), rows[0]["fences"].clone()),
+        (3.into(), 0.into())
+    );
+    assert_eq!(
+        (rows[1]["pins"].clone(), rows[1]["fences"].clone()),
+        (0.into(), 3.into())
+    );
+    for r in rows {
+        assert_eq!(r["parts_in"], 40);
+        assert_eq!(r["seed"], 1);
+        let total: u64 = r["outcomes"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|v| v.as_u64().unwrap())
+            .sum();
+        assert_eq!(total, 40);
+        let [lo, hi] = [
+            r["success_ci95"][0].as_f64().unwrap(),
+            r["success_ci95"][1].as_f64().unwrap(),
+        ];
+        let rate = r["success_rate"].as_f64().unwrap();
+        assert!(lo <= rate && rate <= hi, "{r}");
+        // Footprint: obstacle span along the belt plus the part's length (tripoly2's hypotenuse).
+        let span = &r["obstacle_span_m"];
+        let length = 0.02 * 5f64.sqrt();
+        let expect = span[1].as_f64().unwrap() - span[0].as_f64().unwrap() + length;
+        assert!(
+            (r["footprint_m"].as_f64().unwrap() - expect).abs() < 1e-12,
+            "{r}"
+        );
+        assert!(
+            r["latency_p99_s"].as_f64().unwrap() >= r["latency_mean_s"].as_f64().unwrap() - 0.05
+        );
+    }
+    // The quickstart's pins span x = 0.148 … 0.452 m.
+    assert!((rows[0]["footprint_m"].as_f64().unwrap() - (0.304 + 0.02 * 5f64.sqrt())).abs() < 1e-9);
+
+    // The table has one row per scenario and names the part stream.
+    let t = pinfeed(&["compare", &pins, &fences, "--parts", "40"]);
+    assert!(t.status.success());
+    let text = String::from_utf8_lossy(&t.stdout);
+    assert!(text.starts_with("part stream of "), "{text}");
+    assert!(text.contains("seed 1, 40 parts, one every 4 s"), "{text}");
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.starts_with("quickstart "))
+            .count(),
+        1,
+        "{text}"
+    );
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.starts_with("tripoly2_fences "))
+            .count(),
+        1,
+        "{text}"
+    );
+}
+
+#[test]
+fn the_first_file_s_feed_is_imposed_and_can_be_made_uniform() {
+    // The compact pins have the quickstart's feed; a different seed or a uniform feed changes
+    // the parts, identically for every design.
+    let (a, b) = (
+        scenario("quickstart.toml"),
+        scenario("tripoly2_pins_compact.toml"),
+    );
+    let run = |extra: &[&str]| -> Vec<Value> {
+        let mut args = vec!["compare", &a, &b, "--parts", "30", "--json"];
+        args.extend(extra);
+        let out = pinfeed(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<Value>(&out.stdout)
+            .unwrap()
+            .as_array()
+            .unwrap()
+            .clone()
+    };
+    let same = run(&[]);
+    // The pins only moved along the belt: every part ends the same way.
+    assert_eq!(same[0]["outcomes"], same[1]["outcomes"]);
+    // Any orientation: other parts (pushes the layout was not designed for, some long enough to
+    // reach the next, closer pin), on both designs.
+    let uniform = run(&["--uniform-orientation", "--seed", "5"]);
+    for r in &uniform {
+        assert_eq!(
+            (r["seed"].clone(), r["parts_in"].clone()),
+            (5.into(), 30.into())
+        );
+    }
+    assert_ne!(
+        same[0]["contacts_per_part"],
+        uniform[0]["contacts_per_part"]
+    );
+}
+
+#[test]
+fn a_scenario_with_another_part_is_refused() {
+    let out = pinfeed(&[
+        "compare",
+        &scenario("quickstart.toml"),
+        &scenario("tripoly1.toml"),
+        "--parts",
+        "10",
+    ]);
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("tripoly1.toml cannot run on the part stream of"),
+        "{err}"
+    );
+    assert!(err.contains("same shape, scale and support"), "{err}");
+}
