@@ -4,6 +4,8 @@
 pub mod bench;
 pub mod contact;
 pub mod map;
+pub mod mc;
+pub mod merge;
 pub mod part;
 pub mod run;
 
@@ -27,6 +29,10 @@ pub enum Command {
     Map(map::MapArgs),
     /// Simulate a feeder line from a scenario file: throughput and orientation success.
     Run(run::RunArgs),
+    /// Monte Carlo robustness study: success rate and outcome mix per sweep point, with 95% intervals.
+    Mc(mc::McArgs),
+    /// Merge the shard files of a Monte Carlo study into its report (the same bytes as one run).
+    Merge(merge::MergeArgs),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
 }
@@ -38,6 +44,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Contact(a) => contact::run(&a),
         Command::Map(a) => map::run(&a),
         Command::Run(a) => run::run(&a),
+        Command::Mc(a) => mc::run(&a),
+        Command::Merge(a) => merge::run(&a),
         Command::Bench(a) => bench::run(&a),
     }
 }

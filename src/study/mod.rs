@@ -1,6 +1,8 @@
 //! Studies built on the contact model and the line: what a contact costs and how accurate it is
-//! (`contact_cost`), what a set of configuration maps costs (`map_cost`); later Monte Carlo robustness and accuracy-vs-time.
+//! (`contact_cost`), what a set of configuration maps costs (`map_cost`), what accuracy costs in
+//! time (`accuracy`), and Monte Carlo robustness studies with sharding and merging (`mc`).
 
 pub mod accuracy;
 pub mod contact_cost;
 pub mod map_cost;
+pub mod mc;
