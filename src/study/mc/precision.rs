@@ -29,20 +29,28 @@ pub struct PrecisionRow {
     pub samples_per_s: f64,
 }
 
-/// Run the first `n` samples of the study's first point for each `n` in `counts`, timed, on
-/// `threads` threads.
+/// Run the first `n` samples of the study's first point for each `n` in `counts` on `threads`
+/// threads, `repeats` times, and keep the fastest wall time (on a shared machine the fastest run
+/// is the one least disturbed by other work).
 pub fn measure(
     study: &Study,
     counts: &[u64],
     threads: usize,
+    repeats: usize,
 ) -> Result<Vec<PrecisionRow>, StudyError> {
     let mut rows = Vec::new();
     for &n in counts {
         let n = n.min(study.samples);
-        let t0 = Instant::now();
-        let tallies = run::run_range_with_threads(study, 0..n, Some(threads), &|| {})?;
-        let wall = t0.elapsed().as_secs_f64();
-        let successes = tallies.get(&0).map_or(0, |t| t.outcomes.success);
+        let mut wall = f64::INFINITY;
+        let mut tallies = Default::default();
+        for _ in 0..repeats.max(1) {
+            let t0 = Instant::now();
+            tallies = run::run_range_with_threads(study, 0..n, Some(threads), &|| {})?;
+            wall = wall.min(t0.elapsed().as_secs_f64());
+        }
+        let successes = tallies
+            .get(&0)
+            .map_or(0, |t: &super::tally::PointTally| t.outcomes.success);
         let ci = wilson_interval(successes, n);
         rows.push(PrecisionRow {
             samples: n,
@@ -64,23 +72,38 @@ pub fn samples_for(p: f64, h: f64) -> f64 {
     (z * z * (p * (1.0 - p)).max(1e-4) / (h * h)).ceil()
 }
 
-/// The Markdown section (with its markers). `one_thread` and `two_threads` are samples/s of the
-/// largest count on 1 and 2 threads.
+/// How the measurement was taken.
+#[derive(Debug, Clone)]
+pub struct Conditions {
+    /// Samples/s of the largest count on 1 and on 2 threads.
+    pub one_thread: f64,
+    pub two_threads: f64,
+    /// Timed runs per count (the fastest is kept).
+    pub repeats: usize,
+    /// 1-minute load average before and after.
+    pub load_before: String,
+    pub load_after: String,
+}
+
+/// The Markdown section (with its markers): `rows` at the study's fidelity, `fidelities` the
+/// largest count at each fidelity.
 pub fn section(
     cmd: &str,
     study_file: &str,
     rows: &[PrecisionRow],
-    one_thread: f64,
-    two_threads: f64,
-    load: (&str, &str),
+    fidelities: &[(String, PrecisionRow)],
+    c: &Conditions,
 ) -> String {
+    let (one_thread, two_threads, repeats) = (c.one_thread, c.two_threads, c.repeats);
+    let load = (&c.load_before, &c.load_after);
     let mut s = format!(
         "{BEGIN}\n## The statistical side: Monte Carlo precision against samples and time\n\n\
          Regenerate this section (the rest of the file is `bench accuracy`'s):\n\n```\n{cmd}\n```\n\n\
          The bundled study `{study_file}` (the quickstart line under μc uniform in [0.3, 0.7] and a \
          random tripod per part; one sample = one part through a freshly perturbed line), run for \
-         increasing sample counts on this machine (2 threads; 1-minute load average {} before, {} \
-         after — the machine is shared, so times are upper bounds). The interval is the 95% Wilson \
+         increasing sample counts on this machine (2 threads; wall time = the fastest of {repeats} \
+         runs; 1-minute load average {} before, {} after — the machine is shared with other builds, \
+         so times are upper bounds). The interval is the 95% Wilson \
          score interval of the success rate; its half-width shrinks as 1/√n, so each halving costs \
          four times the samples and the time.\n\n\
          | samples | successes | success rate | 95% interval | half-width | wall time (s) | samples/s |\n\
@@ -128,6 +151,25 @@ pub fn section(
             two_threads / one_thread.max(1e-9),
             50.0 * two_threads / one_thread.max(1e-9)
         ));
+    }
+    if !fidelities.is_empty() {
+        s.push_str(
+            "\nFidelity against statistics: the same samples with a cheaper contact model. A faster \
+             model buys more samples per second, but its success rate is a different number — a \
+             bias no sample count removes (compare each interval with the exact model's):\n\n\
+             | fidelity | success rate | 95% interval | samples/s (2 threads) | wall time for ±1% |\n\
+             |---|---|---|---|---|\n",
+        );
+        for (name, r) in fidelities {
+            let t = samples_for(r.rate, 0.01) / r.samples_per_s.max(1e-9);
+            s.push_str(&format!(
+                "| {name} | {:.2}% | [{:.2}%, {:.2}%] | {:.0} | {t:.1} s |\n",
+                100.0 * r.rate,
+                100.0 * r.ci95[0],
+                100.0 * r.ci95[1],
+                r.samples_per_s
+            ));
+        }
     }
     s.push_str(END);
     s.push('\n');

@@ -262,7 +262,7 @@ pub fn markdown(r: &McReport, figure: &str) -> String {
         h.study, h.command
     );
     s.push_str(&format!(
-        "Scenario `{}` (`{}`, {} model), seed {}, {} samples per sweep point, {} points, {} samples in all. \
+        "Scenario `{}` (`{}`, {} model), seed {}, {} samples per sweep point, {} point{}, {} samples in all. \
          A sample is {}. Intervals are 95% Wilson score intervals. Study hash {} (pinfeed {}).\n\n",
         h.scenario_file,
         h.scenario,
@@ -270,6 +270,7 @@ pub fn markdown(r: &McReport, figure: &str) -> String {
         h.seed,
         h.samples_per_point,
         h.points.len(),
+        if h.points.len() == 1 { "" } else { "s" },
         r.total_samples,
         r.sample,
         h.study_hash,
