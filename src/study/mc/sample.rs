@@ -170,6 +170,58 @@ fn draw_polygon(
     ))
 }
 
+/// One obstacle of the perturbed line: a pin with its position and radius errors (redrawn until
+/// it lies over the belt, clear of the entry, with a radius ≥ 0) and the sample's μc; any other
+/// kind of obstacle unchanged.
+#[allow(unreachable_patterns)] // other kinds (fences, issue 5) pass through
+fn draw_obstacle(
+    ob: &Obstacle,
+    p: &Perturbations,
+    st: &mut Streams,
+    belt: &crate::scenario::Belt,
+    radius: f64,
+    mu_c: Option<f64>,
+    other: &mut u32,
+) -> Result<Obstacle, String> {
+    let pin = match ob {
+        Obstacle::Pin(pin) => pin,
+        unchanged => return Ok(unchanged.clone()),
+    };
+    let any = |_: f64| true;
+    for _ in 0..=super::distribution::MAX_REDRAWS {
+        let mut none = 0;
+        let ex = draw_value(&p.pin_x, &mut st.pin_x, "pin_x", any, &mut none)?;
+        let ey = draw_value(&p.pin_y, &mut st.pin_y, "pin_y", any, &mut none)?;
+        let er = draw_value(
+            &p.pin_radius,
+            &mut st.pin_radius,
+            "pin_radius",
+            any,
+            &mut none,
+        )?;
+        let centre = pin.centre + Vec2::new(ex.unwrap_or(0.0), ey.unwrap_or(0.0));
+        let r = pin.radius + er.unwrap_or(0.0);
+        let valid = r >= 0.0
+            && centre.y.abs() <= belt.width / 2.0
+            && centre.x > radius + r
+            && centre.x < belt.length;
+        if valid {
+            return Ok(Obstacle::Pin(PinObstacle {
+                name: pin.name.clone(),
+                centre,
+                radius: r,
+                mu_c: mu_c.unwrap_or(pin.mu_c),
+            }));
+        }
+        *other += 1;
+    }
+    Err(format!(
+        "pin `{}`: {} perturbed positions in a row left the belt, touched the entry or had a negative radius",
+        pin.name,
+        super::distribution::MAX_REDRAWS + 1
+    ))
+}
+
 /// Draw sample `sample` of a study seeded with `seed` at the sweep point `p`: the perturbed scene.
 /// A pure function of its arguments.
 pub fn draw_scene(
@@ -212,43 +264,9 @@ pub fn draw_scene(
 
     let mut obstacles = Vec::with_capacity(base.obstacles.len());
     for ob in &base.obstacles {
-        let Obstacle::Pin(pin) = ob;
-        let mut drawn = None;
-        for _ in 0..=super::distribution::MAX_REDRAWS {
-            let mut none = 0;
-            let any = |_: f64| true;
-            let ex = draw_value(&p.pin_x, &mut st.pin_x, "pin_x", any, &mut none)?;
-            let ey = draw_value(&p.pin_y, &mut st.pin_y, "pin_y", any, &mut none)?;
-            let er = draw_value(
-                &p.pin_radius,
-                &mut st.pin_radius,
-                "pin_radius",
-                any,
-                &mut none,
-            )?;
-            let c = pin.centre + Vec2::new(ex.unwrap_or(0.0), ey.unwrap_or(0.0));
-            let r = pin.radius + er.unwrap_or(0.0);
-            let valid =
-                r >= 0.0 && c.y.abs() <= belt.width / 2.0 && c.x > radius + r && c.x < belt.length;
-            if valid {
-                drawn = Some((c, r));
-                break;
-            }
-            other += 1;
-        }
-        let Some((centre, r)) = drawn else {
-            return Err(format!(
-                "pin `{}`: {} perturbed positions in a row left the belt, touched the entry or had a negative radius",
-                pin.name,
-                super::distribution::MAX_REDRAWS + 1
-            ));
-        };
-        obstacles.push(Obstacle::Pin(PinObstacle {
-            name: pin.name.clone(),
-            centre,
-            radius: r,
-            mu_c: mu_c.unwrap_or(pin.mu_c),
-        }));
+        obstacles.push(draw_obstacle(
+            ob, p, &mut st, &belt, radius, mu_c, &mut other,
+        )?);
     }
     let neighbours = neighbours(&obstacles, radius);
 
