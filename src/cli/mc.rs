@@ -6,6 +6,7 @@
 //! `pinfeed merge`.
 
 use crate::report::plot_sensitivity::plot_sensitivity;
+use crate::study::mc::atomic::{produce_atomic, write_atomic};
 use crate::study::mc::report::{self, McReport, StudyHeader};
 use crate::study::mc::shard::{self, ShardFile, ShardSpec};
 use crate::study::mc::{self, run};
@@ -132,14 +133,19 @@ pub fn run(args: &McArgs) -> Result<()> {
 pub fn publish(r: &McReport, dir: &Path, json: bool, quiet: bool) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let figure = "sensitivity.svg";
+    // Each file appears whole or not at all (written beside it, then renamed).
     let md = dir.join("report.md");
-    std::fs::write(&md, report::markdown(r, figure))
+    write_atomic(&md, report::markdown(r, figure).as_bytes(), &mut |_| {})
         .with_context(|| format!("writing {}", md.display()))?;
     let js = dir.join("report.json");
     let json_text = report::json(r);
-    std::fs::write(&js, &json_text).with_context(|| format!("writing {}", js.display()))?;
+    write_atomic(&js, json_text.as_bytes(), &mut |_| {})
+        .with_context(|| format!("writing {}", js.display()))?;
     let svg = dir.join(figure);
-    plot_sensitivity(r, &svg).with_context(|| format!("writing {}", svg.display()))?;
+    produce_atomic(&svg, |tmp| {
+        plot_sensitivity(r, tmp).map_err(|e| std::io::Error::other(e.to_string()))
+    })
+    .with_context(|| format!("writing {}", svg.display()))?;
     let text = if json {
         json_text
     } else if quiet {

@@ -20,8 +20,9 @@
 //! * [`distribution`], [`perturbations`], [`smooth_support`]: what is uncertain and how it is drawn;
 //! * [`sample`]: one perturbed line and its one part; [`run`]: many samples in parallel;
 //! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report;
-//! * [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
+//! * [`atomic`]: files written by rename; [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
 
+pub mod atomic;
 pub mod compile;
 pub mod distribution;
 pub mod error;

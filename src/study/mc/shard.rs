@@ -8,8 +8,8 @@
 //!   and scenario hashes, seed, samples per point, sweep grid, pinfeed version), the shard's index
 //!   and sample range, and per touched point the integer counts and the latency histogram
 //!   serialised as HdrHistogram V2 (base64).
-//! * It is written atomically: to a hidden temporary file in the same folder, flushed to disk, then
-//!   renamed over the final name, so a killed job leaves either no shard file or a complete one.
+//! * It is written atomically ([`super::atomic`]), so a killed job leaves either no shard file or a
+//!   complete one.
 //! * [`merge`] checks that the shards fit together (same format, pinfeed version, study hash, seed
 //!   and grid; sample ranges that cover [0, T) exactly once; counts that add up to each range) and
 //!   adds them exactly.
@@ -21,9 +21,10 @@ use base64::Engine as _;
 use hdrhistogram::serialization::{Deserializer, Serializer, V2Serializer};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+
+pub use super::atomic::write_atomic;
 
 /// The format tag of a shard file.
 pub const FORMAT: &str = "pinfeed-mc-shard";
@@ -234,34 +235,6 @@ impl ShardPoint {
     }
 }
 
-/// Write `bytes` to `path` atomically: a hidden temporary file beside it, flushed, then renamed.
-/// `before_rename` sees the temporary path (tests use it to check that nothing is at `path` yet).
-pub fn write_atomic(
-    path: &Path,
-    bytes: &[u8],
-    before_rename: &mut dyn FnMut(&Path),
-) -> std::io::Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("shard");
-    let tmp_name = format!(".{name}.tmp-{}", std::process::id());
-    let tmp = match dir {
-        Some(d) => d.join(tmp_name),
-        None => PathBuf::from(tmp_name),
-    };
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        before_rename(&tmp);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
 /// Read a shard file.
 pub fn read(path: &Path) -> Result<ShardFile, StudyError> {
     let text = std::fs::read_to_string(path)
@@ -443,35 +416,5 @@ mod tests {
                 assert_eq!(next, total);
             }
         }
-    }
-
-    #[test]
-    fn atomic_write_renames_only_a_complete_file() {
-        let dir = std::env::temp_dir().join(format!("pinfeed-atomic-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("shard-0000-of-0001.json");
-        let _ = std::fs::remove_file(&path);
-        let mut seen = None;
-        write_atomic(&path, b"complete", &mut |tmp: &Path| {
-            // Before the rename only the hidden temporary file exists, already complete.
-            assert!(!path.exists());
-            assert_eq!(std::fs::read(tmp).unwrap(), b"complete");
-            assert!(tmp.file_name().unwrap().to_str().unwrap().starts_with('.'));
-            seen = Some(tmp.to_path_buf());
-        })
-        .unwrap();
-        assert_eq!(std::fs::read(&path).unwrap(), b"complete");
-        assert!(!seen.unwrap().exists());
-        // A failed write (the target is a directory) leaves no temporary file behind.
-        let target = dir.join("occupied");
-        std::fs::create_dir_all(target.join("x")).unwrap();
-        assert!(write_atomic(&target, b"x", &mut |_| {}).is_err());
-        let leftovers: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap()
-            .filter_map(|e| e.ok())
-            .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
-            .collect();
-        assert!(leftovers.is_empty());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
