@@ -20,8 +20,8 @@
 //! * belt speed: one value (in the quasi-static model it rescales time: latencies, not outcomes);
 //! * shape: an error added to each coordinate of each vertex (part frame, m); the polygon is
 //!   re-validated and re-centred on its new centroid; an invalid polygon (self-intersecting, too
-//!   wide for the belt) is redrawn and counted, and after 1000 failures in a row the study stops
-//!   with an error naming the sample;
+//!   wide for the belt, or a sliver that cannot carry the support model) is redrawn and counted,
+//!   and after 1000 failures in a row the study stops with an error naming the sample;
 //! * support: uniform, a random tripod, or a random smooth density ([`super::smooth_support`]),
 //!   on the perturbed polygon;
 //! * pins: errors added to each pin's x, y and radius; a pin that would leave the belt, sit within
@@ -170,6 +170,24 @@ fn draw_polygon(
     ))
 }
 
+/// The support of one sample on its (perturbed) polygon.
+fn draw_support(
+    polygon: &Polygon,
+    choice: &SupportChoice,
+    rng: &mut ChaCha8Rng,
+    redraws: &mut u32,
+) -> Result<Support, String> {
+    Ok(match choice {
+        SupportChoice::Uniform => Support::Uniform,
+        SupportChoice::Tripod => Support::random_tripod(polygon, rng)?,
+        SupportChoice::Smooth(params) => {
+            let (s, n) = random_smooth_support(polygon, params, rng)?;
+            *redraws += n;
+            s
+        }
+    })
+}
+
 /// One obstacle of the perturbed line: a pin with its position and radius errors (redrawn until
 /// it lies over the belt, clear of the entry, with a radius ≥ 0) and the sample's μc; any other
 /// kind of obstacle unchanged.
@@ -249,18 +267,23 @@ pub fn draw_scene(
     )?
     .unwrap_or(base.belt.speed);
     let belt = crate::scenario::Belt { speed, ..base.belt };
-    let polygon = draw_polygon(base, &p.shape, &mut st.shape, &mut shape_redraws)?;
-    let radius = polygon.radius();
-    let support = match p.support {
-        SupportChoice::Uniform => Support::Uniform,
-        SupportChoice::Tripod => Support::random_tripod(&polygon, &mut st.support)?,
-        SupportChoice::Smooth(params) => {
-            let (s, n) = random_smooth_support(&polygon, &params, &mut st.support)?;
-            other += n;
-            s
+    // A perturbed polygon that cannot carry the support (a sliver with no tripod around its
+    // centroid) is redrawn like an invalid one.
+    let mut attempts = 0;
+    let (polygon, model) = loop {
+        let polygon = draw_polygon(base, &p.shape, &mut st.shape, &mut shape_redraws)?;
+        let model = draw_support(&polygon, &p.support, &mut st.support, &mut other)
+            .and_then(|support| PartModel::new(&polygon, &support));
+        match model {
+            Ok(m) => break (polygon, m),
+            Err(_) if p.shape.is_some_and(|d| !d.is_fixed()) && attempts < MAX_SHAPE_REDRAWS => {
+                attempts += 1;
+                shape_redraws += 1;
+            }
+            Err(e) => return Err(format!("support: {e}")),
         }
     };
-    let model = PartModel::new(&polygon, &support)?;
+    let radius = polygon.radius();
 
     let mut obstacles = Vec::with_capacity(base.obstacles.len());
     for ob in &base.obstacles {
