@@ -479,15 +479,15 @@ fn perturbations_are_reproducible_per_sample_index() {
 #[test]
 fn invalid_perturbed_polygons_are_redrawn_or_reported() {
     let d = tmp("shape");
-    let big = |sd: f64| {
+    let big = |sd: f64, support: &str| {
         let p = write_study(
             &d,
-            &format!("samples = 10\n[uncertain.shape]\ndistribution = \"normal\"\nsd = {sd}\n"),
+            &format!("samples = 10\n[uncertain.shape]\ndistribution = \"normal\"\nsd = {sd}\n[uncertain.support]\nmodel = \"{support}\"\n"),
         );
         mc::load(&p, None).unwrap()
     };
     // 3 cm vertex errors on a 4 cm part: many triangles no longer fit the 10 cm belt.
-    let st = big(0.03);
+    let st = big(0.03, "uniform");
     let mut redraws = 0;
     for i in 0..10 {
         let ds = sample::draw_scene(&st.scene, &st.points[0], st.seed, i).unwrap();
@@ -496,7 +496,22 @@ fn invalid_perturbed_polygons_are_redrawn_or_reported() {
     }
     assert!(redraws > 0);
     // 10 m errors: no valid part comes out; a clear error, no panic, no endless loop.
-    let st = big(10.0);
+    // Slivers that cannot carry a tripod around their centroid are redrawn too, never an error.
+    // The shape streams are the same for both supports (one stream per parameter), so any extra
+    // redraw under the tripod is a sliver the tripod could not stand on.
+    let redraws = |support: &str| {
+        let st = big(0.008, support);
+        (0..40)
+            .map(|i| {
+                sample::draw_scene(&st.scene, &st.points[0], st.seed, i)
+                    .unwrap()
+                    .shape_redraws
+            })
+            .sum::<u32>()
+    };
+    let (uniform, tripod) = (redraws("uniform"), redraws("tripod"));
+    assert!(tripod > uniform, "tripod {tripod}, uniform {uniform}");
+    let st = big(10.0, "uniform");
     let e = sample::draw_scene(&st.scene, &st.points[0], st.seed, 0)
         .err()
         .expect("refused");

@@ -1,7 +1,8 @@
 //! Running a range of samples in parallel. Global sample index g ∈ [0, points × N) maps to sweep
 //! point g / N and sample g mod N (so a shard's contiguous range covers whole points in order).
 //! Samples run on rayon in chunks with an order-preserving collect and are counted in index order,
-//! so the tallies do not depend on the thread count.
+//! so the tallies do not depend on the thread count; neither does the error of a failing study
+//! (the failure with the lowest index is reported).
 
 use super::sample::{run_sample, SampleResult};
 use super::tally::PointTally;
@@ -35,14 +36,16 @@ pub fn run_range(
     let mut start = range.start;
     while start < range.end {
         let end = (start + CHUNK).min(range.end);
-        let results: Vec<SampleResult> = (start..end)
+        let results: Vec<Result<SampleResult, StudyError>> = (start..end)
             .into_par_iter()
             .map(|g| {
                 let r = run_global(study, g);
                 tick();
                 r
             })
-            .collect::<Result<_, _>>()?;
+            .collect();
+        // The first failure in index order, whichever thread met it first.
+        let results: Vec<SampleResult> = results.into_iter().collect::<Result<_, _>>()?;
         for (g, r) in (start..end).zip(&results) {
             let (point, _) = locate(study, g);
             tallies.entry(point).or_default().add(r);
