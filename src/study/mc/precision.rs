@@ -151,6 +151,13 @@ pub fn section(
             two_threads / one_thread.max(1e-9),
             50.0 * two_threads / one_thread.max(1e-9)
         ));
+        if two_threads > 2.0 * one_thread {
+            s.push_str(
+                "(Above 100% is measurement noise: other work on the shared machine slowed the \
+                 single-thread runs more than the two-thread ones. Samples share nothing, so the \
+                 ideal is 100%.)\n",
+            );
+        }
     }
     if !fidelities.is_empty() {
         s.push_str(
