@@ -58,24 +58,27 @@ fn continuity_through_pure_translation() {
     }
 }
 
-/// The centre of rotation passes through the part (and across its edges) during a push: a long
-/// rectangle struck near its end with high friction pivots about a point inside itself.
+/// The centre of rotation passes through the part and across its edges during one push: a 4×1
+/// rectangle at 30° struck at d = 0.3 with μc = 1 first pivots about a point inside itself, then the
+/// COR moves out through an edge. The COR is measured from successive recorded poses
+/// (r = c + ẑ×Δc/Δθ); the push must stay ok at every fidelity.
 #[test]
 fn cor_inside_the_part_and_on_an_edge() {
     let p = poly("rect:4:1");
     let m = model(&p);
     let a = p.radius();
-    let mut inside_seen = false;
-    let mut outside_seen = false;
     for fid in FIDELITIES {
         let s = settings(fid, 1.0);
         let mut trace: Vec<TraceSample> = Vec::new();
-        let pose = Pose::new(0.0, 0.0, 90.0f64.to_radians());
-        let start = Vec2::new(1.01 * a, 0.9 * a);
+        let pose = Pose::new(0.0, 0.0, 30.0f64.to_radians());
+        let start = Vec2::new(1.01 * a, 0.3 * a);
         let o = push(&m, pose, start, &Pin::point(), &s, Some(&mut trace));
         check(&o, "pivot");
-        assert!(o.status.is_ok(), "{:?}", o.status);
-        // COR from successive poses: r = c + ẑ×v/ω.
+        assert!(o.status.is_ok(), "{fid}: {:?}", o.status);
+        if fid != Fidelity::Exact {
+            continue;
+        }
+        let (mut inside, mut outside) = (0, 0);
         for w in trace.windows(2) {
             let (a0, b0) = (w[0].pose, w[1].pose);
             let dth = b0.theta - a0.theta;
@@ -84,17 +87,18 @@ fn cor_inside_the_part_and_on_an_edge() {
             }
             let v = Vec2::new(b0.x - a0.x, b0.y - a0.y);
             let r = Vec2::new(a0.x, a0.y) + v.perp() / dth;
-            if fid == Fidelity::Exact {
-                if p.contains(a0.apply_inverse(r)) {
-                    inside_seen = true;
-                } else {
-                    outside_seen = true;
-                }
+            if p.contains(a0.apply_inverse(r)) {
+                inside += 1;
+            } else {
+                outside += 1;
             }
         }
+        // Inside at some steps and outside at others: by continuity the COR crossed an edge.
+        assert!(
+            inside > 0 && outside > 0,
+            "COR inside {inside}, outside {outside} steps"
+        );
     }
-    assert!(inside_seen, "the exact model's COR never entered the part");
-    let _ = outside_seen;
 }
 
 /// A pin exactly level with a vertex that leads into the part (the square at 30°: its rightmost

@@ -26,6 +26,26 @@ pub enum BenchWhat {
         #[arg(long, default_value = "results/accuracy-vs-time")]
         out: PathBuf,
     },
+    /// Monte Carlo precision against samples and wall time (and 1- vs 2-thread efficiency) for a
+    /// study; writes a marked section of results/accuracy-vs-time.md.
+    McPrecision {
+        /// A study without sweeps.
+        #[arg(long, default_value = "studies/quickstart_mu_tripod.toml")]
+        study: PathBuf,
+        /// Sample counts, comma-separated.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "100,200,500,1000,2000,5000"
+        )]
+        samples: Vec<u64>,
+        /// Timed runs per count; the fastest is kept.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// The Markdown file that receives the section.
+        #[arg(long, default_value = "results/accuracy-vs-time.md")]
+        out: PathBuf,
+    },
     /// Time, evaluations and self-accuracy per contact for each fidelity on the reference parts;
     /// writes results/contact-model.md.
     Contact {
@@ -72,8 +92,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             if let Some(dir) = out.parent() {
                 std::fs::create_dir_all(dir).ok();
             }
-            let md = crate::study::accuracy::report_markdown(&st, &cmd);
             let p_md = out.with_extension("md");
+            // Keep the Monte Carlo precision section (`bench mc-precision`) of the old report.
+            let mut md = crate::study::accuracy::report_markdown(&st, &cmd);
+            let old = std::fs::read_to_string(&p_md).unwrap_or_default();
+            if let Some(section) = crate::study::mc::precision::existing(&old) {
+                md = crate::study::mc::precision::splice(&md, &section);
+            }
             let p_csv = out.with_extension("csv");
             let p_svg = out.with_extension("svg");
             std::fs::write(&p_md, md).with_context(|| format!("writing {}", p_md.display()))?;
@@ -132,6 +157,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             Ok(())
         }
         BenchWhat::Maps { repeats, out } => bench_maps(*repeats, out),
+        BenchWhat::McPrecision {
+            study,
+            samples,
+            repeats,
+            out,
+        } => super::bench_mc::run(study, samples, *repeats, out),
     }
 }
 

@@ -216,19 +216,30 @@ pub(crate) fn settings_and_pin(c: &Case) -> (ContactSettings, Pin) {
 pub fn run_case(c: &Case, want_trace: bool) -> Result<(Polygon, ContactOutcome, Vec<TraceSample>)> {
     check_inputs(c)?;
     let (poly, model) = compile_part(&c.part, &c.support)?;
+    let (out, trace) = run_compiled(c, &poly, &model, want_trace);
+    Ok((poly, out, trace))
+}
+
+/// Run a validated case on an already compiled part.
+fn run_compiled(
+    c: &Case,
+    poly: &Polygon,
+    model: &PartModel,
+    want_trace: bool,
+) -> (ContactOutcome, Vec<TraceSample>) {
     let (settings, pin) = settings_and_pin(c);
-    let (pose, start) = case_geometry(&poly, c);
+    let (pose, start) = case_geometry(poly, c);
     let mut trace: Vec<TraceSample> = Vec::new();
     let recorder: Option<&mut dyn crate::mechanics::Recorder> =
         if want_trace { Some(&mut trace) } else { None };
     let out = match c.fence {
         Some((angle, length)) => {
-            let fence = case_fence(&poly, c, angle, length);
-            push_fence(&model, pose, &fence, &settings, recorder)
+            let fence = case_fence(poly, c, angle, length);
+            push_fence(model, pose, &fence, &settings, recorder)
         }
-        None => push(&model, pose, start, &pin, &settings, recorder),
+        None => push(model, pose, start, &pin, &settings, recorder),
     };
-    Ok((poly, out, trace))
+    (out, trace)
 }
 
 fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
@@ -397,6 +408,7 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
         .from_path(path)
         .with_context(|| format!("reading {}", path.display()))?;
     let mut wtr = csv::Writer::from_writer(std::io::stdout().lock());
+    let mut compiled: std::collections::HashMap<String, (Polygon, PartModel)> = Default::default();
     for (i, row) in rdr.deserialize::<CaseRow>().enumerate() {
         let row = row.map_err(|e| {
             let line = e.position().map(|p| p.line()).unwrap_or(i as u64 + 2);
@@ -421,8 +433,15 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
             tol: args.tol,
             fence: None,
         };
-        let (_, out, _) =
-            run_case(&c, false).with_context(|| format!("{}:{line}", path.display()))?;
+        check_inputs(&c).with_context(|| format!("{}:{line}", path.display()))?;
+        // Compile each distinct part once for the whole batch.
+        if !compiled.contains_key(&c.part) {
+            let pm = compile_part(&c.part, &c.support)
+                .with_context(|| format!("{}:{line}", path.display()))?;
+            compiled.insert(c.part.clone(), pm);
+        }
+        let (poly, model) = &compiled[&c.part];
+        let (out, _) = run_compiled(&c, poly, model, false);
         wtr.serialize(CaseOut {
             part: &c.part,
             theta0: c.theta0_deg,

@@ -2,9 +2,12 @@
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
 pub mod bench;
+pub mod bench_mc;
 pub mod compare;
 pub mod contact;
 pub mod map;
+pub mod mc;
+pub mod merge;
 pub mod part;
 pub mod run;
 
@@ -30,6 +33,10 @@ pub enum Command {
     Run(run::RunArgs),
     /// Run several line designs on the same part stream and print one table.
     Compare(compare::CompareArgs),
+    /// Monte Carlo robustness study: success rate and outcome mix per sweep point, with 95% intervals.
+    Mc(mc::McArgs),
+    /// Merge the shard files of a Monte Carlo study into its report (the same bytes as one run).
+    Merge(merge::MergeArgs),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
 }
@@ -42,6 +49,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Map(a) => map::run(&a),
         Command::Run(a) => run::run(&a),
         Command::Compare(a) => compare::run(&a),
+        Command::Mc(a) => mc::run(&a),
+        Command::Merge(a) => merge::run(&a),
         Command::Bench(a) => bench::run(&a),
     }
 }

@@ -65,19 +65,7 @@ pub fn segment_distance(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> f64 {
 
 /// Is `p` strictly inside the polygon with vertices `v` (crossing-number test)?
 pub fn point_in_polygon(p: Vec2, v: &[Vec2]) -> bool {
-    let m = v.len();
-    let mut inside = false;
-    for i in 0..m {
-        let a = v[i];
-        let b = v[(i + 1) % m];
-        if (a.y > p.y) != (b.y > p.y) {
-            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-            if p.x < x {
-                inside = !inside;
-            }
-        }
-    }
-    inside
+    crate::geometry::polygon::ring_contains(v, p)
 }
 
 /// Distance between two simple polygons given by their vertices; 0 if they intersect or one

@@ -374,20 +374,7 @@ impl Polygon {
 
     /// Does the part-frame point `p` lie strictly inside the polygon (crossing-number test)?
     pub fn contains(&self, p: Vec2) -> bool {
-        let v = &self.vertices;
-        let m = v.len();
-        let mut inside = false;
-        for i in 0..m {
-            let a = v[i];
-            let b = v[(i + 1) % m];
-            if (a.y > p.y) != (b.y > p.y) {
-                let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-                if p.x < x {
-                    inside = !inside;
-                }
-            }
-        }
-        inside
+        ring_contains(&self.vertices, p)
     }
 
     /// Distance from a part-frame point to the polygon's boundary, with the nearest edge.
@@ -405,6 +392,24 @@ impl Polygon {
         }
         best
     }
+}
+
+/// Is `p` strictly inside the simple polygon with vertices `ring` (any orientation; crossing-number
+/// test)?
+pub fn ring_contains(ring: &[Vec2], p: Vec2) -> bool {
+    let m = ring.len();
+    let mut inside = false;
+    for i in 0..m {
+        let a = ring[i];
+        let b = ring[(i + 1) % m];
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+            if p.x < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
 }
 
 /// Convex hull by Andrew's monotone chain, counter-clockwise, collinear points removed.

@@ -18,7 +18,9 @@
 //! consistent: for stick, μc λn ∓ λt (normalised by |f|), for slide-left/right the signed sine between
 //! v_b and v_pin. The integrator locates the zero crossings of these as mode-switch events.
 
-use super::part_model::{point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist};
+use super::part_model::{
+    point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist, WarmTwist,
+};
 use crate::geometry::Vec2;
 use serde::Serialize;
 
@@ -71,9 +73,9 @@ pub struct Instant {
 /// Warm starts carried from instant to instant.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Warm {
-    pub left: Option<Twist>,
-    pub right: Option<Twist>,
-    pub normal: Option<Twist>,
+    pub left: Option<WarmTwist>,
+    pub right: Option<WarmTwist>,
+    pub normal: Option<WarmTwist>,
     pub stick_omega: Option<f64>,
 }
 
@@ -120,11 +122,11 @@ fn slide_instant(
     fid: Fidelity,
     g: &ContactGeom,
     f_dir: Vec2,
-    warm: &mut Option<Twist>,
+    warm: &mut Option<WarmTwist>,
     evals: &mut u64,
 ) -> Result<(Twist, Vec2, Vec2), SolveFailure> {
-    let s = model.twist_for_wrench(fid, wrench_of(f_dir, g.p), *warm, evals)?;
-    *warm = Some(s.twist);
+    let (s, next) = model.twist_for_wrench(fid, wrench_of(f_dir, g.p), warm.as_ref(), evals)?;
+    *warm = Some(next);
     let vb = point_velocity(s.twist, g.p);
     Ok((s.twist, vb, Vec2::new(s.wrench[0], s.wrench[1])))
 }

@@ -137,6 +137,40 @@ const N_EVENTS: usize = 7;
 /// Tolerance band of a mode margin after a ping-pong (a sine: about 0.006°).
 const BOUNCE_BAND: f64 = 1e-4;
 
+impl<'a, 'r> Ctx<'a, 'r> {
+    /// A context for one obstacle pass: `poly` is the polygon the obstacle touches (the part, or
+    /// its hull for a fence); lengths are already normalised.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        model: &'a PartModel,
+        poly: &'a Polygon,
+        settings: &ContactSettings,
+        mu: f64,
+        rho: f64,
+        vdir: Vec2,
+        start: Vec2,
+        fence: Option<FenceGeom>,
+        recorder: Option<&'r mut dyn Recorder>,
+    ) -> Self {
+        Ctx {
+            model,
+            poly,
+            fid: settings.fidelity,
+            fr: Friction::new(mu),
+            rho,
+            vdir,
+            start,
+            fence,
+            tol: settings.tol,
+            scale: model.scale(),
+            evals: 0,
+            warm: Warm::default(),
+            recorder,
+            band: [0.0; N_EVENTS],
+        }
+    }
+}
+
 impl Ctx<'_, '_> {
     fn pin_at(&self, s: f64) -> Vec2 {
         self.start + self.vdir * s
@@ -1300,22 +1334,17 @@ pub fn push(
     recorder: Option<&mut dyn Recorder>,
 ) -> ContactOutcome {
     let k = model.scale();
-    let mut ctx = Ctx {
+    let mut ctx = Ctx::new(
         model,
-        poly: model.polygon(),
-        fid: settings.fidelity,
-        fr: Friction::new(settings.mu_c),
-        rho: pin.radius / k,
-        vdir: Vec2::new(-1.0, pin.lateral_speed),
-        start: pin_start / k,
-        fence: None,
-        tol: settings.tol,
-        scale: k,
-        evals: 0,
-        warm: Warm::default(),
+        model.polygon(),
+        settings,
+        settings.mu_c,
+        pin.radius / k,
+        Vec2::new(-1.0, pin.lateral_speed),
+        pin_start / k,
+        None,
         recorder,
-        band: [0.0; N_EVENTS],
-    };
+    );
     // The pin must start clear of the part.
     let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
     let local = pose_n.apply_inverse(ctx.start);
@@ -1338,22 +1367,17 @@ pub fn push_fence(
 ) -> ContactOutcome {
     let k = model.scale();
     let geom = FenceGeom::new(fence, k);
-    let mut ctx = Ctx {
+    let mut ctx = Ctx::new(
         model,
-        poly: model.hull(),
-        fid: settings.fidelity,
-        fr: Friction::new(fence.mu_f),
-        rho: 0.0,
-        vdir: Vec2::new(-1.0, 0.0),
-        start: geom.p1(),
-        fence: Some(geom),
-        tol: settings.tol,
-        scale: k,
-        evals: 0,
-        warm: Warm::default(),
+        model.hull(),
+        settings,
+        fence.mu_f,
+        0.0,
+        Vec2::new(-1.0, 0.0),
+        geom.p1(),
+        Some(geom),
         recorder,
-        band: [0.0; N_EVENTS],
-    };
+    );
     // Sliding along a steep fence is slow (it stops altogether at the jam angle): allow the belt
     // travel a fence of this length can take before calling the part held.
     let settings = ContactSettings {
@@ -1374,22 +1398,17 @@ pub fn first_instant(
 ) -> Option<(ContactGeom, Instant)> {
     let k = model.scale();
     let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    let mut ctx = Ctx {
+    let mut ctx = Ctx::new(
         model,
-        poly: model.polygon(),
-        fid: settings.fidelity,
-        fr: Friction::new(settings.mu_c),
-        rho: pin.radius / k,
-        vdir: Vec2::new(-1.0, pin.lateral_speed),
-        start: pin_start / k,
-        fence: None,
-        tol: settings.tol,
-        scale: k,
-        evals: 0,
-        warm: Warm::default(),
-        recorder: None,
-        band: [0.0; N_EVENTS],
-    };
+        model.polygon(),
+        settings,
+        settings.mu_c,
+        pin.radius / k,
+        Vec2::new(-1.0, pin.lateral_speed),
+        pin_start / k,
+        None,
+        None,
+    );
     let dir = ctx.vdir.normalized();
     let hit = first_contact(ctx.poly, &pose_n, ctx.start, dir, ctx.rho, 0.0)?;
     if hit.grazing {

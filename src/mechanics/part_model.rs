@@ -228,6 +228,18 @@ pub struct Solved {
     pub wrench: Wrench,
 }
 
+/// What a twist solve leaves behind for the next one: the solution, the wrench it answered, the
+/// multiplier λ (∇D = λ w at the optimum) and the Hessian of D there. With these the next solve
+/// starts from a first-order prediction (implicit function theorem on ∇D(ξ) = λ w, w·ξ = 1):
+/// [H −w; wᵀ 0] [dξ; dλ] = [λ dw; −dw·ξ].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WarmTwist {
+    pub twist: Twist,
+    pub wrench: Wrench,
+    pub lambda: f64,
+    pub hess: Option<[[f64; 3]; 3]>,
+}
+
 /// The compiled part: normalised geometry and support data. Immutable; shared by all contacts.
 pub struct PartModel {
     poly: Polygon,
@@ -330,13 +342,14 @@ impl PartModel {
     }
 
     /// ξ normal to the limit surface at wrench direction `w`, normalised so that w·ξ = 1.
+    /// `warm` is what the previous solve of the same kind left (see [`WarmTwist`]).
     pub fn twist_for_wrench(
         &self,
         fid: Fidelity,
         w: Wrench,
-        warm: Option<Twist>,
+        warm: Option<&WarmTwist>,
         evals: &mut u64,
-    ) -> Result<Solved, SolveFailure> {
+    ) -> Result<(Solved, WarmTwist), SolveFailure> {
         match fid {
             Fidelity::Exact => self.exact_twist_for_wrench(w, warm, evals),
             _ => {
@@ -348,10 +361,17 @@ impl PartModel {
                     return Err(SolveFailure::NonFinite);
                 }
                 let xi = scale3(xi, 1.0 / d);
-                Ok(Solved {
+                let solved = Solved {
                     twist: xi,
                     wrench: self.wrench_for_twist(fid, xi, evals),
-                })
+                };
+                let next = WarmTwist {
+                    twist: xi,
+                    wrench: w,
+                    lambda: 0.0,
+                    hess: None,
+                };
+                Ok((solved, next))
             }
         }
     }
@@ -396,9 +416,9 @@ impl PartModel {
     fn exact_twist_for_wrench(
         &self,
         w: Wrench,
-        warm: Option<Twist>,
+        warm: Option<&WarmTwist>,
         evals: &mut u64,
-    ) -> Result<Solved, SolveFailure> {
+    ) -> Result<(Solved, WarmTwist), SolveFailure> {
         let wn = norm3(w);
         if wn.is_nan() || wn <= 0.0 || !wn.is_finite() {
             return Err(SolveFailure::NonFinite);
@@ -406,12 +426,27 @@ impl PartModel {
         let wh = scale3(w, 1.0 / wn);
         let (e1, e2) = orthonormal_complement(wh);
         let xi0 = scale3(wh, 1.0 / wn);
-        let start = match warm {
-            Some(x) if dot3(w, x) > 0.0 => scale3(x, 1.0 / dot3(w, x)),
+        let predicted = warm.and_then(|p| predict_twist(p, w));
+        let start = match (predicted, warm) {
+            (Some(x), _) => x,
+            (None, Some(p)) if dot3(w, p.twist) > 0.0 => scale3(p.twist, 1.0 / dot3(w, p.twist)),
             _ => {
                 let g = self.ellipsoid_guess(w);
                 scale3(g, 1.0 / dot3(w, g))
             }
+        };
+        let done = |xi: Twist, d: &Dissipation| {
+            let solved = Solved {
+                twist: xi,
+                wrench: d.grad,
+            };
+            let next = WarmTwist {
+                twist: xi,
+                wrench: w,
+                lambda: dot3(d.grad, w) / dot3(w, w),
+                hess: Some(d.hess),
+            };
+            (solved, next)
         };
         let mut z = [dot3(e1, start), dot3(e2, start)];
         let at = |z: [f64; 2]| axpy3(axpy3(xi0, z[0], e1), z[1], e2);
@@ -429,10 +464,7 @@ impl PartModel {
             }
             // Converged, or at the rounding floor of the gradient (small and no longer improving).
             if residual <= NEWTON_TOL || (residual <= 1e-9 && residual > 0.5 * prev_residual) {
-                return Ok(Solved {
-                    twist: xi,
-                    wrench: d.grad,
-                });
+                return Ok(done(xi, &d));
             }
             let h11 = quad3(&d.hess, e1, e1);
             let h12 = quad3(&d.hess, e1, e2);
@@ -454,10 +486,7 @@ impl PartModel {
             // Converged to rounding: the Newton step no longer moves the twist.
             let step_len = (dz[0] * dz[0] + dz[1] * dz[1]).sqrt();
             if step_len <= 1e-14 * norm3(xi) {
-                return Ok(Solved {
-                    twist: xi,
-                    wrench: d.grad,
-                });
+                return Ok(done(xi, &d));
             }
             // Line search on the directional derivative φ'(t) = ∇D(ξ(z + t dz))·dz, which is
             // monotone for convex D. Unlike the value of D it stays informative near the optimum,
@@ -486,10 +515,7 @@ impl PartModel {
             }
             if !accepted {
                 if residual <= 1e-9 {
-                    return Ok(Solved {
-                        twist: xi,
-                        wrench: d.grad,
-                    });
+                    return Ok(done(xi, &d));
                 }
                 return Err(SolveFailure::NoConvergence {
                     iterations: it + 1,
@@ -498,10 +524,7 @@ impl PartModel {
             }
         }
         if residual <= 1e-9 {
-            return Ok(Solved {
-                twist: xi,
-                wrench: d.grad,
-            });
+            return Ok(done(xi, &d));
         }
         Err(SolveFailure::NoConvergence {
             iterations: NEWTON_MAX,
@@ -595,6 +618,45 @@ impl PartModel {
     }
 }
 
+/// First-order prediction of the twist for wrench `w` from the previous solution (see
+/// [`WarmTwist`]), normalised to w·ξ = 1; `None` without a Hessian or if the system is singular.
+fn predict_twist(p: &WarmTwist, w: Wrench) -> Option<Twist> {
+    let h = p.hess?;
+    let dw = [w[0] - p.wrench[0], w[1] - p.wrench[1], w[2] - p.wrench[2]];
+    let w0 = p.wrench;
+    // [H −w0; w0ᵀ 0] [dξ; dλ] = [λ dw; −dw·ξ0], solved by Gaussian elimination with pivoting.
+    let mut a = [
+        [h[0][0], h[0][1], h[0][2], -w0[0], p.lambda * dw[0]],
+        [h[1][0], h[1][1], h[1][2], -w0[1], p.lambda * dw[1]],
+        [h[2][0], h[2][1], h[2][2], -w0[2], p.lambda * dw[2]],
+        [w0[0], w0[1], w0[2], 0.0, -dot3(dw, p.twist)],
+    ];
+    for col in 0..4 {
+        let piv = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[piv][col].abs() < 1e-300 {
+            return None;
+        }
+        a.swap(col, piv);
+        let pivot_row = a[col];
+        for (r, row) in a.iter_mut().enumerate() {
+            if r != col {
+                let f = row[col] / pivot_row[col];
+                for (x, p) in row.iter_mut().zip(pivot_row).skip(col) {
+                    *x -= f * p;
+                }
+            }
+        }
+    }
+    let dxi = [a[0][4] / a[0][0], a[1][4] / a[1][1], a[2][4] / a[2][2]];
+    let xi = [
+        p.twist[0] + dxi[0],
+        p.twist[1] + dxi[1],
+        p.twist[2] + dxi[2],
+    ];
+    let c = dot3(w, xi);
+    (c > 0.0 && c.is_finite()).then(|| scale3(xi, 1.0 / c))
+}
+
 /// Two unit vectors orthogonal to the unit vector `w` and to each other.
 fn orthonormal_complement(w: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     // Pick the coordinate axis least aligned with w.
@@ -626,7 +688,7 @@ mod tests {
         let m = PartModel::new(&poly, &Support::Uniform).unwrap();
         let mut ev = 0;
         let w = [0.3, -1.0, 0.2];
-        let s = m
+        let (s, _) = m
             .twist_for_wrench(Fidelity::Ellipsoid, w, None, &mut ev)
             .unwrap();
         assert!((dot3(w, s.twist) - 1.0).abs() < 1e-14);

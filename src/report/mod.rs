@@ -11,3 +11,4 @@ pub mod plot_line;
 pub mod plot_map;
 pub mod plot_orientations;
 pub mod plot_part;
+pub mod plot_sensitivity;

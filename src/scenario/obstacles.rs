@@ -69,19 +69,25 @@ pub(super) fn compile_obstacles(
         }
         obstacles.push(ob);
     }
-    let neighbours = obstacles
+    let neighbours = neighbour_lists(&obstacles, part_radius);
+    Ok((obstacles, neighbours))
+}
+
+/// For each obstacle, the others a part of circumradius `a` touching it could touch: those within
+/// 2a (between pin discs and fence segments), ascending.
+pub fn neighbour_lists(obstacles: &[Obstacle], a: f64) -> Vec<Vec<usize>> {
+    obstacles
         .iter()
         .enumerate()
-        .map(|(i, a)| {
+        .map(|(i, p)| {
             obstacles
                 .iter()
                 .enumerate()
-                .filter(|&(j, b)| j != i && obstacle_distance(a, b) <= 2.0 * part_radius)
+                .filter(|&(j, q)| j != i && obstacle_distance(p, q) <= 2.0 * a)
                 .map(|(j, _)| j)
                 .collect()
         })
-        .collect();
-    Ok((obstacles, neighbours))
+        .collect()
 }
 
 /// Distance between two obstacles (0 when they overlap), m.

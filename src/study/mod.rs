@@ -1,8 +1,10 @@
 //! Studies built on the contact model and the line: what a contact costs and how accurate it is
-//! (`contact_cost`), what a set of configuration maps costs (`map_cost`), line designs side by side
-//! on one part stream (`compare`); later Monte Carlo robustness and accuracy-vs-time.
+//! (`contact_cost`), what a set of configuration maps costs (`map_cost`), what accuracy costs in
+//! time (`accuracy`), Monte Carlo robustness studies with sharding and merging (`mc`), and line
+//! designs side by side on one part stream (`compare`).
 
 pub mod accuracy;
 pub mod compare;
 pub mod contact_cost;
 pub mod map_cost;
+pub mod mc;

@@ -1,0 +1,164 @@
+//! `pinfeed mc STUDY.toml`: a Monte Carlo robustness study (README "Monte Carlo studies"). Without
+//! `--shard` it runs every sample and writes `report.md`, `report.json` and `sensitivity.svg` to
+//! `<out>` (default `results/mc/<study name>/`), printing the table (or the JSON with `--json`).
+//! With `--shard K/N` it runs one contiguous share of the samples and writes only a shard file
+//! (`<out>/shard-K-of-N.json`, default `<out>` = `results/mc/<study name>/shards/`) for
+//! `pinfeed merge`.
+
+use crate::report::plot_sensitivity::plot_sensitivity;
+use crate::study::mc::atomic::{produce_atomic, write_atomic};
+use crate::study::mc::report::{self, McReport, StudyHeader};
+use crate::study::mc::shard::{self, ShardFile, ShardSpec};
+use crate::study::mc::{self, run};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Arguments of `pinfeed mc`.
+#[derive(Debug, Args)]
+pub struct McArgs {
+    /// Study file (TOML; see README "Monte Carlo studies").
+    pub study: PathBuf,
+    /// Samples per sweep point (overrides the study's `samples`).
+    #[arg(long)]
+    pub samples: Option<u64>,
+    /// Print the report as JSON instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Worker threads (default: all cores); the results do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Run shard K of N (K 0-based) and write a shard file; `/N` takes K from
+    /// SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Folder for the report (or the shard file).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// No table and no progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// The default report folder of a study.
+pub fn default_dir(study_name: &str) -> PathBuf {
+    PathBuf::from("results").join("mc").join(study_name)
+}
+
+fn progress(total: u64, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
+    b.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} samples  {per_sec}  eta {eta}")
+            .expect("valid progress template"),
+    );
+    b
+}
+
+pub fn run(args: &McArgs) -> Result<()> {
+    if let Some(n) = args.samples {
+        if !(1..=mc::MAX_SAMPLES).contains(&n) {
+            bail!("--samples must lie in [1, {}], got {n}", mc::MAX_SAMPLES);
+        }
+    }
+    if let Some(t) = args.threads {
+        if !(1..=1024).contains(&t) {
+            bail!("--threads must lie in [1, 1024], got {t}");
+        }
+    }
+    let study = mc::load(&args.study, args.samples)?;
+    let header = StudyHeader::of(&study);
+    let total = study.total_samples();
+    let shard = match &args.shard {
+        Some(text) => {
+            Some(ShardSpec::parse(text, &|k| std::env::var(k).ok()).map_err(anyhow::Error::msg)?)
+        }
+        None => None,
+    };
+    let range = shard.map_or(0..total, |s| s.range(total));
+    let bar = progress(range.end - range.start, args.quiet);
+    let started = Instant::now();
+    let tallies = run::run_range_with_threads(&study, range.clone(), args.threads, &|| bar.inc(1))
+        .with_context(|| format!("running {}", args.study.display()))?;
+    let wall = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let n = range.end - range.start;
+    let speed = format!(
+        "{n} samples in {wall:.2} s wall: {:.0} samples/s",
+        n as f64 / wall.max(1e-9)
+    );
+
+    if let Some(spec) = shard {
+        let dir = args
+            .out
+            .clone()
+            .unwrap_or_else(|| default_dir(&study.name).join("shards"));
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        let path = dir.join(spec.file_name());
+        let file = ShardFile::new(&header, spec, range.clone(), &tallies);
+        let text = serde_json::to_string_pretty(&file)? + "\n";
+        shard::write_atomic(&path, text.as_bytes(), &mut |_| {})
+            .with_context(|| format!("writing {}", path.display()))?;
+        if !args.quiet {
+            eprintln!(
+                "shard {}/{}: samples [{}, {}) of {total}; {speed}; wrote {}",
+                spec.index,
+                spec.count,
+                range.start,
+                range.end,
+                path.display()
+            );
+        }
+        return Ok(());
+    }
+    let tallies: Vec<_> = (0..study.points.len())
+        .map(|j| tallies.get(&j).cloned().unwrap_or_default())
+        .collect();
+    let r = report::build(&header, &tallies);
+    let dir = args.out.clone().unwrap_or_else(|| default_dir(&study.name));
+    publish(&r, &dir, args.json, args.quiet)?;
+    if !args.quiet && !args.json {
+        eprintln!("{speed}");
+    }
+    Ok(())
+}
+
+/// Write a report's files (`report.md`, `report.json`, `sensitivity.svg`) to `dir` and print the
+/// table or the JSON. `mc` and `merge` share it, so their outputs are the same bytes.
+pub fn publish(r: &McReport, dir: &Path, json: bool, quiet: bool) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let figure = "sensitivity.svg";
+    // Each file appears whole or not at all (written beside it, then renamed).
+    let md = dir.join("report.md");
+    write_atomic(&md, report::markdown(r, figure).as_bytes(), &mut |_| {})
+        .with_context(|| format!("writing {}", md.display()))?;
+    let js = dir.join("report.json");
+    let json_text = report::json(r);
+    write_atomic(&js, json_text.as_bytes(), &mut |_| {})
+        .with_context(|| format!("writing {}", js.display()))?;
+    let svg = dir.join(figure);
+    produce_atomic(&svg, |tmp| {
+        plot_sensitivity(r, tmp).map_err(|e| std::io::Error::other(e.to_string()))
+    })
+    .with_context(|| format!("writing {}", svg.display()))?;
+    let text = if json {
+        json_text
+    } else if quiet {
+        String::new()
+    } else {
+        format!("{}\nreport: {}\n", report::table(r), md.display())
+    };
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|_| stdout.flush())
+    {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e).context("writing to stdout"),
+        _ => Ok(()),
+    }
+}

@@ -1,0 +1,522 @@
+//! Validation of a study file: [`RawStudy`] → distributions per sweep point, with errors located by
+//! the scenario parser's machinery (file:line:column, key, what is allowed).
+//!
+//! Sweeps: each `[[sweep]]` names a parameter and its values (`values = [...]`, or `from`, `to`,
+//! `steps` evenly spaced, ends included). `NAME` fixes the parameter at each value; `NAME.FIELD`
+//! overrides one field of its declared distribution (`shape.sd`, `mu_c.max`, `support.width`).
+//! One or two sweeps make a grid; the first sweep varies slowest (point = i₀·n₁ + i₁).
+
+use super::distribution::Distribution;
+use super::perturbations::{Perturbations, SmoothParams, SupportChoice};
+use super::raw::*;
+use crate::scenario::error::Locator;
+use crate::scenario::location::KeyPath;
+use crate::scenario::{ScenarioError, SupportKind};
+
+type R<T> = Result<T, ScenarioError>;
+
+/// Largest number of sweep points.
+pub const MAX_POINTS: usize = 10_000;
+
+/// Names of the distribution parameters, in the order they are drawn.
+pub const DISTRIBUTION_PARAMETERS: [&str; 8] = [
+    "mu_c",
+    "belt_speed",
+    "shape",
+    "pin_x",
+    "pin_y",
+    "pin_radius",
+    "pose_theta",
+    "pose_y",
+];
+
+/// A swept parameter and its values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepAxis {
+    pub parameter: String,
+    pub values: Vec<f64>,
+}
+
+fn err(loc: &Locator, path: &str, msg: impl Into<String>) -> ScenarioError {
+    loc.at_key(&KeyPath::parse(path), msg)
+}
+
+fn finite(loc: &Locator, path: &str, v: f64) -> R<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(err(loc, path, format!("must be a finite number, got {v}")))
+    }
+}
+
+fn slot<'a>(u: &'a RawUncertain, name: &str) -> &'a Option<RawDistribution> {
+    match name {
+        "mu_c" => &u.mu_c,
+        "belt_speed" => &u.belt_speed,
+        "shape" => &u.shape,
+        "pin_x" => &u.pin_x,
+        "pin_y" => &u.pin_y,
+        "pin_radius" => &u.pin_radius,
+        "pose_theta" => &u.pose_theta,
+        _ => &u.pose_y,
+    }
+}
+
+fn slot_mut<'a>(u: &'a mut RawUncertain, name: &str) -> &'a mut Option<RawDistribution> {
+    match name {
+        "mu_c" => &mut u.mu_c,
+        "belt_speed" => &mut u.belt_speed,
+        "shape" => &mut u.shape,
+        "pin_x" => &mut u.pin_x,
+        "pin_y" => &mut u.pin_y,
+        "pin_radius" => &mut u.pin_radius,
+        "pose_theta" => &mut u.pose_theta,
+        _ => &mut u.pose_y,
+    }
+}
+
+/// The domain a parameter's value must lie in (values outside are refused or redrawn).
+fn domain(name: &str) -> (f64, bool, &'static str) {
+    match name {
+        "mu_c" => (0.0, true, "at least 0 (a friction coefficient)"),
+        "belt_speed" => (0.0, false, "greater than 0 (m/s)"),
+        _ => (f64::NEG_INFINITY, true, ""),
+    }
+}
+
+/// Does `v` lie in the domain of parameter `name`?
+pub fn in_domain(name: &str, v: f64) -> bool {
+    let (lo, closed, _) = domain(name);
+    v.is_finite() && (v > lo || (closed && v == lo))
+}
+
+fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Distribution> {
+    let base = format!("uncertain.{name}");
+    let key = |k: &str| format!("{base}.{k}");
+    let Some(kind) = d.distribution else {
+        return Err(err(
+            loc,
+            &base,
+            "give distribution = \"fixed\" (value), \"uniform\" (min, max), \"normal\" (mean, sd) or \"triangular\" (min, mode, max)",
+        ));
+    };
+    let given = [
+        ("value", d.value),
+        ("min", d.min),
+        ("max", d.max),
+        ("mean", d.mean),
+        ("sd", d.sd),
+        ("mode", d.mode),
+    ];
+    let (needed, optional): (&[&str], &[&str]) = match kind {
+        DistributionKind::Fixed => (&["value"], &[]),
+        DistributionKind::Uniform => (&["min", "max"], &[]),
+        DistributionKind::Normal => (&["sd"], &["mean", "min", "max"]),
+        DistributionKind::Triangular => (&["min", "mode", "max"], &[]),
+    };
+    for (k, v) in given {
+        if v.is_some() && !needed.contains(&k) && !optional.contains(&k) {
+            let mut takes = needed.join(", ");
+            if !optional.is_empty() {
+                takes.push_str(&format!(" (optional: {})", optional.join(", ")));
+            }
+            return Err(err(
+                loc,
+                &key(k),
+                format!("does not apply to this distribution, which takes {takes}"),
+            ));
+        }
+    }
+    let mut vals = std::collections::BTreeMap::new();
+    for (k, v) in given {
+        if let Some(v) = v {
+            vals.insert(k, finite(loc, &key(k), v)?);
+        }
+    }
+    for k in needed {
+        if !vals.contains_key(k) {
+            return Err(err(
+                loc,
+                &base,
+                format!(
+                    "this distribution needs {}; `{k}` is missing",
+                    needed.join(", ")
+                ),
+            ));
+        }
+    }
+    let g = |k: &str| vals.get(k).copied();
+    let (lo_dom, _, dom_text) = domain(name);
+    let check_in_domain = |k: &str, v: f64| -> R<()> {
+        if lo_dom.is_finite() && !in_domain(name, v) {
+            return Err(err(
+                loc,
+                &key(k),
+                format!("{name} must be {dom_text}, got {v}"),
+            ));
+        }
+        Ok(())
+    };
+    let dist = match kind {
+        DistributionKind::Fixed => {
+            let v = g("value").expect("checked");
+            check_in_domain("value", v)?;
+            Distribution::Fixed(v)
+        }
+        DistributionKind::Uniform => {
+            let (min, max) = (g("min").expect("checked"), g("max").expect("checked"));
+            if min > max {
+                return Err(err(
+                    loc,
+                    &key("max"),
+                    format!("must be at least min ({min}), got {max}"),
+                ));
+            }
+            check_in_domain("min", min)?;
+            Distribution::Uniform { min, max }
+        }
+        DistributionKind::Triangular => {
+            let (min, mode, max) = (
+                g("min").expect("checked"),
+                g("mode").expect("checked"),
+                g("max").expect("checked"),
+            );
+            if !(min <= mode && mode <= max) {
+                return Err(err(
+                    loc,
+                    &key("mode"),
+                    format!("needs min ≤ mode ≤ max, got {min}, {mode}, {max}"),
+                ));
+            }
+            check_in_domain("min", min)?;
+            Distribution::Triangular { min, mode, max }
+        }
+        DistributionKind::Normal => {
+            let sd = g("sd").expect("checked");
+            if sd < 0.0 {
+                return Err(err(
+                    loc,
+                    &key("sd"),
+                    format!("must be at least 0, got {sd}"),
+                ));
+            }
+            let mean = g("mean").unwrap_or(0.0);
+            let lo = g("min").unwrap_or(f64::NEG_INFINITY);
+            let hi = g("max").unwrap_or(f64::INFINITY);
+            if lo > hi {
+                return Err(err(
+                    loc,
+                    &key("max"),
+                    format!("must be at least min ({lo}), got {hi}"),
+                ));
+            }
+            if !(lo..=hi).contains(&mean) {
+                return Err(err(
+                    loc,
+                    &key("mean"),
+                    format!("must lie within the truncation [{lo}, {hi}], got {mean}"),
+                ));
+            }
+            let where_ = if d.mean.is_some() { "mean" } else { "sd" };
+            check_in_domain(where_, mean)?;
+            Distribution::Normal { mean, sd, lo, hi }
+        }
+    };
+    Ok(dist)
+}
+
+fn compile_support(loc: &Locator, s: &RawSupport) -> R<SupportChoice> {
+    let Some(model) = s.model else {
+        return Err(err(
+            loc,
+            "uncertain.support",
+            "give model = \"uniform\", \"tripod\" or \"smooth\"",
+        ));
+    };
+    let smooth_keys = [
+        ("bumps", s.bumps),
+        ("width", s.width),
+        ("contrast", s.contrast),
+        ("points", s.points),
+    ];
+    if model != SupportModel::Smooth {
+        if let Some((k, _)) = smooth_keys.iter().find(|(_, v)| v.is_some()) {
+            return Err(err(
+                loc,
+                &format!("uncertain.support.{k}"),
+                "applies only to model = \"smooth\"",
+            ));
+        }
+    }
+    Ok(match model {
+        SupportModel::Uniform => SupportChoice::Uniform,
+        SupportModel::Tripod => SupportChoice::Tripod,
+        SupportModel::Smooth => {
+            let d = SmoothParams::default();
+            let whole = |k: &str, v: Option<f64>, lo: f64, hi: f64, dflt: usize| -> R<usize> {
+                let Some(v) = v else { return Ok(dflt) };
+                let path = format!("uncertain.support.{k}");
+                if !(v.is_finite() && v.fract() == 0.0 && (lo..=hi).contains(&v)) {
+                    return Err(err(
+                        loc,
+                        &path,
+                        format!("must be a whole number in [{lo}, {hi}], got {v}"),
+                    ));
+                }
+                Ok(v as usize)
+            };
+            let real = |k: &str, v: Option<f64>, lo: f64, hi: f64, dflt: f64| -> R<f64> {
+                let Some(v) = v else { return Ok(dflt) };
+                let path = format!("uncertain.support.{k}");
+                let v = finite(loc, &path, v)?;
+                if !(lo..=hi).contains(&v) || (k == "width" && v == 0.0) {
+                    return Err(err(
+                        loc,
+                        &path,
+                        format!(
+                            "must lie in {}{lo}, {hi}], got {v}",
+                            if k == "width" { "(" } else { "[" }
+                        ),
+                    ));
+                }
+                Ok(v)
+            };
+            SupportChoice::Smooth(SmoothParams {
+                bumps: whole("bumps", s.bumps, 0.0, 50.0, d.bumps)?,
+                width: real("width", s.width, 0.0, 10.0, d.width)?,
+                contrast: real("contrast", s.contrast, 0.0, 100.0, d.contrast)?,
+                points: whole("points", s.points, 8.0, 2000.0, d.points)?,
+            })
+        }
+    })
+}
+
+/// Compile the `[uncertain]` table. `scenario_support` is the scenario's own support, used when
+/// the study does not declare one.
+pub fn compile_uncertain(
+    loc: &Locator,
+    u: &RawUncertain,
+    scenario_support: SupportKind,
+) -> R<Perturbations> {
+    let mut d: Vec<Option<Distribution>> = Vec::new();
+    for name in DISTRIBUTION_PARAMETERS {
+        d.push(match slot(u, name) {
+            Some(raw) => Some(compile_distribution(loc, name, raw)?),
+            None => None,
+        });
+    }
+    let support = match &u.support {
+        Some(s) => compile_support(loc, s)?,
+        None => match scenario_support {
+            SupportKind::Uniform => SupportChoice::Uniform,
+            SupportKind::Tripod => SupportChoice::Tripod,
+        },
+    };
+    Ok(Perturbations {
+        mu_c: d[0],
+        belt_speed: d[1],
+        shape: d[2],
+        pin_x: d[3],
+        pin_y: d[4],
+        pin_radius: d[5],
+        pose_theta: d[6],
+        pose_y: d[7],
+        support,
+    })
+}
+
+/// Set the field a sweep names to `value` (see the module docs).
+fn apply_sweep(u: &mut RawUncertain, parameter: &str, value: f64) -> Result<(), String> {
+    let (name, field) = match parameter.split_once('.') {
+        Some((n, f)) => (n, Some(f)),
+        None => (parameter, None),
+    };
+    if name == "support" {
+        let Some(s) = u.support.as_mut() else {
+            return Err("[uncertain.support] is not declared; declare model = \"smooth\" to sweep its fields".into());
+        };
+        let target = match field {
+            Some("bumps") => &mut s.bumps,
+            Some("width") => &mut s.width,
+            Some("contrast") => &mut s.contrast,
+            Some("points") => &mut s.points,
+            _ => {
+                return Err(format!(
+                    "`{parameter}`: the support can be swept only through support.bumps, support.width, support.contrast or support.points"
+                ))
+            }
+        };
+        *target = Some(value);
+        return Ok(());
+    }
+    if !DISTRIBUTION_PARAMETERS.contains(&name) {
+        return Err(format!(
+            "unknown parameter `{name}`; expected one of {}, support",
+            DISTRIBUTION_PARAMETERS.join(", ")
+        ));
+    }
+    let d = slot_mut(u, name);
+    match field {
+        None => {
+            *d = Some(RawDistribution {
+                distribution: Some(DistributionKind::Fixed),
+                value: Some(value),
+                ..RawDistribution::default()
+            });
+        }
+        Some(f) => {
+            let Some(raw) = d.as_mut() else {
+                return Err(format!(
+                    "[uncertain.{name}] is not declared; declare its distribution, or sweep `{name}` itself to fix it at each value"
+                ));
+            };
+            let target = match f {
+                "value" => &mut raw.value,
+                "min" => &mut raw.min,
+                "max" => &mut raw.max,
+                "mean" => &mut raw.mean,
+                "sd" => &mut raw.sd,
+                "mode" => &mut raw.mode,
+                other => {
+                    return Err(format!(
+                        "`{other}` is not a distribution field; expected value, min, max, mean, sd or mode"
+                    ))
+                }
+            };
+            *target = Some(value);
+        }
+    }
+    Ok(())
+}
+
+/// Compile the sweeps into axes.
+pub fn compile_sweeps(loc: &Locator, sweeps: &[RawSweep]) -> R<Vec<SweepAxis>> {
+    if sweeps.len() > 2 {
+        return Err(err(
+            loc,
+            "sweep[2]",
+            format!(
+                "at most two sweeps (a grid) are supported, got {}",
+                sweeps.len()
+            ),
+        ));
+    }
+    let mut axes: Vec<SweepAxis> = Vec::new();
+    for (k, s) in sweeps.iter().enumerate() {
+        let base = format!("sweep[{k}]");
+        if axes.iter().any(|a| a.parameter == s.parameter) {
+            return Err(err(
+                loc,
+                &format!("{base}.parameter"),
+                format!("`{}` is already swept", s.parameter),
+            ));
+        }
+        let values = match (&s.values, s.from, s.to, s.steps) {
+            (Some(v), None, None, None) => {
+                if v.is_empty() || v.len() > 1000 {
+                    return Err(err(
+                        loc,
+                        &format!("{base}.values"),
+                        format!("needs 1 to 1000 values, got {}", v.len()),
+                    ));
+                }
+                for (i, &x) in v.iter().enumerate() {
+                    finite(loc, &format!("{base}.values[{i}]"), x)?;
+                }
+                v.clone()
+            }
+            (None, Some(from), Some(to), Some(steps)) => {
+                let from = finite(loc, &format!("{base}.from"), from)?;
+                let to = finite(loc, &format!("{base}.to"), to)?;
+                if !(2..=1000).contains(&steps) {
+                    return Err(err(
+                        loc,
+                        &format!("{base}.steps"),
+                        format!("must lie in [2, 1000], got {steps}"),
+                    ));
+                }
+                (0..steps)
+                    .map(|i| from + (to - from) * i as f64 / (steps - 1) as f64)
+                    .collect()
+            }
+            _ => return Err(err(
+                loc,
+                &base,
+                "give either values = [...] or from, to and steps (evenly spaced, ends included)",
+            )),
+        };
+        axes.push(SweepAxis {
+            parameter: s.parameter.clone(),
+            values,
+        });
+    }
+    let points: usize = axes.iter().map(|a| a.values.len()).product();
+    if points > MAX_POINTS {
+        return Err(err(
+            loc,
+            "sweep",
+            format!("the grid has {points} points; at most {MAX_POINTS} are allowed"),
+        ));
+    }
+    Ok(axes)
+}
+
+/// The parameter values of every grid point (first axis slowest); one empty point without sweeps.
+pub fn grid(axes: &[SweepAxis]) -> Vec<Vec<f64>> {
+    let mut points = vec![Vec::new()];
+    for a in axes {
+        points = points
+            .into_iter()
+            .flat_map(|p| {
+                a.values.iter().map(move |&v| {
+                    let mut q = p.clone();
+                    q.push(v);
+                    q
+                })
+            })
+            .collect();
+    }
+    points
+}
+
+/// The perturbations at every grid point. A sweep value that makes the study invalid is reported
+/// at the sweep, with the underlying problem.
+pub fn compile_points(
+    loc: &Locator,
+    u: &RawUncertain,
+    axes: &[SweepAxis],
+    scenario_support: SupportKind,
+) -> R<Vec<Perturbations>> {
+    let mut out = Vec::new();
+    for values in grid(axes) {
+        let mut raw = u.clone();
+        for (k, (axis, &v)) in axes.iter().zip(&values).enumerate() {
+            apply_sweep(&mut raw, &axis.parameter, v)
+                .map_err(|m| err(loc, &format!("sweep[{k}].parameter"), m))?;
+        }
+        let p = compile_uncertain(loc, &raw, scenario_support).map_err(|e| {
+            let inner = e
+                .invalid()
+                .map(|i| format!("{}: {}", i.key, i.message))
+                .unwrap_or_else(|| e.to_string());
+            let at = axes
+                .iter()
+                .zip(&values)
+                .map(|(a, v)| format!("{} = {v}", a.parameter))
+                .collect::<Vec<_>>()
+                .join(", ");
+            // Locate at the sweep whose parameter the problem is about (else the last one).
+            let culprit = e.invalid().map(|i| i.key.clone()).unwrap_or_default();
+            let k = axes
+                .iter()
+                .position(|a| {
+                    let name = a.parameter.split('.').next().unwrap_or("");
+                    culprit.starts_with(&format!("uncertain.{name}"))
+                })
+                .unwrap_or(axes.len().saturating_sub(1));
+            err(loc, &format!("sweep[{k}]"), format!("at {at}: {inner}"))
+        })?;
+        out.push(p);
+    }
+    Ok(out)
+}

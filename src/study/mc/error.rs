@@ -1,0 +1,65 @@
+//! Why a Monte Carlo study could not be loaded, run, sharded or merged.
+
+use crate::engine::EngineError;
+use crate::scenario::{InvalidScenario, ScenarioError};
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Errors of the Monte Carlo study.
+#[derive(Debug, Error)]
+pub enum StudyError {
+    /// The study file could not be read.
+    #[error("{}: cannot read the study: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A located problem in the study file (file:line:column, key, what is allowed).
+    #[error("{0}")]
+    Invalid(Box<InvalidScenario>),
+    /// The scenario the study points at is invalid.
+    #[error("{0}")]
+    Scenario(ScenarioError),
+    /// A sample could not be drawn (e.g. a shape tolerance so large that no valid polygon comes out).
+    #[error("sample {sample} of sweep point {point}: {reason}")]
+    Sample {
+        point: usize,
+        sample: u64,
+        reason: String,
+    },
+    /// The line engine refused a sample.
+    #[error("sample {sample} of sweep point {point}: {source}")]
+    Engine {
+        point: usize,
+        sample: u64,
+        #[source]
+        source: EngineError,
+    },
+    /// The worker threads could not be started.
+    #[error("cannot start {threads} worker threads: {reason}")]
+    Threads { threads: usize, reason: String },
+    /// A shard file or a set of shard files that cannot be used.
+    #[error("{0}")]
+    Shard(String),
+}
+
+impl StudyError {
+    /// The located details of an invalid study file.
+    pub fn invalid(&self) -> Option<&InvalidScenario> {
+        match self {
+            StudyError::Invalid(i) => Some(i),
+            _ => None,
+        }
+    }
+}
+
+impl From<ScenarioError> for StudyError {
+    /// A located error built with the scenario machinery on the *study* file.
+    fn from(e: ScenarioError) -> StudyError {
+        match e {
+            ScenarioError::Invalid(i) => StudyError::Invalid(i),
+            other => StudyError::Scenario(other),
+        }
+    }
+}

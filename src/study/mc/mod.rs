@@ -1,0 +1,188 @@
+//! Monte Carlo robustness studies (issue 6): how often a line orients its parts when the physics
+//! and the build are uncertain.
+//!
+//! A study file (TOML, README "Monte Carlo studies") points at a scenario and declares uncertain
+//! parameters — pin–part friction μc, the support model (uniform, a random tripod, a random smooth
+//! density), shape tolerance, pin position and radius errors, entry pose noise, belt speed — and
+//! optionally sweeps one or two of them over a grid. For each sweep point, N samples are drawn; a
+//! sample is one part through a freshly perturbed line ([`sample`]). Computed per point: the count
+//! of each outcome class, the success rate with its 95% Wilson score interval (and the same interval
+//! for every other class), contacts per part, and latency quantiles (entry → exit, HDR histogram).
+//!
+//! Determinism: sample i draws only from streams derived from (seed, i), samples run in parallel
+//! with an order-preserving collect, and results are reduced in index order into integer counts and
+//! histograms ([`tally`]), so the report does not depend on the thread count. The same holds across
+//! machines: `--shard k/n` runs a contiguous range of the sample indices and writes the counts to a
+//! self-describing shard file ([`shard`]); `merge` adds shards exactly and writes byte for byte the
+//! report one unsharded run writes ([`report`]).
+//!
+//! * [`raw`], [`compile`]: the study file and its validation (located errors);
+//! * [`distribution`], [`perturbations`], [`smooth_support`]: what is uncertain and how it is drawn;
+//! * [`sample`]: one perturbed line and its one part; [`run`]: many samples in parallel;
+//! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report;
+//! * [`atomic`]: files written by rename; [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
+
+pub mod atomic;
+pub mod compile;
+pub mod distribution;
+pub mod error;
+pub mod hash;
+pub mod perturbations;
+pub mod precision;
+pub mod raw;
+pub mod report;
+pub mod run;
+pub mod sample;
+pub mod shard;
+pub mod smooth_support;
+pub mod tally;
+
+pub use compile::SweepAxis;
+pub use error::StudyError;
+pub use perturbations::Perturbations;
+
+use crate::scenario::error::Locator;
+use crate::scenario::location::KeyPath;
+use crate::scenario::Scene;
+use std::path::{Path, PathBuf};
+
+/// Default samples per sweep point.
+pub const DEFAULT_SAMPLES: u64 = 1000;
+/// Largest number of samples per sweep point.
+pub const MAX_SAMPLES: u64 = 1_000_000_000;
+
+/// A loaded, validated study.
+#[derive(Debug)]
+pub struct Study {
+    /// Names the report folder.
+    pub name: String,
+    /// The study file as given.
+    pub file: PathBuf,
+    /// The scenario file, resolved against the study file's folder.
+    pub scenario_file: PathBuf,
+    /// The nominal line.
+    pub scene: Scene,
+    pub seed: u64,
+    /// Samples per sweep point.
+    pub samples: u64,
+    pub axes: Vec<SweepAxis>,
+    /// Parameter values of each point (one per axis), first axis slowest.
+    pub point_values: Vec<Vec<f64>>,
+    /// Perturbations of each point.
+    pub points: Vec<Perturbations>,
+    /// Perturbations as declared, before any sweep.
+    pub declared: Perturbations,
+    /// Content hash of the study file, the scenario file and the samples per point.
+    pub study_hash: u64,
+    /// Content hash of the scenario file.
+    pub scenario_hash: u64,
+}
+
+impl Study {
+    /// Total samples: points × samples per point.
+    pub fn total_samples(&self) -> u64 {
+        self.points.len() as u64 * self.samples
+    }
+}
+
+/// Read and validate a study file; `samples` overrides the file's samples per point.
+pub fn load(path: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
+    let source = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(path, &source, samples)
+}
+
+/// Validate study text; `file` locates errors and resolves the scenario path.
+pub fn parse(file: &Path, source: &str, samples: Option<u64>) -> Result<Study, StudyError> {
+    let loc = Locator::new(file, source);
+    let raw: raw::RawStudy = toml::from_str(source).map_err(|e| loc.from_toml(&e))?;
+    let at = |k: &str, m: String| -> StudyError { loc.at_key(&KeyPath::parse(k), m).into() };
+    let name = match &raw.name {
+        Some(n) => {
+            let ok = !n.is_empty()
+                && n.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+            if !ok {
+                return Err(at(
+                    "name",
+                    format!("'{n}' must be non-empty and use only letters, digits, '-' and '_' (it names the report folder)"),
+                ));
+            }
+            n.clone()
+        }
+        None => file
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("study")
+            .to_string(),
+    };
+    let samples = match samples {
+        Some(n) => n,
+        None => raw.samples.unwrap_or(DEFAULT_SAMPLES),
+    };
+    if !(1..=MAX_SAMPLES).contains(&samples) {
+        return Err(at(
+            "samples",
+            format!("must lie in [1, {MAX_SAMPLES}] (samples per sweep point), got {samples}"),
+        ));
+    }
+    let scenario_file = normalise(&file.parent().unwrap_or(Path::new("")).join(&raw.scenario));
+    let scenario_text = std::fs::read_to_string(&scenario_file).map_err(|e| {
+        at(
+            "scenario",
+            format!(
+                "cannot read the scenario {} ({e}); the path is relative to the study file",
+                scenario_file.display()
+            ),
+        )
+    })?;
+    let scene =
+        crate::scenario::parse(&scenario_file, &scenario_text).map_err(StudyError::Scenario)?;
+    let declared = compile::compile_uncertain(&loc, &raw.uncertain, scene.part.support)?;
+    let axes = compile::compile_sweeps(&loc, &raw.sweep)?;
+    let points = if axes.is_empty() {
+        vec![declared.clone()]
+    } else {
+        compile::compile_points(&loc, &raw.uncertain, &axes, scene.part.support)?
+    };
+    let samples_text = samples.to_string();
+    let study_hash = hash::fnv1a(&[
+        b"pinfeed-mc-study",
+        source.as_bytes(),
+        scenario_text.as_bytes(),
+        samples_text.as_bytes(),
+    ]);
+    let scenario_hash = hash::fnv1a(&[scenario_text.as_bytes()]);
+    Ok(Study {
+        name,
+        file: file.to_path_buf(),
+        scenario_file,
+        scene,
+        seed: raw.seed.unwrap_or(1),
+        samples,
+        point_values: compile::grid(&axes),
+        axes,
+        points,
+        declared,
+        study_hash,
+        scenario_hash,
+    })
+}
+
+/// `a/b/../c` → `a/c` (lexically; a leading `..` is kept).
+fn normalise(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let mut out: Vec<Component> = Vec::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out.iter().collect()
+}

@@ -1,0 +1,95 @@
+//! The compiled uncertain parameters of one sweep point: which distribution each parameter follows
+//! and which support model the part gets. Units: metres and m/s as in scenarios; `pose_theta` is in
+//! degrees as written and converted when drawn.
+
+use super::distribution::Distribution;
+
+/// Parameters of the random smooth pressure density (see [`super::smooth_support`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SmoothParams {
+    /// Number of Gaussian bumps added to the uniform base pressure.
+    pub bumps: usize,
+    /// Bump standard deviation in units of the part's a.
+    pub width: f64,
+    /// Largest bump height relative to the base pressure.
+    pub contrast: f64,
+    /// Approximate number of support points.
+    pub points: usize,
+}
+
+impl Default for SmoothParams {
+    fn default() -> Self {
+        SmoothParams {
+            bumps: 3,
+            width: 0.3,
+            contrast: 2.0,
+            points: 48,
+        }
+    }
+}
+
+/// How the part's weight rests on the belt in a sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SupportChoice {
+    Uniform,
+    /// A random tripod per sample.
+    Tripod,
+    /// A random smooth density per sample.
+    Smooth(SmoothParams),
+}
+
+impl SupportChoice {
+    pub fn describe(&self) -> String {
+        match self {
+            SupportChoice::Uniform => "uniform pressure".into(),
+            SupportChoice::Tripod => "a random tripod per sample".into(),
+            SupportChoice::Smooth(p) => format!(
+                "a random smooth density per sample ({} bumps of width {} a, contrast {}, {} points)",
+                p.bumps, p.width, p.contrast, p.points
+            ),
+        }
+    }
+}
+
+/// The uncertain parameters at one sweep point; `None` keeps the scenario's nominal value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Perturbations {
+    /// μc at every pin.
+    pub mu_c: Option<Distribution>,
+    /// Belt speed (m/s).
+    pub belt_speed: Option<Distribution>,
+    /// Error of each vertex coordinate (m).
+    pub shape: Option<Distribution>,
+    /// Errors of each pin's x, y and radius (m).
+    pub pin_x: Option<Distribution>,
+    pub pin_y: Option<Distribution>,
+    pub pin_radius: Option<Distribution>,
+    /// Error of the entry orientation (degrees) and lateral offset (m).
+    pub pose_theta: Option<Distribution>,
+    pub pose_y: Option<Distribution>,
+    pub support: SupportChoice,
+}
+
+impl Perturbations {
+    /// One line per parameter that is not nominal, e.g. `mu_c: uniform [0.3, 0.7]`.
+    pub fn describe(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let named = [
+            ("mu_c", &self.mu_c, ""),
+            ("belt_speed", &self.belt_speed, " m/s"),
+            ("shape", &self.shape, " m per vertex coordinate"),
+            ("pin_x", &self.pin_x, " m added"),
+            ("pin_y", &self.pin_y, " m added"),
+            ("pin_radius", &self.pin_radius, " m added"),
+            ("pose_theta", &self.pose_theta, "° added"),
+            ("pose_y", &self.pose_y, " m added"),
+        ];
+        for (name, d, unit) in named {
+            if let Some(d) = d {
+                out.push(format!("{name}: {}{unit}", d.describe()));
+            }
+        }
+        out.push(format!("support: {}", self.support.describe()));
+        out
+    }
+}

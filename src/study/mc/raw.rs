@@ -1,0 +1,128 @@
+//! The study file as written: serde structs mirroring the TOML (README "Study format"), each with
+//! `deny_unknown_fields` so a misspelt key is a located error. Values are checked in
+//! [`super::compile`]; this layer only fixes names and types.
+//!
+//! ```toml
+//! scenario = "../scenarios/quickstart.toml"   # relative to this file
+//! seed = 1
+//! samples = 1000                              # per sweep point
+//!
+//! [uncertain.mu_c]                            # one table per uncertain parameter
+//! distribution = "uniform"
+//! min = 0.3
+//! max = 0.7
+//!
+//! [uncertain.support]
+//! model = "tripod"
+//!
+//! [[sweep]]
+//! parameter = "shape.sd"
+//! values = [0.0, 0.0002, 0.0005]
+//! ```
+
+use serde::Deserialize;
+
+/// The whole study file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawStudy {
+    /// Names the report folder (default: the file name without `.toml`).
+    pub name: Option<String>,
+    /// The scenario file, relative to the study file.
+    pub scenario: String,
+    /// Seed of the study's random streams (default 1).
+    pub seed: Option<u64>,
+    /// Samples per sweep point (default 1000).
+    pub samples: Option<u64>,
+    #[serde(default)]
+    pub uncertain: RawUncertain,
+    #[serde(default)]
+    pub sweep: Vec<RawSweep>,
+}
+
+/// `[uncertain]`: every parameter is optional; a missing one keeps the scenario's nominal value.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawUncertain {
+    /// Pin–part friction μc (its value; one draw per sample, used at every pin).
+    pub mu_c: Option<RawDistribution>,
+    /// Belt speed (m/s, its value).
+    pub belt_speed: Option<RawDistribution>,
+    /// Error added to each coordinate of each vertex of the part (m).
+    pub shape: Option<RawDistribution>,
+    /// Error added to each pin's x (m).
+    pub pin_x: Option<RawDistribution>,
+    /// Error added to each pin's y (m).
+    pub pin_y: Option<RawDistribution>,
+    /// Error added to each pin's radius (m).
+    pub pin_radius: Option<RawDistribution>,
+    /// Error added to the entry orientation drawn by the scenario's feed (degrees).
+    pub pose_theta: Option<RawDistribution>,
+    /// Error added to the entry lateral offset drawn by the scenario's feed (m).
+    pub pose_y: Option<RawDistribution>,
+    /// How the part's weight rests on the belt.
+    pub support: Option<RawSupport>,
+}
+
+/// Kinds of distribution.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DistributionKind {
+    Fixed,
+    Uniform,
+    Normal,
+    Triangular,
+}
+
+/// A distribution of one number: `fixed` (value), `uniform` (min, max), `normal` (mean, sd,
+/// optional min/max truncation), `triangular` (min, mode, max).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDistribution {
+    pub distribution: Option<DistributionKind>,
+    pub value: Option<f64>,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub mean: Option<f64>,
+    pub sd: Option<f64>,
+    pub mode: Option<f64>,
+}
+
+/// Support models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SupportModel {
+    /// Uniform pressure over the footprint.
+    Uniform,
+    /// A random tripod per sample (SPEC §2).
+    Tripod,
+    /// A random smooth pressure density per sample (see [`super::smooth_support`]).
+    Smooth,
+}
+
+/// `[uncertain.support]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSupport {
+    pub model: Option<SupportModel>,
+    /// Smooth: number of Gaussian bumps (default 3).
+    pub bumps: Option<f64>,
+    /// Smooth: bump width (standard deviation) in units of the part's a (default 0.3).
+    pub width: Option<f64>,
+    /// Smooth: largest bump height relative to the base pressure (default 2).
+    pub contrast: Option<f64>,
+    /// Smooth: number of support points (default 48).
+    pub points: Option<f64>,
+}
+
+/// `[[sweep]]`: one swept parameter. `parameter` is `NAME` (the parameter fixed at each value) or
+/// `NAME.FIELD` (one field of its distribution, e.g. `shape.sd`, `mu_c.max`, `support.width`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSweep {
+    pub parameter: String,
+    pub values: Option<Vec<f64>>,
+    pub from: Option<f64>,
+    pub to: Option<f64>,
+    pub steps: Option<u32>,
+}

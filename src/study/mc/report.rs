@@ -1,0 +1,297 @@
+//! The study's report: per sweep point the outcome counts, the success rate and every class's share
+//! with its 95% Wilson score interval, contacts per part and latency quantiles; as JSON, as a
+//! Markdown table (the terminal output) and as a Markdown document headed by the command that
+//! regenerates it. The report is a pure function of the [`StudyHeader`] and the integer tallies —
+//! no wall-clock time, no floating sums over samples — so one run and merged shards give the same
+//! bytes.
+
+use super::tally::PointTally;
+use super::Study;
+use crate::engine::metrics::wilson_interval;
+use crate::engine::{OutcomeCounts, PartOutcome};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Everything about a study a report needs besides the counts; stored in every shard.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StudyHeader {
+    pub study: String,
+    pub study_file: String,
+    pub scenario_file: String,
+    pub scenario: String,
+    pub fidelity: String,
+    pub study_hash: String,
+    pub scenario_hash: String,
+    pub pinfeed_version: String,
+    pub seed: u64,
+    pub samples_per_point: u64,
+    pub sweep: Vec<SweepOut>,
+    /// Parameter values of each point (one per swept parameter).
+    pub points: Vec<Vec<f64>>,
+    /// The uncertain parameters as declared (before sweeps).
+    pub uncertain: Vec<String>,
+    /// The command that regenerates the report.
+    pub command: String,
+}
+
+/// A swept parameter in the report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepOut {
+    pub parameter: String,
+    pub values: Vec<f64>,
+}
+
+impl StudyHeader {
+    /// The header of a loaded study.
+    pub fn of(study: &Study) -> StudyHeader {
+        let file = study.file.display().to_string();
+        StudyHeader {
+            study: study.name.clone(),
+            study_file: file.clone(),
+            scenario_file: study.scenario_file.display().to_string(),
+            scenario: study.scene.name.clone(),
+            fidelity: study.scene.contact.fidelity.name().to_string(),
+            study_hash: super::hash::hex(study.study_hash),
+            scenario_hash: super::hash::hex(study.scenario_hash),
+            pinfeed_version: env!("CARGO_PKG_VERSION").to_string(),
+            seed: study.seed,
+            samples_per_point: study.samples,
+            sweep: study
+                .axes
+                .iter()
+                .map(|a| SweepOut {
+                    parameter: a.parameter.clone(),
+                    values: a.values.clone(),
+                })
+                .collect(),
+            points: study.point_values.clone(),
+            uncertain: study.declared.describe(),
+            command: format!(
+                "cargo run --release -- mc {file} --samples {}",
+                study.samples
+            ),
+        }
+    }
+
+    /// Total samples of the study.
+    pub fn total_samples(&self) -> u64 {
+        self.points.len() as u64 * self.samples_per_point
+    }
+}
+
+/// A share with its 95% Wilson interval.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Share {
+    pub count: u64,
+    pub rate: f64,
+    pub ci95: [f64; 2],
+}
+
+/// Latency quantiles (s).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Latency {
+    pub p50: f64,
+    pub p90: f64,
+    pub p99: f64,
+    pub max: f64,
+}
+
+/// One sweep point of the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PointReport {
+    /// Swept parameter → value.
+    pub values: BTreeMap<String, f64>,
+    pub samples: u64,
+    pub outcomes: OutcomeCounts,
+    pub success_rate: f64,
+    pub success_ci95: [f64; 2],
+    /// Every class's share with its interval.
+    pub shares: BTreeMap<String, Share>,
+    pub contacts_per_part: f64,
+    /// Of the parts that reached the end of the belt.
+    pub latency_s: Option<Latency>,
+    pub shape_redraws: u64,
+    pub other_redraws: u64,
+}
+
+/// The whole report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct McReport {
+    #[serde(flatten)]
+    pub header: StudyHeader,
+    /// What one sample is.
+    pub sample: String,
+    pub total_samples: u64,
+    pub results: Vec<PointReport>,
+}
+
+/// What a sample is, in one sentence (README and `sample` module docs).
+pub const SAMPLE_MEANING: &str =
+    "one part through a freshly perturbed copy of the line (independent samples; no part-part collisions)";
+
+fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
+    let n = t.samples;
+    let mut shares = BTreeMap::new();
+    for c in PartOutcome::ALL {
+        let k = t.outcomes.get(c);
+        shares.insert(
+            c.name().to_string(),
+            Share {
+                count: k,
+                rate: if n > 0 { k as f64 / n as f64 } else { 0.0 },
+                ci95: wilson_interval(k, n),
+            },
+        );
+    }
+    let h = &t.latency_us;
+    let latency = (!h.is_empty()).then(|| {
+        let q = |p: f64| h.value_at_quantile(p) as f64 * 1e-6;
+        Latency {
+            p50: q(0.5),
+            p90: q(0.9),
+            p99: q(0.99),
+            max: h.max() as f64 * 1e-6,
+        }
+    });
+    let success = shares["success"];
+    PointReport {
+        values: header
+            .sweep
+            .iter()
+            .zip(&header.points[j])
+            .map(|(a, &v)| (a.parameter.clone(), v))
+            .collect(),
+        samples: n,
+        outcomes: t.outcomes,
+        success_rate: success.rate,
+        success_ci95: success.ci95,
+        shares,
+        contacts_per_part: if n > 0 {
+            t.contacts as f64 / n as f64
+        } else {
+            0.0
+        },
+        latency_s: latency,
+        shape_redraws: t.shape_redraws,
+        other_redraws: t.other_redraws,
+    }
+}
+
+/// Build the report from the header and the tally of every point (index order).
+pub fn build(header: &StudyHeader, tallies: &[PointTally]) -> McReport {
+    McReport {
+        header: header.clone(),
+        sample: SAMPLE_MEANING.to_string(),
+        total_samples: tallies.iter().map(|t| t.samples).sum(),
+        results: tallies
+            .iter()
+            .enumerate()
+            .map(|(j, t)| point_report(header, j, t))
+            .collect(),
+    }
+}
+
+/// The report as pretty JSON with a final newline.
+pub fn json(r: &McReport) -> String {
+    serde_json::to_string_pretty(r).expect("a report serialises") + "\n"
+}
+
+fn pct(s: &Share) -> String {
+    format!(
+        "{:.1}% [{:.1}, {:.1}]",
+        100.0 * s.rate,
+        100.0 * s.ci95[0],
+        100.0 * s.ci95[1]
+    )
+}
+
+/// The per-point table (Markdown; also what the terminal shows).
+pub fn table(r: &McReport) -> String {
+    // Classes shown: success always, the others where any point has one.
+    let shown: Vec<PartOutcome> = PartOutcome::ALL
+        .into_iter()
+        .filter(|&c| c == PartOutcome::Success || r.results.iter().any(|p| p.outcomes.get(c) > 0))
+        .collect();
+    let mut head: Vec<String> = r.header.sweep.iter().map(|a| a.parameter.clone()).collect();
+    head.push("samples".into());
+    for c in &shown {
+        head.push(format!("{} % [95% CI]", c.name()));
+    }
+    head.extend(
+        [
+            "contacts/part",
+            "latency p50 s",
+            "p99 s",
+            "redrawn shapes",
+            "other redraws",
+        ]
+        .map(String::from),
+    );
+    let mut s = format!("| {} |\n|{}\n", head.join(" | "), "---|".repeat(head.len()));
+    for p in &r.results {
+        let mut row: Vec<String> = r
+            .header
+            .sweep
+            .iter()
+            .map(|a| format!("{}", p.values[&a.parameter]))
+            .collect();
+        row.push(p.samples.to_string());
+        for c in &shown {
+            row.push(pct(&p.shares[c.name()]));
+        }
+        row.push(format!("{:.2}", p.contacts_per_part));
+        match p.latency_s {
+            Some(l) => {
+                row.push(format!("{:.2}", l.p50));
+                row.push(format!("{:.2}", l.p99));
+            }
+            None => row.extend(["–".to_string(), "–".to_string()]),
+        }
+        row.push(p.shape_redraws.to_string());
+        row.push(p.other_redraws.to_string());
+        s.push_str(&format!("| {} |\n", row.join(" | ")));
+    }
+    s
+}
+
+/// The Markdown document: the regenerating command, what was studied, the figure and the table.
+pub fn markdown(r: &McReport, figure: &str) -> String {
+    let h = &r.header;
+    let mut s = format!(
+        "# Monte Carlo study: {}\n\nRegenerate (writes this file, report.json and {figure}):\n\n```\n{}\n```\n\n",
+        h.study, h.command
+    );
+    s.push_str(&format!(
+        "Scenario `{}` (`{}`, {} model), seed {}, {} samples per sweep point, {} point{}, {} samples in all. \
+         A sample is {}. Intervals are 95% Wilson score intervals. Study hash {} (pinfeed {}).\n\n",
+        h.scenario_file,
+        h.scenario,
+        h.fidelity,
+        h.seed,
+        h.samples_per_point,
+        h.points.len(),
+        if h.points.len() == 1 { "" } else { "s" },
+        r.total_samples,
+        r.sample,
+        h.study_hash,
+        h.pinfeed_version
+    ));
+    s.push_str("Uncertain parameters:\n\n");
+    for u in &h.uncertain {
+        s.push_str(&format!("- {u}\n"));
+    }
+    for a in &h.sweep {
+        s.push_str(&format!(
+            "- swept: `{}` over {}\n",
+            a.parameter,
+            a.values
+                .iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    s.push_str(&format!("\n![sensitivity]({figure})\n\n"));
+    s.push_str(&table(r));
+    s
+}

@@ -1,0 +1,420 @@
+//! Sharding a study over machines (DESIGN.md "Scaling past one machine").
+//!
+//! * `--shard k/n` (k 0-based) runs global samples [⌊k·T/n⌋, ⌊(k+1)·T/n⌋) of T. With `--shard /n`
+//!   (or `auto/n`) k comes from the batch scheduler: `SLURM_ARRAY_TASK_ID` (minus
+//!   `SLURM_ARRAY_TASK_MIN` when set, so `--array=1-8` works too), else `JOB_COMPLETION_INDEX`
+//!   (Kubernetes Indexed Jobs).
+//! * A shard file is self-describing JSON: format tag and version, the study header (name, study
+//!   and scenario hashes, seed, samples per point, sweep grid, pinfeed version), the shard's index
+//!   and sample range, and per touched point the integer counts and the latency histogram
+//!   serialised as HdrHistogram V2 (base64).
+//! * It is written atomically ([`super::atomic`]), so a killed job leaves either no shard file or a
+//!   complete one.
+//! * [`merge`] checks that the shards fit together (same format, pinfeed version, study hash, seed
+//!   and grid; sample ranges that cover [0, T) exactly once; counts that add up to each range) and
+//!   adds them exactly.
+
+use super::tally::{add_count, latency_histogram, PointTally};
+use super::{report::StudyHeader, StudyError};
+use crate::engine::{OutcomeCounts, PartOutcome};
+use base64::Engine as _;
+use hdrhistogram::serialization::{Deserializer, Serializer, V2Serializer};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+pub use super::atomic::write_atomic;
+
+/// The format tag of a shard file.
+pub const FORMAT: &str = "pinfeed-mc-shard";
+/// The shard file format version.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Which shard to run: index k of n.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShardSpec {
+    pub index: u64,
+    pub count: u64,
+}
+
+impl ShardSpec {
+    /// Parse `k/n`, `/n` or `auto/n`; a missing k is read with `env` (the process environment in
+    /// the CLI) from SLURM_ARRAY_TASK_ID (− SLURM_ARRAY_TASK_MIN) or JOB_COMPLETION_INDEX.
+    pub fn parse(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<ShardSpec, String> {
+        let usage = "write --shard K/N with 0 ≤ K < N (K 0-based), or --shard /N to take K from SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX";
+        let (k, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("--shard '{text}': {usage}"))?;
+        let count: u64 = n
+            .trim()
+            .parse()
+            .map_err(|_| format!("--shard '{text}': N must be a whole number; {usage}"))?;
+        if count == 0 {
+            return Err(format!("--shard '{text}': N must be at least 1"));
+        }
+        let k = k.trim();
+        let index = if k.is_empty() || k == "auto" {
+            from_scheduler(env).map_err(|e| format!("--shard '{text}': {e}"))?
+        } else {
+            k.parse()
+                .map_err(|_| format!("--shard '{text}': K must be a whole number; {usage}"))?
+        };
+        if index >= count {
+            return Err(format!(
+                "--shard '{text}': shard index {index} is out of range for {count} shards (K is 0-based: 0 to {})",
+                count - 1
+            ));
+        }
+        Ok(ShardSpec { index, count })
+    }
+
+    /// The global sample range of this shard out of `total`.
+    pub fn range(&self, total: u64) -> Range<u64> {
+        let at = |k: u64| (k as u128 * total as u128 / self.count as u128) as u64;
+        at(self.index)..at(self.index + 1)
+    }
+
+    /// The shard file's name: `shard-0003-of-0008.json`.
+    pub fn file_name(&self) -> String {
+        format!("shard-{:04}-of-{:04}.json", self.index, self.count)
+    }
+}
+
+fn from_scheduler(env: &dyn Fn(&str) -> Option<String>) -> Result<u64, String> {
+    let num = |var: &str| -> Result<Option<u64>, String> {
+        match env(var) {
+            None => Ok(None),
+            Some(v) if v.trim().is_empty() => Ok(None),
+            Some(v) => v
+                .trim()
+                .parse()
+                .map(Some)
+                .map_err(|_| format!("{var}='{v}' is not a whole number")),
+        }
+    };
+    if let Some(id) = num("SLURM_ARRAY_TASK_ID")? {
+        let min = num("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
+        return id.checked_sub(min).ok_or_else(|| {
+            format!("SLURM_ARRAY_TASK_ID ({id}) is below SLURM_ARRAY_TASK_MIN ({min})")
+        });
+    }
+    if let Some(k) = num("JOB_COMPLETION_INDEX")? {
+        return Ok(k);
+    }
+    Err(
+        "no shard index given and neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX is set"
+            .into(),
+    )
+}
+
+/// One point's counts in a shard file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardPoint {
+    pub point: usize,
+    pub samples: u64,
+    /// Count per outcome class (every class listed).
+    pub outcomes: BTreeMap<String, u64>,
+    pub contacts: u64,
+    pub shape_redraws: u64,
+    pub other_redraws: u64,
+    /// Latency histogram (µs), HdrHistogram V2 serialisation, base64.
+    pub latency_us_hdr_v2: String,
+}
+
+/// Which shard a file holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardId {
+    pub index: u64,
+    pub count: u64,
+}
+
+/// A shard file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardFile {
+    pub format: String,
+    pub format_version: u32,
+    pub header: StudyHeader,
+    pub shard: ShardId,
+    /// Global sample range [start, end).
+    pub samples: [u64; 2],
+    pub points: Vec<ShardPoint>,
+}
+
+impl ShardFile {
+    /// Build a shard file from the tallies of the points its range touches.
+    pub fn new(
+        header: &StudyHeader,
+        spec: ShardSpec,
+        range: Range<u64>,
+        tallies: &BTreeMap<usize, PointTally>,
+    ) -> ShardFile {
+        let points = tallies
+            .iter()
+            .map(|(&point, t)| {
+                let mut bytes = Vec::new();
+                V2Serializer::new()
+                    .serialize(&t.latency_us, &mut bytes)
+                    .expect("serialising a histogram to memory cannot fail");
+                ShardPoint {
+                    point,
+                    samples: t.samples,
+                    outcomes: PartOutcome::ALL
+                        .iter()
+                        .map(|&c| (c.name().to_string(), t.outcomes.get(c)))
+                        .collect(),
+                    contacts: t.contacts,
+                    shape_redraws: t.shape_redraws,
+                    other_redraws: t.other_redraws,
+                    latency_us_hdr_v2: base64::engine::general_purpose::STANDARD.encode(bytes),
+                }
+            })
+            .collect();
+        ShardFile {
+            format: FORMAT.to_string(),
+            format_version: FORMAT_VERSION,
+            header: header.clone(),
+            shard: ShardId {
+                index: spec.index,
+                count: spec.count,
+            },
+            samples: [range.start, range.end],
+            points,
+        }
+    }
+}
+
+impl ShardPoint {
+    /// The exact tally this point carries.
+    fn tally(&self) -> Result<PointTally, String> {
+        let mut outcomes = OutcomeCounts::default();
+        for (name, &n) in &self.outcomes {
+            let c = PartOutcome::ALL
+                .into_iter()
+                .find(|c| c.name() == name)
+                .ok_or_else(|| format!("unknown outcome class `{name}`"))?;
+            add_count(&mut outcomes, c, n);
+        }
+        if outcomes.total() != self.samples {
+            return Err(format!(
+                "point {}: the outcome counts add up to {}, not to its {} samples",
+                self.point,
+                outcomes.total(),
+                self.samples
+            ));
+        }
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(&self.latency_us_hdr_v2)
+            .map_err(|e| format!("point {}: latency histogram is not base64: {e}", self.point))?;
+        let h: hdrhistogram::Histogram<u64> = Deserializer::new()
+            .deserialize(&mut bytes.as_slice())
+            .map_err(|e| {
+                format!(
+                    "point {}: latency histogram is not HdrHistogram V2: {e:?}",
+                    self.point
+                )
+            })?;
+        let mut latency_us = latency_histogram();
+        latency_us.add(&h).map_err(|e| {
+            format!(
+                "point {}: latency histogram out of range: {e:?}",
+                self.point
+            )
+        })?;
+        Ok(PointTally {
+            samples: self.samples,
+            outcomes,
+            contacts: self.contacts,
+            shape_redraws: self.shape_redraws,
+            other_redraws: self.other_redraws,
+            latency_us,
+        })
+    }
+}
+
+/// Read a shard file.
+pub fn read(path: &Path) -> Result<ShardFile, StudyError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| StudyError::Shard(format!("{}: cannot read: {e}", path.display())))?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+        StudyError::Shard(format!(
+            "{}: not a pinfeed shard file (not JSON: {e})",
+            path.display()
+        ))
+    })?;
+    if value.get("format").and_then(|f| f.as_str()) != Some(FORMAT) {
+        return Err(StudyError::Shard(format!(
+            "{}: not a pinfeed shard file (no \"format\": \"{FORMAT}\")",
+            path.display()
+        )));
+    }
+    let v = value.get("format_version").and_then(|v| v.as_u64());
+    if v != Some(FORMAT_VERSION as u64) {
+        return Err(StudyError::Shard(format!(
+            "{}: shard format version {} is not supported (this pinfeed reads version {FORMAT_VERSION})",
+            path.display(),
+            v.map_or("missing".to_string(), |v| v.to_string())
+        )));
+    }
+    serde_json::from_value(value)
+        .map_err(|e| StudyError::Shard(format!("{}: malformed shard file: {e}", path.display())))
+}
+
+/// Check that the shards fit together and add them: the common header and each point's tally.
+pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTally>), StudyError> {
+    let bad = |m: String| Err(StudyError::Shard(m));
+    let Some((first_path, first)) = files.first() else {
+        return bad("no shard files given".into());
+    };
+    let h0 = &first.header;
+    let p0 = first_path.display();
+    for (path, f) in &files[1..] {
+        let h = &f.header;
+        let p = path.display();
+        if h.pinfeed_version != h0.pinfeed_version {
+            return bad(format!(
+                "{p} was written by pinfeed {} but {p0} by pinfeed {}: shards must come from the same version",
+                h.pinfeed_version, h0.pinfeed_version
+            ));
+        }
+        if h.study_hash != h0.study_hash {
+            return bad(format!(
+                "{p} belongs to a different study than {p0} (study hash {} vs {}: the study file, its scenario or --samples differ)",
+                h.study_hash, h0.study_hash
+            ));
+        }
+        if h.seed != h0.seed || h.samples_per_point != h0.samples_per_point || h.points != h0.points
+        {
+            return bad(format!(
+                "{p} and {p0} have the same study hash but a different seed, sample count or sweep grid"
+            ));
+        }
+    }
+    let total = h0.total_samples();
+    let mut order: Vec<&(PathBuf, ShardFile)> = files.iter().collect();
+    order.sort_by_key(|(_, f)| (f.samples[0], f.samples[1]));
+    let mut covered = 0u64;
+    let mut last: Option<&Path> = None;
+    for (path, f) in &order {
+        let [a, b] = f.samples;
+        if a > b || b > total {
+            return bad(format!(
+                "{}: sample range [{a}, {b}) does not lie within the study's {total} samples",
+                path.display()
+            ));
+        }
+        if a == b {
+            continue;
+        }
+        if a < covered {
+            return bad(format!(
+                "shards overlap: {} covers samples [{a}, {b}) but {} already covers up to {covered}",
+                path.display(),
+                last.map_or("another shard".into(), |p| p.display().to_string())
+            ));
+        }
+        if a > covered {
+            return bad(format!(
+                "samples [{covered}, {a}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?)"
+            ));
+        }
+        covered = b;
+        last = Some(path);
+    }
+    if covered < total {
+        return bad(format!(
+            "samples [{covered}, {total}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?)"
+        ));
+    }
+    let mut tallies: Vec<PointTally> = (0..h0.points.len())
+        .map(|_| PointTally::default())
+        .collect();
+    let n = h0.samples_per_point;
+    for (path, f) in &order {
+        let [a, b] = f.samples;
+        for sp in &f.points {
+            let t = sp
+                .tally()
+                .map_err(|e| StudyError::Shard(format!("{}: {e}", path.display())))?;
+            // The samples of this point inside the shard's range.
+            let (lo, hi) = (sp.point as u64 * n, (sp.point as u64 + 1) * n);
+            let expected = b.min(hi).saturating_sub(a.max(lo));
+            if sp.point >= tallies.len() || t.samples != expected {
+                return bad(format!(
+                    "{}: point {} holds {} samples but the shard's range [{a}, {b}) gives it {expected}",
+                    path.display(),
+                    sp.point,
+                    t.samples
+                ));
+            }
+            tallies[sp.point]
+                .merge(&t)
+                .map_err(|e| StudyError::Shard(format!("{}: {e}", path.display())))?;
+        }
+    }
+    for (j, t) in tallies.iter().enumerate() {
+        if t.samples != n {
+            return bad(format!(
+                "point {j} has {} samples after merging, expected {n}: a shard lacks the counts of its range",
+                t.samples
+            ));
+        }
+    }
+    Ok((h0.clone(), tallies))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env_of(vars: &[(&str, &str)]) -> impl Fn(&str) -> Option<String> {
+        let v: Vec<(String, String)> = vars
+            .iter()
+            .map(|(a, b)| (a.to_string(), b.to_string()))
+            .collect();
+        move |k| v.iter().find(|(a, _)| a == k).map(|(_, b)| b.clone())
+    }
+
+    #[test]
+    fn shard_spec_parses_and_takes_index_from_schedulers() {
+        let none = env_of(&[]);
+        assert_eq!(
+            ShardSpec::parse("2/4", &none).unwrap(),
+            ShardSpec { index: 2, count: 4 }
+        );
+        assert!(ShardSpec::parse("4/4", &none)
+            .unwrap_err()
+            .contains("0-based"));
+        assert!(ShardSpec::parse("1/0", &none).is_err());
+        assert!(ShardSpec::parse("3", &none).is_err());
+        assert!(ShardSpec::parse("/4", &none)
+            .unwrap_err()
+            .contains("SLURM_ARRAY_TASK_ID"));
+        let slurm = env_of(&[("SLURM_ARRAY_TASK_ID", "5"), ("SLURM_ARRAY_TASK_MIN", "1")]);
+        assert_eq!(ShardSpec::parse("/8", &slurm).unwrap().index, 4);
+        let k8s = env_of(&[("JOB_COMPLETION_INDEX", "3")]);
+        assert_eq!(ShardSpec::parse("auto/8", &k8s).unwrap().index, 3);
+        let junk = env_of(&[("JOB_COMPLETION_INDEX", "x")]);
+        assert!(ShardSpec::parse("/8", &junk)
+            .unwrap_err()
+            .contains("not a whole number"));
+    }
+
+    #[test]
+    fn ranges_partition_the_samples() {
+        for total in [0u64, 1, 7, 1000, 1001] {
+            for n in 1..=9u64 {
+                let mut next = 0;
+                for k in 0..n {
+                    let r = ShardSpec { index: k, count: n }.range(total);
+                    assert_eq!(r.start, next);
+                    next = r.end;
+                }
+                assert_eq!(next, total);
+            }
+        }
+    }
+}

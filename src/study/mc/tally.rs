@@ -1,0 +1,80 @@
+//! Exact accumulators of one sweep point: integer counts per outcome class, contacts and redraws,
+//! and an HDR histogram of latencies (µs, 3 significant digits, as the line's metrics). Adding two
+//! tallies is exact and commutative, so shards merge to the same numbers as one run.
+
+use super::sample::SampleResult;
+use crate::engine::{OutcomeCounts, PartOutcome};
+use hdrhistogram::Histogram;
+
+/// Counts of one sweep point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointTally {
+    pub samples: u64,
+    pub outcomes: OutcomeCounts,
+    /// Pin encounters, summed over the samples.
+    pub contacts: u64,
+    pub shape_redraws: u64,
+    pub other_redraws: u64,
+    /// Entry → exit of the parts that reached the end of the belt (µs).
+    pub latency_us: Histogram<u64>,
+}
+
+/// An empty latency histogram: 1 µs to 10⁶ s, 3 significant digits.
+pub fn latency_histogram() -> Histogram<u64> {
+    Histogram::new_with_bounds(1, 1_000_000_000_000, 3)
+        .expect("valid histogram bounds: 1 µs to 10⁶ s, 3 significant digits")
+}
+
+impl Default for PointTally {
+    fn default() -> Self {
+        PointTally {
+            samples: 0,
+            outcomes: OutcomeCounts::default(),
+            contacts: 0,
+            shape_redraws: 0,
+            other_redraws: 0,
+            latency_us: latency_histogram(),
+        }
+    }
+}
+
+impl PointTally {
+    /// Count one sample.
+    pub fn add(&mut self, r: &SampleResult) {
+        self.samples += 1;
+        self.outcomes.add(r.outcome);
+        self.contacts += r.contacts as u64;
+        self.shape_redraws += r.shape_redraws as u64;
+        self.other_redraws += r.other_redraws as u64;
+        if let Some(us) = r.latency_us {
+            self.latency_us.saturating_record(us);
+        }
+    }
+
+    /// Add another tally of the same point.
+    pub fn merge(&mut self, o: &PointTally) -> Result<(), String> {
+        self.samples += o.samples;
+        for c in PartOutcome::ALL {
+            add_count(&mut self.outcomes, c, o.outcomes.get(c));
+        }
+        self.contacts += o.contacts;
+        self.shape_redraws += o.shape_redraws;
+        self.other_redraws += o.other_redraws;
+        self.latency_us
+            .add(&o.latency_us)
+            .map_err(|e| format!("latency histograms do not add up: {e:?}"))
+    }
+}
+
+/// Add `n` to the count of class `c`.
+pub fn add_count(counts: &mut OutcomeCounts, c: PartOutcome, n: u64) {
+    match c {
+        PartOutcome::Success => counts.success += n,
+        PartOutcome::WrongOrientation => counts.wrong_orientation += n,
+        PartOutcome::Collision => counts.collision += n,
+        PartOutcome::MultiContact => counts.multi_contact += n,
+        PartOutcome::OffBelt => counts.off_belt += n,
+        PartOutcome::Jam => counts.jam += n,
+        PartOutcome::Solver => counts.solver += n,
+    }
+}

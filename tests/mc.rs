@@ -1,0 +1,534 @@
+//! Monte Carlo studies (issue 6 acceptance): one run and merged shards give the same bytes, the
+//! thread count changes nothing, `merge` refuses shards that do not fit, an interrupted shard job
+//! leaves no shard file, bad study files give located errors, and perturbations are reproducible
+//! per sample index.
+
+use pinfeed::study::mc::{self, sample};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn scenario() -> String {
+    format!("{}/scenarios/quickstart.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh, empty folder for one test.
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pinfeed-mc-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Every uncertain parameter, a 3 × 2 grid and a handful of samples per point.
+const GRID_STUDY: &str = r#"
+name = "grid"
+seed = 3
+samples = 5
+
+[uncertain.mu_c]
+distribution = "uniform"
+min = 0.3
+max = 0.7
+
+[uncertain.belt_speed]
+distribution = "normal"
+mean = 0.05
+sd = 0.005
+min = 0.03
+
+[uncertain.shape]
+distribution = "normal"
+sd = 0.0002
+
+[uncertain.pin_x]
+distribution = "triangular"
+min = -0.001
+mode = 0.0
+max = 0.001
+
+[uncertain.pin_y]
+distribution = "normal"
+sd = 0.001
+
+[uncertain.pin_radius]
+distribution = "uniform"
+min = -0.0005
+max = 0.0005
+
+[uncertain.pose_theta]
+distribution = "normal"
+sd = 2.0
+
+[uncertain.pose_y]
+distribution = "uniform"
+min = -0.001
+max = 0.001
+
+[uncertain.support]
+model = "tripod"
+
+[[sweep]]
+parameter = "shape.sd"
+values = [0.0, 0.0005, 0.001]
+
+[[sweep]]
+parameter = "mu_c.max"
+from = 0.6
+to = 0.8
+steps = 2
+"#;
+
+fn write_study(dir: &Path, body: &str) -> PathBuf {
+    let p = dir.join("study.toml");
+    std::fs::write(&p, format!("scenario = \"{}\"\n{body}", scenario())).unwrap();
+    p
+}
+
+fn pinfeed(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(args)
+        .output()
+        .expect("run pinfeed")
+}
+
+fn ok(args: &[&str]) -> Output {
+    let out = pinfeed(args);
+    assert!(
+        out.status.success(),
+        "pinfeed {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The command must fail with exit code 1, print nothing on stdout, and not panic; returns stderr.
+fn refused(args: &[&str]) -> String {
+    let out = pinfeed(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert!(out.stdout.is_empty(), "{args:?} printed a result");
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    stderr
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+const REPORT_FILES: [&str; 3] = ["report.md", "report.json", "sensitivity.svg"];
+
+#[test]
+fn four_merged_shards_give_the_same_bytes_as_one_run() {
+    let d = tmp("shards");
+    let study = write_study(&d, GRID_STUDY);
+    let full = d.join("full");
+    let one = ok(&["mc", s(&study), "--json", "--quiet", "--out", s(&full)]);
+    let shards = d.join("shards");
+    for k in 0..4 {
+        ok(&[
+            "mc",
+            s(&study),
+            "--shard",
+            &format!("{k}/4"),
+            "--out",
+            s(&shards),
+            "--quiet",
+        ]);
+    }
+    // Given in any order.
+    let files: Vec<String> = [3, 1, 0, 2]
+        .iter()
+        .map(|k| s(&shards.join(format!("shard-000{k}-of-0004.json"))).to_string())
+        .collect();
+    let merged = d.join("merged");
+    let mut args = vec!["merge", "--json", "--quiet", "--out", s(&merged)];
+    args.extend(files.iter().map(String::as_str));
+    let m = ok(&args);
+    assert_eq!(one.stdout, m.stdout, "JSON on stdout differs");
+    for f in REPORT_FILES {
+        let a = std::fs::read(full.join(f)).unwrap();
+        let b = std::fs::read(merged.join(f)).unwrap();
+        assert!(
+            a == b,
+            "{f} differs between the full run and the merged shards"
+        );
+    }
+    // The report covers every sample of the 3 × 2 grid.
+    let r: serde_json::Value = serde_json::from_slice(&one.stdout).unwrap();
+    assert_eq!(r["total_samples"], 30);
+    assert_eq!(r["results"].as_array().unwrap().len(), 6);
+    // The table (not JSON) is the same too.
+    let t1 = ok(&["mc", s(&study), "--out", s(&full)]);
+    let mut args = vec!["merge", "--out", s(&merged)];
+    args.extend(files.iter().map(String::as_str));
+    let t2 = ok(&args);
+    let table = |o: &Output| {
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter(|l| l.starts_with('|'))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(table(&t1), table(&t2));
+    assert!(table(&t1).contains("| shape.sd | mu_c.max | samples | success % [95% CI]"));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn one_and_two_threads_give_identical_results() {
+    let d = tmp("threads");
+    let body = r#"
+samples = 24
+[uncertain.mu_c]
+distribution = "uniform"
+min = 0.3
+max = 0.7
+[uncertain.support]
+model = "smooth"
+bumps = 2
+points = 24
+"#;
+    let study = write_study(&d, body);
+    let (a, b) = (d.join("a"), d.join("b"));
+    ok(&["mc", s(&study), "--threads", "1", "--quiet", "--out", s(&a)]);
+    ok(&["mc", s(&study), "--threads", "2", "--quiet", "--out", s(&b)]);
+    for f in REPORT_FILES {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    // And sample by sample, through the library.
+    let st = mc::load(&study, None).unwrap();
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            use rayon::prelude::*;
+            (0..st.total_samples())
+                .into_par_iter()
+                .map(|g| mc::run::run_global(&st, g).unwrap())
+                .collect::<Vec<_>>()
+        })
+    };
+    assert_eq!(run(1), run(2));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn merge_refuses_shards_that_do_not_fit() {
+    let d = tmp("refuse");
+    let study = write_study(
+        &d,
+        "samples = 20\n[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = 0.4\nmax = 0.6\n",
+    );
+    let shards = d.join("shards");
+    // One folder per run (`label`): the same spec of another study must not overwrite a file.
+    let run_shard = |label: &str, spec: &str, extra: &[&str]| {
+        let dir = shards.join(label);
+        let mut args = vec![
+            "mc",
+            s(&study),
+            "--shard",
+            spec,
+            "--quiet",
+            "--out",
+            s(&dir),
+        ];
+        args.extend_from_slice(extra);
+        ok(&args);
+        let k: Vec<&str> = spec.split('/').collect();
+        dir.join(format!(
+            "shard-{:04}-of-{:04}.json",
+            k[0].parse::<u32>().unwrap(),
+            k[1].parse::<u32>().unwrap()
+        ))
+    };
+    let a0 = run_shard("a0", "0/2", &[]);
+    let a1 = run_shard("a1", "1/2", &[]);
+    let b1 = run_shard("b1", "1/3", &[]);
+    let merged = d.join("merged");
+    let merge = |files: &[&Path]| {
+        let mut args = vec!["merge", "--out", s(&merged)];
+        args.extend(files.iter().map(|p| s(p)));
+        refused(&args)
+    };
+    // Missing: half the samples.
+    let e = merge(&[&a0]);
+    assert!(e.contains("samples [10, 20) are missing"), "{e}");
+    // Overlapping: the same shard twice, and shards of different splits.
+    let e = merge(&[&a0, &a1, &a1]);
+    assert!(e.contains("shards overlap"), "{e}");
+    let e = merge(&[&a0, &a1, &b1]);
+    assert!(e.contains("shards overlap") && e.contains("[6, 13)"), "{e}");
+    // Mismatched: another sample count is another study.
+    let c1 = run_shard("c1", "1/2", &["--samples", "30"]);
+    let e = merge(&[&a0, &c1]);
+    assert!(e.contains("belongs to a different study"), "{e}");
+    // Another seed changes the study file, hence the hash.
+    let text = std::fs::read_to_string(&study).unwrap();
+    std::fs::write(
+        &study,
+        text.replace("samples = 20", "seed = 99\nsamples = 20"),
+    )
+    .unwrap();
+    let s1 = run_shard("seed", "1/2", &[]);
+    let e = merge(&[&a0, &s1]);
+    assert!(e.contains("different study"), "{e}");
+    // Another pinfeed version.
+    let v1 = d.join("v1.json");
+    let t = std::fs::read_to_string(&a1).unwrap();
+    std::fs::write(
+        &v1,
+        t.replace("\"pinfeed_version\": \"", "\"pinfeed_version\": \"9"),
+    )
+    .unwrap();
+    let e = merge(&[&a0, &v1]);
+    assert!(e.contains("same version"), "{e}");
+    // Counts that do not add up to the shard's range.
+    let bad = d.join("bad.json");
+    std::fs::write(&bad, t.replace("\"samples\": 10", "\"samples\": 9")).unwrap();
+    let e = merge(&[&a0, &bad]);
+    assert!(e.contains("add up"), "{e}");
+    // Not a shard at all.
+    let junk = d.join("junk.json");
+    std::fs::write(&junk, "{\"hello\": 1}").unwrap();
+    let e = merge(&[&junk]);
+    assert!(e.contains("not a pinfeed shard file"), "{e}");
+    assert!(!merged.exists(), "a refused merge wrote a report");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn an_interrupted_shard_job_leaves_no_shard_file() {
+    let d = tmp("interrupt");
+    let study = write_study(&d, "samples = 10000000\n");
+    let out = d.join("shards");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args([
+            "mc",
+            s(&study),
+            "--shard",
+            "0/1",
+            "--quiet",
+            "--out",
+            s(&out),
+        ])
+        .spawn()
+        .expect("start pinfeed");
+    std::thread::sleep(std::time::Duration::from_millis(700));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the job finished before it could be interrupted"
+    );
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success());
+    let left: Vec<String> = std::fs::read_dir(&out)
+        .map(|r| {
+            r.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .collect()
+        })
+        .unwrap_or_default();
+    assert!(
+        left.iter().all(|n| !n.starts_with("shard-")),
+        "partial shard file left behind: {left:?}"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+fn fixture(name: &str) -> String {
+    format!(
+        "{}/tests/fixtures/studies/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+/// `pinfeed mc FIXTURE` fails with `FILE:LINE:COLUMN: key `KEY`: ...` containing every word.
+fn assert_located(name: &str, line: usize, column: usize, key: &str, words: &[&str]) {
+    let out_dir = tmp(&format!("bad-{name}"));
+    let e = refused(&["mc", &fixture(name), "--out", s(&out_dir)]);
+    let head = format!("{name}:{line}:{column}: key `{key}`: ");
+    assert!(e.contains(&head), "{name}: expected '{head}' in:\n{e}");
+    for w in words {
+        assert!(e.contains(w), "{name}: expected '{w}' in:\n{e}");
+    }
+    assert!(
+        e.contains(&format!("{line} | ")),
+        "{name}: no excerpt:\n{e}"
+    );
+    std::fs::remove_dir_all(&out_dir).unwrap();
+}
+
+#[test]
+fn bad_study_files_give_located_errors() {
+    assert_located(
+        "unknown_key.toml",
+        5,
+        12,
+        "uncertain.mu_cc",
+        &["unknown field `mu_cc`", "`mu_c`"],
+    );
+    assert_located(
+        "negative_friction.toml",
+        7,
+        7,
+        "uncertain.mu_c.min",
+        &["mu_c must be at least 0", "-0.1"],
+    );
+    assert_located(
+        "wrong_field.toml",
+        9,
+        6,
+        "uncertain.pin_y.sd",
+        &["does not apply to this distribution, which takes min, max"],
+    );
+    assert_located(
+        "undeclared_sweep.toml",
+        6,
+        13,
+        "sweep[0].parameter",
+        &["[uncertain.shape] is not declared"],
+    );
+    assert_located(
+        "bad_sweep_value.toml",
+        9,
+        1,
+        "sweep[0]",
+        &["at mu_c = -0.2", "must be at least 0"],
+    );
+    assert_located(
+        "missing_scenario.toml",
+        2,
+        12,
+        "scenario",
+        &["cannot read the scenario", "relative to the study file"],
+    );
+    assert_located(
+        "wrong_type.toml",
+        3,
+        11,
+        "samples",
+        &["invalid type: string \"many\""],
+    );
+    assert_located(
+        "bad_support.toml",
+        6,
+        9,
+        "uncertain.support.model",
+        &["unknown variant `warped`", "`smooth`"],
+    );
+}
+
+/// The study with every parameter, loaded through the library.
+fn grid_study(name: &str) -> (PathBuf, mc::Study) {
+    let d = tmp(name);
+    let p = write_study(&d, GRID_STUDY);
+    let st = mc::load(&p, None).unwrap();
+    (d, st)
+}
+
+#[test]
+fn perturbations_are_reproducible_per_sample_index() {
+    let (d, st) = grid_study("repro");
+    let key = |point: usize, i: u64| {
+        let ds = sample::draw_scene(&st.scene, &st.points[point], st.seed, i).unwrap();
+        let sc = ds.scene;
+        (
+            format!("{:?}", sc.part.polygon.vertices()),
+            format!("{:?}", sc.obstacles),
+            format!("{:?} {:?}", sc.feed.orientation, sc.feed.lateral),
+            sc.contact.mu_c,
+            sc.belt.speed,
+        )
+    };
+    let first = key(3, 4);
+    // Other samples drawn in between change nothing.
+    for i in 0..4 {
+        key(3, i);
+    }
+    assert_eq!(first, key(3, 4));
+    assert_ne!(first.0, key(3, 5).0);
+    assert_ne!(first.1, key(3, 5).1);
+    assert_ne!(first.2, key(3, 5).2);
+    // Common random numbers: at shape.sd 0.001 each vertex moves exactly twice as far as at
+    // 0.0005 (points 4 and 2 share mu_c.max), before re-centring on the new centroid.
+    let base = st.scene.part.polygon.vertices().to_vec();
+    let offsets = |point: usize| {
+        let ds = sample::draw_scene(&st.scene, &st.points[point], st.seed, 7).unwrap();
+        let v = ds.scene.part.polygon.vertices().to_vec();
+        // Undo the re-centring: the polygon's offset is where its centroid moved.
+        let off = ds.scene.part.polygon.offset();
+        v.iter()
+            .zip(&base)
+            .map(|(a, b)| (a.x + off.x - b.x, a.y + off.y - b.y))
+            .collect::<Vec<_>>()
+    };
+    let (half, full) = (offsets(2), offsets(4));
+    for (h, f) in half.iter().zip(&full) {
+        assert!((2.0 * h.0 - f.0).abs() < 1e-12 && (2.0 * h.1 - f.1).abs() < 1e-12);
+    }
+    assert!(half.iter().any(|h| h.0.abs() > 1e-6));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn invalid_perturbed_polygons_are_redrawn_or_reported() {
+    let d = tmp("shape");
+    let big = |sd: f64, support: &str| {
+        let p = write_study(
+            &d,
+            &format!("samples = 10\n[uncertain.shape]\ndistribution = \"normal\"\nsd = {sd}\n[uncertain.support]\nmodel = \"{support}\"\n"),
+        );
+        mc::load(&p, None).unwrap()
+    };
+    // 3 cm vertex errors on a 4 cm part: many triangles no longer fit the 10 cm belt.
+    let st = big(0.03, "uniform");
+    let mut redraws = 0;
+    for i in 0..10 {
+        let ds = sample::draw_scene(&st.scene, &st.points[0], st.seed, i).unwrap();
+        assert!(2.0 * ds.scene.part.radius <= st.scene.belt.width);
+        redraws += ds.shape_redraws;
+    }
+    assert!(redraws > 0);
+    // 10 m errors: no valid part comes out; a clear error, no panic, no endless loop.
+    // Slivers that cannot carry a tripod around their centroid are redrawn too, never an error.
+    // The shape streams are the same for both supports (one stream per parameter), so any extra
+    // redraw under the tripod is a sliver the tripod could not stand on.
+    let redraws = |support: &str| {
+        let st = big(0.008, support);
+        (0..40)
+            .map(|i| {
+                sample::draw_scene(&st.scene, &st.points[0], st.seed, i)
+                    .unwrap()
+                    .shape_redraws
+            })
+            .sum::<u32>()
+    };
+    let (uniform, tripod) = (redraws("uniform"), redraws("tripod"));
+    assert!(tripod > uniform, "tripod {tripod}, uniform {uniform}");
+    let st = big(10.0, "uniform");
+    let e = sample::draw_scene(&st.scene, &st.points[0], st.seed, 0)
+        .err()
+        .expect("refused");
+    assert!(e.contains("shape tolerance is too large"), "{e}");
+    let e = refused(&["mc", s(&d.join("study.toml")), "--out", s(&d.join("o"))]);
+    assert!(e.contains("sample 0 of sweep point 0: shape:"), "{e}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn a_study_without_uncertainty_reproduces_the_nominal_line() {
+    let d = tmp("nominal");
+    let p = write_study(&d, "samples = 40\n");
+    let out = ok(&["mc", s(&p), "--json", "--quiet", "--out", s(&d.join("o"))]);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The quickstart layout brings every part to 16° ± 3° (scenarios/quickstart.toml).
+    assert_eq!(r["results"][0]["outcomes"]["success"], 40, "{r}");
+    assert_eq!(r["results"][0]["shares"]["success"]["ci95"][1], 1.0);
+    std::fs::remove_dir_all(&d).unwrap();
+}
