@@ -15,7 +15,6 @@ use crate::scenario::{FeedSource, Lateral, Orientation};
 use crate::study::compare::compare;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed compare`.
@@ -115,13 +114,5 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             format!("{feed}\n{}", compare_table::text(&rows))
         }
     };
-    let mut stdout = std::io::stdout().lock();
-    match stdout
-        .write_all(text.as_bytes())
-        .and_then(|_| stdout.flush())
-    {
-        // A closed pipe (`| head`) is the reader's choice, not an error.
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e).context("writing to stdout"),
-        _ => Ok(()),
-    }
+    super::stdout::print_result(&text)
 }

@@ -10,6 +10,7 @@ pub mod mc;
 pub mod merge;
 pub mod part;
 pub mod run;
+pub mod stdout;
 
 use clap::{Parser, Subcommand};
 

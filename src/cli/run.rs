@@ -8,7 +8,6 @@ use crate::report::{line_table, parts_csv, plot_line, plot_orientations};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -116,16 +115,5 @@ pub fn run(args: &RunArgs) -> Result<()> {
         ));
         text.push_str(&format!("results                   {}\n", dir.display()));
     }
-    let mut stdout = std::io::stdout().lock();
-    match stdout
-        .write_all(text.as_bytes())
-        .and_then(|_| stdout.flush())
-    {
-        // A closed pipe (`| head`) is the reader's choice, not an error.
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            return Err(e).context("writing to stdout")
-        }
-        _ => {}
-    }
-    Ok(())
+    super::stdout::print_result(&text)
 }
