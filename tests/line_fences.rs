@@ -1,7 +1,8 @@
 //! Fences on the line (issue 5): a long fence delivers every part in the orientation it leaves a
-//! flush edge in; a fence at the jam angle jams parts (and just below it does not); a fence that
-//! carries parts over the belt's edge drops them; a pin beside a fence is a second contact; the
-//! per-obstacle counters include fences.
+//! flush edge in; a fence at the jam angle jams parts (and just below it does not, but holds them
+//! so long that the next part catches up: a collision); a fence that carries parts over the belt's
+//! edge drops them; a pin beside a fence is a second contact; the per-obstacle counters include
+//! fences.
 
 use pinfeed::engine::{self, PartRecord, RunOptions, RunResult};
 use pinfeed::geometry::{part_from_spec, wrap_deg, Pose};
@@ -165,6 +166,15 @@ fn a_fence_at_the_jam_angle_jams_parts_and_just_below_it_does_not() {
     assert_eq!(slide.summary.outcomes.success, slide.summary.parts_in);
     let latency = slide.summary.latency_s.unwrap();
     assert!(latency.p50 > 2.0 * exit_time, "{latency:?}");
+    // Fed every 12 s instead, each part is caught on the fence by the next one: collisions between
+    // a part held by a fence and a free part are found.
+    let crowded = run(&scene(&scenario_text(
+        "angle = 62.0\nlength = 0.15\nmu_f = 0.5",
+        "",
+    )));
+    let o = crowded.summary.outcomes;
+    assert!(o.collision * 2 > crowded.summary.parts_in, "{o:?}");
+    assert_eq!(o.collision % 2, 0, "collisions take two parts off: {o:?}");
 }
 
 #[test]
