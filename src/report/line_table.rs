@@ -1,5 +1,5 @@
 //! The terminal summary of a line run: outcomes, success rate with its 95% interval, throughput,
-//! latency, contacts and per-pin statistics (definitions in [`crate::engine::metrics`]).
+//! latency, contacts and per-obstacle statistics (definitions in [`crate::engine::metrics`]).
 
 use crate::engine::{PartOutcome, Summary};
 use std::fmt::Write;
