@@ -28,29 +28,7 @@ pub fn point_segment_distance(p: Vec2, a: Vec2, b: Vec2) -> f64 {
     (a + e * t - p).norm()
 }
 
-fn orient(a: Vec2, b: Vec2, c: Vec2) -> f64 {
-    (b - a).cross(c - a)
-}
-
-/// Do the closed segments [p1, p2] and [q1, q2] intersect?
-pub fn segments_intersect(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> bool {
-    let d1 = orient(q1, q2, p1);
-    let d2 = orient(q1, q2, p2);
-    let d3 = orient(p1, p2, q1);
-    let d4 = orient(p1, p2, q2);
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    let on = |a: Vec2, b: Vec2, p: Vec2| {
-        p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
-    };
-    (d1 == 0.0 && on(q1, q2, p1))
-        || (d2 == 0.0 && on(q1, q2, p2))
-        || (d3 == 0.0 && on(p1, p2, q1))
-        || (d4 == 0.0 && on(p1, p2, q2))
-}
+pub use crate::geometry::polygon::segments_intersect;
 
 /// Distance between segments [p1, p2] and [q1, q2] (0 if they intersect).
 pub fn segment_distance(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> f64 {

@@ -78,7 +78,7 @@ fn on_segment(a: Vec2, b: Vec2, p: Vec2) -> bool {
 }
 
 /// Do the closed segments [p1,p2] and [q1,q2] share a point?
-fn segments_intersect(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> bool {
+pub fn segments_intersect(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> bool {
     let d1 = orient(q1, q2, p1);
     let d2 = orient(q1, q2, p2);
     let d3 = orient(p1, p2, q1);
