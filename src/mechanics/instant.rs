@@ -162,6 +162,39 @@ fn stick_instant(
     })
 }
 
+struct Side {
+    instant: Instant,
+    margin: f64,
+}
+
+/// Sliding on one cone edge (`sign` +1 left, −1 right): the scaled twist, the force, and the
+/// margin — the signed sine between v_b and v_pin, forced negative when n·v_b ≤ ε (that side can
+/// never slide: SPEC's guard for large μc).
+fn slide_side(
+    model: &PartModel,
+    fid: Fidelity,
+    g: &ContactGeom,
+    f_dir: Vec2,
+    sign: f64,
+    warm: &mut Option<WarmTwist>,
+    evals: &mut u64,
+) -> Result<Side, SolveFailure> {
+    let (xi, vb, f) = slide_instant(model, fid, g, f_dir, warm, evals)?;
+    let mut margin = sign * sine(vb, g.v_pin);
+    if g.n.dot(vb) <= GUARD * vb.norm() {
+        margin = margin.min(-1e-3);
+    }
+    Ok(Side {
+        instant: Instant {
+            mode: Mode::Slide,
+            twist: scaled_slide(g, xi, vb),
+            force: f,
+            margins: [1.0, 1.0],
+        },
+        margin,
+    })
+}
+
 /// Solve the instant assuming `mode` (no consistency decision), returning margins for event location.
 pub fn solve_in_mode(
     model: &PartModel,
@@ -184,31 +217,21 @@ pub fn solve_in_mode(
             })
         }
         Mode::SlideLeft => {
-            let (xi, vb, f) =
-                slide_instant(model, fid, g, fr.left_edge(g.n), &mut warm.left, evals)?;
-            let mut m = sine(vb, g.v_pin);
-            if g.n.dot(vb) <= GUARD * vb.norm() {
-                m = m.min(-1e-3);
-            }
+            let f_dir = fr.left_edge(g.n);
+            let m = slide_side(model, fid, g, f_dir, 1.0, &mut warm.left, evals)?;
             Ok(Instant {
                 mode,
-                twist: scaled_slide(g, xi, vb),
-                force: f,
-                margins: [m, 1.0],
+                margins: [m.margin, 1.0],
+                ..m.instant
             })
         }
         Mode::SlideRight => {
-            let (xi, vb, f) =
-                slide_instant(model, fid, g, fr.right_edge(g.n), &mut warm.right, evals)?;
-            let mut m = -sine(vb, g.v_pin);
-            if g.n.dot(vb) <= GUARD * vb.norm() {
-                m = m.min(-1e-3);
-            }
+            let f_dir = fr.right_edge(g.n);
+            let m = slide_side(model, fid, g, f_dir, -1.0, &mut warm.right, evals)?;
             Ok(Instant {
                 mode,
-                twist: scaled_slide(g, xi, vb),
-                force: f,
-                margins: [1.0, m],
+                margins: [1.0, m.margin],
+                ..m.instant
             })
         }
     }
