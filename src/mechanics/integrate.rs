@@ -28,7 +28,7 @@ use super::instant::{
     classify, push_margin, solve_in_mode, ContactGeom, Friction, Instant, Mode, Warm,
 };
 use super::outcome::{
-    ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, TraceSample,
+    ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
 use super::part_model::{Fidelity, PartModel, SolveFailure};
 use crate::geometry::{first_contact, Feature, Polygon, Pose, Vec2};
@@ -119,6 +119,8 @@ struct Ctx<'a, 'r> {
     /// The fence, when the obstacle is one (`poly` is then the part's hull).
     fence: Option<FenceGeom>,
     tol: f64,
+    /// μs: the trace reports forces in units of m g (the model's are in units of μs m g).
+    mu_s: f64,
     scale: f64,
     evals: u64,
     warm: Warm,
@@ -136,6 +138,39 @@ enum End {
 const N_EVENTS: usize = 7;
 /// Tolerance band of a mode margin after a ping-pong (a sine: about 0.006°).
 const BOUNCE_BAND: f64 = 1e-4;
+/// Step acceptance guard: the most one accepted step may change θ (radians) or the contact
+/// coordinate ℓ (units of a) / φ (radians). The embedded error estimate is only asymptotic for
+/// small changes: near a singular instant (a sliding twist whose contact velocity turns tangential,
+/// so κ = n·v_pin / n·v_b blows up) all seven stages can agree on a huge rate and a step of 1e-4 a
+/// of travel passes the error test while turning the part by 900°. No real contact needs more
+/// than this per step at any tolerance: the guard shrinks the step instead. A flush fence edge
+/// translates at constant rates, so its fence coordinate is not limited.
+const MAX_STEP_CHANGE: f64 = 0.5;
+/// Disc pins below this radius (units of a) are point pins: the disc's ride round a vertex
+/// (φ turning at a rate ∝ 1/ρ) then lasts less than 1e-9 a of travel and changes the pose by
+/// O(ρ), far below any tolerance, while resolving it would need steps below the integrator's
+/// floor. So the model is continuous in ρ down to 0 (to O(ρ)).
+pub const POINT_PIN_RADIUS: f64 = 1e-9;
+
+/// Does a step from `y0` to `y1` on `feat` pass the acceptance guard?
+fn step_change_ok(feat: Feat, y0: [f64; 2], y1: [f64; 2]) -> bool {
+    let d_theta = (y1[0] - y0[0]).abs();
+    let d_contact = match feat {
+        Feat::FenceEdge(_) => 0.0,
+        _ => (y1[1] - y0[1]).abs(),
+    };
+    d_theta <= MAX_STEP_CHANGE && d_contact <= MAX_STEP_CHANGE
+}
+
+/// The largest step (units of a) on `feat`: a flush fence edge translates at constant rates, so a
+/// single step may take it along any length of fence (its events are monotone in the travel);
+/// elsewhere two units of a, so that no event can come and go within one step.
+fn max_step(feat: Feat) -> f64 {
+    match feat {
+        Feat::FenceEdge(_) => f64::INFINITY,
+        _ => 2.0,
+    }
+}
 
 impl<'a, 'r> Ctx<'a, 'r> {
     /// A context for one obstacle pass: `poly` is the polygon the obstacle touches (the part, or
@@ -157,11 +192,12 @@ impl<'a, 'r> Ctx<'a, 'r> {
             poly,
             fid: settings.fidelity,
             fr: Friction::new(mu),
-            rho,
+            rho: if rho < POINT_PIN_RADIUS { 0.0 } else { rho },
             vdir,
             start,
             fence,
             tol: settings.tol,
+            mu_s: settings.mu_s,
             scale: model.scale(),
             evals: 0,
             warm: Warm::default(),
@@ -270,9 +306,27 @@ impl Ctx<'_, '_> {
         Ok((d, inst))
     }
 
-    /// Event functions (positive while nothing happens).
+    /// Event functions (positive while nothing happens): separation, the two mode margins, then
+    /// the geometric ones of [`Ctx::feature_events`].
     fn events(&self, feat: Feat, y: [f64; 2], inst: &Instant) -> [f64; N_EVENTS] {
         let g = self.geom(feat, y);
+        let [e3, e4, e5, e6] = self.feature_events(feat, y, &g);
+        let b = &self.band;
+        [
+            push_margin(&g) + b[0],
+            inst.margins[0] + b[1],
+            inst.margins[1] + b[2],
+            e3 + b[3],
+            e4 + b[4],
+            e5 + b[5],
+            e6 + b[6],
+        ]
+    }
+
+    /// The geometric event functions (positive while the contact stays on its feature): an edge's
+    /// two ends (units of a), a disc's normal cone at a vertex (sines), a fence vertex's
+    /// neighbours and the fence's two ends (units of a).
+    fn feature_events(&self, feat: Feat, y: [f64; 2], g: &ContactGeom) -> [f64; 4] {
         let (mut e5, mut e6) = (1.0, 1.0);
         let (e3, e4) = match feat {
             Feat::Edge(k) => {
@@ -302,16 +356,33 @@ impl Ctx<'_, '_> {
             }
             Feat::FenceEdge(_) => (1.0, 1.0),
         };
-        let b = &self.band;
-        [
-            push_margin(&g) + b[0],
-            inst.margins[0] + b[1],
-            inst.margins[1] + b[2],
-            e3 + b[3],
-            e4 + b[4],
-            e5 + b[5],
-            e6 + b[6],
-        ]
+        [e3, e4, e5, e6]
+    }
+
+    /// The self-check at the end of a contact (a few event functions and one distance): the state
+    /// must still lie on its feature, and the pin must not overlap the part. Both hold by
+    /// construction in exact arithmetic and to the landing tolerance in a correct run; a failure
+    /// means an accepted step or landing went wrong.
+    fn self_check(&self, s: f64, feat: Feat, y: [f64; 2]) -> Option<SelfCheck> {
+        let limit = 10.0 * self.tol;
+        let g = self.geom(feat, y);
+        if self.feature_events(feat, y, &g).iter().any(|&e| e < -limit) {
+            return Some(SelfCheck::OffFeature);
+        }
+        if self.fence.is_none() {
+            let pose = self.pose(s, feat, y);
+            let centre = pose.apply_inverse(self.pin_at(s));
+            let (dist, _) = self.poly.distance_to_boundary(centre);
+            let depth = if self.poly.contains(centre) {
+                dist + self.rho
+            } else {
+                self.rho - dist
+            };
+            if depth > limit {
+                return Some(SelfCheck::Penetration);
+            }
+        }
+        None
     }
 
     /// The flush edge k's supported interval and the point where the force line through the
@@ -415,7 +486,7 @@ impl Ctx<'_, '_> {
             pose: Pose::new(pose.x * k, pose.y * k, pose.theta),
             pin_centre: self.pin_at(s) * k,
             contact_point: pose.apply(g.p) * k,
-            force: inst.force.rotate(y[0]),
+            force: inst.force.rotate(y[0]) * self.mu_s,
             mode: inst.mode,
             feature: feat.public(),
         };
@@ -474,6 +545,16 @@ struct StepResult {
     err: f64,
     /// The seven stage derivatives (for the dense output).
     k: [[f64; 2]; 7],
+}
+
+/// A trial step while landing on an event.
+enum Trial {
+    /// No step: the state at the start of the step.
+    Start,
+    /// A valid step and the located event's function after it.
+    Step(Box<StepResult>, f64),
+    /// A step that failed, or whose result cannot be trusted.
+    Invalid,
 }
 
 /// One Dormand–Prince step of size h from (y0, f0).
@@ -793,6 +874,22 @@ impl Tally {
     }
 }
 
+/// The end of a contact that separated at (s, feat, y), after the self-check.
+fn separated(ctx: &Ctx, s: f64, feat: Feat, y: [f64; 2]) -> (End, f64, Pose) {
+    let p = ctx.pose(s, feat, y);
+    match ctx.self_check(s, feat, y) {
+        None => (End::Separated, s, p),
+        Some(check) => (
+            End::Stop(ContactStatus::SelfCheck {
+                check,
+                s: s * ctx.scale,
+            }),
+            s,
+            p,
+        ),
+    }
+}
+
 /// Integrate one contact from its first touch until separation. Returns the end and the final state.
 fn integrate_contact(
     ctx: &mut Ctx,
@@ -819,7 +916,6 @@ fn integrate_contact(
     ctx.record(s, feat, y, &inst);
     let mut f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
     let mut ev0 = ctx.events(feat, y, &inst);
-    let h_max = 2.0;
     let h_min = 1e-13;
     // First step: a tenth of a, shrunk by the error control if the motion is fast.
     let mut h = 0.1;
@@ -876,8 +972,13 @@ fn integrate_contact(
                     continue;
                 }
             };
-            if step.err > 1.0 {
-                h *= (0.9 * step.err.powf(-0.2)).max(0.2);
+            let guarded = !step_change_ok(feat, y, step.y1);
+            if step.err > 1.0 || guarded {
+                h *= if guarded {
+                    0.25
+                } else {
+                    (0.9 * step.err.powf(-0.2)).max(0.2)
+                };
                 if h < h_min {
                     let p = ctx.pose(s, feat, y);
                     return (
@@ -915,7 +1016,7 @@ fn integrate_contact(
                         pose,
                     );
                 }
-                h = (h * factor).min(h_max);
+                h = (h * factor).min(max_step(feat));
                 continue;
             }
             // Locate the earliest crossing on the interpolant.
@@ -923,6 +1024,7 @@ fn integrate_contact(
             let mut best = (2.0, 0usize);
             let warm_saved = ctx.warm;
             let root_tol = 1e-3 * ctx.tol;
+            let ctx_tol = ctx.tol;
             let band = ctx.band;
             for &i in &crossed {
                 let g0 = ev0[i].max(0.0);
@@ -962,28 +1064,61 @@ fn integrate_contact(
             }
             ctx.warm = warm_saved;
             let (t_est, i) = best;
-            // Refine on real steps: g(t) = event i after a Dormand–Prince step of t·h from (s, y).
-            let real = |t: f64, ctx: &mut Ctx| -> Option<StepResult> {
-                if t * h <= 1e-15 {
-                    return None;
-                }
-                dp_step(ctx, feat, mode, y, f0, t * h).ok()
+            // A sub-step of the accepted step must agree with its dense output (both are
+            // accurate to about tol; 1e3·tol leaves room for a mode boundary inside the step).
+            let near_dense = |r: &StepResult, t: f64| {
+                let yd = dense(y0c, y1c, &kc, hc, t);
+                (r.y1[0] - yd[0]).abs() <= 1e3 * ctx_tol && (r.y1[1] - yd[1]).abs() <= 1e3 * ctx_tol
             };
-            let g_of = |r: &Option<StepResult>, ctx: &Ctx| -> f64 {
-                match r {
-                    Some(r) => ctx.events(feat, r.y1, &r.inst1)[i],
-                    None => ev0[i].max(0.0),
+            // Refine on real steps: g(t) = event i after a Dormand–Prince step of t·h from (s, y).
+            // A trial step counts only if it is itself accurate (its own error estimate within 10×
+            // the tolerance: sub-steps of an accepted step may sit just above it), passes the step
+            // guard and crosses neither the separation nor another geometric event; otherwise its event
+            // value means nothing (the −880° case of issue 11 landed on such a step) and the
+            // bracket shrinks from above.
+            let real = |t: f64, ctx: &mut Ctx| -> Trial {
+                if t * h <= 1e-15 {
+                    return Trial::Start;
+                }
+                match dp_step(ctx, feat, mode, y, f0, t * h) {
+                    Ok(r) if step_change_ok(feat, y, r.y1) && near_dense(&r, t) => {
+                        let ev = ctx.events(feat, r.y1, &r.inst1);
+                        if [0, 3, 4, 5, 6].iter().all(|&j| j == i || ev[j] >= -slack) {
+                            Trial::Step(Box::new(r), ev[i])
+                        } else {
+                            Trial::Invalid
+                        }
+                    }
+                    _ => Trial::Invalid,
                 }
             };
             let (mut a, mut b) = (0.0f64, 1.0f64);
             let (mut ga, mut gb) = (ev0[i].max(0.0), ev1[i]);
-            let mut best_step: Option<StepResult> = None;
-            let mut best_t = 0.0;
+            // The landing: the trial at the largest t with g ≥ 0 (or g just below 0 within the
+            // landing tolerance), and its g.
+            let mut best: (Trial, f64, f64) = (Trial::Start, 0.0, ev0[i].max(0.0));
             let mut t = t_est.clamp(0.0, 1.0);
             let mut side = 0;
+            let mut any_invalid = false;
+            // Landing tolerance: far below the integration tolerance, far above rounding.
+            let g_tol = land_tol;
             for _ in 0..40 {
-                let r = real(t, ctx);
-                let gt = g_of(&r, ctx);
+                let trial = real(t, ctx);
+                let gt = match &trial {
+                    Trial::Start => ev0[i].max(0.0),
+                    Trial::Step(_, g) => *g,
+                    Trial::Invalid => {
+                        any_invalid = true;
+                        b = t;
+                        side = 0;
+                        if (b - a) * h <= 1e-13 {
+                            break;
+                        }
+                        t = 0.5 * (a + b);
+                        continue;
+                    }
+                };
+                let close = gt.abs() <= g_tol;
                 if gt < 0.0 {
                     b = t;
                     gb = gt;
@@ -991,23 +1126,19 @@ fn integrate_contact(
                         ga *= 0.5;
                     }
                     side = -1;
+                    if close {
+                        best = (trial, t, gt);
+                    }
                 } else {
                     a = t;
                     ga = gt;
-                    best_step = r;
-                    best_t = t;
+                    best = (trial, t, gt);
                     if side == 1 {
                         gb *= 0.5;
                     }
                     side = 1;
                 }
-                // Landing tolerance: far below the integration tolerance, far above rounding.
-                let g_tol = land_tol;
-                if gt.abs() <= g_tol || (b - a) * h <= 1e-13 {
-                    if gt < 0.0 && gt.abs() <= g_tol {
-                        best_step = real(t, ctx);
-                        best_t = t;
-                    }
+                if close || (b - a) * h <= 1e-13 {
                     break;
                 }
                 t = (a * gb - b * ga) / (gb - ga);
@@ -1015,19 +1146,38 @@ fn integrate_contact(
                     t = 0.5 * (a + b);
                 }
             }
-            match best_step {
-                Some(r) => {
+            let (landing, best_t, best_g) = best;
+            let (s_land, y_land, inst_land) = match landing {
+                Trial::Step(r, _) => {
                     segs.steps += 1;
-                    (Some(i), s + best_t * h, r.y1, r.inst1)
+                    (s + best_t * h, r.y1, r.inst1)
                 }
-                None => (Some(i), s, y, inst),
+                _ => (s, y, inst),
+            };
+            if any_invalid && best_g > slack {
+                // The event lies beyond a stretch the integrator cannot resolve (the rates blow up
+                // before it). Near a separation that is the triple point where the pin's path turns
+                // tangent while the sliding side's contact velocity does too (κ = n·v_pin / n·v_b →
+                // 0/0): the part is within asin(push margin) of letting go, so it separates here
+                // when that margin is below min(1e3·tol, 1e-3) (an orientation error below 0.06°).
+                // Anywhere else, say so rather than apply the event at a state short of it.
+                let g = ctx.geom(feat, y_land);
+                if push_margin(&g).abs() <= (1e3 * ctx.tol).min(1e-3) {
+                    (Some(0), s_land, y_land, inst_land)
+                } else {
+                    let p = ctx.pose(s, feat, y);
+                    return (
+                        End::Stop(ContactStatus::StepTooSmall { s: s * ctx.scale }),
+                        s,
+                        p,
+                    );
+                }
+            } else {
+                (Some(i), s_land, y_land, inst_land)
             }
         };
         let i = event.expect("an event was found");
 
-        if std::env::var("PINFEED_DEBUG").is_ok() {
-            eprintln!("event {i} at s={s_ev} mode={mode:?} feat={feat:?} y={y_ev:?} margins={:?} ev0={ev0:?}", inst_ev.margins);
-        }
         segs.events += 1;
         if segs.events > settings.max_events {
             let p = ctx.pose(s_ev, feat, y_ev);
@@ -1135,8 +1285,7 @@ fn integrate_contact(
             _ => unreachable!("event index out of range"),
         };
         let Some((nf, ny, forced)) = next else {
-            let p = ctx.pose(s, feat, y);
-            return (End::Separated, s, p);
+            return separated(ctx, s, feat, y);
         };
         if nf != feat {
             // Event indices mean different things on the new feature: start with no bands, except
@@ -1181,10 +1330,7 @@ fn integrate_contact(
                 inst = it;
                 mode = it.mode;
             }
-            Settle::Separate => {
-                let p = ctx.pose(s, nf, ny);
-                return (End::Separated, s, p);
-            }
+            Settle::Separate => return separated(ctx, s, nf, ny),
             Settle::Stop(st) => {
                 let p = ctx.pose(s, nf, ny);
                 return (End::Stop(st), s, p);
@@ -1199,7 +1345,7 @@ fn integrate_contact(
                 *e = 0.0;
             }
         }
-        h = h.max(1e-6);
+        h = h.clamp(1e-6, max_step(feat).max(1e-6));
     }
 }
 

@@ -24,6 +24,8 @@ pub mod vote;
 pub use fence::FenceSpec;
 pub use instant::Mode;
 pub use integrate::{fence_first_touch, first_instant, push, push_fence, ContactSettings, Pin};
-pub use outcome::{ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, TraceSample};
+pub use outcome::{
+    ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
+};
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
 pub use vote::mason_vote;

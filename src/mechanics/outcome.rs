@@ -77,6 +77,30 @@ pub enum ContactStatus {
     /// The part jammed against a fence (α + atan μf ≥ 90°): it stops in the world while the belt
     /// slips under it, and would stay there for ever. `pose_final` is where it stopped.
     Jam { s: f64 },
+    /// The contact model's own consistency check failed: the computed state contradicts the
+    /// contact it was computed for (see [`SelfCheck`]). The result is not trustworthy; `pose_final`
+    /// is the last state that passed the check.
+    SelfCheck { check: SelfCheck, s: f64 },
+}
+
+/// Which consistency check a contact failed (each is cheap and runs on every contact).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SelfCheck {
+    /// At the end of a contact the tracked contact point lies off its feature (beyond an edge's
+    /// end, outside a vertex's normal cone, off a fence), by more than the event-landing tolerance.
+    OffFeature,
+    /// At the end of a contact the pin overlaps the part.
+    Penetration,
+}
+
+impl SelfCheck {
+    pub fn name(self) -> &'static str {
+        match self {
+            SelfCheck::OffFeature => "off_feature",
+            SelfCheck::Penetration => "penetration",
+        }
+    }
 }
 
 impl ContactStatus {
@@ -95,6 +119,7 @@ impl ContactStatus {
             ContactStatus::StepTooSmall { .. } => "step_too_small",
             ContactStatus::Solver { .. } => "solver",
             ContactStatus::Jam { .. } => "jam",
+            ContactStatus::SelfCheck { .. } => "self_check",
         }
     }
 }
@@ -132,7 +157,9 @@ pub struct TraceSample {
     pub pose: Pose,
     pub pin_centre: Vec2,
     pub contact_point: Vec2,
-    /// Force the pin applies to the part (world axes), in units of μs m g.
+    /// Force the pin applies to the part (world axes), in units of the part's weight m g: the
+    /// contact model's force (units of μs m g) times μs, so it scales with μs while the motion
+    /// does not (multiply by m g for newtons).
     pub force: Vec2,
     pub mode: Mode,
     pub feature: ContactFeature,
