@@ -94,9 +94,24 @@ EOF
 started=()
 stop_daemons() {
     [ "$KEEP" = 1 ] && { say "KEEP=1: daemons left running (SLURM_CONF=$SLURM_CONF)"; return; }
+    local pids=() pid
     for pidfile in "${started[@]}"; do
-        if [ -s "$pidfile" ]; then kill "$(cat "$pidfile")" 2>/dev/null || true; fi
+        if [ -s "$pidfile" ]; then
+            pid=$(cat "$pidfile")
+            kill "$pid" 2>/dev/null && pids+=("$pid")
+        fi
     done
+    # Wait (at most 30 s) until they have exited, so that a rerun can start its own.
+    local alive
+    for _ in $(seq 30); do
+        alive=0
+        for pid in "${pids[@]}"; do # an exited daemon not yet reaped shows as Z
+            case "$(ps -o stat= -p "$pid" 2>/dev/null)" in "" | Z*) ;; *) alive=1 ;; esac
+        done
+        [ "$alive" = 0 ] && return 0
+        sleep 1
+    done
+    echo "slurm_e2e: daemons ${pids[*]} still running after 30 s" >&2
 }
 trap stop_daemons EXIT
 
