@@ -302,42 +302,96 @@ fn merge_refuses_shards_that_do_not_fit() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
-#[test]
-fn an_interrupted_shard_job_leaves_no_shard_file() {
-    let d = tmp("interrupt");
-    let study = write_study(&d, "samples = 10000000\n");
-    let out = d.join("shards");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args([
-            "mc",
-            s(&study),
-            "--shard",
-            "0/1",
-            "--quiet",
-            "--out",
-            s(&out),
-        ])
-        .spawn()
-        .expect("start pinfeed");
-    std::thread::sleep(std::time::Duration::from_millis(700));
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "the job finished before it could be interrupted"
-    );
-    child.kill().unwrap();
-    let status = child.wait().unwrap();
-    assert!(!status.success());
-    let left: Vec<String> = std::fs::read_dir(&out)
+/// File names in `dir` (none if it does not exist).
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
         .map(|r| {
             r.filter_map(|e| e.ok())
                 .map(|e| e.file_name().to_string_lossy().to_string())
                 .collect()
         })
         .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// A shard job killed between writing its shard and renaming it into place leaves no shard file
+/// (or the previous one, untouched), and a rerun writes the shard whole. The kill is injected, not
+/// timed: `PINFEED_FAULT=after-temp-write` aborts the process right after the hidden temporary file
+/// is complete and before the rename (src/study/mc/atomic.rs). The test fails if the shard were
+/// written in place (a `shard-*` file after the abort, or the previous one changed), if the fault
+/// struck before the bytes were complete (the temporary file differs from what the rerun writes),
+/// if the rename came before the fault point, or if the rerun did not write a whole, readable shard.
+#[test]
+fn an_interrupted_shard_job_leaves_no_shard_file() {
+    let d = tmp("interrupt");
+    let study = write_study(&d, "samples = 20\n");
+    let out = d.join("shards");
+    let args = [
+        "mc",
+        s(&study),
+        "--shard",
+        "0/1",
+        "--quiet",
+        "--out",
+        s(&out),
+    ];
+    let final_name = "shard-0000-of-0001.json";
+    // Runs the job with the fault; returns the bytes of the temporary file it left (one not in
+    // `earlier`: its name carries the job's pid).
+    let killed_run = |earlier: &[String]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+            .args(args)
+            .env("PINFEED_FAULT", "after-temp-write")
+            .output()
+            .expect("run pinfeed");
+        assert!(
+            !o.status.success(),
+            "the injected fault did not stop the job"
+        );
+        #[cfg(unix)]
+        {
+            use std::os::unix::process::ExitStatusExt;
+            assert_eq!(
+                o.status.signal(),
+                Some(6),
+                "not killed by SIGABRT: {:?}",
+                o.status
+            );
+        }
+        let temps: Vec<String> = names_in(&out)
+            .into_iter()
+            .filter(|n| n.starts_with(&format!(".{final_name}.tmp-")) && !earlier.contains(n))
+            .collect();
+        assert_eq!(temps.len(), 1, "{:?}", names_in(&out));
+        std::fs::read(out.join(&temps[0])).unwrap()
+    };
+    // 1. No shard yet: the killed job leaves none under the final name.
+    let interrupted = killed_run(&[]);
     assert!(
-        left.iter().all(|n| !n.starts_with("shard-")),
-        "partial shard file left behind: {left:?}"
+        names_in(&out).iter().all(|n| !n.starts_with("shard-")),
+        "shard file left behind by a killed job: {:?}",
+        names_in(&out)
     );
+    // 2. A rerun writes it whole: the same bytes the killed job had complete in its temporary file.
+    ok(&args);
+    let shard_path = out.join(final_name);
+    let whole = std::fs::read(&shard_path).expect("the rerun wrote the shard");
+    assert_eq!(
+        whole, interrupted,
+        "the rerun's shard differs from the killed job's bytes"
+    );
+    let shard = pinfeed::study::mc::shard::read(&shard_path).unwrap();
+    assert_eq!(shard.samples, [0, 20]);
+    assert_eq!(shard.points.iter().map(|p| p.samples).sum::<u64>(), 20);
+    // 3. A job killed while an earlier shard file is in place leaves that file as it was.
+    let earlier = names_in(&out);
+    std::fs::write(&shard_path, b"earlier shard").unwrap();
+    killed_run(&earlier);
+    assert_eq!(std::fs::read(&shard_path).unwrap(), b"earlier shard");
+    // ... and a rerun replaces it whole.
+    ok(&args);
+    assert_eq!(std::fs::read(&shard_path).unwrap(), whole);
     std::fs::remove_dir_all(&d).unwrap();
 }
 

@@ -3,9 +3,27 @@
 //! one file system is atomic on POSIX). A process killed at any moment leaves either the old file,
 //! or the complete new one — never a partial file under the final name. Shard files and reports
 //! are written this way.
+//!
+//! Fault injection (for tests): with the environment variable `PINFEED_FAULT=after-temp-write`
+//! (read once per process), the process aborts — like a job killed by its scheduler — right after
+//! the first temporary file is complete and before it is renamed, so a test can check
+//! deterministically, without timing, what an interrupted job leaves behind. Any other value, or
+//! none, changes nothing.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The environment variable that injects a fault, and its one value.
+pub const FAULT_VAR: &str = "PINFEED_FAULT";
+pub const FAULT_AFTER_TEMP_WRITE: &str = "after-temp-write";
+
+/// Whether `PINFEED_FAULT=after-temp-write` is set (read once).
+fn abort_after_temp_write() -> bool {
+    static FAULT: OnceLock<bool> = OnceLock::new();
+    *FAULT
+        .get_or_init(|| std::env::var(FAULT_VAR).is_ok_and(|v| v.trim() == FAULT_AFTER_TEMP_WRITE))
+}
 
 /// The hidden temporary path beside `path`.
 pub fn temporary_path(path: &Path) -> PathBuf {
@@ -24,7 +42,13 @@ pub fn produce_atomic(
     write: impl FnOnce(&Path) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     let tmp = temporary_path(path);
-    let result = write(&tmp).and_then(|_| std::fs::rename(&tmp, path));
+    let result = write(&tmp).and_then(|_| {
+        if abort_after_temp_write() {
+            // Injected fault: die between the complete temporary file and the rename.
+            std::process::abort();
+        }
+        std::fs::rename(&tmp, path)
+    });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
