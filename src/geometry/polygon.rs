@@ -696,6 +696,41 @@ mod tests {
     }
 
     #[test]
+    fn ldexp_and_magnitude_exponent_are_exact_at_the_extremes() {
+        assert_eq!(ldexp(1.0, 1023), 2f64.powi(1023));
+        assert_eq!(ldexp(f64::MAX, -1024), f64::MAX / 2f64.powi(1023) / 2.0);
+        assert_eq!(ldexp(5e-324, 1074), 1.0);
+        assert_eq!(ldexp(1.0, -1076), 0.0);
+        for m in [5e-324, 1e-310, 2.2e-308, 0.75, 1.0, 1e300, f64::MAX] {
+            let e = magnitude_exponent(&[Vec2::new(-m, 0.0)]);
+            let q = ldexp(m, -e);
+            assert!((0.5..1.0).contains(&q), "{m:e}: e = {e}, q = {q}");
+        }
+    }
+
+    #[test]
+    fn power_of_two_copies_are_bit_identical() {
+        let v = [(0.3, -0.1), (1.7, 0.2), (0.4, 1.1), (-0.2, 0.5)];
+        let p = Polygon::from_xy(&v).unwrap();
+        for e in [-250, -1, 7, 240] {
+            let k = 2f64.powi(e);
+            let s: Vec<(f64, f64)> = v.iter().map(|&(x, y)| (x * k, y * k)).collect();
+            let q = Polygon::from_xy(&s).unwrap();
+            assert_eq!(q.radius(), p.radius() * k);
+            assert_eq!(q.area(), p.area() * k * k);
+            assert_eq!(q.polar_moment(), p.polar_moment() * k * k * k * k);
+            assert_eq!(q.offset(), p.offset() * k);
+            let thetas = |x: &Polygon| {
+                x.stable_states()
+                    .iter()
+                    .map(|s| s.theta)
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(thetas(&q), thetas(&p));
+        }
+    }
+
+    #[test]
     fn concave_hull() {
         let l = Polygon::from_xy(&[
             (0.0, 0.0),
