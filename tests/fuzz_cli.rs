@@ -17,10 +17,12 @@
 
 use clap::Parser;
 use pinfeed::cli::contact::{run_case, Case};
-use pinfeed::geometry::{Polygon, PolygonError, Vec2};
+use pinfeed::geometry::{Polygon, PolygonError};
 use pinfeed::mechanics::Fidelity;
 use proptest::prelude::*;
 use std::process::Command;
+
+mod shapes;
 
 // ---------------------------------------------------------------------------------------------
 // Strategies.
@@ -43,25 +45,7 @@ fn number() -> BoxedStrategy<String> {
 
 /// A star-shaped polygon about the origin (3–8 vertices, radii in [0.2, 1]).
 fn star() -> impl Strategy<Value = Vec<(f64, f64)>> {
-    (3usize..9).prop_flat_map(|n| {
-        (
-            prop::collection::vec(1.0f64..1.9, n),
-            prop::collection::vec(0.2f64..1.0, n),
-            0.0f64..std::f64::consts::TAU,
-        )
-            .prop_map(|(gaps, radii, start)| {
-                let total: f64 = gaps.iter().sum();
-                let mut phi = start;
-                gaps.iter()
-                    .zip(&radii)
-                    .map(|(g, r)| {
-                        let v = Vec2::from_angle(phi) * *r;
-                        phi += g / total * std::f64::consts::TAU;
-                        (v.x, v.y)
-                    })
-                    .collect()
-            })
-    })
+    shapes::star_polygon(3..9)
 }
 
 fn vertex_text(v: &[(f64, f64)]) -> String {

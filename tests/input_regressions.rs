@@ -32,6 +32,15 @@ fn refused_saying(args: &[&str], words: &[&str]) -> String {
     err
 }
 
+/// `contact` on tripoly1 at θ0 = 10°, d = 0.2 with `extra` flags must be refused saying `words`.
+fn contact_refused_saying(extra: &[&str], words: &[&str]) {
+    let mut args = vec![
+        "contact", "--part", "tripoly1", "--theta0", "10", "--d", "0.2",
+    ];
+    args.extend_from_slice(extra);
+    refused_saying(&args, words);
+}
+
 fn json(args: &[&str]) -> serde_json::Value {
     let out = pinfeed(args);
     assert!(
@@ -225,17 +234,8 @@ fn polygons_at_extreme_magnitudes_are_accepted_or_refused_for_their_size() {
 /// Issue 11 item 7: `contact --fence=30:1e20` returned contact false with status ok.
 #[test]
 fn contact_fence_length_1e20_is_refused() {
-    refused_saying(
-        &[
-            "contact",
-            "--part",
-            "tripoly1",
-            "--theta0",
-            "10",
-            "--d",
-            "0.2",
-            "--fence=30:1e20",
-        ],
+    contact_refused_saying(
+        &["--fence=30:1e20"],
         &["--fence", "length", "1000·a", "got 1e20"],
     );
     // The longest allowed fence still works.
@@ -256,18 +256,8 @@ fn contact_fence_length_1e20_is_refused() {
 /// Issue 11 item 7: `--pin-radius 1e308` was accepted.
 #[test]
 fn contact_pin_radius_1e308_is_refused() {
-    refused_saying(
-        &[
-            "contact",
-            "--part",
-            "tripoly1",
-            "--theta0",
-            "10",
-            "--d",
-            "0.2",
-            "--pin-radius",
-            "1e308",
-        ],
+    contact_refused_saying(
+        &["--pin-radius", "1e308"],
         &["--pin-radius", "10·a", "got 1e308"],
     );
 }
@@ -275,18 +265,8 @@ fn contact_pin_radius_1e308_is_refused() {
 /// Issue 11 item 7: `--pin-speed 1e308` was accepted.
 #[test]
 fn contact_pin_speed_1e308_is_refused() {
-    refused_saying(
-        &[
-            "contact",
-            "--part",
-            "tripoly1",
-            "--theta0",
-            "10",
-            "--d",
-            "0.2",
-            "--pin-speed",
-            "1e308",
-        ],
+    contact_refused_saying(
+        &["--pin-speed", "1e308"],
         &["--pin-speed", "[-10, 10]", "got 1e308"],
     );
 }
@@ -338,9 +318,6 @@ fn contact_d_beyond_reach_is_refused() {
 /// The other contact ranges: friction, tolerance, each naming the flag, range and value.
 #[test]
 fn contact_friction_and_tolerance_ranges() {
-    let base = [
-        "contact", "--part", "tripoly2", "--theta0", "10", "--d", "0.2",
-    ];
     for (extra, words) in [
         (["--mu-c", "11"], ["--mu-c", "[0, 10]"]),
         (["--mu-s", "1e308"], ["--mu-s", "got 1e308"]),
@@ -348,9 +325,7 @@ fn contact_friction_and_tolerance_ranges() {
         (["--tol", "1e-13"], ["--tol", "[1e-12, 0.01]"]),
         (["--tol", "0.5"], ["--tol", "got 0.5"]),
     ] {
-        let mut args = base.to_vec();
-        args.extend(extra);
-        refused_saying(&args, &words);
+        contact_refused_saying(&extra, &words);
     }
 }
 
