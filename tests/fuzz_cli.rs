@@ -295,7 +295,12 @@ fn map_args() -> BoxedStrategy<Vec<String>> {
             }
             a.extend(m);
             a.extend(s);
-            mutate(a, how, at)
+            // Mutations must not drop --no-write (the command would write a report directory).
+            let mut a = mutate(a, how, at);
+            if !a.iter().any(|w| w == "--no-write") {
+                a.push("--no-write".into());
+            }
+            a
         })
         .boxed()
 }
@@ -331,8 +336,13 @@ fn assert_json_finite(v: &serde_json::Value, path: &str) -> Result<(), TestCaseE
 /// Run the binary and check the outcome contract; `csv` output is checked for non-finite fields,
 /// `--json` output must be one JSON document of finite numbers, a table must show no NaN or inf.
 fn check_binary(args: &[String], csv: bool) -> Result<(), TestCaseError> {
+    // In a scratch directory: whatever a mutated command line might write stays out of the
+    // repository.
+    let dir = std::env::temp_dir().join(format!("pinfeed-fuzz-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch directory");
     let out = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
         .args(args)
+        .current_dir(&dir)
         .output()
         .expect("run pinfeed");
     let err = String::from_utf8_lossy(&out.stderr);
