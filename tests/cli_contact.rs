@@ -165,7 +165,10 @@ fn batch_errors_name_the_line() {
     let out = pinfeed(&["contact", "--cases", cases.to_str().unwrap()]);
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("bad.csv:2") && err.contains("mu-c"), "{err}");
+    assert!(
+        err.contains("bad.csv:2") && err.contains("column mu_c"),
+        "{err}"
+    );
     std::fs::write(
         &cases,
         "part,theta0,d,mu_c,colour\ntripoly2,90,0.3,0.5,red\n",

@@ -6,6 +6,8 @@ use pinfeed::geometry::polygon::convex_hull;
 use pinfeed::geometry::{part_from_spec, PartSpecError, Polygon, PolygonError, Vec2};
 use proptest::prelude::*;
 
+mod shapes;
+
 const DEG_TOL: f64 = 1e-6;
 
 fn stable_deg(p: &Polygon) -> Vec<f64> {
@@ -291,29 +293,9 @@ fn scaled_and_mirrored_helpers() {
 // ---------------------------------------------------------------------------------------------
 // Property tests on random simple polygons.
 
-/// Star-shaped polygon about the origin: increasing angles (every gap < 180°, so the ring is simple)
-/// with radii in [0.2, 1].
+/// Star-shaped polygon about the origin, 3–11 vertices (see [`shapes::star_polygon`]).
 fn star_polygon() -> impl Strategy<Value = Vec<(f64, f64)>> {
-    (3usize..12)
-        .prop_flat_map(|n| {
-            (
-                prop::collection::vec(1.0f64..1.9, n),
-                prop::collection::vec(0.2f64..1.0, n),
-                0.0f64..std::f64::consts::TAU,
-            )
-        })
-        .prop_map(|(gaps, radii, start)| {
-            let total: f64 = gaps.iter().sum();
-            let mut phi = start;
-            gaps.iter()
-                .zip(&radii)
-                .map(|(g, r)| {
-                    let v = Vec2::from_angle(phi) * *r;
-                    phi += g / total * std::f64::consts::TAU;
-                    (v.x, v.y)
-                })
-                .collect()
-        })
+    shapes::star_polygon(3..12)
 }
 
 /// Convex polygon: the convex hull of 3–12 points on a random ellipse.

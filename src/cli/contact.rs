@@ -64,7 +64,8 @@ pub struct ContactArgs {
     #[arg(long, value_name = "ANGLE_DEG[:LENGTH]", allow_hyphen_values = true)]
     pub fence: Option<String>,
     /// Batch mode: a CSV with columns part,theta0,d,mu_c (+ optional model,pin_radius,mu_s); one
-    /// output row per case goes to stdout.
+    /// output row per case goes to stdout. `--fence`, `--pin-speed`, `--support`, `--tol` and the
+    /// defaults of the optional columns apply to every row.
     #[arg(long, value_name = "FILE.csv", conflicts_with_all = ["part", "theta0", "d", "json", "trace", "plot"])]
     pub cases: Option<PathBuf>,
 }
@@ -121,7 +122,10 @@ pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>)> {
         .parse()
         .with_context(|| format!("--fence '{spec}': the angle is not a number"))?;
     if !(angle.is_finite() && angle.abs() < 90.0) {
-        bail!("--fence '{spec}': the angle must be strictly between -90 and 90 degrees");
+        bail!(
+            "--fence '{spec}': the angle must be strictly between -90 and 90 degrees, got {}",
+            num(angle)
+        );
     }
     let length = match it.next() {
         None => None,
@@ -131,7 +135,10 @@ pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>)> {
                 .parse()
                 .with_context(|| format!("--fence '{spec}': the length is not a number"))?;
             if !(l.is_finite() && l > 0.0) {
-                bail!("--fence '{spec}': the length must be a positive number");
+                bail!(
+                    "--fence '{spec}': the length must be a positive number (part units), got {}",
+                    num(l)
+                );
             }
             Some(l)
         }
@@ -146,38 +153,174 @@ pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>)
     crate::maps::fence_pass_start(poly, c.d, angle_deg, length, c.mu_c)
 }
 
-/// Refuse non-finite or out-of-range settings of a case with a message naming the option.
-pub(crate) fn check_inputs(c: &Case) -> Result<()> {
-    let finite = |name: &str, v: f64| -> Result<()> {
-        if !v.is_finite() {
-            bail!("{name} must be a finite number, got {v}");
-        }
-        Ok(())
-    };
-    finite("theta0", c.theta0_deg)?;
-    finite("d", c.d)?;
-    finite("mu-c", c.mu_c)?;
-    finite("mu-s", c.mu_s)?;
-    finite("pin-radius", c.pin_radius)?;
-    finite("pin-speed", c.pin_speed)?;
-    finite("tol", c.tol)?;
-    if c.mu_c < 0.0 {
-        bail!("mu-c (contact friction) must be >= 0, got {}", c.mu_c);
+/// Ranges of the numeric settings of a contact (README "One contact"). Lengths relative to the part
+/// are in units of `a`, so the ranges mean the same at any magnitude of the part.
+pub mod limits {
+    /// |θ0| in degrees: any angle within it is represented to better than 1e-11 rad.
+    pub const THETA0_DEG: f64 = 1e6;
+    /// Pin–part (or fence) friction μc.
+    pub const MU_C: (f64, f64) = (0.0, 10.0);
+    /// Part–belt friction μs (it scales forces only).
+    pub const MU_S: (f64, f64) = (1e-6, 100.0);
+    /// Pin radius in units of a.
+    pub const PIN_RADIUS_A: f64 = 10.0;
+    /// |w|: lateral pin speed as a fraction of the belt speed.
+    pub const PIN_SPEED: f64 = 10.0;
+    /// Integration tolerance per step.
+    pub const TOL: (f64, f64) = (1e-12, 1e-2);
+    /// Fence length in units of a.
+    pub const FENCE_LENGTH_A: (f64, f64) = (1e-3, 1e3);
+    /// |d| for a fence pass (the fence's placement does not depend on d; beyond this its start
+    /// would lose precision).
+    pub const FENCE_D: f64 = 100.0;
+}
+
+/// A number for a message: plain when moderate, in exponent notation when huge or tiny (so that
+/// 1e308 does not print as 309 digits).
+pub(crate) fn num(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
-    if c.mu_s <= 0.0 {
-        bail!("mu-s (support friction) must be > 0, got {}", c.mu_s);
-    }
-    if c.pin_radius < 0.0 {
-        bail!("pin-radius must be >= 0, got {}", c.pin_radius);
-    }
-    if !(c.tol > 0.0 && c.tol <= 1e-2) {
-        bail!("tol must be in (0, 0.01], got {}", c.tol);
-    }
-    if c.d.abs() > 100.0 {
+}
+
+/// `name must lie in [lo, hi] (what), got v` unless `lo ≤ v ≤ hi` (and v finite).
+fn in_range(name: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<()> {
+    if !(v.is_finite() && v >= lo && v <= hi) {
+        let kind = if v.is_finite() {
+            ""
+        } else {
+            "a finite number "
+        };
         bail!(
-            "d must be within [-100, 100] (it is in units of a), got {}",
-            c.d
+            "{name} must be {kind}in [{}, {}] ({what}), got {}",
+            num(lo),
+            num(hi),
+            num(v)
         );
+    }
+    Ok(())
+}
+
+/// The flag naming a setting (`mu_c` → `--mu-c`).
+fn flag(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
+}
+
+/// Refuse non-finite or out-of-range settings of a case (the ones that do not depend on the part)
+/// with a message naming the option, its range and the value.
+pub(crate) fn check_inputs(c: &Case) -> Result<()> {
+    check_inputs_named(c, &flag)
+}
+
+/// [`check_inputs`] with the settings named by `name` (a flag, or a CSV column).
+fn check_inputs_named(c: &Case, name: &dyn Fn(&str) -> String) -> Result<()> {
+    use limits::*;
+    in_range(
+        &name("theta0"),
+        c.theta0_deg,
+        -THETA0_DEG,
+        THETA0_DEG,
+        "degrees",
+    )?;
+    if !c.d.is_finite() {
+        bail!("{} must be a finite number, got {}", name("d"), num(c.d));
+    }
+    in_range(
+        &name("mu_c"),
+        c.mu_c,
+        MU_C.0,
+        MU_C.1,
+        "friction coefficient",
+    )?;
+    in_range(
+        &name("mu_s"),
+        c.mu_s,
+        MU_S.0,
+        MU_S.1,
+        "support friction; it scales forces only",
+    )?;
+    if !(c.pin_radius.is_finite() && c.pin_radius >= 0.0) {
+        bail!(
+            "{} must be a finite number >= 0 (part units, at most {PIN_RADIUS_A}·a), got {}",
+            name("pin_radius"),
+            num(c.pin_radius)
+        );
+    }
+    in_range(
+        &name("pin_speed"),
+        c.pin_speed,
+        -PIN_SPEED,
+        PIN_SPEED,
+        "fraction of the belt speed",
+    )?;
+    in_range(
+        &name("tol"),
+        c.tol,
+        TOL.0,
+        TOL.1,
+        "integration tolerance per step",
+    )?;
+    Ok(())
+}
+
+/// Largest |d| at which the pin of a case can touch the part: the disc's reach 1 + ρ/a, widened for
+/// a moving pin by the lateral distance it covers while crossing the part (about 2.02·(a + ρ) of
+/// belt travel at |w| per unit).
+pub fn reach(c: &Case, a: f64) -> f64 {
+    (1.0 + c.pin_radius / a) * (1.0 + 2.02 * c.pin_speed.abs())
+}
+
+/// Refuse settings of a case that are out of range relative to the part (`a` = its size): pin
+/// radius, d beyond what can touch, fence length.
+pub(crate) fn check_geometry(c: &Case, poly: &Polygon) -> Result<()> {
+    check_geometry_named(c, poly, &flag)
+}
+
+fn check_geometry_named(c: &Case, poly: &Polygon, name: &dyn Fn(&str) -> String) -> Result<()> {
+    use limits::*;
+    let a = poly.radius();
+    let rmax = PIN_RADIUS_A * a;
+    if c.pin_radius > rmax {
+        bail!(
+            "{} must lie in [0, {}] (part units: at most {PIN_RADIUS_A}·a, a = {}), got {}",
+            name("pin_radius"),
+            num(rmax),
+            num(a),
+            num(c.pin_radius)
+        );
+    }
+    match c.fence {
+        Some((_, length)) => {
+            in_range(&name("d"), c.d, -FENCE_D, FENCE_D, "units of a")?;
+            if let Some(l) = length {
+                let (lo, hi) = (FENCE_LENGTH_A.0 * a, FENCE_LENGTH_A.1 * a);
+                if !(l >= lo && l <= hi) {
+                    bail!(
+                        "--fence: the length must lie in [{}, {}] (part units: {}·a to {}·a, a = {}), got {}",
+                        num(lo),
+                        num(hi),
+                        FENCE_LENGTH_A.0,
+                        FENCE_LENGTH_A.1,
+                        num(a),
+                        num(l)
+                    );
+                }
+            }
+        }
+        None => {
+            let limit = reach(c, a);
+            if c.d.abs() > limit {
+                bail!(
+                    "{} = {} is out of range: it must lie in [-{}, {}] (units of a: beyond it this pin cannot touch the part)",
+                    name("d"),
+                    num(c.d),
+                    num(limit),
+                    num(limit)
+                );
+            }
+        }
     }
     Ok(())
 }
@@ -216,6 +359,7 @@ pub(crate) fn settings_and_pin(c: &Case) -> (ContactSettings, Pin) {
 pub fn run_case(c: &Case, want_trace: bool) -> Result<(Polygon, ContactOutcome, Vec<TraceSample>)> {
     check_inputs(c)?;
     let (poly, model) = compile_part(&c.part, &c.support)?;
+    check_geometry(c, &poly)?;
     let (out, trace) = run_compiled(c, &poly, &model, want_trace);
     Ok((poly, out, trace))
 }
@@ -409,6 +553,7 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
         .with_context(|| format!("reading {}", path.display()))?;
     let mut wtr = csv::Writer::from_writer(std::io::stdout().lock());
     let mut compiled: std::collections::HashMap<String, (Polygon, PartModel)> = Default::default();
+    let fence = args.fence.as_deref().map(parse_fence).transpose()?;
     for (i, row) in rdr.deserialize::<CaseRow>().enumerate() {
         let row = row.map_err(|e| {
             let line = e.position().map(|p| p.line()).unwrap_or(i as u64 + 2);
@@ -431,16 +576,31 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
             pin_speed: args.pin_speed,
             support: args.support.clone(),
             tol: args.tol,
-            fence: None,
+            fence,
         };
-        check_inputs(&c).with_context(|| format!("{}:{line}", path.display()))?;
+        // A setting given in the row is named by its column, one taken from a flag by the flag.
+        let in_row = |field: &str| match field {
+            "theta0" | "d" | "mu_c" => true,
+            "pin_radius" => row.pin_radius.is_some(),
+            "mu_s" => row.mu_s.is_some(),
+            _ => false,
+        };
+        let name = |field: &str| {
+            if in_row(field) {
+                format!("column {field}")
+            } else {
+                flag(field)
+            }
+        };
+        let at = || format!("{}:{line}", path.display());
+        check_inputs_named(&c, &name).with_context(at)?;
         // Compile each distinct part once for the whole batch.
         if !compiled.contains_key(&c.part) {
-            let pm = compile_part(&c.part, &c.support)
-                .with_context(|| format!("{}:{line}", path.display()))?;
+            let pm = compile_part(&c.part, &c.support).with_context(at)?;
             compiled.insert(c.part.clone(), pm);
         }
         let (poly, model) = &compiled[&c.part];
+        check_geometry_named(&c, poly, &name).with_context(at)?;
         let (out, _) = run_compiled(&c, poly, model, false);
         wtr.serialize(CaseOut {
             part: &c.part,

@@ -11,11 +11,12 @@
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
 
 use super::contact::{
-    case_fence, check_inputs, compile_part, parse_fence, parse_model, settings_and_pin, Case,
+    case_fence, check_geometry, check_inputs, compile_part, num, parse_fence, parse_model,
+    settings_and_pin, Case,
 };
 use crate::maps::{compute_maps, ConfigurationMap, MapFence, MapSettings};
 use crate::report::{map_table, plot_map};
-use anyhow::{Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -222,6 +223,57 @@ fn figure_name(m: &ConfigurationMap) -> String {
     }
 }
 
+/// Most contact parameters in one map command.
+pub const MAX_DS: usize = 1000;
+/// Most contacts (maps × θ0 samples) in one map command: bounds the memory (about 100 bytes each)
+/// and the time.
+pub const MAX_CONTACTS: usize = 3_600_000;
+/// Most worker threads.
+pub const MAX_THREADS: usize = 1024;
+
+/// Refuse out-of-range map settings with the flag, the range and the value.
+fn check_map_args(args: &MapArgs) -> Result<()> {
+    if args.threads > MAX_THREADS {
+        bail!(
+            "--threads must lie in [0, {MAX_THREADS}] (0: one per core), got {}",
+            args.threads
+        );
+    }
+    if args.d.len() > MAX_DS {
+        bail!(
+            "--d takes at most {MAX_DS} contact parameters, got {}",
+            args.d.len()
+        );
+    }
+    if !(args.theta_step.is_finite() && args.theta_step > 0.0 && args.theta_step <= 360.0) {
+        bail!(
+            "--theta-step: theta step must be a finite number of degrees in (0, 360] dividing 360, got {}",
+            num(args.theta_step)
+        );
+    }
+    let grid =
+        crate::maps::theta_grid(args.theta_step).map_err(|e| anyhow!("--theta-step: {e}"))?;
+    let maps = if args.fence.is_some() {
+        1
+    } else {
+        args.d.len()
+    };
+    if maps * grid.len() > MAX_CONTACTS {
+        bail!(
+            "{maps} maps × {} θ0 samples = {} contacts; at most {MAX_CONTACTS} are allowed in one command (raise --theta-step or give fewer --d)",
+            grid.len(),
+            maps * grid.len()
+        );
+    }
+    if !(args.threshold.is_finite() && args.threshold > 0.0 && args.threshold <= 360.0) {
+        bail!(
+            "--threshold must be a finite number of degrees in (0, 360], got {}",
+            num(args.threshold)
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: &MapArgs) -> Result<()> {
     let model = parse_model(&args.model)?;
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;
@@ -239,7 +291,21 @@ pub fn run(args: &MapArgs) -> Result<()> {
         fence,
     };
     check_inputs(&template)?;
+    check_map_args(args)?;
     let (poly, part_model) = compile_part(&args.part, &args.support)?;
+    if fence.is_some() {
+        check_geometry(&template, &poly)?;
+    } else {
+        for &d in &args.d {
+            check_geometry(
+                &Case {
+                    d,
+                    ..template.clone()
+                },
+                &poly,
+            )?;
+        }
+    }
     let (contact, pin) = settings_and_pin(&template);
     let settings = MapSettings {
         theta_step_deg: args.theta_step,

@@ -10,6 +10,13 @@
 //!   edge lengths, so floating-point collinear) is dropped: it does not change the shape, and keeping
 //!   it would split a flat side into two edges. Nearly collinear vertices are kept.
 //!
+//! Scale invariance: validation and the sums run on the vertices divided by a power of two that
+//! brings the largest coordinate into [0.5, 1) — an exact division — so every test and every
+//! tolerance is the same at any magnitude, and a copy scaled by a power of two gives bit-identical
+//! results scaled back. The scaled-back size `a`, area (∝ a²) and polar moment (∝ a⁴) must be
+//! finite, normal doubles; a part whose mass properties cannot be represented (a beyond about
+//! 1e±75) is refused with [`PolygonError::NotRepresentable`] rather than carrying inf or NaN.
+//!
 //! Mass properties use the shoelace formulas; `a` is the largest centroid-to-vertex distance.
 //! Stable states (SPEC §1) are the orientations θ at which an edge of the convex hull has its outward
 //! normal along −y and the foot of the perpendicular from the centroid lies strictly inside that edge:
@@ -34,6 +41,14 @@ pub enum PolygonError {
     },
     #[error("the polygon has zero area (all vertices are collinear or it folds onto itself)")]
     ZeroArea,
+    #[error("the part's {quantity} {direction} double precision at this size (a ≈ {a}): give the vertices in a unit where a lies between about 1e-70 and 1e70")]
+    NotRepresentable {
+        quantity: &'static str,
+        direction: &'static str,
+        a: String,
+    },
+    #[error("scale factor must be a positive finite number, got {0}")]
+    BadScale(f64),
     #[error("the polygon is not simple: edge {edge_a} ({a0} -> {a1}) and edge {edge_b} ({b0} -> {b1}) intersect")]
     SelfIntersecting {
         edge_a: usize,
@@ -104,8 +119,215 @@ fn signed_area(v: &[Vec2]) -> f64 {
     0.5 * s
 }
 
+/// A polygon validated and measured in normalised coordinates (largest |coordinate| in [0.5, 1)).
+struct Unit {
+    /// Counter-clockwise, centroid at the origin.
+    vertices: Vec<Vec2>,
+    /// Centroid in the normalised input coordinates.
+    centroid: Vec2,
+    area: f64,
+    polar: f64,
+    radius: f64,
+    convex: bool,
+    hull: Vec<Vec2>,
+}
+
+/// Validate and measure a vertex list whose coordinates are at most 1 in magnitude (see
+/// [`Polygon::new`]); every tolerance is relative to the list's size.
+fn validated_unit(points: &[Vec2]) -> Result<Unit, PolygonError> {
+    let n = points.len();
+    // Size of the part, for relative tolerances.
+    let (mut lo, mut hi) = (points[0], points[0]);
+    for p in points {
+        lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
+        hi = Vec2::new(hi.x.max(p.x), hi.y.max(p.y));
+    }
+    let size = (hi - lo).norm();
+    for i in 0..n {
+        let j = (i + 1) % n;
+        if (points[j] - points[i]).norm() <= 1e-12 * size {
+            let (index, previous) = if j == 0 { (n - 1, 0) } else { (j, i) };
+            return Err(PolygonError::RepeatedVertex {
+                index,
+                previous,
+                hint: if j == 0 {
+                    " — the ring closes itself; do not repeat the first vertex at the end"
+                } else {
+                    ""
+                },
+            });
+        }
+    }
+    let area = signed_area(points);
+    // All vertices on one line: say so before any talk of self-intersection.
+    if convex_hull(points).len() < 3 {
+        return Err(PolygonError::ZeroArea);
+    }
+    // Simplicity: non-adjacent edges must not touch; adjacent edges must not fold back.
+    for i in 0..n {
+        let (a0, a1) = (points[i], points[(i + 1) % n]);
+        for j in i + 1..n {
+            let (b0, b1) = (points[j], points[(j + 1) % n]);
+            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+            let hit = if adjacent {
+                // Shared vertex: they intersect elsewhere only if collinear and overlapping.
+                let (shared, p, q) = if j == i + 1 {
+                    (a1, a0, b1)
+                } else {
+                    (a0, a1, b0)
+                };
+                let u = p - shared;
+                let w = q - shared;
+                u.cross(w).abs() <= 1e-15 * u.norm() * w.norm() && u.dot(w) > 0.0
+            } else {
+                segments_intersect(a0, a1, b0, b1)
+            };
+            if hit {
+                return Err(PolygonError::SelfIntersecting {
+                    edge_a: i,
+                    edge_b: j,
+                    a0: i,
+                    a1: (i + 1) % n,
+                    b0: j,
+                    b1: (j + 1) % n,
+                });
+            }
+        }
+    }
+    if area.abs() <= 1e-12 * size * size {
+        return Err(PolygonError::ZeroArea);
+    }
+    let mut v: Vec<Vec2> = points.to_vec();
+    if area < 0.0 {
+        v.reverse();
+    }
+    // Drop vertices that are exactly collinear with their neighbours.
+    let mut k = 0;
+    while k < v.len() && v.len() > 3 {
+        let m = v.len();
+        let prev = v[(k + m - 1) % m];
+        let next = v[(k + 1) % m];
+        let e1 = v[k] - prev;
+        let e2 = next - v[k];
+        if e1.cross(e2).abs() <= 1e-15 * e1.norm() * e2.norm() && e1.dot(e2) > 0.0 {
+            v.remove(k);
+            k = k.saturating_sub(1);
+        } else {
+            k += 1;
+        }
+    }
+    // Centroid (relative to the first vertex for accuracy).
+    let o = v[0];
+    let mut a2 = 0.0;
+    let mut cx = Vec2::ZERO;
+    for i in 1..v.len() - 1 {
+        let p = v[i] - o;
+        let q = v[i + 1] - o;
+        let c = p.cross(q);
+        a2 += c;
+        cx += (p + q) * c;
+    }
+    let centroid = o + cx / (3.0 * a2);
+    for p in v.iter_mut() {
+        *p -= centroid;
+    }
+    let m = v.len();
+    let mut polar = 0.0;
+    let mut radius: f64 = 0.0;
+    let mut convex = true;
+    for i in 0..m {
+        let p = v[i];
+        let q = v[(i + 1) % m];
+        let r = v[(i + 2) % m];
+        let c = p.cross(q);
+        polar += c * (p.dot(p) + p.dot(q) + q.dot(q));
+        radius = radius.max(p.norm());
+        if (q - p).cross(r - q) < 0.0 {
+            convex = false;
+        }
+    }
+    polar /= 12.0;
+    let hull = convex_hull(&v);
+    Ok(Unit {
+        vertices: v,
+        centroid,
+        area: area.abs(),
+        polar,
+        radius,
+        convex,
+        hull,
+    })
+}
+
+/// `2^e` for any `e` in [−1022, 1023], exactly.
+fn pow2(e: i32) -> f64 {
+    debug_assert!((-1022..=1023).contains(&e));
+    f64::from_bits(((e + 1023) as u64) << 52)
+}
+
+/// `x · 2^e` for any `e` (in steps of representable powers of two, so the factor itself never
+/// overflows or underflows). Exact unless the result is subnormal, zero or infinite.
+fn ldexp(mut x: f64, mut e: i32) -> f64 {
+    while e > 1000 {
+        x *= pow2(1000);
+        e -= 1000;
+    }
+    while e < -1000 {
+        x *= pow2(-1000);
+        e += 1000;
+    }
+    x * pow2(e)
+}
+
+/// The power of two `e` with every coordinate of `points` below 2^e in magnitude and the largest at
+/// least 2^(e−1) (all points finite, not all zero).
+fn magnitude_exponent(points: &[Vec2]) -> i32 {
+    let m = points
+        .iter()
+        .map(|p| p.x.abs().max(p.y.abs()))
+        .fold(0.0, f64::max);
+    // log2 of a finite positive double is exact enough to pick the exponent; correct by one if
+    // rounding landed on the wrong side.
+    let mut e = m.log2().floor() as i32 + 1;
+    while ldexp(m, -e) >= 1.0 {
+        e += 1;
+    }
+    while e > -1100 && ldexp(m, -(e - 1)) < 1.0 {
+        e -= 1;
+    }
+    e
+}
+
+/// `a ≈ r · 2^e` written as a decimal (for messages; never overflows).
+fn approx_decimal(r: f64, e: i32) -> String {
+    let l = r.log10() + f64::from(e) * std::f64::consts::LOG10_2;
+    let exp = l.floor();
+    format!("{:.2}e{}", 10f64.powf(l - exp), exp as i64)
+}
+
+/// A mass property scaled back from normalised units: it must be a normal, finite double.
+fn representable(value: f64, quantity: &'static str, r: f64, e: i32) -> Result<f64, PolygonError> {
+    if value.is_normal() {
+        return Ok(value);
+    }
+    Err(PolygonError::NotRepresentable {
+        quantity,
+        direction: if value.is_infinite() || value.is_nan() {
+            "overflows"
+        } else {
+            "underflows"
+        },
+        a: approx_decimal(r, e),
+    })
+}
+
 impl Polygon {
     /// Build a part from a vertex list in any orientation and any unit.
+    ///
+    /// Every test and sum is computed on the vertices divided by a power of two that brings the
+    /// largest coordinate into [0.5, 1) (exact), so validation and the results do not depend on
+    /// the magnitude of the input; the mass properties are then scaled back and must be
+    /// representable (finite and normal), else [`PolygonError::NotRepresentable`].
     pub fn new(points: &[Vec2]) -> Result<Polygon, PolygonError> {
         let n = points.len();
         if n < 3 {
@@ -120,126 +342,45 @@ impl Polygon {
                 });
             }
         }
-        // Size of the part, for relative tolerances.
-        let (mut lo, mut hi) = (points[0], points[0]);
-        for p in points {
-            lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
-            hi = Vec2::new(hi.x.max(p.x), hi.y.max(p.y));
+        if points.iter().all(|p| p.x == 0.0 && p.y == 0.0) {
+            return Err(PolygonError::RepeatedVertex {
+                index: 1,
+                previous: 0,
+                hint: "",
+            });
         }
-        let size = (hi - lo).norm();
-        for i in 0..n {
-            let j = (i + 1) % n;
-            if (points[j] - points[i]).norm() <= 1e-12 * size {
-                let (index, previous) = if j == 0 { (n - 1, 0) } else { (j, i) };
-                return Err(PolygonError::RepeatedVertex {
-                    index,
-                    previous,
-                    hint: if j == 0 {
-                        " — the ring closes itself; do not repeat the first vertex at the end"
-                    } else {
-                        ""
-                    },
-                });
-            }
+        let e = magnitude_exponent(points);
+        let q: Vec<Vec2> = points
+            .iter()
+            .map(|p| Vec2::new(ldexp(p.x, -e), ldexp(p.y, -e)))
+            .collect();
+        let unit = validated_unit(&q)?;
+        // Scale back: lengths by 2^e, area by 4^e, polar moment by 16^e.
+        let a = representable(ldexp(unit.radius, e), "size a", unit.radius, e)?;
+        let area = representable(ldexp(ldexp(unit.area, e), e), "area (∝ a²)", unit.radius, e)?;
+        let polar = representable(
+            ldexp(ldexp(ldexp(ldexp(unit.polar, e), e), e), e),
+            "polar moment (∝ a⁴)",
+            unit.radius,
+            e,
+        )?;
+        let back = |v: Vec2| Vec2::new(ldexp(v.x, e), ldexp(v.y, e));
+        let offset = back(unit.centroid);
+        if !offset.is_finite() {
+            return Err(PolygonError::NotRepresentable {
+                quantity: "centroid",
+                direction: "overflows",
+                a: approx_decimal(unit.radius, e),
+            });
         }
-        let area = signed_area(points);
-        // All vertices on one line: say so before any talk of self-intersection.
-        if convex_hull(points).len() < 3 {
-            return Err(PolygonError::ZeroArea);
-        }
-        // Simplicity: non-adjacent edges must not touch; adjacent edges must not fold back.
-        for i in 0..n {
-            let (a0, a1) = (points[i], points[(i + 1) % n]);
-            for j in i + 1..n {
-                let (b0, b1) = (points[j], points[(j + 1) % n]);
-                let adjacent = j == i + 1 || (i == 0 && j == n - 1);
-                let hit = if adjacent {
-                    // Shared vertex: they intersect elsewhere only if collinear and overlapping.
-                    let (shared, p, q) = if j == i + 1 {
-                        (a1, a0, b1)
-                    } else {
-                        (a0, a1, b0)
-                    };
-                    let u = p - shared;
-                    let w = q - shared;
-                    u.cross(w).abs() <= 1e-15 * u.norm() * w.norm() && u.dot(w) > 0.0
-                } else {
-                    segments_intersect(a0, a1, b0, b1)
-                };
-                if hit {
-                    return Err(PolygonError::SelfIntersecting {
-                        edge_a: i,
-                        edge_b: j,
-                        a0: i,
-                        a1: (i + 1) % n,
-                        b0: j,
-                        b1: (j + 1) % n,
-                    });
-                }
-            }
-        }
-        if area.abs() <= 1e-12 * size * size {
-            return Err(PolygonError::ZeroArea);
-        }
-        let mut v: Vec<Vec2> = points.to_vec();
-        if area < 0.0 {
-            v.reverse();
-        }
-        // Drop vertices that are exactly collinear with their neighbours.
-        let mut k = 0;
-        while k < v.len() && v.len() > 3 {
-            let m = v.len();
-            let prev = v[(k + m - 1) % m];
-            let next = v[(k + 1) % m];
-            let e1 = v[k] - prev;
-            let e2 = next - v[k];
-            if e1.cross(e2).abs() <= 1e-15 * e1.norm() * e2.norm() && e1.dot(e2) > 0.0 {
-                v.remove(k);
-                k = k.saturating_sub(1);
-            } else {
-                k += 1;
-            }
-        }
-        // Centroid (relative to the first vertex for accuracy).
-        let o = v[0];
-        let mut a2 = 0.0;
-        let mut cx = Vec2::ZERO;
-        for i in 1..v.len() - 1 {
-            let p = v[i] - o;
-            let q = v[i + 1] - o;
-            let c = p.cross(q);
-            a2 += c;
-            cx += (p + q) * c;
-        }
-        let centroid = o + cx / (3.0 * a2);
-        for p in v.iter_mut() {
-            *p -= centroid;
-        }
-        let m = v.len();
-        let mut polar = 0.0;
-        let mut radius: f64 = 0.0;
-        let mut convex = true;
-        for i in 0..m {
-            let p = v[i];
-            let q = v[(i + 1) % m];
-            let r = v[(i + 2) % m];
-            let c = p.cross(q);
-            polar += c * (p.dot(p) + p.dot(q) + q.dot(q));
-            radius = radius.max(p.norm());
-            if (q - p).cross(r - q) < 0.0 {
-                convex = false;
-            }
-        }
-        polar /= 12.0;
-        let hull = convex_hull(&v);
         Ok(Polygon {
-            vertices: v,
-            offset: centroid,
-            area: area.abs(),
+            vertices: unit.vertices.iter().map(|&v| back(v)).collect(),
+            offset,
+            area,
             polar_moment: polar,
-            radius,
-            convex,
-            hull,
+            radius: a,
+            convex: unit.convex,
+            hull: unit.hull.iter().map(|&v| back(v)).collect(),
         })
     }
 
@@ -307,10 +448,56 @@ impl Polygon {
         &self.hull
     }
 
-    /// The same polygon scaled by `k > 0` about its centroid.
-    pub fn scaled(&self, k: f64) -> Polygon {
+    /// The same polygon scaled by `k > 0` about its centroid, or why it cannot be: `k` not positive
+    /// and finite ([`PolygonError::BadScale`]), or a scaled size, area or polar moment that a
+    /// double cannot hold ([`PolygonError::NotRepresentable`]). Use this for factors that come
+    /// from input (a scenario's `scale`).
+    pub fn try_scaled(&self, k: f64) -> Result<Polygon, PolygonError> {
+        if !(k.is_finite() && k > 0.0) {
+            return Err(PolygonError::BadScale(k));
+        }
         let v: Vec<Vec2> = self.vertices.iter().map(|&p| p * k).collect();
-        Polygon::new(&v).expect("scaling a valid polygon by a positive factor keeps it valid")
+        match Polygon::new(&v) {
+            Ok(p) => Ok(p),
+            Err(e @ PolygonError::NotRepresentable { .. }) => Err(e),
+            // Only rounding (or overflow / underflow of a coordinate) can make a scaled copy of a
+            // valid polygon fail a shape test: scale the measured polygon directly instead.
+            Err(_) => self.scaled_directly(k),
+        }
+    }
+
+    /// Scale the stored vertices and mass properties by `k` without re-validating the shape.
+    fn scaled_directly(&self, k: f64) -> Result<Polygon, PolygonError> {
+        let e = magnitude_exponent(&self.vertices);
+        let r = ldexp(self.radius, -e);
+        // a·k ≈ r · (k / 2^l) · 2^(e + l), for the message.
+        let l = k.log2().round() as i32;
+        let (rk, ek) = (r * ldexp(k, -l), e + l);
+        let check = |v: f64, q: &'static str| representable(v, q, rk, ek);
+        let a = check(self.radius * k, "size a")?;
+        let area = check(self.area * k * k, "area (∝ a²)")?;
+        let polar = check(self.polar_moment * k * k * k * k, "polar moment (∝ a⁴)")?;
+        Ok(Polygon {
+            vertices: self.vertices.iter().map(|&p| p * k).collect(),
+            offset: Vec2::ZERO,
+            area,
+            polar_moment: polar,
+            radius: a,
+            convex: self.convex,
+            hull: self.hull.iter().map(|&p| p * k).collect(),
+        })
+    }
+
+    /// The same polygon scaled by `k` about its centroid, for factors known to be representable
+    /// (such as `1 / a`, which scales any valid polygon to a = 1).
+    ///
+    /// # Panics
+    /// If [`Polygon::try_scaled`] fails: `k` not positive and finite, or a scaled size, area or
+    /// polar moment out of double range. Factors from input must go through `try_scaled`.
+    pub fn scaled(&self, k: f64) -> Polygon {
+        self.try_scaled(k).unwrap_or_else(|e| {
+            panic!("Polygon::scaled({k}): {e} (use try_scaled for factors from input)")
+        })
     }
 
     /// The mirror image about the part frame's x axis (y → −y), re-normalised counter-clockwise.
@@ -506,6 +693,41 @@ mod tests {
         ));
         // A spike: the ring runs out and straight back along the same line.
         assert!(Polygon::from_xy(&[(0.0, 0.0), (2.0, 0.0), (1.0, 0.0), (1.0, 1.0)]).is_err());
+    }
+
+    #[test]
+    fn ldexp_and_magnitude_exponent_are_exact_at_the_extremes() {
+        assert_eq!(ldexp(1.0, 1023), 2f64.powi(1023));
+        assert_eq!(ldexp(f64::MAX, -1024), f64::MAX / 2f64.powi(1023) / 2.0);
+        assert_eq!(ldexp(5e-324, 1074), 1.0);
+        assert_eq!(ldexp(1.0, -1076), 0.0);
+        for m in [5e-324, 1e-310, 2.2e-308, 0.75, 1.0, 1e300, f64::MAX] {
+            let e = magnitude_exponent(&[Vec2::new(-m, 0.0)]);
+            let q = ldexp(m, -e);
+            assert!((0.5..1.0).contains(&q), "{m:e}: e = {e}, q = {q}");
+        }
+    }
+
+    #[test]
+    fn power_of_two_copies_are_bit_identical() {
+        let v = [(0.3, -0.1), (1.7, 0.2), (0.4, 1.1), (-0.2, 0.5)];
+        let p = Polygon::from_xy(&v).unwrap();
+        for e in [-250, -1, 7, 240] {
+            let k = 2f64.powi(e);
+            let s: Vec<(f64, f64)> = v.iter().map(|&(x, y)| (x * k, y * k)).collect();
+            let q = Polygon::from_xy(&s).unwrap();
+            assert_eq!(q.radius(), p.radius() * k);
+            assert_eq!(q.area(), p.area() * k * k);
+            assert_eq!(q.polar_moment(), p.polar_moment() * k * k * k * k);
+            assert_eq!(q.offset(), p.offset() * k);
+            let thetas = |x: &Polygon| {
+                x.stable_states()
+                    .iter()
+                    .map(|s| s.theta)
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(thetas(&q), thetas(&p));
+        }
     }
 
     #[test]

@@ -1,0 +1,567 @@
+//! Fuzzing the command line and polygon validation (issue 11), bounded to run in CI.
+//!
+//! * Random and mutated argument vectors for `part`, `contact` and `map --no-write` (small grids),
+//!   built from the real flags with numbers drawn across every magnitude and from the awkward
+//!   values (NaN, ±inf, −0, 5e-324, 1e308, words that are not numbers), run through the built
+//!   binary: never a panic (exit status 101, "panicked"), exit status 0, 1 (a refusal whose first
+//!   stderr line is `error: ` and a cause) or 2 (clap's usage error), and no NaN or infinity in
+//!   any JSON or CSV printed.
+//! * The same argument vectors in-process (`Cli::try_parse_from` + `cli::run`) under
+//!   `catch_unwind`, many more of them, asserting only that nothing panics.
+//! * Random polygons across magnitudes 1e-300 … 1e300: a scaled copy is accepted or refused with
+//!   the polygon at unit size, with the same stable states and the same a / scale; where its mass
+//!   properties cannot be represented it is refused for that reason and no other.
+//! * Contacts on copies scaled by powers of two give bit-identical rotations.
+//!
+//! Failing cases proptest finds are kept in `fuzz_cli.proptest-regressions` and re-run first.
+
+use clap::Parser;
+use pinfeed::cli::contact::{run_case, Case};
+use pinfeed::geometry::{Polygon, PolygonError};
+use pinfeed::mechanics::Fidelity;
+use proptest::prelude::*;
+use std::process::Command;
+
+mod shapes;
+
+// ---------------------------------------------------------------------------------------------
+// Strategies.
+
+/// A number as a user might type it, or something that only looks like one.
+fn number() -> BoxedStrategy<String> {
+    prop_oneof![
+        3 => prop::sample::select(vec![
+            "nan", "NaN", "inf", "-inf", "infinity", "0", "-0", "1e308", "-1e308", "5e-324",
+            "-5e-324", "1e-300", "1e300", "1e6", "-1e6", "1e-13", "1e-12", "0.01", "10", "100",
+            "1000", "-90", "90", "89.999", "abc", "", "1,2", "0x10", "1e", "--", "+1", ".5",
+        ])
+        .prop_map(String::from),
+        4 => (-2.0f64..2.0).prop_map(|x| x.to_string()),
+        2 => (-400.0f64..400.0).prop_map(|x| x.to_string()),
+        3 => (-9.99f64..9.99, -320i32..309).prop_map(|(m, e)| format!("{m:.3}e{e}")),
+    ]
+    .boxed()
+}
+
+/// A star-shaped polygon about the origin (3–8 vertices, radii in [0.2, 1]).
+fn star() -> impl Strategy<Value = Vec<(f64, f64)>> {
+    shapes::star_polygon(3..9)
+}
+
+fn vertex_text(v: &[(f64, f64)]) -> String {
+    v.iter()
+        .map(|(x, y)| format!("{x:e},{y:e}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// A vertex list: a star polygon at a random magnitude, sometimes mutated (a vertex dropped,
+/// repeated or swapped, a coordinate replaced by an awkward number).
+fn vertex_list() -> BoxedStrategy<String> {
+    (
+        star(),
+        prop_oneof![1 => -300i32..300, 3 => -60i32..60],
+        prop_oneof![3 => Just(5usize), 1 => 0usize..5],
+        any::<prop::sample::Index>(),
+        number(),
+    )
+        .prop_map(|(v, e, mutation, at, num)| {
+            let k = 10f64.powi(e);
+            let mut words: Vec<String> = v
+                .iter()
+                .map(|&(x, y)| format!("{:e},{:e}", x * k, y * k))
+                .collect();
+            let i = at.index(words.len());
+            match mutation {
+                0 => {
+                    words.remove(i);
+                }
+                1 => {
+                    let w = words[i].clone();
+                    words.insert(i, w);
+                }
+                2 => words.swap(i, (i + 1) % v.len()),
+                3 => {
+                    let y = words[i].split(',').nth(1).unwrap().to_string();
+                    words[i] = format!("{num},{y}");
+                }
+                _ => {}
+            }
+            words.join(" ")
+        })
+        .boxed()
+}
+
+/// A part specification: a named part (with random parameters) or a vertex list.
+fn part_spec() -> BoxedStrategy<String> {
+    prop_oneof![
+        1 => prop::sample::select(vec!["tripoly1", "tripoly2", "square", "lshape", "blob", ""])
+            .prop_map(String::from),
+        1 => (number(), number()).prop_map(|(w, h)| format!("rect:{w}:{h}")),
+        1 => prop_oneof![Just("3".to_string()), Just("7".to_string()), number()]
+            .prop_map(|n| format!("ngon:{n}")),
+        3 => vertex_list().prop_map(|v| format!("vertices:{v}")),
+    ]
+    .boxed()
+}
+
+/// A flag and the range its plausible values are drawn from (log-uniform when `log`).
+type FlagRange = (&'static str, f64, f64, bool);
+
+/// Optional `--flag=value` words: each flag present with probability 0.4, its value mostly drawn
+/// from the flag's plausible range, sometimes any number.
+fn optional_flags(flags: &'static [FlagRange]) -> BoxedStrategy<Vec<String>> {
+    prop::collection::vec(
+        (
+            prop::bool::weighted(0.4),
+            0.0f64..1.0,
+            number(),
+            prop::bool::weighted(0.8),
+        ),
+        flags.len(),
+    )
+    .prop_map(move |vals| {
+        flags
+            .iter()
+            .zip(vals)
+            .filter(|(_, (on, ..))| *on)
+            .map(|(&(f, lo, hi, log), (_, u, any, plausible))| {
+                let v = if !plausible {
+                    any
+                } else if log {
+                    format!(
+                        "{:e}",
+                        10f64.powf(lo.log10() + u * (hi.log10() - lo.log10()))
+                    )
+                } else if f == "threads" {
+                    ((lo + u * (hi - lo)) as usize).to_string()
+                } else {
+                    (lo + u * (hi - lo)).to_string()
+                };
+                format!("--{f}={v}")
+            })
+            .collect()
+    })
+    .boxed()
+}
+
+fn model() -> impl Strategy<Value = Vec<String>> {
+    prop::option::of(prop::sample::select(vec![
+        "exact",
+        "ellipsoid",
+        "tip",
+        "quantum",
+    ]))
+    .prop_map(|m| m.map(|m| vec![format!("--model={m}")]).unwrap_or_default())
+}
+
+fn support() -> impl Strategy<Value = Vec<String>> {
+    prop::option::of(prop_oneof![
+        Just("uniform".to_string()),
+        (0u64..1000).prop_map(|s| format!("tripod:{s}")),
+        number().prop_map(|s| format!("tripod:{s}")),
+    ])
+    .prop_map(|s| {
+        s.map(|s| vec![format!("--support={s}")])
+            .unwrap_or_default()
+    })
+}
+
+fn fence() -> impl Strategy<Value = Vec<String>> {
+    prop::option::weighted(
+        0.25,
+        prop_oneof![
+            (-89.0f64..89.0).prop_map(|a| format!("{a}")),
+            (-89.0f64..89.0, number()).prop_map(|(a, l)| format!("{a}:{l}")),
+            (number(), number()).prop_map(|(a, l)| format!("{a}:{l}")),
+        ],
+    )
+    .prop_map(|f| f.map(|f| vec![format!("--fence={f}")]).unwrap_or_default())
+}
+
+/// Drop, repeat or swap one word after the sub-command (or leave the vector alone).
+fn mutate(mut args: Vec<String>, how: usize, at: prop::sample::Index) -> Vec<String> {
+    if args.len() < 2 {
+        return args;
+    }
+    let i = 1 + at.index(args.len() - 1);
+    match how {
+        0 => {
+            args.remove(i);
+        }
+        1 => {
+            let w = args[i].clone();
+            args.insert(i, w);
+        }
+        2 if i + 1 < args.len() => args.swap(i, i + 1),
+        _ => {}
+    }
+    args
+}
+
+/// `part` argument vectors.
+fn part_args() -> BoxedStrategy<Vec<String>> {
+    (
+        part_spec(),
+        any::<bool>(),
+        0usize..6,
+        any::<prop::sample::Index>(),
+    )
+        .prop_map(|(spec, by_vertices, how, at)| {
+            let mut a = vec!["part".to_string()];
+            match spec.strip_prefix("vertices:") {
+                Some(v) if by_vertices => a.push(format!("--vertices={v}")),
+                _ => a.push(spec),
+            }
+            a.push("--json".into());
+            mutate(a, how, at)
+        })
+        .boxed()
+}
+
+/// Contact parameters mostly where pins touch, sometimes anywhere.
+fn contact_d() -> BoxedStrategy<String> {
+    prop_oneof![3 => (-1.1f64..1.1).prop_map(|d| d.to_string()), 1 => number()].boxed()
+}
+
+/// `contact` argument vectors (always `--json`).
+fn contact_args() -> BoxedStrategy<Vec<String>> {
+    (
+        part_spec(),
+        prop_oneof![3 => (-720.0f64..720.0).prop_map(|t| t.to_string()), 1 => number()],
+        contact_d(),
+        optional_flags(&[
+            ("mu-c", 0.0, 2.0, false),
+            ("mu-s", 0.01, 2.0, false),
+            ("pin-radius", 0.0, 0.5, false),
+            ("pin-speed", -1.0, 1.0, false),
+            ("tol", 1e-9, 1e-3, true),
+        ]),
+        (model(), support(), fence()),
+        (0usize..12, any::<prop::sample::Index>()),
+    )
+        .prop_map(|(part, theta0, d, flags, (m, s, f), (how, at))| {
+            let mut a: Vec<String> = vec![
+                "contact".into(),
+                format!("--part={part}"),
+                format!("--theta0={theta0}"),
+                format!("--d={d}"),
+                "--json".into(),
+            ];
+            a.extend(flags);
+            a.extend(m);
+            a.extend(s);
+            a.extend(f);
+            mutate(a, how, at)
+        })
+        .boxed()
+}
+
+/// `map --no-write --csv` argument vectors on small grids (at most 36 θ0 per map).
+fn map_args() -> BoxedStrategy<Vec<String>> {
+    (
+        part_spec(),
+        prop::collection::vec(contact_d(), 1..3),
+        prop_oneof![
+            3 => prop::sample::select(vec!["10", "15", "30", "45", "90", "120", "360"])
+                .prop_map(String::from),
+            1 => number(),
+        ],
+        optional_flags(&[
+            ("mu-c", 0.0, 2.0, false),
+            ("pin-radius", 0.0, 0.5, false),
+            ("tol", 1e-8, 1e-3, true),
+            ("threshold", 0.5, 30.0, false),
+            ("threads", 1.0, 3.0, false),
+        ]),
+        (model(), support(), fence()),
+        (0usize..12, any::<prop::sample::Index>()),
+    )
+        .prop_map(|(part, ds, step, flags, (m, s, f), (how, at))| {
+            let mut a: Vec<String> = vec![
+                "map".into(),
+                format!("--part={part}"),
+                format!("--theta-step={step}"),
+                "--no-write".into(),
+                "--csv".into(),
+            ];
+            if f.is_empty() {
+                a.push(format!("--d={}", ds.join(",")));
+                a.extend(flags);
+            } else {
+                // A fence map takes neither --d nor --pin-radius.
+                a.extend(flags.into_iter().filter(|w| !w.starts_with("--pin-radius")));
+                a.extend(f);
+            }
+            a.extend(m);
+            a.extend(s);
+            // Mutations must not drop --no-write (the command would write a report directory).
+            let mut a = mutate(a, how, at);
+            if !a.iter().any(|w| w == "--no-write") {
+                a.push("--no-write".into());
+            }
+            a
+        })
+        .boxed()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checks.
+
+/// Every number of a JSON document is finite and no value is null (part and contact reports have
+/// no optional fields; serde_json writes a non-finite float as null).
+fn assert_json_finite(v: &serde_json::Value, path: &str) -> Result<(), TestCaseError> {
+    match v {
+        serde_json::Value::Null => Err(TestCaseError::fail(format!("{path} is null"))),
+        serde_json::Value::Number(n) => {
+            prop_assert!(n.as_f64().is_some_and(f64::is_finite), "{path} = {n}");
+            Ok(())
+        }
+        serde_json::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                assert_json_finite(x, &format!("{path}[{i}]"))?;
+            }
+            Ok(())
+        }
+        serde_json::Value::Object(o) => {
+            for (k, x) in o {
+                assert_json_finite(x, &format!("{path}.{k}"))?;
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Run the binary and check the outcome contract; `csv` output is checked for non-finite fields,
+/// `--json` output must be one JSON document of finite numbers, a table must show no NaN or inf.
+fn check_binary(args: &[String], csv: bool) -> Result<(), TestCaseError> {
+    // In a scratch directory: whatever a mutated command line might write stays out of the
+    // repository.
+    let dir = std::env::temp_dir().join(format!("pinfeed-fuzz-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let out = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(args)
+        .current_dir(&dir)
+        .output()
+        .expect("run pinfeed");
+    let err = String::from_utf8_lossy(&out.stderr);
+    let code = out.status.code();
+    prop_assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    prop_assert!(
+        matches!(code, Some(0..=2)),
+        "{args:?}: exit status {code:?}: {err}"
+    );
+    match code {
+        Some(0) => {
+            let text = String::from_utf8_lossy(&out.stdout);
+            if csv {
+                for line in text.lines() {
+                    for field in line.split(',') {
+                        let f = field.to_ascii_lowercase();
+                        prop_assert!(
+                            !(f.contains("nan") || f.contains("inf")),
+                            "{args:?}: non-finite field in {line}"
+                        );
+                    }
+                }
+            } else if args.iter().any(|a| a == "--json") {
+                let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+                    TestCaseError::fail(format!("{args:?}: not JSON ({e}): {text}"))
+                })?;
+                assert_json_finite(&v, "")?;
+            } else {
+                // A mutation dropped --json: the table must not show a non-finite number either.
+                let bad = text
+                    .split(|c: char| c.is_whitespace() || "(),°".contains(c))
+                    .any(|w| matches!(w.trim_start_matches(['+', '-']), "NaN" | "inf"));
+                prop_assert!(!bad, "{args:?}: non-finite number in {text}");
+            }
+        }
+        Some(1) => {
+            let first = err.lines().next().unwrap_or("");
+            prop_assert!(
+                first.starts_with("error: ") && first.len() > "error: ".len() + 5,
+                "{args:?}: the first stderr line should be the cause: {err}"
+            );
+            prop_assert!(
+                out.stdout.is_empty(),
+                "{args:?}: printed a result and failed"
+            );
+        }
+        _ => prop_assert!(err.starts_with("error:"), "{args:?}: {err}"),
+    }
+    Ok(())
+}
+
+/// Parse and run in-process; a panic fails, an error (or a clap refusal) is fine.
+fn check_in_process(args: &[String]) -> Result<(), TestCaseError> {
+    let argv: Vec<String> = std::iter::once("pinfeed".to_string())
+        .chain(args.iter().cloned())
+        .collect();
+    let result = std::panic::catch_unwind(|| match pinfeed::cli::Cli::try_parse_from(&argv) {
+        Ok(cli) => pinfeed::cli::run(cli).err().map(|e| format!("{e:#}")),
+        Err(e) => Some(e.to_string()),
+    });
+    match result {
+        Err(_) => Err(TestCaseError::fail(format!("{args:?} panicked"))),
+        Ok(Some(msg)) => {
+            prop_assert!(!msg.trim().is_empty(), "{args:?}: empty error");
+            Ok(())
+        }
+        Ok(None) => Ok(()),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn part_argv_through_the_binary(args in part_args()) {
+        check_binary(&args, false)?;
+    }
+
+    #[test]
+    fn contact_argv_through_the_binary(args in contact_args()) {
+        check_binary(&args, false)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    #[test]
+    fn map_argv_through_the_binary(args in map_args()) {
+        check_binary(&args, true)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    #[test]
+    fn part_and_contact_argv_in_process(args in prop_oneof![part_args(), contact_args()]) {
+        check_in_process(&args)?;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Magnitudes.
+
+/// Can a polygon of this unit-size shape be represented at scale k? Its size, area and polar
+/// moment must be normal doubles — with a margin of 2^±8 either side, where rounding of the
+/// scaled coordinates could tip a borderline case.
+fn representable_at(unit: &Polygon, k: f64, margin: f64) -> bool {
+    let fits = |v: f64| {
+        v.is_normal() && v.abs() < f64::MAX / margin && v.abs() > f64::MIN_POSITIVE * margin
+    };
+    fits(unit.radius() * k)
+        && fits(unit.area() * k * k)
+        && fits(unit.polar_moment() * k * k * k * k)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    /// Scaled copies are accepted or refused together, with the same stable states and a / k;
+    /// beyond the representable range the refusal says so.
+    #[test]
+    fn scaled_copies_are_accepted_or_refused_together(
+        v in star(), e in -300i32..300, frac in 0.0f64..1.0, mutation in 0usize..3,
+        at in any::<prop::sample::Index>(),
+    ) {
+        let mut v = v;
+        // Sometimes a degenerate shape, to check that refusals do not depend on the scale either.
+        let i = at.index(v.len());
+        match mutation {
+            1 => { let p = v[i]; v.insert(i, p); }
+            2 => { let j = (i + 1) % v.len(); v[j] = v[i]; }
+            _ => {}
+        }
+        let k = 10f64.powf(f64::from(e) + frac);
+        let unit = Polygon::from_xy(&v);
+        let scaled: Vec<(f64, f64)> = v.iter().map(|&(x, y)| (x * k, y * k)).collect();
+        let got = Polygon::from_xy(&scaled);
+        match (&unit, &got) {
+            (Ok(u), Ok(p)) => {
+                prop_assert!((p.radius() / k / u.radius() - 1.0).abs() < 1e-12, "a: {} vs {}", p.radius(), u.radius());
+                for x in [p.area(), p.polar_moment(), p.radius(), p.offset().x, p.offset().y] {
+                    prop_assert!(x.is_finite());
+                }
+                prop_assert!(p.area().is_normal() && p.polar_moment().is_normal());
+                let (su, sp) = (u.stable_states(), p.stable_states());
+                prop_assert_eq!(su.len(), sp.len());
+                for (a, b) in su.iter().zip(&sp) {
+                    prop_assert!((a.theta - b.theta).abs() < 1e-9, "{} vs {}", a.theta, b.theta);
+                    prop_assert_eq!(a.hull_edge, b.hull_edge);
+                }
+                prop_assert!(representable_at(u, k, 1.0));
+            }
+            (Ok(u), Err(err)) => {
+                prop_assert!(matches!(err, PolygonError::NotRepresentable { .. }), "k = {k:e}: {err}");
+                prop_assert!(!representable_at(u, k, 256.0), "k = {k:e} fits but was refused: {err}");
+            }
+            (Err(eu), Err(ep)) => {
+                if !matches!(ep, PolygonError::NotRepresentable { .. }) {
+                    prop_assert_eq!(std::mem::discriminant(eu), std::mem::discriminant(ep), "{} vs {}", eu, ep);
+                }
+            }
+            (Err(eu), Ok(_)) => prop_assert!(false, "unit refused ({eu}) but accepted at k = {k:e}"),
+        }
+    }
+
+    /// `try_scaled` agrees with building the scaled copy, and never panics.
+    #[test]
+    fn try_scaled_refuses_exactly_the_unrepresentable(v in star(), e in -320i32..310) {
+        let u = Polygon::from_xy(&v).unwrap();
+        let k = 10f64.powi(e);
+        match u.try_scaled(k) {
+            Ok(p) => {
+                prop_assert!(representable_at(&u, k, 1.0));
+                prop_assert!((p.radius() / k / u.radius() - 1.0).abs() < 1e-12);
+            }
+            Err(err) => {
+                prop_assert!(matches!(err, PolygonError::NotRepresentable { .. } | PolygonError::BadScale(_)), "{err}");
+                prop_assert!(!representable_at(&u, k, 256.0), "k = {k:e}: {err}");
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    /// A contact on a copy scaled by 2^j is the contact at unit size, bit for bit: the polygon is
+    /// validated and measured in normalised coordinates and the contact model works in units of a.
+    #[test]
+    fn contacts_on_power_of_two_copies_are_bit_identical(
+        v in star(), j in -220i32..220, theta0 in 0.0f64..360.0, d in -0.95f64..0.95,
+        mu_c in 0.0f64..1.5, rho in prop_oneof![Just(0.0), 0.01f64..0.3],
+    ) {
+        let k = 2f64.powi(j);
+        let case = |scale: f64| Case {
+            part: format!(
+                "vertices:{}",
+                vertex_text(&v.iter().map(|&(x, y)| (x * scale, y * scale)).collect::<Vec<_>>())
+            ),
+            theta0_deg: theta0,
+            d,
+            mu_c,
+            mu_s: 0.3,
+            model: Fidelity::Exact,
+            pin_radius: rho * scale,
+            pin_speed: 0.0,
+            support: "uniform".into(),
+            tol: 1e-6,
+            fence: None,
+        };
+        let (pu, u, _) = run_case(&case(1.0), false).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
+        let (pk, s, _) = run_case(&case(k), false).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
+        prop_assert_eq!(pk.radius(), pu.radius() * k);
+        prop_assert_eq!(u.status.name(), s.status.name());
+        prop_assert_eq!(u.contact, s.contact);
+        prop_assert_eq!(u.rotation, s.rotation);
+        prop_assert_eq!(u.pose_final.x * k, s.pose_final.x);
+        prop_assert_eq!(u.pose_final.y * k, s.pose_final.y);
+    }
+}
