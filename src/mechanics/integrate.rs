@@ -487,6 +487,8 @@ impl Ctx<'_, '_> {
             pin_centre: self.pin_at(s) * k,
             contact_point: pose.apply(g.p) * k,
             force: inst.force.rotate(y[0]) * self.mu_s,
+            normal: g.n.rotate(y[0]),
+            rotation_rate: inst.twist[2] / k,
             mode: inst.mode,
             feature: feat.public(),
         };

@@ -161,6 +161,10 @@ pub struct TraceSample {
     /// contact model's force (units of μs m g) times μs, so it scales with μs while the motion
     /// does not (multiply by m g for newtons).
     pub force: Vec2,
+    /// Unit contact normal into the part (world axes): the force's normal direction.
+    pub normal: Vec2,
+    /// Rotation rate dθ/ds (radians per unit of pin travel, caller's units).
+    pub rotation_rate: f64,
     pub mode: Mode,
     pub feature: ContactFeature,
 }
