@@ -394,7 +394,7 @@ fn compare_case(seed: u64) -> Verdict {
         dc,
         tol_c: (3.0 * ec / a).max(1e-3),
         reproducer: format!(
-            "pinfeed contact --part 'vertices:{}' --theta0 {:.6} --d={:.6} --mu-c {:.6}  \
+            "[seed {seed}] pinfeed contact --part 'vertices:{}' --theta0 {:.6} --d={:.6} --mu-c {:.6}  \
              (production rotation {:.3}°, reference {:.3}° ± {:.3}°)",
             verts.join(" "),
             c.theta0.to_degrees(),
@@ -513,6 +513,12 @@ fn one_case() {
         .unwrap_or(0);
     eprintln!("{:?}", random_case(seed));
     eprintln!("{:?}", compare_case(seed));
+    let c = random_case(seed);
+    let part = reference_part(&library_polygon(&c.verts));
+    for h in [0.04, 0.02, 0.01, 0.005] {
+        let r = reference::push(&part, c.theta0, c.d, c.mu, h * part.a, 40.0);
+        eprintln!("h {h}: rotation {:.4}° {r:?}", (r.theta - c.theta0).to_degrees());
+    }
     let _ = push;
 }
 

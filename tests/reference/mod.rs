@@ -300,8 +300,15 @@ fn cor_of(part: &Part, q: (f64, f64)) -> V {
     V::new(q.1.cos(), q.1.sin()) * (part.a * q.0.exp())
 }
 
+/// Largest ln(|r|/a) searched.
+const T_MAX: f64 = 13.8;
+
 /// J(r) = D of the twist about COR r normalised by w(f)·ξ = 1.
 fn j_cor(part: &Part, p: V, f: V, q: (f64, f64)) -> f64 {
+    // COR between 3e-4·a and 1e6·a; beyond that the point at infinity stands for it.
+    if !(-8.0..=T_MAX).contains(&q.0) {
+        return f64::INFINITY;
+    }
     let r = cor_of(part, q);
     let g = (p - r).cross(f);
     if g.abs() < 1e-300 {
@@ -372,6 +379,16 @@ fn refine(jf: &dyn Fn((f64, f64)) -> f64, q0: (f64, f64), step: f64) -> ((f64, f
 /// that w(f)·ξ = 1: brute-force search over the COR plane (see the module doc).
 pub fn edge_twist(part: &Part, p: V, f: V, warm: &mut Option<(f64, f64)>) -> Twist {
     let jf = |q: (f64, f64)| j_cor(part, p, f, q);
+    let far = (30.0f64).ln();
+    let from_far = |psi: f64| {
+        let a = refine(&jf, (far, psi), 0.25);
+        let b = refine(&jf, (far, psi + PI), 0.25);
+        if a.1 <= b.1 {
+            a
+        } else {
+            b
+        }
+    };
     let (q, jq) = match *warm {
         None => {
             let mut best = ((0.0, 0.0), f64::INFINITY);
@@ -387,15 +404,16 @@ pub fn edge_twist(part: &Part, p: V, f: V, warm: &mut Option<(f64, f64)>) -> Twi
             }
             refine(&jf, best.0, 0.25)
         }
+        // A far COR: ω may be changing sign (the minimiser passes through infinity), so search
+        // both sides afresh.
+        Some(q0) if q0.0 > far => from_far(q0.1),
         Some(q0) => {
-            let mut res = refine(&jf, q0, 0.02);
-            if res.0 .0 > (30.0f64).ln() {
-                let anti = refine(&jf, (res.0 .0, res.0 .1 + PI), 0.05);
-                if anti.1 < res.1 {
-                    res = anti;
-                }
+            let res = refine(&jf, q0, 0.02);
+            if res.0 .0 > far {
+                from_far(res.0 .1)
+            } else {
+                res
             }
-            res
         }
     };
     let j_inf = 1.0 / f.norm();
@@ -638,6 +656,12 @@ impl Run<'_> {
         let n = self.part.normal(k);
         let vp = self.v_pin(pose);
         self.stages += 1;
+        if std::env::var("REF_CHECK").is_ok() {
+            let mut w0 = self.warm;
+            let a = instant(self.part, p, n, vp, self.mu, &mut w0);
+            let b = instant(self.part, p, n, vp, self.mu, &mut Warm::default());
+            eprintln!("s {s:.4} th {:.5} warm {:?} fresh {:?} wl {:?} wr {:?}", pose.th, a, b, self.warm.left, self.warm.right);
+        }
         match instant(self.part, p, n, vp, self.mu, &mut self.warm) {
             None => (V::new(0.0, 0.0), 0.0),
             Some((xi, mode)) => {
