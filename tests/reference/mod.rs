@@ -117,6 +117,14 @@ impl Twist {
     }
 }
 
+/// Gauss–Legendre nodes per panel of the boundary quadrature.
+const GL_NODES: usize = 6;
+/// Panel length in units of the panel start's distance from the nearest singularity of the
+/// integrand √(h² + t²) (at t = ±ih).
+const PANEL: f64 = 2.0;
+/// Gauss nodes per direction of the collapsed product rule on each fan triangle (far field).
+const FAR_NODES: usize = 4;
+
 /// Gauss–Legendre nodes and weights on [0, 1] (Newton on the Legendre recurrence).
 pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(n);
@@ -151,6 +159,8 @@ pub struct Part {
     /// Largest centroid-to-vertex distance.
     pub a: f64,
     gl: Vec<(f64, f64)>,
+    /// Per edge: start, unit direction, length, outward unit normal.
+    edges: Vec<(V, V, f64, V)>,
     /// Area quadrature (points, weights summing to the area) for far CORs and translations.
     far: Vec<(V, f64)>,
 }
@@ -185,8 +195,16 @@ impl Part {
         let c = cx * (1.0 / area);
         let verts: Vec<V> = pts.iter().map(|&p| p - c).collect();
         let a = verts.iter().map(|p| p.norm()).fold(0.0, f64::max);
-        let gl = gauss_legendre(8);
-        let g6 = gauss_legendre(6);
+        let gl = gauss_legendre(GL_NODES);
+        let g6 = gauss_legendre(FAR_NODES);
+        let edges = (0..n)
+            .map(|k| {
+                let (a, b) = (verts[k], verts[(k + 1) % n]);
+                let l = (b - a).norm();
+                let e = (b - a) * (1.0 / l);
+                (a, e, l, -e.perp())
+            })
+            .collect();
         let mut far = Vec::new();
         for i in 0..n {
             let (p, q) = (verts[i], verts[(i + 1) % n]);
@@ -203,6 +221,7 @@ impl Part {
             area,
             a,
             gl,
+            edges,
             far,
         })
     }
@@ -230,7 +249,7 @@ impl Part {
         while lo < t1 && guard < 200 {
             guard += 1;
             let reach = (h2 + lo * lo).sqrt().max(1e-300);
-            let hi = (lo + 2.0 * reach).min(t1);
+            let hi = (lo + PANEL * reach).min(t1);
             let w = hi - lo;
             for &(x, wx) in &self.gl {
                 let t = lo + w * x;
@@ -247,10 +266,7 @@ impl Part {
             return self.far.iter().map(|&(x, w)| w * (x - r).norm()).sum();
         }
         let mut total = 0.0;
-        for k in 0..self.n() {
-            let (a, e, l) = self.edge(k);
-            // Outward normal of a CCW edge: −ẑ×e.
-            let out = -e.perp();
+        for &(a, e, l, out) in &self.edges {
             let h = (a - r).dot(out);
             if h == 0.0 {
                 continue;
@@ -317,12 +333,15 @@ fn j_cor(part: &Part, p: V, f: V, q: (f64, f64)) -> f64 {
     part.i0(r) / (part.area * g.abs())
 }
 
-/// Derivative-free stencil search with quadratic-fit jumps, from q0 with initial step `step`.
+/// Derivative-free search from q0 with initial stencil step `step`: at each stencil (centre and
+/// six neighbours) a quadratic model is fitted and its minimiser tried; the best point seen is kept
+/// (monotone descent); the stencil moves to a better neighbour (growing) or shrinks.
 fn refine(jf: &dyn Fn((f64, f64)) -> f64, q0: (f64, f64), step: f64) -> ((f64, f64), f64) {
+    const FLOOR: f64 = 1e-6;
     let mut q = q0;
     let mut j0 = jf(q);
     let mut s = step;
-    for _ in 0..400 {
+    for _ in 0..200 {
         let at = |dt: f64, dp: f64| (q.0 + dt, q.1 + dp);
         let pts = [
             at(s, 0.0),
@@ -338,13 +357,6 @@ fn refine(jf: &dyn Fn((f64, f64)) -> f64, q0: (f64, f64), step: f64) -> ((f64, f
             .enumerate()
             .min_by(|a, b| a.1.total_cmp(b.1))
             .expect("six points");
-        if jb < j0 {
-            q = pts[ib];
-            j0 = jb;
-            s = (s * 2.0).min(1.0);
-            continue;
-        }
-        // The centre is the best of the stencil: quadratic model, Newton jump inside the stencil.
         let (jpt, jmt, jpp, jmp, jpd, jmd) = (vals[0], vals[1], vals[2], vals[3], vals[4], vals[5]);
         let gt = (jpt - jmt) / (2.0 * s);
         let gp = (jpp - jmp) / (2.0 * s);
@@ -352,24 +364,37 @@ fn refine(jf: &dyn Fn((f64, f64)) -> f64, q0: (f64, f64), step: f64) -> ((f64, f
         let hpp = (jpp - 2.0 * j0 + jmp) / (s * s);
         let htp = (jpd + jmd - jpt - jmt - jpp - jmp + 2.0 * j0) / (2.0 * s * s);
         let det = htt * hpp - htp * htp;
-        let mut shrink_to = s / 4.0;
+        let mut newton = None;
         if htt > 0.0 && det > 0.0 && det.is_finite() {
             let dt = -(hpp * gt - htp * gp) / det;
             let dp = -(htt * gp - htp * gt) / det;
             let dn = dt.abs().max(dp.abs());
-            if dn <= s {
+            if dn <= 8.0 * s {
                 let cand = (q.0 + dt, q.1 + dp);
                 let jc = jf(cand);
-                if jc < j0 {
-                    q = cand;
-                    j0 = jc;
+                if jc <= j0 && jc <= jb {
+                    newton = Some((cand, jc, dn));
                 }
-                shrink_to = (2.0 * dn).clamp(s / 64.0, s / 4.0);
             }
         }
-        s = shrink_to;
-        if s < 2e-7 {
-            break;
+        let at_floor = s <= FLOOR;
+        if let Some((cand, jc, dn)) = newton {
+            q = cand;
+            j0 = jc;
+            // Quadratic convergence: the remaining error is about dn².
+            s = (4.0 * dn * dn).clamp(FLOOR, (s / 2.0).max(FLOOR));
+            if at_floor || dn <= FLOOR {
+                break;
+            }
+        } else if jb < j0 {
+            q = pts[ib];
+            j0 = jb;
+            s = (s * 2.0).min(1.0);
+        } else {
+            if at_floor {
+                break;
+            }
+            s = (s / 4.0).max(FLOOR);
         }
     }
     (q, j0)
@@ -542,10 +567,7 @@ pub fn instant(
     if right {
         return Some((scale_to(xr), RefMode::SlideRight));
     }
-    Some((
-        stick_twist(part, p, v_pin, &mut warm.stick),
-        RefMode::Stick,
-    ))
+    Some((stick_twist(part, p, v_pin, &mut warm.stick), RefMode::Stick))
 }
 
 /// Where a pin at height y moving along −x first meets the part at rest at orientation θ.
@@ -656,12 +678,6 @@ impl Run<'_> {
         let n = self.part.normal(k);
         let vp = self.v_pin(pose);
         self.stages += 1;
-        if std::env::var("REF_CHECK").is_ok() {
-            let mut w0 = self.warm;
-            let a = instant(self.part, p, n, vp, self.mu, &mut w0);
-            let b = instant(self.part, p, n, vp, self.mu, &mut Warm::default());
-            eprintln!("s {s:.4} th {:.5} warm {:?} fresh {:?} wl {:?} wr {:?}", pose.th, a, b, self.warm.left, self.warm.right);
-        }
         match instant(self.part, p, n, vp, self.mu, &mut self.warm) {
             None => (V::new(0.0, 0.0), 0.0),
             Some((xi, mode)) => {
@@ -739,63 +755,73 @@ pub fn push(part: &Part, theta0: f64, d: f64, mu: f64, h: f64, max_travel: f64) 
         if part.normal(k).dot(run.v_pin(pose)) <= 0.0 {
             break RefStatus::Separated;
         }
-        let (ell0, _, _) = run.on_edge(pose, s, k);
         let len = part.edge(k).2;
+        // Event functions, positive while the contact goes on along edge k: the pin's distance
+        // from the edge's two ends, and n·v_pin (the pin pushes).
+        let events = |run: &Run, p: Pose, s: f64| -> [f64; 3] {
+            let (ell, _, _) = run.on_edge(p, s, k);
+            [ell, len - ell, part.normal(k).dot(run.v_pin(p)) * a]
+        };
+        let ev0 = events(&run, pose, s);
         let next = run.rk4(pose, s, h, k);
-        let (ell1, _, _) = run.on_edge(next, s + h, k);
+        let ev1 = events(&run, next, s + h);
         out.steps += 1;
-        if (0.0..=len).contains(&ell1) {
+        if ev1.iter().all(|&e| e >= 0.0) {
             pose = run.project(next, s + h, k);
             s += h;
             stalls = 0;
             continue;
         }
-        // The pin passes an end of the edge within this step: land on the vertex.
-        let target = if ell1 > len { len } else { 0.0 };
-        let phi = |run: &mut Run, tau: f64| -> (Pose, f64) {
-            if tau == 0.0 {
-                return (pose, ell0 - target);
+        // An event within this step: land on the earliest one by the Illinois method on the
+        // fraction τ of a real step.
+        let mut first: Option<(f64, Pose, usize)> = None;
+        for i in (0..3).filter(|&i| ev1[i] < 0.0) {
+            let (mut ta, mut fa) = (0.0, ev0[i]);
+            let (mut tb, mut fb) = (1.0, ev1[i]);
+            let mut land = (1.0, next);
+            if fa <= 1e-13 * a {
+                land = (0.0, pose);
+            } else {
+                let mut side = 0;
+                for _ in 0..60 {
+                    let mut t = (ta * fb - tb * fa) / (fb - fa);
+                    if !t.is_finite() || t <= ta || t >= tb {
+                        t = 0.5 * (ta + tb);
+                    }
+                    let pt = run.rk4(pose, s, t * h, k);
+                    let ft = events(&run, pt, s + t * h)[i];
+                    land = (t, pt);
+                    if ft.abs() <= 1e-12 * a || (tb - ta) < 1e-14 {
+                        break;
+                    }
+                    if ft < 0.0 {
+                        tb = t;
+                        fb = ft;
+                        if side == -1 {
+                            fa *= 0.5;
+                        }
+                        side = -1;
+                    } else {
+                        ta = t;
+                        fa = ft;
+                        if side == 1 {
+                            fb *= 0.5;
+                        }
+                        side = 1;
+                    }
+                }
             }
-            let p = run.rk4(pose, s, tau * h, k);
-            let (e, _, _) = run.on_edge(p, s + tau * h, k);
-            (p, e - target)
-        };
-        let (mut ta, mut fa) = (0.0, ell0 - target);
-        let (mut tb, mut fb) = (1.0, ell1 - target);
-        let mut land = (next, 1.0);
-        if fa.abs() <= 1e-13 * a {
-            land = (pose, 0.0);
-        } else {
-            let mut side = 0;
-            for _ in 0..60 {
-                let mut t = (ta * fb - tb * fa) / (fb - fa);
-                if !t.is_finite() || t <= ta || t >= tb {
-                    t = 0.5 * (ta + tb);
-                }
-                let (pt, ft) = phi(&mut run, t);
-                land = (pt, t);
-                if ft.abs() <= 1e-12 * a || (tb - ta) < 1e-14 {
-                    break;
-                }
-                if (ft > 0.0) == (fb > 0.0) {
-                    tb = t;
-                    fb = ft;
-                    if side == -1 {
-                        fa *= 0.5;
-                    }
-                    side = -1;
-                } else {
-                    ta = t;
-                    fa = ft;
-                    if side == 1 {
-                        fb *= 0.5;
-                    }
-                    side = 1;
-                }
+            if first.is_none_or(|f| land.0 < f.0) {
+                first = Some((land.0, land.1, i));
             }
         }
-        let (p_land, tau) = land;
+        let (tau, p_land, which) = first.expect("an event is negative");
         s += tau * h;
+        if which == 2 {
+            // The pin stops pushing: the contact separates here.
+            pose = p_land;
+            break RefStatus::Separated;
+        }
         pose = run.project(p_land, s, k);
         if tau * h <= 1e-9 * a {
             stalls += 1;
@@ -805,8 +831,9 @@ pub fn push(part: &Part, theta0: f64, d: f64, mu: f64, h: f64, max_travel: f64) 
         } else {
             stalls = 0;
         }
-        // Pass onto the neighbouring edge if it faces the pin's motion, else separate.
-        let nk = if target == len {
+        // The pin reached a vertex: it passes onto the neighbouring edge if that edge faces the
+        // pin's motion, else the contact separates.
+        let nk = if which == 1 {
             (k + 1) % n_edges
         } else {
             (k + n_edges - 1) % n_edges
