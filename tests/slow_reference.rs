@@ -6,22 +6,27 @@
 //! ellipse, at a random scale), θ0 uniform, d uniform over the range that touches, μc ∈ [0, 1.5]
 //! (a few exactly 0), point pins. Cases are skipped — counted, and the count bounded — when
 //! (decided from the initial geometry, before either model runs):
-//! * the first touch is within 0.002·a of a vertex (which edge is struck is ill-conditioned);
+//! * the first touch is within 5e-4·a of a vertex (which edge is struck is ill-conditioned);
 //! * Mason's vote is nearly a tie: the median of the centroid's signed distances from the lines of
-//!   v_pin, f_L, f_R is below 0.01·a (a push nearly through the centroid: metastable, the sense of
+//!   v_pin, f_L, f_R is below 3e-3·a (a push nearly through the centroid: metastable, the sense of
 //!   rotation is decided by rounding).
 //!
 //! Cases the production model does not finish with status `ok`, and cases the reference cannot
 //! finish (travel limit, a pin hooked on a vertex, h and h/2 ending differently), are also skipped,
-//! counted and bounded. Every other case must agree: final orientation within
-//! max(3·(reference's error estimate), 0.05°), centroid within max(3·estimate, 1e-3·a).
+//! counted and bounded (< 1% of the cases; the geometric skips < 2%). Every other case must agree:
+//! final orientation (signed total rotation) within max(3·(reference's error estimate), 0.05°),
+//! final centroid within max(3·estimate, 1e-3·a + 2e-4·(contact travel)) — except the centroid of
+//! the cases in [`KNOWN`], production defects this comparison found.
+//!
+//! A control test runs the same comparison against the ellipsoid fidelity and requires most pushes
+//! to disagree, so the comparison is shown to be able to fail.
 
 mod common;
 mod reference;
 
 use pinfeed::geometry::{Polygon, Pose, Vec2};
 use pinfeed::mechanics::{
-    first_instant, mason_vote, ContactSettings, Fidelity, PartModel, Pin, Support,
+    first_instant, mason_vote, ContactOutcome, ContactSettings, Fidelity, PartModel, Pin, Support,
 };
 use rayon::prelude::*;
 use reference::{Part, RefStatus, Rng, Twist, V};
@@ -104,16 +109,29 @@ fn ill_conditioned(part: &Part, c: &Case) -> Option<&'static str> {
     let Some(t) = reference::first_touch(part, c.theta0, c.d * part.a) else {
         return Some("miss");
     };
-    if t.ell.min(t.len - t.ell) < 0.002 * part.a {
+    if t.ell.min(t.len - t.ell) < 5e-4 * part.a {
         return Some("near_vertex");
     }
     let (a, e, _) = part.edge(t.edge);
     let p = a + e * t.ell;
     let vp = V::new(-1.0, 0.0).rot(-c.theta0);
-    if reference::vote_median(p, e.perp(), vp, c.mu).abs() < 0.01 * part.a {
+    if reference::vote_median(p, e.perp(), vp, c.mu).abs() < 3e-3 * part.a {
         return Some("near_central");
     }
     None
+}
+
+/// The production model on a case, the CLI's way (tests/common `run`).
+fn run_production(c: &Case, poly: &Polygon, settings: &ContactSettings) -> ContactOutcome {
+    let model = PartModel::new(poly, &Support::Uniform).unwrap();
+    common::run(
+        &model,
+        poly,
+        c.theta0.to_degrees(),
+        c.d,
+        Pin::point(),
+        settings,
+    )
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -411,16 +429,7 @@ fn compare_case(seed: u64, fidelity: Fidelity, geometric_skips: bool) -> Verdict
         Some(why) if geometric_skips => return Verdict::Skip(why),
         _ => {}
     }
-    let model = PartModel::new(&poly, &Support::Uniform).unwrap();
-    let settings = common::settings(fidelity, c.mu);
-    let prod = common::run(
-        &model,
-        &poly,
-        c.theta0.to_degrees(),
-        c.d,
-        Pin::point(),
-        &settings,
-    );
+    let prod = run_production(&c, &poly, &common::settings(fidelity, c.mu));
     if !prod.status.is_ok() {
         return Verdict::Skip(prod.status.name());
     }
@@ -579,7 +588,7 @@ fn run_comparison(
 fn assert_agreement(s: &Summary) {
     let n = s.cases as f64;
     assert!(
-        (s.skipped(true) as f64) < 0.05 * n,
+        (s.skipped(true) as f64) < 0.02 * n,
         "too many ill-conditioned cases: {:?}",
         s.skips
     );
@@ -600,10 +609,14 @@ fn assert_agreement(s: &Summary) {
 
 /// The acceptance run: 1 000 random whole pushes against the exact model.
 ///
-/// Measured (seeds 0..1000, 2026-11-23): 975 compared, skipped 19 near-central and 6 near-vertex,
-/// none for a non-ok status or a reference failure; all 975 agree. |Δθ| median 1.7e-4°, 99%
-/// 3.1e-3°, max 0.38° (a case whose own error estimate is 0.40°); the reference's error estimate
-/// median 4.6e-4°, 90% 3.6e-3°; |Δc|/a median 3e-6, max 1.8e-2. About 16 s of CPU in `--release`.
+/// Measured (seeds 0..1000, 2026-11-23, step H = 0.04·a): 994 compared, skipped 5 near-central
+/// and 1 near-vertex, none for a non-ok status or a reference failure; all 994 agree in
+/// orientation and all but seed 37 (in [`KNOWN`]) in centroid. (With the geometric skips off,
+/// all 1000 agree as well.) |Δθ| median 1.6e-4°, 90% 8.2e-4°,
+/// 99% 2.8e-3°, max 7.3e-3° (seed 932, allowed 0.05°); the reference's own error estimate median
+/// 4.5e-4°, 90% 3.5e-3°, max 3.5e-2°; |Δc|/a median 3.1e-6, 99% 4.4e-5, max 2.2e-2 (seed 37).
+/// Over seeds 0..5000 the same holds (max |Δθ| 2.2e-2°). About 16 s of CPU in `--release`
+/// (rayon over the cases; the order of the results does not depend on the threads).
 #[test]
 fn reference_agrees_with_production_over_random_pushes() {
     let s = run_comparison(0..1000, Fidelity::Exact, true);
@@ -625,34 +638,31 @@ fn comparison_tells_the_ellipsoid_from_the_exact_model() {
     );
 }
 
+/// A number from the environment, or the default.
+fn env_u64(name: &str, default: u64) -> u64 {
+    std::env::var(name)
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(default)
+}
+
 /// A single push, for debugging one case: `SLOW_REF_CASE=<seed> cargo test --release --test
 /// slow_reference one_case -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn one_case() {
-    let seed: u64 = std::env::var("SLOW_REF_CASE")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
+    let seed: u64 = env_u64("SLOW_REF_CASE", 0);
     let c = random_case(seed);
     eprintln!("{c:?}");
     eprintln!("{:?}", compare_case(seed, Fidelity::Exact, false));
     let poly = library_polygon(&c.verts);
     let part = reference_part(&poly);
-    let model = PartModel::new(&poly, &Support::Uniform).unwrap();
     for tol in [1e-6, 1e-8, 1e-10] {
         let settings = ContactSettings {
             tol,
             ..common::settings(Fidelity::Exact, c.mu)
         };
-        let o = common::run(
-            &model,
-            &poly,
-            c.theta0.to_degrees(),
-            c.d,
-            Pin::point(),
-            &settings,
-        );
+        let o = run_production(&c, &poly, &settings);
         eprintln!(
             "production tol {tol:e}: rotation {:.5}°, centroid ({}, {}), contacts {}, {}",
             o.rotation.to_degrees(),
@@ -672,17 +682,15 @@ fn one_case() {
 }
 
 /// A deeper run: `SLOW_REF_CASES=5000 cargo test --release --test slow_reference many_cases --
-/// --ignored --nocapture` (default 5 000 cases, seeds from 0; `SLOW_REF_NO_SKIP=1` also compares
-/// the ill-conditioned cases, to see what the skips hide).
+/// --ignored --nocapture` (default 5 000 cases, seeds from `SLOW_REF_FIRST`, default 0;
+/// `SLOW_REF_NO_SKIP=1` also compares the ill-conditioned cases, to see what the skips hide).
 #[test]
 #[ignore]
 fn many_cases() {
-    let n: u64 = std::env::var("SLOW_REF_CASES")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(5000);
+    let n: u64 = env_u64("SLOW_REF_CASES", 5000);
+    let first: u64 = env_u64("SLOW_REF_FIRST", 0);
     let skips = std::env::var("SLOW_REF_NO_SKIP").is_err();
-    let s = run_comparison(0..n, Fidelity::Exact, skips);
+    let s = run_comparison(first..first + n, Fidelity::Exact, skips);
     s.print("slow reference vs exact model", true);
     assert_agreement(&s);
 }
@@ -697,16 +705,7 @@ fn known_defects_are_fixed() {
     for &(seed, why) in KNOWN {
         let c = random_case(seed);
         let poly = library_polygon(&c.verts);
-        let model = PartModel::new(&poly, &Support::Uniform).unwrap();
-        let settings = common::settings(Fidelity::Exact, c.mu);
-        let o = common::run(
-            &model,
-            &poly,
-            c.theta0.to_degrees(),
-            c.d,
-            Pin::point(),
-            &settings,
-        );
+        let o = run_production(&c, &poly, &common::settings(Fidelity::Exact, c.mu));
         assert_eq!(o.contacts, 1, "seed {seed} ({why}): contacts");
         match compare_case(seed, Fidelity::Exact, true) {
             Verdict::Compared(cmp) => assert!(cmp.dc <= cmp.tol_c, "{}", cmp.line()),

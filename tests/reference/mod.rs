@@ -14,10 +14,12 @@
 //!   only, no gradient, no Newton on the limit surface): the friction-cone edge twists
 //!   ξ_e = argmin D(ξ) subject to w(f_e)·ξ = 1 are found over the COR plane, where the problem is
 //!   J(r) = I0(r) / (A |(p − r)×f|) (ω = 1/((p − r)×f), v = −ω ẑ×r), by a log-polar grid
-//!   (|r| from 0.05·a to 1100·a, 36 directions) and then a stencil search with quadratic-fit jumps
-//!   in (ln|r|, arg r); pure translation along f (J = 1/|f|) is the point at infinity, compared
-//!   explicitly. A far COR is also tried on the antipodal side (the minimiser passes through infinity
-//!   when ω changes sign). The stick problem, the 1-D convex minimisation over ω with v_c = v_pin, is
+//!   (|r| from 0.05·a to 1100·a, 36 directions) on a fresh contact, then from the previous
+//!   instant's COR, a stencil search with quadratic-fit jumps in (ln|r|, arg r) (function values
+//!   only, monotone descent); pure translation along f (J = 1/|f|) is the point at infinity,
+//!   compared explicitly. When the COR is far (beyond 30·a), ω may be about to change sign (the
+//!   minimiser passes through infinity), so the search restarts on both sides from 30·a. The stick
+//!   problem, the 1-D convex minimisation over ω with v_c = v_pin, is
 //!   solved by golden-section search. Stick iff v_pin lies in the cone of v_R, v_L; otherwise slide on
 //!   the violated side scaled by κ = (n·v_pin)/(n·v_b); μc = 0 slides along the normal.
 //! * **Integration** in the world frame, on the pose (x, y, θ) itself, with classical RK4 steps of
@@ -27,7 +29,7 @@
 //!   again (no drift). When the pin passes an edge end, the step is shortened (secant on the step
 //!   fraction) to land on the vertex, and the point pin passes onto the next edge if that edge faces
 //!   the pin's motion (n·v_pin > 0), else the contact separates. The contact also separates when the
-//!   pin stops pushing (n·v_pin ≤ 0).
+//!   pin stops pushing (n·v_pin ≤ 0), located within the step in the same way.
 //! * **Own accuracy**: [`push_with_error`] runs a push at h and at h/2 and returns the h/2 result with
 //!   the difference as its error estimate.
 //!
