@@ -391,6 +391,22 @@ const KNOWN: &[(u64, &str)] = &[
     (37, "re-touch after tangential separation"),
     (4344, "re-touch after tangential separation"),
     (4794, "re-touch after tangential separation"),
+    (6658, "re-touch after tangential separation"),
+    (6803, "re-touch after tangential separation"),
+];
+
+/// Open disagreements found by `many_cases` (seeds 5000..15000), not excused anywhere: the
+/// production model at its default tolerance (1e-6) is off, and agrees with the reference at
+/// tol 1e-8 and 1e-10. They are not in the CI run; [`known_defects_are_fixed`] checks them.
+const OPEN: &[(u64, &str)] = &[
+    (
+        12739,
+        "rotation −73.466° at default tol, −74.194° at 1e-8 and in the reference (μc 0.033, 3 edges)",
+    ),
+    (
+        7956,
+        "centroid off by 4.3e-3·a after 6·a of stick at default tol (rotation agrees)",
+    ),
 ];
 
 impl Compared {
@@ -695,13 +711,20 @@ fn many_cases() {
     assert_agreement(&s);
 }
 
-/// The production defects in [`KNOWN`] as a regression test: a convex part struck by a point pin
-/// is touched once, and its final centroid agrees with the reference. Fails until the re-touch
-/// after a tangential separation is fixed in `src/mechanics/integrate.rs` (`run_passes` /
-/// `next_touch`); then drop the `ignore` and empty [`KNOWN`].
+/// The production defects in [`KNOWN`] and [`OPEN`] as a regression test: a convex part struck by
+/// a point pin is touched once, and its final pose agrees with the reference. Fails until the
+/// re-touch after a tangential separation is fixed in `src/mechanics/integrate.rs` (`run_passes` /
+/// `next_touch`) and the default tolerance holds on the open cases; then drop the `ignore` and
+/// empty the lists.
 #[test]
-#[ignore = "production defect found by the reference: re-touch after tangential separation"]
+#[ignore = "production defects found by the reference (re-touch after tangential separation; default-tolerance error)"]
 fn known_defects_are_fixed() {
+    for &(seed, why) in OPEN {
+        match compare_case(seed, Fidelity::Exact, true) {
+            Verdict::Compared(cmp) => assert!(cmp.agrees(), "{why}: {}", cmp.line()),
+            Verdict::Skip(w) => panic!("seed {seed} skipped: {w}"),
+        }
+    }
     for &(seed, why) in KNOWN {
         let c = random_case(seed);
         let poly = library_polygon(&c.verts);
