@@ -319,8 +319,9 @@ fn sense_of_rotation_follows_mason_vote() {
     assert!(checked > 200, "only {checked} instants checked");
 }
 
-/// The reference's instant against the production model's first instant at random contacts (same
-/// mode, twists within 1e-5): the two algorithms agree where they overlap, before any integration.
+/// The reference's instant against the production model's first instant at random contacts (the
+/// twist within 1e-5 in units of a): the two algorithms agree where they overlap, before any
+/// integration.
 #[test]
 fn first_instant_agrees_with_production() {
     let mut compared = 0;
