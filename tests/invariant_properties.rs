@@ -272,8 +272,9 @@ proptest! {
         let o = run(&m, &p, theta, d, disc(&p, rho), &s);
         prop_assert_eq!(point.status.name(), o.status.name());
         if point.status.is_ok() {
-            // O(ρ) from the disc's ride round a vertex and its start offset, plus the tolerance.
-            let bound = 1e-5 + 1e3 * rho;
+            // O(ρ) from the disc's ride round a vertex and its start offset, plus the point
+            // pin's own error at the default tolerance (up to ~5e-5 rad on such cases).
+            let bound = 1e-4 + 1e3 * rho;
             prop_assert!((o.rotation - point.rotation).abs() < bound,
                 "ρ={rho}: {} vs {}", o.rotation.to_degrees(), point.rotation.to_degrees());
         }

@@ -547,6 +547,41 @@ struct StepResult {
     err: f64,
     /// The seven stage derivatives (for the dense output).
     k: [[f64; 2]; 7],
+    /// The first interior stage (as a fraction of the step) at which the mode's own margins were
+    /// clearly violated: a mode switch that comes and goes inside the step.
+    margin_dip: Option<f64>,
+}
+
+/// A stage's mode margin below −MARGIN_DIP (a sine) means the mode broke inside the step even if
+/// it holds again at both ends (stage states are approximations: a clear violation only).
+const MARGIN_DIP: f64 = 1e-3;
+
+/// The geometric event functions (edge ends, normal cone, fence ends) depend on the state alone,
+/// so the dense output shows, without solving anything, an event that comes and goes inside one
+/// step — which the end-point signs miss. Returns the first of eight interior fractions of the step
+/// at which an event positive at both ends dips below −slack.
+fn geometric_dip(
+    ctx: &Ctx,
+    feat: Feat,
+    y0: [f64; 2],
+    step: &StepResult,
+    h: f64,
+    ev1: &[f64; N_EVENTS],
+    slack: f64,
+) -> Option<f64> {
+    // Nothing to miss unless an event not yet crossed ends the step near zero (the guard keeps a
+    // step's change of the contact coordinate below 0.5).
+    if !(3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j])) {
+        return None;
+    }
+    (1..8).map(|k| k as f64 / 8.0).find(|&t| {
+        let yt = dense(y0, step.y1, &step.k, h, t);
+        let g = ctx.geom(feat, yt);
+        ctx.feature_events(feat, yt, &g)
+            .iter()
+            .zip(&ev1[3..])
+            .any(|(&e, &e1)| e1 >= 0.0 && e < -slack)
+    })
 }
 
 /// A trial step while landing on an event.
@@ -571,6 +606,7 @@ fn dp_step(
     let mut k = [[0.0f64; 2]; 7];
     k[0] = f0;
     let mut inst_last = None;
+    let mut margin_dip = None;
     for i in 1..7 {
         let mut yi = y0;
         for (j, kj) in k.iter().enumerate().take(i) {
@@ -580,9 +616,14 @@ fn dp_step(
                 yi[1] += h * a * kj[1];
             }
         }
-        let _ = C[i];
         let (d, inst) = ctx.rhs(feat, mode, yi)?;
         k[i] = d;
+        let broken = inst.margins[0] + ctx.band[1] < -MARGIN_DIP
+            || inst.margins[1] + ctx.band[2] < -MARGIN_DIP;
+        // Interior stages only (C < 1; stages 5 and 6 sit at the step's end).
+        if C[i] < 1.0 && broken && margin_dip.is_none() {
+            margin_dip = Some(C[i]);
+        }
         inst_last = Some(inst);
     }
     // Stage 7 is evaluated at y1 (FSAL).
@@ -608,6 +649,7 @@ fn dp_step(
         inst1: inst_last.expect("six stages ran"),
         err,
         k,
+        margin_dip,
     })
 }
 
@@ -845,6 +887,27 @@ struct Tally {
     open: Option<(Feat, Mode, f64, f64)>,
     events: u32,
     steps: u32,
+    /// Pin travel (units of a) in the current contact during which a pin turned the part slower
+    /// than [`NOISE_RATE`]·tol per unit of travel (see [`ContactStatus::Metastable`]).
+    still: f64,
+}
+
+/// A pin pushing with |ω| below NOISE_RATE·tol (radians per unit a of travel) turns the part less
+/// over one a than a single step's error: its sense of rotation is noise.
+const NOISE_RATE: f64 = 10.0;
+/// How long (units of a of pin travel) a pin may push within the noise rate before the side the part
+/// finally falls to is taken as decided by noise rather than by the inputs.
+const METASTABLE_TRAVEL: f64 = 1.0;
+
+impl Tally {
+    /// Count `travel` of pushing at rate `omega` on `feat` towards the metastable ride (point
+    /// contacts only: a pin, a fence's end, a vertex on a fence; a flush fence edge translates
+    /// stably).
+    fn ride(&mut self, ctx: &Ctx, feat: Feat, omega: f64, travel: f64) {
+        if !matches!(feat, Feat::FenceEdge(_)) && omega.abs() < NOISE_RATE * ctx.tol {
+            self.still += travel;
+        }
+    }
 }
 
 impl Tally {
@@ -877,8 +940,12 @@ impl Tally {
 }
 
 /// The end of a contact that separated at (s, feat, y), after the self-check.
-fn separated(ctx: &Ctx, s: f64, feat: Feat, y: [f64; 2]) -> (End, f64, Pose) {
+fn separated(ctx: &Ctx, s: f64, feat: Feat, y: [f64; 2], segs: &Tally) -> (End, f64, Pose) {
     let p = ctx.pose(s, feat, y);
+    if segs.still > METASTABLE_TRAVEL {
+        let travel = segs.still * ctx.scale;
+        return (End::Stop(ContactStatus::Metastable { travel }), s, p);
+    }
     match ctx.self_check(s, feat, y) {
         None => (End::Separated, s, p),
         Some(check) => (
@@ -902,6 +969,7 @@ fn integrate_contact(
     segs: &mut Tally,
 ) -> (End, f64, Pose) {
     let mut s = s_start;
+    segs.still = 0.0;
     let (mut feat, mut y, mut inst) = match settle(ctx, s, feat0, y_start) {
         Settle::Go(f, yy, i) => (f, yy, i),
         Settle::Separate => {
@@ -992,6 +1060,17 @@ fn integrate_contact(
                 continue;
             }
             let ev1 = ctx.events(feat, step.y1, &step.inst1);
+            let mode_dip = step.margin_dip.filter(|_| ev1[1] >= 0.0 && ev1[2] >= 0.0);
+            if let Some(t_dip) = geometric_dip(ctx, feat, y, &step, h, &ev1, slack).or(mode_dip) {
+                // The contact runs off its feature and back (e.g. past an edge's end), or its mode
+                // breaks and recovers, within the step: shorten the step so that it ends beyond
+                // the first crossing, where the event is located as usual. (Below 1e-10 a a dip
+                // is the start state itself sitting on the boundary: the endpoint rule decides.)
+                if h * t_dip >= 1e-10 {
+                    h *= t_dip;
+                    continue;
+                }
+            }
             let crossed: Vec<usize> = (0..N_EVENTS)
                 .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -slack)
                 .collect();
@@ -1003,6 +1082,7 @@ fn integrate_contact(
                         *b = 0.0;
                     }
                 }
+                segs.ride(ctx, feat, step.f1[0].abs().max(f0[0].abs()), h);
                 s += h;
                 y = step.y1;
                 inst = step.inst1;
@@ -1152,6 +1232,7 @@ fn integrate_contact(
             let (s_land, y_land, inst_land) = match landing {
                 Trial::Step(r, _) => {
                     segs.steps += 1;
+                    segs.ride(ctx, feat, r.f1[0].abs().max(f0[0].abs()), best_t * h);
                     (s + best_t * h, r.y1, r.inst1)
                 }
                 _ => (s, y, inst),
@@ -1287,7 +1368,7 @@ fn integrate_contact(
             _ => unreachable!("event index out of range"),
         };
         let Some((nf, ny, forced)) = next else {
-            return separated(ctx, s, feat, y);
+            return separated(ctx, s, feat, y, segs);
         };
         if nf != feat {
             // Event indices mean different things on the new feature: start with no bands, except
@@ -1332,7 +1413,7 @@ fn integrate_contact(
                 inst = it;
                 mode = it.mode;
             }
-            Settle::Separate => return separated(ctx, s, nf, ny),
+            Settle::Separate => return separated(ctx, s, nf, ny, segs),
             Settle::Stop(st) => {
                 let p = ctx.pose(s, nf, ny);
                 return (End::Stop(st), s, p);
@@ -1400,6 +1481,14 @@ fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touc
             }
         }
         let (feat, y) = initial_state(ctx, cur, hit.feature, hit.normal);
+        // The contact state must put the part where it is: a ray that runs along an edge it has
+        // just left (the pin separated moving tangentially) can report a touch elsewhere on that
+        // edge, which would teleport the part. Such a touch pushes nothing: look past it.
+        let at = ctx.pose(s_touch, feat, y);
+        if (at.x - cur.x).abs() > 1e-9 || (at.y - cur.y).abs() > 1e-9 {
+            min_travel = hit.travel + 1e-9;
+            continue;
+        }
         return Touch::At(s_touch, feat, y);
     }
     Touch::None
@@ -1433,6 +1522,7 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
         list: Vec::new(),
         open: None,
         events: 0,
+        still: 0.0,
         steps: 0,
     };
     let mut after_separation = false;

@@ -81,6 +81,12 @@ pub enum ContactStatus {
     /// contact it was computed for (see [`SelfCheck`]). The result is not trustworthy; `pose_final`
     /// is the last state that passed the check.
     SelfCheck { check: SelfCheck, s: f64 },
+    /// The push rode an unstable equilibrium (its force line through the centroid: a tie in
+    /// Mason's vote) for `travel` of pin travel, turning slower than the tolerance resolves, and
+    /// then the part fell off to one side. Which side is decided by rounding and the tolerance, not
+    /// by the inputs, so `pose_final` is one of two possible outcomes. (Still riding at the travel
+    /// limit is [`ContactStatus::TravelLimit`].)
+    Metastable { travel: f64 },
 }
 
 /// Which consistency check a contact failed (each is cheap and runs on every contact).
@@ -120,6 +126,7 @@ impl ContactStatus {
             ContactStatus::Solver { .. } => "solver",
             ContactStatus::Jam { .. } => "jam",
             ContactStatus::SelfCheck { .. } => "self_check",
+            ContactStatus::Metastable { .. } => "metastable",
         }
     }
 }
