@@ -7,11 +7,13 @@
 //! * [`compile`]: checks and conversion to [`Scene`];
 //! * [`obstacles`]: pins and fences, their checks and neighbour lists;
 //! * [`scene`]: the compiled types the engine reads;
+//! * [`limits`]: the physically meaningful range of every number;
 //! * [`location`], [`error`]: spans → line/column and key paths, and the located error;
 //! * [`shared_feed`]: one reference scene's part stream imposed on others (`pinfeed compare`).
 
 pub mod compile;
 pub mod error;
+pub mod limits;
 pub mod location;
 pub mod obstacles;
 pub mod raw;
@@ -104,7 +106,11 @@ any = true
     fn validation_errors_name_key_and_range() {
         let e = err(&GOOD.replace("speed = 0.05", "speed = -0.05"));
         assert_eq!((e.line, e.column, e.key.as_str()), (3, 9, "belt.speed"));
-        assert!(e.message.contains("greater than 0"));
+        assert!(
+            e.message.contains("must lie in [0.0001, 10] (m/s)"),
+            "{}",
+            e.message
+        );
         let e = err(&GOOD.replace("radius = 0.002", "radius = 0.002\nmu_c = -1"));
         assert_eq!(e.key, "obstacles[0].mu_c");
         let e = err(&GOOD.replace("kind = \"pin\"", "kind = \"moving_pin\""));

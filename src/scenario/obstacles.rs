@@ -162,9 +162,12 @@ impl At<'_, '_, '_> {
     /// A friction coefficient, or the part's μc.
     fn friction(&self, k: &str, v: Option<f64>) -> R<f64> {
         match v {
-            Some(m) => self
-                .c
-                .non_negative(&self.path(k), m, "friction coefficient"),
+            Some(m) => self.c.range(
+                &self.path(k),
+                m,
+                super::limits::FRICTION,
+                "friction coefficient",
+            ),
             None => Ok(self.part_mu_c),
         }
     }
@@ -182,7 +185,13 @@ fn pin(at: &At, ro: &RawObstacle) -> R<PinObstacle> {
     only_keys(at.c, at.i, ro, "pin", "x, y, radius, mu_c")?;
     let needs = "a pin needs x, y and radius (m)";
     let radius = at.need("radius", ro.radius, needs)?;
-    let radius = at.c.non_negative(&at.path("radius"), radius, "m")?;
+    let radius = at.c.within(
+        &at.path("radius"),
+        radius,
+        0.0,
+        at.belt.width,
+        "m; 0 is a point pin, at most the belt width",
+    )?;
     let x = at.need("x", ro.x, needs)?;
     let x = at.x_within(x, radius + at.part_radius, "the pin's centre", "a + radius")?;
     let y = at.y_over(at.need("y", ro.y, needs)?)?;
@@ -209,7 +218,14 @@ fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
         ));
     }
     let length = at.need("length", ro.length, needs)?;
-    let length = c.positive(&at.path("length"), length, "m")?;
+    let min_length = super::limits::FENCE_MIN_LENGTH_OF_A * at.part_radius;
+    let length = c.finite(&at.path("length"), length)?;
+    if length < min_length {
+        return Err(c.err(
+            &at.path("length"),
+            format!("must be at least {min_length:e} m (10⁻⁶ of the part's a; a shorter fence is a point), got {length}"),
+        ));
+    }
     let f = FenceObstacle {
         name: at.name(&ro.name, "fence")?,
         start: Vec2::new(x, y),
