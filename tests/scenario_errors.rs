@@ -304,7 +304,7 @@ fn huge_belt_length_is_refused() {
         5,
         10,
         "belt.length",
-        &["must lie in [1e-6, 10000] (m), got 1e308"],
+        &["must lie in [1e-9, 10000] (m), got 1e308"],
     );
 }
 

@@ -8,7 +8,8 @@
 //! line one could build with many orders of magnitude to spare, and keep every derived quantity
 //! (event times, areas, moments, histogram sizes) finite and representable:
 //!
-//! * lengths of the line (belt width and length) from 1 µm to 1 km (10 km for the belt length);
+//! * lengths of the line (belt width and length) from 1 nm (the smallest part) to 1 km (10 km for
+//!   the belt length);
 //! * the part: `scale` from 1 nm to 1 km per unit, and the scaled part's circumradius a from 1 nm
 //!   to 1 km; vertex coordinates (in the file's units) finite with the largest magnitude in
 //!   [1e-9, 1e9], so that the polygon's area and moments stay normal floating-point numbers;
@@ -24,9 +25,9 @@
 /// Belt speed, m/s.
 pub const BELT_SPEED: (f64, f64) = (1e-4, 10.0);
 /// Belt width, m.
-pub const BELT_WIDTH: (f64, f64) = (1e-6, 1e3);
+pub const BELT_WIDTH: (f64, f64) = (1e-9, 1e3);
 /// Belt length, m.
-pub const BELT_LENGTH: (f64, f64) = (1e-6, 1e4);
+pub const BELT_LENGTH: (f64, f64) = (1e-9, 1e4);
 /// Metres per unit of the part's coordinates.
 pub const PART_SCALE: (f64, f64) = (1e-9, 1e3);
 /// The scaled part's circumradius a, m.
