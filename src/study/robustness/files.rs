@@ -323,16 +323,11 @@ fn numbers(lines: &[String]) -> Vec<(usize, usize, usize)> {
 
 /// Header text without brackets.
 fn header_name(line: &str) -> Option<&str> {
-    let t = line.trim();
-    let t = t.split('#').next()?.trim();
+    let t = line.split('#').next()?.trim();
     let t = t
         .strip_prefix("[[")
         .and_then(|t| t.strip_suffix("]]"))
-        .or_else(|| {
-            t.strip_prefix('[')
-                .and_then(|t| t.strip_suffix(']'))
-                .filter(|_| true)
-        })?;
+        .or_else(|| t.strip_prefix('[').and_then(|t| t.strip_suffix(']')))?;
     Some(t.trim())
 }
 

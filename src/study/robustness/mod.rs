@@ -60,10 +60,10 @@ impl Target {
     /// Mixed into the seed so that the targets draw different streams.
     fn tag(self) -> u64 {
         match self {
-            Target::Scenarios => 0x5ce0_a210,
-            Target::Studies => 0x057d_1e5,
-            Target::Contacts => 0xc0_47ac7,
-            Target::Polygons => 0x9017_9075,
+            Target::Scenarios => 0x1000_0001,
+            Target::Studies => 0x1000_0002,
+            Target::Contacts => 0x1000_0003,
+            Target::Polygons => 0x1000_0004,
         }
     }
     /// What a case of this target is.
