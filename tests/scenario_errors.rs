@@ -158,7 +158,7 @@ fn fence_length_must_be_positive() {
         22,
         10,
         "obstacles[0].length",
-        &["must be at least", "a shorter fence is a point", "got -0.1"],
+        &["must lie in [", "a shorter fence is a point", "got -0.1"],
     );
 }
 

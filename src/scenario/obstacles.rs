@@ -218,12 +218,19 @@ fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
         ));
     }
     let length = at.need("length", ro.length, needs)?;
-    let min_length = super::limits::FENCE_MIN_LENGTH_OF_A * at.part_radius;
+    let (lo, hi) = super::limits::FENCE_LENGTH_OF_A;
+    let (min_length, max_length) = (lo * at.part_radius, hi * at.part_radius);
     let length = c.finite(&at.path("length"), length)?;
-    if length < min_length {
+    if !(min_length..=max_length).contains(&length) {
         return Err(c.err(
             &at.path("length"),
-            format!("must be at least {min_length:e} m (10⁻⁶ of the part's a; a shorter fence is a point), got {length}"),
+            format!(
+                "must lie in [{}, {}] m (10⁻⁶ a to 10⁴ a, a = {} m: a shorter fence is a point, a longer one a slide of more than 10⁴ part sizes), got {}",
+                super::limits::num(min_length),
+                super::limits::num(max_length),
+                super::limits::num(at.part_radius),
+                super::limits::num(length)
+            ),
         ));
     }
     let f = FenceObstacle {
