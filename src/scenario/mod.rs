@@ -174,6 +174,23 @@ any = true
     }
 
     #[test]
+    fn a_fence_longer_than_ten_thousand_part_sizes_is_refused() {
+        // A 20 µm part (a = 27.5 µm) against a 0.1 m fence: a slide of 3600 a is fine, one of
+        // 10⁴ a or more is refused by name (its cost grows with length / a).
+        let tiny = GOOD.replace("scale = 0.02", "scale = 0.00002");
+        let fence = |len: &str| {
+            tiny.replace(
+                "[goal]",
+                &format!("[[obstacles]]\nkind = \"fence\"\nx = 0.4\ny = -0.09\nangle = 30\nlength = {len}\n\n[goal]"),
+            )
+        };
+        assert!(parse(Path::new("f.toml"), &fence("0.1")).is_ok());
+        let e = err(&fence("0.3"));
+        assert_eq!(e.key, "obstacles[1].length");
+        assert!(e.message.contains("10⁻⁶ a to 10⁴ a"), "{}", e.message);
+    }
+
+    #[test]
     fn missing_part_is_reported() {
         let src = GOOD.replace("[part]\nshape = \"tripoly2\"\nscale = 0.02\n", "");
         let e = err(&src);
