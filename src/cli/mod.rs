@@ -5,6 +5,7 @@ pub mod bench;
 pub mod bench_mc;
 pub mod compare;
 pub mod contact;
+pub mod fuzz;
 pub mod map;
 pub mod mc;
 pub mod merge;
@@ -40,6 +41,8 @@ pub enum Command {
     Merge(merge::MergeArgs),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
+    /// Fuzz the inputs (scenario and study files, contacts, polygons) and write results/robustness.md.
+    Fuzz(fuzz::FuzzArgs),
 }
 
 /// Run a parsed command line.
@@ -53,5 +56,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Mc(a) => mc::run(&a),
         Command::Merge(a) => merge::run(&a),
         Command::Bench(a) => bench::run(&a),
+        Command::Fuzz(a) => fuzz::run(&a),
     }
 }

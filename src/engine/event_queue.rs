@@ -55,11 +55,17 @@ impl PartialOrd for Event {
 }
 
 /// A min-queue of events by (time, sequence number).
+///
+/// Defence in depth: an event at a non-finite time (which validated scenarios never produce) is
+/// not queued; it is counted and the first one kept, and the engine stops the run with
+/// [`super::EngineError::NonFiniteTime`] instead of panicking or looping.
 #[derive(Debug, Default)]
 pub struct EventQueue {
     heap: BinaryHeap<Event>,
     next_seq: u64,
     scheduled: u64,
+    refused: u64,
+    first_refused: Option<(f64, EventKind)>,
 }
 
 impl EventQueue {
@@ -67,17 +73,29 @@ impl EventQueue {
         EventQueue::default()
     }
 
-    /// Schedule `kind` at `time` (seconds; finite). Returns the event's sequence number.
-    pub fn schedule(&mut self, time: f64, kind: EventKind) -> u64 {
-        assert!(
-            time.is_finite(),
-            "event time must be finite: {kind:?} at {time}"
-        );
+    /// Schedule `kind` at `time` (seconds). Returns the event's sequence number, or None when
+    /// `time` is not finite: the event is then refused and counted ([`EventQueue::refused`]).
+    pub fn schedule(&mut self, time: f64, kind: EventKind) -> Option<u64> {
+        if !time.is_finite() {
+            self.refused += 1;
+            self.first_refused.get_or_insert((time, kind));
+            return None;
+        }
         let seq = self.next_seq;
         self.next_seq += 1;
         self.scheduled += 1;
         self.heap.push(Event { time, seq, kind });
-        seq
+        Some(seq)
+    }
+
+    /// Events refused because their time was not finite.
+    pub fn refused(&self) -> u64 {
+        self.refused
+    }
+
+    /// The first refused event: its time and kind.
+    pub fn first_refused(&self) -> Option<(f64, EventKind)> {
+        self.first_refused
     }
 
     /// The earliest event (lowest sequence number among equal times).
@@ -131,5 +149,16 @@ mod tests {
         // total_cmp puts −0 before +0: the order depends only on the values, never on the heap.
         assert_eq!(a.kind, EventKind::Exit { part: 1 });
         assert_eq!(b.kind, EventKind::Exit { part: 0 });
+    }
+
+    #[test]
+    fn a_non_finite_time_is_refused_and_counted() {
+        let mut q = EventQueue::new();
+        assert_eq!(q.schedule(1.0, EventKind::Exit { part: 0 }), Some(0));
+        assert_eq!(q.schedule(f64::INFINITY, EventKind::Exit { part: 1 }), None);
+        assert_eq!(q.schedule(f64::NAN, EventKind::Arrival { part: 2 }), None);
+        assert_eq!((q.len(), q.refused(), q.scheduled()), (1, 2, 1));
+        let (t, kind) = q.first_refused().unwrap();
+        assert_eq!((t, kind), (f64::INFINITY, EventKind::Exit { part: 1 }));
     }
 }

@@ -82,6 +82,14 @@ impl RunOptions {
 pub enum EngineError {
     #[error("part {index}: {reason}")]
     PartDraw { index: u64, reason: String },
+    /// An event time came out non-finite (NaN or ±∞): the scene's numbers leave f64. Validated
+    /// scenarios never get here; the engine refuses instead of panicking.
+    #[error("an event time is not finite ({kind:?} at {time} s; {refused} event(s) refused): the scene's numbers are out of range (see README \"Scenario format\")")]
+    NonFiniteTime {
+        time: f64,
+        kind: super::event_queue::EventKind,
+        refused: u64,
+    },
 }
 
 /// One finished part.
@@ -171,7 +179,15 @@ pub fn run(
     if opts.parts > 0 {
         line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
     }
-    while let Some(ev) = line.queue.pop() {
+    loop {
+        if let Some((time, kind)) = line.queue.first_refused() {
+            return Err(EngineError::NonFiniteTime {
+                time,
+                kind,
+                refused: line.queue.refused(),
+            });
+        }
+        let Some(ev) = line.queue.pop() else { break };
         line.handle(ev)?;
         if line.finished % 256 == 0 {
             progress(line.finished);

@@ -7,6 +7,7 @@
 //! * obstacles (pins and fences) are checked in [`super::obstacles`].
 
 use super::error::{Locator, ScenarioError};
+use super::limits;
 use super::location::KeyPath;
 use super::raw::*;
 use super::scene::*;
@@ -31,29 +32,25 @@ impl Checker<'_, '_> {
             Err(self.err(path, format!("must be a finite number, got {v}")))
         }
     }
-    pub(super) fn positive(&self, path: &str, v: f64, unit: &str) -> R<f64> {
-        self.finite(path, v)?;
-        if v > 0.0 {
-            Ok(v)
-        } else {
-            Err(self.err(path, format!("must be greater than 0 ({unit}), got {v}")))
-        }
-    }
-    pub(super) fn non_negative(&self, path: &str, v: f64, unit: &str) -> R<f64> {
-        self.finite(path, v)?;
-        if v >= 0.0 {
-            Ok(v)
-        } else {
-            Err(self.err(path, format!("must be at least 0 ({unit}), got {v}")))
-        }
-    }
     pub(super) fn within(&self, path: &str, v: f64, lo: f64, hi: f64, unit: &str) -> R<f64> {
         self.finite(path, v)?;
         if v >= lo && v <= hi {
             Ok(v)
         } else {
-            Err(self.err(path, format!("must lie in [{lo}, {hi}] ({unit}), got {v}")))
+            Err(self.err(
+                path,
+                format!(
+                    "must lie in [{}, {}] ({unit}), got {}",
+                    limits::num(lo),
+                    limits::num(hi),
+                    limits::num(v)
+                ),
+            ))
         }
+    }
+    /// `v` within one of the [`super::limits`] ranges.
+    pub(super) fn range(&self, path: &str, v: f64, r: (f64, f64), unit: &str) -> R<f64> {
+        self.within(path, v, r.0, r.1, unit)
     }
     fn missing(&self, section: &str, msg: &str) -> ScenarioError {
         self.err(section, msg.to_string())
@@ -88,9 +85,9 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         ));
     };
     let belt = Belt {
-        speed: c.positive("belt.speed", rb.speed, "m/s")?,
-        width: c.positive("belt.width", rb.width, "m")?,
-        length: c.positive("belt.length", rb.length, "m")?,
+        speed: c.range("belt.speed", rb.speed, limits::BELT_SPEED, "m/s")?,
+        width: c.range("belt.width", rb.width, limits::BELT_WIDTH, "m")?,
+        length: c.range("belt.length", rb.length, limits::BELT_LENGTH, "m")?,
     };
 
     // [part]
@@ -124,6 +121,27 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
             (shape.trim().to_string(), p)
         }
         (None, Some(vs)) => {
+            let (lo, hi) = limits::VERTEX_MAGNITUDE;
+            let mut largest = 0.0f64;
+            for (i, v) in vs.iter().enumerate() {
+                for (k, &x) in v.iter().enumerate() {
+                    let path = format!("part.vertices[{i}][{k}]");
+                    c.finite(&path, x)?;
+                    if x.abs() > hi {
+                        return Err(c.err(
+                            &path,
+                            format!("a vertex coordinate must lie within ±{} units (use part.scale for large parts), got {}", limits::num(hi), limits::num(x)),
+                        ));
+                    }
+                    largest = largest.max(x.abs());
+                }
+            }
+            if largest < lo {
+                return Err(c.err(
+                    "part.vertices",
+                    format!("the largest vertex coordinate must be at least {} units in magnitude (use part.scale for small parts), got {}", limits::num(lo), limits::num(largest)),
+                ));
+            }
             let pts: Vec<Vec2> = vs.iter().map(|v| Vec2::new(v[0], v[1])).collect();
             let p = Polygon::new(&pts).map_err(|e| {
                 c.err(
@@ -134,11 +152,50 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
             ("vertices".to_string(), p)
         }
     };
-    let scale = c.positive("part.scale", rp.scale.unwrap_or(1.0), "m per unit")?;
+    let scale = c.range(
+        "part.scale",
+        rp.scale.unwrap_or(1.0),
+        limits::PART_SCALE,
+        "m per unit",
+    )?;
+    let scaled_radius = poly.radius() * scale;
+    if !limits::contains(limits::PART_RADIUS, scaled_radius) {
+        let key = if rp.scale.is_some() {
+            "part.scale"
+        } else {
+            "part"
+        };
+        return Err(c.err(
+            key,
+            format!(
+                "the scaled part's size a (centroid to farthest vertex) must lie in {} m, got {} m ({} units × scale {})",
+                limits::show(limits::PART_RADIUS),
+                limits::num(scaled_radius),
+                limits::num(poly.radius()),
+                limits::num(scale)
+            ),
+        ));
+    }
     let polygon = poly.scaled(scale);
     let radius = polygon.radius();
-    let mu_c = c.non_negative("part.mu_c", rp.mu_c.unwrap_or(0.5), "friction coefficient")?;
-    let mu_s = c.positive("part.mu_s", rp.mu_s.unwrap_or(0.3), "friction coefficient")?;
+    let mu_c = c.range(
+        "part.mu_c",
+        rp.mu_c.unwrap_or(0.5),
+        limits::FRICTION,
+        "friction coefficient",
+    )?;
+    let mu_s = c.range(
+        "part.mu_s",
+        rp.mu_s.unwrap_or(0.3),
+        limits::FRICTION,
+        "friction coefficient",
+    )?;
+    if mu_s == 0.0 {
+        return Err(c.err(
+            "part.mu_s",
+            "must be greater than 0 (friction coefficient; it scales forces)",
+        ));
+    }
     let model = PartModel::new(&polygon, &Support::Uniform).map_err(|e| {
         c.err(
             "part",
@@ -173,15 +230,20 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
                 "give headway (seconds between arrivals) or rate (arrivals per second)",
             ))
         }
-        (Some(h), None) => c.positive("feed.headway", h, "s")?,
-        (None, Some(r)) => 1.0 / c.positive("feed.rate", r, "arrivals per second")?,
+        (Some(h), None) => c.range("feed.headway", h, limits::HEADWAY, "s")?,
+        (None, Some(r)) => 1.0 / c.range("feed.rate", r, limits::RATE, "arrivals per second")?,
     };
     let arrival = match rf.arrival {
         ArrivalKind::Periodic => Arrival::Periodic { headway },
         ArrivalKind::Poisson => Arrival::Poisson { headway },
     };
     let jitter = c
-        .non_negative("feed.jitter", rf.jitter.unwrap_or(0.0), "degrees")?
+        .range(
+            "feed.jitter",
+            rf.jitter.unwrap_or(0.0),
+            limits::JITTER_DEG,
+            "degrees",
+        )?
         .to_radians();
     let orientation = match rf.orientation {
         OrientationKind::Uniform => {
@@ -226,7 +288,12 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
                         ));
                     }
                     for (i, &x) in w.iter().enumerate() {
-                        c.non_negative(&format!("feed.weights[{i}]"), x, "relative weight")?;
+                        c.range(
+                            &format!("feed.weights[{i}]"),
+                            x,
+                            limits::WEIGHT,
+                            "relative weight",
+                        )?;
                     }
                     w.clone()
                 }
@@ -316,7 +383,13 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
                 LateralKind::Normal => {
                     allowed(&["mean", "sd"])?;
                     let mean = on_belt("mean", l.mean)?;
-                    let sd = c.non_negative("feed.lateral.sd", l.sd.unwrap_or(0.0), "m")?;
+                    let sd = c.within(
+                        "feed.lateral.sd",
+                        l.sd.unwrap_or(0.0),
+                        0.0,
+                        belt.width,
+                        "m; at most the belt width",
+                    )?;
                     Lateral::Normal {
                         mean,
                         sd,
@@ -367,8 +440,13 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
                     let mut os = Vec::new();
                     for (j, &o) in s.orientations.iter().enumerate() {
                         os.push(
-                            c.finite(&format!("goal.sets[{i}].orientations[{j}]"), o)?
-                                .to_radians(),
+                            c.range(
+                                &format!("goal.sets[{i}].orientations[{j}]"),
+                                o,
+                                limits::ORIENTATION_DEG,
+                                "degrees",
+                            )?
+                            .to_radians(),
                         );
                     }
                     let tol = s.tolerance.unwrap_or(5.0);
@@ -399,10 +477,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
     // [model]
     let defaults = ContactSettings::default();
     let tol = raw.model.tol.unwrap_or(defaults.tol);
-    let tol = c.finite("model.tol", tol)?;
-    if !(tol > 0.0 && tol <= 1e-2) {
-        return Err(c.err("model.tol", format!("must lie in (0, 0.01], got {tol}")));
-    }
+    let tol = c.range("model.tol", tol, limits::TOL, "relative, in units of a")?;
     let max_travel = c.within(
         "model.max_travel",
         raw.model.max_travel.unwrap_or(defaults.max_travel),
@@ -431,11 +506,20 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         histogram_svg: ro.histogram_svg.unwrap_or(true),
         histogram_bin_deg: {
             let b = ro.histogram_bin.unwrap_or(5.0);
-            c.finite("output.histogram_bin", b)?;
-            if !(b > 0.0 && b <= 90.0 && (360.0 / b - (360.0 / b).round()).abs() < 1e-9) {
+            // At most 360 / 0.01 = 36 000 bins: the histogram's memory is bounded.
+            c.range(
+                "output.histogram_bin",
+                b,
+                limits::HISTOGRAM_BIN_DEG,
+                "degrees; it must divide 360",
+            )?;
+            if (360.0 / b - (360.0 / b).round()).abs() >= 1e-9 {
                 return Err(c.err(
                     "output.histogram_bin",
-                    format!("must divide 360 and lie in (0, 90] degrees, got {b}"),
+                    format!(
+                        "must divide 360 (degrees, in {}), got {b}",
+                        limits::show(limits::HISTOGRAM_BIN_DEG)
+                    ),
                 ));
             }
             b

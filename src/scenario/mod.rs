@@ -7,11 +7,13 @@
 //! * [`compile`]: checks and conversion to [`Scene`];
 //! * [`obstacles`]: pins and fences, their checks and neighbour lists;
 //! * [`scene`]: the compiled types the engine reads;
+//! * [`limits`]: the physically meaningful range of every number;
 //! * [`location`], [`error`]: spans → line/column and key paths, and the located error;
 //! * [`shared_feed`]: one reference scene's part stream imposed on others (`pinfeed compare`).
 
 pub mod compile;
 pub mod error;
+pub mod limits;
 pub mod location;
 pub mod obstacles;
 pub mod raw;
@@ -104,7 +106,11 @@ any = true
     fn validation_errors_name_key_and_range() {
         let e = err(&GOOD.replace("speed = 0.05", "speed = -0.05"));
         assert_eq!((e.line, e.column, e.key.as_str()), (3, 9, "belt.speed"));
-        assert!(e.message.contains("greater than 0"));
+        assert!(
+            e.message.contains("must lie in [0.0001, 10] (m/s)"),
+            "{}",
+            e.message
+        );
         let e = err(&GOOD.replace("radius = 0.002", "radius = 0.002\nmu_c = -1"));
         assert_eq!(e.key, "obstacles[0].mu_c");
         let e = err(&GOOD.replace("kind = \"pin\"", "kind = \"moving_pin\""));
@@ -165,6 +171,23 @@ any = true
         // Too close to the entry (x must exceed a = 0.0275 m).
         let e = err(&text.replace("x = 0.4", "x = 0.02"));
         assert_eq!(e.key, "obstacles[1].x");
+    }
+
+    #[test]
+    fn a_fence_longer_than_ten_thousand_part_sizes_is_refused() {
+        // A 20 µm part (a = 27.5 µm) against a 0.1 m fence: a slide of 3600 a is fine, one of
+        // 10⁴ a or more is refused by name (its cost grows with length / a).
+        let tiny = GOOD.replace("scale = 0.02", "scale = 0.00002");
+        let fence = |len: &str| {
+            tiny.replace(
+                "[goal]",
+                &format!("[[obstacles]]\nkind = \"fence\"\nx = 0.4\ny = -0.09\nangle = 30\nlength = {len}\n\n[goal]"),
+            )
+        };
+        assert!(parse(Path::new("f.toml"), &fence("0.1")).is_ok());
+        let e = err(&fence("0.3"));
+        assert_eq!(e.key, "obstacles[1].length");
+        assert!(e.message.contains("10⁻⁶ a to 10⁴ a"), "{}", e.message);
     }
 
     #[test]

@@ -162,9 +162,12 @@ impl At<'_, '_, '_> {
     /// A friction coefficient, or the part's μc.
     fn friction(&self, k: &str, v: Option<f64>) -> R<f64> {
         match v {
-            Some(m) => self
-                .c
-                .non_negative(&self.path(k), m, "friction coefficient"),
+            Some(m) => self.c.range(
+                &self.path(k),
+                m,
+                super::limits::FRICTION,
+                "friction coefficient",
+            ),
             None => Ok(self.part_mu_c),
         }
     }
@@ -182,7 +185,13 @@ fn pin(at: &At, ro: &RawObstacle) -> R<PinObstacle> {
     only_keys(at.c, at.i, ro, "pin", "x, y, radius, mu_c")?;
     let needs = "a pin needs x, y and radius (m)";
     let radius = at.need("radius", ro.radius, needs)?;
-    let radius = at.c.non_negative(&at.path("radius"), radius, "m")?;
+    let radius = at.c.within(
+        &at.path("radius"),
+        radius,
+        0.0,
+        at.belt.width,
+        "m; 0 is a point pin, at most the belt width",
+    )?;
     let x = at.need("x", ro.x, needs)?;
     let x = at.x_within(x, radius + at.part_radius, "the pin's centre", "a + radius")?;
     let y = at.y_over(at.need("y", ro.y, needs)?)?;
@@ -209,7 +218,21 @@ fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
         ));
     }
     let length = at.need("length", ro.length, needs)?;
-    let length = c.positive(&at.path("length"), length, "m")?;
+    let (lo, hi) = super::limits::FENCE_LENGTH_OF_A;
+    let (min_length, max_length) = (lo * at.part_radius, hi * at.part_radius);
+    let length = c.finite(&at.path("length"), length)?;
+    if !(min_length..=max_length).contains(&length) {
+        return Err(c.err(
+            &at.path("length"),
+            format!(
+                "must lie in [{}, {}] m (10⁻⁶ a to 10⁴ a, a = {} m: a shorter fence is a point, a longer one a slide of more than 10⁴ part sizes), got {}",
+                super::limits::num(min_length),
+                super::limits::num(max_length),
+                super::limits::num(at.part_radius),
+                super::limits::num(length)
+            ),
+        ));
+    }
     let f = FenceObstacle {
         name: at.name(&ro.name, "fence")?,
         start: Vec2::new(x, y),

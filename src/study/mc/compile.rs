@@ -10,6 +10,7 @@ use super::distribution::Distribution;
 use super::perturbations::{Perturbations, SmoothParams, SupportChoice};
 use super::raw::*;
 use crate::scenario::error::Locator;
+use crate::scenario::limits::num;
 use crate::scenario::location::KeyPath;
 use crate::scenario::{ScenarioError, SupportKind};
 
@@ -75,19 +76,31 @@ fn slot_mut<'a>(u: &'a mut RawUncertain, name: &str) -> &'a mut Option<RawDistri
     }
 }
 
-/// The domain a parameter's value must lie in (values outside are refused or redrawn).
-fn domain(name: &str) -> (f64, bool, &'static str) {
+/// Largest error (m) a study may add to a length (shape, pin position and radius, lateral pose):
+/// the longest belt (README "Study format").
+pub const LENGTH_ERROR: (f64, f64) = (-1e3, 1e3);
+/// Largest error (degrees) a study may add to the entry orientation.
+pub const ANGLE_ERROR: (f64, f64) = (-360.0, 360.0);
+
+/// The physical range of parameter `name` and its unit (crate::scenario::limits): every value a
+/// study gives (value, min, max, mean, mode) must lie in it, a standard deviation must not exceed
+/// its width, and a drawn friction or belt speed outside it is redrawn.
+pub fn domain(name: &str) -> ((f64, f64), &'static str) {
+    use crate::scenario::limits;
     match name {
-        "mu_c" => (0.0, true, "at least 0 (a friction coefficient)"),
-        "belt_speed" => (0.0, false, "greater than 0 (m/s)"),
-        _ => (f64::NEG_INFINITY, true, ""),
+        "mu_c" => (limits::FRICTION, "a friction coefficient"),
+        "belt_speed" => (limits::BELT_SPEED, "m/s"),
+        "pose_theta" => (
+            ANGLE_ERROR,
+            "degrees, an error added to the entry orientation",
+        ),
+        _ => (LENGTH_ERROR, "m, an error added to a length or position"),
     }
 }
 
 /// Does `v` lie in the domain of parameter `name`?
 pub fn in_domain(name: &str, v: f64) -> bool {
-    let (lo, closed, _) = domain(name);
-    v.is_finite() && (v > lo || (closed && v == lo))
+    crate::scenario::limits::contains(domain(name).0, v)
 }
 
 fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Distribution> {
@@ -146,17 +159,42 @@ fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Dis
         }
     }
     let g = |k: &str| vals.get(k).copied();
-    let (lo_dom, _, dom_text) = domain(name);
+    let ((lo_dom, hi_dom), dom_text) = domain(name);
     let check_in_domain = |k: &str, v: f64| -> R<()> {
-        if lo_dom.is_finite() && !in_domain(name, v) {
+        if !in_domain(name, v) {
             return Err(err(
                 loc,
                 &key(k),
-                format!("{name} must be {dom_text}, got {v}"),
+                format!(
+                    "{name} must be at least {} and at most {} ({dom_text}), got {}",
+                    num(lo_dom),
+                    num(hi_dom),
+                    num(v)
+                ),
             ));
         }
         Ok(())
     };
+    for (k, v) in &vals {
+        if *k == "sd" {
+            let widest = hi_dom - lo_dom;
+            if !(0.0..=widest).contains(v) {
+                return Err(err(
+                    loc,
+                    &key(k),
+                    format!(
+                        "must lie in [0, {}] (the width of {name}'s range [{}, {}], {dom_text}), got {}",
+                        num(widest),
+                        num(lo_dom),
+                        num(hi_dom),
+                        num(*v)
+                    ),
+                ));
+            }
+        } else {
+            check_in_domain(k, *v)?;
+        }
+    }
     let dist = match kind {
         DistributionKind::Fixed => {
             let v = g("value").expect("checked");

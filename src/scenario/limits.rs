@@ -1,0 +1,99 @@
+//! The physically meaningful range of every number in a scenario or study file (README "Scenario
+//! format", "Study format"). A value outside its range is refused with a located error naming the
+//! key, the range and the value, before any geometry or simulation sees it.
+//!
+//! Why ranges at all: the simulator is scale invariant in principle, but a number like
+//! `belt.speed = 5e-324` or `part.scale = 1e-200` is not a feeder line, and its arithmetic leaves
+//! f64 (event times of 1e308 s, areas that underflow to 0). The ranges below span every feeder
+//! line one could build with many orders of magnitude to spare, and keep every derived quantity
+//! (event times, areas, moments, histogram sizes) finite and representable:
+//!
+//! * lengths of the line (belt width and length) from 1 nm (the smallest part) to 1 km (10 km for
+//!   the belt length);
+//! * the part: `scale` from 1 nm to 1 km per unit, and the scaled part's circumradius a from 1 nm
+//!   to 1 km; vertex coordinates (in the file's units) finite with the largest magnitude in
+//!   [1e-9, 1e9], so that the polygon's area and moments stay normal floating-point numbers;
+//! * belt speed from 0.1 mm/s to 10 m/s: with the longest belt, a part is on the belt at most
+//!   10⁸ s;
+//! * headway from 1 µs to 10⁶ s (rate from 10⁻⁶ to 10⁶ per second): with 10⁹ parts the last
+//!   arrival is at most 10¹⁵ s;
+//! * friction coefficients from 0 to 5 (measured values lie below about 2);
+//! * angles: goal orientations within ±360°, tolerances and jitter up to 180°;
+//! * integration tolerance from 1e-10 to 1e-2 (relative, in units of a);
+//! * the orientation histogram's bin from 0.01° to 90° (at most 36 000 bins: bounded memory);
+//! * a fence's length from 10⁻⁶ a to 10⁴ a (the cost of a slide grows with its length in units
+//!   of a).
+
+/// Belt speed, m/s.
+pub const BELT_SPEED: (f64, f64) = (1e-4, 10.0);
+/// Belt width, m.
+pub const BELT_WIDTH: (f64, f64) = (1e-9, 1e3);
+/// Belt length, m.
+pub const BELT_LENGTH: (f64, f64) = (1e-9, 1e4);
+/// Metres per unit of the part's coordinates.
+pub const PART_SCALE: (f64, f64) = (1e-9, 1e3);
+/// The scaled part's circumradius a, m.
+pub const PART_RADIUS: (f64, f64) = (1e-9, 1e3);
+/// Largest magnitude of a vertex coordinate, in the file's units.
+pub const VERTEX_MAGNITUDE: (f64, f64) = (1e-9, 1e9);
+/// Friction coefficients (μc, μs, μf).
+pub const FRICTION: (f64, f64) = (0.0, 5.0);
+/// Seconds between arrivals.
+pub const HEADWAY: (f64, f64) = (1e-6, 1e6);
+/// Arrivals per second.
+pub const RATE: (f64, f64) = (1e-6, 1e6);
+/// Relative weight of a stable state.
+pub const WEIGHT: (f64, f64) = (0.0, 1e6);
+/// Orientation jitter (standard deviation), degrees.
+pub const JITTER_DEG: (f64, f64) = (0.0, 180.0);
+/// Goal orientations, degrees.
+pub const ORIENTATION_DEG: (f64, f64) = (-360.0, 360.0);
+/// Integration tolerance (relative).
+pub const TOL: (f64, f64) = (1e-10, 1e-2);
+/// Orientation histogram bin width, degrees.
+pub const HISTOGRAM_BIN_DEG: (f64, f64) = (0.01, 90.0);
+/// Fence length, in units of the part's a: shorter is a point; longer is a slide the contact
+/// model integrates in steps of at most 2a, so its cost grows with length/a (a 1 nm part along a
+/// 10 cm fence would take 10⁸ steps). 10⁴ a is a 1 mm part along a 10 m fence.
+pub const FENCE_LENGTH_OF_A: (f64, f64) = (1e-6, 1e4);
+
+/// A number as a message shows it: plain between 10⁻⁴ and 10¹⁵, else in exponent notation (so
+/// 1e-300 is not printed with 300 zeros).
+pub fn num(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// Human-readable `[lo, hi]`.
+pub fn show(r: (f64, f64)) -> String {
+    format!("[{}, {}]", num(r.0), num(r.1))
+}
+
+/// Does `v` lie in the closed range `r` (false for NaN and ±∞)?
+pub fn contains(r: (f64, f64), v: f64) -> bool {
+    v.is_finite() && v >= r.0 && v <= r.1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn derived_times_and_bins_stay_bounded() {
+        // The longest stay on the belt, the latest arrival and the most histogram bins.
+        assert!(BELT_LENGTH.1 / BELT_SPEED.0 <= 1e8);
+        assert!(1e9 * HEADWAY.1 <= 1e15);
+        assert!(360.0 / HISTOGRAM_BIN_DEG.0 <= 36_000.0 + 1e-9);
+        assert!(!contains(BELT_SPEED, f64::NAN));
+        assert!(!contains(BELT_SPEED, 5e-324));
+        assert!(contains(BELT_SPEED, 0.05));
+        assert_eq!(
+            (num(1e-300), num(0.05), num(-1e308)),
+            ("1e-300".into(), "0.05".into(), "-1e308".into())
+        );
+        assert_eq!(show(PART_SCALE), "[1e-9, 1000]");
+    }
+}

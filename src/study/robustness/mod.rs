@@ -1,0 +1,437 @@
+//! Fuzzing the simulator's inputs in-process (issue 11): generated and mutated scenario and study
+//! files, random contacts and random polygons, each run under `catch_unwind` with a per-case
+//! watchdog, tallied into clean errors, successes, panics, hangs, non-finite outputs and contact
+//! self-check disagreements (`pinfeed fuzz`, results/robustness.md).
+//!
+//! * [`files`]: scenario and study files mutated from the bundled ones and the test fixtures;
+//! * [`contacts`]: random star polygons pushed by point and disc pins at two tolerances;
+//! * [`polygons`]: vertex lists at extreme magnitudes, near-degenerate and self-intersecting.
+//!
+//! Determinism: case i of a target draws only from `random::stream(seed ^ tag, i)` and the results
+//! are tallied in index order, so the counts and the listed reproducers do not depend on the
+//! thread count. Only hangs depend on the machine (a case slower than the time budget counts as a
+//! hang); the report says so.
+//!
+//! A case runs on its own thread: a panic is caught there (the panic hook is silenced while
+//! fuzzing, and the message and location are recorded), and a case still running after the budget
+//! is reported as a hang and left to finish in the background (after [`MAX_HANGS`] hangs the run
+//! stops, so runaway threads cannot pile up).
+
+pub mod contacts;
+pub mod files;
+pub mod polygons;
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Hung cases after which a target stops generating new ones.
+pub const MAX_HANGS: u64 = 8;
+/// Problems of each kind listed in the report.
+pub const LISTED: usize = 5;
+
+/// What to fuzz.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Target {
+    Scenarios,
+    Studies,
+    Contacts,
+    Polygons,
+}
+
+impl Target {
+    pub const ALL: [Target; 4] = [
+        Target::Scenarios,
+        Target::Studies,
+        Target::Contacts,
+        Target::Polygons,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::Scenarios => "scenarios",
+            Target::Studies => "studies",
+            Target::Contacts => "contacts",
+            Target::Polygons => "polygons",
+        }
+    }
+    /// Mixed into the seed so that the targets draw different streams.
+    fn tag(self) -> u64 {
+        match self {
+            Target::Scenarios => 0x1000_0001,
+            Target::Studies => 0x1000_0002,
+            Target::Contacts => 0x1000_0003,
+            Target::Polygons => 0x1000_0004,
+        }
+    }
+    /// What a case of this target is.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Target::Scenarios => files::SCENARIO_DESCRIPTION,
+            Target::Studies => files::STUDY_DESCRIPTION,
+            Target::Contacts => contacts::DESCRIPTION,
+            Target::Polygons => polygons::DESCRIPTION,
+        }
+    }
+}
+
+/// How one case ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Class {
+    /// Refused with an error pointing at the input (file:line:column and an excerpt).
+    Located,
+    /// Refused with an error that names its cause (a key, a parameter, a sample) but not a place.
+    Named,
+    /// Refused with an error that says neither where nor why.
+    Unlocated,
+    /// Accepted and run, every output finite (a contact: status `ok` at both tolerances, agreeing).
+    Success,
+    /// A contact that ended with a named status other than `ok` (at the default tolerance).
+    Status,
+    /// Accepted, but an output is NaN or infinite.
+    NonFinite,
+    /// A contact `ok` at both tolerances whose rotations differ by more than 1°.
+    Disagreement,
+    /// A contact `ok` at the default tolerance but not at the tighter one.
+    OkThenFailed,
+    Panic,
+    Hang,
+}
+
+impl Class {
+    /// Problems: listed in the report with their reproducers.
+    pub fn is_problem(self) -> bool {
+        matches!(
+            self,
+            Class::Unlocated
+                | Class::NonFinite
+                | Class::Disagreement
+                | Class::OkThenFailed
+                | Class::Panic
+                | Class::Hang
+        )
+    }
+}
+
+/// The result of one case.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaseReport {
+    pub class: Class,
+    /// Contacts: the status at the default tolerance.
+    pub status: Option<String>,
+    /// For problems: what happened and how to reproduce it.
+    pub detail: String,
+}
+
+impl CaseReport {
+    pub fn new(class: Class) -> CaseReport {
+        CaseReport {
+            class,
+            status: None,
+            detail: String::new(),
+        }
+    }
+    pub fn with(class: Class, detail: impl Into<String>) -> CaseReport {
+        CaseReport {
+            class,
+            status: None,
+            detail: detail.into(),
+        }
+    }
+}
+
+/// Per-target counts.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Tally {
+    pub generated: u64,
+    pub counts: BTreeMap<Class, u64>,
+    /// Contacts: statuses at the default tolerance, by name.
+    pub statuses: BTreeMap<String, u64>,
+    /// The first few problems of each class, in case order: (case index, detail).
+    pub problems: BTreeMap<Class, Vec<(u64, String)>>,
+    /// The run stopped early after too many hangs.
+    pub stopped_early: bool,
+    pub seconds: f64,
+}
+
+impl Tally {
+    pub fn count(&self, c: Class) -> u64 {
+        self.counts.get(&c).copied().unwrap_or(0)
+    }
+    fn add(&mut self, index: u64, r: &CaseReport) {
+        self.generated += 1;
+        *self.counts.entry(r.class).or_insert(0) += 1;
+        if let Some(s) = &r.status {
+            *self.statuses.entry(s.clone()).or_insert(0) += 1;
+        }
+        if r.class.is_problem() {
+            let list = self.problems.entry(r.class).or_default();
+            if list.len() < LISTED {
+                list.push((index, r.detail.clone()));
+            }
+        }
+    }
+}
+
+/// Settings of a fuzzing run.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub seed: u64,
+    pub threads: usize,
+    /// A case running longer than this is a hang.
+    pub budget: Duration,
+    /// The project root (bundled scenarios, studies and test fixtures are read from it).
+    pub root: PathBuf,
+}
+
+/// Everything the generators need, shared by the case threads.
+pub struct Corpus {
+    pub files: files::Seeds,
+}
+
+impl Corpus {
+    pub fn load(root: &Path) -> Result<Corpus, String> {
+        Ok(Corpus {
+            files: files::Seeds::load(root)?,
+        })
+    }
+}
+
+/// Run case `index` of `target` (no guard): a pure function of (corpus, seed, index).
+pub fn run_case(target: Target, corpus: &Corpus, seed: u64, index: u64) -> CaseReport {
+    let mut rng = crate::random::stream(seed ^ target.tag(), index);
+    match target {
+        Target::Scenarios => files::scenario_case(&corpus.files, &mut rng).1,
+        Target::Studies => files::study_case(&corpus.files, &mut rng).1,
+        Target::Contacts => contacts::case(&mut rng),
+        Target::Polygons => polygons::case(&mut rng),
+    }
+}
+
+/// The input of case `index` as text (a scenario or study file, a contact or part command line).
+pub fn case_input(target: Target, corpus: &Corpus, seed: u64, index: u64) -> String {
+    let mut rng = crate::random::stream(seed ^ target.tag(), index);
+    match target {
+        Target::Scenarios => files::scenario_input(&corpus.files, &mut rng),
+        Target::Studies => files::study_input(&corpus.files, &mut rng),
+        Target::Contacts => contacts::input(&mut rng),
+        Target::Polygons => polygons::input(&mut rng),
+    }
+}
+
+thread_local! {
+    static LAST_PANIC: RefCell<Option<String>> = const { RefCell::new(None) };
+}
+
+/// The message of a caught panic, with its location when the hook recorded it.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    let msg = if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "(non-string panic payload)".to_string()
+    };
+    match LAST_PANIC.with(|p| p.borrow_mut().take()) {
+        Some(at) => format!("panicked at {at}: {msg}"),
+        None => format!("panicked: {msg}"),
+    }
+}
+
+/// Run one case on its own thread, catching a panic and giving up after `budget`.
+fn guarded(
+    target: Target,
+    corpus: &Arc<Corpus>,
+    seed: u64,
+    index: u64,
+    budget: Duration,
+) -> CaseReport {
+    let (tx, rx) = mpsc::channel();
+    let c = Arc::clone(corpus);
+    let spawned = std::thread::Builder::new()
+        .name(format!("fuzz-{}-{index}", target.name()))
+        .stack_size(16 << 20)
+        .spawn(move || {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                run_case(target, &c, seed, index)
+            }));
+            let report = match r {
+                Ok(r) => r,
+                Err(payload) => CaseReport::with(Class::Panic, panic_message(payload.as_ref())),
+            };
+            let _ = tx.send(report);
+        });
+    let handle = match spawned {
+        Ok(h) => h,
+        Err(e) => return CaseReport::with(Class::Hang, format!("cannot start a thread: {e}")),
+    };
+    match rx.recv_timeout(budget) {
+        Ok(mut r) => {
+            let _ = handle.join();
+            if r.class.is_problem() {
+                r.detail = format!("{} (case {index}): {}", target.name(), r.detail);
+            }
+            r
+        }
+        Err(mpsc::RecvTimeoutError::Timeout) => CaseReport::with(
+            Class::Hang,
+            format!(
+                "{} (case {index}): still running after {:.0} s",
+                target.name(),
+                budget.as_secs_f64()
+            ),
+        ),
+        Err(mpsc::RecvTimeoutError::Disconnected) => {
+            CaseReport::with(Class::Panic, "the case thread ended without a result")
+        }
+    }
+}
+
+/// Run `count` cases of `target`; `progress` is called with the number of finished cases.
+pub fn run_target(
+    target: Target,
+    count: u64,
+    corpus: &Arc<Corpus>,
+    opts: &Options,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Tally {
+    let start = Instant::now();
+    let next = AtomicU64::new(0);
+    let done = AtomicU64::new(0);
+    let hangs = AtomicU64::new(0);
+    let stop = AtomicBool::new(false);
+    let results: Mutex<Vec<Option<CaseReport>>> = Mutex::new(vec![None; count as usize]);
+    let previous_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|info| {
+        let at = info
+            .location()
+            .map(|l| format!("{}:{}:{}", l.file(), l.line(), l.column()))
+            .unwrap_or_else(|| "an unknown place".into());
+        LAST_PANIC.with(|p| *p.borrow_mut() = Some(at));
+    }));
+    std::thread::scope(|s| {
+        for _ in 0..opts.threads.max(1) {
+            s.spawn(|| loop {
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= count {
+                    break;
+                }
+                let r = guarded(target, corpus, opts.seed, i, opts.budget);
+                if r.class == Class::Hang && hangs.fetch_add(1, Ordering::Relaxed) + 1 >= MAX_HANGS
+                {
+                    stop.store(true, Ordering::Relaxed);
+                }
+                results.lock().expect("results lock")[i as usize] = Some(r);
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if d % 1000 == 0 {
+                    progress(d);
+                }
+            });
+        }
+    });
+    std::panic::set_hook(previous_hook);
+    let mut tally = Tally::default();
+    for (i, r) in results
+        .into_inner()
+        .expect("results lock")
+        .into_iter()
+        .enumerate()
+    {
+        match r {
+            Some(r) => tally.add(i as u64, &r),
+            None => tally.stopped_early = true,
+        }
+    }
+    tally.seconds = start.elapsed().as_secs_f64();
+    tally
+}
+
+/// The report (results/robustness.md): headed by `command`, one row per target, the contact
+/// statuses and the first problems of each kind.
+pub fn report(command: &str, opts: &Options, tallies: &[(Target, Tally)]) -> String {
+    let mut s = String::new();
+    s.push_str("# Robustness: fuzzing the inputs\n\nRegenerate with:\n\n");
+    s.push_str(&format!("    {command}\n\n"));
+    s.push_str(&format!(
+        "Seed {}, time budget {:.0} s per case (a slower case counts as a hang). The counts and the \
+listed cases do not depend on the thread count; hangs and times depend on the machine. \
+Re-run one case with `pinfeed fuzz TARGET --seed {} --case N` (prints its input and how it ended).\n\n",
+        opts.seed,
+        opts.budget.as_secs_f64(),
+        opts.seed
+    ));
+    s.push_str("## What was generated\n\n");
+    for (t, _) in tallies {
+        s.push_str(&format!("* **{}**: {}\n", t.name(), t.describe()));
+    }
+    s.push_str("\n## Counts\n\n");
+    s.push_str("| target | generated | located errors | errors naming the cause | unlocated errors | successes | other statuses | panics | hangs | non-finite outputs | self-check disagreements | ok, then failed at 1000× tighter tol | seconds |\n");
+    s.push_str("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (t, y) in tallies {
+        s.push_str(&format!(
+            "| {} | {}{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} |\n",
+            t.name(),
+            y.generated,
+            if y.stopped_early {
+                " (stopped early)"
+            } else {
+                ""
+            },
+            y.count(Class::Located),
+            y.count(Class::Named),
+            y.count(Class::Unlocated),
+            y.count(Class::Success),
+            y.count(Class::Status),
+            y.count(Class::Panic),
+            y.count(Class::Hang),
+            y.count(Class::NonFinite),
+            y.count(Class::Disagreement),
+            y.count(Class::OkThenFailed),
+            y.seconds
+        ));
+    }
+    for (t, y) in tallies {
+        if y.statuses.is_empty() {
+            continue;
+        }
+        s.push_str(&format!(
+            "\n## {} statuses (default tolerance)\n\n| status | count |\n|---|---:|\n",
+            t.name()
+        ));
+        for (name, n) in &y.statuses {
+            s.push_str(&format!("| `{name}` | {n} |\n"));
+        }
+    }
+    let mut any = false;
+    for (t, y) in tallies {
+        for (class, list) in &y.problems {
+            if !any {
+                s.push_str("\n## Problems (the first few of each kind)\n\n");
+                any = true;
+            }
+            s.push_str(&format!(
+                "* {} — {:?} ({}):\n",
+                t.name(),
+                class,
+                y.count(*class)
+            ));
+            for (_, d) in list {
+                s.push_str(&format!("  * `{}`\n", d.replace('`', "'")));
+            }
+        }
+    }
+    if !any {
+        s.push_str("\nNo problems: no panic, hang, non-finite output, unlocated error or self-check disagreement.\n");
+    }
+    s
+}
+
+/// Does every number in `values` lie in f64's finite range?
+pub fn all_finite(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite())
+}
