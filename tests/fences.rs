@@ -288,6 +288,18 @@ fn fence_sweep_has_no_numerical_failures() {
                 let th = 360.0 * rng.random::<f64>();
                 let o = run_fence(&m, &p, th, &fence(&p, angle, d, len, mu), fid);
                 assert_finite(&o, name);
+                // The jam rule: a jam only where |α| + atan μf ≥ 90° (either sign of α), and a
+                // flush edge on such a fence always jams.
+                let steep = angle.abs() + mu.atan().to_degrees() >= 90.0;
+                let jammed = matches!(o.status, ContactStatus::Jam { .. });
+                assert!(
+                    !jammed || steep,
+                    "{name} {fid} α={angle} μf={mu}: jam below 90°"
+                );
+                let flush = o.segments.iter().any(|s| s.feature.kind() == "fence_edge");
+                if steep && flush {
+                    assert!(jammed, "{name} {fid} α={angle} μf={mu}: flush, no jam");
+                }
                 if !matches!(
                     o.status,
                     ContactStatus::Ok

@@ -558,11 +558,14 @@ const MARGIN_DIP: f64 = 1e-3;
 
 /// The geometric event functions (edge ends, normal cone, fence ends) depend on the state alone,
 /// so the dense output shows, without solving anything, an event that comes and goes inside one
-/// step — which the end-point signs miss. Returns the first of eight interior fractions of the step
-/// at which an event positive at both ends dips below −slack.
+/// step — which the end-point signs miss; likewise a disc pin's brief second touch on a concave
+/// part. Returns the first of eight interior fractions of the step at which an event positive at
+/// both ends dips below −slack, or the pin overlaps another edge.
+#[allow(clippy::too_many_arguments)]
 fn geometric_dip(
     ctx: &Ctx,
     feat: Feat,
+    s: f64,
     y0: [f64; 2],
     step: &StepResult,
     h: f64,
@@ -570,17 +573,22 @@ fn geometric_dip(
     slack: f64,
 ) -> Option<f64> {
     // Nothing to miss unless an event not yet crossed ends the step near zero (the guard keeps a
-    // step's change of the contact coordinate below 0.5).
-    if !(3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j])) {
+    // step's change of the contact coordinate below 0.5) or a disc could touch a second edge.
+    let near = (3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j]));
+    let second = !ctx.poly.is_convex() && ctx.rho > 0.0 && ctx.fence.is_none();
+    if !near && !second {
         return None;
     }
     (1..8).map(|k| k as f64 / 8.0).find(|&t| {
         let yt = dense(y0, step.y1, &step.k, h, t);
         let g = ctx.geom(feat, yt);
-        ctx.feature_events(feat, yt, &g)
-            .iter()
-            .zip(&ev1[3..])
-            .any(|(&e, &e1)| e1 >= 0.0 && e < -slack)
+        let dips = near
+            && ctx
+                .feature_events(feat, yt, &g)
+                .iter()
+                .zip(&ev1[3..])
+                .any(|(&e, &e1)| e1 >= 0.0 && e < -slack);
+        dips || (second && second_contact(ctx, feat, &ctx.pose(s + t * h, feat, yt), s + t * h))
     })
 }
 
@@ -1061,7 +1069,8 @@ fn integrate_contact(
             }
             let ev1 = ctx.events(feat, step.y1, &step.inst1);
             let mode_dip = step.margin_dip.filter(|_| ev1[1] >= 0.0 && ev1[2] >= 0.0);
-            if let Some(t_dip) = geometric_dip(ctx, feat, y, &step, h, &ev1, slack).or(mode_dip) {
+            if let Some(t_dip) = geometric_dip(ctx, feat, s, y, &step, h, &ev1, slack).or(mode_dip)
+            {
                 // The contact runs off its feature and back (e.g. past an edge's end), or its mode
                 // breaks and recovers, within the step: shorten the step so that it ends beyond
                 // the first crossing, where the event is located as usual. (Below 1e-10 a a dip

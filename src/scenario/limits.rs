@@ -21,8 +21,8 @@
 //! * angles: goal orientations within ±360°, tolerances and jitter up to 180°;
 //! * integration tolerance from 1e-10 to 1e-2 (relative, in units of a);
 //! * the orientation histogram's bin from 0.01° to 90° (at most 36 000 bins: bounded memory);
-//! * a fence's length from 10⁻⁶ a to 10⁴ a (the cost of a slide grows with its length in units
-//!   of a).
+//! * a fence's length from 10⁻⁶ a to 10⁶ a (a flush edge slides any length in a few steps, but a
+//!   vertex held on the fence line still steps at most 2a at a time).
 
 /// Belt speed, m/s.
 pub const BELT_SPEED: (f64, f64) = (1e-4, 10.0);
@@ -52,10 +52,11 @@ pub const ORIENTATION_DEG: (f64, f64) = (-360.0, 360.0);
 pub const TOL: (f64, f64) = (1e-10, 1e-2);
 /// Orientation histogram bin width, degrees.
 pub const HISTOGRAM_BIN_DEG: (f64, f64) = (0.01, 90.0);
-/// Fence length, in units of the part's a: shorter is a point; longer is a slide the contact
-/// model integrates in steps of at most 2a, so its cost grows with length/a (a 1 nm part along a
-/// 10 cm fence would take 10⁸ steps). 10⁴ a is a 1 mm part along a 10 m fence.
-pub const FENCE_LENGTH_OF_A: (f64, f64) = (1e-6, 1e4);
+/// Fence length, in units of the part's a: shorter is a point. A flush edge translates along
+/// the fence in a handful of steps whatever its length, but a vertex held on the fence line is
+/// integrated in steps of at most 2a: 10⁶ a (a 0.1 mm part along a 100 m fence) bounds that
+/// worst case to 5·10⁵ steps.
+pub const FENCE_LENGTH_OF_A: (f64, f64) = (1e-6, 1e6);
 
 /// A number as a message shows it: plain between 10⁻⁴ and 10¹⁵, else in exponent notation (so
 /// 1e-300 is not printed with 300 zeros).

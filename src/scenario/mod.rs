@@ -174,20 +174,19 @@ any = true
     }
 
     #[test]
-    fn a_fence_longer_than_ten_thousand_part_sizes_is_refused() {
-        // A 20 µm part (a = 27.5 µm) against a 0.1 m fence: a slide of 3600 a is fine, one of
-        // 10⁴ a or more is refused by name (its cost grows with length / a).
-        let tiny = GOOD.replace("scale = 0.02", "scale = 0.00002");
-        let fence = |len: &str| {
-            tiny.replace(
+    fn a_fence_longer_than_a_million_part_sizes_is_refused() {
+        // A 20 nm part (a = 27.5 nm) against a 0.1 m fence: a slide of 3.6·10⁶ a is refused by
+        // name; a 1 µm part (a = 1.4 µm, 7·10⁴ a) is fine.
+        let fence = |scale: &str| {
+            GOOD.replace("scale = 0.02", &format!("scale = {scale}")).replace(
                 "[goal]",
-                &format!("[[obstacles]]\nkind = \"fence\"\nx = 0.4\ny = -0.09\nangle = 30\nlength = {len}\n\n[goal]"),
+                "[[obstacles]]\nkind = \"fence\"\nx = 0.4\ny = -0.09\nangle = 30\nlength = 0.1\n\n[goal]",
             )
         };
-        assert!(parse(Path::new("f.toml"), &fence("0.1")).is_ok());
-        let e = err(&fence("0.3"));
+        assert!(parse(Path::new("f.toml"), &fence("0.000001")).is_ok());
+        let e = err(&fence("0.00000002"));
         assert_eq!(e.key, "obstacles[1].length");
-        assert!(e.message.contains("10⁻⁶ a to 10⁴ a"), "{}", e.message);
+        assert!(e.message.contains("10⁻⁶ a to 10⁶ a"), "{}", e.message);
     }
 
     #[test]

@@ -225,7 +225,7 @@ fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
         return Err(c.err(
             &at.path("length"),
             format!(
-                "must lie in [{}, {}] m (10⁻⁶ a to 10⁴ a, a = {} m: a shorter fence is a point, a longer one a slide of more than 10⁴ part sizes), got {}",
+                "must lie in [{}, {}] m (10⁻⁶ a to 10⁶ a, a = {} m: a shorter fence is a point, a longer one a slide of more than 10⁶ part sizes), got {}",
                 super::limits::num(min_length),
                 super::limits::num(max_length),
                 super::limits::num(at.part_radius),
