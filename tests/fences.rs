@@ -144,9 +144,11 @@ fn exact_aligns_no_later_than_the_cor_tip_bound() {
     assert!(compared > 20, "only {compared} comparable pushes");
 }
 
-/// μs scales forces only: fence contacts are bit-identical for any μs.
+/// μs scales forces only: fence contacts are bit-identical for any μs, and the recorded fence
+/// forces (units of m g) scale by exactly the ratio of the μs (40 here).
 #[test]
 fn fence_mu_s_invariance() {
+    use pinfeed::mechanics::TraceSample;
     let p = poly("tripoly1");
     let m = model(&p);
     let f = fence(&p, 40.0, 0.2, 15.0, 0.4);
@@ -156,10 +158,20 @@ fn fence_mu_s_invariance() {
             mu_s: 0.05,
             ..ContactSettings::default()
         };
-        let a = push_fence(&m, Pose::new(0.0, 0.0, 1.0), &f, &s, None);
+        let (mut ta, mut tb): (Vec<TraceSample>, Vec<TraceSample>) = (Vec::new(), Vec::new());
+        let a = push_fence(&m, Pose::new(0.0, 0.0, 1.0), &f, &s, Some(&mut ta));
         s.mu_s = 2.0;
-        let b = push_fence(&m, Pose::new(0.0, 0.0, 1.0), &f, &s, None);
+        let b = push_fence(&m, Pose::new(0.0, 0.0, 1.0), &f, &s, Some(&mut tb));
         assert_eq!(a, b, "{fid}");
+        assert_eq!(ta.len(), tb.len());
+        for (x, y) in ta.iter().zip(&tb) {
+            assert_eq!(x.pose, y.pose);
+            assert!(x.force.norm() > 0.0);
+            assert!(
+                (y.force.norm() / x.force.norm() - 40.0).abs() < 1e-11,
+                "{fid}"
+            );
+        }
     }
 }
 

@@ -908,11 +908,12 @@ const NOISE_RATE: f64 = 10.0;
 const METASTABLE_TRAVEL: f64 = 1.0;
 
 impl Tally {
-    /// Count `travel` of pushing at rate `omega` on `feat` towards the metastable ride (point
-    /// contacts only: a pin, a fence's end, a vertex on a fence; a flush fence edge translates
-    /// stably).
+    /// Count `travel` of pushing at rate `omega` on `feat` towards the metastable ride (a pin, or
+    /// a fence's end acting as one; a part dragged along a fence by a sticking vertex or a flush
+    /// edge is held stably, not balanced).
     fn ride(&mut self, ctx: &Ctx, feat: Feat, omega: f64, travel: f64) {
-        if !matches!(feat, Feat::FenceEdge(_)) && omega.abs() < NOISE_RATE * ctx.tol {
+        let pin_like = matches!(feat, Feat::Edge(_) | Feat::Vertex(_));
+        if pin_like && omega.abs() < NOISE_RATE * ctx.tol {
             self.still += travel;
         }
     }
