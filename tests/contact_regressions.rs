@@ -285,3 +285,55 @@ fn a_ride_on_an_unstable_equilibrium_is_metastable() {
         );
     }
 }
+
+/// Found by `pinfeed fuzz scenarios` (case 36330): a 1.4 nm part (scale 1e-9) among 2 mm pins —
+/// discs 10⁶ a wide, 10⁸ a away — hung the line: a grazing touch was stepped past by 1e-9 a,
+/// below the travel's rounding at 1e8 a, and grazing touches were handed between obstacles for
+/// ever at one instant. Steps past a graze are now relative and bounded, and a part that only
+/// grazes 16 times in a row leaves as a `solver` outcome (`grazing_loop`).
+#[test]
+fn giant_pins_against_a_tiny_part_do_not_hang_the_line() {
+    let text = quickstart_with(&[
+        ("scale = 0.02 ", "scale = 1e-9 "),
+        ("y = 0.004 ", "y = 1e-9 "),
+    ]);
+    let scene = scenario::parse(Path::new("q.toml"), &text).unwrap();
+    let opts = RunOptions {
+        parts: 3,
+        ..RunOptions::from_scene(&scene)
+    };
+    let s = engine::run(&scene, &opts, &mut |_| {}).unwrap().summary;
+    assert_eq!(s.outcomes.total(), 3);
+    assert_eq!(
+        s.outcomes.solver,
+        s.causes.solver.get("grazing_loop").copied().unwrap_or(0)
+    );
+}
+
+/// Found by `pinfeed fuzz contacts` (12 of 10⁶ `ok` contacts more than 1° apart between the
+/// default tolerance and 1e-9, and 206 `ok` then `multi_contact`): a sticking pin lets go of an
+/// edge by the edge turning parallel to its path, then runs on along the edge's line into a reflex
+/// corner. Casting the path again decided by rounding whether it struck the next edge (−36.6°),
+/// the corner (`multi_contact`) or nothing (−23.1°). The corner is now reported at every
+/// tolerance, as when the pin slides into it in contact.
+#[test]
+fn tangential_release_into_a_reflex_corner_is_a_multi_contact() {
+    let p = part("0.900114,0.061997 0.625824,0.193981 0.145756,0.933133 -0.797799,0.306426 -0.682673,-0.384111 -0.426394,-0.309059 -0.446985,-0.861307");
+    for tol in [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
+        let o = contact(
+            &p,
+            &Support::Uniform,
+            260.083445,
+            -0.385968,
+            1.622616,
+            0.0,
+            tol,
+        );
+        assert!(
+            matches!(o.status, ContactStatus::MultiContact { .. }),
+            "tol {tol}: {:?}",
+            o.status
+        );
+        assert!((o.rotation.to_degrees() + 23.087).abs() < 0.01, "tol {tol}");
+    }
+}

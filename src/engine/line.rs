@@ -128,6 +128,10 @@ pub struct RunResult {
     pub paths: Vec<SamplePath>,
 }
 
+/// Grazing touches in a row after which a part is taken off as a `solver` outcome (cause
+/// `grazing_loop`) rather than handed between obstacles for ever.
+const MAX_GRAZES: u32 = 16;
+
 struct ActivePart {
     arrival: f64,
     theta_in: f64,
@@ -136,6 +140,9 @@ struct ActivePart {
     /// The obstacle whose push ended last (its pin has passed; it cannot touch the part again).
     last_obstacle: Option<usize>,
     contacts: u32,
+    /// Touches in a row that pushed nothing (grazes): bounded, so that two obstacles that each
+    /// only graze the part cannot hand it back and forth for ever at one instant.
+    grazes: u32,
     /// Own contact model (random tripod), else the scene's.
     model: Option<PartModel>,
     path: Option<Vec<(f64, Pose)>>,
@@ -274,6 +281,7 @@ impl Line<'_> {
             },
             last_obstacle: None,
             contacts: 0,
+            grazes: 0,
             model: d.model,
             path: ((index as usize) < self.opts.sample_paths).then(|| vec![(t, pose)]),
         };
@@ -312,7 +320,9 @@ impl Line<'_> {
                     let start = pin.centre / k;
                     let rho = pin.radius / k;
                     let mut min_travel = 0.0;
-                    loop {
+                    let mut found = None;
+                    // Past a grazing touch (relative step: travels can be 1e8 a), at most 8 times.
+                    for _ in 0..8 {
                         match first_contact(
                             poly,
                             &pose_n,
@@ -321,11 +331,17 @@ impl Line<'_> {
                             rho,
                             min_travel,
                         ) {
-                            None => break None,
-                            Some(h) if h.grazing => min_travel = h.travel + 1e-9,
-                            Some(h) => break Some(h.travel * k),
+                            None => break,
+                            Some(h) if h.grazing => {
+                                min_travel = h.travel + 1e-9 * (1.0 + h.travel.abs())
+                            }
+                            Some(h) => {
+                                found = Some(h.travel * k);
+                                break;
+                            }
                         }
                     }
+                    found
                 }
                 Obstacle::Fence(fence) => fence_first_touch(model, pose, &fence.spec()),
             };
@@ -398,12 +414,19 @@ impl Line<'_> {
         }
         if !out.contact {
             // The model found only a grazing touch: the pin passes without pushing.
+            part.grazes += 1;
+            if part.grazes > MAX_GRAZES {
+                self.active.insert(index, part);
+                self.finish(index, t, PartOutcome::Solver, "grazing_loop");
+                return;
+            }
             part.last_obstacle = Some(j);
             self.plan_next(index, &mut part, t);
             self.active.insert(index, part);
             self.check_pairs(index, t);
             return;
         }
+        part.grazes = 0;
         let s_touch = out.travel_to_contact;
         let s_end = out
             .segments

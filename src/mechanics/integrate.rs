@@ -948,6 +948,16 @@ impl Tally {
     }
 }
 
+/// After a pin separates from edge k (its path tangent to the edge at orientation `theta`), is the
+/// vertex it runs towards along the edge reflex?
+fn reflex_ahead(ctx: &Ctx, k: usize, theta: f64) -> bool {
+    let (a, b) = ctx.poly.edge(k);
+    let towards_b = (b - a).dot(ctx.vdir.rotate(-theta)) > 0.0;
+    let m = ctx.poly.len();
+    let v = if towards_b { (k + 1) % m } else { k };
+    !ctx.poly.vertex_is_convex(v)
+}
+
 /// The end of a contact that separated at (s, feat, y), after the self-check.
 fn separated(ctx: &Ctx, s: f64, feat: Feat, y: [f64; 2], segs: &Tally) -> (End, f64, Pose) {
     let p = ctx.pose(s, feat, y);
@@ -1289,6 +1299,18 @@ fn integrate_contact(
         // Apply the event.
         let m = ctx.poly.len();
         let next: Option<(Feat, [f64; 2], Option<Mode>)> = match (i, feat) {
+            (0, Feat::Edge(k)) if ctx.fence.is_none() && reflex_ahead(ctx, k, y[0]) => {
+                // The edge let go by turning parallel to the pin's path, so the pin runs on along
+                // the edge's line into the reflex corner ahead, where the next edge blocks it: the
+                // pin touches two edges at once (as when it slides into the corner in contact).
+                // Casting the path again would decide that by rounding.
+                let p = ctx.pose(s, feat, y);
+                return (
+                    End::Stop(ContactStatus::MultiContact { s: s * ctx.scale }),
+                    s,
+                    p,
+                );
+            }
             (0, _) => None,
             (1 | 2, Feat::FenceEdge(k)) => {
                 let (f, yy) = flush_pivot(ctx, k, y, i == 2);
@@ -1479,8 +1501,9 @@ fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touc
             return Touch::None;
         };
         if hit.grazing {
-            // A touch that pushes nothing: continue along the path past it.
-            min_travel = hit.travel + 1e-9;
+            // A touch that pushes nothing: continue along the path past it (a relative step:
+            // the travel can be 1e8 a).
+            min_travel = hit.travel + 1e-9 * (1.0 + hit.travel.abs());
             continue;
         }
         let s_touch = s + hit.travel / dir_len;
@@ -1496,7 +1519,7 @@ fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touc
         // edge, which would teleport the part. Such a touch pushes nothing: look past it.
         let at = ctx.pose(s_touch, feat, y);
         if (at.x - cur.x).abs() > 1e-9 || (at.y - cur.y).abs() > 1e-9 {
-            min_travel = hit.travel + 1e-9;
+            min_travel = hit.travel + 1e-9 * (1.0 + hit.travel.abs());
             continue;
         }
         return Touch::At(s_touch, feat, y);
