@@ -144,25 +144,22 @@ fn issue11_fence_cost_does_not_grow_as_the_part_shrinks() {
 /// The triple point (a sliding contact that turns tangent to the pin's path just as it would
 /// stick): tripoly1 on a random tripod turned −29.7° at the default tolerance and −5.0° at 1e-8,
 /// both `ok` (and a square on a tripod ended `step_too_small`). The part now separates where the
-/// push margin vanishes, converging with the tolerance.
+/// push margin vanishes, converging with the tolerance; tripoly1 ends with its hypotenuse along
+/// the pin's path (θ = 0, a rotation of exactly −5° from θ0 = 5°: geometry, not a recorded output).
 #[test]
 fn triple_point_of_sliding_sticking_and_separation() {
-    for (name, seed, th, d, exact_deg) in [
-        ("tripoly1", 0, 5.0, -0.3, -5.0),
-        (
-            "square",
-            1,
-            310.82580073694925,
-            0.25691447551149293,
-            49.1742,
-        ),
+    for (name, seed, th, d, geometric_deg) in [
+        ("tripoly1", 0, 5.0, -0.3, Some(-5.0)),
+        ("square", 1, 310.82580073694925, 0.25691447551149293, None),
     ] {
         let p = poly(name);
         let sup = Support::parse(&format!("tripod:{seed}"), &p).unwrap();
         let a = contact(&p, &sup, th, d, 0.5, 0.0, 1e-6);
         let b = contact(&p, &sup, th, d, 0.5, 0.0, 1e-9);
         agrees(&a, &b, 0.01);
-        assert!((b.rotation.to_degrees() - exact_deg).abs() < 1e-3, "{name}");
+        if let Some(g) = geometric_deg {
+            assert!((b.rotation.to_degrees() - g).abs() < 1e-3, "{name}");
+        }
     }
 }
 
@@ -319,8 +316,8 @@ fn giant_pins_against_a_tiny_part_do_not_hang_the_line() {
 #[test]
 fn tangential_release_into_a_reflex_corner_is_a_multi_contact() {
     let p = part("0.900114,0.061997 0.625824,0.193981 0.145756,0.933133 -0.797799,0.306426 -0.682673,-0.384111 -0.426394,-0.309059 -0.446985,-0.861307");
-    for tol in [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
-        let o = contact(
+    let at = |tol: f64| {
+        contact(
             &p,
             &Support::Uniform,
             260.083445,
@@ -328,12 +325,20 @@ fn tangential_release_into_a_reflex_corner_is_a_multi_contact() {
             1.622616,
             0.0,
             tol,
-        );
+        )
+    };
+    let fine = at(1e-10);
+    for tol in [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
+        let o = at(tol);
         assert!(
             matches!(o.status, ContactStatus::MultiContact { .. }),
             "tol {tol}: {:?}",
             o.status
         );
-        assert!((o.rotation.to_degrees() + 23.087).abs() < 0.01, "tol {tol}");
+        assert_eq!(o.contacts, 1, "tol {tol}");
+        assert!(
+            (o.rotation - fine.rotation).abs().to_degrees() < 0.01,
+            "tol {tol}"
+        );
     }
 }
