@@ -95,8 +95,28 @@ fn trace_and_plot_files() {
     );
     let csv = std::fs::read_to_string(&trace).unwrap();
     let mut lines = csv.lines();
-    assert!(lines.next().unwrap().starts_with("s,x,y,theta_deg"));
-    assert!(lines.count() >= 3, "a contact has several recorded steps");
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("s,x,y,theta_deg"));
+    assert!(
+        header.ends_with("normal_x,normal_y,rotation_rate"),
+        "{header}"
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            let cols: Vec<&str> = l.split(',').collect();
+            assert_eq!(cols.len(), 16, "{l}");
+            [8, 9, 13, 14, 15]
+                .iter()
+                .map(|&i| cols[i].parse().unwrap())
+                .collect()
+        })
+        .collect();
+    assert!(rows.len() >= 3, "a contact has several recorded steps");
+    for r in &rows {
+        // The normal is a unit vector, and the force presses along it: f·n > 0.
+        assert!((r[2].hypot(r[3]) - 1.0).abs() < 1e-12, "{r:?}");
+        assert!(r[0] * r[2] + r[1] * r[3] > 0.0, "{r:?}");
+    }
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(svg.contains("<svg") && svg.len() > 1000);
 }

@@ -81,6 +81,33 @@ fn fence_push(m: &PartModel, theta_deg: f64, f: &FenceSpec, fid: Fidelity) -> Co
     push_fence(m, Pose::new(0.0, 0.0, theta_deg.to_radians()), f, &s, None)
 }
 
+/// A whole push with its trace, by the CLI's convention (pin just clear at y = d·a), when the
+/// polygon is valid and the push ends `ok`: (a, trace).
+fn recorded_push(
+    vertices: &[(f64, f64)],
+    theta: f64,
+    d: f64,
+    mu: f64,
+    rho: f64,
+    fid: Fidelity,
+) -> Option<(f64, Vec<TraceSample>)> {
+    let p = polygon(vertices)?;
+    let a = p.radius();
+    let pin = disc(&p, rho);
+    let mut trace: Vec<TraceSample> = Vec::new();
+    let start = Vec2::new(a * 1.01 + pin.radius, d * a);
+    let pose = Pose::new(0.0, 0.0, theta.to_radians());
+    let o = push(
+        &model(&p),
+        pose,
+        start,
+        &pin,
+        &settings(fid, mu),
+        Some(&mut trace),
+    );
+    o.status.is_ok().then_some((a, trace))
+}
+
 proptest! {
     // A fixed seed: CI runs the same cases every time (failures found are kept in the regression
     // file beside this one as well).
@@ -200,17 +227,9 @@ proptest! {
         rho in radius(),
         fid in fidelity(),
     ) {
-        let Some(p) = polygon(&vertices) else { return Ok(()); };
-        let m = model(&p);
-        let a = p.radius();
-        let pin = disc(&p, rho);
-        let mut trace: Vec<TraceSample> = Vec::new();
-        let start = Vec2::new(a * 1.01 + pin.radius, d * a);
-        let o = push(&m, Pose::new(0.0, 0.0, theta.to_radians()), start, &pin, &settings(fid, mu),
-            Some(&mut trace));
-        if !o.status.is_ok() {
+        let Some((a, trace)) = recorded_push(&vertices, theta, d, mu, rho, fid) else {
             return Ok(());
-        }
+        };
         let v_push = Vec2::new(-1.0, 0.0);
         for t in &trace {
             let to_centroid = Vec2::new(t.pose.x, t.pose.y) - t.contact_point;
@@ -227,6 +246,37 @@ proptest! {
             }
             prop_assert_eq!(t.rotation_rate.signum() as i32, vote,
                 "s={} mode={:?} feature={:?}", t.s, t.mode, t.feature);
+        }
+    }
+
+    /// The recorded contact force obeys Coulomb's law at every sample of a whole push: it presses
+    /// (λn > 0), lies inside the friction cone |λt| ≤ μc λn, on its edge while sliding (and along
+    /// the normal when μc = 0). Fails on a wrong friction side or a force not re-solved after a
+    /// mode switch.
+    #[test]
+    fn recorded_forces_obey_coulomb(
+        vertices in shapes::star_polygon(3..10),
+        theta in 0.0f64..360.0,
+        d in -0.95f64..0.95,
+        mu in prop_oneof![Just(0.0), 0.0f64..1.5],
+        rho in radius(),
+        fid in fidelity(),
+    ) {
+        use pinfeed::mechanics::Mode;
+        let Some((_, trace)) = recorded_push(&vertices, theta, d, mu, rho, fid) else {
+            return Ok(());
+        };
+        for t in &trace {
+            let ln = t.force.dot(t.normal);
+            let lt = t.force.dot(t.normal.perp());
+            prop_assert!(ln > 0.0, "λn {ln} at s={}", t.s);
+            // Inside up to the stick margin's tolerance band (1e-4 of |f| after a stick/slide
+            // ping-pong; events are landed to 1e-8).
+            let band = 1e-4 * t.force.norm();
+            prop_assert!(lt.abs() <= mu * ln + band, "|λt| {lt} > μc λn {}", mu * ln);
+            if matches!(t.mode, Mode::SlideLeft | Mode::SlideRight | Mode::Slide) {
+                prop_assert!((lt.abs() - mu * ln).abs() <= 1e-9 * ln, "sliding off the cone edge");
+            }
         }
     }
 

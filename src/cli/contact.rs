@@ -489,13 +489,13 @@ fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(
         f,
-        "s,x,y,theta_deg,pin_x,pin_y,contact_x,contact_y,force_x,force_y,mode,feature,index"
+        "s,x,y,theta_deg,pin_x,pin_y,contact_x,contact_y,force_x,force_y,mode,feature,index,normal_x,normal_y,rotation_rate"
     )?;
     for t in trace {
         let (kind, idx) = (t.feature.kind(), t.feature.index());
         writeln!(
             f,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             t.s,
             t.pose.x,
             t.pose.y,
@@ -508,7 +508,10 @@ fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
             t.force.y,
             t.mode.name(),
             kind,
-            idx
+            idx,
+            t.normal.x,
+            t.normal.y,
+            t.rotation_rate
         )?;
     }
     Ok(())
