@@ -195,35 +195,21 @@ fn no_re_touch_along_an_edge_just_left() {
 #[test]
 fn edge_end_crossed_and_recrossed_within_one_step() {
     let p = part("0.360947,1.373581 -0.124181,1.019174 -0.379230,0.683607 -0.656518,-0.041566 -0.657246,-0.528447 -0.558923,-0.796685 -0.248343,-1.055143 0.645699,-0.770184");
-    let a = contact(
-        &p,
-        &Support::Uniform,
-        233.501682,
-        -0.593081,
-        0.032945,
-        0.0,
-        1e-6,
-    );
-    let b = contact(
-        &p,
-        &Support::Uniform,
-        233.501682,
-        -0.593081,
-        0.032945,
-        0.0,
-        1e-9,
-    );
-    agrees(&a, &b, 0.01);
-    let coarse = contact(
-        &p,
-        &Support::Uniform,
-        233.501682,
-        -0.593081,
-        0.032945,
-        0.0,
-        1e-5,
-    );
-    agrees(&coarse, &b, 0.01);
+    let at = |tol: f64| {
+        contact(
+            &p,
+            &Support::Uniform,
+            233.501682,
+            -0.593081,
+            0.032945,
+            0.0,
+            tol,
+        )
+    };
+    let fine = at(1e-9);
+    for tol in [1e-5, 1e-6] {
+        agrees(&at(tol), &fine, 0.01);
+    }
 }
 
 /// Found by the property tests: a disc pin sticking on a vertex slipped briefly (0.09 a of
@@ -233,26 +219,11 @@ fn edge_end_crossed_and_recrossed_within_one_step() {
 fn mode_switch_and_back_within_one_step() {
     let p = part("0.2521992509332431,0.6679098076444939 -0.6018217346783077,-0.06634127395201873 0.13579102556630226,-0.17429874141858762");
     let r = 0.19330293878496985 * p.radius();
-    let fine = contact(
-        &p,
-        &Support::Uniform,
-        189.27606353247435,
-        0.5392986588748061,
-        0.5657847435213283,
-        r,
-        1e-9,
-    );
+    let (th, d, mu) = (189.27606353247435, 0.5392986588748061, 0.5657847435213283);
+    let at = |tol: f64| contact(&p, &Support::Uniform, th, d, mu, r, tol);
+    let fine = at(1e-9);
     for tol in [1e-5, 1e-6] {
-        let o = contact(
-            &p,
-            &Support::Uniform,
-            189.27606353247435,
-            0.5392986588748061,
-            0.5657847435213283,
-            r,
-            tol,
-        );
-        agrees(&o, &fine, 0.01);
+        agrees(&at(tol), &fine, 0.01);
     }
 }
 
