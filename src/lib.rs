@@ -21,4 +21,5 @@ pub mod mechanics;
 pub mod random;
 pub mod report;
 pub mod scenario;
+pub mod sensing;
 pub mod study;

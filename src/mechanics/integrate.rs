@@ -1452,6 +1452,8 @@ fn integrate_contact(
             }
         }
         segs.open(feat, mode, s, y[0]);
+        // The state just after the event (the force may jump here): a recorder sees both sides.
+        ctx.record(s, feat, y, &inst);
         f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
         ev0 = ctx.events(feat, y, &inst);
         // Freshly started segments begin at their boundary: do not re-trigger on rounding.

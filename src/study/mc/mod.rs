@@ -24,7 +24,7 @@
 
 pub mod atomic;
 pub mod compile;
-pub mod distribution;
+pub use crate::random::distribution;
 pub mod error;
 pub mod hash;
 pub mod perturbations;

@@ -2,6 +2,8 @@
 //! (seed, stream index), so results never depend on thread count, sharding or evaluation order.
 //! (`StdRng` is not used: its algorithm may change between rand releases.)
 
+pub mod distribution;
+
 pub use rand::rngs::ChaCha8Rng;
 use rand::SeedableRng;
 

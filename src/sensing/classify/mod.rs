@@ -1,0 +1,82 @@
+//! Classifiers: a reading and the hypotheses' simulated templates → a decision (and a posterior
+//! where the method has one), with "unknown" allowed.
+//!
+//! One interface for every method: [`build`] trains a classifier by name on a [`TemplateSet`] and
+//! the sensor's settings (templates aligned, fits and noise model precomputed once), and
+//! [`Classifier::classify`] decides one [`Reading`]. Methods:
+//! * `sign-matrix` — the thesis's empirical method (ch. 5, app. D), the baseline;
+//! * `timing` — contact duration(s) against the templates' durations, jitter and model spread
+//!   giving a posterior;
+//! * `likelihood` — a matched filter over the template ensembles with the sensor's noise model,
+//!   posterior over hypotheses, reject option below a posterior threshold;
+//! * `zero-crossings` — vertex vs edge by the thesis's rule (≥ 3 zero crossings of the derivative
+//!   of a degree-6 fit), for the `vertex`/`edge` hypotheses.
+
+use super::reading::Reading;
+use super::settings::SensorSettings;
+use super::templates::TemplateSet;
+use serde::Serialize;
+
+/// A classifier's decision.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Decision {
+    /// The index of the chosen hypothesis.
+    Hypothesis(usize),
+    /// No decision (posterior below the reject threshold, no contact detected, scores tied).
+    Unknown,
+}
+
+/// A decision and, where the method has one, the posterior over the hypotheses (sums to 1).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Classification {
+    pub decision: Decision,
+    pub posterior: Option<Vec<f64>>,
+}
+
+impl Classification {
+    pub fn unknown() -> Classification {
+        Classification {
+            decision: Decision::Unknown,
+            posterior: None,
+        }
+    }
+}
+
+/// Options shared by the classifiers.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ClassifierOptions {
+    /// Reject option: decide "unknown" when the largest posterior is below this (0: never reject).
+    pub reject_below: f64,
+}
+
+impl Default for ClassifierOptions {
+    fn default() -> Self {
+        ClassifierOptions { reject_below: 0.0 }
+    }
+}
+
+/// A trained classifier.
+pub trait Classifier: Send + Sync {
+    /// The method's name (as [`build`] takes it).
+    fn name(&self) -> &'static str;
+    /// Decide one reading.
+    fn classify(&self, reading: &Reading) -> Classification;
+}
+
+/// The names [`build`] accepts.
+pub const NAMES: [&str; 4] = ["sign-matrix", "timing", "likelihood", "zero-crossings"];
+
+/// Trains the classifier `name` (one of [`NAMES`]) on `templates` for readings of `sensor`.
+pub fn build(
+    name: &str,
+    templates: &TemplateSet,
+    sensor: &SensorSettings,
+    options: &ClassifierOptions,
+) -> Result<Box<dyn Classifier>, String> {
+    let _ = (templates, sensor, options);
+    Err(format!(
+        "unknown classifier '{name}'; known: {}",
+        NAMES.join(", ")
+    ))
+}

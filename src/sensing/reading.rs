@@ -1,0 +1,196 @@
+//! What a sensor reports for one pass: the sampled, noisy F/T signal or the contact instants
+//! (the reading model is documented in [`super::settings`]).
+//!
+//! Randomness: every reading draws from the RNG it is given (the caller derives it from its own
+//! seeded stream: per part and sensor in the line, per trial in `pinfeed sense`), in a fixed order —
+//! the sampling phase, then per sample the channels in order, then the timing jitter — so a reading
+//! is a pure function of (signal, settings, stream).
+
+use super::settings::{SensorKind, SensorSettings, CHANNELS};
+use super::signal::ContactSignal;
+use rand::RngExt;
+use rand_distr::{Distribution, StandardNormal};
+use serde::Serialize;
+
+/// A sampled F/T signal: sample k is at time `t0 + k·dt` (s since the pass began).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Sampled {
+    pub t0: f64,
+    pub dt: f64,
+    /// Channels Fx, Fy, Fz (N), Tx, Ty, Tz (N·mm) per sample.
+    pub values: Vec<[f64; CHANNELS]>,
+}
+
+impl Sampled {
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+    /// Time of sample k.
+    pub fn time(&self, k: usize) -> f64 {
+        self.t0 + k as f64 * self.dt
+    }
+    /// One channel as a vector.
+    pub fn channel(&self, c: usize) -> Vec<f64> {
+        self.values.iter().map(|v| v[c]).collect()
+    }
+}
+
+/// Contact instants reported by a timing sensor: each detected contact as (begin, end) in seconds
+/// since the pass began, jitter included. Empty when |F| never crossed the threshold.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct ContactTimes {
+    pub intervals: Vec<(f64, f64)>,
+}
+
+impl ContactTimes {
+    /// Total detected contact time (s).
+    pub fn duration(&self) -> f64 {
+        self.intervals.iter().map(|(b, e)| e - b).sum()
+    }
+    /// The detected durations, in order.
+    pub fn durations(&self) -> Vec<f64> {
+        self.intervals.iter().map(|(b, e)| e - b).collect()
+    }
+}
+
+/// One sensor's reading of one pass.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Reading {
+    Ft(Sampled),
+    Timing(ContactTimes),
+}
+
+/// Time (s) sampled before the first contact and after the last one: a fifth of the contact time,
+/// at least 20 ms and 10 sample periods (a detector needs quiet on both sides of the contact).
+pub fn padding(signal: &ContactSignal, rate: f64) -> f64 {
+    (0.2 * signal.duration()).max(0.02).max(10.0 / rate)
+}
+
+/// The largest number of samples one reading may hold (memory bound: 10⁶ samples of 6 channels).
+pub const MAX_SAMPLES: usize = 1_000_000;
+
+/// Samples `signal` with `sensor` (noise, bias, drift, low-pass, quantisation) over the contact and
+/// its padding; `None` when the pin never touched or the window would exceed [`MAX_SAMPLES`].
+pub fn sample_ft(
+    signal: &ContactSignal,
+    sensor: &SensorSettings,
+    rng: &mut impl rand::Rng,
+) -> Option<Sampled> {
+    let (b, e) = signal.span()?;
+    let pad = padding(signal, sensor.rate);
+    let dt = 1.0 / sensor.rate;
+    let phase: f64 = rng.random::<f64>() * dt;
+    let start = b - pad;
+    let n = (((e + pad) - start) / dt).ceil() as usize + 1;
+    if n > MAX_SAMPLES {
+        return None;
+    }
+    let t0 = start + phase;
+    let alpha = sensor
+        .lowpass
+        .map(|fc| 1.0 - (-2.0 * std::f64::consts::PI * fc * dt).exp());
+    let mut state = [0.0; CHANNELS];
+    let mut values = Vec::with_capacity(n);
+    for k in 0..n {
+        let t = t0 + k as f64 * dt;
+        let clean = signal.at(t);
+        let mut out = [0.0; CHANNELS];
+        for c in 0..CHANNELS {
+            let noise = if sensor.noise(c) > 0.0 {
+                let z: f64 = StandardNormal.sample(rng);
+                sensor.noise(c) * z
+            } else {
+                0.0
+            };
+            let x = clean[c] + sensor.bias(c) + sensor.drift(c) * (t - t0) + noise;
+            let y = match alpha {
+                Some(a) if k > 0 => state[c] + a * (x - state[c]),
+                _ => x,
+            };
+            state[c] = y;
+            let q = sensor.resolution(c);
+            out[c] = if q > 0.0 { q * (y / q).round() } else { y };
+        }
+        values.push(out);
+    }
+    Some(Sampled { t0, dt, values })
+}
+
+/// The contact instants of a timing sensor: where the clean |F| crosses the threshold (located to
+/// 1e-9 s by bisection between the signal's knots), each with Gaussian jitter.
+pub fn sample_timing(
+    signal: &ContactSignal,
+    sensor: &SensorSettings,
+    rng: &mut impl rand::Rng,
+) -> ContactTimes {
+    let mut intervals = Vec::new();
+    for &(b, e) in &signal.contacts {
+        // Crossings of |F| = threshold inside [b, e], scanned on a grid fine enough for the
+        // contact (256 cells) and refined by bisection.
+        let above = |t: f64| signal.force_magnitude(t) >= sensor.threshold;
+        let n = 256;
+        let h = (e - b) / n as f64;
+        let mut begin: Option<f64> = None;
+        let mut prev = above(b);
+        if prev {
+            begin = Some(b);
+        }
+        for k in 1..=n {
+            let t = if k == n { e } else { b + k as f64 * h };
+            let now = above(t);
+            if now != prev {
+                let tc = bisect(&above, t - h, t, prev);
+                if now {
+                    begin = Some(tc);
+                } else if let Some(tb) = begin.take() {
+                    intervals.push((tb, tc));
+                }
+            }
+            prev = now;
+        }
+        if let Some(tb) = begin {
+            intervals.push((tb, e));
+        }
+    }
+    let mut jittered = Vec::with_capacity(intervals.len());
+    for (tb, te) in intervals {
+        let (zb, ze): (f64, f64) = (StandardNormal.sample(rng), StandardNormal.sample(rng));
+        let (jb, je) = (tb + sensor.jitter * zb, te + sensor.jitter * ze);
+        jittered.push((jb, je.max(jb)));
+    }
+    ContactTimes {
+        intervals: jittered,
+    }
+}
+
+fn bisect(above: &impl Fn(f64) -> bool, mut lo: f64, mut hi: f64, lo_state: bool) -> f64 {
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if above(mid) == lo_state {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo < 1e-9 {
+            break;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The reading of `sensor` for one pass: F/T samples or contact instants by the sensor's kind.
+/// `None` for an F/T sensor whose pin never touched (nothing to read) or whose window is too long.
+pub fn read(
+    signal: &ContactSignal,
+    sensor: &SensorSettings,
+    rng: &mut impl rand::Rng,
+) -> Option<Reading> {
+    match sensor.kind {
+        SensorKind::Ft => sample_ft(signal, sensor, rng).map(Reading::Ft),
+        SensorKind::Timing => Some(Reading::Timing(sample_timing(signal, sensor, rng))),
+    }
+}
