@@ -44,10 +44,13 @@ use super::outcome::PartOutcome;
 use super::overlap::{capsule_clearance, first_touch, polygon_clearance, segment_distance};
 use super::part_stream::{arrival_gap, draw_part};
 use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
+use super::sensing::{describe, sense_pass, SensorStats};
 use crate::mechanics::{
-    fence_first_touch, ContactSettings, ContactStatus, PartModel, Pin, SolveFailure,
+    fence_first_touch, ContactOutcome, ContactSettings, ContactStatus, PartModel, Pin, Recorder,
+    SolveFailure, TraceSample,
 };
-use crate::scenario::{Arrival, Obstacle, Scene};
+use crate::scenario::{Arrival, Obstacle, PinObstacle, Scene, SensorPin};
+use crate::sensing::signal::{KnotRecorder, SignalScale};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use thiserror::Error;
@@ -106,6 +109,8 @@ pub struct PartRecord {
     pub theta_out_deg: f64,
     pub y_in_m: f64,
     pub y_out_m: f64,
+    /// Sensor decisions, `pin=decision (posterior)` separated by `; ` (empty without sensors).
+    pub sensed: String,
 }
 
 /// The path of a sample part: world poses at successive instants (s, pose).
@@ -146,6 +151,8 @@ struct ActivePart {
     /// Own contact model (random tripod), else the scene's.
     model: Option<PartModel>,
     path: Option<Vec<(f64, Pose)>>,
+    /// Sensor pins that have read this part (obstacle index) and their decisions.
+    sensed: Vec<(usize, String)>,
 }
 
 struct Line<'a> {
@@ -158,6 +165,8 @@ struct Line<'a> {
     events: Vec<Event>,
     paths: Vec<SamplePath>,
     finished: u64,
+    /// Sensor pins (obstacle index, index into `metrics.sensors`); empty in a passive scene.
+    sensor_pins: Vec<(usize, usize)>,
 }
 
 /// Run the line: a pure function of (scene, options). `progress` is called with the number of
@@ -172,16 +181,30 @@ pub fn run(
         .iter()
         .map(|o| o.name().to_string())
         .collect();
+    let mut metrics = Metrics::new(names, scene.output.histogram_bin_deg);
+    let mut sensor_pins = Vec::new();
+    for (j, o) in scene.obstacles.iter().enumerate() {
+        if let Obstacle::Pin(PinObstacle {
+            name,
+            sensor: Some(sensor),
+            ..
+        }) = o
+        {
+            sensor_pins.push((j, metrics.sensors.len()));
+            metrics.sensors.push(SensorStats::new(name, sensor));
+        }
+    }
     let mut line = Line {
         scene,
         opts,
         queue: EventQueue::new(),
         active: BTreeMap::new(),
-        metrics: Metrics::new(names, scene.output.histogram_bin_deg),
+        metrics,
         records: Vec::new(),
         events: Vec::new(),
         paths: Vec::new(),
         finished: 0,
+        sensor_pins,
     };
     if opts.parts > 0 {
         line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
@@ -284,6 +307,7 @@ impl Line<'_> {
             grazes: 0,
             model: d.model,
             path: ((index as usize) < self.opts.sample_paths).then(|| vec![(t, pose)]),
+            sensed: Vec::new(),
         };
         self.plan_next(index, &mut part, t);
         self.active.insert(index, part);
@@ -404,7 +428,14 @@ impl Line<'_> {
             Obstacle::Fence(fence) => (Pusher::Fence(fence.spec()), scene.contact),
         };
         let model = part.model.as_ref().unwrap_or(&scene.part.model);
-        let out = pusher.push(model, pose, &settings, None);
+        // A sensor pin records the push's knots as it computes it (the only push of this pass).
+        let sensor = match &scene.obstacles[j] {
+            Obstacle::Pin(p) => p.sensor.as_deref(),
+            Obstacle::Fence(_) => None,
+        };
+        let mut knots = KnotRecorder::default();
+        let recorder: Option<&mut dyn Recorder> = sensor.map(|_| &mut knots as &mut dyn Recorder);
+        let out = pusher.push(model, pose, &settings, recorder);
         self.metrics.work.contact_solves += 1;
         self.metrics.work.model_evaluations += out.evaluations;
         if matches!(out.status, ContactStatus::PinInsidePart) {
@@ -427,6 +458,10 @@ impl Line<'_> {
             return;
         }
         part.grazes = 0;
+        if let Some(sensor) = sensor {
+            let decision = self.sense(index, j, sensor, &out, &knots.samples, pose.theta);
+            part.sensed.push((j, decision));
+        }
         let s_touch = out.travel_to_contact;
         let s_end = out
             .segments
@@ -467,6 +502,9 @@ impl Line<'_> {
             stop,
             trace: None,
         };
+        if sensor.is_some() {
+            plan.set_trace(&knots.samples);
+        }
         // Another obstacle within reach of this push?
         if scene.effects.obstacle_sweeps && !scene.neighbours[j].is_empty() {
             if plan.ensure_trace(model) {
@@ -613,6 +651,7 @@ impl Line<'_> {
         let pose = part.motion.world_pose(t, self.speed());
         let theta_deg = wrap_deg(pose.theta.to_degrees());
         self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
+        self.count_untouched(&part, pose.x);
         self.metrics.cause(outcome, cause);
         if self.opts.keep_records {
             self.records.push(PartRecord {
@@ -626,6 +665,12 @@ impl Line<'_> {
                 theta_out_deg: theta_deg,
                 y_in_m: part.y_in,
                 y_out_m: pose.y,
+                sensed: part
+                    .sensed
+                    .iter()
+                    .map(|(j, d)| format!("{}={d}", self.scene.obstacles[*j].name()))
+                    .collect::<Vec<_>>()
+                    .join("; "),
             });
         }
         if let Some(mut poses) = part.path {
@@ -639,6 +684,47 @@ impl Line<'_> {
             });
         }
         self.finished += 1;
+    }
+
+    /// Read and classify a pass against a sensor pin: the sensor's statistics count it, and the
+    /// decision (as text for the part's record) is returned (see [`super::sensing`]).
+    fn sense(
+        &mut self,
+        index: u64,
+        j: usize,
+        sensor: &SensorPin,
+        out: &ContactOutcome,
+        knots: &[TraceSample],
+        theta: f64,
+    ) -> String {
+        let scale = SignalScale {
+            mass: self.scene.part.mass,
+            belt_speed: self.speed(),
+            height: sensor.settings.height,
+            metres_per_unit: 1.0,
+        };
+        let sensed = sense_pass(sensor, out, knots, &scale, theta, self.opts.seed, index, j);
+        self.metrics.work.sensor_readings += 1;
+        self.metrics.work.signal_knots += sensed.knots as u64;
+        self.metrics.work.classifications += 1;
+        if let Some(&(_, k)) = self.sensor_pins.iter().find(|(o, _)| *o == j) {
+            self.metrics.sensors[k].add(&sensed);
+        }
+        describe(&sensor.labels, &sensed.classification)
+    }
+
+    /// A part leaving the line at world x `x` has gone past every sensor pin upstream of it:
+    /// those that did not read it count it as untouched.
+    fn count_untouched(&mut self, part: &ActivePart, x: f64) {
+        for &(j, k) in &self.sensor_pins {
+            let passed = match &self.scene.obstacles[j] {
+                Obstacle::Pin(p) => p.centre.x < x,
+                Obstacle::Fence(_) => false,
+            };
+            if passed && !part.sensed.iter().any(|(o, _)| *o == j) {
+                self.metrics.sensors[k].untouched += 1;
+            }
+        }
     }
 
     /// Check the motion part `index` has just started against every other part on the belt.

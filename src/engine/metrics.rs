@@ -46,6 +46,12 @@ pub struct WorkCounters {
     pub clearance_evaluations: u64,
     /// Random tripods drawn (support = "tripod").
     pub tripods_drawn: u64,
+    /// Sensor readings taken (passes against sensor pins).
+    pub sensor_readings: u64,
+    /// Integrator knots recorded for sensor signals (the push itself, never a second one).
+    pub signal_knots: u64,
+    /// Readings classified.
+    pub classifications: u64,
 }
 
 /// Per-obstacle statistics.
@@ -83,6 +89,8 @@ pub struct Metrics {
     pub orientation_bins: Vec<u64>,
     pub bin_deg: f64,
     pub work: WorkCounters,
+    /// Per sensor pin, in obstacle order.
+    pub sensors: Vec<super::sensing::SensorStats>,
 }
 
 impl Metrics {
@@ -116,6 +124,7 @@ impl Metrics {
             orientation_bins: vec![0; bins],
             bin_deg,
             work: WorkCounters::default(),
+            sensors: Vec::new(),
         }
     }
 
@@ -225,6 +234,10 @@ pub struct Summary {
     /// First arrival to last event (s).
     pub simulated_time_s: f64,
     pub work: WorkCounters,
+    /// Sensor pins: readings, confusion against the truth, parts that passed untouched (absent
+    /// from the JSON when the scene has no sensor).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sensors: Vec<super::sensing::SensorStats>,
 }
 
 /// The 95% Wilson score interval for `k` successes in `n` trials.
@@ -315,6 +328,7 @@ impl Metrics {
             },
             simulated_time_s: span,
             work: self.work,
+            sensors: self.sensors.clone(),
         }
     }
 }

@@ -18,6 +18,7 @@ pub mod motion;
 pub mod outcome;
 pub mod overlap;
 pub mod part_stream;
+pub mod sensing;
 
 pub use line::{run, EngineError, PartRecord, RunOptions, RunResult, SamplePath};
 pub use metrics::Summary;

@@ -103,9 +103,16 @@ impl ContactPlan {
             again.pose_final, self.outcome.pose_final,
             "push is not pure"
         );
+        self.set_trace(&samples);
+        true
+    }
+
+    /// Keep the trace of a push that was recorded when it was computed (a sensor pin's knots), so
+    /// that nothing pushes it again.
+    pub fn set_trace(&mut self, samples: &[TraceSample]) {
         let mut trace = Vec::with_capacity(samples.len() + 2);
         trace.push((self.s_touch, self.pose_ref));
-        for s in &samples {
+        for s in samples {
             if s.s
                 > trace
                     .last()
@@ -120,7 +127,6 @@ impl ContactPlan {
             trace.push((self.s_end, self.outcome.pose_final));
         }
         self.trace = Some(trace);
-        true
     }
 
     /// Belt-frame pose at pin travel `s` (inside the contact: from the trace, if recorded).

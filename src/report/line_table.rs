@@ -86,6 +86,9 @@ pub fn table(s: &Summary) -> String {
             let _ = writeln!(o, "{label:<26}{}", list.join(", "));
         }
     }
+    for sensor in &s.sensors {
+        sensor_table(&mut o, sensor);
+    }
     // The most populated orientation bins.
     let h = &s.orientation_histogram;
     let mut bins: Vec<(usize, u64)> = h
@@ -116,4 +119,36 @@ pub fn table(s: &Summary) -> String {
         s.simulated_time_s, s.work.events, s.work.contact_solves
     );
     o
+}
+
+/// A sensor pin's block: readings, accuracy, untouched parts and the confusion matrix (rows: the
+/// true hypothesis, columns: the decision).
+fn sensor_table(o: &mut String, s: &crate::engine::sensing::SensorStats) {
+    let _ = writeln!(
+        o,
+        "sensor {:<19}{} readings ({}), {} correct ({:.1}%), {} parts passed untouched",
+        s.name,
+        s.readings,
+        s.classifier,
+        s.correct,
+        100.0 * s.accuracy(),
+        s.untouched
+    );
+    let width = s.labels.iter().map(|l| l.len()).max().unwrap_or(0).max(7);
+    let mut head = format!("  {:>width$} →", "true");
+    for l in s.labels.iter().map(String::as_str).chain(["unknown"]) {
+        head += &format!(" {l:>width$}");
+    }
+    let _ = writeln!(o, "{head}");
+    let rows = s.labels.iter().map(String::as_str).chain(["other"]);
+    for (label, row) in rows.zip(&s.confusion) {
+        if label == "other" && row.iter().all(|&c| c == 0) {
+            continue;
+        }
+        let mut line = format!("  {label:>width$}  ");
+        for c in row {
+            line += &format!(" {c:>width$}");
+        }
+        let _ = writeln!(o, "{line}");
+    }
 }

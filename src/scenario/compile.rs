@@ -196,6 +196,12 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
             "must be greater than 0 (friction coefficient; it scales forces)",
         ));
     }
+    let mass = c.range(
+        "part.mass",
+        rp.mass.unwrap_or(0.05),
+        limits::MASS_KG,
+        "kg",
+    )?;
     let model = PartModel::new(&polygon, &Support::Uniform).map_err(|e| {
         c.err(
             "part",
@@ -408,7 +414,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
     };
 
     // [[obstacles]]
-    let (obstacles, neighbours) =
+    let (mut obstacles, neighbours, sensor_drafts) =
         super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, radius, mu_c)?;
 
     // [goal]
@@ -533,20 +539,34 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         },
     };
 
+    let part = PartSpec {
+        label,
+        polygon,
+        radius,
+        model,
+        support: rp.support,
+        mu_c,
+        mu_s,
+        mass,
+        stable_states,
+    };
+    // Sensor pins: train each sensor's classifier on templates of this scene.
+    for (i, draft) in &sensor_drafts {
+        if let Obstacle::Pin(pin) = &obstacles[*i] {
+            let trained = super::sensors::train(
+                &c, *i, draft, pin, &part, &feed, belt.speed, &contact, seed,
+            )?;
+            if let Obstacle::Pin(pin) = &mut obstacles[*i] {
+                pin.sensor = Some(std::sync::Arc::new(trained));
+            }
+        }
+    }
+
     Ok(Scene {
         name,
         seed,
         belt,
-        part: PartSpec {
-            label,
-            polygon,
-            radius,
-            model,
-            support: rp.support,
-            mu_c,
-            mu_s,
-            stable_states,
-        },
+        part,
         feed,
         obstacles,
         neighbours,

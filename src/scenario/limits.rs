@@ -38,6 +38,8 @@ pub const PART_RADIUS: (f64, f64) = (1e-9, 1e3);
 pub const VERTEX_MAGNITUDE: (f64, f64) = (1e-9, 1e9);
 /// Friction coefficients (μc, μs, μf).
 pub const FRICTION: (f64, f64) = (0.0, 5.0);
+/// Part mass (kg): from a microgram to a tonne (sensor forces scale with it).
+pub const MASS_KG: (f64, f64) = (1e-9, 1e3);
 /// Seconds between arrivals.
 pub const HEADWAY: (f64, f64) = (1e-6, 1e6);
 /// Arrivals per second.

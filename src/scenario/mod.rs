@@ -18,6 +18,7 @@ pub mod location;
 pub mod obstacles;
 pub mod raw;
 pub mod scene;
+pub mod sensors;
 pub mod shared_feed;
 
 pub use error::{InvalidScenario, ScenarioError};

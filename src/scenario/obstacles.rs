@@ -28,14 +28,23 @@ use crate::geometry::Vec2;
 type R<T> = Result<T, ScenarioError>;
 
 /// The obstacles of a scene and, for each, its neighbours (ascending indices).
+/// Compiled obstacles, their neighbour lists, and the sensors still to be trained (obstacle index
+/// and validated settings: training needs the whole scene, see [`super::sensors::train`]).
+pub(super) type Compiled = (
+    Vec<Obstacle>,
+    Vec<Vec<usize>>,
+    Vec<(usize, super::sensors::SensorDraft)>,
+);
+
 pub(super) fn compile_obstacles(
     c: &Checker,
     raw: &[RawObstacle],
     belt: &Belt,
     part_radius: f64,
     part_mu_c: f64,
-) -> R<(Vec<Obstacle>, Vec<Vec<usize>>)> {
+) -> R<Compiled> {
     let mut obstacles: Vec<Obstacle> = Vec::new();
+    let mut sensors = Vec::new();
     for (i, ro) in raw.iter().enumerate() {
         let at = At {
             c,
@@ -44,17 +53,24 @@ pub(super) fn compile_obstacles(
             part_radius,
             part_mu_c,
         };
+        if ro.sensor.is_some() && ro.kind != ObstacleKind::SensorPin {
+            return Err(c.err(
+                &format!("obstacles[{i}].sensor"),
+                "only a kind = \"sensor_pin\" has a sensor",
+            ));
+        }
         let ob = match ro.kind {
             ObstacleKind::Pin => Obstacle::Pin(pin(&at, ro)?),
+            ObstacleKind::SensorPin => {
+                let raw_sensor = ro.sensor.clone().unwrap_or_default();
+                sensors.push((i, super::sensors::validate(c, i, &raw_sensor)?));
+                Obstacle::Pin(pin(&at, ro)?)
+            }
             ObstacleKind::Fence => Obstacle::Fence(fence(&at, ro)?),
-            other => {
-                let name = match other {
-                    ObstacleKind::SensorPin => "sensor_pin",
-                    _ => "moving_pin",
-                };
+            ObstacleKind::MovingPin => {
                 return Err(c.err(
                     &format!("obstacles[{i}].kind"),
-                    format!("obstacle kind \"{name}\" is not yet supported; this version simulates kind = \"pin\" and kind = \"fence\""),
+                    "obstacle kind \"moving_pin\" is not yet supported; this version simulates kind = \"pin\", \"sensor_pin\" and \"fence\"",
                 ));
             }
         };
@@ -70,7 +86,7 @@ pub(super) fn compile_obstacles(
         obstacles.push(ob);
     }
     let neighbours = neighbour_lists(&obstacles, part_radius);
-    Ok((obstacles, neighbours))
+    Ok((obstacles, neighbours, sensors))
 }
 
 /// For each obstacle, the others a part of circumradius `a` touching it could touch: those within
@@ -200,6 +216,7 @@ fn pin(at: &At, ro: &RawObstacle) -> R<PinObstacle> {
         centre: Vec2::new(x, y),
         radius,
         mu_c: at.friction("mu_c", ro.mu_c)?,
+        sensor: None,
     })
 }
 

@@ -61,6 +61,8 @@ pub struct RawPart {
     pub mu_c: Option<f64>,
     /// Part–belt friction coefficient (default 0.3; scales forces only).
     pub mu_s: Option<f64>,
+    /// Part mass (kg, default 0.05): turns the contact model's forces into newtons for sensors.
+    pub mass: Option<f64>,
     #[serde(default)]
     pub support: SupportKind,
 }
@@ -152,6 +154,48 @@ pub struct RawObstacle {
     pub length: Option<f64>,
     /// Fence–part friction (default: the part's mu_c).
     pub mu_f: Option<f64>,
+    /// `[obstacles.sensor]`: the sensor of a `sensor_pin`.
+    pub sensor: Option<RawSensor>,
+}
+
+/// `[obstacles.sensor]` of a sensor pin (README "Sensor pins"; defaults in
+/// [`crate::sensing::settings`]). Units: N, N·mm, m, s, Hz.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RawSensor {
+    /// `ft` (force/torque, default) or `timing`.
+    #[serde(rename = "type")]
+    pub kind: Option<crate::sensing::SensorKind>,
+    pub rate: Option<f64>,
+    pub height: Option<f64>,
+    pub noise_force: Option<f64>,
+    pub noise_torque: Option<f64>,
+    pub bias_force: Option<f64>,
+    pub bias_torque: Option<f64>,
+    pub drift_force: Option<f64>,
+    pub drift_torque: Option<f64>,
+    pub resolution_force: Option<f64>,
+    pub resolution_force_z: Option<f64>,
+    pub resolution_torque: Option<f64>,
+    pub lowpass: Option<f64>,
+    pub threshold: Option<f64>,
+    pub jitter: Option<f64>,
+    /// Classifier name (default `likelihood` for F/T, `timing` for a timing sensor).
+    pub classifier: Option<String>,
+    /// `"stable"` (the part's stable states, default), `"vertex-edge"`, or a list of degrees.
+    pub hypotheses: Option<RawHypotheses>,
+    /// Templates per hypothesis (default 32).
+    pub templates: Option<u64>,
+    /// Reject option: decide "unknown" below this posterior (default 0: never).
+    pub reject_below: Option<f64>,
+}
+
+/// The hypotheses of a sensor: a name or a list of orientations (degrees).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum RawHypotheses {
+    Named(String),
+    Degrees(Vec<f64>),
 }
 
 /// `[goal]`: which final orientations count as correct.

@@ -4,6 +4,10 @@
 pub use super::raw::SupportKind;
 use crate::geometry::{Polygon, StableState, Vec2};
 use crate::mechanics::{ContactSettings, FenceSpec, PartModel};
+use crate::sensing::classify::Classifier;
+use crate::sensing::templates::Hypotheses;
+use crate::sensing::SensorSettings;
+use std::sync::Arc;
 
 /// The belt: parts enter at x = 0 and leave at x = `length`; it spans y ∈ [−width/2, width/2].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,6 +34,8 @@ pub struct PartSpec {
     pub support: SupportKind,
     pub mu_c: f64,
     pub mu_s: f64,
+    /// Mass (kg): sensors turn forces into newtons with it.
+    pub mass: f64,
     pub stable_states: Vec<StableState>,
 }
 
@@ -90,7 +96,7 @@ pub struct Feed {
     pub lateral: Lateral,
 }
 
-/// A fixed pin over the belt.
+/// A fixed pin over the belt, with an optional sensor (`kind = "sensor_pin"` in the file).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PinObstacle {
     pub name: String,
@@ -100,6 +106,51 @@ pub struct PinObstacle {
     pub radius: f64,
     /// Pin–part friction.
     pub mu_c: f64,
+    /// The pin's sensor and its trained classifier, if it has one.
+    pub sensor: Option<Arc<SensorPin>>,
+}
+
+/// A pin's sensor: its settings, its hypotheses and the classifier trained on their templates
+/// (compiled once with the scene; see [`super::sensors`]).
+pub struct SensorPin {
+    pub settings: SensorSettings,
+    /// Classifier name (one of [`crate::sensing::classify::NAMES`]).
+    pub classifier_name: String,
+    pub hypotheses: Hypotheses,
+    pub labels: Vec<String>,
+    pub templates_per_hypothesis: usize,
+    pub reject_below: f64,
+    /// The contact parameter d the templates were simulated at (the pin against the feed's
+    /// mean lateral offset), and the spread of d they were drawn with.
+    pub template_d: f64,
+    pub template_d_sd: f64,
+    pub classifier: Box<dyn Classifier>,
+}
+
+impl std::fmt::Debug for SensorPin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SensorPin")
+            .field("settings", &self.settings)
+            .field("classifier", &self.classifier_name)
+            .field("hypotheses", &self.hypotheses)
+            .field("templates_per_hypothesis", &self.templates_per_hypothesis)
+            .field("template_d", &self.template_d)
+            .finish()
+    }
+}
+
+impl PartialEq for SensorPin {
+    /// Two sensors are equal when everything they were compiled from is (the trained classifier
+    /// is a function of it).
+    fn eq(&self, o: &Self) -> bool {
+        self.settings == o.settings
+            && self.classifier_name == o.classifier_name
+            && self.hypotheses == o.hypotheses
+            && self.templates_per_hypothesis == o.templates_per_hypothesis
+            && self.reject_below == o.reject_below
+            && self.template_d == o.template_d
+            && self.template_d_sd == o.template_d_sd
+    }
 }
 
 /// A fixed fence over the belt (SPEC §6): the segment from `start` (its upstream end) along

@@ -70,8 +70,20 @@ pub fn padding(signal: &ContactSignal, rate: f64) -> f64 {
     (0.2 * signal.duration()).max(0.02).max(10.0 / rate)
 }
 
-/// The largest number of samples one reading may hold (memory bound: 10⁶ samples of 6 channels).
-pub const MAX_SAMPLES: usize = 1_000_000;
+/// The largest number of samples one reading may hold (memory bound: 2·10⁵ samples of 6 channels,
+/// 9.6 MB; e.g. 200 s of contact at 1 kHz). A longer window is not read (the sensor reports nothing).
+pub const MAX_SAMPLES: usize = 200_000;
+/// The most samples a classifier may hold over all its templates (memory bound: 10⁷ samples of 6
+/// channels, 480 MB); training a larger set is refused with a message naming the sizes.
+pub const MAX_TEMPLATE_SAMPLES: usize = 10_000_000;
+
+/// Samples a reading of `signal` at `rate` would hold (0 without contact).
+pub fn samples_needed(signal: &ContactSignal, rate: f64) -> usize {
+    match signal.span() {
+        Some((b, e)) => (((e - b) + 2.0 * padding(signal, rate)) * rate).ceil() as usize + 1,
+        None => 0,
+    }
+}
 
 /// Samples `signal` with `sensor` (noise, bias, drift, low-pass, quantisation) over the contact and
 /// its padding; `None` when the pin never touched or the window would exceed [`MAX_SAMPLES`].

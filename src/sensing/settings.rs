@@ -128,9 +128,9 @@ fn check(field: &'static str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<()
 
 impl SensorSettings {
     /// Checks every setting against its physical range (the bounds keep sample counts and memory
-    /// bounded: at most 10⁶ Hz; noise, bias and drift below 10⁶ N).
+    /// bounded: at most 10⁵ Hz; noise, bias and drift below 10⁶ N).
     pub fn validate(&self) -> Result<(), SettingError> {
-        check("rate", self.rate, 1.0, 1e6, "Hz, > 0")?;
+        check("rate", self.rate, 1.0, 1e5, "Hz, > 0")?;
         check("height", self.height, 0.0, 10.0, "m, ≥ 0")?;
         check("noise_force", self.noise_force, 0.0, 1e6, "N, ≥ 0")?;
         check("noise_torque", self.noise_torque, 0.0, 1e9, "N·mm, ≥ 0")?;

@@ -219,6 +219,7 @@ fn draw_obstacle(
                 centre,
                 radius: r,
                 mu_c: mu_c.unwrap_or(pin.mu_c),
+                sensor: pin.sensor.clone(),
             }));
         }
         *other += 1;
@@ -296,6 +297,7 @@ pub fn draw_scene(
             support: SupportKind::Uniform,
             mu_c: mu_c.unwrap_or(base.part.mu_c),
             mu_s: base.part.mu_s,
+            mass: base.part.mass,
         },
         feed: base.feed.clone(),
         obstacles,

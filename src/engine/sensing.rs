@@ -1,0 +1,176 @@
+//! Sensor pins in the line (SPEC §4; issue "Sensor pins"): a push against a pin with a sensor is
+//! computed once with a knot recorder, its clean signal read through the sensor's noise model on
+//! a stream of its own, and classified with the sensor's trained classifier; the decision joins the
+//! part's record and the sensor's statistics.
+//!
+//! Truth: the simulator knows which hypothesis each part really is — for orientation hypotheses the
+//! one nearest (on the circle) to the part's orientation when the pin touches it, for vertex/edge
+//! the contact model's own first-contact feature — so the summary gives each sensor's confusion
+//! matrix against it. Parts that pass the sensor pin without touching it are counted apart.
+//!
+//! Randomness: the reading of part i by obstacle j draws from stream (seed, 2⁶² | i·2¹⁶ | j), apart
+//! from every part's own stream (seed, i), so sensing never shifts what a part draws, and the run
+//! stays a pure function of (scene, seed).
+//!
+//! A scene with no sensor pin runs none of this: its `work.sensor_readings`, `work.signal_knots` and
+//! `work.classifications` stay 0 (a test checks it).
+
+use crate::mechanics::{ContactOutcome, TraceSample};
+use crate::random::stream;
+use crate::scenario::SensorPin;
+use crate::sensing::classify::{Classification, Decision};
+use crate::sensing::reading::read;
+use crate::sensing::signal::{ContactSignal, SignalScale};
+use crate::sensing::templates::{vertex_edge_class, Hypotheses};
+use serde::Serialize;
+
+/// First stream index of sensor readings (parts use 0, 1, 2, …).
+const SENSOR_STREAMS: u64 = 1 << 62;
+
+/// The stream of the reading of part `part` by obstacle `obstacle`.
+pub fn reading_stream(part: u64, obstacle: usize) -> u64 {
+    SENSOR_STREAMS | (part << 16) | (obstacle as u64 & 0xffff)
+}
+
+/// One sensed pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensedPass {
+    /// The hypothesis the part really is (None: no hypothesis applies, e.g. no first feature).
+    pub truth: Option<usize>,
+    pub classification: Classification,
+    /// Knots the signal was built from.
+    pub knots: usize,
+}
+
+/// Reads and classifies one pass of part `part` (pose θ `theta` rad just before contact) against
+/// sensor pin `obstacle`.
+#[allow(clippy::too_many_arguments)]
+pub fn sense_pass(
+    sensor: &SensorPin,
+    outcome: &ContactOutcome,
+    knots: &[TraceSample],
+    scale: &SignalScale,
+    theta: f64,
+    seed: u64,
+    part: u64,
+    obstacle: usize,
+) -> SensedPass {
+    let signal = ContactSignal::new(outcome, knots, scale);
+    let mut rng = stream(seed, reading_stream(part, obstacle));
+    let classification = match read(&signal, &sensor.settings, &mut rng) {
+        Some(r) => sensor.classifier.classify(&r),
+        None => Classification::unknown(),
+    };
+    let truth = match &sensor.hypotheses {
+        Hypotheses::Orientations { degrees, .. } => nearest(degrees, theta.to_degrees()),
+        Hypotheses::VertexEdge { .. } => signal.first_feature.map(vertex_edge_class),
+    };
+    SensedPass {
+        truth,
+        classification,
+        knots: knots.len(),
+    }
+}
+
+/// Index of the orientation nearest `deg` on the circle.
+pub fn nearest(degrees: &[f64], deg: f64) -> Option<usize> {
+    let dist = |a: f64| {
+        let d = (a - deg).rem_euclid(360.0);
+        d.min(360.0 - d)
+    };
+    degrees
+        .iter()
+        .enumerate()
+        .min_by(|(_, a), (_, b)| dist(**a).total_cmp(&dist(**b)))
+        .map(|(i, _)| i)
+}
+
+/// A sensor's statistics over a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SensorStats {
+    /// The sensor pin's name.
+    pub name: String,
+    pub classifier: String,
+    pub labels: Vec<String>,
+    /// Passes read.
+    pub readings: u64,
+    /// Parts that went past the pin without touching it.
+    pub untouched: u64,
+    /// confusion[true][decided]: decided = hypothesis index, or `labels.len()` for "unknown";
+    /// a last row counts readings whose truth matches no hypothesis.
+    pub confusion: Vec<Vec<u64>>,
+    /// Readings decided correctly.
+    pub correct: u64,
+}
+
+impl SensorStats {
+    pub fn new(name: &str, sensor: &SensorPin) -> SensorStats {
+        let k = sensor.labels.len();
+        SensorStats {
+            name: name.to_string(),
+            classifier: sensor.classifier_name.clone(),
+            labels: sensor.labels.clone(),
+            readings: 0,
+            untouched: 0,
+            confusion: vec![vec![0; k + 1]; k + 1],
+            correct: 0,
+        }
+    }
+
+    /// Counts one sensed pass.
+    pub fn add(&mut self, p: &SensedPass) {
+        let k = self.labels.len();
+        self.readings += 1;
+        let col = match p.classification.decision {
+            Decision::Hypothesis(h) if h < k => h,
+            _ => k,
+        };
+        let row = p.truth.filter(|&t| t < k).unwrap_or(k);
+        self.confusion[row][col] += 1;
+        if row < k && row == col {
+            self.correct += 1;
+        }
+    }
+
+    /// Share of readings decided correctly.
+    pub fn accuracy(&self) -> f64 {
+        if self.readings == 0 {
+            0.0
+        } else {
+            self.correct as f64 / self.readings as f64
+        }
+    }
+}
+
+/// A decision as text for the per-part record: `label` (with its posterior when the method gives
+/// one, e.g. `135 (0.97)`) or `unknown`.
+pub fn describe(labels: &[String], c: &Classification) -> String {
+    match c.decision {
+        Decision::Hypothesis(h) => match &c.posterior {
+            Some(p) => format!("{} ({:.3})", labels[h], p[h]),
+            None => labels[h].clone(),
+        },
+        Decision::Unknown => "unknown".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nearest_wraps_round_the_circle() {
+        let d = [0.0, 135.0, 225.0];
+        assert_eq!(nearest(&d, 355.0), Some(0));
+        assert_eq!(nearest(&d, 170.0), Some(1));
+        assert_eq!(nearest(&d, 190.0), Some(2));
+        assert_eq!(nearest(&d, -20.0), Some(0));
+    }
+
+    #[test]
+    fn reading_streams_are_distinct_from_part_streams() {
+        assert!(reading_stream(0, 0) >= SENSOR_STREAMS);
+        assert_ne!(reading_stream(1, 0), reading_stream(0, 1));
+        assert_ne!(reading_stream(3, 2), reading_stream(2, 3));
+    }
+}

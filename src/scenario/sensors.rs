@@ -1,0 +1,260 @@
+//! `[obstacles.sensor]` of a `sensor_pin`: validation of the sensor's settings and hypotheses, and
+//! training of its classifier on simulated templates (README "Sensor pins"; SPEC §4).
+//!
+//! The templates model what the sensor expects: the part reaching the pin as fed — orientation
+//! one of the hypotheses (with the feed's orientation jitter), lateral offset drawn from the
+//! feed's lateral distribution (as a spread of d about the pin's offset from the feed's mean),
+//! the pin's μc, the scene's support model (random tripods when `support = "tripod"`) and fidelity.
+//! A sensor placed after other obstacles sees parts those obstacles have moved; the templates do not
+//! know that, and the summary's confusion matrix shows what it costs. Templates are drawn from the
+//! scene's seed on streams of their own, so the same file always trains the same classifier.
+
+use super::compile::Checker;
+use super::raw::{RawHypotheses, RawSensor};
+use super::scene::{Feed, Lateral, Orientation, PartSpec, PinObstacle, SensorPin, SupportKind};
+use super::ScenarioError;
+use crate::mechanics::ContactSettings;
+use crate::random::distribution::Distribution;
+use crate::sensing::classify::{self, ClassifierOptions};
+use crate::sensing::templates::{build_templates, Hypotheses, PushSetup, Uncertainty};
+use crate::sensing::{SensorKind, SensorSettings};
+
+type R<T> = Result<T, ScenarioError>;
+
+/// Templates per hypothesis: default and the most a file may ask for (training time is bounded).
+const DEFAULT_TEMPLATES: u64 = 32;
+const MAX_TEMPLATES: u64 = 1024;
+
+/// A sensor's validated settings, before training.
+#[derive(Debug, Clone)]
+pub(super) struct SensorDraft {
+    pub settings: SensorSettings,
+    pub classifier: String,
+    pub hypotheses: Option<Vec<f64>>,
+    pub vertex_edge: bool,
+    pub templates: usize,
+    pub reject_below: f64,
+}
+
+/// Validates `[obstacles.<i>.sensor]`.
+pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<SensorDraft> {
+    let path = |k: &str| format!("obstacles[{i}].sensor.{k}");
+    let d = SensorSettings::default();
+    let kind = raw.kind.unwrap_or_default();
+    let settings = SensorSettings {
+        kind,
+        rate: raw.rate.unwrap_or(d.rate),
+        height: raw.height.unwrap_or(d.height),
+        noise_force: raw.noise_force.unwrap_or(d.noise_force),
+        noise_torque: raw.noise_torque.unwrap_or(d.noise_torque),
+        bias_force: raw.bias_force.unwrap_or(d.bias_force),
+        bias_torque: raw.bias_torque.unwrap_or(d.bias_torque),
+        drift_force: raw.drift_force.unwrap_or(d.drift_force),
+        drift_torque: raw.drift_torque.unwrap_or(d.drift_torque),
+        resolution_force: raw.resolution_force.unwrap_or(d.resolution_force),
+        resolution_force_z: raw.resolution_force_z.unwrap_or(d.resolution_force_z),
+        resolution_torque: raw.resolution_torque.unwrap_or(d.resolution_torque),
+        lowpass: raw.lowpass,
+        threshold: raw.threshold.unwrap_or(d.threshold),
+        jitter: raw.jitter.unwrap_or(d.jitter),
+    };
+    if let Err(e) = settings.validate() {
+        return Err(c.err(&path(e.field), e.message));
+    }
+    let classifier = raw.classifier.clone().unwrap_or_else(|| {
+        match kind {
+            SensorKind::Ft => "likelihood",
+            SensorKind::Timing => "timing",
+        }
+        .to_string()
+    });
+    if !classify::NAMES.contains(&classifier.as_str()) {
+        return Err(c.err(
+            &path("classifier"),
+            format!(
+                "unknown classifier '{classifier}'; known: {}",
+                classify::NAMES.join(", ")
+            ),
+        ));
+    }
+    let (hypotheses, vertex_edge) = match &raw.hypotheses {
+        None => (None, false),
+        Some(RawHypotheses::Named(n)) if n == "stable" => (None, false),
+        Some(RawHypotheses::Named(n)) if n == "vertex-edge" => (None, true),
+        Some(RawHypotheses::Named(n)) => {
+            return Err(c.err(
+                &path("hypotheses"),
+                format!("must be \"stable\", \"vertex-edge\" or a list of orientations in degrees, got \"{n}\""),
+            ))
+        }
+        Some(RawHypotheses::Degrees(list)) => (Some(degrees(c, &path("hypotheses"), list)?), false),
+    };
+    if classifier == "zero-crossings" && !vertex_edge {
+        return Err(c.err(
+            &path("classifier"),
+            "zero-crossings decides vertex or edge contact only: set hypotheses = \"vertex-edge\"",
+        ));
+    }
+    if vertex_edge && !matches!(classifier.as_str(), "zero-crossings" | "likelihood") {
+        return Err(c.err(
+            &path("classifier"),
+            format!("classifier '{classifier}' cannot decide vertex/edge hypotheses; use zero-crossings or likelihood"),
+        ));
+    }
+    let templates = raw.templates.unwrap_or(DEFAULT_TEMPLATES);
+    if !(1..=MAX_TEMPLATES).contains(&templates) {
+        return Err(c.err(
+            &path("templates"),
+            format!("must lie in [1, {MAX_TEMPLATES}] (templates per hypothesis), got {templates}"),
+        ));
+    }
+    let reject_below = c.within(
+        &path("reject_below"),
+        raw.reject_below.unwrap_or(0.0),
+        0.0,
+        1.0,
+        "a posterior probability",
+    )?;
+    Ok(SensorDraft {
+        settings,
+        classifier,
+        hypotheses,
+        vertex_edge,
+        templates: templates as usize,
+        reject_below,
+    })
+}
+
+/// Hypothesis orientations (degrees): finite, within ±360, at least two, no two the same angle.
+fn degrees(c: &Checker, path: &str, list: &[f64]) -> R<Vec<f64>> {
+    if list.len() < 2 {
+        return Err(c.err(path, "needs at least two orientations (degrees) to tell apart"));
+    }
+    for &v in list {
+        c.within(path, v, -360.0, 360.0, "degrees")?;
+    }
+    for (a, &x) in list.iter().enumerate() {
+        for &y in &list[..a] {
+            let diff = (x - y).rem_euclid(360.0);
+            if diff.min(360.0 - diff) < 1e-9 {
+                return Err(c.err(
+                    path,
+                    format!("orientations {y} and {x} are the same angle: each hypothesis once"),
+                ));
+            }
+        }
+    }
+    Ok(list.to_vec())
+}
+
+/// Mean and standard deviation of the feed's lateral offset (m).
+fn lateral_moments(l: &Lateral) -> (f64, f64) {
+    match *l {
+        Lateral::Fixed(y) => (y, 0.0),
+        Lateral::Uniform { min, max } => (0.5 * (min + max), (max - min) / 12f64.sqrt()),
+        Lateral::Normal { mean, sd, .. } => (mean, sd),
+    }
+}
+
+/// Trains the sensor of `pin` (obstacle `i`) for this scene.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn train(
+    c: &Checker,
+    i: usize,
+    draft: &SensorDraft,
+    pin: &PinObstacle,
+    part: &PartSpec,
+    feed: &Feed,
+    belt_speed: f64,
+    contact: &ContactSettings,
+    seed: u64,
+) -> R<SensorPin> {
+    let a = part.radius;
+    let (y_mean, y_sd) = lateral_moments(&feed.lateral);
+    let template_d = (pin.centre.y - y_mean) / a;
+    let template_d_sd = y_sd / a;
+    let theta_sd_deg = match &feed.orientation {
+        Orientation::Stable { jitter, .. } => jitter.to_degrees(),
+        Orientation::Uniform => 0.0,
+    };
+    let stable: Vec<f64> = part
+        .stable_states
+        .iter()
+        .map(|s| s.theta.to_degrees())
+        .collect();
+    let hypotheses = if draft.vertex_edge {
+        let degrees = match &feed.orientation {
+            Orientation::Stable { .. } => stable.clone(),
+            Orientation::Uniform => (0..72).map(|k| k as f64 * 5.0).collect(),
+        };
+        Hypotheses::VertexEdge { degrees }
+    } else {
+        let degrees = draft.hypotheses.clone().unwrap_or_else(|| stable.clone());
+        if degrees.len() < 2 {
+            return Err(c.err(
+                &format!("obstacles[{i}].sensor.hypotheses"),
+                format!(
+                    "the part has {} stable state(s): list at least two orientations to tell apart",
+                    degrees.len()
+                ),
+            ));
+        }
+        Hypotheses::Orientations {
+            labels: degrees.iter().map(|d| label(*d)).collect(),
+            degrees,
+        }
+    };
+    let setup = PushSetup {
+        polygon: part.polygon.clone(),
+        d: template_d,
+        pin_radius: pin.radius,
+        mu_c: pin.mu_c,
+        mu_s: part.mu_s,
+        fidelity: contact.fidelity,
+        tol: contact.tol,
+        mass: part.mass,
+        belt_speed,
+        height: draft.settings.height,
+    };
+    let unc = Uncertainty {
+        mu_c: Distribution::Fixed(pin.mu_c),
+        tripod: part.support == SupportKind::Tripod,
+        theta_sd_deg,
+        d_sd: template_d_sd,
+    };
+    // Templates of sensor i draw from streams of their own (salted by the obstacle index).
+    let template_seed = seed ^ (0x5e05_0000_0000_0000 | i as u64);
+    let set = build_templates(&setup, &part.model, &hypotheses, &unc, draft.templates, template_seed)
+        .map_err(|e| c.err(&format!("obstacles[{i}].sensor"), format!("cannot simulate the templates: {e}")))?;
+    if let Some(h) = set.members.iter().position(|m| m.is_empty()) {
+        return Err(c.err(
+            &format!("obstacles[{i}].sensor.hypotheses"),
+            format!(
+                "hypothesis '{}' never occurs at this pin (no template could be simulated): the pin at d = {template_d:.3} cannot tell it",
+                set.labels[h]
+            ),
+        ));
+    }
+    let options = ClassifierOptions {
+        reject_below: draft.reject_below,
+    };
+    let classifier = classify::build(&draft.classifier, &set, &draft.settings, &options)
+        .map_err(|e| c.err(&format!("obstacles[{i}].sensor.classifier"), e))?;
+    Ok(SensorPin {
+        settings: draft.settings,
+        classifier_name: draft.classifier.clone(),
+        labels: set.labels.clone(),
+        hypotheses,
+        templates_per_hypothesis: draft.templates,
+        reject_below: draft.reject_below,
+        template_d,
+        template_d_sd,
+        classifier,
+    })
+}
+
+/// A hypothesis label: the orientation in degrees, shortest form.
+pub fn label(deg: f64) -> String {
+    let r = (deg * 1000.0).round() / 1000.0;
+    format!("{r}")
+}
