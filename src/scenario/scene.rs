@@ -112,6 +112,7 @@ pub struct PinObstacle {
 
 /// A pin's sensor: its settings, its hypotheses and the classifier trained on their templates
 /// (compiled once with the scene; see [`super::sensors`]).
+#[derive(Clone)]
 pub struct SensorPin {
     pub settings: SensorSettings,
     /// Classifier name (one of [`crate::sensing::classify::NAMES`]).
@@ -124,7 +125,7 @@ pub struct SensorPin {
     /// mean lateral offset), and the spread of d they were drawn with.
     pub template_d: f64,
     pub template_d_sd: f64,
-    pub classifier: Box<dyn Classifier>,
+    pub classifier: Arc<dyn Classifier>,
 }
 
 impl std::fmt::Debug for SensorPin {

@@ -249,7 +249,7 @@ pub(super) fn train(
         reject_below: draft.reject_below,
         template_d,
         template_d_sd,
-        classifier,
+        classifier: std::sync::Arc::from(classifier),
     })
 }
 
