@@ -73,7 +73,14 @@ fn recording_does_not_change_the_push() {
                 let settings = ContactSettings::default();
                 let bare = push(&model, pose, start, &Pin::point(), &settings, None);
                 let mut rec = KnotRecorder::default();
-                let seen = push(&model, pose, start, &Pin::point(), &settings, Some(&mut rec));
+                let seen = push(
+                    &model,
+                    pose,
+                    start,
+                    &Pin::point(),
+                    &settings,
+                    Some(&mut rec),
+                );
                 assert_eq!(bare, seen, "{part} θ0={th} d={d}");
             }
         }
@@ -145,13 +152,21 @@ fn torques_are_r_cross_f() {
                     (rx * f.y - ry * f.x) * 1e3,
                 ];
                 for i in 0..3 {
-                    assert!((c[3 + i] - t[i]).abs() < 1e-9, "T{i}: {} vs {}", c[3 + i], t[i]);
+                    assert!(
+                        (c[3 + i] - t[i]).abs() < 1e-9,
+                        "T{i}: {} vs {}",
+                        c[3 + i],
+                        t[i]
+                    );
                 }
                 seen_tz |= c[5].abs() > 1e-6;
             }
         }
     }
-    assert!(seen_tz, "a frictional disc pin feels a moment about its axis");
+    assert!(
+        seen_tz,
+        "a frictional disc pin feels a moment about its axis"
+    );
 }
 
 /// Mirroring the part about the belt axis and negating d and θ0 negates Fy, Tx and Tz and keeps
@@ -273,7 +288,16 @@ fn interpolated_signal_converges_under_refinement() {
             for d in [-0.3, -0.1, 0.2] {
                 let err_at = |tol: f64| {
                     let (mut s, model) = setup(part, 0.02, 0.5);
-                    let fine = simulate(&PushSetup { tol: 1e-10, ..s.clone() }, &model, th, d, 0.5);
+                    let fine = simulate(
+                        &PushSetup {
+                            tol: 1e-10,
+                            ..s.clone()
+                        },
+                        &model,
+                        th,
+                        d,
+                        0.5,
+                    );
                     s.tol = tol;
                     let coarse = simulate(&s, &model, th, d, 0.5);
                     let Some((b, e)) = fine.signal.span() else {
@@ -284,7 +308,12 @@ fn interpolated_signal_converges_under_refinement() {
                         let t = b + (e - b) * (i as f64 + 0.5) / 400.0;
                         // Skip instants next to an event, where the two contacts switch at
                         // slightly different times.
-                        if fine.signal.contacts.iter().any(|&(x, y)| (t - x).abs() < 1e-3 || (t - y).abs() < 1e-3) {
+                        if fine
+                            .signal
+                            .contacts
+                            .iter()
+                            .any(|&(x, y)| (t - x).abs() < 1e-3 || (t - y).abs() < 1e-3)
+                        {
                             continue;
                         }
                         let (x, y) = (fine.signal.at(t), coarse.signal.at(t));

@@ -43,8 +43,8 @@ use super::motion::{ContactPlan, Motion, Pusher, Stop};
 use super::outcome::PartOutcome;
 use super::overlap::{capsule_clearance, first_touch, polygon_clearance, segment_distance};
 use super::part_stream::{arrival_gap, draw_part};
-use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
 use super::sensing::{describe, sense_pass, SensorStats};
+use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
 use crate::mechanics::{
     fence_first_touch, ContactOutcome, ContactSettings, ContactStatus, PartModel, Pin, Recorder,
     SolveFailure, TraceSample,

@@ -196,12 +196,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
             "must be greater than 0 (friction coefficient; it scales forces)",
         ));
     }
-    let mass = c.range(
-        "part.mass",
-        rp.mass.unwrap_or(0.05),
-        limits::MASS_KG,
-        "kg",
-    )?;
+    let mass = c.range("part.mass", rp.mass.unwrap_or(0.05), limits::MASS_KG, "kg")?;
     let model = PartModel::new(&polygon, &Support::Uniform).map_err(|e| {
         c.err(
             "part",

@@ -128,7 +128,10 @@ pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<SensorDraft>
 /// Hypothesis orientations (degrees): finite, within ±360, at least two, no two the same angle.
 fn degrees(c: &Checker, path: &str, list: &[f64]) -> R<Vec<f64>> {
     if list.len() < 2 {
-        return Err(c.err(path, "needs at least two orientations (degrees) to tell apart"));
+        return Err(c.err(
+            path,
+            "needs at least two orientations (degrees) to tell apart",
+        ));
     }
     for &v in list {
         c.within(path, v, -360.0, 360.0, "degrees")?;
@@ -224,8 +227,20 @@ pub(super) fn train(
     };
     // Templates of sensor i draw from streams of their own (salted by the obstacle index).
     let template_seed = seed ^ (0x5e05_0000_0000_0000 | i as u64);
-    let set = build_templates(&setup, &part.model, &hypotheses, &unc, draft.templates, template_seed)
-        .map_err(|e| c.err(&format!("obstacles[{i}].sensor"), format!("cannot simulate the templates: {e}")))?;
+    let set = build_templates(
+        &setup,
+        &part.model,
+        &hypotheses,
+        &unc,
+        draft.templates,
+        template_seed,
+    )
+    .map_err(|e| {
+        c.err(
+            &format!("obstacles[{i}].sensor"),
+            format!("cannot simulate the templates: {e}"),
+        )
+    })?;
     if let Some(h) = set.members.iter().position(|m| m.is_empty()) {
         return Err(c.err(
             &format!("obstacles[{i}].sensor.hypotheses"),
