@@ -19,8 +19,9 @@ type R<T> = Result<T, ScenarioError>;
 /// Largest number of sweep points.
 pub const MAX_POINTS: usize = 10_000;
 
-/// Names of the distribution parameters, in the order they are drawn.
-pub const DISTRIBUTION_PARAMETERS: [&str; 8] = [
+/// Names of the distribution parameters, in the order they are drawn (the sensor parameters
+/// last: their streams come after every earlier one, so studies without them draw as before).
+pub const DISTRIBUTION_PARAMETERS: [&str; 12] = [
     "mu_c",
     "belt_speed",
     "shape",
@@ -29,6 +30,19 @@ pub const DISTRIBUTION_PARAMETERS: [&str; 8] = [
     "pin_radius",
     "pose_theta",
     "pose_y",
+    "sensor_noise",
+    "sensor_bias",
+    "sensor_threshold",
+    "sensor_jitter",
+];
+
+/// The parameters that act on sensor pins' settings: a study may give them only for a scenario
+/// with at least one sensor pin.
+pub const SENSOR_PARAMETERS: [&str; 4] = [
+    "sensor_noise",
+    "sensor_bias",
+    "sensor_threshold",
+    "sensor_jitter",
 ];
 
 /// A swept parameter and its values.
@@ -59,6 +73,10 @@ fn slot<'a>(u: &'a RawUncertain, name: &str) -> &'a Option<RawDistribution> {
         "pin_y" => &u.pin_y,
         "pin_radius" => &u.pin_radius,
         "pose_theta" => &u.pose_theta,
+        "sensor_noise" => &u.sensor_noise,
+        "sensor_bias" => &u.sensor_bias,
+        "sensor_threshold" => &u.sensor_threshold,
+        "sensor_jitter" => &u.sensor_jitter,
         _ => &u.pose_y,
     }
 }
@@ -72,6 +90,10 @@ fn slot_mut<'a>(u: &'a mut RawUncertain, name: &str) -> &'a mut Option<RawDistri
         "pin_y" => &mut u.pin_y,
         "pin_radius" => &mut u.pin_radius,
         "pose_theta" => &mut u.pose_theta,
+        "sensor_noise" => &mut u.sensor_noise,
+        "sensor_bias" => &mut u.sensor_bias,
+        "sensor_threshold" => &mut u.sensor_threshold,
+        "sensor_jitter" => &mut u.sensor_jitter,
         _ => &mut u.pose_y,
     }
 }
@@ -81,6 +103,16 @@ fn slot_mut<'a>(u: &'a mut RawUncertain, name: &str) -> &'a mut Option<RawDistri
 pub const LENGTH_ERROR: (f64, f64) = (-1e3, 1e3);
 /// Largest error (degrees) a study may add to the entry orientation.
 pub const ANGLE_ERROR: (f64, f64) = (-360.0, 360.0);
+/// Range of the sensor noise factor (0: an ideal sensor's white noise and jitter).
+pub const SENSOR_NOISE_FACTOR: (f64, f64) = (0.0, 1e6);
+/// Range of the error added to a sensor's force bias (N): the range of the bias itself
+/// ([`crate::sensing::SensorSettings::validate`]).
+pub const SENSOR_BIAS: (f64, f64) = (-1e6, 1e6);
+/// Range of a timing threshold (N, > 0): the sensor's own range
+/// ([`crate::sensing::SensorSettings::validate`]).
+pub const SENSOR_THRESHOLD: (f64, f64) = (1e-9, 1e6);
+/// Range of the error added to a sensor's timing jitter (s): ± the largest jitter a sensor takes.
+pub const SENSOR_JITTER: (f64, f64) = (-10.0, 10.0);
 
 /// The physical range of parameter `name` and its unit (crate::scenario::limits): every value a
 /// study gives (value, min, max, mean, mode) must lie in it, a standard deviation must not exceed
@@ -94,6 +126,13 @@ pub fn domain(name: &str) -> ((f64, f64), &'static str) {
             ANGLE_ERROR,
             "degrees, an error added to the entry orientation",
         ),
+        "sensor_noise" => (
+            SENSOR_NOISE_FACTOR,
+            "a factor multiplying every sensor's white noise and timing jitter",
+        ),
+        "sensor_bias" => (SENSOR_BIAS, "N, added to every sensor's force bias"),
+        "sensor_threshold" => (SENSOR_THRESHOLD, "N, every sensor's timing threshold, > 0"),
+        "sensor_jitter" => (SENSOR_JITTER, "s, added to every sensor's timing jitter"),
         _ => (LENGTH_ERROR, "m, an error added to a length or position"),
     }
 }
@@ -359,6 +398,10 @@ pub fn compile_uncertain(
         pin_radius: d[5],
         pose_theta: d[6],
         pose_y: d[7],
+        sensor_noise: d[8],
+        sensor_bias: d[9],
+        sensor_threshold: d[10],
+        sensor_jitter: d[11],
         support,
     })
 }
@@ -557,4 +600,32 @@ pub fn compile_points(
         out.push(p);
     }
     Ok(out)
+}
+
+/// Sensor parameters need a sensor pin: with none in the scenario, the first sensor parameter the
+/// study gives (an `[uncertain.sensor_*]` table, else a sweep of one) is a located error.
+pub fn check_sensor_parameters(
+    loc: &Locator,
+    u: &RawUncertain,
+    sweeps: &[RawSweep],
+    scenario_has_sensor: bool,
+) -> R<()> {
+    if scenario_has_sensor {
+        return Ok(());
+    }
+    let msg = |name: &str| {
+        format!(
+            "{name} perturbs sensor pins, but the scenario has no sensor pin (kind = \"sensor_pin\"); remove it or point the study at a scenario with one"
+        )
+    };
+    if let Some(name) = SENSOR_PARAMETERS.iter().find(|n| slot(u, n).is_some()) {
+        return Err(err(loc, &format!("uncertain.{name}"), msg(name)));
+    }
+    for (k, s) in sweeps.iter().enumerate() {
+        let name = s.parameter.split('.').next().unwrap_or("");
+        if SENSOR_PARAMETERS.contains(&name) {
+            return Err(err(loc, &format!("sweep[{k}].parameter"), msg(name)));
+        }
+    }
+    Ok(())
 }

@@ -3,7 +3,8 @@
 //!
 //! A study file (TOML, README "Monte Carlo studies") points at a scenario and declares uncertain
 //! parameters — pin–part friction μc, the support model (uniform, a random tripod, a random smooth
-//! density), shape tolerance, pin position and radius errors, entry pose noise, belt speed — and
+//! density), shape tolerance, pin position and radius errors, entry pose noise, belt speed, sensor
+//! pins' noise, bias, timing threshold and jitter — and
 //! optionally sweeps one or two of them over a grid. For each sweep point, N samples are drawn; a
 //! sample is one part through a freshly perturbed line ([`sample`]). Computed per point: the count
 //! of each outcome class, the success rate with its 95% Wilson score interval (and the same interval
@@ -140,6 +141,11 @@ pub fn parse(file: &Path, source: &str, samples: Option<u64>) -> Result<Study, S
     })?;
     let scene =
         crate::scenario::parse(&scenario_file, &scenario_text).map_err(StudyError::Scenario)?;
+    let has_sensor = scene.obstacles.iter().any(|o| match o {
+        crate::scenario::Obstacle::Pin(p) => p.sensor.is_some(),
+        crate::scenario::Obstacle::Fence(_) => false,
+    });
+    compile::check_sensor_parameters(&loc, &raw.uncertain, &raw.sweep, has_sensor)?;
     let declared = compile::compile_uncertain(&loc, &raw.uncertain, scene.part.support)?;
     let axes = compile::compile_sweeps(&loc, &raw.sweep)?;
     let points = if axes.is_empty() {

@@ -67,10 +67,25 @@ pub struct Perturbations {
     /// Error of the entry orientation (degrees) and lateral offset (m).
     pub pose_theta: Option<Distribution>,
     pub pose_y: Option<Distribution>,
+    /// Sensor pins (one draw per sample, applied to every sensor pin): factor on the white-noise
+    /// σ and timing jitter, error added to the force bias (N), the timing threshold (N), error
+    /// added to the timing jitter (s).
+    pub sensor_noise: Option<Distribution>,
+    pub sensor_bias: Option<Distribution>,
+    pub sensor_threshold: Option<Distribution>,
+    pub sensor_jitter: Option<Distribution>,
     pub support: SupportChoice,
 }
 
 impl Perturbations {
+    /// Does any parameter act on sensor pins?
+    pub fn perturbs_sensors(&self) -> bool {
+        self.sensor_noise.is_some()
+            || self.sensor_bias.is_some()
+            || self.sensor_threshold.is_some()
+            || self.sensor_jitter.is_some()
+    }
+
     /// One line per parameter that is not nominal, e.g. `mu_c: uniform [0.3, 0.7]`.
     pub fn describe(&self) -> Vec<String> {
         let mut out = Vec::new();
@@ -83,6 +98,18 @@ impl Perturbations {
             ("pin_radius", &self.pin_radius, " m added"),
             ("pose_theta", &self.pose_theta, "° added"),
             ("pose_y", &self.pose_y, " m added"),
+            (
+                "sensor_noise",
+                &self.sensor_noise,
+                " × every sensor's noise σ and jitter",
+            ),
+            (
+                "sensor_bias",
+                &self.sensor_bias,
+                " N added to the force bias",
+            ),
+            ("sensor_threshold", &self.sensor_threshold, " N"),
+            ("sensor_jitter", &self.sensor_jitter, " s added"),
         ];
         for (name, d, unit) in named {
             if let Some(d) = d {

@@ -62,6 +62,14 @@ pub struct RawUncertain {
     pub pose_y: Option<RawDistribution>,
     /// How the part's weight rests on the belt.
     pub support: Option<RawSupport>,
+    /// Factor multiplying every sensor's white-noise σ (force and torque) and timing jitter.
+    pub sensor_noise: Option<RawDistribution>,
+    /// Added to every sensor's force bias (N, each force channel).
+    pub sensor_bias: Option<RawDistribution>,
+    /// Every sensor's timing threshold (N, its value).
+    pub sensor_threshold: Option<RawDistribution>,
+    /// Added to every sensor's timing jitter (s).
+    pub sensor_jitter: Option<RawDistribution>,
 }
 
 /// Kinds of distribution.

@@ -32,6 +32,10 @@ pub struct StudyHeader {
     pub uncertain: Vec<String>,
     /// The command that regenerates the report.
     pub command: String,
+    /// The line's sensor pins, `name (classifier, kind)`; absent without sensors (the report is
+    /// then what it was before sensors existed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sensors: Vec<String>,
 }
 
 /// A swept parameter in the report.
@@ -70,6 +74,22 @@ impl StudyHeader {
                 "cargo run --release -- mc {file} --samples {}",
                 study.samples
             ),
+            sensors: study
+                .scene
+                .obstacles
+                .iter()
+                .filter_map(|o| match o {
+                    crate::scenario::Obstacle::Pin(p) => p.sensor.as_ref().map(|s| {
+                        format!(
+                            "{} ({}, {})",
+                            p.name,
+                            s.classifier_name,
+                            s.settings.kind.name()
+                        )
+                    }),
+                    crate::scenario::Obstacle::Fence(_) => None,
+                })
+                .collect(),
         }
     }
 
@@ -96,6 +116,18 @@ pub struct Latency {
     pub max: f64,
 }
 
+/// What the sensor pins told, over every reading of a sweep point (all sensor pins together).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SensorShare {
+    /// Passes read by sensor pins.
+    pub readings: u64,
+    /// Readings decided correctly (against the truth the simulator knows).
+    pub correct: u64,
+    /// correct / readings (0 without readings), with its 95% Wilson interval.
+    pub accuracy: f64,
+    pub ci95: [f64; 2],
+}
+
 /// One sweep point of the report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PointReport {
@@ -112,6 +144,9 @@ pub struct PointReport {
     pub latency_s: Option<Latency>,
     pub shape_redraws: u64,
     pub other_redraws: u64,
+    /// Sensor accuracy; only when the line has sensor pins.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<SensorShare>,
 }
 
 /// The whole report.
@@ -174,6 +209,16 @@ fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
         latency_s: latency,
         shape_redraws: t.shape_redraws,
         other_redraws: t.other_redraws,
+        sensor: (!header.sensors.is_empty()).then(|| SensorShare {
+            readings: t.sensor_readings,
+            correct: t.sensor_correct,
+            accuracy: if t.sensor_readings > 0 {
+                t.sensor_correct as f64 / t.sensor_readings as f64
+            } else {
+                0.0
+            },
+            ci95: wilson_interval(t.sensor_correct, t.sensor_readings),
+        }),
     }
 }
 
@@ -227,6 +272,11 @@ pub fn table(r: &McReport) -> String {
         ]
         .map(String::from),
     );
+    let sensing = !r.header.sensors.is_empty();
+    if sensing {
+        head.push("sensor readings".into());
+        head.push("sensor accuracy % [95% CI]".into());
+    }
     let mut s = format!("| {} |\n|{}\n", head.join(" | "), "---|".repeat(head.len()));
     for p in &r.results {
         let mut row: Vec<String> = r
@@ -249,6 +299,19 @@ pub fn table(r: &McReport) -> String {
         }
         row.push(p.shape_redraws.to_string());
         row.push(p.other_redraws.to_string());
+        if let Some(sn) = p.sensor.filter(|_| sensing) {
+            row.push(sn.readings.to_string());
+            row.push(if sn.readings > 0 {
+                format!(
+                    "{:.1}% [{:.1}, {:.1}]",
+                    100.0 * sn.accuracy,
+                    100.0 * sn.ci95[0],
+                    100.0 * sn.ci95[1]
+                )
+            } else {
+                "–".to_string()
+            });
+        }
         s.push_str(&format!("| {} |\n", row.join(" | ")));
     }
     s
@@ -289,6 +352,14 @@ pub fn markdown(r: &McReport, figure: &str) -> String {
                 .map(|v| v.to_string())
                 .collect::<Vec<_>>()
                 .join(", ")
+        ));
+    }
+    if !h.sensors.is_empty() {
+        s.push_str(&format!(
+            "\nSensor pins: {}. Sensor accuracy is the share of their readings decided correctly \
+             (against the truth the simulator knows), all sensor pins together; each classifier is \
+             the one trained on the scenario's nominal sensor.\n",
+            h.sensors.join(", ")
         ));
     }
     s.push_str(&format!("\n![sensitivity]({figure})\n\n"));

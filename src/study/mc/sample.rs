@@ -8,10 +8,12 @@
 //! is drawn afresh for every sample, so the success rate is the probability that a random part on
 //! a random realisation of the line ends in the goal.
 //!
-//! Random streams (DESIGN.md "determinism"): sample i of a study seeded with s draws ten sub-seeds
-//! from `random::stream(s, i)`, in the fixed order μc, belt speed, shape, pin x, pin y, pin radius,
-//! pose θ, pose y, support, feed, and each parameter draws from its own ChaCha8 stream seeded with
-//! its sub-seed. A parameter's draws therefore never depend on how many draws another one needed
+//! Random streams (DESIGN.md "determinism"): sample i of a study seeded with s draws fifteen
+//! sub-seeds from `random::stream(s, i)`, in the fixed order μc, belt speed, shape, pin x, pin y,
+//! pin radius, pose θ, pose y, support, feed, sensor noise, sensor bias, sensor threshold, sensor
+//! jitter, sensor readings, and each parameter draws from its own ChaCha8 stream seeded with its
+//! sub-seed. (The sensor sub-seeds come last, so a study written before they existed draws the same
+//! numbers as it always did.) A parameter's draws therefore never depend on how many draws another one needed
 //! (redraws), on the thread count or on sharding, and sample i sees the same underlying numbers at
 //! every sweep point (common random numbers).
 //!
@@ -27,7 +29,21 @@
 //! * pins: errors added to each pin's x, y and radius; a pin that would leave the belt, sit within
 //!   a + radius of the entry, or get a negative radius is redrawn (counted);
 //! * pose: the scenario's own feed draws the entry orientation and lateral offset, then the pose
-//!   errors are added; the lateral offset is clamped to keep the part on the belt.
+//!   errors are added; the lateral offset is clamped to keep the part on the belt;
+//! * sensors: one value of each sensor parameter, applied to every sensor pin (which is a pin like
+//!   any other for the errors above and keeps its sensor): the jitter error is added to the jitter,
+//!   the bias error to the force bias (torque bias unchanged: a force channel's zero offset puts no
+//!   offset on the torque channels), the threshold replaces the timing threshold, and then the
+//!   noise factor multiplies the white-noise σ of every channel and the jitter
+//!   ([`SensorSettings::with_noise_factor`]). A value that would make some sensor's settings invalid
+//!   (a negative jitter, say) is redrawn (counted). The classifier stays the one trained on the
+//!   scenario's nominal sensor: the study measures a classifier whose sensor is not what it assumed;
+//! * readings: the sensor's noise in sample i is drawn from the sample's own readings sub-seed,
+//!   so readings are independent across samples.
+//!
+//! Obstacles are matched exhaustively: a pin (sensor or not) gets the pin errors; a fence is not a
+//! pin and no study parameter perturbs it yet, so it passes unchanged — explicitly, so that a new
+//! kind of obstacle cannot slip through this step unnoticed.
 
 use super::distribution::Distribution;
 use super::perturbations::{Perturbations, SupportChoice};
@@ -38,9 +54,12 @@ use crate::geometry::{Polygon, Vec2};
 use crate::mechanics::{PartModel, Support};
 use crate::random::{stream, ChaCha8Rng};
 use crate::scenario::{
-    Arrival, Feed, Lateral, Obstacle, Orientation, PartSpec, PinObstacle, Scene, SupportKind,
+    Arrival, Feed, Lateral, Obstacle, Orientation, PartSpec, PinObstacle, Scene, SensorPin,
+    SupportKind,
 };
+use crate::sensing::SensorSettings;
 use rand::{RngExt, SeedableRng};
+use std::sync::Arc;
 
 /// Redraws of a whole polygon before the study gives up.
 pub const MAX_SHAPE_REDRAWS: u32 = 1000;
@@ -57,6 +76,9 @@ pub struct SampleResult {
     pub shape_redraws: u32,
     /// Other values redrawn (out of their domain: negative friction, pins off the belt, …).
     pub other_redraws: u32,
+    /// Readings taken by the line's sensor pins, and those decided correctly (0 without sensors).
+    pub sensor_readings: u32,
+    pub sensor_correct: u32,
 }
 
 /// The per-parameter random streams of one sample.
@@ -71,26 +93,52 @@ struct Streams {
     pose_y: ChaCha8Rng,
     support: ChaCha8Rng,
     feed_seed: u64,
+    sensor_noise: ChaCha8Rng,
+    sensor_bias: ChaCha8Rng,
+    sensor_threshold: ChaCha8Rng,
+    sensor_jitter: ChaCha8Rng,
+    /// Seed of the sample's line run: its sensor readings' noise.
+    readings_seed: u64,
 }
 
 impl Streams {
     fn new(seed: u64, sample: u64) -> Streams {
         let mut master = stream(seed, sample);
         let mut next = || ChaCha8Rng::seed_from_u64(master.random::<u64>());
-        let mut s = Streams {
-            mu_c: next(),
-            belt_speed: next(),
-            shape: next(),
-            pin_x: next(),
-            pin_y: next(),
-            pin_radius: next(),
-            pose_theta: next(),
-            pose_y: next(),
-            support: next(),
-            feed_seed: 0,
-        };
-        s.feed_seed = master.random::<u64>();
-        s
+        let (mu_c, belt_speed, shape, pin_x, pin_y, pin_radius, pose_theta, pose_y, support) = (
+            next(),
+            next(),
+            next(),
+            next(),
+            next(),
+            next(),
+            next(),
+            next(),
+            next(),
+        );
+        let feed_seed = master.random::<u64>();
+        // Appended after the feed's: every earlier sub-seed is what it was before sensors.
+        let mut next = || ChaCha8Rng::seed_from_u64(master.random::<u64>());
+        let (sensor_noise, sensor_bias, sensor_threshold, sensor_jitter) =
+            (next(), next(), next(), next());
+        let readings_seed = master.random::<u64>();
+        Streams {
+            mu_c,
+            belt_speed,
+            shape,
+            pin_x,
+            pin_y,
+            pin_radius,
+            pose_theta,
+            pose_y,
+            support,
+            feed_seed,
+            sensor_noise,
+            sensor_bias,
+            sensor_threshold,
+            sensor_jitter,
+            readings_seed,
+        }
     }
 }
 
@@ -100,6 +148,138 @@ pub struct DrawnScene {
     pub scene: Scene,
     pub shape_redraws: u32,
     pub other_redraws: u32,
+    /// The seed to run the scene with: it draws the sensor readings' noise (0 when the line has
+    /// no sensor pin, as before sensors existed).
+    pub run_seed: u64,
+}
+
+/// One sample's values of the sensor parameters (`None`: the scenario's own setting).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct SensorDraw {
+    noise: Option<f64>,
+    bias: Option<f64>,
+    threshold: Option<f64>,
+    jitter: Option<f64>,
+}
+
+impl SensorDraw {
+    fn is_nominal(&self) -> bool {
+        *self == SensorDraw::default()
+    }
+
+    /// The settings of a sensor under these values (module docs: errors first, then the factor).
+    fn apply(&self, s: &SensorSettings) -> SensorSettings {
+        let mut out = *s;
+        if let Some(b) = self.bias {
+            out.bias_force += b;
+        }
+        if let Some(t) = self.threshold {
+            out.threshold = t;
+        }
+        if let Some(j) = self.jitter {
+            out.jitter += j;
+        }
+        match self.noise {
+            Some(f) => out.with_noise_factor(f),
+            None => out,
+        }
+    }
+}
+
+/// The sensors of the scene's pins.
+fn sensors(scene: &Scene) -> Vec<&SensorPin> {
+    scene
+        .obstacles
+        .iter()
+        .filter_map(|o| match o {
+            Obstacle::Pin(p) => p.sensor.as_deref(),
+            Obstacle::Fence(_) => None,
+        })
+        .collect()
+}
+
+/// Draw the sample's sensor parameters; a value that would make any sensor's settings invalid is
+/// redrawn (counted in `redraws`).
+fn draw_sensor_values(
+    base: &Scene,
+    p: &Perturbations,
+    st: &mut Streams,
+    redraws: &mut u32,
+) -> Result<SensorDraw, String> {
+    if !p.perturbs_sensors() {
+        return Ok(SensorDraw::default());
+    }
+    let sensors = sensors(base);
+    let mut pick = |d: &Option<Distribution>,
+                    rng: &mut ChaCha8Rng,
+                    name: &str,
+                    set: fn(f64) -> SensorDraw|
+     -> Result<Option<f64>, String> {
+        let ok = |v: f64| {
+            super::compile::in_domain(name, v)
+                && sensors
+                    .iter()
+                    .all(|s| set(v).apply(&s.settings).validate().is_ok())
+        };
+        draw_value(d, rng, name, ok, redraws)
+    };
+    Ok(SensorDraw {
+        noise: pick(&p.sensor_noise, &mut st.sensor_noise, "sensor_noise", |v| {
+            SensorDraw {
+                noise: Some(v),
+                ..SensorDraw::default()
+            }
+        })?,
+        bias: pick(&p.sensor_bias, &mut st.sensor_bias, "sensor_bias", |v| {
+            SensorDraw {
+                bias: Some(v),
+                ..SensorDraw::default()
+            }
+        })?,
+        threshold: pick(
+            &p.sensor_threshold,
+            &mut st.sensor_threshold,
+            "sensor_threshold",
+            |v| SensorDraw {
+                threshold: Some(v),
+                ..SensorDraw::default()
+            },
+        )?,
+        jitter: pick(
+            &p.sensor_jitter,
+            &mut st.sensor_jitter,
+            "sensor_jitter",
+            |v| SensorDraw {
+                jitter: Some(v),
+                ..SensorDraw::default()
+            },
+        )?,
+    })
+}
+
+/// A pin's sensor under the sample's sensor values: the same sensor (and trained classifier) with
+/// perturbed settings.
+fn perturb_sensor(
+    pin: &PinObstacle,
+    values: &SensorDraw,
+) -> Result<Option<Arc<SensorPin>>, String> {
+    let Some(sensor) = &pin.sensor else {
+        return Ok(None);
+    };
+    if values.is_nominal() {
+        return Ok(Some(Arc::clone(sensor)));
+    }
+    let settings = values.apply(&sensor.settings);
+    settings.validate().map_err(|e| {
+        format!(
+            "sensor pin `{}`: the perturbed sensor settings are invalid ({e})",
+            pin.name
+        )
+    })?;
+    Ok(Some(Arc::new(SensorPin {
+        settings,
+        ..SensorPin::clone(sensor)
+    })))
 }
 
 fn draw_value(
@@ -178,10 +358,11 @@ fn draw_support(
     })
 }
 
-/// One obstacle of the perturbed line: a pin with its position and radius errors (redrawn until
-/// it lies over the belt, clear of the entry, with a radius ≥ 0) and the sample's μc; any other
-/// kind of obstacle unchanged.
-#[allow(unreachable_patterns)] // other kinds (fences, issue 5) pass through
+/// One obstacle of the perturbed line: a pin (with or without a sensor) with its position and
+/// radius errors (redrawn until it lies over the belt, clear of the entry, with a radius ≥ 0), the
+/// sample's μc and its sensor under the sample's sensor values; a fence unchanged (no parameter
+/// perturbs fences). No catch-all: a new obstacle kind must be handled here.
+#[allow(clippy::too_many_arguments)]
 fn draw_obstacle(
     ob: &Obstacle,
     p: &Perturbations,
@@ -189,11 +370,12 @@ fn draw_obstacle(
     belt: &crate::scenario::Belt,
     radius: f64,
     mu_c: Option<f64>,
+    sensor_values: &SensorDraw,
     other: &mut u32,
 ) -> Result<Obstacle, String> {
     let pin = match ob {
         Obstacle::Pin(pin) => pin,
-        unchanged => return Ok(unchanged.clone()),
+        Obstacle::Fence(fence) => return Ok(Obstacle::Fence(fence.clone())),
     };
     let any = |_: f64| true;
     for _ in 0..=super::distribution::MAX_REDRAWS {
@@ -219,7 +401,7 @@ fn draw_obstacle(
                 centre,
                 radius: r,
                 mu_c: mu_c.unwrap_or(pin.mu_c),
-                sensor: pin.sensor.clone(),
+                sensor: perturb_sensor(pin, sensor_values)?,
             }));
         }
         *other += 1;
@@ -275,11 +457,19 @@ pub fn draw_scene(
         }
     };
     let radius = polygon.radius();
+    let sensor_values = draw_sensor_values(base, p, &mut st, &mut other)?;
 
     let mut obstacles = Vec::with_capacity(base.obstacles.len());
     for ob in &base.obstacles {
         obstacles.push(draw_obstacle(
-            ob, p, &mut st, &belt, radius, mu_c, &mut other,
+            ob,
+            p,
+            &mut st,
+            &belt,
+            radius,
+            mu_c,
+            &sensor_values,
+            &mut other,
         )?);
     }
     let neighbours = neighbours(&obstacles, radius);
@@ -339,10 +529,16 @@ pub fn draw_scene(
         },
         lateral: Lateral::Fixed(y),
     };
+    let run_seed = if sensors(base).is_empty() {
+        0
+    } else {
+        st.readings_seed
+    };
     Ok(DrawnScene {
         scene,
         shape_redraws,
         other_redraws: other,
+        run_seed,
     })
 }
 
@@ -362,7 +558,8 @@ pub fn run_sample(
     let drawn = draw_scene(base, p, seed, sample).map_err(fail)?;
     let opts = RunOptions {
         parts: 1,
-        seed: 0,
+        // The part's pose is fixed in the drawn feed, so the seed draws only sensor readings.
+        seed: drawn.run_seed,
         sample_paths: 0,
         keep_records: true,
     };
@@ -381,11 +578,16 @@ pub fn run_sample(
     let latency_us = outcome
         .exited()
         .then(|| ((record.end_s - record.arrival_s) * 1e6).round().max(1.0) as u64);
+    let sensed = |f: fn(&crate::engine::sensing::SensorStats) -> u64| {
+        run.metrics.sensors.iter().map(f).sum::<u64>() as u32
+    };
     Ok(SampleResult {
         outcome,
         contacts: record.contacts,
         latency_us,
         shape_redraws: drawn.shape_redraws,
         other_redraws: drawn.other_redraws,
+        sensor_readings: sensed(|s| s.readings),
+        sensor_correct: sensed(|s| s.correct),
     })
 }

@@ -121,6 +121,16 @@ pub struct ShardPoint {
     pub other_redraws: u64,
     /// Latency histogram (µs), HdrHistogram V2 serialisation, base64.
     pub latency_us_hdr_v2: String,
+    /// Sensor readings and correct decisions; left out when 0 (a line without sensors writes
+    /// the same shard files as before sensors existed).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sensor_readings: u64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sensor_correct: u64,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 /// Which shard a file holds.
@@ -170,6 +180,8 @@ impl ShardFile {
                     shape_redraws: t.shape_redraws,
                     other_redraws: t.other_redraws,
                     latency_us_hdr_v2: base64::engine::general_purpose::STANDARD.encode(bytes),
+                    sensor_readings: t.sensor_readings,
+                    sensor_correct: t.sensor_correct,
                 }
             })
             .collect();
@@ -224,6 +236,12 @@ impl ShardPoint {
                 self.point
             )
         })?;
+        if self.sensor_correct > self.sensor_readings {
+            return Err(format!(
+                "point {}: {} correct sensor decisions out of {} readings",
+                self.point, self.sensor_correct, self.sensor_readings
+            ));
+        }
         Ok(PointTally {
             samples: self.samples,
             outcomes,
@@ -231,6 +249,8 @@ impl ShardPoint {
             shape_redraws: self.shape_redraws,
             other_redraws: self.other_redraws,
             latency_us,
+            sensor_readings: self.sensor_readings,
+            sensor_correct: self.sensor_correct,
         })
     }
 }

@@ -17,6 +17,10 @@ pub struct PointTally {
     pub other_redraws: u64,
     /// Entry → exit of the parts that reached the end of the belt (µs).
     pub latency_us: Histogram<u64>,
+    /// Sensor readings (passes against sensor pins) and those decided correctly, summed over
+    /// the samples and the line's sensor pins (0 without sensors).
+    pub sensor_readings: u64,
+    pub sensor_correct: u64,
 }
 
 /// An empty latency histogram: 1 µs to 10⁶ s, 3 significant digits.
@@ -34,6 +38,8 @@ impl Default for PointTally {
             shape_redraws: 0,
             other_redraws: 0,
             latency_us: latency_histogram(),
+            sensor_readings: 0,
+            sensor_correct: 0,
         }
     }
 }
@@ -46,6 +52,8 @@ impl PointTally {
         self.contacts += r.contacts as u64;
         self.shape_redraws += r.shape_redraws as u64;
         self.other_redraws += r.other_redraws as u64;
+        self.sensor_readings += r.sensor_readings as u64;
+        self.sensor_correct += r.sensor_correct as u64;
         if let Some(us) = r.latency_us {
             self.latency_us.saturating_record(us);
         }
@@ -60,6 +68,8 @@ impl PointTally {
         self.contacts += o.contacts;
         self.shape_redraws += o.shape_redraws;
         self.other_redraws += o.other_redraws;
+        self.sensor_readings += o.sensor_readings;
+        self.sensor_correct += o.sensor_correct;
         self.latency_us
             .add(&o.latency_us)
             .map_err(|e| format!("latency histograms do not add up: {e:?}"))
