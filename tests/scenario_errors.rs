@@ -121,7 +121,7 @@ fn reserved_obstacle_kind_is_not_yet_supported() {
         "obstacles[0].kind",
         &[
             "\"moving_pin\" is not yet supported",
-            "kind = \"pin\" and kind = \"fence\"",
+            "kind = \"pin\", \"sensor_pin\" and \"fence\"",
         ],
     );
 }
