@@ -62,25 +62,32 @@ pub fn noise_var(sensor: &SensorSettings, c: usize) -> f64 {
     sensor.noise(c).powi(2) + q * q / 12.0
 }
 
-/// The reading's channels with the sensor's known bias and drift removed; `None` when it is empty
-/// or holds a non-finite value.
-pub fn clean_values(s: &Sampled, sensor: &SensorSettings) -> Option<Vec<[f64; CHANNELS]>> {
+/// The reading's channels with the sensor's known bias and drift removed (borrowed when there is
+/// none); `None` when it is empty or holds a non-finite value.
+pub fn clean_values<'a>(
+    s: &'a Sampled,
+    sensor: &SensorSettings,
+) -> Option<std::borrow::Cow<'a, [[f64; CHANNELS]]>> {
+    use std::borrow::Cow;
     if s.values.is_empty() || !s.dt.is_finite() || s.dt <= 0.0 || !s.t0.is_finite() {
         return None;
     }
-    let mut out = Vec::with_capacity(s.values.len());
-    for (k, v) in s.values.iter().enumerate() {
-        let t = k as f64 * s.dt;
-        let mut w = [0.0; CHANNELS];
-        for c in 0..CHANNELS {
-            if !v[c].is_finite() {
-                return None;
-            }
-            w[c] = v[c] - sensor.bias(c) - sensor.drift(c) * t;
-        }
-        out.push(w);
+    if s.values.iter().flatten().any(|x| !x.is_finite()) {
+        return None;
     }
-    Some(out)
+    if (0..CHANNELS).all(|c| sensor.bias(c) == 0.0 && sensor.drift(c) == 0.0) {
+        return Some(Cow::Borrowed(&s.values));
+    }
+    let out = s
+        .values
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let t = k as f64 * s.dt;
+            std::array::from_fn(|c| v[c] - sensor.bias(c) - sensor.drift(c) * t)
+        })
+        .collect();
+    Some(Cow::Owned(out))
 }
 
 /// The contact in samples: first and last index (inclusive) where |(Fx, Fy)| smoothed by a
@@ -103,16 +110,17 @@ pub fn detect(values: &[[f64; CHANNELS]], threshold: f64, window: usize) -> Opti
         py.push(sy);
     }
     let h = window / 2;
-    let mag = |k: usize| {
+    // |mean| ≥ threshold ⇔ |sum|² ≥ (threshold · count)².
+    let above = |k: usize| {
         let lo = k.saturating_sub(h);
         let hi = (k + h).min(n - 1);
         let m = (hi - lo + 1) as f64;
-        let fx = (px[hi + 1] - px[lo]) / m;
-        let fy = (py[hi + 1] - py[lo]) / m;
-        (fx * fx + fy * fy).sqrt()
+        let fx = px[hi + 1] - px[lo];
+        let fy = py[hi + 1] - py[lo];
+        fx * fx + fy * fy >= (threshold * m).powi(2)
     };
-    let first = (0..n).find(|&k| mag(k) >= threshold)?;
-    let last = (first..n).rev().find(|&k| mag(k) >= threshold)?;
+    let first = (0..n).find(|&k| above(k))?;
+    let last = (first..n).rev().find(|&k| above(k))?;
     Some((first, last))
 }
 
@@ -142,8 +150,9 @@ pub fn lowpass(v: &mut [[f64; CHANNELS]], sensor: &SensorSettings) {
     let Some(fc) = sensor.lowpass else { return };
     let a = 1.0 - (-2.0 * std::f64::consts::PI * fc / sensor.rate).exp();
     for k in 1..v.len() {
-        for c in 0..CHANNELS {
-            v[k][c] = v[k - 1][c] + a * (v[k][c] - v[k - 1][c]);
+        let prev = v[k - 1];
+        for (x, p) in v[k].iter_mut().zip(prev) {
+            *x = p + a * (*x - p);
         }
     }
 }

@@ -77,8 +77,9 @@ pub const NAMES: [&str; 4] = ["sign-matrix", "timing", "likelihood", "zero-cross
 ///
 /// Errors: an unknown name (the message lists the known ones), invalid sensor settings or
 /// options, labels and ensembles that do not match, a hypothesis with an empty ensemble (for the
-/// template-based methods), hypotheses other than `vertex`/`edge` for `zero-crossings`, templates
-/// whose contact the detector cannot see.
+/// template-based methods), hypotheses other than `vertex`/`edge` for `zero-crossings`. Templates
+/// whose contact the detector cannot see at this noise level are no error: such a classifier
+/// answers Unknown.
 pub fn build(
     name: &str,
     templates: &TemplateSet,
