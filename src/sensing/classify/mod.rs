@@ -12,6 +12,12 @@
 //! * `zero-crossings` — vertex vs edge by the thesis's rule (≥ 3 zero crossings of the derivative
 //!   of a degree-6 fit), for the `vertex`/`edge` hypotheses.
 
+pub mod common;
+pub mod likelihood;
+pub mod sign_matrix;
+pub mod timing;
+pub mod zero_crossings;
+
 use super::reading::Reading;
 use super::settings::SensorSettings;
 use super::templates::TemplateSet;
@@ -68,15 +74,56 @@ pub trait Classifier: Send + Sync {
 pub const NAMES: [&str; 4] = ["sign-matrix", "timing", "likelihood", "zero-crossings"];
 
 /// Trains the classifier `name` (one of [`NAMES`]) on `templates` for readings of `sensor`.
+///
+/// Errors: an unknown name (the message lists the known ones), invalid sensor settings or
+/// options, labels and ensembles that do not match, a hypothesis with an empty ensemble (for the
+/// template-based methods), hypotheses other than `vertex`/`edge` for `zero-crossings`, templates
+/// whose contact the detector cannot see.
 pub fn build(
     name: &str,
     templates: &TemplateSet,
     sensor: &SensorSettings,
     options: &ClassifierOptions,
 ) -> Result<Box<dyn Classifier>, String> {
-    let _ = (templates, sensor, options);
-    Err(format!(
-        "unknown classifier '{name}'; known: {}",
-        NAMES.join(", ")
-    ))
+    if !NAMES.contains(&name) {
+        return Err(format!(
+            "unknown classifier '{name}'; known: {}",
+            NAMES.join(", ")
+        ));
+    }
+    sensor
+        .validate()
+        .map_err(|e| format!("{name}: sensor settings: {e}"))?;
+    if !(0.0..=1.0).contains(&options.reject_below) {
+        return Err(format!(
+            "{name}: reject_below must lie in [0, 1], got {}",
+            options.reject_below
+        ));
+    }
+    if templates.labels.len() != templates.members.len() {
+        return Err(format!(
+            "{name}: {} labels but {} template ensembles",
+            templates.labels.len(),
+            templates.members.len()
+        ));
+    }
+    if name == "zero-crossings" {
+        return Ok(Box::new(zero_crossings::ZeroCrossings::new(
+            templates, sensor,
+        )?));
+    }
+    if templates.labels.is_empty() {
+        return Err(format!("{name}: no hypotheses"));
+    }
+    if let Some(h) = templates.members.iter().position(|m| m.is_empty()) {
+        return Err(format!(
+            "{name}: hypothesis '{}' has no templates (an empty ensemble cannot be matched)",
+            templates.labels[h]
+        ));
+    }
+    Ok(match name {
+        "sign-matrix" => Box::new(sign_matrix::SignMatrixClassifier::new(templates, sensor)?),
+        "timing" => Box::new(timing::Timing::new(templates, sensor, options)?),
+        _ => Box::new(likelihood::Likelihood::new(templates, sensor, options)?),
+    })
 }

@@ -1,0 +1,260 @@
+//! Helpers shared by the classifiers: the reading's baseline removal, contact detection on an F/T
+//! reading, noise-free template sampling, and least-squares polynomial fits (thesis app. D2, with
+//! nalgebra).
+//!
+//! **Contact detection** (the thesis detects contact by eye; every choice here is ours): the
+//! horizontal force magnitude |(Fx, Fy)| is smoothed by a centred moving average of
+//! [`DETECT_WINDOW`] samples and compared with a threshold T = max(sensor threshold,
+//! [`DETECT_SIGMAS`] · σ_eff), where σ_eff = √(σ² + q²/12)/√window is the smoothed per-channel noise
+//! (white noise σ and quantisation step q of Fx/Fy). The contact is the span from the first sample
+//! above T to the last one. With T six smoothed standard deviations above zero a quiet reading
+//! crosses it with probability ≈ e⁻¹⁸ per sample, so the detector reports no contact rather than a
+//! false one — when the noise grows without bound the F/T classifiers answer Unknown.
+
+use crate::sensing::reading::Sampled;
+use crate::sensing::settings::{SensorSettings, CHANNELS};
+use crate::sensing::signal::ContactSignal;
+use nalgebra::{DMatrix, DVector};
+
+/// Samples in the centred moving average applied to |F| before thresholding.
+pub const DETECT_WINDOW: usize = 5;
+/// Threshold in smoothed noise standard deviations.
+pub const DETECT_SIGMAS: f64 = 6.0;
+
+/// Effective (white + quantisation) noise variance of channel `c`.
+pub fn noise_var(sensor: &SensorSettings, c: usize) -> f64 {
+    let q = sensor.resolution(c);
+    sensor.noise(c).powi(2) + q * q / 12.0
+}
+
+/// The |F| threshold the detector uses for readings of `sensor`.
+pub fn detect_threshold(sensor: &SensorSettings) -> f64 {
+    let var = noise_var(sensor, 0).max(noise_var(sensor, 1));
+    let sd = (var / DETECT_WINDOW as f64).sqrt();
+    sensor.threshold.max(DETECT_SIGMAS * sd)
+}
+
+/// The reading's channels with the sensor's known bias and drift removed; `None` when it is empty
+/// or holds a non-finite value.
+pub fn clean_values(s: &Sampled, sensor: &SensorSettings) -> Option<Vec<[f64; CHANNELS]>> {
+    if s.values.is_empty() || !s.dt.is_finite() || s.dt <= 0.0 || !s.t0.is_finite() {
+        return None;
+    }
+    let mut out = Vec::with_capacity(s.values.len());
+    for (k, v) in s.values.iter().enumerate() {
+        let t = k as f64 * s.dt;
+        let mut w = [0.0; CHANNELS];
+        for c in 0..CHANNELS {
+            if !v[c].is_finite() {
+                return None;
+            }
+            w[c] = v[c] - sensor.bias(c) - sensor.drift(c) * t;
+        }
+        out.push(w);
+    }
+    Some(out)
+}
+
+/// The detected contact in samples: first and last index (inclusive) where the smoothed |(Fx, Fy)|
+/// reaches `threshold`; `None` when it never does.
+pub fn detect(values: &[[f64; CHANNELS]], threshold: f64) -> Option<(usize, usize)> {
+    let n = values.len();
+    if n == 0 {
+        return None;
+    }
+    let h = DETECT_WINDOW / 2;
+    let mag = |k: usize| {
+        let lo = k.saturating_sub(h);
+        let hi = (k + h).min(n - 1);
+        let (mut fx, mut fy) = (0.0, 0.0);
+        for v in &values[lo..=hi] {
+            fx += v[0];
+            fy += v[1];
+        }
+        let m = (hi - lo + 1) as f64;
+        ((fx / m).powi(2) + (fy / m).powi(2)).sqrt()
+    };
+    let first = (0..n).find(|&k| mag(k) >= threshold)?;
+    let last = (first..n).rev().find(|&k| mag(k) >= threshold)?;
+    Some((first, last))
+}
+
+/// The noise-free reading of `signal` at `rate`: samples at t_b − pad + (k + phase)·dt over the
+/// contact and `pad` seconds either side (t_b the first contact begin), with the sensor's low-pass
+/// applied. Returns the samples and the time of sample 0; `None` when the pin never touched.
+pub fn sample_clean(
+    signal: &ContactSignal,
+    sensor: &SensorSettings,
+    pad: f64,
+    phase: f64,
+) -> Option<(f64, Vec<[f64; CHANNELS]>)> {
+    let (b, e) = signal.span()?;
+    let dt = 1.0 / sensor.rate;
+    let t0 = b - pad + phase * dt;
+    let n = (((e + pad) - t0) / dt).ceil().max(1.0) as usize;
+    if n > crate::sensing::reading::MAX_SAMPLES {
+        return None;
+    }
+    let mut v: Vec<[f64; CHANNELS]> = (0..n).map(|k| signal.at(t0 + k as f64 * dt)).collect();
+    lowpass(&mut v, sensor);
+    Some((t0, v))
+}
+
+/// Applies the sensor's first-order low-pass (if any) in place, as the reading model does.
+pub fn lowpass(v: &mut [[f64; CHANNELS]], sensor: &SensorSettings) {
+    let Some(fc) = sensor.lowpass else { return };
+    let a = 1.0 - (-2.0 * std::f64::consts::PI * fc / sensor.rate).exp();
+    for k in 1..v.len() {
+        for c in 0..CHANNELS {
+            v[k][c] = v[k - 1][c] + a * (v[k][c] - v[k - 1][c]);
+        }
+    }
+}
+
+/// A least-squares polynomial fit (thesis app. D2: the normal equations' minimiser, computed here by
+/// SVD for conditioning) of `y` against `x`, with x mapped affinely onto [−1, 1]. Coefficients in
+/// increasing degree of the scaled variable; `None` when there are fewer points than coefficients,
+/// or a value is not finite.
+pub fn polyfit(x: &[f64], y: &[f64], degree: usize) -> Option<Vec<f64>> {
+    let n = x.len();
+    let m = degree + 1;
+    if n != y.len() || n < m || x.iter().chain(y).any(|v| !v.is_finite()) {
+        return None;
+    }
+    let (lo, hi) = (x[0].min(x[n - 1]), x[0].max(x[n - 1]));
+    if hi <= lo {
+        return None;
+    }
+    let a = DMatrix::from_fn(n, m, |i, j| scale(x[i], lo, hi).powi(j as i32));
+    let b = DVector::from_column_slice(y);
+    let svd = a.svd(true, true);
+    let sol = svd.solve(&b, 1e-12).ok()?;
+    let coef: Vec<f64> = sol.iter().copied().collect();
+    coef.iter().all(|c| c.is_finite()).then_some(coef)
+}
+
+/// Maps x from [lo, hi] onto [−1, 1].
+pub fn scale(x: f64, lo: f64, hi: f64) -> f64 {
+    2.0 * (x - lo) / (hi - lo) - 1.0
+}
+
+/// The derivative's coefficients.
+pub fn derivative(p: &[f64]) -> Vec<f64> {
+    p.iter()
+        .enumerate()
+        .skip(1)
+        .map(|(j, c)| j as f64 * c)
+        .collect()
+}
+
+/// Evaluates a polynomial (increasing degree) by Horner's rule.
+pub fn eval(p: &[f64], x: f64) -> f64 {
+    p.iter().rev().fold(0.0, |acc, c| acc * x + c)
+}
+
+/// Sign in {−1, 0, 1}.
+pub fn sign(x: f64) -> i8 {
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Index of the largest finite value when it is unique (others more than `tie` below); `None` on a
+/// tie or when nothing is finite.
+pub fn unique_argmax(v: &[f64], tie: f64) -> Option<usize> {
+    let (i, &best) = v
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| x.is_finite())
+        .max_by(|a, b| a.1.total_cmp(b.1))?;
+    let rivals = v
+        .iter()
+        .enumerate()
+        .filter(|&(j, &x)| j != i && x.is_finite() && x >= best - tie)
+        .count();
+    (rivals == 0).then_some(i)
+}
+
+/// Normalises log-likelihoods into a posterior (equal priors); `None` when none is finite.
+pub fn posterior(ll: &[f64]) -> Option<Vec<f64>> {
+    let m = ll
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !m.is_finite() {
+        return None;
+    }
+    let w: Vec<f64> = ll
+        .iter()
+        .map(|&x| if x.is_finite() { (x - m).exp() } else { 0.0 })
+        .collect();
+    let s: f64 = w.iter().sum();
+    Some(w.iter().map(|x| x / s).collect())
+}
+
+/// log Σ exp(v), −∞ for an empty or all −∞ slice.
+pub fn log_sum_exp(v: &[f64]) -> f64 {
+    let m = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !m.is_finite() {
+        return m;
+    }
+    m + v.iter().map(|x| (x - m).exp()).sum::<f64>().ln()
+}
+
+/// A decision from a posterior with the reject option: the arg-max when it reaches `reject_below`
+/// and is unique, Unknown otherwise.
+pub fn decide(post: Option<Vec<f64>>, reject_below: f64) -> super::Classification {
+    use super::{Classification, Decision};
+    let Some(p) = post else {
+        return Classification::unknown();
+    };
+    let decision = match unique_argmax(&p, 0.0) {
+        Some(i) if p[i] >= reject_below => Decision::Hypothesis(i),
+        _ => Decision::Unknown,
+    };
+    Classification {
+        decision,
+        posterior: Some(p),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polyfit_recovers_a_cubic() {
+        let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
+        let y: Vec<f64> = x.iter().map(|&t| 1.0 - 2.0 * t + 0.5 * t * t * t).collect();
+        let p = polyfit(&x, &y, 3).unwrap();
+        for (&t, &v) in x.iter().zip(&y) {
+            assert!((eval(&p, scale(t, 0.0, 4.9)) - v).abs() < 1e-9);
+        }
+        assert!(polyfit(&x[..3], &y[..3], 3).is_none());
+    }
+
+    #[test]
+    fn detection_finds_a_pulse_and_ignores_quiet() {
+        let mut v = vec![[0.0; CHANNELS]; 100];
+        for s in v.iter_mut().take(70).skip(30) {
+            s[0] = 0.2;
+        }
+        assert_eq!(detect(&v, 0.05), Some((29, 70)));
+        assert_eq!(detect(&vec![[0.0; CHANNELS]; 10], 0.05), None);
+        assert_eq!(detect(&[], 0.05), None);
+    }
+
+    #[test]
+    fn posterior_and_ties() {
+        let p = posterior(&[0.0, 0.0, f64::NEG_INFINITY]).unwrap();
+        assert_eq!(p, vec![0.5, 0.5, 0.0]);
+        assert_eq!(unique_argmax(&p, 0.0), None);
+        assert_eq!(unique_argmax(&[1.0, 2.0], 0.0), Some(1));
+        assert!(posterior(&[f64::NAN]).is_none());
+    }
+}
