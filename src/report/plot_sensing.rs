@@ -21,8 +21,20 @@ pub struct Overlay<'a> {
     pub label: String,
 }
 
+/// Distinct, readable colours (then plotters' palette).
 fn colour(i: usize) -> RGBAColor {
-    Palette99::pick(i).to_rgba()
+    const FIXED: [(u8, u8, u8); 6] = [
+        (214, 39, 40),
+        (31, 119, 180),
+        (44, 160, 44),
+        (255, 127, 14),
+        (148, 103, 189),
+        (140, 86, 75),
+    ];
+    match FIXED.get(i) {
+        Some(&(r, g, b)) => RGBColor(r, g, b).to_rgba(),
+        None => Palette99::pick(i).to_rgba(),
+    }
 }
 
 /// Templates per hypothesis (Fx and Fy panels) with one reading over them.

@@ -266,13 +266,17 @@ impl Evaluation {
 
 /// A classifier factory: [`classify::build`] or a test double.
 pub type Factory<'f> =
-    dyn Fn(&str, &TemplateSet, &SensorSettings) -> Result<Box<dyn Classifier>, String> + 'f;
+    dyn Fn(&str, &TemplateSet, &SensorSettings) -> Result<Box<dyn Classifier>, String> + Sync + 'f;
 
-/// The classifiers that apply to a sensor kind and hypotheses (the default list).
+/// The classifiers that apply to a sensor kind and hypotheses (the default list): an F/T sensor
+/// feeds the thesis's method, the matched filter and the contact duration it shows; a timing sensor
+/// only the durations; vertex/edge adds the thesis's zero-crossing rule.
 pub fn applicable(kind: SensorKind, hyps: &Hypotheses) -> Vec<String> {
     let names: &[&str] = match (kind, hyps) {
         (SensorKind::Timing, _) => &["timing"],
-        (SensorKind::Ft, Hypotheses::Orientations { .. }) => &["sign-matrix", "likelihood"],
+        (SensorKind::Ft, Hypotheses::Orientations { .. }) => {
+            &["sign-matrix", "likelihood", "timing"]
+        }
         (SensorKind::Ft, Hypotheses::VertexEdge { .. }) => &["zero-crossings", "likelihood"],
     };
     names.iter().map(|s| s.to_string()).collect()
