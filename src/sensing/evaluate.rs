@@ -160,9 +160,15 @@ impl Confusion {
         }
     }
 
-    /// 95% Wilson interval of the accuracy.
+    /// 95% Wilson interval of the accuracy (widened by rounding so it always holds the estimate:
+    /// at 100% the formula's upper bound can round to 1 − 2⁻⁵³).
     pub fn accuracy_ci95(&self) -> [f64; 2] {
-        wilson_interval(self.correct(), self.total())
+        let [lo, hi] = wilson_interval(self.correct(), self.total());
+        if self.total() == 0 {
+            return [lo, hi];
+        }
+        let p = self.accuracy();
+        [lo.min(p), hi.max(p)]
     }
 
     /// Plug-in mutual information I(state; decision) in bits, "unknown" a decision of its own.
