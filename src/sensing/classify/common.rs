@@ -3,10 +3,12 @@
 //! nalgebra).
 //!
 //! **Contact detection** (the thesis detects contact by eye; every choice here is ours): the
-//! horizontal force magnitude |(Fx, Fy)| is smoothed by a centred moving average of
-//! [`DETECT_WINDOW`] samples and compared with a threshold T = max(sensor threshold,
-//! [`DETECT_SIGMAS`] · σ_eff), where σ_eff = √(σ² + q²/12)/√window is the smoothed per-channel noise
-//! (white noise σ and quantisation step q of Fx/Fy). The contact is the span from the first sample
+//! horizontal force magnitude |(Fx, Fy)| is smoothed by a centred moving average of w samples and
+//! compared with a threshold T = max(sensor threshold, [`DETECT_SIGMAS`] · σ/√w), σ = √(σ_n² +
+//! q²/12) the per-channel noise of Fx/Fy (white noise σ_n, quantisation step q). The window w is
+//! the smallest of at least [`MIN_WINDOW`] samples that brings 6σ/√w down to the sensor's
+//! threshold, capped at [`MAX_WINDOW_S`] seconds: quiet sensors keep sharp edges, noisy ones
+//! average longer before the threshold has to rise. The contact is the span from the first sample
 //! above T to the last one. With T six smoothed standard deviations above zero a quiet reading
 //! crosses it with probability ≈ e⁻¹⁸ per sample, so the detector reports no contact rather than a
 //! false one — when the noise grows without bound the F/T classifiers answer Unknown.
@@ -16,22 +18,48 @@ use crate::sensing::settings::{SensorSettings, CHANNELS};
 use crate::sensing::signal::ContactSignal;
 use nalgebra::{DMatrix, DVector};
 
-/// Samples in the centred moving average applied to |F| before thresholding.
-pub const DETECT_WINDOW: usize = 5;
+/// Fewest samples in the centred moving average applied to (Fx, Fy) before thresholding.
+pub const MIN_WINDOW: usize = 5;
+/// Longest smoothing window (s).
+pub const MAX_WINDOW_S: f64 = 0.05;
 /// Threshold in smoothed noise standard deviations.
 pub const DETECT_SIGMAS: f64 = 6.0;
+
+/// The contact detector for readings of one sensor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detector {
+    /// Samples in the centred moving average (odd).
+    pub window: usize,
+    /// |F| threshold (N).
+    pub threshold: f64,
+}
+
+impl Detector {
+    pub fn new(sensor: &SensorSettings) -> Detector {
+        let sd = noise_var(sensor, 0).max(noise_var(sensor, 1)).sqrt();
+        let want = (DETECT_SIGMAS * sd / sensor.threshold).powi(2).ceil();
+        let cap = (MAX_WINDOW_S * sensor.rate).floor().max(MIN_WINDOW as f64);
+        let w = want.clamp(MIN_WINDOW as f64, cap) as usize;
+        let window = w | 1;
+        Detector {
+            window,
+            threshold: sensor
+                .threshold
+                .max(DETECT_SIGMAS * sd / (window as f64).sqrt()),
+        }
+    }
+
+    /// The detected contact: first and last sample index (inclusive) where the smoothed
+    /// |(Fx, Fy)| reaches the threshold; `None` when it never does.
+    pub fn detect(&self, values: &[[f64; CHANNELS]]) -> Option<(usize, usize)> {
+        detect(values, self.threshold, self.window)
+    }
+}
 
 /// Effective (white + quantisation) noise variance of channel `c`.
 pub fn noise_var(sensor: &SensorSettings, c: usize) -> f64 {
     let q = sensor.resolution(c);
     sensor.noise(c).powi(2) + q * q / 12.0
-}
-
-/// The |F| threshold the detector uses for readings of `sensor`.
-pub fn detect_threshold(sensor: &SensorSettings) -> f64 {
-    let var = noise_var(sensor, 0).max(noise_var(sensor, 1));
-    let sd = (var / DETECT_WINDOW as f64).sqrt();
-    sensor.threshold.max(DETECT_SIGMAS * sd)
 }
 
 /// The reading's channels with the sensor's known bias and drift removed; `None` when it is empty
@@ -55,24 +83,33 @@ pub fn clean_values(s: &Sampled, sensor: &SensorSettings) -> Option<Vec<[f64; CH
     Some(out)
 }
 
-/// The detected contact in samples: first and last index (inclusive) where the smoothed |(Fx, Fy)|
-/// reaches `threshold`; `None` when it never does.
-pub fn detect(values: &[[f64; CHANNELS]], threshold: f64) -> Option<(usize, usize)> {
+/// The contact in samples: first and last index (inclusive) where |(Fx, Fy)| smoothed by a
+/// centred moving average of `window` samples reaches `threshold`; `None` when it never does.
+pub fn detect(values: &[[f64; CHANNELS]], threshold: f64, window: usize) -> Option<(usize, usize)> {
     let n = values.len();
     if n == 0 {
         return None;
     }
-    let h = DETECT_WINDOW / 2;
+    // Prefix sums make any window O(1) per sample.
+    let mut px = Vec::with_capacity(n + 1);
+    let mut py = Vec::with_capacity(n + 1);
+    let (mut sx, mut sy) = (0.0, 0.0);
+    px.push(0.0);
+    py.push(0.0);
+    for v in values {
+        sx += v[0];
+        sy += v[1];
+        px.push(sx);
+        py.push(sy);
+    }
+    let h = window / 2;
     let mag = |k: usize| {
         let lo = k.saturating_sub(h);
         let hi = (k + h).min(n - 1);
-        let (mut fx, mut fy) = (0.0, 0.0);
-        for v in &values[lo..=hi] {
-            fx += v[0];
-            fy += v[1];
-        }
         let m = (hi - lo + 1) as f64;
-        ((fx / m).powi(2) + (fy / m).powi(2)).sqrt()
+        let fx = (px[hi + 1] - px[lo]) / m;
+        let fy = (py[hi + 1] - py[lo]) / m;
+        (fx * fx + fy * fy).sqrt()
     };
     let first = (0..n).find(|&k| mag(k) >= threshold)?;
     let last = (first..n).rev().find(|&k| mag(k) >= threshold)?;
@@ -244,9 +281,9 @@ mod tests {
         for s in v.iter_mut().take(70).skip(30) {
             s[0] = 0.2;
         }
-        assert_eq!(detect(&v, 0.05), Some((29, 70)));
-        assert_eq!(detect(&vec![[0.0; CHANNELS]; 10], 0.05), None);
-        assert_eq!(detect(&[], 0.05), None);
+        assert_eq!(detect(&v, 0.05, 5), Some((29, 70)));
+        assert_eq!(detect(&vec![[0.0; CHANNELS]; 10], 0.05, 5), None);
+        assert_eq!(detect(&[], 0.05, 5), None);
     }
 
     #[test]

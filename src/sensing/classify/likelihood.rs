@@ -27,7 +27,9 @@
 //! * **Mixture and posterior.** log p(y | h) = log-sum-exp over members − ln n_h (the ensemble
 //!   stands for the declared uncertainty); the posterior normalises over hypotheses with equal
 //!   priors; the reject option answers Unknown when the largest posterior is below
-//!   `reject_below`. No contact detected, empty or non-finite reading → Unknown.
+//!   `reject_below`. No contact detected, empty or non-finite reading → Unknown; when the detector
+//!   cannot see even the noise-free templates' contacts (noise far above the signal) every
+//!   reading is Unknown.
 //!
 //! Works for any hypotheses with templates, including `vertex`/`edge` (the likelihood alternative
 //! to the thesis's zero-crossing rule).
@@ -71,7 +73,7 @@ pub struct Likelihood {
     block: usize,
     blocks: usize,
     lags: usize,
-    threshold: f64,
+    detector: common::Detector,
     sensor: SensorSettings,
     options: ClassifierOptions,
 }
@@ -83,26 +85,24 @@ impl Likelihood {
         options: &ClassifierOptions,
     ) -> Result<Likelihood, String> {
         let dt = 1.0 / sensor.rate;
-        let threshold = common::detect_threshold(sensor);
+        let detector = common::Detector::new(sensor);
         let p = PHASES as f64;
         // Pass 1: spans, the detector's delays, channel scales.
         let mut delays: Vec<f64> = Vec::new();
         let mut longest: f64 = 0.0;
         let mut scale = [0.0f64; CHANNELS];
-        for (h, members) in templates.members.iter().enumerate() {
-            let mut usable = 0;
+        for members in &templates.members {
             for s in members {
                 let Some((b, e)) = s.span() else { continue };
+                longest = longest.max(e - b);
                 let pad = reading::padding(s, sensor.rate);
-                let mut found = false;
                 for ph in 0..PHASES {
                     let phase = (ph as f64 + 0.5) / p;
                     let Some((t0, v)) = common::sample_clean(s, sensor, pad, phase) else {
                         continue;
                     };
-                    if let Some((kb, _)) = common::detect(&v, threshold) {
+                    if let Some((kb, _)) = detector.detect(&v) {
                         delays.push((t0 + kb as f64 * dt - b) / dt);
-                        found = true;
                     }
                     for x in &v {
                         for c in 0..CHANNELS {
@@ -110,18 +110,23 @@ impl Likelihood {
                         }
                     }
                 }
-                if found {
-                    usable += 1;
-                    longest = longest.max(e - b);
-                }
             }
-            if usable == 0 {
-                return Err(format!(
-                    "likelihood: no template of hypothesis '{}' has a contact the detector sees \
-                     (|F| never reaches {threshold} N)",
-                    templates.labels[h]
-                ));
-            }
+        }
+        if delays.is_empty() {
+            // The detector sees none of the templates' contacts at this noise level: no reading
+            // of these pushes will be detected either, so every answer is Unknown.
+            return Ok(Likelihood {
+                base: Vec::new(),
+                members: Vec::new(),
+                ranges: Vec::new(),
+                pre: 0,
+                block: 1,
+                blocks: 0,
+                lags: 0,
+                detector,
+                sensor: *sensor,
+                options: *options,
+            });
         }
         let dmin = delays.iter().copied().fold(f64::INFINITY, f64::min);
         let dmax = delays.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -229,7 +234,7 @@ impl Likelihood {
             block,
             blocks,
             lags,
-            threshold,
+            detector,
             sensor: *sensor,
             options: *options,
         })
@@ -240,7 +245,7 @@ impl Likelihood {
     fn block_sums(&self, r: &Reading) -> Option<Vec<f64>> {
         let Reading::Ft(s) = r else { return None };
         let v = common::clean_values(s, &self.sensor)?;
-        let (kb, _) = common::detect(&v, self.threshold)?;
+        let (kb, _) = self.detector.detect(&v)?;
         let mut y = vec![0.0; USED.len() * self.blocks];
         let first = kb as i64 - self.pre as i64;
         let lo = (-first).max(0) as usize;
@@ -258,6 +263,9 @@ impl Likelihood {
     /// log p(reading | h) per hypothesis (up to a common constant); `None` when no contact is
     /// detected.
     pub fn log_likelihoods(&self, r: &Reading) -> Option<Vec<f64>> {
+        if self.members.is_empty() {
+            return None;
+        }
         let y = self.block_sums(r)?;
         let dims = y.len();
         let mut acc = vec![0.0; self.lags];

@@ -110,25 +110,18 @@ pub fn score(a: &SignMatrix, b: &SignMatrix) -> usize {
 
 impl SignMatrixClassifier {
     pub fn new(templates: &TemplateSet, sensor: &SensorSettings) -> Result<Self, String> {
-        let thr = common::detect_threshold(sensor);
+        let thr = common::Detector::new(sensor);
         let mut matrices = Vec::new();
-        for (h, members) in templates.members.iter().enumerate() {
+        for members in &templates.members {
             let mut mh = Vec::new();
             for s in members {
                 let pad = reading::padding(s, sensor.rate);
                 let Some((_, v)) = common::sample_clean(s, sensor, pad, 0.5) else {
                     continue;
                 };
-                if let Some(m) = common::detect(&v, thr).and_then(|c| sign_matrix(&v, c)) {
+                if let Some(m) = thr.detect(&v).and_then(|c| sign_matrix(&v, c)) {
                     mh.push(m);
                 }
-            }
-            if mh.is_empty() {
-                return Err(format!(
-                    "sign-matrix: no template of hypothesis '{}' has a detectable contact (|F| \
-                     never reaches {thr} N)",
-                    templates.labels[h]
-                ));
             }
             matrices.push(mh);
         }
@@ -138,11 +131,18 @@ impl SignMatrixClassifier {
         })
     }
 
-    /// The mean /40 score of `m` against each hypothesis.
+    /// The mean /40 score of `m` against each hypothesis (−∞ for a hypothesis none of whose
+    /// templates has a contact the detector sees: at that noise level it cannot be matched).
     pub fn scores(&self, m: &SignMatrix) -> Vec<f64> {
         self.matrices
             .iter()
-            .map(|mh| mh.iter().map(|t| score(m, t) as f64).sum::<f64>() / mh.len() as f64)
+            .map(|mh| {
+                if mh.is_empty() {
+                    f64::NEG_INFINITY
+                } else {
+                    mh.iter().map(|t| score(m, t) as f64).sum::<f64>() / mh.len() as f64
+                }
+            })
             .collect()
     }
 }
@@ -159,7 +159,8 @@ impl Classifier for SignMatrixClassifier {
         let Some(v) = common::clean_values(s, &self.sensor) else {
             return Classification::unknown();
         };
-        let Some(m) = common::detect(&v, common::detect_threshold(&self.sensor))
+        let Some(m) = common::Detector::new(&self.sensor)
+            .detect(&v)
             .and_then(|c| sign_matrix(&v, c))
         else {
             return Classification::unknown();

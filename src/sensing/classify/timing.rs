@@ -66,7 +66,7 @@ impl Timing {
             ..*sensor
         };
         let mut rng = crate::random::stream(0, 0); // unused: zero jitter draws nothing that matters
-        let thr = common::detect_threshold(sensor);
+        let thr = common::Detector::new(sensor);
         let dt = 1.0 / sensor.rate;
         let phases = 4;
         let mut timing = Vec::new();
@@ -84,7 +84,7 @@ impl Timing {
                 for p in 0..phases {
                     let phase = (p as f64 + 0.5) / phases as f64;
                     if let Some((_, v)) = common::sample_clean(s, sensor, pad, phase) {
-                        if let Some((b, e)) = common::detect(&v, thr) {
+                        if let Some((b, e)) = thr.detect(&v) {
                             sum += (e - b) as f64 * dt;
                             got += 1;
                         }
@@ -166,8 +166,7 @@ impl Classifier for Timing {
                 let Some(v) = common::clean_values(s, &self.sensor) else {
                     return Classification::unknown();
                 };
-                let Some((b, e)) = common::detect(&v, common::detect_threshold(&self.sensor))
-                else {
+                let Some((b, e)) = common::Detector::new(&self.sensor).detect(&v) else {
                     return Classification::unknown();
                 };
                 (vec![(e - b) as f64 * s.dt], true)

@@ -60,7 +60,7 @@ pub fn derivative_zero_crossings(y: &[f64]) -> Option<usize> {
 
 /// The Fx profile over the detected contact of a reading (bias removed), or `None`.
 fn profile(values: &[[f64; CHANNELS]], sensor: &SensorSettings) -> Option<Vec<f64>> {
-    let (b, e) = common::detect(values, common::detect_threshold(sensor))?;
+    let (b, e) = common::Detector::new(sensor).detect(values)?;
     Some(values[b..=e].iter().map(|v| v[0]).collect())
 }
 
