@@ -41,7 +41,7 @@ pub enum Command {
     /// Merge the shard files of a Monte Carlo study into its report (the same bytes as one run).
     Merge(merge::MergeArgs),
     /// What a sensorised pin can tell: classifiers' confusion, accuracy and information under noise.
-    Sense(sense::SenseArgs),
+    Sense(Box<sense::SenseArgs>),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
     /// Fuzz the inputs (scenario and study files, contacts, polygons) and write results/robustness.md.

@@ -549,13 +549,11 @@ fn plan(a: &SenseArgs) -> Result<Plan> {
     for &f in &a.noise {
         in_range("--noise", f, 0.0, 1e6, "factor on the nominal noise, ≥ 0")?;
     }
-    if a.placement {
-        if a.placement_d.is_empty() || a.placement_d.len() > MAX_PLACEMENT_D {
-            bail!(
-                "--placement-d takes 1 to {MAX_PLACEMENT_D} offsets, got {}",
-                a.placement_d.len()
-            );
-        }
+    if a.placement && (a.placement_d.is_empty() || a.placement_d.len() > MAX_PLACEMENT_D) {
+        bail!(
+            "--placement-d takes 1 to {MAX_PLACEMENT_D} offsets, got {}",
+            a.placement_d.len()
+        );
     }
     let truth = match a.truth.trim() {
         "cycle" => TruthDraw::Cycle,

@@ -57,8 +57,9 @@ pub fn plot_templates(
     let pad = 0.08 * tmax;
     let (t0, t1) = (-pad, tmax + pad);
     let n = 400;
-    // Curves: (hypothesis, member, channel) → points in (ms, N).
-    let mut curves: Vec<(usize, usize, [Vec<(f64, f64)>; 2])> = Vec::new();
+    // Curves: (hypothesis, member, [Fx, Fy] points in (ms, N)).
+    type Curve = (usize, usize, [Vec<(f64, f64)>; 2]);
+    let mut curves: Vec<Curve> = Vec::new();
     for (h, members) in templates.members.iter().enumerate() {
         for (m, s) in members.iter().enumerate() {
             let Some((b, _)) = s.span() else { continue };
