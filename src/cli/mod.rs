@@ -11,6 +11,7 @@ pub mod mc;
 pub mod merge;
 pub mod part;
 pub mod run;
+pub mod sense;
 pub mod stdout;
 
 use clap::{Parser, Subcommand};
@@ -39,6 +40,8 @@ pub enum Command {
     Mc(mc::McArgs),
     /// Merge the shard files of a Monte Carlo study into its report (the same bytes as one run).
     Merge(merge::MergeArgs),
+    /// What a sensorised pin can tell: classifiers' confusion, accuracy and information under noise.
+    Sense(Box<sense::SenseArgs>),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
     /// Fuzz the inputs (scenario and study files, contacts, polygons) and write results/robustness.md.
@@ -55,6 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compare(a) => compare::run(&a),
         Command::Mc(a) => mc::run(&a),
         Command::Merge(a) => merge::run(&a),
+        Command::Sense(a) => sense::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Fuzz(a) => fuzz::run(&a),
     }

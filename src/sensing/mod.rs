@@ -6,9 +6,13 @@
 //! * [`signal`]: the clean force/torque signal of a pass, taken from the push itself;
 //! * [`reading`]: sampling, noise, bias, drift, low-pass and quantisation, or contact instants;
 //! * [`templates`]: hypotheses and their simulated template ensembles under declared uncertainty;
-//! * [`classify`]: classifiers behind one interface.
+//! * [`classify`]: classifiers behind one interface;
+//! * [`evaluate`]: classifiers scored on simulated trials (confusion, accuracy, mutual information);
+//! * [`placement`]: which pin offset and sensor kind tell the hypotheses apart best.
 
 pub mod classify;
+pub mod evaluate;
+pub mod placement;
 pub mod reading;
 pub mod settings;
 pub mod signal;
