@@ -7,7 +7,7 @@ use pinfeed::mechanics::{
 };
 use pinfeed::random::stream;
 use pinfeed::sensing::reading::sample_ft;
-use pinfeed::sensing::signal::{channels, ContactSignal, KnotRecorder, SignalScale, GRAVITY};
+use pinfeed::sensing::signal::{channels, KnotRecorder, GRAVITY};
 use pinfeed::sensing::templates::{simulate, PushSetup};
 use pinfeed::sensing::SensorSettings;
 
