@@ -62,7 +62,7 @@ def pairs_text(c, labels):
         return "all"
     if not p:
         return "none"
-    return ", ".join(f"{labels[i]}\u2009|\u2009{labels[j]}" for i, j in p)
+    return ", ".join(f"{labels[i]}/{labels[j]}" for i, j in p)
 
 
 def last_all_apart(r, name):

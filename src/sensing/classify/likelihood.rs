@@ -297,7 +297,15 @@ impl Likelihood {
         Some(
             self.ranges
                 .iter()
-                .map(|r| log_sum_exp(&per_member[r.clone()]) - (r.len() as f64).ln())
+                .map(|r| {
+                    if r.is_empty() {
+                        // No template of this hypothesis makes a detectable contact: a reading
+                        // with a contact cannot come from it.
+                        f64::NEG_INFINITY
+                    } else {
+                        log_sum_exp(&per_member[r.clone()]) - (r.len() as f64).ln()
+                    }
+                })
                 .collect(),
         )
     }
