@@ -3,7 +3,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::geometry::named;
-use pinfeed::mechanics::{Fidelity, PartModel, Support};
+use pinfeed::mechanics::{PartModel, Support};
 use pinfeed::random::distribution::Distribution;
 use pinfeed::random::stream;
 use pinfeed::sensing::classify::{build, ClassifierOptions};
@@ -15,18 +15,7 @@ use std::hint::black_box;
 fn bench_classify(c: &mut Criterion) {
     let poly = named::part_from_spec("tripoly1").unwrap().scaled(0.02);
     let model = PartModel::new(&poly, &Support::Uniform).unwrap();
-    let setup = PushSetup {
-        polygon: poly.clone(),
-        d: -0.2,
-        pin_radius: 0.0,
-        mu_c: 0.5,
-        mu_s: 0.3,
-        fidelity: Fidelity::Exact,
-        tol: 1e-6,
-        mass: 0.05,
-        belt_speed: 0.05,
-        height: 0.02,
-    };
+    let setup = PushSetup::nominal(poly.clone(), -0.2);
     let deg = [0.0, 135.0, 225.0];
     let hyps = Hypotheses::Orientations {
         labels: deg.iter().map(|d| format!("{d}")).collect(),

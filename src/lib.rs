@@ -22,4 +22,5 @@ pub mod random;
 pub mod report;
 pub mod scenario;
 pub mod sensing;
+pub mod statistics;
 pub mod study;

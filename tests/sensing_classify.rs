@@ -16,18 +16,7 @@ const SEED: u64 = 12;
 fn setup(part: &str, d: f64) -> (PushSetup, PartModel) {
     let poly = named::part_from_spec(part).unwrap().scaled(0.02);
     let model = PartModel::new(&poly, &Support::Uniform).unwrap();
-    let setup = PushSetup {
-        polygon: poly,
-        d,
-        pin_radius: 0.0,
-        mu_c: 0.5,
-        mu_s: 0.3,
-        fidelity: Fidelity::Exact,
-        tol: 1e-6,
-        mass: 0.05,
-        belt_speed: 0.05,
-        height: 0.02,
-    };
+    let setup = PushSetup::nominal(poly, d);
     (setup, model)
 }
 

@@ -3,7 +3,7 @@
 //! across thread counts.
 
 use pinfeed::geometry::named;
-use pinfeed::mechanics::{Fidelity, PartModel, Support};
+use pinfeed::mechanics::{PartModel, Support};
 use pinfeed::random::distribution::Distribution;
 use pinfeed::sensing::classify::{Classification, Classifier, Decision};
 use pinfeed::sensing::evaluate::{
@@ -108,18 +108,7 @@ fn tripoly1(d: f64) -> Fixture {
         labels: degrees.iter().map(|d| format!("{d:.0}")).collect(),
         degrees,
     };
-    let setup = PushSetup {
-        polygon: poly,
-        d,
-        pin_radius: 0.0,
-        mu_c: 0.5,
-        mu_s: 0.3,
-        fidelity: Fidelity::Exact,
-        tol: 1e-6,
-        mass: 0.05,
-        belt_speed: 0.05,
-        height: 0.02,
-    };
+    let setup = PushSetup::nominal(poly, d);
     Fixture { setup, model, hyps }
 }
 

@@ -3,7 +3,7 @@
 
 use pinfeed::geometry::{named, Polygon, Vec2};
 use pinfeed::mechanics::{
-    push, ContactFeature, ContactSettings, Fidelity, Mode, PartModel, Pin, Support, TraceSample,
+    push, ContactFeature, ContactSettings, Mode, PartModel, Pin, Support, TraceSample,
 };
 use pinfeed::random::stream;
 use pinfeed::sensing::reading::sample_ft;
@@ -21,19 +21,13 @@ fn setup(part: &str, scale: f64, mu_c: f64) -> (PushSetup, PartModel) {
 
 fn setup_poly(poly: Polygon, mu_c: f64) -> (PushSetup, PartModel) {
     let model = PartModel::new(&poly, &Support::Uniform).unwrap();
-    let s = PushSetup {
-        polygon: poly,
-        d: 0.0,
-        pin_radius: 0.0,
-        mu_c,
-        mu_s: 0.3,
-        fidelity: Fidelity::Exact,
-        tol: 1e-6,
-        mass: 0.05,
-        belt_speed: 0.05,
-        height: 0.02,
-    };
-    (s, model)
+    (
+        PushSetup {
+            mu_c,
+            ..PushSetup::nominal(poly, 0.0)
+        },
+        model,
+    )
 }
 
 /// Knots of one push with the trace samples (for the per-knot checks).

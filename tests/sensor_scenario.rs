@@ -141,14 +141,22 @@ fn sensor_scene_reads_every_part_and_is_reproducible() {
     let probe = &s[0];
     assert_eq!(probe.readings + probe.untouched, 60);
     assert!(probe.readings >= 55, "{probe:?}");
-    let total: u64 = probe.confusion.iter().flatten().sum();
-    assert_eq!(total, probe.readings);
+    assert_eq!(probe.confusion.total() + probe.unmatched, probe.readings);
+    assert_eq!(
+        probe.unmatched, 0,
+        "every stable-state reading has a nearest state"
+    );
     assert_eq!(a.summary.work.sensor_readings, probe.readings);
     assert_eq!(a.summary.work.classifications, probe.readings);
     assert!(a.summary.work.signal_knots >= 5 * probe.readings);
     // The probe tells 225° from the other two (the thesis's finding at d < 0): that row is right.
-    let k = probe.labels.iter().position(|l| l == "225").unwrap();
-    let row = &probe.confusion[k];
+    let k = probe
+        .confusion
+        .labels
+        .iter()
+        .position(|l| l == "225°")
+        .unwrap();
+    let row = &probe.confusion.counts[k];
     let n: u64 = row.iter().sum();
     assert!(n > 0 && row[k] * 10 >= n * 9, "225° row {row:?}");
 }

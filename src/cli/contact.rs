@@ -186,7 +186,7 @@ pub(crate) fn num(v: f64) -> String {
 }
 
 /// `name must lie in [lo, hi] (what), got v` unless `lo ≤ v ≤ hi` (and v finite).
-fn in_range(name: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<()> {
+pub(crate) fn in_range(name: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<()> {
     if !(v.is_finite() && v >= lo && v <= hi) {
         let kind = if v.is_finite() {
             ""

@@ -12,7 +12,7 @@
 //! headed by the command that regenerates it, `sense.json`, and the SVG figures. The time spent goes
 //! to standard error.
 
-use super::contact::{num, parse_model};
+use super::contact::{in_range, num, parse_model};
 use crate::geometry::named;
 use crate::mechanics::{PartModel, Support};
 use crate::random::distribution::Distribution;
@@ -173,13 +173,10 @@ pub struct SenseArgs {
     pub no_write: bool,
 }
 
-/// Most hypotheses, noise factors, placement offsets, threads.
-pub const MAX_HYPOTHESES: usize = 64;
+/// Most noise factors, placement offsets, threads (hypotheses: [`Hypotheses::orientations`]).
 pub const MAX_FACTORS: usize = 64;
 pub const MAX_PLACEMENT_D: usize = 201;
 pub const MAX_THREADS: usize = 1024;
-/// Orientation sweep of `vertex-edge` (degrees).
-pub const VERTEX_EDGE_STEP_DEG: f64 = 5.0;
 
 /// The declared uncertainty, as reported.
 #[derive(Debug, Serialize)]
@@ -333,19 +330,6 @@ pub fn default_out_dir(part: &str) -> PathBuf {
     Path::new("results").join("sensing").join(name)
 }
 
-/// `flag must lie in [lo, hi] (what), got v` unless finite and within.
-fn in_range(flag: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<()> {
-    if !(v.is_finite() && v >= lo && v <= hi) {
-        bail!(
-            "{flag} must be a finite number in [{}, {}] ({what}), got {}",
-            num(lo),
-            num(hi),
-            num(v)
-        );
-    }
-    Ok(())
-}
-
 /// `flag must be > lo …` for strictly positive quantities.
 fn positive(flag: &str, v: f64, hi: f64, what: &str) -> Result<()> {
     if !(v.is_finite() && v > 0.0 && v <= hi) {
@@ -358,68 +342,26 @@ fn positive(flag: &str, v: f64, hi: f64, what: &str) -> Result<()> {
     Ok(())
 }
 
-fn label_of(deg: f64) -> String {
-    let r = (deg * 10.0).round() / 10.0;
-    if (r - r.round()).abs() < 1e-9 {
-        format!("{}°", r.round())
-    } else {
-        format!("{r:.1}°")
-    }
-}
-
-/// Parse `--hypotheses` for a part.
+/// Parse `--hypotheses` for a part: `stable`, `vertex-edge` or a list of degrees.
 pub fn parse_hypotheses(spec: &str, poly: &crate::geometry::Polygon) -> Result<Hypotheses> {
     let s = spec.trim();
-    match s.to_lowercase().as_str() {
-        "stable" => {
-            let degrees: Vec<f64> = poly
-                .stable_states()
-                .iter()
-                .map(|st| st.theta.to_degrees())
-                .collect();
-            if degrees.len() < 2 {
-                bail!(
-                    "--hypotheses stable: the part has {} stable state(s); list orientations instead (e.g. --hypotheses 0,90)",
-                    degrees.len()
-                );
-            }
-            Ok(Hypotheses::Orientations {
-                labels: degrees.iter().map(|&d| label_of(d)).collect(),
-                degrees,
-            })
-        }
-        "vertex-edge" => Ok(Hypotheses::VertexEdge {
-            degrees: (0..(360.0 / VERTEX_EDGE_STEP_DEG) as usize)
-                .map(|i| i as f64 * VERTEX_EDGE_STEP_DEG)
-                .collect(),
-        }),
+    let hyps = match s.to_lowercase().as_str() {
+        "stable" => Hypotheses::stable_states(poly),
+        "vertex-edge" => Ok(Hypotheses::vertex_edge_sweep()),
         _ => {
-            let mut degrees = Vec::new();
-            for tok in s.split(',') {
-                let t = tok.trim();
-                let v: f64 = t.parse().map_err(|_| {
-                    anyhow!("--hypotheses: '{t}' is not a number of degrees (or give stable or vertex-edge)")
-                })?;
-                if !(v.is_finite() && (0.0..360.0).contains(&v)) {
-                    bail!("--hypotheses: orientation {} is out of range: each must lie in [0, 360) degrees", num(v));
-                }
-                if let Some(&p) = degrees.iter().find(|&&p: &&f64| (p - v).abs() < 1e-9) {
-                    bail!("--hypotheses: orientation {} is listed twice", num(p));
-                }
-                degrees.push(v);
-            }
-            if degrees.len() < 2 || degrees.len() > MAX_HYPOTHESES {
-                bail!(
-                    "--hypotheses: give between 2 and {MAX_HYPOTHESES} orientations, got {}",
-                    degrees.len()
-                );
-            }
-            Ok(Hypotheses::Orientations {
-                labels: degrees.iter().map(|&d| label_of(d)).collect(),
-                degrees,
-            })
+            let degrees = s
+                .split(',')
+                .map(|tok| {
+                    let t = tok.trim();
+                    t.parse::<f64>().map_err(|_| {
+                        anyhow!("--hypotheses: '{t}' is not a number of degrees (or give stable or vertex-edge)")
+                    })
+                })
+                .collect::<Result<Vec<f64>>>()?;
+            Hypotheses::orientations(degrees)
         }
-    }
+    };
+    hyps.map_err(|e| anyhow!("--hypotheses {s}: {e}"))
 }
 
 fn parse_range(spec: &str) -> Result<Distribution> {

@@ -19,6 +19,7 @@ use crate::mechanics::{ContactOutcome, TraceSample};
 use crate::random::stream;
 use crate::scenario::SensorPin;
 use crate::sensing::classify::{Classification, Decision};
+use crate::sensing::confusion::Confusion;
 use crate::sensing::reading::read;
 use crate::sensing::signal::{ContactSignal, SignalScale};
 use crate::sensing::templates::{vertex_edge_class, Hypotheses};
@@ -91,53 +92,34 @@ pub struct SensorStats {
     /// The sensor pin's name.
     pub name: String,
     pub classifier: String,
-    pub labels: Vec<String>,
     /// Passes read.
     pub readings: u64,
     /// Parts that went past the pin without touching it.
     pub untouched: u64,
-    /// confusion[true][decided]: decided = hypothesis index, or `labels.len()` for "unknown";
-    /// a last row counts readings whose truth matches no hypothesis.
-    pub confusion: Vec<Vec<u64>>,
-    /// Readings decided correctly.
-    pub correct: u64,
+    /// Readings whose truth matches no hypothesis (a vertex/edge pass with no first feature).
+    pub unmatched: u64,
+    /// Decisions against the truth, over the readings that have one.
+    pub confusion: Confusion,
 }
 
 impl SensorStats {
     pub fn new(name: &str, sensor: &SensorPin) -> SensorStats {
-        let k = sensor.labels.len();
         SensorStats {
             name: name.to_string(),
             classifier: sensor.classifier_name.clone(),
-            labels: sensor.labels.clone(),
             readings: 0,
             untouched: 0,
-            confusion: vec![vec![0; k + 1]; k + 1],
-            correct: 0,
+            unmatched: 0,
+            confusion: Confusion::new(&sensor.labels),
         }
     }
 
     /// Counts one sensed pass.
     pub fn add(&mut self, p: &SensedPass) {
-        let k = self.labels.len();
         self.readings += 1;
-        let col = match p.classification.decision {
-            Decision::Hypothesis(h) if h < k => h,
-            _ => k,
-        };
-        let row = p.truth.filter(|&t| t < k).unwrap_or(k);
-        self.confusion[row][col] += 1;
-        if row < k && row == col {
-            self.correct += 1;
-        }
-    }
-
-    /// Share of readings decided correctly.
-    pub fn accuracy(&self) -> f64 {
-        if self.readings == 0 {
-            0.0
-        } else {
-            self.correct as f64 / self.readings as f64
+        match p.truth.filter(|&t| t < self.confusion.k()) {
+            Some(t) => self.confusion.add(t, p.classification.decision),
+            None => self.unmatched += 1,
         }
     }
 }

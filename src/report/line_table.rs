@@ -124,30 +124,30 @@ pub fn table(s: &Summary) -> String {
 /// A sensor pin's block: readings, accuracy, untouched parts and the confusion matrix (rows: the
 /// true hypothesis, columns: the decision).
 fn sensor_table(o: &mut String, s: &crate::engine::sensing::SensorStats) {
+    let c = &s.confusion;
     let _ = writeln!(
         o,
         "sensor {:<19}{} readings ({}), {} correct ({:.1}%), {} parts passed untouched",
         s.name,
         s.readings,
         s.classifier,
-        s.correct,
-        100.0 * s.accuracy(),
+        c.correct(),
+        100.0 * c.accuracy(),
         s.untouched
     );
-    let width = s.labels.iter().map(|l| l.len()).max().unwrap_or(0).max(7);
+    if s.unmatched > 0 {
+        let _ = writeln!(o, "  {} readings matched no hypothesis", s.unmatched);
+    }
+    let width = c.labels.iter().map(|l| l.len()).max().unwrap_or(0).max(7);
     let mut head = format!("  {:>width$} →", "true");
-    for l in s.labels.iter().map(String::as_str).chain(["unknown"]) {
+    for l in c.labels.iter().map(String::as_str).chain(["unknown"]) {
         head += &format!(" {l:>width$}");
     }
     let _ = writeln!(o, "{head}");
-    let rows = s.labels.iter().map(String::as_str).chain(["other"]);
-    for (label, row) in rows.zip(&s.confusion) {
-        if label == "other" && row.iter().all(|&c| c == 0) {
-            continue;
-        }
+    for (label, row) in c.labels.iter().zip(&c.counts) {
         let mut line = format!("  {label:>width$}  ");
-        for c in row {
-            line += &format!(" {c:>width$}");
+        for n in row {
+            line += &format!(" {n:>width$}");
         }
         let _ = writeln!(o, "{line}");
     }

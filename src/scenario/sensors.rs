@@ -87,7 +87,10 @@ pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<SensorDraft>
                 format!("must be \"stable\", \"vertex-edge\" or a list of orientations in degrees, got \"{n}\""),
             ))
         }
-        Some(RawHypotheses::Degrees(list)) => (Some(degrees(c, &path("hypotheses"), list)?), false),
+        Some(RawHypotheses::Degrees(list)) => {
+            Hypotheses::orientations(list.clone()).map_err(|e| c.err(&path("hypotheses"), e))?;
+            (Some(list.clone()), false)
+        }
     };
     if classifier == "zero-crossings" && !vertex_edge {
         return Err(c.err(
@@ -125,31 +128,6 @@ pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<SensorDraft>
     })
 }
 
-/// Hypothesis orientations (degrees): finite, within ±360, at least two, no two the same angle.
-fn degrees(c: &Checker, path: &str, list: &[f64]) -> R<Vec<f64>> {
-    if list.len() < 2 {
-        return Err(c.err(
-            path,
-            "needs at least two orientations (degrees) to tell apart",
-        ));
-    }
-    for &v in list {
-        c.within(path, v, -360.0, 360.0, "degrees")?;
-    }
-    for (a, &x) in list.iter().enumerate() {
-        for &y in &list[..a] {
-            let diff = (x - y).rem_euclid(360.0);
-            if diff.min(360.0 - diff) < 1e-9 {
-                return Err(c.err(
-                    path,
-                    format!("orientations {y} and {x} are the same angle: each hypothesis once"),
-                ));
-            }
-        }
-    }
-    Ok(list.to_vec())
-}
-
 /// Mean and standard deviation of the feed's lateral offset (m).
 fn lateral_moments(l: &Lateral) -> (f64, f64) {
     match *l {
@@ -180,32 +158,21 @@ pub(super) fn train(
         Orientation::Stable { jitter, .. } => jitter.to_degrees(),
         Orientation::Uniform => 0.0,
     };
-    let stable: Vec<f64> = part
-        .stable_states
-        .iter()
-        .map(|s| s.theta.to_degrees())
-        .collect();
+    let at_hypotheses = |e: String| c.err(&format!("obstacles[{i}].sensor.hypotheses"), e);
     let hypotheses = if draft.vertex_edge {
-        let degrees = match &feed.orientation {
-            Orientation::Stable { .. } => stable.clone(),
-            Orientation::Uniform => (0..72).map(|k| k as f64 * 5.0).collect(),
-        };
-        Hypotheses::VertexEdge { degrees }
+        match &feed.orientation {
+            // Parts fed in their stable states meet the pin in those states.
+            Orientation::Stable { thetas, .. } => Hypotheses::VertexEdge {
+                degrees: thetas.iter().map(|t| t.to_degrees()).collect(),
+            },
+            Orientation::Uniform => Hypotheses::vertex_edge_sweep(),
+        }
     } else {
-        let degrees = draft.hypotheses.clone().unwrap_or_else(|| stable.clone());
-        if degrees.len() < 2 {
-            return Err(c.err(
-                &format!("obstacles[{i}].sensor.hypotheses"),
-                format!(
-                    "the part has {} stable state(s): list at least two orientations to tell apart",
-                    degrees.len()
-                ),
-            ));
+        match &draft.hypotheses {
+            Some(degrees) => Hypotheses::orientations(degrees.clone()),
+            None => Hypotheses::stable_states(&part.polygon),
         }
-        Hypotheses::Orientations {
-            labels: degrees.iter().map(|d| label(*d)).collect(),
-            degrees,
-        }
+        .map_err(at_hypotheses)?
     };
     let setup = PushSetup {
         polygon: part.polygon.clone(),
@@ -266,10 +233,4 @@ pub(super) fn train(
         template_d_sd,
         classifier: std::sync::Arc::from(classifier),
     })
-}
-
-/// A hypothesis label: the orientation in degrees, shortest form.
-pub fn label(deg: f64) -> String {
-    let r = (deg * 1000.0).round() / 1000.0;
-    format!("{r}")
 }

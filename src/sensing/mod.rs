@@ -7,10 +7,12 @@
 //! * [`reading`]: sampling, noise, bias, drift, low-pass and quantisation, or contact instants;
 //! * [`templates`]: hypotheses and their simulated template ensembles under declared uncertainty;
 //! * [`classify`]: classifiers behind one interface;
+//! * [`confusion`]: confusion matrices, accuracy and mutual information;
 //! * [`evaluate`]: classifiers scored on simulated trials (confusion, accuracy, mutual information);
 //! * [`placement`]: which pin offset and sensor kind tell the hypotheses apart best.
 
 pub mod classify;
+pub mod confusion;
 pub mod evaluate;
 pub mod placement;
 pub mod reading;

@@ -73,8 +73,8 @@ pub fn padding(signal: &ContactSignal, rate: f64) -> f64 {
 /// The largest number of samples one reading may hold (memory bound: 2·10⁵ samples of 6 channels,
 /// 9.6 MB; e.g. 200 s of contact at 1 kHz). A longer window is not read (the sensor reports nothing).
 pub const MAX_SAMPLES: usize = 200_000;
-/// The most samples a classifier may hold over all its templates (memory bound: 10⁷ samples of 6
-/// channels, 480 MB); training a larger set is refused with a message naming the sizes.
+/// The most samples a classifier's training may draw over all its templates (10⁷ samples of 6
+/// channels: bounded time and memory); a larger set is refused with a message naming the sizes.
 pub const MAX_TEMPLATE_SAMPLES: usize = 10_000_000;
 
 /// Samples a reading of `signal` at `rate` would hold (0 without contact).
@@ -85,49 +85,80 @@ pub fn samples_needed(signal: &ContactSignal, rate: f64) -> usize {
     }
 }
 
-/// Samples `signal` with `sensor` (noise, bias, drift, low-pass, quantisation) over the contact and
-/// its padding; `None` when the pin never touched or the window would exceed [`MAX_SAMPLES`].
+/// The sampling window of a reading of `signal` at `rate` with sampling phase `phase` ∈ [0, 1)
+/// (a fraction of the period): the time of sample 0 and the number of samples, covering the
+/// contact and [`padding`] either side. `None` when the pin never touched or the window would
+/// exceed [`MAX_SAMPLES`].
+pub fn window(signal: &ContactSignal, rate: f64, phase: f64) -> Option<(f64, usize)> {
+    let (b, e) = signal.span()?;
+    let pad = padding(signal, rate);
+    let dt = 1.0 / rate;
+    let start = b - pad;
+    let n = (((e + pad) - start) / dt).ceil() as usize + 1;
+    (n <= MAX_SAMPLES).then_some((start + phase * dt, n))
+}
+
+/// The sensor's first-order low-pass (if any), in place: y_k = y_{k−1} + α (x_k − y_{k−1}),
+/// y_0 = x_0, α = 1 − e^{−2π f_c / rate}.
+pub fn lowpass(values: &mut [[f64; CHANNELS]], sensor: &SensorSettings) {
+    let Some(fc) = sensor.lowpass else { return };
+    let a = 1.0 - (-2.0 * std::f64::consts::PI * fc / sensor.rate).exp();
+    for k in 1..values.len() {
+        let prev = values[k - 1];
+        for (x, p) in values[k].iter_mut().zip(prev) {
+            *x = p + a * (*x - p);
+        }
+    }
+}
+
+/// The noise-free reading of `signal` (the sensor's low-pass applied, nothing else) over the
+/// [`window`] with sampling phase `phase`: the time of sample 0 and the samples. What a classifier's
+/// templates look like to this sensor.
+pub fn sample_clean(
+    signal: &ContactSignal,
+    sensor: &SensorSettings,
+    phase: f64,
+) -> Option<(f64, Vec<[f64; CHANNELS]>)> {
+    let (t0, n) = window(signal, sensor.rate, phase)?;
+    let dt = 1.0 / sensor.rate;
+    let mut values: Vec<[f64; CHANNELS]> = (0..n).map(|k| signal.at(t0 + k as f64 * dt)).collect();
+    lowpass(&mut values, sensor);
+    Some((t0, values))
+}
+
+/// Samples `signal` with `sensor` (noise, bias, drift, low-pass, quantisation) over the
+/// [`window`], with a sampling phase drawn uniformly; `None` when the pin never touched or the
+/// window would exceed [`MAX_SAMPLES`].
 pub fn sample_ft(
     signal: &ContactSignal,
     sensor: &SensorSettings,
     rng: &mut impl rand::Rng,
 ) -> Option<Sampled> {
-    let (b, e) = signal.span()?;
-    let pad = padding(signal, sensor.rate);
+    let phase: f64 = rng.random::<f64>();
+    let (t0, n) = window(signal, sensor.rate, phase)?;
     let dt = 1.0 / sensor.rate;
-    let phase: f64 = rng.random::<f64>() * dt;
-    let start = b - pad;
-    let n = (((e + pad) - start) / dt).ceil() as usize + 1;
-    if n > MAX_SAMPLES {
-        return None;
-    }
-    let t0 = start + phase;
-    let alpha = sensor
-        .lowpass
-        .map(|fc| 1.0 - (-2.0 * std::f64::consts::PI * fc * dt).exp());
-    let mut state = [0.0; CHANNELS];
-    let mut values = Vec::with_capacity(n);
+    let mut values: Vec<[f64; CHANNELS]> = Vec::with_capacity(n);
     for k in 0..n {
         let t = t0 + k as f64 * dt;
         let clean = signal.at(t);
-        let mut out = [0.0; CHANNELS];
-        for c in 0..CHANNELS {
+        values.push(std::array::from_fn(|c| {
             let noise = if sensor.noise(c) > 0.0 {
                 let z: f64 = StandardNormal.sample(rng);
                 sensor.noise(c) * z
             } else {
                 0.0
             };
-            let x = clean[c] + sensor.bias(c) + sensor.drift(c) * (t - t0) + noise;
-            let y = match alpha {
-                Some(a) if k > 0 => state[c] + a * (x - state[c]),
-                _ => x,
-            };
-            state[c] = y;
+            clean[c] + sensor.bias(c) + sensor.drift(c) * (t - t0) + noise
+        }));
+    }
+    lowpass(&mut values, sensor);
+    for v in &mut values {
+        for (c, x) in v.iter_mut().enumerate() {
             let q = sensor.resolution(c);
-            out[c] = if q > 0.0 { q * (y / q).round() } else { y };
+            if q > 0.0 {
+                *x = q * (*x / q).round();
+            }
         }
-        values.push(out);
     }
     Some(Sampled { t0, dt, values })
 }

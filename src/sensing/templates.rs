@@ -41,6 +41,24 @@ pub struct PushSetup {
 }
 
 impl PushSetup {
+    /// The nominal push of `pinfeed sense`'s defaults for `polygon` (in metres) at offset `d`: a
+    /// point pin, μc 0.5, μs 0.3, the exact model at tolerance 1e-6, a 50 g part on a 5 cm/s belt,
+    /// the sensor origin 2 cm above the contact.
+    pub fn nominal(polygon: Polygon, d: f64) -> PushSetup {
+        PushSetup {
+            polygon,
+            d,
+            pin_radius: 0.0,
+            mu_c: 0.5,
+            mu_s: 0.3,
+            fidelity: Fidelity::Exact,
+            tol: 1e-6,
+            mass: 0.05,
+            belt_speed: 0.05,
+            height: 0.02,
+        }
+    }
+
     /// The signal scale of this setup (lengths already in metres).
     pub fn scale(&self) -> SignalScale {
         SignalScale {
@@ -105,6 +123,78 @@ impl Hypotheses {
     }
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+}
+
+/// Most hypotheses a sensor is asked to tell apart.
+pub const MAX_HYPOTHESES: usize = 64;
+/// Orientation step (degrees) of the pushes drawn for vertex/edge hypotheses over any orientation.
+pub const VERTEX_EDGE_STEP_DEG: f64 = 5.0;
+
+impl Hypotheses {
+    /// The part's stable states (SPEC §1), labelled by their orientation; at least two are needed.
+    pub fn stable_states(poly: &Polygon) -> Result<Hypotheses, String> {
+        let degrees: Vec<f64> = poly
+            .stable_states()
+            .iter()
+            .map(|s| s.theta.to_degrees())
+            .collect();
+        if degrees.len() < 2 {
+            return Err(format!(
+                "the part has {} stable state(s): list at least two orientations (degrees) to tell apart",
+                degrees.len()
+            ));
+        }
+        Hypotheses::orientations(degrees)
+    }
+
+    /// Listed orientations (degrees): each finite and within ±360, between 2 and
+    /// [`MAX_HYPOTHESES`] of them, no two the same angle (modulo 360°).
+    pub fn orientations(degrees: Vec<f64>) -> Result<Hypotheses, String> {
+        if degrees.len() < 2 || degrees.len() > MAX_HYPOTHESES {
+            return Err(format!(
+                "give between 2 and {MAX_HYPOTHESES} orientations (degrees), got {}",
+                degrees.len()
+            ));
+        }
+        for (i, &x) in degrees.iter().enumerate() {
+            if !(x.is_finite() && (-360.0..=360.0).contains(&x)) {
+                return Err(format!(
+                    "orientation {x} is out of range: each must lie in [-360, 360] degrees"
+                ));
+            }
+            for &y in &degrees[..i] {
+                let diff = (x - y).rem_euclid(360.0);
+                if diff.min(360.0 - diff) < 1e-9 {
+                    return Err(format!(
+                        "orientations {y} and {x} are the same angle: list each hypothesis once"
+                    ));
+                }
+            }
+        }
+        Ok(Hypotheses::Orientations {
+            labels: degrees.iter().map(|&d| orientation_label(d)).collect(),
+            degrees,
+        })
+    }
+
+    /// Vertex or edge first contact over orientations every [`VERTEX_EDGE_STEP_DEG`].
+    pub fn vertex_edge_sweep() -> Hypotheses {
+        Hypotheses::VertexEdge {
+            degrees: (0..(360.0 / VERTEX_EDGE_STEP_DEG) as usize)
+                .map(|i| i as f64 * VERTEX_EDGE_STEP_DEG)
+                .collect(),
+        }
+    }
+}
+
+/// The label of an orientation hypothesis: degrees to one decimal, e.g. `135°`, `206.6°`.
+pub fn orientation_label(deg: f64) -> String {
+    let r = (deg * 10.0).round() / 10.0;
+    if (r - r.round()).abs() < 1e-9 {
+        format!("{}°", r.round())
+    } else {
+        format!("{r:.1}°")
     }
 }
 

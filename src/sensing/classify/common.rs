@@ -15,7 +15,6 @@
 
 use crate::sensing::reading::Sampled;
 use crate::sensing::settings::{SensorSettings, CHANNELS};
-use crate::sensing::signal::ContactSignal;
 use nalgebra::{DMatrix, DVector};
 
 /// Fewest samples in the centred moving average applied to (Fx, Fy) before thresholding.
@@ -122,39 +121,6 @@ pub fn detect(values: &[[f64; CHANNELS]], threshold: f64, window: usize) -> Opti
     let first = (0..n).find(|&k| above(k))?;
     let last = (first..n).rev().find(|&k| above(k))?;
     Some((first, last))
-}
-
-/// The noise-free reading of `signal` at `rate`: samples at t_b − pad + (k + phase)·dt over the
-/// contact and `pad` seconds either side (t_b the first contact begin), with the sensor's low-pass
-/// applied. Returns the samples and the time of sample 0; `None` when the pin never touched.
-pub fn sample_clean(
-    signal: &ContactSignal,
-    sensor: &SensorSettings,
-    pad: f64,
-    phase: f64,
-) -> Option<(f64, Vec<[f64; CHANNELS]>)> {
-    let (b, e) = signal.span()?;
-    let dt = 1.0 / sensor.rate;
-    let t0 = b - pad + phase * dt;
-    let n = (((e + pad) - t0) / dt).ceil().max(1.0) as usize;
-    if n > crate::sensing::reading::MAX_SAMPLES {
-        return None;
-    }
-    let mut v: Vec<[f64; CHANNELS]> = (0..n).map(|k| signal.at(t0 + k as f64 * dt)).collect();
-    lowpass(&mut v, sensor);
-    Some((t0, v))
-}
-
-/// Applies the sensor's first-order low-pass (if any) in place, as the reading model does.
-pub fn lowpass(v: &mut [[f64; CHANNELS]], sensor: &SensorSettings) {
-    let Some(fc) = sensor.lowpass else { return };
-    let a = 1.0 - (-2.0 * std::f64::consts::PI * fc / sensor.rate).exp();
-    for k in 1..v.len() {
-        let prev = v[k - 1];
-        for (x, p) in v[k].iter_mut().zip(prev) {
-            *x = p + a * (*x - p);
-        }
-    }
 }
 
 /// A least-squares polynomial fit (thesis app. D2: the normal equations' minimiser, computed here by

@@ -96,10 +96,9 @@ impl Likelihood {
             for s in members {
                 let Some((b, e)) = s.span() else { continue };
                 longest = longest.max(e - b);
-                let pad = reading::padding(s, sensor.rate);
                 for ph in 0..PHASES {
                     let phase = (ph as f64 + 0.5) / p;
-                    let Some((t0, v)) = common::sample_clean(s, sensor, pad, phase) else {
+                    let Some((t0, v)) = reading::sample_clean(s, sensor, phase) else {
                         continue;
                     };
                     if let Some((kb, _)) = detector.detect(&v) {
@@ -186,7 +185,7 @@ impl Likelihood {
                         let ph = o.rem_euclid(PHASES as i64) as usize;
                         let off = (l - l_lo) as usize;
                         let mut v: Vec<[f64; CHANNELS]> = fine[ph][off..off + frame].to_vec();
-                        common::lowpass(&mut v, sensor);
+                        reading::lowpass(&mut v, sensor);
                         let mut out = vec![0.0; dims];
                         for (ci, &c) in USED.iter().enumerate() {
                             for (i, x) in v.iter().enumerate() {

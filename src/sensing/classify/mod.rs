@@ -108,6 +108,20 @@ pub fn build(
             templates.members.len()
         ));
     }
+    // Training samples every template at the sensor's rate: bound the work and the memory.
+    let samples: usize = templates
+        .members
+        .iter()
+        .flatten()
+        .map(|s| super::reading::samples_needed(s, sensor.rate))
+        .sum();
+    if samples > super::reading::MAX_TEMPLATE_SAMPLES {
+        return Err(format!(
+            "{name}: the templates would hold {samples} samples at {} Hz (at most {}): lower the rate or the number of templates",
+            sensor.rate,
+            super::reading::MAX_TEMPLATE_SAMPLES
+        ));
+    }
     if name == "zero-crossings" {
         return Ok(Box::new(zero_crossings::ZeroCrossings::new(
             templates, sensor,

@@ -115,8 +115,7 @@ impl SignMatrixClassifier {
         for members in &templates.members {
             let mut mh = Vec::new();
             for s in members {
-                let pad = reading::padding(s, sensor.rate);
-                let Some((_, v)) = common::sample_clean(s, sensor, pad, 0.5) else {
+                let Some((_, v)) = reading::sample_clean(s, sensor, 0.5) else {
                     continue;
                 };
                 if let Some(m) = thr.detect(&v).and_then(|c| sign_matrix(&v, c)) {

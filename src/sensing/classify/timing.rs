@@ -78,12 +78,11 @@ impl Timing {
             let mut fh = Vec::new();
             for s in members {
                 th.push(reading::sample_timing(s, &exact, &mut rng).durations());
-                let pad = reading::padding(s, sensor.rate);
                 let mut sum = 0.0;
                 let mut got = 0;
                 for p in 0..phases {
                     let phase = (p as f64 + 0.5) / phases as f64;
-                    if let Some((_, v)) = common::sample_clean(s, sensor, pad, phase) {
+                    if let Some((_, v)) = reading::sample_clean(s, sensor, phase) {
                         if let Some((b, e)) = thr.detect(&v) {
                             sum += (e - b) as f64 * dt;
                             got += 1;

@@ -8,7 +8,7 @@
 //! success rate and the measured samples per second.
 
 use super::{run, Study, StudyError};
-use crate::engine::metrics::wilson_interval;
+use crate::statistics::wilson_interval;
 use serde::Serialize;
 use std::time::Instant;
 

@@ -7,8 +7,8 @@
 
 use super::tally::PointTally;
 use super::Study;
-use crate::engine::metrics::wilson_interval;
 use crate::engine::{OutcomeCounts, PartOutcome};
+use crate::statistics::wilson_interval;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 

@@ -588,6 +588,6 @@ pub fn run_sample(
         shape_redraws: drawn.shape_redraws,
         other_redraws: drawn.other_redraws,
         sensor_readings: sensed(|s| s.readings),
-        sensor_correct: sensed(|s| s.correct),
+        sensor_correct: sensed(|s| s.confusion.correct()),
     })
 }
