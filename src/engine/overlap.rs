@@ -16,30 +16,7 @@
 
 use crate::geometry::Vec2;
 
-/// Distance from point `p` to segment [a, b].
-pub fn point_segment_distance(p: Vec2, a: Vec2, b: Vec2) -> f64 {
-    let e = b - a;
-    let l2 = e.norm2();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(e) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + e * t - p).norm()
-}
-
-pub use crate::geometry::polygon::segments_intersect;
-
-/// Distance between segments [p1, p2] and [q1, q2] (0 if they intersect).
-pub fn segment_distance(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> f64 {
-    if segments_intersect(p1, p2, q1, q2) {
-        return 0.0;
-    }
-    point_segment_distance(p1, q1, q2)
-        .min(point_segment_distance(p2, q1, q2))
-        .min(point_segment_distance(q1, p1, p2))
-        .min(point_segment_distance(q2, p1, p2))
-}
+pub use crate::geometry::segment::{point_segment_distance, segment_distance, segments_intersect};
 
 /// Is `p` strictly inside the polygon with vertices `v` (crossing-number test)?
 pub fn point_in_polygon(p: Vec2, v: &[Vec2]) -> bool {

@@ -5,6 +5,7 @@
 pub mod first_contact;
 pub mod named;
 pub mod polygon;
+pub mod segment;
 pub mod vec2;
 
 pub use first_contact::{first_contact, first_contact_travelling_x, Feature, FirstContact};

@@ -22,7 +22,7 @@ use super::compile::Checker;
 use super::raw::{ObstacleKind, RawObstacle};
 use super::scene::{Belt, FenceObstacle, Obstacle, PinObstacle};
 use super::ScenarioError;
-use crate::engine::overlap::segment_distance;
+use crate::geometry::segment::segment_distance;
 use crate::geometry::Vec2;
 
 type R<T> = Result<T, ScenarioError>;
