@@ -321,3 +321,84 @@ fn interpolated_signal_converges_under_refinement() {
         }
     }
 }
+
+/// Sampling a signal in one sweep gives exactly the values of `at` at every instant, across events,
+/// gaps between contacts and the quiet either side, on real pushes and on a made-up pass with two
+/// contacts.
+#[test]
+fn sweep_sampling_equals_pointwise_evaluation() {
+    for part in ["tripoly1", "tripoly2", "lshape"] {
+        let (s, model) = setup(part, 0.02, 0.5);
+        for th in (0..24).map(|k| k as f64 * 15.0 + 1.0) {
+            for d in [-0.8, -0.5, -0.2, 0.1, 0.4, 0.7] {
+                let pass = simulate(&s, &model, th, d, 0.5);
+                let Some((b, e)) = pass.signal.span() else {
+                    continue;
+                };
+                let (t0, dt) = (b - 0.05, (e - b + 0.1) / 997.0);
+                let swept = pass.signal.sample(t0, dt, 1000);
+                for (k, v) in swept.iter().enumerate() {
+                    assert_eq!(
+                        *v,
+                        pass.signal.at(t0 + k as f64 * dt),
+                        "{part} θ0={th} d={d} k={k}"
+                    );
+                }
+            }
+        }
+    }
+    // Real pushes rarely strike twice; a made-up pass with two contacts, an event inside the
+    // first (a mode switch: knots on both sides at one instant) and a gap between them.
+    let knot = |s: f64, fx: f64, mode: Mode, feature: ContactFeature| TraceSample {
+        s,
+        pose: pinfeed::geometry::Pose::new(0.0, 0.0, 0.0),
+        pin_centre: Vec2::new(0.0, 0.0),
+        contact_point: Vec2::new(0.0, 0.0),
+        force: Vec2::new(fx, 0.1 * fx),
+        normal: Vec2::new(-1.0, 0.0),
+        rotation_rate: 0.0,
+        mode,
+        feature,
+    };
+    let (e0, e1) = (ContactFeature::Edge(0), ContactFeature::Edge(1));
+    let samples = vec![
+        knot(1.0, -0.2, Mode::Stick, e0),
+        knot(1.3, -0.5, Mode::Stick, e0),
+        knot(1.5, -0.6, Mode::Stick, e0),
+        knot(1.5, -0.6, Mode::SlideLeft, e0),
+        knot(2.0, -0.3, Mode::SlideLeft, e0),
+        knot(3.0, -0.4, Mode::Stick, e1),
+        knot(3.6, -0.9, Mode::Stick, e1),
+        knot(4.0, -0.1, Mode::Stick, e1),
+    ];
+    let seg = |a: f64, b: f64, mode: Mode, feature: ContactFeature| pinfeed::mechanics::Segment {
+        feature,
+        mode,
+        s_begin: a,
+        s_end: b,
+        theta_begin: 0.0,
+        theta_end: 0.0,
+    };
+    let mut outcome = push(
+        &setup("square", 1.0, 0.5).1,
+        pinfeed::geometry::Pose::new(0.0, 0.0, 0.0),
+        Vec2::new(2.0, 0.0),
+        &Pin::point(),
+        &ContactSettings::default(),
+        None,
+    );
+    outcome.segments = vec![
+        seg(1.0, 1.5, Mode::Stick, e0),
+        seg(1.5, 2.0, Mode::SlideLeft, e0),
+        seg(3.0, 4.0, Mode::Stick, e1),
+    ];
+    let scale = PushSetup::nominal(named::part_from_spec("square").unwrap(), 0.0).scale();
+    let made = pinfeed::sensing::ContactSignal::new(&outcome, &samples, &scale);
+    assert_eq!(made.contacts.len(), 2);
+    let (t0, dt) = (0.5 / 0.05, 4.0 / 0.05 / 1000.0);
+    let swept = made.sample(t0, dt, 1000);
+    for (k, v) in swept.iter().enumerate() {
+        assert_eq!(*v, made.at(t0 + k as f64 * dt), "made-up pass, k={k}");
+    }
+    assert!(swept.iter().any(|v| v[0] == 0.0) && swept.iter().any(|v| v[0] > 0.0));
+}

@@ -121,7 +121,7 @@ pub fn sample_clean(
 ) -> Option<(f64, Vec<[f64; CHANNELS]>)> {
     let (t0, n) = window(signal, sensor.rate, phase)?;
     let dt = 1.0 / sensor.rate;
-    let mut values: Vec<[f64; CHANNELS]> = (0..n).map(|k| signal.at(t0 + k as f64 * dt)).collect();
+    let mut values = signal.sample(t0, dt, n);
     lowpass(&mut values, sensor);
     Some((t0, values))
 }
@@ -137,19 +137,18 @@ pub fn sample_ft(
     let phase: f64 = rng.random::<f64>();
     let (t0, n) = window(signal, sensor.rate, phase)?;
     let dt = 1.0 / sensor.rate;
-    let mut values: Vec<[f64; CHANNELS]> = Vec::with_capacity(n);
-    for k in 0..n {
-        let t = t0 + k as f64 * dt;
-        let clean = signal.at(t);
-        values.push(std::array::from_fn(|c| {
+    let mut values = signal.sample(t0, dt, n);
+    for (k, v) in values.iter_mut().enumerate() {
+        let elapsed = k as f64 * dt;
+        for (c, x) in v.iter_mut().enumerate() {
             let noise = if sensor.noise(c) > 0.0 {
                 let z: f64 = StandardNormal.sample(rng);
                 sensor.noise(c) * z
             } else {
                 0.0
             };
-            clean[c] + sensor.bias(c) + sensor.drift(c) * (t - t0) + noise
-        }));
+            *x += sensor.bias(c) + sensor.drift(c) * elapsed + noise;
+        }
     }
     lowpass(&mut values, sensor);
     for v in &mut values {

@@ -163,6 +163,32 @@ impl ContactSignal {
         }
     }
 
+    /// The clean channels at t0, t0 + dt, …, n samples: the same values as [`Self::at`] at each
+    /// instant, found by walking the contacts and runs once instead of searching them per sample.
+    pub fn sample(&self, t0: f64, dt: f64, n: usize) -> Vec<[f64; CHANNELS]> {
+        let (mut c, mut r) = (0, 0);
+        (0..n)
+            .map(|k| {
+                let t = t0 + k as f64 * dt;
+                while c < self.contacts.len() && self.contacts[c].1 < t {
+                    c += 1;
+                }
+                if c == self.contacts.len() || self.contacts[c].0 > t {
+                    return [0.0; CHANNELS];
+                }
+                // The last run starting at or before t; runs follow each other in time, so it is
+                // the last run covering t if any run does.
+                while r + 1 < self.runs.len() && self.runs[r + 1].t[0] <= t {
+                    r += 1;
+                }
+                match self.runs.get(r) {
+                    Some(run) if run.t[0] <= t && t <= run.t[run.t.len() - 1] => run.eval(t),
+                    _ => self.at(t),
+                }
+            })
+            .collect()
+    }
+
     fn nearest(&self, t: f64) -> [f64; CHANNELS] {
         let mut best = (f64::INFINITY, [0.0; CHANNELS]);
         for r in &self.runs {
