@@ -192,21 +192,9 @@ pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
 
 /// The default report directory of a part: `results/maps/<part>` (a vertex list is `custom`).
 pub fn default_out_dir(part: &str) -> PathBuf {
-    let name = if part.trim().to_lowercase().starts_with("vertices:") {
-        "custom".to_string()
-    } else {
-        part.trim()
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect()
-    };
-    Path::new("results").join("maps").join(name)
+    Path::new("results")
+        .join("maps")
+        .join(super::part_folder(part))
 }
 
 /// The angle of a fence map as the user gave it (degrees; 0 for pin maps).

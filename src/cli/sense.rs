@@ -313,21 +313,9 @@ pub fn command_line(a: &SenseArgs) -> String {
 
 /// The default report directory: `results/sensing/<part>` (a vertex list is `custom`).
 pub fn default_out_dir(part: &str) -> PathBuf {
-    let p = part.trim();
-    let name: String = if p.to_lowercase().starts_with("vertices:") {
-        "custom".into()
-    } else {
-        p.chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect()
-    };
-    Path::new("results").join("sensing").join(name)
+    Path::new("results")
+        .join("sensing")
+        .join(super::part_folder(part))
 }
 
 /// `flag must be > lo …` for strictly positive quantities.
