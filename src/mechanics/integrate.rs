@@ -31,6 +31,7 @@ use super::outcome::{
     ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
 use super::part_model::{Fidelity, PartModel, SolveFailure};
+use super::pin_path::{PinPath, Turn};
 use crate::geometry::{first_contact, Feature, Polygon, Pose, Vec2};
 use serde::Serialize;
 
@@ -128,6 +129,10 @@ struct Ctx<'a, 'r> {
     /// Per-event tolerance band: event i fires when its function drops below −band[i]. Zero except
     /// for a mode margin that just bounced (see the ping-pong rule in `integrate_contact`).
     band: [f64; N_EVENTS],
+    /// Changes of the pin's lateral speed still ahead (normalised travel), in order; `start` and
+    /// `vdir` describe the current piece of the path (see [`super::pin_path`]).
+    turns: Vec<Turn>,
+    next_turn: usize,
 }
 
 enum End {
@@ -136,6 +141,8 @@ enum End {
 }
 
 const N_EVENTS: usize = 7;
+/// Pseudo-event index of a turn of the pin's path (a change of its lateral speed).
+const TURN: usize = N_EVENTS;
 /// Tolerance band of a mode margin after a ping-pong (a sine: about 0.006°).
 const BOUNCE_BAND: f64 = 1e-4;
 /// Step acceptance guard: the most one accepted step may change θ (radians) or the contact
@@ -203,13 +210,44 @@ impl<'a, 'r> Ctx<'a, 'r> {
             warm: Warm::default(),
             recorder,
             band: [0.0; N_EVENTS],
+            turns: Vec::new(),
+            next_turn: 0,
         }
+    }
+
+    /// Let the pin follow `path` (its lateral speed changes at the path's turns).
+    fn with_path(mut self, path: &PinPath) -> Self {
+        self.vdir = Vec2::new(-1.0, path.initial_speed());
+        self.turns = path.scaled(self.scale).collect();
+        self
     }
 }
 
 impl Ctx<'_, '_> {
     fn pin_at(&self, s: f64) -> Vec2 {
         self.start + self.vdir * s
+    }
+
+    /// Travel of the next change of the pin's lateral speed (∞ if none is left).
+    fn turn_at(&self) -> f64 {
+        self.turns
+            .get(self.next_turn)
+            .map_or(f64::INFINITY, |t| t.s)
+    }
+
+    /// Take the next turn: the pin, where it stands at the turn, goes on along its new direction
+    /// (`start` is moved so that `pin_at` stays continuous).
+    fn take_turn(&mut self) {
+        let t = self.turns[self.next_turn];
+        let at = self.pin_at(t.s);
+        self.vdir = Vec2::new(-1.0, t.w);
+        self.start = at - self.vdir * t.s;
+        self.next_turn += 1;
+    }
+
+    /// Is travel `s` at the next turn (to rounding)?
+    fn at_turn(&self, s: f64) -> bool {
+        self.turn_at() - s <= 1e-12 * (1.0 + s.abs())
     }
 
     fn geom(&self, feat: Feat, y: [f64; 2]) -> ContactGeom {
@@ -1042,7 +1080,15 @@ fn integrate_contact(
         let pending = (0..N_EVENTS).find(|&i| ev0[i] < -slack);
         let (event, s_ev, y_ev, inst_ev) = if let Some(i) = pending {
             (Some(i), s, y, inst)
+        } else if ctx.at_turn(s) {
+            (Some(TURN), s, y, inst)
         } else {
+            // A step never crosses a turn of the pin's path: it ends there.
+            let to_turn = ctx.turn_at() - s;
+            let clipped = h >= to_turn;
+            if clipped {
+                h = to_turn;
+            }
             let step = match dp_step(ctx, feat, mode, y, f0, h) {
                 Ok(r) => r,
                 Err(failure) => {
@@ -1103,7 +1149,7 @@ fn integrate_contact(
                     }
                 }
                 segs.ride(ctx, feat, step.f1[0].abs().max(f0[0].abs()), h);
-                s += h;
+                s = if clipped { ctx.turn_at() } else { s + h };
                 y = step.y1;
                 inst = step.inst1;
                 f0 = step.f1;
@@ -1281,7 +1327,8 @@ fn integrate_contact(
         };
         let i = event.expect("an event was found");
 
-        segs.events += 1;
+        // Turns of the pin's path are bounded by the path itself; only contact events count.
+        segs.events += u32::from(i != TURN);
         if segs.events > settings.max_events {
             let p = ctx.pose(s_ev, feat, y_ev);
             return (
@@ -1299,6 +1346,11 @@ fn integrate_contact(
         // Apply the event.
         let m = ctx.poly.len();
         let next: Option<(Feat, [f64; 2], Option<Mode>)> = match (i, feat) {
+            (TURN, _) => {
+                // The pin's lateral speed changes: same contact, mode settled again.
+                ctx.take_turn();
+                Some((feat, y, None))
+            }
             (0, Feat::Edge(k)) if ctx.fence.is_none() && reflex_ahead(ctx, k, y[0]) => {
                 // The edge let go by turning parallel to the pin's path, so the pin runs on along
                 // the edge's line into the reflex corner ahead, where the next edge blocks it: the
@@ -1494,9 +1546,33 @@ fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touc
             }
         };
     }
+    let mut s = s;
+    let mut min_travel = if after_separation { 1e-9 } else { 0.0 };
+    // Piece by piece along the pin's path: a touch beyond the next turn is not on this piece.
+    loop {
+        let touch = cast_piece(ctx, cur, s, min_travel);
+        let s_turn = ctx.turn_at();
+        let beyond_turn = match &touch {
+            Touch::At(t, ..) => *t > s_turn,
+            Touch::Stop(ContactStatus::MultiContact { s: t }) => *t / k > s_turn,
+            Touch::Stop(_) => false,
+            Touch::None => s_turn.is_finite(),
+        };
+        if !beyond_turn {
+            return touch;
+        }
+        s = s_turn;
+        ctx.take_turn();
+        min_travel = 0.0;
+    }
+}
+
+/// The first touch of the pin on the current piece of its path (extended as a ray), after travel
+/// `s` plus `min_travel` along the path.
+fn cast_piece(ctx: &mut Ctx, cur: &Pose, s: f64, mut min_travel: f64) -> Touch {
+    let k = ctx.scale;
     let dir_len = ctx.vdir.norm();
     let dir = ctx.vdir / dir_len;
-    let mut min_travel = if after_separation { 1e-9 } else { 0.0 };
     for _ in 0..8 {
         let Some(hit) = first_contact(ctx.poly, cur, ctx.pin_at(s), dir, ctx.rho, min_travel)
         else {
@@ -1606,18 +1682,25 @@ pub fn push(
     settings: &ContactSettings,
     recorder: Option<&mut dyn Recorder>,
 ) -> ContactOutcome {
+    let path = PinPath::constant(pin.lateral_speed);
+    push_path(
+        model, pose, pin_start, pin.radius, &path, settings, recorder,
+    )
+}
+
+/// Push a part with a pin of radius `radius` whose lateral speed follows `path` (SPEC §5: one push
+/// with the pin's true relative velocity (−V, w(s)), each change of w a step boundary). Pure.
+pub fn push_path(
+    model: &PartModel,
+    pose: Pose,
+    pin_start: Vec2,
+    radius: f64,
+    path: &PinPath,
+    settings: &ContactSettings,
+    recorder: Option<&mut dyn Recorder>,
+) -> ContactOutcome {
     let k = model.scale();
-    let mut ctx = Ctx::new(
-        model,
-        model.polygon(),
-        settings,
-        settings.mu_c,
-        pin.radius / k,
-        Vec2::new(-1.0, pin.lateral_speed),
-        pin_start / k,
-        None,
-        recorder,
-    );
+    let mut ctx = pin_ctx(model, pin_start, radius, path, settings, recorder);
     // The pin must start clear of the part.
     let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
     let local = pose_n.apply_inverse(ctx.start);
@@ -1626,6 +1709,51 @@ pub fn push(
         return untouched(pose, ContactStatus::PinInsidePart);
     }
     run_passes(&mut ctx, settings, pose)
+}
+
+fn pin_ctx<'a, 'r>(
+    model: &'a PartModel,
+    pin_start: Vec2,
+    radius: f64,
+    path: &PinPath,
+    settings: &ContactSettings,
+    recorder: Option<&'r mut dyn Recorder>,
+) -> Ctx<'a, 'r> {
+    let k = model.scale();
+    Ctx::new(
+        model,
+        model.polygon(),
+        settings,
+        settings.mu_c,
+        radius / k,
+        Vec2::new(-1.0, 0.0),
+        pin_start / k,
+        None,
+        recorder,
+    )
+    .with_path(path)
+}
+
+/// Belt travel (caller's units) until a pin of radius `radius` starting at `pin_start` and
+/// following `path` first touches the part resting at `pose` so as to push it (grazes skipped; a
+/// strike into a reflex corner counts), or `None`: the same query the contact model starts with,
+/// for scheduling pin contacts in the line.
+pub fn pin_first_touch(
+    model: &PartModel,
+    pose: Pose,
+    pin_start: Vec2,
+    radius: f64,
+    path: &PinPath,
+) -> Option<f64> {
+    let k = model.scale();
+    let settings = ContactSettings::default();
+    let mut ctx = pin_ctx(model, pin_start, radius, path, &settings, None);
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    match next_touch(&mut ctx, &pose_n, 0.0, false) {
+        Touch::At(s, ..) => Some(s * k),
+        Touch::Stop(ContactStatus::MultiContact { s }) => Some(s),
+        _ => None,
+    }
 }
 
 /// Push a part resting at `pose` with a fence (SPEC §6; see [`super::fence`]): the fence travels at

@@ -7,6 +7,7 @@
 //! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
 //! * [`integrate`]: one pin pass, integrated in pin travel with error control and event location.
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
+//! * [`pin_path`]: a moving pin's lateral speed profile over a pass (SPEC §5).
 //! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!
@@ -19,13 +20,18 @@ pub mod integrate;
 pub mod limit_surface;
 pub mod outcome;
 pub mod part_model;
+pub mod pin_path;
 pub mod vote;
 
 pub use fence::FenceSpec;
 pub use instant::Mode;
-pub use integrate::{fence_first_touch, first_instant, push, push_fence, ContactSettings, Pin};
+pub use integrate::{
+    fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path,
+    ContactSettings, Pin,
+};
 pub use outcome::{
     ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
+pub use pin_path::{PinPath, Turn};
 pub use vote::mason_vote;

@@ -1,0 +1,152 @@
+//! A pin's path relative to the belt when its lateral speed changes during a pass (SPEC §5).
+//!
+//! A moving pin's lateral velocity is piecewise constant in pin travel: it starts at `w0` and
+//! changes to `w` at each [`Turn`]. Relative to the belt the pin moves along (−1, w) (speeds as
+//! fractions of the belt speed), so its path is a polyline in the belt frame parametrised by the
+//! travel s (= belt speed × time). Each turn is a step boundary of the integrator, like a mode
+//! switch: the state is continuous there and the mode is settled again with the new velocity.
+//!
+//! A continuous acceleration (a trapezoidal actuator move) is approximated by constant-velocity
+//! pieces whose positions agree with the true move at the piece ends; `results/online.md` measures
+//! what that costs against a finely resolved acceleration phase.
+
+use serde::Serialize;
+
+/// From pin travel `s` (caller's units, measured from the start of the pass) on, the pin's lateral
+/// speed is `w` (a fraction of the belt speed).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Turn {
+    pub s: f64,
+    pub w: f64,
+}
+
+/// The largest lateral pin speed accepted, as a multiple of the belt speed.
+pub const MAX_LATERAL_SPEED: f64 = 1e3;
+
+/// The lateral speed profile of a pin over one pass: `w0` at the start, then each turn in order.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct PinPath {
+    w0: f64,
+    turns: Vec<Turn>,
+}
+
+impl PinPath {
+    /// A pin moving at constant lateral speed `w` (0: a still pin).
+    pub fn constant(w: f64) -> PinPath {
+        PinPath {
+            w0: w,
+            turns: Vec::new(),
+        }
+    }
+
+    /// A profile starting at `w0` with `turns`; travels must be finite, positive and increasing,
+    /// speeds finite and within ±[`MAX_LATERAL_SPEED`].
+    pub fn new(w0: f64, turns: Vec<Turn>) -> Result<PinPath, String> {
+        let speed_ok = |w: f64| w.is_finite() && w.abs() <= MAX_LATERAL_SPEED;
+        if !speed_ok(w0) {
+            return Err(format!(
+                "lateral pin speed {w0} is not within ±{MAX_LATERAL_SPEED} belt speeds"
+            ));
+        }
+        let mut last = 0.0;
+        for (i, t) in turns.iter().enumerate() {
+            if !(t.s.is_finite() && t.s > last) {
+                return Err(format!(
+                    "turn {i}: travel {} must be finite and greater than {last}",
+                    t.s
+                ));
+            }
+            if !speed_ok(t.w) {
+                return Err(format!(
+                    "turn {i}: lateral pin speed {} is not within ±{MAX_LATERAL_SPEED} belt speeds",
+                    t.w
+                ));
+            }
+            last = t.s;
+        }
+        Ok(PinPath { w0, turns })
+    }
+
+    /// The thesis's app. E set-up: the pin moves across the belt at lateral speed `w` from lateral
+    /// position `y0` until it stands at `y_stop` (then still). Positions in the caller's units.
+    pub fn move_to(w: f64, y0: f64, y_stop: f64) -> Result<PinPath, String> {
+        if y_stop == y0 || w == 0.0 {
+            return PinPath::new(0.0, Vec::new());
+        }
+        if (y_stop - y0) * w < 0.0 {
+            return Err(format!(
+                "a pin moving at lateral speed {w} from y = {y0} never reaches y = {y_stop}"
+            ));
+        }
+        let s = (y_stop - y0) / w;
+        PinPath::new(w, vec![Turn { s, w: 0.0 }])
+    }
+
+    pub fn initial_speed(&self) -> f64 {
+        self.w0
+    }
+
+    pub fn turns(&self) -> &[Turn] {
+        &self.turns
+    }
+
+    /// Lateral speed at travel `s` (the speed after a turn at exactly `s`).
+    pub fn speed_at(&self, s: f64) -> f64 {
+        self.turns
+            .iter()
+            .take_while(|t| t.s <= s)
+            .last()
+            .map_or(self.w0, |t| t.w)
+    }
+
+    /// Lateral displacement of the pin after travel `s` (caller's units).
+    pub fn offset_at(&self, s: f64) -> f64 {
+        let mut y = 0.0;
+        let (mut from, mut w) = (0.0, self.w0);
+        for t in &self.turns {
+            if t.s >= s {
+                break;
+            }
+            y += w * (t.s - from);
+            from = t.s;
+            w = t.w;
+        }
+        y + w * (s - from)
+    }
+
+    /// The same profile in normalised units (travels divided by `scale`).
+    pub(crate) fn scaled(&self, scale: f64) -> impl Iterator<Item = Turn> + '_ {
+        self.turns.iter().map(move |t| Turn {
+            s: t.s / scale,
+            w: t.w,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_integrate_the_speed_profile() {
+        let p = PinPath::new(1.0, vec![Turn { s: 2.0, w: -0.5 }, Turn { s: 4.0, w: 0.0 }]).unwrap();
+        assert_eq!(p.offset_at(1.0), 1.0);
+        assert_eq!(p.offset_at(2.0), 2.0);
+        assert_eq!(p.offset_at(3.0), 1.5);
+        assert_eq!(p.offset_at(10.0), 1.0);
+        assert_eq!(p.speed_at(1.9), 1.0);
+        assert_eq!(p.speed_at(2.0), -0.5);
+        assert_eq!(p.speed_at(5.0), 0.0);
+    }
+
+    #[test]
+    fn bad_profiles_are_refused() {
+        assert!(PinPath::new(f64::NAN, vec![]).is_err());
+        assert!(PinPath::new(0.0, vec![Turn { s: 0.0, w: 1.0 }]).is_err());
+        assert!(PinPath::new(0.0, vec![Turn { s: 2.0, w: 1.0 }, Turn { s: 1.0, w: 0.0 }]).is_err());
+        assert!(PinPath::new(0.0, vec![Turn { s: 1.0, w: 1e9 }]).is_err());
+        assert!(PinPath::move_to(1.0, 0.0, -1.0).is_err());
+        let p = PinPath::move_to(-1.0, 0.3, 0.1).unwrap();
+        assert!((p.offset_at(100.0) + 0.2).abs() < 1e-15);
+    }
+}
