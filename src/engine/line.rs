@@ -15,7 +15,7 @@
 //!   to be reached (distance between pin discs and fence segments ≤ 2a, precomputed per scene) is
 //!   checked against the part's recorded path during the push; a touch ends the push there as
 //!   `multi_contact`. The contact model itself reports a pin in a concave notch (also
-//!   `multi_contact`).
+//!   `multi_contact`). See [`super::contact`].
 //! * **part–part overlap**: whenever a part's motion changes (arrival, contact begin, contact end),
 //!   its new motion is checked against every other part on the belt over the time both motions are
 //!   known (until the earlier of their next events). Every interval of time in which two parts
@@ -23,11 +23,13 @@
 //!   (bounding capsules in the belt frame) skips distant pairs; close pairs are resolved in time
 //!   with [`super::overlap::first_touch`]. The first overlap schedules a collision event; both
 //!   parts are taken off the line then, unless one of them has already gone.
-//!   Only while two or more parts share the belt does this run (`work.part_part_checks`).
+//!   Only while two or more parts share the belt does this run (`work.part_part_checks`). See
+//!   [`super::pairs`].
 //! * **off the belt**: after a push, a centroid outside |y| ≤ width/2 means the part falls off. A
 //!   fence carries parts across the belt, so during a fence push whose reach (the fence's lateral
 //!   extent plus a: the centroid stays within a of the contact on the fence) crosses an edge the
-//!   recorded path is checked too, and the part falls off where its centroid crosses the edge.
+//!   recorded path is checked too, and the part falls off where its centroid crosses the edge
+//!   ([`super::contact`]).
 //! * **jam**: an obstacle that holds the part for good: a pin still pushing it after the contact
 //!   model's travel limit (cause `travel_limit`), or a fence at α + atan μf ≥ 90° against which the
 //!   part stops in the world while the belt slips under it (cause `fence_angle`, SPEC §6). A real
@@ -35,132 +37,50 @@
 //!   parts behind it are still measured.
 //! * **solver**: any other failure of the contact model, with its cause.
 //!
-//! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it.
+//! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it. What a
+//! run takes and gives is in [`super::results`].
 
 use super::event_queue::{Event, EventKind, EventQueue};
-use super::metrics::{Metrics, Summary};
-use super::motion::{ContactPlan, Motion, Pusher, Stop};
+use super::metrics::Metrics;
+use super::motion::{Motion, Stop};
 use super::outcome::PartOutcome;
-use super::overlap::{capsule_clearance, first_touch, polygon_clearance, segment_distance};
 use super::part_stream::{arrival_gap, draw_part};
+use super::results::{EngineError, PartRecord, RunOptions, RunResult, SamplePath};
 use super::sensing::{describe, sense_pass, SensorStats};
 use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
-use crate::mechanics::{
-    fence_first_touch, ContactOutcome, ContactSettings, ContactStatus, PartModel, Pin, Recorder,
-    SolveFailure, TraceSample,
-};
+use crate::mechanics::{fence_first_touch, ContactOutcome, PartModel, TraceSample};
 use crate::scenario::{Arrival, Obstacle, PinObstacle, Scene, SensorPin};
-use crate::sensing::signal::{KnotRecorder, SignalScale};
-use serde::Serialize;
+use crate::sensing::signal::SignalScale;
 use std::collections::BTreeMap;
-use thiserror::Error;
 
-/// What a run needs beyond the scene.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunOptions {
-    /// Number of parts (default: the scene's).
-    pub parts: u64,
-    /// Seed (default: the scene's).
-    pub seed: u64,
-    /// Record the paths of the first `sample_paths` parts (for drawing).
-    pub sample_paths: usize,
-    /// Keep one record per part (for the per-part CSV).
-    pub keep_records: bool,
-}
-
-impl RunOptions {
-    /// The scene's own settings: its number of parts and seed, nothing recorded.
-    pub fn from_scene(scene: &Scene) -> RunOptions {
-        RunOptions {
-            parts: scene.feed.parts,
-            seed: scene.seed,
-            sample_paths: 0,
-            keep_records: false,
-        }
-    }
-}
-
-/// Why a run could not be carried out.
-#[derive(Debug, Error)]
-pub enum EngineError {
-    #[error("part {index}: {reason}")]
-    PartDraw { index: u64, reason: String },
-    /// An event time came out non-finite (NaN or ±∞): the scene's numbers leave f64. Validated
-    /// scenarios never get here; the engine refuses instead of panicking.
-    #[error("an event time is not finite ({kind:?} at {time} s; {refused} event(s) refused): the scene's numbers are out of range (see README \"Scenario format\")")]
-    NonFiniteTime {
-        time: f64,
-        kind: super::event_queue::EventKind,
-        refused: u64,
-    },
-}
-
-/// One finished part.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PartRecord {
-    pub part: u64,
-    pub arrival_s: f64,
-    pub end_s: f64,
-    pub outcome: &'static str,
-    /// Cause behind multi_contact or solver, else empty.
-    pub cause: &'static str,
-    pub contacts: u32,
-    pub theta_in_deg: f64,
-    pub theta_out_deg: f64,
-    pub y_in_m: f64,
-    pub y_out_m: f64,
-    /// Sensor decisions, `pin=decision (posterior)` separated by `; ` (empty without sensors).
-    pub sensed: String,
-}
-
-/// The path of a sample part: world poses at successive instants (s, pose).
-#[derive(Debug, Clone, PartialEq)]
-pub struct SamplePath {
-    pub part: u64,
-    pub outcome: PartOutcome,
-    pub poses: Vec<(f64, Pose)>,
-}
-
-/// Everything a run produces.
-#[derive(Debug, Clone)]
-pub struct RunResult {
-    pub summary: Summary,
-    pub metrics: Metrics,
-    /// Per-part records, if asked for.
-    pub records: Vec<PartRecord>,
-    /// Every event taken off the queue, if the scene's event log is on.
-    pub events: Vec<Event>,
-    pub paths: Vec<SamplePath>,
-}
-
-/// Grazing touches in a row after which a part is taken off as a `solver` outcome (cause
-/// `grazing_loop`) rather than handed between obstacles for ever.
-const MAX_GRAZES: u32 = 16;
-
-struct ActivePart {
+/// A part on the belt: where it came in, how it moves now, and what has happened to it.
+pub(super) struct ActivePart {
     arrival: f64,
     theta_in: f64,
     y_in: f64,
-    motion: Motion,
+    pub(super) motion: Motion,
     /// The obstacle whose push ended last (its pin has passed; it cannot touch the part again).
-    last_obstacle: Option<usize>,
-    contacts: u32,
+    pub(super) last_obstacle: Option<usize>,
+    pub(super) contacts: u32,
     /// Touches in a row that pushed nothing (grazes): bounded, so that two obstacles that each
     /// only graze the part cannot hand it back and forth for ever at one instant.
-    grazes: u32,
+    pub(super) grazes: u32,
     /// Own contact model (random tripod), else the scene's.
-    model: Option<PartModel>,
-    path: Option<Vec<(f64, Pose)>>,
+    pub(super) model: Option<PartModel>,
+    pub(super) path: Option<Vec<(f64, Pose)>>,
     /// Sensor pins that have read this part (obstacle index) and their decisions.
-    sensed: Vec<(usize, String)>,
+    pub(super) sensed: Vec<(usize, String)>,
 }
 
-struct Line<'a> {
-    scene: &'a Scene,
+/// The run state: the scene it runs, the event queue, the parts on the belt and what they have
+/// produced so far. Its event handlers live here and beside it in [`super::contact`] (contact
+/// begin) and [`super::pairs`] (part–part checks).
+pub(super) struct Line<'a> {
+    pub(super) scene: &'a Scene,
     opts: &'a RunOptions,
-    queue: EventQueue,
-    active: BTreeMap<u64, ActivePart>,
-    metrics: Metrics,
+    pub(super) queue: EventQueue,
+    pub(super) active: BTreeMap<u64, ActivePart>,
+    pub(super) metrics: Metrics,
     records: Vec<PartRecord>,
     events: Vec<Event>,
     paths: Vec<SamplePath>,
@@ -247,7 +167,7 @@ pub fn run(
 }
 
 impl Line<'_> {
-    fn speed(&self) -> f64 {
+    pub(super) fn speed(&self) -> f64 {
         self.scene.belt.speed
     }
 
@@ -318,7 +238,7 @@ impl Line<'_> {
     /// From a free state, find the next event: the first obstacle the part will touch (first-contact
     /// ray cast for a pin, first touch of a fence, in the belt frame exactly as the contact model
     /// finds them), or the exit.
-    fn plan_next(&mut self, index: u64, part: &mut ActivePart, now: f64) {
+    pub(super) fn plan_next(&mut self, index: u64, part: &mut ActivePart, now: f64) {
         let Motion::Free { t0, pose, .. } = part.motion else {
             unreachable!("plan_next on a held part");
         };
@@ -401,195 +321,6 @@ impl Line<'_> {
         part.motion = Motion::Free { t0, pose, until };
     }
 
-    fn contact_begin(&mut self, t: f64, index: u64, j: usize) {
-        let scene = self.scene;
-        let v = self.speed();
-        let Some(mut part) = self.active.remove(&index) else {
-            return; // the part has already left the line
-        };
-        let Motion::Free { t0, pose, .. } = part.motion else {
-            unreachable!("contact begin for a held part");
-        };
-        let (pusher, settings) = match &scene.obstacles[j] {
-            Obstacle::Pin(pin) => (
-                Pusher::Pin {
-                    centre: pin.centre,
-                    pin: Pin {
-                        radius: pin.radius,
-                        lateral_speed: 0.0,
-                    },
-                },
-                ContactSettings {
-                    mu_c: pin.mu_c,
-                    ..scene.contact
-                },
-            ),
-            // The fence's own μf replaces the contact friction inside `push_fence`.
-            Obstacle::Fence(fence) => (Pusher::Fence(fence.spec()), scene.contact),
-        };
-        let model = part.model.as_ref().unwrap_or(&scene.part.model);
-        // A sensor pin records the push's knots as it computes it (the only push of this pass).
-        let sensor = match &scene.obstacles[j] {
-            Obstacle::Pin(p) => p.sensor.as_deref(),
-            Obstacle::Fence(_) => None,
-        };
-        let mut knots = KnotRecorder::default();
-        let recorder: Option<&mut dyn Recorder> = sensor.map(|_| &mut knots as &mut dyn Recorder);
-        let out = pusher.push(model, pose, &settings, recorder);
-        self.metrics.work.contact_solves += 1;
-        self.metrics.work.model_evaluations += out.evaluations;
-        if matches!(out.status, ContactStatus::PinInsidePart) {
-            self.active.insert(index, part);
-            self.finish(index, t, PartOutcome::MultiContact, "pin_inside_part");
-            return;
-        }
-        if !out.contact {
-            // The model found only a grazing touch: the pin passes without pushing.
-            part.grazes += 1;
-            if part.grazes > MAX_GRAZES {
-                self.active.insert(index, part);
-                self.finish(index, t, PartOutcome::Solver, "grazing_loop");
-                return;
-            }
-            part.last_obstacle = Some(j);
-            self.plan_next(index, &mut part, t);
-            self.active.insert(index, part);
-            self.check_pairs(index, t);
-            return;
-        }
-        part.grazes = 0;
-        if let Some(sensor) = sensor {
-            let decision = self.sense(index, j, sensor, &out, &knots.samples, pose.theta);
-            part.sensed.push((j, decision));
-        }
-        let s_touch = out.travel_to_contact;
-        let s_end = out
-            .segments
-            .last()
-            .map(|s| s.s_end)
-            .unwrap_or(s_touch + out.contact_length)
-            .max(s_touch);
-        let stop = match out.status {
-            ContactStatus::Ok => None,
-            ContactStatus::MultiContact { .. } => Some(Stop::MultiContact { cause: "notch" }),
-            ContactStatus::TravelLimit { .. } => Some(Stop::Jam {
-                cause: "travel_limit",
-            }),
-            ContactStatus::Jam { .. } => Some(Stop::Jam {
-                cause: "fence_angle",
-            }),
-            ContactStatus::Solver { failure, .. } => Some(Stop::Solver {
-                cause: match failure {
-                    SolveFailure::NoConvergence { .. } => "no_convergence",
-                    SolveFailure::NonFinite => "non_finite",
-                },
-            }),
-            other => Some(Stop::Solver {
-                cause: other.name(),
-            }),
-        };
-        let mut plan = ContactPlan {
-            obstacle: j,
-            t_ref: t0,
-            pose_ref: pose,
-            pusher,
-            settings,
-            outcome: out,
-            s_touch,
-            s_end,
-            t_begin: t,
-            t_end: (t0 + s_end / v).max(t),
-            stop,
-            trace: None,
-        };
-        if sensor.is_some() {
-            plan.set_trace(&knots.samples);
-        }
-        // Another obstacle within reach of this push?
-        if scene.effects.obstacle_sweeps && !scene.neighbours[j].is_empty() {
-            if plan.ensure_trace(model) {
-                self.metrics.work.traces_recorded += 1;
-            }
-            let held = Motion::Held(Box::new(plan.clone()));
-            let poly = &scene.part.polygon;
-            let a = scene.part.radius;
-            let breaks = plan.step_times(v);
-            let mut earliest: Option<f64> = None;
-            for &nb in &scene.neighbours[j] {
-                self.metrics.work.obstacle_sweep_checks += 1;
-                let (p, q, radius) = scene.obstacles[nb].capsule();
-                let end = earliest.unwrap_or(plan.t_end);
-                let mut evals = 0;
-                let hit = first_touch(
-                    plan.t_begin,
-                    end,
-                    &breaks,
-                    &mut |tau| {
-                        let pose = held.world_pose(tau, v);
-                        capsule_clearance(p, q, radius, &poly.world_vertices(&pose))
-                    },
-                    &|ta, tb| {
-                        let (p, q) = (held.world_pose(ta, v), held.world_pose(tb, v));
-                        (q.position() - p.position()).norm() + a * (q.theta - p.theta).abs()
-                    },
-                    1e-6 * a,
-                    &mut evals,
-                );
-                self.metrics.work.clearance_evaluations += evals;
-                if let Some(tm) = hit {
-                    earliest = Some(earliest.map_or(tm, |e: f64| e.min(tm)));
-                }
-            }
-            if let Some(tm) = earliest {
-                plan.t_end = tm.max(t);
-                plan.stop = Some(Stop::MultiContact {
-                    cause: "second_obstacle",
-                });
-            }
-        }
-        // A fence carries the part across the belt: does its centroid cross an edge on the way?
-        if let Obstacle::Fence(_) = &scene.obstacles[j] {
-            let half = scene.belt.width / 2.0;
-            let [y_min, y_max] = scene.obstacles[j].y_range();
-            let a = scene.part.radius;
-            if y_min - a < -half || y_max + a > half {
-                if plan.ensure_trace(model) {
-                    self.metrics.work.traces_recorded += 1;
-                }
-                if let Some(tm) = edge_crossing(&plan, v, half) {
-                    plan.t_end = tm.max(t);
-                    plan.stop = Some(Stop::OffBelt);
-                }
-            }
-        }
-        part.contacts += 1;
-        self.metrics.contacts += 1;
-        self.metrics.obstacles[j].contacts += 1;
-        if part.path.is_some() {
-            if plan.ensure_trace(model) {
-                self.metrics.work.traces_recorded += 1;
-            }
-            let held = Motion::Held(Box::new(plan.clone()));
-            let mut times = vec![plan.t_begin];
-            times.extend(plan.step_times(v));
-            times.push(plan.t_end);
-            if let Some(path) = part.path.as_mut() {
-                path.extend(times.iter().map(|&tau| (tau, held.world_pose(tau, v))));
-            }
-        }
-        let t_end = plan.t_end;
-        part.motion = Motion::Held(Box::new(plan));
-        self.queue.schedule(
-            t_end,
-            EventKind::ContactEnd {
-                part: index,
-                obstacle: j as u32,
-            },
-        );
-        self.active.insert(index, part);
-        self.check_pairs(index, t);
-    }
-
     fn contact_end(&mut self, t: f64, index: u64, j: usize) {
         let Some(mut part) = self.active.remove(&index) else {
             return;
@@ -644,7 +375,7 @@ impl Line<'_> {
     }
 
     /// Take part `index` off the line at time `t` with `outcome`.
-    fn finish(&mut self, index: u64, t: f64, outcome: PartOutcome, cause: &'static str) {
+    pub(super) fn finish(&mut self, index: u64, t: f64, outcome: PartOutcome, cause: &'static str) {
         let Some(part) = self.active.remove(&index) else {
             return;
         };
@@ -688,7 +419,7 @@ impl Line<'_> {
 
     /// Read and classify a pass against a sensor pin: the sensor's statistics count it, and the
     /// decision (as text for the part's record) is returned (see [`super::sensing`]).
-    fn sense(
+    pub(super) fn sense(
         &mut self,
         index: u64,
         j: usize,
@@ -726,127 +457,4 @@ impl Line<'_> {
             }
         }
     }
-
-    /// Check the motion part `index` has just started against every other part on the belt.
-    fn check_pairs(&mut self, index: u64, now: f64) {
-        if !self.scene.effects.collisions || self.active.len() < 2 {
-            return;
-        }
-        let scene = self.scene;
-        let v = self.speed();
-        let a = scene.part.radius;
-        let others: Vec<u64> = self
-            .active
-            .keys()
-            .copied()
-            .filter(|&k| k != index)
-            .collect();
-        for other in others {
-            self.metrics.work.part_part_checks += 1;
-            let end = self.active[&index]
-                .motion
-                .until()
-                .min(self.active[&other].motion.until());
-            if end < now {
-                continue;
-            }
-            // Broad phase in the belt frame that is the world at `now`: a free part is a disc of
-            // radius a at rest; a held part stays within 2a of the obstacle holding it — within
-            // 2a + ρ of a pin's centre, within 2a + length/2 of a fence's midpoint — whose
-            // belt-frame path runs back along −x.
-            let capsule = |p: &ActivePart| -> (Vec2, Vec2, f64) {
-                match &p.motion {
-                    Motion::Free { .. } => {
-                        let c = p.motion.world_pose(now, v).position();
-                        (c, c, a)
-                    }
-                    Motion::Held(plan) => {
-                        let (p, q, r) = scene.obstacles[plan.obstacle].capsule();
-                        let x = (p + q) * 0.5;
-                        let reach = 2.0 * a + r + (q - p).norm() / 2.0;
-                        (x, x - Vec2::new(v * (end - now), 0.0), reach)
-                    }
-                }
-            };
-            let (p0, p1, r1) = capsule(&self.active[&index]);
-            let (q0, q1, r2) = capsule(&self.active[&other]);
-            if segment_distance(p0, p1, q0, q1) > r1 + r2 {
-                continue;
-            }
-            self.metrics.work.part_part_narrow_checks += 1;
-            for k in [index, other] {
-                let part = self.active.get_mut(&k).expect("active part");
-                if let Motion::Held(plan) = &mut part.motion {
-                    let model = part.model.as_ref().unwrap_or(&scene.part.model);
-                    if plan.ensure_trace(model) {
-                        self.metrics.work.traces_recorded += 1;
-                    }
-                }
-            }
-            let (pi, pj) = (&self.active[&index], &self.active[&other]);
-            let mut breaks: Vec<f64> = Vec::new();
-            for p in [pi, pj] {
-                if let Motion::Held(plan) = &p.motion {
-                    breaks.extend(plan.step_times(v));
-                }
-            }
-            breaks.sort_by(f64::total_cmp);
-            let poly = &scene.part.polygon;
-            let belt_motion = |m: &Motion, ta: f64, tb: f64| -> f64 {
-                let (p, q) = (m.world_pose(ta, v), m.world_pose(tb, v));
-                let d = q.position() - p.position() - Vec2::new(v * (tb - ta), 0.0);
-                d.norm() + a * (q.theta - p.theta).abs()
-            };
-            let mut evals = 0;
-            let hit = first_touch(
-                now,
-                end,
-                &breaks,
-                &mut |tau| {
-                    polygon_clearance(
-                        &poly.world_vertices(&pi.motion.world_pose(tau, v)),
-                        &poly.world_vertices(&pj.motion.world_pose(tau, v)),
-                    )
-                },
-                &|ta, tb| belt_motion(&pi.motion, ta, tb) + belt_motion(&pj.motion, ta, tb),
-                1e-6 * a,
-                &mut evals,
-            );
-            self.metrics.work.clearance_evaluations += evals;
-            if let Some(tc) = hit {
-                self.queue.schedule(
-                    tc,
-                    EventKind::Collision {
-                        first: index.min(other),
-                        second: index.max(other),
-                    },
-                );
-            }
-        }
-    }
-}
-
-/// The first time in (t_begin, t_end] at which the held part's centroid lies beyond |y| = `half`
-/// (the belt's edge), following the recorded path (linear between steps, as everywhere in the
-/// line).
-fn edge_crossing(plan: &ContactPlan, speed: f64, half: f64) -> Option<f64> {
-    let held = Motion::Held(Box::new(plan.clone()));
-    let mut times = vec![plan.t_begin];
-    times.extend(plan.step_times(speed));
-    times.push(plan.t_end);
-    let beyond = |t: f64| held.world_pose(t, speed).y.abs() - half;
-    let mut prev = (times[0], beyond(times[0]));
-    if prev.1 > 0.0 {
-        return Some(prev.0);
-    }
-    for &t in &times[1..] {
-        let g = beyond(t);
-        if g > 0.0 {
-            // Linear between the steps: the crossing of |y| = half (g ≤ 0 before, > 0 now).
-            let u = prev.1 / (prev.1 - g);
-            return Some(prev.0 + u * (t - prev.0));
-        }
-        prev = (t, g);
-    }
-    None
 }

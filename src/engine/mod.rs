@@ -6,20 +6,27 @@
 //! * [`part_stream`]: part i drawn from its own random stream (seed, i);
 //! * [`motion`]: a part riding the belt or held by a pin or fence, and its pose at any time;
 //! * [`overlap`]: clearance between parts and obstacles, and the first touch over a time window;
-//! * [`line`]: the event loop, detection of collisions, multi-contacts, off-belt parts and jams;
+//! * [`line`]: the event loop: arrivals, the next event of a free part, contact end, exit;
+//! * [`contact`]: contact begin: the push, its stop, neighbouring obstacles and the belt's edges;
+//! * [`pairs`]: part–part overlap checks (broad and narrow phase);
+//! * [`results`]: what a run takes ([`RunOptions`]) and gives ([`RunResult`]);
 //! * [`outcome`]: the classes a part can end in;
 //! * [`metrics`]: counts, rates, latency histogram, per-obstacle statistics, work counters and the
 //!   deterministic [`Summary`].
 
+pub mod contact;
 pub mod event_queue;
 pub mod line;
 pub mod metrics;
 pub mod motion;
 pub mod outcome;
 pub mod overlap;
+pub mod pairs;
 pub mod part_stream;
+pub mod results;
 pub mod sensing;
 
-pub use line::{run, EngineError, PartRecord, RunOptions, RunResult, SamplePath};
+pub use line::run;
 pub use metrics::Summary;
 pub use outcome::{OutcomeCounts, PartOutcome};
+pub use results::{EngineError, PartRecord, RunOptions, RunResult, SamplePath};

@@ -165,6 +165,15 @@ impl ContactPlan {
         )
     }
 
+    /// World times at which the recorded path is known: first touch, the recorded steps inside
+    /// (t_begin, t_end), and the end.
+    pub fn path_times(&self, speed: f64) -> Vec<f64> {
+        let mut times = vec![self.t_begin];
+        times.extend(self.step_times(speed));
+        times.push(self.t_end);
+        times
+    }
+
     /// World times of the recorded steps inside (t_begin, t_end).
     pub fn step_times(&self, speed: f64) -> Vec<f64> {
         match &self.trace {

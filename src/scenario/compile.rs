@@ -6,9 +6,9 @@
 //!   within [−width/2 + a, width/2 − a];
 //! * obstacles (pins and fences) are checked in [`super::obstacles`].
 
+use super::checker::Checker;
 use super::error::{Locator, ScenarioError};
 use super::limits;
-use super::location::KeyPath;
 use super::raw::*;
 use super::scene::*;
 use crate::geometry::{named, Polygon, Vec2};
@@ -16,50 +16,9 @@ use crate::mechanics::{ContactSettings, PartModel, Support};
 
 type R<T> = Result<T, ScenarioError>;
 
-/// Builds located errors and checks numbers against their allowed ranges.
-pub(super) struct Checker<'a, 'b> {
-    loc: &'b Locator<'a>,
-}
-
-impl Checker<'_, '_> {
-    pub(super) fn err(&self, path: &str, msg: impl Into<String>) -> ScenarioError {
-        self.loc.at_key(&KeyPath::parse(path), msg)
-    }
-    pub(super) fn finite(&self, path: &str, v: f64) -> R<f64> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.err(path, format!("must be a finite number, got {v}")))
-        }
-    }
-    pub(super) fn within(&self, path: &str, v: f64, lo: f64, hi: f64, unit: &str) -> R<f64> {
-        self.finite(path, v)?;
-        if v >= lo && v <= hi {
-            Ok(v)
-        } else {
-            Err(self.err(
-                path,
-                format!(
-                    "must lie in [{}, {}] ({unit}), got {}",
-                    limits::num(lo),
-                    limits::num(hi),
-                    limits::num(v)
-                ),
-            ))
-        }
-    }
-    /// `v` within one of the [`super::limits`] ranges.
-    pub(super) fn range(&self, path: &str, v: f64, r: (f64, f64), unit: &str) -> R<f64> {
-        self.within(path, v, r.0, r.1, unit)
-    }
-    fn missing(&self, section: &str, msg: &str) -> ScenarioError {
-        self.err(section, msg.to_string())
-    }
-}
-
 /// Compile a parsed scenario. `default_name` names the scene when the file does not.
 pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene> {
-    let c = Checker { loc };
+    let c = Checker::new(loc);
     let name = match &raw.name {
         Some(n) => {
             let ok = !n.is_empty()

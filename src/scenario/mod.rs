@@ -4,13 +4,15 @@
 //! into an immutable [`Scene`] (DESIGN.md "model vs state"; SPEC §1 units and frames, §7 the line).
 //!
 //! * [`raw`]: serde structs mirroring the file;
-//! * [`compile`]: checks and conversion to [`Scene`];
+//! * [`compile`]: checks and conversion to [`Scene`], one function per section;
+//! * [`checker`]: range checks and located errors, shared by every section;
 //! * [`obstacles`]: pins and fences, their checks and neighbour lists;
 //! * [`scene`]: the compiled types the engine reads;
 //! * [`limits`]: the physically meaningful range of every number;
 //! * [`location`], [`error`]: spans → line/column and key paths, and the located error;
 //! * [`shared_feed`]: one reference scene's part stream imposed on others (`pinfeed compare`).
 
+pub mod checker;
 pub mod compile;
 pub mod error;
 pub mod limits;

@@ -18,7 +18,7 @@
 //! Two obstacles are neighbours when their distance (between the pins' discs and the fences'
 //! segments) is at most 2a: only then can a part touching one touch the other.
 
-use super::compile::Checker;
+use super::checker::Checker;
 use super::raw::{ObstacleKind, RawObstacle};
 use super::scene::{Belt, FenceObstacle, Obstacle, PinObstacle};
 use super::ScenarioError;

@@ -9,7 +9,7 @@
 //! know that, and the summary's confusion matrix shows what it costs. Templates are drawn from the
 //! scene's seed on streams of their own, so the same file always trains the same classifier.
 
-use super::compile::Checker;
+use super::checker::Checker;
 use super::raw::{RawHypotheses, RawSensor};
 use super::scene::{Feed, Lateral, Orientation, PartSpec, PinObstacle, SensorPin, SupportKind};
 use super::ScenarioError;

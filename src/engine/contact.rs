@@ -1,0 +1,325 @@
+//! Contact begin: a part touches an obstacle and the contact model gives the whole push (SPEC §6,
+//! §7).
+//!
+//! In order: the obstacle becomes a [`Pusher`] with its contact settings ([`pusher_for`]); the push
+//! is run (recording its knots for a sensor pin); a grazing touch lets the part ride on, a pin
+//! inside the part ends it as `multi_contact`; otherwise the push becomes a [`ContactPlan`] whose
+//! [`Stop`] comes from the contact status ([`stop_of`]). The plan is then cut short where a
+//! neighbouring obstacle touches the part during the push (`sweep_neighbours`, the
+//! `second_obstacle` multi-contact) and where a fence carries the part's centroid across the belt's
+//! edge ([`edge_crossing`], off the belt). A sample part's path records the push
+//! (`record_path`).
+
+use super::event_queue::EventKind;
+use super::line::{ActivePart, Line};
+use super::metrics::WorkCounters;
+use super::motion::{ContactPlan, Motion, Pusher, Stop};
+use super::outcome::PartOutcome;
+use super::overlap::{capsule_clearance, first_touch};
+use crate::geometry::Pose;
+use crate::mechanics::{
+    ContactOutcome, ContactSettings, ContactStatus, PartModel, Pin, Recorder, SolveFailure,
+};
+use crate::scenario::{Obstacle, Scene, SensorPin};
+use crate::sensing::signal::KnotRecorder;
+
+/// Grazing touches in a row after which a part is taken off as a `solver` outcome (cause
+/// `grazing_loop`) rather than handed between obstacles for ever.
+const MAX_GRAZES: u32 = 16;
+
+impl Line<'_> {
+    /// Part `index` touches obstacle `j` at time `t`: run the push and hold the part until it
+    /// ends (or take it off the line at once).
+    pub(super) fn contact_begin(&mut self, t: f64, index: u64, j: usize) {
+        let scene = self.scene;
+        let v = self.speed();
+        let Some(mut part) = self.active.remove(&index) else {
+            return; // the part has already left the line
+        };
+        let Motion::Free { t0, pose, .. } = part.motion else {
+            unreachable!("contact begin for a held part");
+        };
+        let obstacle = &scene.obstacles[j];
+        let (pusher, settings) = pusher_for(obstacle, &scene.contact);
+        let model = part.model.as_ref().unwrap_or(&scene.part.model);
+        // A sensor pin records the push's knots as it computes it (the only push of this pass).
+        let sensor = sensor_of(obstacle);
+        let mut knots = KnotRecorder::default();
+        let recorder: Option<&mut dyn Recorder> = sensor.map(|_| &mut knots as &mut dyn Recorder);
+        let out = pusher.push(model, pose, &settings, recorder);
+        self.metrics.work.contact_solves += 1;
+        self.metrics.work.model_evaluations += out.evaluations;
+        if matches!(out.status, ContactStatus::PinInsidePart) {
+            self.active.insert(index, part);
+            self.finish(index, t, PartOutcome::MultiContact, "pin_inside_part");
+            return;
+        }
+        if !out.contact {
+            self.graze(t, index, j, part);
+            return;
+        }
+        part.grazes = 0;
+        if let Some(sensor) = sensor {
+            let decision = self.sense(index, j, sensor, &out, &knots.samples, pose.theta);
+            part.sensed.push((j, decision));
+        }
+        let mut plan = plan_of(j, (t0, pose), pusher, settings, out, t, v);
+        if sensor.is_some() {
+            plan.set_trace(&knots.samples);
+        }
+        let work = &mut self.metrics.work;
+        if let Some(tm) = sweep_neighbours(scene, &mut plan, model, work) {
+            plan.t_end = tm.max(t);
+            plan.stop = Some(Stop::MultiContact {
+                cause: "second_obstacle",
+            });
+        }
+        if let Some(tm) = fence_off_belt(scene, &mut plan, model, work) {
+            plan.t_end = tm.max(t);
+            plan.stop = Some(Stop::OffBelt);
+        }
+        part.contacts += 1;
+        self.metrics.contacts += 1;
+        self.metrics.obstacles[j].contacts += 1;
+        if let Some(path) = part.path.as_mut() {
+            record_path(&mut plan, model, v, path, &mut self.metrics.work);
+        }
+        self.hold(t, index, part, plan);
+    }
+
+    /// The model found only a grazing touch: the obstacle passes without pushing, and the part
+    /// rides on (unless it has grazed too often in a row).
+    fn graze(&mut self, t: f64, index: u64, j: usize, mut part: ActivePart) {
+        part.grazes += 1;
+        if part.grazes > MAX_GRAZES {
+            self.active.insert(index, part);
+            self.finish(index, t, PartOutcome::Solver, "grazing_loop");
+            return;
+        }
+        part.last_obstacle = Some(j);
+        self.plan_next(index, &mut part, t);
+        self.active.insert(index, part);
+        self.check_pairs(index, t);
+    }
+
+    /// Hold part `index` in `plan` from time `t`: its contact end is scheduled and its new motion
+    /// checked against the other parts.
+    fn hold(&mut self, t: f64, index: u64, mut part: ActivePart, plan: ContactPlan) {
+        let (t_end, j) = (plan.t_end, plan.obstacle);
+        part.motion = Motion::Held(Box::new(plan));
+        self.queue.schedule(
+            t_end,
+            EventKind::ContactEnd {
+                part: index,
+                obstacle: j as u32,
+            },
+        );
+        self.active.insert(index, part);
+        self.check_pairs(index, t);
+    }
+}
+
+/// The obstacle as the contact model takes it, with the settings of its push: a pin's own μc
+/// replaces the scene's; a fence's own μf replaces the contact friction inside `push_fence`.
+pub fn pusher_for(obstacle: &Obstacle, contact: &ContactSettings) -> (Pusher, ContactSettings) {
+    match obstacle {
+        Obstacle::Pin(pin) => (
+            Pusher::Pin {
+                centre: pin.centre,
+                pin: Pin {
+                    radius: pin.radius,
+                    lateral_speed: 0.0,
+                },
+            },
+            ContactSettings {
+                mu_c: pin.mu_c,
+                ..*contact
+            },
+        ),
+        Obstacle::Fence(fence) => (Pusher::Fence(fence.spec()), *contact),
+    }
+}
+
+/// The sensor on an obstacle, if it is a sensor pin.
+fn sensor_of(obstacle: &Obstacle) -> Option<&SensorPin> {
+    match obstacle {
+        Obstacle::Pin(p) => p.sensor.as_deref(),
+        Obstacle::Fence(_) => None,
+    }
+}
+
+/// Why the line stops a part at the end of a push with contact status `status` (None: it rides
+/// on).
+pub fn stop_of(status: &ContactStatus) -> Option<Stop> {
+    match status {
+        ContactStatus::Ok => None,
+        ContactStatus::MultiContact { .. } => Some(Stop::MultiContact { cause: "notch" }),
+        ContactStatus::TravelLimit { .. } => Some(Stop::Jam {
+            cause: "travel_limit",
+        }),
+        ContactStatus::Jam { .. } => Some(Stop::Jam {
+            cause: "fence_angle",
+        }),
+        ContactStatus::Solver { failure, .. } => Some(Stop::Solver {
+            cause: match failure {
+                SolveFailure::NoConvergence { .. } => "no_convergence",
+                SolveFailure::NonFinite => "non_finite",
+            },
+        }),
+        other => Some(Stop::Solver {
+            cause: other.name(),
+        }),
+    }
+}
+
+/// The plan of a push by obstacle `j` of a part at world pose `pose_ref` at anchor time `t_ref`,
+/// touched at time `t_begin`: its contact spans the pin travel from first touch to the end of the
+/// last contact; `speed` is the belt's (m/s).
+fn plan_of(
+    j: usize,
+    (t_ref, pose_ref): (f64, Pose),
+    pusher: Pusher,
+    settings: ContactSettings,
+    outcome: ContactOutcome,
+    t_begin: f64,
+    speed: f64,
+) -> ContactPlan {
+    let s_touch = outcome.travel_to_contact;
+    let s_end = outcome
+        .segments
+        .last()
+        .map(|s| s.s_end)
+        .unwrap_or(s_touch + outcome.contact_length)
+        .max(s_touch);
+    let stop = stop_of(&outcome.status);
+    ContactPlan {
+        obstacle: j,
+        t_ref,
+        pose_ref,
+        pusher,
+        settings,
+        outcome,
+        s_touch,
+        s_end,
+        t_begin,
+        t_end: (t_ref + s_end / speed).max(t_begin),
+        stop,
+        trace: None,
+    }
+}
+
+/// Record the push's trace if it is not yet recorded, counting the work.
+pub(super) fn ensure_trace(plan: &mut ContactPlan, model: &PartModel, work: &mut WorkCounters) {
+    if plan.ensure_trace(model) {
+        work.traces_recorded += 1;
+    }
+}
+
+/// The earliest time in the push at which another obstacle within reach of the pushing one (the
+/// scene's neighbour list) touches the part, following its recorded path; None if none does or
+/// the scene does not sweep obstacles.
+pub(super) fn sweep_neighbours(
+    scene: &Scene,
+    plan: &mut ContactPlan,
+    model: &PartModel,
+    work: &mut WorkCounters,
+) -> Option<f64> {
+    let neighbours = &scene.neighbours[plan.obstacle];
+    if !scene.effects.obstacle_sweeps || neighbours.is_empty() {
+        return None;
+    }
+    ensure_trace(plan, model, work);
+    let v = scene.belt.speed;
+    let held = Motion::Held(Box::new(plan.clone()));
+    let poly = &scene.part.polygon;
+    let a = scene.part.radius;
+    let breaks = plan.step_times(v);
+    let mut earliest: Option<f64> = None;
+    for &nb in neighbours {
+        work.obstacle_sweep_checks += 1;
+        let (p, q, radius) = scene.obstacles[nb].capsule();
+        let end = earliest.unwrap_or(plan.t_end);
+        let mut evals = 0;
+        let hit = first_touch(
+            plan.t_begin,
+            end,
+            &breaks,
+            &mut |tau| {
+                let pose = held.world_pose(tau, v);
+                capsule_clearance(p, q, radius, &poly.world_vertices(&pose))
+            },
+            &|ta, tb| {
+                let (p, q) = (held.world_pose(ta, v), held.world_pose(tb, v));
+                (q.position() - p.position()).norm() + a * (q.theta - p.theta).abs()
+            },
+            1e-6 * a,
+            &mut evals,
+        );
+        work.clearance_evaluations += evals;
+        if let Some(tm) = hit {
+            earliest = Some(earliest.map_or(tm, |e: f64| e.min(tm)));
+        }
+    }
+    earliest
+}
+
+/// A fence carries the part across the belt: the time its centroid crosses an edge of the belt
+/// during the push, if the fence's reach (its lateral extent plus a) crosses one at all.
+fn fence_off_belt(
+    scene: &Scene,
+    plan: &mut ContactPlan,
+    model: &PartModel,
+    work: &mut WorkCounters,
+) -> Option<f64> {
+    let obstacle = &scene.obstacles[plan.obstacle];
+    let Obstacle::Fence(_) = obstacle else {
+        return None;
+    };
+    let half = scene.belt.width / 2.0;
+    let [y_min, y_max] = obstacle.y_range();
+    let a = scene.part.radius;
+    let reach_crosses_edge = y_min - a < -half || y_max + a > half;
+    if !reach_crosses_edge {
+        return None;
+    }
+    ensure_trace(plan, model, work);
+    edge_crossing(plan, scene.belt.speed, half)
+}
+
+/// The first time in (t_begin, t_end] at which the held part's centroid lies beyond |y| = `half`
+/// (the belt's edge), following the recorded path (linear between steps, as everywhere in the
+/// line).
+pub fn edge_crossing(plan: &ContactPlan, speed: f64, half: f64) -> Option<f64> {
+    let held = Motion::Held(Box::new(plan.clone()));
+    let times = plan.path_times(speed);
+    let beyond = |t: f64| held.world_pose(t, speed).y.abs() - half;
+    let mut prev = (times[0], beyond(times[0]));
+    if prev.1 > 0.0 {
+        return Some(prev.0);
+    }
+    for &t in &times[1..] {
+        let g = beyond(t);
+        if g > 0.0 {
+            // Linear between the steps: the crossing of |y| = half (g ≤ 0 before, > 0 now).
+            let u = prev.1 / (prev.1 - g);
+            return Some(prev.0 + u * (t - prev.0));
+        }
+        prev = (t, g);
+    }
+    None
+}
+
+/// Append the push's world poses (at first touch, each recorded step and the end) to a sample
+/// part's path; `speed` is the belt's (m/s).
+fn record_path(
+    plan: &mut ContactPlan,
+    model: &PartModel,
+    speed: f64,
+    path: &mut Vec<(f64, Pose)>,
+    work: &mut WorkCounters,
+) {
+    ensure_trace(plan, model, work);
+    let held = Motion::Held(Box::new(plan.clone()));
+    let times = plan.path_times(speed);
+    path.extend(times.iter().map(|&tau| (tau, held.world_pose(tau, speed))));
+}
