@@ -113,16 +113,13 @@ fn unknown_value_lists_the_allowed_ones() {
 }
 
 #[test]
-fn reserved_obstacle_kind_is_not_yet_supported() {
+fn moving_pin_needs_its_travel() {
     assert_error(
-        "unsupported_kind.toml",
-        18,
-        8,
-        "obstacles[0].kind",
-        &[
-            "\"moving_pin\" is not yet supported",
-            "kind = \"pin\", \"sensor_pin\" and \"fence\"",
-        ],
+        "moving_pin_without_travel.toml",
+        17,
+        1,
+        "obstacles[0]",
+        &["a moving pin needs travel", "`travel` is missing"],
     );
 }
 

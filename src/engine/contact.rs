@@ -16,11 +16,13 @@ use super::metrics::WorkCounters;
 use super::motion::{ContactPlan, Motion, Pusher, Stop};
 use super::outcome::PartOutcome;
 use super::overlap::{capsule_clearance, first_touch};
-use crate::geometry::Pose;
+use super::sensing::SensedPass;
+use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
-    ContactOutcome, ContactSettings, ContactStatus, PartModel, Pin, Recorder, SolveFailure,
+    ContactOutcome, ContactSettings, ContactStatus, PartModel, PinPath, Recorder, SolveFailure,
 };
 use crate::scenario::{Obstacle, Scene, SensorPin};
+use crate::sensing::classify::Decision;
 use crate::sensing::signal::KnotRecorder;
 
 /// Grazing touches in a row after which a part is taken off as a `solver` outcome (cause
@@ -40,7 +42,11 @@ impl Line<'_> {
             unreachable!("contact begin for a held part");
         };
         let obstacle = &scene.obstacles[j];
-        let (pusher, settings) = pusher_for(obstacle, &scene.contact);
+        let placed = match obstacle {
+            Obstacle::Pin(pin) => Some(self.pin_motion(j, pin, t0)),
+            Obstacle::Fence(_) => None,
+        };
+        let (pusher, settings) = pusher_for(obstacle, &scene.contact, placed);
         let model = part.model.as_ref().unwrap_or(&scene.part.model);
         // A sensor pin records the push's knots as it computes it (the only push of this pass).
         let sensor = sensor_of(obstacle);
@@ -59,16 +65,21 @@ impl Line<'_> {
             return;
         }
         part.grazes = 0;
+        let mut reading = None;
         if let Some(sensor) = sensor {
-            let decision = self.sense(index, j, sensor, &out, &knots.samples, pose.theta);
+            let (decision, sensed) = self.sense(index, j, sensor, &out, &knots.samples, pose.theta);
             part.sensed.push((j, decision));
+            reading = Some(sensed);
         }
         let mut plan = plan_of(j, (t0, pose), pusher, settings, out, t, v);
         if sensor.is_some() {
             plan.set_trace(&knots.samples);
         }
+        let capsules = |nb: usize| self.capsule_during(nb, plan.t_begin, plan.t_end);
+        let capsules: Vec<Option<(Vec2, Vec2, f64)>> =
+            scene.neighbours[j].iter().map(|&nb| capsules(nb)).collect();
         let work = &mut self.metrics.work;
-        if let Some(tm) = sweep_neighbours(scene, &mut plan, model, work) {
+        if let Some(tm) = sweep_neighbours(scene, &mut plan, model, &capsules, work) {
             plan.t_end = tm.max(t);
             plan.stop = Some(Stop::MultiContact {
                 cause: "second_obstacle",
@@ -84,7 +95,41 @@ impl Line<'_> {
         if let Some(path) = part.path.as_mut() {
             record_path(&mut plan, model, v, path, &mut self.metrics.work);
         }
+        if let Some(sensed) = reading {
+            self.schedule_decision(index, &mut part, j, &sensed, plan.t_end);
+        }
         self.hold(t, index, part, plan);
+    }
+
+    /// With a controller, a reading becomes a decision once the reading is over (the end of the
+    /// push) and the controller has computed (its latency).
+    fn schedule_decision(
+        &mut self,
+        index: u64,
+        part: &mut ActivePart,
+        j: usize,
+        sensed: &SensedPass,
+        t_end: f64,
+    ) {
+        let Some(c) = self.control.as_ref() else {
+            return;
+        };
+        let c12 = &sensed.classification;
+        let h = match c12.decision {
+            Decision::Hypothesis(h) => Some(h),
+            Decision::Unknown => None,
+        };
+        let posterior = h.and_then(|h| c12.posterior.as_ref().map(|p| p[h]));
+        let decision = c.decision(h, posterior);
+        part.decided.push((j, decision, sensed.truth));
+        self.queue.schedule(
+            t_end + c.latency(),
+            EventKind::Decision {
+                part: index,
+                obstacle: j as u32,
+                hypothesis: decision.map_or(u32::MAX, |h| h as u32),
+            },
+        );
     }
 
     /// The model found only a grazing touch: the obstacle passes without pushing, and the part
@@ -120,16 +165,23 @@ impl Line<'_> {
 }
 
 /// The obstacle as the contact model takes it, with the settings of its push: a pin's own μc
-/// replaces the scene's; a fence's own μf replaces the contact friction inside `push_fence`.
-pub fn pusher_for(obstacle: &Obstacle, contact: &ContactSettings) -> (Pusher, ContactSettings) {
+/// replaces the scene's; a fence's own μf replaces the contact friction inside `push_fence`. A
+/// pin stands at `placed`'s centre at the anchor time and follows its path (default: where the
+/// scene puts it, still).
+pub fn pusher_for(
+    obstacle: &Obstacle,
+    contact: &ContactSettings,
+    placed: Option<(Vec2, PinPath)>,
+) -> (Pusher, ContactSettings) {
     match obstacle {
         Obstacle::Pin(pin) => (
-            Pusher::Pin {
-                centre: pin.centre,
-                pin: Pin {
+            {
+                let (centre, path) = placed.unwrap_or((pin.centre, PinPath::constant(0.0)));
+                Pusher::Pin {
+                    centre,
                     radius: pin.radius,
-                    lateral_speed: 0.0,
-                },
+                    path,
+                }
             },
             ContactSettings {
                 mu_c: pin.mu_c,
@@ -222,6 +274,7 @@ pub(super) fn sweep_neighbours(
     scene: &Scene,
     plan: &mut ContactPlan,
     model: &PartModel,
+    capsules: &[Option<(Vec2, Vec2, f64)>],
     work: &mut WorkCounters,
 ) -> Option<f64> {
     let neighbours = &scene.neighbours[plan.obstacle];
@@ -235,9 +288,9 @@ pub(super) fn sweep_neighbours(
     let a = scene.part.radius;
     let breaks = plan.step_times(v);
     let mut earliest: Option<f64> = None;
-    for &nb in neighbours {
+    // Where each neighbour can be during the push (a withdrawn retractable pin is not there).
+    for &(p, q, radius) in capsules.iter().flatten() {
         work.obstacle_sweep_checks += 1;
-        let (p, q, radius) = scene.obstacles[nb].capsule();
         let end = earliest.unwrap_or(plan.t_end);
         let mut evals = 0;
         let hit = first_touch(

@@ -24,6 +24,13 @@ pub enum EventKind {
     Exit { part: u64 },
     /// Parts `first` < `second` overlap.
     Collision { first: u64, second: u64 },
+    /// Sensor pin `obstacle`'s decision on `part` reaches the controller (after its latency):
+    /// hypothesis index, or `u32::MAX` for no decision.
+    Decision {
+        part: u64,
+        obstacle: u32,
+        hypothesis: u32,
+    },
 }
 
 /// A scheduled event.
@@ -96,6 +103,11 @@ impl EventQueue {
     /// The first refused event: its time and kind.
     pub fn first_refused(&self) -> Option<(f64, EventKind)> {
         self.first_refused
+    }
+
+    /// The sequence number the next scheduled event will get.
+    pub fn next_seq(&self) -> u64 {
+        self.next_seq
     }
 
     /// The earliest event (lowest sequence number among equal times).

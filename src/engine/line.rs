@@ -40,15 +40,18 @@
 //! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it. What a
 //! run takes and gives is in [`super::results`].
 
+use super::controller::Control;
 use super::event_queue::{Event, EventKind, EventQueue};
 use super::metrics::Metrics;
 use super::motion::{Motion, Stop};
 use super::outcome::PartOutcome;
 use super::part_stream::{arrival_gap, draw_part};
 use super::results::{EngineError, PartRecord, RunOptions, RunResult, SamplePath};
-use super::sensing::{describe, sense_pass, SensorStats};
-use crate::geometry::{first_contact, wrap_deg, Pose, Vec2};
-use crate::mechanics::{fence_first_touch, ContactOutcome, PartModel, TraceSample};
+use super::sensing::{describe, sense_pass, SensedPass, SensorStats};
+use crate::geometry::{wrap_deg, Pose};
+use crate::mechanics::{
+    fence_first_touch, pin_first_touch, ContactOutcome, PartModel, TraceSample,
+};
 use crate::scenario::{Arrival, Obstacle, PinObstacle, Scene, SensorPin};
 use crate::sensing::signal::SignalScale;
 use std::collections::BTreeMap;
@@ -59,7 +62,9 @@ pub(super) struct ActivePart {
     theta_in: f64,
     y_in: f64,
     pub(super) motion: Motion,
-    /// The obstacle whose push ended last (its pin has passed; it cannot touch the part again).
+    /// The obstacle whose push ended last (its pin has passed; it cannot touch the part again: a
+    /// still pin's path is behind the part, and a dynamic pin only moves for the next part once
+    /// this one has cleared it, see [`super::controller`]).
     pub(super) last_obstacle: Option<usize>,
     pub(super) contacts: u32,
     /// Touches in a row that pushed nothing (grazes): bounded, so that two obstacles that each
@@ -70,6 +75,11 @@ pub(super) struct ActivePart {
     pub(super) path: Option<Vec<(f64, Pose)>>,
     /// Sensor pins that have read this part (obstacle index) and their decisions.
     pub(super) sensed: Vec<(usize, String)>,
+    /// Decisions taken on this part for the controller: (sensor, decision, true state).
+    pub(super) decided: Vec<(usize, Option<usize>, Option<usize>)>,
+    /// The part's events are valid from this sequence number on: a part planned again after an
+    /// actuator moved leaves its older contact, exit and collision events stale.
+    pub(super) valid_from: u64,
 }
 
 /// The run state: the scene it runs, the event queue, the parts on the belt and what they have
@@ -87,6 +97,8 @@ pub(super) struct Line<'a> {
     finished: u64,
     /// Sensor pins (obstacle index, index into `metrics.sensors`); empty in a passive scene.
     sensor_pins: Vec<(usize, usize)>,
+    /// The controller and the dynamic pins' timelines (None without dynamic pins).
+    pub(super) control: Option<Control>,
 }
 
 /// Run the line: a pure function of (scene, options). `progress` is called with the number of
@@ -125,6 +137,7 @@ pub fn run(
         paths: Vec::new(),
         finished: 0,
         sensor_pins,
+        control: Control::new(scene, scene.effects.event_log || opts.sample_paths > 0),
     };
     if opts.parts > 0 {
         line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
@@ -154,15 +167,21 @@ pub fn run(
         "conservation: every part that enters ends in exactly one class"
     );
     assert_eq!(line.metrics.parts_in, opts.parts);
-    let summary = line
+    let mut summary = line
         .metrics
         .summary(&scene.name, opts.seed, scene.contact.fidelity.name());
+    let mut control_log = Vec::new();
+    if let Some(c) = line.control.as_mut() {
+        summary.controller = Some(c.finish(summary.simulated_time_s));
+        control_log = c.log.take().unwrap_or_default();
+    }
     Ok(RunResult {
         summary,
         metrics: line.metrics,
         records: line.records,
         events: line.events,
         paths: line.paths,
+        control: control_log,
     })
 }
 
@@ -172,6 +191,10 @@ impl Line<'_> {
     }
 
     fn handle(&mut self, ev: Event) -> Result<(), EngineError> {
+        if self.control.is_some() && self.stale(ev.seq, &ev.kind) {
+            self.metrics.work.stale_events += 1;
+            return Ok(());
+        }
         self.metrics.work.events += 1;
         self.metrics.last_event = self.metrics.last_event.max(ev.time);
         if self.scene.effects.event_log {
@@ -193,6 +216,18 @@ impl Line<'_> {
                     self.finish(second, t, PartOutcome::Collision, "");
                 }
             }
+            EventKind::Decision {
+                part,
+                obstacle,
+                hypothesis,
+            } => {
+                let h = (hypothesis != u32::MAX).then_some(hypothesis as usize);
+                self.decide(t, part, obstacle as usize, h);
+            }
+        }
+        // A part that moved on may have freed a dynamic pin for the next command.
+        if self.control.is_some() {
+            self.serve(t);
         }
         Ok(())
     }
@@ -228,6 +263,8 @@ impl Line<'_> {
             model: d.model,
             path: ((index as usize) < self.opts.sample_paths).then(|| vec![(t, pose)]),
             sensed: Vec::new(),
+            decided: Vec::new(),
+            valid_from: 0,
         };
         self.plan_next(index, &mut part, t);
         self.active.insert(index, part);
@@ -244,12 +281,10 @@ impl Line<'_> {
         };
         let v = self.speed();
         let a = self.scene.part.radius;
-        let model = part.model.as_ref().unwrap_or(&self.scene.part.model);
-        let k = model.scale();
-        let poly = model.polygon();
-        let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+        let scene = self.scene;
+        let model = part.model.as_ref().unwrap_or(&scene.part.model);
         let mut best: Option<(f64, usize)> = None;
-        for (j, ob) in self.scene.obstacles.iter().enumerate() {
+        for (j, ob) in scene.obstacles.iter().enumerate() {
             if Some(j) == part.last_obstacle {
                 continue;
             }
@@ -260,32 +295,12 @@ impl Line<'_> {
             }
             self.metrics.work.ray_casts += 1;
             let travel = match ob {
+                // Along the pin's path (a moving pin's commanded motion from t0 on); a
+                // retractable pin withdrawn when the part would reach it lets it pass.
                 Obstacle::Pin(pin) => {
-                    let start = pin.centre / k;
-                    let rho = pin.radius / k;
-                    let mut min_travel = 0.0;
-                    let mut found = None;
-                    // Past a grazing touch (relative step: travels can be 1e8 a), at most 8 times.
-                    for _ in 0..8 {
-                        match first_contact(
-                            poly,
-                            &pose_n,
-                            start,
-                            Vec2::new(-1.0, 0.0),
-                            rho,
-                            min_travel,
-                        ) {
-                            None => break,
-                            Some(h) if h.grazing => {
-                                min_travel = h.travel + 1e-9 * (1.0 + h.travel.abs())
-                            }
-                            Some(h) => {
-                                found = Some(h.travel * k);
-                                break;
-                            }
-                        }
-                    }
-                    found
+                    let (start, path) = self.pin_motion(j, pin, t0);
+                    pin_first_touch(model, pose, start, pin.radius, &path)
+                        .filter(|&tr| self.present_at(j, t0 + tr / v))
                 }
                 Obstacle::Fence(fence) => fence_first_touch(model, pose, &fence.spec()),
             };
@@ -382,6 +397,9 @@ impl Line<'_> {
         let pose = part.motion.world_pose(t, self.speed());
         let theta_deg = wrap_deg(pose.theta.to_degrees());
         self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
+        if let Some(c) = self.control.as_mut() {
+            c.count_decisions(self.scene, &part.decided, outcome);
+        }
         self.count_untouched(&part, pose.x);
         self.metrics.cause(outcome, cause);
         if self.opts.keep_records {
@@ -427,7 +445,7 @@ impl Line<'_> {
         out: &ContactOutcome,
         knots: &[TraceSample],
         theta: f64,
-    ) -> String {
+    ) -> (String, SensedPass) {
         let scale = SignalScale {
             mass: self.scene.part.mass,
             belt_speed: self.speed(),
@@ -441,7 +459,7 @@ impl Line<'_> {
         if let Some(&(_, k)) = self.sensor_pins.iter().find(|(o, _)| *o == j) {
             self.metrics.sensors[k].add(&sensed);
         }
-        describe(&sensor.labels, &sensed.classification)
+        (describe(&sensor.labels, &sensed.classification), sensed)
     }
 
     /// A part leaving the line at world x `x` has gone past every sensor pin upstream of it:

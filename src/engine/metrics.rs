@@ -52,6 +52,14 @@ pub struct WorkCounters {
     pub signal_knots: u64,
     /// Readings classified.
     pub classifications: u64,
+    /// Decisions that reached the controller, commands they gave to dynamic pins, commands that
+    /// could not finish before their part arrived, free parts planned again after a pin's
+    /// timeline changed, and events dropped as stale (all 0 without dynamic pins).
+    pub decisions: u64,
+    pub actuator_commands: u64,
+    pub late_actuations: u64,
+    pub replans: u64,
+    pub stale_events: u64,
 }
 
 /// Per-obstacle statistics.
@@ -238,6 +246,9 @@ pub struct Summary {
     /// from the JSON when the scene has no sensor).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub sensors: Vec<super::sensing::SensorStats>,
+    /// The controller of dynamic pins (absent from the JSON without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub controller: Option<super::controller::ControllerSummary>,
 }
 
 pub use crate::statistics::wilson_interval;
@@ -316,6 +327,7 @@ impl Metrics {
             simulated_time_s: span,
             work: self.work,
             sensors: self.sensors.clone(),
+            controller: None,
         }
     }
 }

@@ -14,7 +14,9 @@
 //! * [`metrics`]: counts, rates, latency histogram, per-obstacle statistics, work counters and the
 //!   deterministic [`Summary`].
 
+pub mod actuator;
 pub mod contact;
+pub mod controller;
 pub mod event_queue;
 pub mod line;
 pub mod metrics;

@@ -16,15 +16,20 @@
 
 use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
-    push, push_fence, ContactOutcome, ContactSettings, FenceSpec, PartModel, Pin, Recorder,
-    TraceSample,
+    push_fence, push_path, ContactOutcome, ContactSettings, FenceSpec, PartModel, PinPath,
+    Recorder, TraceSample,
 };
 
 /// The obstacle pushing a held part, as the contact model takes it (world frame at t_ref, m).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Pusher {
-    /// A pin whose centre stands at `centre`.
-    Pin { centre: Vec2, pin: Pin },
+    /// A pin of radius `radius` whose centre stands at `centre` at the anchor time and then
+    /// follows `path` (a still pin: `PinPath::constant(0.0)`).
+    Pin {
+        centre: Vec2,
+        radius: f64,
+        path: PinPath,
+    },
     /// A fence.
     Fence(FenceSpec),
 }
@@ -40,7 +45,11 @@ impl Pusher {
         recorder: Option<&mut dyn Recorder>,
     ) -> ContactOutcome {
         match self {
-            Pusher::Pin { centre, pin } => push(model, pose, *centre, pin, settings, recorder),
+            Pusher::Pin {
+                centre,
+                radius,
+                path,
+            } => push_path(model, pose, *centre, *radius, path, settings, recorder),
             Pusher::Fence(fence) => push_fence(model, pose, fence, settings, recorder),
         }
     }

@@ -86,4 +86,7 @@ pub struct RunResult {
     /// Every event taken off the queue, if the scene's event log is on.
     pub events: Vec<Event>,
     pub paths: Vec<SamplePath>,
+    /// What the controller did (decisions, actuations, late ones), when the event log is on or
+    /// sample paths are recorded; empty without dynamic pins.
+    pub control: Vec<super::controller::ControlRecord>,
 }

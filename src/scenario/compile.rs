@@ -516,6 +516,16 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         }
     }
 
+    // [controller] and [[rules]]: after training, so that rules can name the sensors' labels.
+    let controller = super::dynamic_check::controller(
+        &c,
+        loc,
+        raw.controller.as_ref(),
+        &raw.rules,
+        &obstacles,
+        &part.label,
+    )?;
+
     Ok(Scene {
         name,
         seed,
@@ -528,5 +538,6 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         contact,
         effects,
         output,
+        controller,
     })
 }

@@ -80,6 +80,13 @@ pub fn contains(r: (f64, f64), v: f64) -> bool {
     v.is_finite() && v >= r.0 && v <= r.1
 }
 
+/// A moving pin's actuator speed limit (m/s).
+pub const ACTUATOR_SPEED: (f64, f64) = (1e-6, 1e3);
+/// A moving pin's actuator acceleration limit (m/s²).
+pub const ACTUATOR_ACCEL: (f64, f64) = (1e-6, 1e6);
+/// Actuator and controller times: settle, raise and lower times, decision latency (s).
+pub const ACTUATOR_TIME: (f64, f64) = (0.0, 1e4);
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,6 +14,8 @@
 
 pub mod checker;
 pub mod compile;
+pub mod dynamic;
+pub mod dynamic_check;
 pub mod error;
 pub mod limits;
 pub mod location;
@@ -23,6 +25,7 @@ pub mod scene;
 pub mod sensors;
 pub mod shared_feed;
 
+pub use dynamic::{Actuator, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target};
 pub use error::{InvalidScenario, ScenarioError};
 pub use scene::*;
 pub use shared_feed::{FeedMismatch, FeedSource};
@@ -117,8 +120,8 @@ any = true
         let e = err(&GOOD.replace("radius = 0.002", "radius = 0.002\nmu_c = -1"));
         assert_eq!(e.key, "obstacles[0].mu_c");
         let e = err(&GOOD.replace("kind = \"pin\"", "kind = \"moving_pin\""));
-        assert_eq!(e.key, "obstacles[0].kind");
-        assert!(e.message.contains("not yet supported"));
+        assert_eq!(e.key, "obstacles[0]");
+        assert!(e.message.contains("`travel` is missing"));
         let e = err(&GOOD.replace("x = 0.3", "x = 0.01"));
         assert_eq!(e.key, "obstacles[0].x");
         let e = err(&GOOD.replace(

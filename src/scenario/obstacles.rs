@@ -19,6 +19,7 @@
 //! segments) is at most 2a: only then can a part touching one touch the other.
 
 use super::checker::Checker;
+use super::dynamic_check;
 use super::raw::{ObstacleKind, RawObstacle};
 use super::scene::{Belt, FenceObstacle, Obstacle, PinObstacle};
 use super::ScenarioError;
@@ -53,25 +54,24 @@ pub(super) fn compile_obstacles(
             part_radius,
             part_mu_c,
         };
-        if ro.sensor.is_some() && ro.kind != ObstacleKind::SensorPin {
+        let sensing = matches!(ro.kind, ObstacleKind::SensorPin | ObstacleKind::MovingPin);
+        if ro.sensor.is_some() && !sensing {
             return Err(c.err(
                 &format!("obstacles[{i}].sensor"),
-                "only a kind = \"sensor_pin\" has a sensor",
+                "only a kind = \"sensor_pin\" or \"moving_pin\" has a sensor",
             ));
         }
         let ob = match ro.kind {
-            ObstacleKind::Pin => Obstacle::Pin(pin(&at, ro)?),
-            ObstacleKind::SensorPin => {
-                let raw_sensor = ro.sensor.clone().unwrap_or_default();
-                sensors.push((i, super::sensors::validate(c, i, &raw_sensor)?));
-                Obstacle::Pin(pin(&at, ro)?)
-            }
             ObstacleKind::Fence => Obstacle::Fence(fence(&at, ro)?),
-            ObstacleKind::MovingPin => {
-                return Err(c.err(
-                    &format!("obstacles[{i}].kind"),
-                    "obstacle kind \"moving_pin\" is not yet supported; this version simulates kind = \"pin\", \"sensor_pin\" and \"fence\"",
-                ));
+            kind => {
+                let mut p = pin(&at, ro, kind)?;
+                p.actuator = dynamic_check::actuator(c, i, ro, kind, p.centre.y, belt)?;
+                let wants_sensor = kind == ObstacleKind::SensorPin || ro.sensor.is_some();
+                if wants_sensor {
+                    let raw_sensor = ro.sensor.clone().unwrap_or_default();
+                    sensors.push((i, super::sensors::validate(c, i, &raw_sensor)?));
+                }
+                Obstacle::Pin(p)
             }
         };
         if obstacles.iter().any(|o| o.name() == ob.name()) {
@@ -121,6 +121,14 @@ fn only_keys(c: &Checker, i: usize, ro: &RawObstacle, kind: &str, takes: &str) -
         ("angle", ro.angle.is_some()),
         ("length", ro.length.is_some()),
         ("mu_f", ro.mu_f.is_some()),
+        ("travel", ro.travel.is_some()),
+        ("speed", ro.speed.is_some()),
+        ("accel", ro.accel.is_some()),
+        ("settle", ro.settle.is_some()),
+        ("pieces", ro.pieces.is_some()),
+        ("raised", ro.raised.is_some()),
+        ("raise_time", ro.raise_time.is_some()),
+        ("lower_time", ro.lower_time.is_some()),
     ];
     for (k, present) in given {
         if present && !takes.split(", ").any(|t| t == k) {
@@ -197,9 +205,22 @@ impl At<'_, '_, '_> {
     }
 }
 
-fn pin(at: &At, ro: &RawObstacle) -> R<PinObstacle> {
-    only_keys(at.c, at.i, ro, "pin", "x, y, radius, mu_c")?;
-    let needs = "a pin needs x, y and radius (m)";
+fn pin(at: &At, ro: &RawObstacle, kind: ObstacleKind) -> R<PinObstacle> {
+    let (what, takes, needs) = match kind {
+        ObstacleKind::MovingPin => (
+            "moving_pin",
+            "x, y, radius, mu_c, travel, speed, accel, settle, pieces, sensor",
+            "a moving pin needs x, y (its home, m), radius (m), travel ([min, max] m), speed (m/s) and accel (m/s²)",
+        ),
+        ObstacleKind::RetractablePin => (
+            "retractable_pin",
+            "x, y, radius, mu_c, raised, raise_time, lower_time",
+            "a retractable pin needs x, y and radius (m)",
+        ),
+        ObstacleKind::SensorPin => ("sensor_pin", "x, y, radius, mu_c, sensor", "a pin needs x, y and radius (m)"),
+        _ => ("pin", "x, y, radius, mu_c", "a pin needs x, y and radius (m)"),
+    };
+    only_keys(at.c, at.i, ro, what, takes)?;
     let radius = at.need("radius", ro.radius, needs)?;
     let radius = at.c.within(
         &at.path("radius"),
@@ -217,6 +238,7 @@ fn pin(at: &At, ro: &RawObstacle) -> R<PinObstacle> {
         radius,
         mu_c: at.friction("mu_c", ro.mu_c)?,
         sensor: None,
+        actuator: None,
     })
 }
 

@@ -26,6 +26,9 @@ pub struct RawScenario {
     pub effects: RawEffects,
     #[serde(default)]
     pub output: RawOutput,
+    pub controller: Option<RawController>,
+    #[serde(default)]
+    pub rules: Vec<RawRule>,
 }
 
 /// `[belt]`: speed (m/s), width (m, the belt spans y ∈ [−width/2, width/2]) and usable length (m,
@@ -129,6 +132,7 @@ pub enum ObstacleKind {
     Pin,
     SensorPin,
     MovingPin,
+    RetractablePin,
     Fence,
 }
 
@@ -154,8 +158,54 @@ pub struct RawObstacle {
     pub length: Option<f64>,
     /// Fence–part friction (default: the part's mu_c).
     pub mu_f: Option<f64>,
-    /// `[obstacles.sensor]`: the sensor of a `sensor_pin`.
+    /// `[obstacles.sensor]`: the sensor of a `sensor_pin` (or of a `moving_pin`).
     pub sensor: Option<RawSensor>,
+    /// A moving pin's lateral range [min, max] (m), speed (m/s) and acceleration (m/s²) limits,
+    /// settle time (s) and the pieces an acceleration phase is resolved into.
+    pub travel: Option<[f64; 2]>,
+    pub speed: Option<f64>,
+    pub accel: Option<f64>,
+    pub settle: Option<f64>,
+    pub pieces: Option<u32>,
+    /// A retractable pin's state before any command, and its switching times (s).
+    pub raised: Option<bool>,
+    pub raise_time: Option<f64>,
+    pub lower_time: Option<f64>,
+}
+
+/// `[controller]`: how decisions become actuator commands (README "Controller and rules").
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RawController {
+    /// Computation time from the end of a reading to the commands (s, default 0.01).
+    pub latency: Option<f64>,
+    /// Decisions with a posterior below this count as no decision (default 0).
+    pub min_posterior: Option<f64>,
+    /// `skip` (default) or `move`: what a command that cannot finish before its part arrives does.
+    pub on_late: Option<String>,
+    /// A policy file (rules written by `pinfeed plan`), relative to the scenario file.
+    pub policy: Option<String>,
+}
+
+/// `[[rules]]`: when `sensor` decides `decides`, bring `pin` to `y` (a moving pin) or `raised`
+/// (a retractable pin) for that part.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRule {
+    pub sensor: String,
+    pub decides: String,
+    pub pin: String,
+    pub y: Option<f64>,
+    pub raised: Option<bool>,
+}
+
+/// A policy file: the part it was planned for, and its rules.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPolicy {
+    pub part: String,
+    #[serde(default)]
+    pub rules: Vec<RawRule>,
 }
 
 /// `[obstacles.sensor]` of a sensor pin (README "Sensor pins"; defaults in

@@ -1,6 +1,7 @@
 //! The compiled scene: everything a run needs, validated, in SI units and radians, never mutated
 //! (DESIGN.md "model vs state"). Run state lives in [`crate::engine`].
 
+use super::dynamic::{Actuator, Controller};
 pub use super::raw::SupportKind;
 use crate::geometry::{Polygon, StableState, Vec2};
 use crate::mechanics::{ContactSettings, FenceSpec, PartModel};
@@ -108,6 +109,8 @@ pub struct PinObstacle {
     pub mu_c: f64,
     /// The pin's sensor and its trained classifier, if it has one.
     pub sensor: Option<Arc<SensorPin>>,
+    /// What moves the pin (a moving or retractable pin), if anything; `centre` is then its home.
+    pub actuator: Option<Actuator>,
 }
 
 /// A pin's sensor: its settings, its hypotheses and the classifier trained on their templates
@@ -190,8 +193,8 @@ impl FenceObstacle {
     }
 }
 
-/// An element over the belt: a fixed pin or a fence. Sensor pins and moving pins are reserved
-/// kinds in the file format and will become variants here.
+/// An element over the belt: a pin (with an optional sensor and an optional actuator: the file
+/// format's `pin`, `sensor_pin`, `moving_pin` and `retractable_pin`) or a fence.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Obstacle {
     Pin(PinObstacle),
@@ -206,9 +209,20 @@ impl Obstacle {
         }
     }
     /// The obstacle as a capsule: the points within `radius` of the segment [p, q] (world, m). A
-    /// pin is a disc (p = q = its centre); a fence is its segment (radius 0).
+    /// pin is a disc (p = q = its centre), a moving pin the whole of its travel; a fence is its
+    /// segment (radius 0).
     pub fn capsule(&self) -> (Vec2, Vec2, f64) {
         match self {
+            Obstacle::Pin(PinObstacle {
+                centre,
+                radius,
+                actuator: Some(Actuator::Moving(m)),
+                ..
+            }) => (
+                Vec2::new(centre.x, m.travel[0]),
+                Vec2::new(centre.x, m.travel[1]),
+                *radius,
+            ),
             Obstacle::Pin(p) => (p.centre, p.centre, p.radius),
             Obstacle::Fence(f) => (f.start, f.end(), 0.0),
         }
@@ -292,4 +306,6 @@ pub struct Scene {
     pub contact: ContactSettings,
     pub effects: Effects,
     pub output: OutputOptions,
+    /// The controller driving the dynamic pins (`[controller]` and `[[rules]]`), if any.
+    pub controller: Option<Controller>,
 }

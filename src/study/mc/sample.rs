@@ -402,6 +402,7 @@ fn draw_obstacle(
                 radius: r,
                 mu_c: mu_c.unwrap_or(pin.mu_c),
                 sensor: perturb_sensor(pin, sensor_values)?,
+                actuator: pin.actuator,
             }));
         }
         *other += 1;
@@ -493,6 +494,7 @@ pub fn draw_scene(
         obstacles,
         neighbours,
         goal: base.goal.clone(),
+        controller: base.controller.clone(),
         contact: crate::mechanics::ContactSettings {
             mu_c: mu_c.unwrap_or(base.contact.mu_c),
             ..base.contact

@@ -1,0 +1,87 @@
+//! Dynamic pins and the controller that drives them (SPEC §5; README "Moving and retractable
+//! pins", "Controller and rules"): the compiled forms. Validation is in
+//! [`super::dynamic_check`].
+
+/// A moving pin's actuator: it translates along y within `travel`, in trapezoidal moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MovingSpec {
+    /// Where it rests before any command (m).
+    pub home: f64,
+    /// The lateral range its centre may reach, [min, max] (m), over the belt.
+    pub travel: [f64; 2],
+    /// Speed limit (m/s) and acceleration limit (m/s²), both > 0.
+    pub speed: f64,
+    pub accel: f64,
+    /// Time after a move before the pin counts as ready (s).
+    pub settle: f64,
+    /// Constant-speed pieces each acceleration phase is resolved into for the contact model.
+    pub pieces: usize,
+}
+
+/// A retractable pin's actuator: raised or withdrawn per part.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RetractSpec {
+    /// Its state before any command.
+    pub raised: bool,
+    /// Time to rise and to withdraw (s).
+    pub raise_time: f64,
+    pub lower_time: f64,
+}
+
+/// What moves a pin, if anything does.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Actuator {
+    Moving(MovingSpec),
+    Retractable(RetractSpec),
+}
+
+/// Where a dynamic pin is asked to be for a part.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Target {
+    /// A moving pin's lateral position (m).
+    Y(f64),
+    /// A retractable pin raised (true) or withdrawn.
+    Raised(bool),
+}
+
+/// What the controller does with a command it cannot carry out before the part arrives.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OnLate {
+    /// Leave the pin as it is for this part (counted as a late actuation).
+    Skip,
+    /// Move anyway: the part may meet a pin in motion, simulated with its true velocity (moving
+    /// pins only; counted too).
+    Move,
+}
+
+impl OnLate {
+    pub fn name(self) -> &'static str {
+        match self {
+            OnLate::Skip => "skip",
+            OnLate::Move => "move",
+        }
+    }
+}
+
+/// One rule: when `sensor` decides `decides` (a hypothesis index, `None` for no decision), bring
+/// `pin` to `target` for that part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rule {
+    pub sensor: usize,
+    pub decides: Option<usize>,
+    pub pin: usize,
+    pub target: Target,
+}
+
+/// The controller: computation latency, rules, and what to do when late.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Controller {
+    /// Time from the end of a reading to the commands (s).
+    pub latency: f64,
+    /// A decision whose posterior is below this counts as no decision.
+    pub min_posterior: f64,
+    pub on_late: OnLate,
+    pub rules: Vec<Rule>,
+    /// Where the rules came from: "scenario" or the policy file's path.
+    pub source: String,
+}
