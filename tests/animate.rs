@@ -586,3 +586,42 @@ fn sensor_run_marks_readings_and_decisions() {
         .iter()
         .all(|d| d.contains('°') || d.contains("unknown")));
 }
+
+#[test]
+fn cli_writes_the_animation() {
+    let dir = std::env::temp_dir().join(format!("pinfeed-animate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("line.svg");
+    let pinfeed = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            "scenarios/quickstart.toml",
+            "--parts",
+            "15",
+            "--quiet",
+            "--out",
+            dir.to_str().unwrap(),
+            "--animate",
+            svg.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+            .args(&args)
+            .output()
+            .unwrap()
+    };
+    let o = pinfeed(&["--animate-speed", "4"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc = std::fs::read_to_string(&svg).unwrap();
+    let svg_el = parse_xml(&doc);
+    let dur = check_animations(&svg_el);
+    assert_eq!(svg_el.with_class("part").len(), animate::DEFAULT_PARTS);
+    // Ten parts every 4 s, 12 s on the belt and a tenth more: about 56 s at ×4.
+    assert!((10.0..20.0).contains(&dur), "dur {dur}");
+    for bad in ["0", "-1", "nan", "1e-6"] {
+        let o = pinfeed(&[&format!("--animate-speed={bad}")]);
+        assert!(!o.status.success(), "--animate-speed {bad} accepted");
+        assert!(String::from_utf8_lossy(&o.stderr).contains("--animate-speed"));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

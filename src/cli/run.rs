@@ -1,7 +1,9 @@
 //! `pinfeed run SCENARIO.toml`: simulate a feeder line (SPEC §7) and report throughput and
 //! orientation success. Writes `summary.json` (and, as the scenario's `[output]` asks, the
 //! per-part CSV, the orientation histogram SVG and the event log) under
-//! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`.
+//! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`. `--draw` and
+//! `--animate` picture sample parts on the line ([`crate::report::plot_line`],
+//! [`crate::report::animate`]).
 
 use crate::engine::{self, RunOptions};
 use crate::report::{animate, line_table, parts_csv, plot_line, plot_orientations};
