@@ -686,7 +686,7 @@ fn belt(s: &mut String, anim: &Animation, lay: &Layout) {
             s,
             r#"<animateTransform attributeName="transform" type="translate" from="0,0" to="{},0" dur="{}s" repeatCount="indefinite"/>"#,
             px(gap_px),
-            num(gap_m / speed / speedup, 4)
+            num((gap_m / speed / speedup).clamp(0.01, 3600.0), 4)
         );
     }
     for i in 0..n {
