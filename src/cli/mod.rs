@@ -50,7 +50,8 @@ pub enum Command {
     Contact(contact::ContactArgs),
     /// Configuration maps θ0 → θf for several d: bands, no-contact runs, figures, report files.
     Map(map::MapArgs),
-    /// Simulate a feeder line from a scenario file: throughput and orientation success.
+    /// Simulate a feeder line from a scenario file: throughput and orientation success
+    /// (`--draw FILE.svg` a still picture, `--animate FILE.svg` an animation of sample parts).
     Run(run::RunArgs),
     /// Run several line designs on the same part stream and print one table.
     Compare(compare::CompareArgs),

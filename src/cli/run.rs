@@ -1,10 +1,12 @@
 //! `pinfeed run SCENARIO.toml`: simulate a feeder line (SPEC §7) and report throughput and
 //! orientation success. Writes `summary.json` (and, as the scenario's `[output]` asks, the
 //! per-part CSV, the orientation histogram SVG and the event log) under
-//! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`.
+//! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`. `--draw` and
+//! `--animate` picture sample parts on the line ([`crate::report::plot_line`],
+//! [`crate::report::animate`]).
 
 use crate::engine::{self, RunOptions};
-use crate::report::{line_table, parts_csv, plot_line, plot_orientations};
+use crate::report::{animate, line_table, parts_csv, plot_line, plot_orientations};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -34,6 +36,14 @@ pub struct RunArgs {
     /// Draw the line from above, to scale, with a few sample parts, into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub draw: Option<PathBuf>,
+    /// Animate the line into this SVG file (plays in a browser, looping): the first sample parts
+    /// travelling the belt to scale, the obstacles, sensor readings and decisions as they happen,
+    /// and each part's outcome colour when it ends.
+    #[arg(long, value_name = "FILE.svg")]
+    pub animate: Option<PathBuf>,
+    /// Simulated seconds per second of animation (default: the loop lasts 20–40 s).
+    #[arg(long, value_name = "X", requires = "animate")]
+    pub animate_speed: Option<f64>,
 }
 
 /// How many of the first parts have their paths recorded when drawing.
@@ -54,6 +64,20 @@ pub fn run(args: &RunArgs) -> Result<()> {
     opts.keep_records = scene.output.parts_csv;
     if args.draw.is_some() {
         opts.sample_paths = SAMPLE_POOL;
+    }
+    if args.animate.is_some() {
+        if let Some(x) = args.animate_speed {
+            if !(x.is_finite() && x > 0.0 && x <= 1e6) {
+                bail!("--animate-speed must lie in (0, 1000000], got {x}");
+            }
+        }
+        opts.sample_paths = opts.sample_paths.max(animate::DEFAULT_PARTS);
+        // Sensor decisions reach the animation through the per-part records.
+        let sensors = scene
+            .obstacles
+            .iter()
+            .any(|o| matches!(o, crate::scenario::Obstacle::Pin(p) if p.sensor.is_some()));
+        opts.keep_records |= sensors;
     }
     let bar = if args.quiet {
         ProgressBar::hidden()
@@ -100,6 +124,22 @@ pub fn run(args: &RunArgs) -> Result<()> {
     if let Some(p) = &args.draw {
         let samples = plot_line::choose_samples(&result.paths, scene.output.draw_parts as usize);
         plot_line::plot_line(&scene, &samples, p)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    if let Some(p) = &args.animate {
+        let anim = animate::from_run(&scene, &result, animate::DEFAULT_PARTS);
+        let aopts = animate::AnimateOptions {
+            speedup: args.animate_speed,
+        };
+        let dur = (anim.t_end - anim.t_start) / aopts.speedup.unwrap_or(1.0);
+        if args.animate_speed.is_some() && dur > animate::MAX_DURATION_S {
+            bail!(
+                "--animate-speed {} would make the animation last {dur:.0} s; at most {} s (choose a larger speed-up)",
+                aopts.speedup.unwrap_or(1.0),
+                animate::MAX_DURATION_S
+            );
+        }
+        std::fs::write(p, animate::render(&anim, &aopts))
             .with_context(|| format!("writing {}", p.display()))?;
     }
 

@@ -1,6 +1,7 @@
 //! Reports for people and programs: terminal tables, JSON/CSV, and SVG figures.
 
 pub mod aligned;
+pub mod animate;
 pub mod compare_table;
 pub mod line_table;
 pub mod map_table;
