@@ -22,9 +22,10 @@
 //! goes.
 
 use super::plot_line::outcome_colour;
+use crate::engine::controller::ControlRecord;
 use crate::engine::{PartOutcome, RunResult};
 use crate::geometry::{wrap_pi, Pose, Vec2};
-use crate::scenario::{Obstacle, Scene};
+use crate::scenario::{Actuator, Obstacle, PinObstacle, Scene};
 use std::fmt::Write;
 
 /// Everything the animation shows (plain data; world frame, metres, seconds, radians).
@@ -1236,7 +1237,7 @@ pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation 
                     radius: p.radius,
                 },
                 sensor: p.sensor.is_some(),
-                track: vec![(t_start, p.centre.y, true)],
+                track: pin_track(p, &result.control, t_start),
             },
             Obstacle::Fence(f) => AnimObstacle {
                 name: f.name.clone(),
@@ -1266,15 +1267,19 @@ pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation 
                     kind: MarkKind::Reading,
                     text: format!("{name}: reading"),
                 });
-                marks.push(AnimMark {
-                    t: te,
-                    at: pin.centre,
-                    kind: MarkKind::Decision,
-                    text: format!("part {} → {decision}", part.part),
-                });
+                // With a controller its own decision records say when decisions were taken.
+                if result.control.is_empty() {
+                    marks.push(AnimMark {
+                        t: te,
+                        at: pin.centre,
+                        kind: MarkKind::Decision,
+                        text: format!("part {} → {decision}", part.part),
+                    });
+                }
             }
         }
     }
+    marks.extend(control_marks(scene, &result.control, &parts));
     Animation {
         title: format!("{} — {} on the line", scene.name, scene.part.label),
         belt_length: scene.belt.length,
@@ -1287,6 +1292,72 @@ pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation 
         t_start,
         t_end,
     }
+}
+
+/// A pin's knots (time, centre y, raised?): where it starts and, for a dynamic pin, each motion the
+/// controller carried out (a retractable pin is withdrawn while in transit).
+fn pin_track(pin: &PinObstacle, control: &[ControlRecord], t_start: f64) -> Vec<(f64, f64, bool)> {
+    let home = pin.centre.y;
+    let mut track = vec![(
+        t_start,
+        home,
+        !matches!(pin.actuator, Some(Actuator::Retractable(r)) if !r.raised),
+    )];
+    for rec in control.iter().filter(|r| r.obstacle == pin.name) {
+        let Some(m) = rec.motion else { continue };
+        match pin.actuator {
+            Some(Actuator::Moving(_)) => {
+                track.push((m.t_start, m.from, true));
+                track.push((m.t_ready, m.to, true));
+            }
+            Some(Actuator::Retractable(_)) => {
+                track.push((m.t_start, home, false));
+                track.push((m.t_ready, home, m.to > 0.5));
+            }
+            None => {}
+        }
+    }
+    track.sort_by(|a, b| a.0.total_cmp(&b.0));
+    track
+}
+
+/// The controller's decisions, actuations and late commands for the animated parts, as marks at
+/// the sensor or the pin concerned.
+fn control_marks(scene: &Scene, control: &[ControlRecord], parts: &[AnimPart]) -> Vec<AnimMark> {
+    control
+        .iter()
+        .filter(|r| parts.iter().any(|p| p.part == r.part))
+        .filter_map(|r| {
+            let Some(Obstacle::Pin(pin)) = scene.obstacles.iter().find(|o| o.name() == r.obstacle)
+            else {
+                return None;
+            };
+            let (kind, text) = match r.kind {
+                "decision" => (MarkKind::Decision, format!("part {} → {}", r.part, r.what)),
+                "actuation" => (
+                    MarkKind::Actuation,
+                    format!("{} {} for part {}", r.obstacle, r.what, r.part),
+                ),
+                "late" => (
+                    MarkKind::Late,
+                    format!("late: {} {} for part {}", r.obstacle, r.what, r.part),
+                ),
+                _ => return None,
+            };
+            let at = match r.motion {
+                Some(m) if matches!(pin.actuator, Some(Actuator::Moving(_))) => {
+                    Vec2::new(pin.centre.x, m.from)
+                }
+                _ => pin.centre,
+            };
+            Some(AnimMark {
+                t: r.t,
+                at,
+                kind,
+                text,
+            })
+        })
+        .collect()
 }
 
 /// `pin=decision; pin2=decision` (a part record's `sensed`) as (pin, decision) pairs.
