@@ -121,6 +121,75 @@ fn trace_and_plot_files() {
     assert!(svg.contains("<svg") && svg.len() > 1000);
 }
 
+/// The strokes of the polylines drawn in `colour` (plotters' SVG: `stroke="#RRGGBB"`), as point
+/// lists.
+fn polylines_in(svg: &str, colour: &str) -> Vec<Vec<(f64, f64)>> {
+    svg.lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains(&format!("stroke=\"{colour}\"")))
+        .map(|l| {
+            let points = l
+                .split("points=\"")
+                .nth(1)
+                .unwrap()
+                .split('"')
+                .next()
+                .unwrap();
+            points
+                .split_whitespace()
+                .map(|p| {
+                    let (x, y) = p.split_once(',').unwrap();
+                    (x.parse().unwrap(), y.parse().unwrap())
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// `--fence ... --plot` draws the fence (at the start and end of contact) and no pin; a pin pass
+/// draws no fence.
+#[test]
+fn fence_plot_draws_the_fence() {
+    let dir = std::env::temp_dir().join(format!("pinfeed-cli-fence-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fence_colour = {
+        let c = pinfeed::report::plot_contact::FENCE_COLOUR;
+        format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)
+    };
+    let draw = |extra: &[&str], file: &str| -> String {
+        let plot = dir.join(file);
+        let mut args = vec![
+            "contact", "--part", "tripoly2", "--theta0", "30", "--d", "0.1", "--plot",
+        ];
+        args.push(plot.to_str().unwrap());
+        args.extend_from_slice(extra);
+        let out = pinfeed(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read_to_string(&plot).unwrap()
+    };
+    let svg = draw(&["--fence", "30"], "fence.svg");
+    assert!(svg.contains("fence α=30°"), "the title names the fence");
+    let fences = polylines_in(&svg, &fence_colour);
+    assert_eq!(fences.len(), 2, "the fence at the start and end of contact");
+    for f in &fences {
+        assert_eq!(f.len(), 2, "a fence is one segment: {f:?}");
+        let (dx, dy) = (f[1].0 - f[0].0, f[1].1 - f[0].1);
+        assert!(dx.hypot(dy) > 0.0, "{f:?}");
+        // Drawn at the fence's angle: 30° from the belt direction (SVG y points down).
+        assert!(((-dy).atan2(dx).to_degrees() - 30.0).abs() < 5.0, "{f:?}");
+    }
+    assert!(
+        polylines_in(&svg, "#FF0000").is_empty() && !svg.contains("fill=\"#FF0000\""),
+        "a fence pass draws no pin"
+    );
+    let pin = draw(&[], "pin.svg");
+    assert!(polylines_in(&pin, &fence_colour).is_empty());
+    assert!(!polylines_in(&pin, "#FF0000").is_empty(), "the pin's path");
+}
+
 /// Batch mode: one output row per case, in order, with the same physics as single runs.
 #[test]
 fn batch_cases_csv() {

@@ -10,6 +10,7 @@ use crate::mechanics::{
     push, push_fence, ContactOutcome, ContactSettings, FenceSpec, Fidelity, PartModel, Pin,
     Support, TraceSample,
 };
+use crate::report::plot_contact::{plot_contact, PassObstacle};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde::{Deserialize, Serialize};
@@ -55,7 +56,7 @@ pub struct ContactArgs {
     /// Write the trajectory and contact force per step to this CSV file.
     #[arg(long, value_name = "FILE.csv")]
     pub trace: Option<PathBuf>,
-    /// Draw the part's successive poses against the pin into this SVG file.
+    /// Draw the part's successive poses against the pin (or the fence) into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
     /// Push with a fence instead of a pin: angle from the belt direction in degrees (−90 < α < 90;
@@ -386,6 +387,50 @@ fn run_compiled(
     (out, trace)
 }
 
+/// The initial pose of a case and its obstacle as the plot draws it: the pin (start, radius,
+/// lateral speed) or the fence segment.
+fn pass_obstacle(poly: &Polygon, c: &Case) -> (Pose, PassObstacle) {
+    let (pose, start) = case_geometry(poly, c);
+    let obstacle = match c.fence {
+        Some((angle, length)) => {
+            let fence = case_fence(poly, c, angle, length);
+            PassObstacle::Fence {
+                start: fence.start,
+                end: fence.start + Vec2::from_angle(fence.angle) * fence.length,
+            }
+        }
+        None => PassObstacle::Pin {
+            start,
+            radius: c.pin_radius,
+            lateral_speed: c.pin_speed,
+        },
+    };
+    (pose, obstacle)
+}
+
+/// The plot's title: the part, θ0, d, the friction and the model (and the fence's angle).
+fn plot_title(c: &Case) -> String {
+    match c.fence {
+        Some((angle, _)) => format!(
+            "{} θ0={}° d={} fence α={}° μf={} ({})",
+            c.part,
+            c.theta0_deg,
+            c.d,
+            angle,
+            c.mu_c,
+            c.model.name()
+        ),
+        None => format!(
+            "{} θ0={}° d={} μc={} ({})",
+            c.part,
+            c.theta0_deg,
+            c.d,
+            c.mu_c,
+            c.model.name()
+        ),
+    }
+}
+
 fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
     ContactReport {
         part: c.part.clone(),
@@ -440,8 +485,8 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         write_trace(path, &trace).with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        let (pose, start) = case_geometry(&poly, &c);
-        crate::report::plot_contact::plot_contact(&poly, pose, start, &out, &trace, &c, path)
+        let (pose, obstacle) = pass_obstacle(&poly, &c);
+        plot_contact(&poly, pose, &obstacle, &out, &trace, &plot_title(&c), path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     let r = report(&c, &out);

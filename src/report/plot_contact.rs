@@ -1,19 +1,39 @@
-//! SVG of one pin pass (like the thesis's Figure 3-1): the part's successive poses in the belt frame,
-//! the pin's path, the pin at the start and end of contact, and the centroid's track.
+//! SVG of one pass (like the thesis's Figure 3-1): the part's successive poses in the belt frame,
+//! the centroid's track, and the obstacle: for a pin its path and the pin at the start and end of
+//! contact; for a fence the fence segment at the start and end of contact (it travels along −x in
+//! the belt frame, as every fixed obstacle does).
 
-use crate::cli::contact::Case;
 use crate::geometry::{Polygon, Pose, Vec2};
 use crate::mechanics::{ContactOutcome, TraceSample};
 use plotters::prelude::*;
 use std::path::Path;
 
+/// The obstacle of a pass as drawn (belt frame at the start of the pass, part units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PassObstacle {
+    /// A pin of radius `radius` whose centre starts at `start` and moves (−1, `lateral_speed`) per
+    /// unit travel.
+    Pin {
+        start: Vec2,
+        radius: f64,
+        lateral_speed: f64,
+    },
+    /// A fence segment from `start` to `end`.
+    Fence { start: Vec2, end: Vec2 },
+}
+
+/// Stroke colour of the fence segments (the pin is red).
+pub const FENCE_COLOUR: RGBColor = RGBColor(20, 130, 60);
+
+/// Draw the pass of `poly` from `pose0` against `obstacle` (its outcome `out` and recorded `trace`)
+/// into the SVG file `path`; `title` heads the plot (the final orientation is appended).
 pub fn plot_contact(
     poly: &Polygon,
     pose0: Pose,
-    pin_start: Vec2,
+    obstacle: &PassObstacle,
     out: &ContactOutcome,
     trace: &[TraceSample],
-    case: &Case,
+    title: &str,
     path: &Path,
 ) -> anyhow::Result<()> {
     let a = poly.radius();
@@ -29,9 +49,15 @@ pub fn plot_contact(
         pts.extend(poly.vertices().iter().map(|&v| p.apply(v)));
     }
     let pin_end_s = out.travel_to_contact + out.contact_length;
-    let pin_end = pin_start + Vec2::new(-1.0, case.pin_speed) * (pin_end_s + a * 0.5);
-    pts.push(pin_start);
-    pts.push(pin_end);
+    if let PassObstacle::Pin {
+        start,
+        lateral_speed,
+        ..
+    } = *obstacle
+    {
+        pts.push(start);
+        pts.push(start + Vec2::new(-1.0, lateral_speed) * (pin_end_s + a * 0.5));
+    }
     let (mut lo, mut hi) = (pts[0], pts[0]);
     for p in &pts {
         lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
@@ -47,12 +73,7 @@ pub fn plot_contact(
     let mut ch = ChartBuilder::on(&root)
         .caption(
             format!(
-                "{} θ0={}° d={} μc={} ({}) → θf={:.2}°",
-                case.part,
-                case.theta0_deg,
-                case.d,
-                case.mu_c,
-                case.model.name(),
+                "{title} → θf={:.2}°",
                 crate::geometry::wrap_deg(out.pose_final.theta.to_degrees())
             ),
             ("sans-serif", 18),
@@ -86,18 +107,95 @@ pub fn plot_contact(
     }
     let track: Vec<(f64, f64)> = poses.iter().map(|p| (p.x, p.y)).collect();
     ch.draw_series(LineSeries::new(track, BLACK.mix(0.5)))?;
-    ch.draw_series(LineSeries::new(
-        vec![(pin_start.x, pin_start.y), (pin_end.x, pin_end.y)],
-        RED.mix(0.5),
-    ))?;
-    let px = |v: f64| ((v / span) * 700.0).max(3.0) as i32;
-    for t in [trace.first(), trace.last()].into_iter().flatten() {
-        ch.draw_series(std::iter::once(Circle::new(
-            (t.pin_centre.x, t.pin_centre.y),
-            px(case.pin_radius),
-            RED.filled(),
-        )))?;
+    match *obstacle {
+        PassObstacle::Pin {
+            start,
+            radius,
+            lateral_speed,
+        } => {
+            let end = start + Vec2::new(-1.0, lateral_speed) * (pin_end_s + a * 0.5);
+            ch.draw_series(LineSeries::new(
+                vec![(start.x, start.y), (end.x, end.y)],
+                RED.mix(0.5),
+            ))?;
+            let px = |v: f64| ((v / span) * 700.0).max(3.0) as i32;
+            for t in [trace.first(), trace.last()].into_iter().flatten() {
+                ch.draw_series(std::iter::once(Circle::new(
+                    (t.pin_centre.x, t.pin_centre.y),
+                    px(radius),
+                    RED.filled(),
+                )))?;
+            }
+        }
+        PassObstacle::Fence { start, end } => {
+            // The fence where the contact begins (thick) and where it ends, inside the view.
+            let view = (
+                Vec2::new(cx - span / 2.0, cy - span / 2.0),
+                Vec2::new(cx + span / 2.0, cy + span / 2.0),
+            );
+            for (s, width) in [(out.travel_to_contact, 3), (pin_end_s, 1)] {
+                let shift = Vec2::new(-s, 0.0);
+                if let Some((p, q)) = clip_segment(start + shift, end + shift, view) {
+                    ch.draw_series(LineSeries::new(
+                        vec![(p.x, p.y), (q.x, q.y)],
+                        FENCE_COLOUR.stroke_width(width),
+                    ))?;
+                }
+            }
+        }
     }
     root.present()?;
     Ok(())
+}
+
+/// The part of segment p → q inside the axis-aligned box (lo, hi), if any (Liang–Barsky).
+fn clip_segment(p: Vec2, q: Vec2, (lo, hi): (Vec2, Vec2)) -> Option<(Vec2, Vec2)> {
+    let d = q - p;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (dp, num) in [
+        (-d.x, p.x - lo.x),
+        (d.x, hi.x - p.x),
+        (-d.y, p.y - lo.y),
+        (d.y, hi.y - p.y),
+    ] {
+        if dp == 0.0 {
+            if num < 0.0 {
+                return None;
+            }
+        } else {
+            let t = num / dp;
+            if dp < 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+    }
+    // An end inside the box stays exactly where it was.
+    let at = |t: f64| {
+        if t <= 0.0 {
+            p
+        } else if t >= 1.0 {
+            q
+        } else {
+            p + d * t
+        }
+    };
+    (t0 <= t1).then(|| (at(t0), at(t1)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clip_keeps_the_inside_and_drops_the_outside() {
+        let view = (Vec2::new(0.0, 0.0), Vec2::new(1.0, 1.0));
+        let (p, q) = clip_segment(Vec2::new(-1.0, 0.5), Vec2::new(2.0, 0.5), view).unwrap();
+        assert!((p.x - 0.0).abs() < 1e-12 && (q.x - 1.0).abs() < 1e-12);
+        assert_eq!(p.y, 0.5);
+        assert!(clip_segment(Vec2::new(-1.0, 2.0), Vec2::new(2.0, 2.0), view).is_none());
+        let inside = (Vec2::new(0.2, 0.3), Vec2::new(0.7, 0.9));
+        assert_eq!(clip_segment(inside.0, inside.1, view), Some(inside));
+    }
 }
