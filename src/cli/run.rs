@@ -120,6 +120,11 @@ pub fn run(args: &RunArgs) -> Result<()> {
         let p = dir.join("events.json");
         std::fs::write(&p, serde_json::to_string(&result.events)? + "\n")
             .with_context(|| format!("writing {}", p.display()))?;
+        if !result.control.is_empty() {
+            let p = dir.join("control.json");
+            std::fs::write(&p, serde_json::to_string(&result.control)? + "\n")
+                .with_context(|| format!("writing {}", p.display()))?;
+        }
     }
     if let Some(p) = &args.draw {
         let samples = plot_line::choose_samples(&result.paths, scene.output.draw_parts as usize);

@@ -89,6 +89,9 @@ pub fn table(s: &Summary) -> String {
     for sensor in &s.sensors {
         sensor_table(&mut o, sensor);
     }
+    if let Some(c) = &s.controller {
+        controller_table(&mut o, c);
+    }
     // The most populated orientation bins.
     let h = &s.orientation_histogram;
     let mut bins: Vec<(usize, u64)> = h
@@ -119,6 +122,46 @@ pub fn table(s: &Summary) -> String {
         s.simulated_time_s, s.work.events, s.work.contact_solves
     );
     o
+}
+
+/// The controller's block: decisions and how their parts ended, misclassifications and the
+/// failures they caused, and per dynamic pin its commands, moves, late ones, travel and use.
+fn controller_table(o: &mut String, c: &crate::engine::controller::ControllerSummary) {
+    let _ = writeln!(
+        o,
+        "controller                rules from {}, latency {} s, late commands: {}",
+        c.rules_from, c.latency_s, c.on_late
+    );
+    for (decision, d) in &c.decisions {
+        let _ = writeln!(
+            o,
+            "  {decision:<24}{:>6} parts, {:>6} ok ({:.1}%), {} wrong decisions ({} failed)",
+            d.parts,
+            d.success,
+            100.0 * d.success as f64 / d.parts.max(1) as f64,
+            d.wrong,
+            d.wrong_failed
+        );
+    }
+    let _ = writeln!(
+        o,
+        "  misclassified             {} parts, {} of them failed; late actuations {}",
+        c.misclassified, c.misclassified_failed, c.late_actuations
+    );
+    for a in &c.actuators {
+        let _ = writeln!(
+            o,
+            "  pin {:<22}{} commands, {} moves, {} late, {} dropped, travel {:.3} m, busy {:.1} s ({:.1}%)",
+            a.name,
+            a.commands,
+            a.moves,
+            a.late,
+            a.dropped,
+            a.travel_m,
+            a.busy_s,
+            100.0 * a.utilisation
+        );
+    }
 }
 
 /// A sensor pin's block: readings, accuracy, untouched parts and the confusion matrix (rows: the
