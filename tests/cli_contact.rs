@@ -314,3 +314,44 @@ fn tripod_support_runs() {
     ]);
     assert_eq!(v["status"], "ok");
 }
+
+/// `--pin-stop-after S`: a pin that stops at once is a still pin; one that stops after the whole
+/// pass is the constant-speed moving pin; in between the stop changes the outcome.
+#[test]
+fn pin_stop_after_spans_still_and_moving_pins() {
+    let th = |extra: &[&str]| -> f64 {
+        let mut args = vec![
+            "contact", "--part", "tripoly2", "--theta0", "40", "--d=-0.2", "--json",
+        ];
+        args.extend_from_slice(extra);
+        json(&args)["theta_final_deg"].as_f64().unwrap()
+    };
+    let still = th(&[]);
+    let moving = th(&["--pin-speed", "0.5"]);
+    assert!(
+        (still - moving).abs() > 1.0,
+        "the lateral speed matters: {still} vs {moving}"
+    );
+    let at_once = th(&["--pin-speed", "0.5", "--pin-stop-after", "1e-9"]);
+    assert!((at_once - still).abs() < 1e-6, "{at_once} vs {still}");
+    let never = th(&["--pin-speed", "0.5", "--pin-stop-after", "100"]);
+    assert!((never - moving).abs() < 1e-9, "{never} vs {moving}");
+    let mid = th(&["--pin-speed", "0.5", "--pin-stop-after", "1.2"]);
+    assert!(
+        (mid - still).abs() > 1e-3 && (mid - moving).abs() > 1e-3,
+        "{mid}"
+    );
+    let out = pinfeed(&[
+        "contact",
+        "--part",
+        "tripoly2",
+        "--theta0",
+        "40",
+        "--d=-0.2",
+        "--pin-speed",
+        "0.5",
+        "--pin-stop-after=-1",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--pin-stop-after must be in"));
+}

@@ -551,6 +551,7 @@ proptest! {
             model: Fidelity::Exact,
             pin_radius: rho * scale,
             pin_speed: 0.0,
+            pin_stop: None,
             support: "uniform".into(),
             tol: 1e-6,
             fence: None,

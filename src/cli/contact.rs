@@ -7,8 +7,8 @@
 
 use crate::geometry::{named, wrap_deg, Polygon, Pose, Vec2};
 use crate::mechanics::{
-    push, push_fence, ContactOutcome, ContactSettings, FenceSpec, Fidelity, PartModel, Pin,
-    Support, TraceSample,
+    push, push_fence, push_path, ContactOutcome, ContactSettings, FenceSpec, Fidelity, PartModel,
+    Pin, PinPath, Support, TraceSample, Turn,
 };
 use crate::report::plot_contact::{plot_contact, PassObstacle};
 use anyhow::{bail, Context, Result};
@@ -44,6 +44,17 @@ pub struct ContactArgs {
     /// Lateral pin speed as a fraction of the belt speed (moving pin).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_speed: f64,
+    /// The thesis's app. E set-up: the pin moves across the belt at `--pin-speed` for this much
+    /// belt travel (units of a, from its start just clear of the part at offset d), then stands
+    /// still at d + w·S — one push with the true relative velocity, the stop mid-contact included
+    /// (SPEC §5).
+    #[arg(
+        long = "pin-stop-after",
+        value_name = "S",
+        allow_hyphen_values = true,
+        requires = "pin_speed"
+    )]
+    pub pin_stop: Option<f64>,
     /// Support: uniform or tripod:SEED.
     #[arg(long, default_value = "uniform")]
     pub support: String,
@@ -82,6 +93,8 @@ pub struct ContactReport {
     pub mu_s: f64,
     pub pin_radius: f64,
     pub pin_speed: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pin_stop: Option<f64>,
     pub contact: bool,
     pub theta_final_deg: f64,
     pub rotation_deg: f64,
@@ -107,6 +120,8 @@ pub struct Case {
     pub model: Fidelity,
     pub pin_radius: f64,
     pub pin_speed: f64,
+    /// A moving pin stops after this much belt travel (units of a).
+    pub pin_stop: Option<f64>,
     pub support: String,
     pub tol: f64,
     /// A fence (angle in degrees, length in part units; None = default length) instead of a pin.
@@ -256,6 +271,15 @@ fn check_inputs_named(c: &Case, name: &dyn Fn(&str) -> String) -> Result<()> {
         PIN_SPEED,
         "fraction of the belt speed",
     )?;
+    if let Some(s_stop) = c.pin_stop {
+        in_range(
+            "--pin-stop-after",
+            s_stop,
+            1e-9,
+            1e3,
+            "units of a of belt travel",
+        )?;
+    }
     in_range(
         &name("tol"),
         c.tol,
@@ -382,7 +406,17 @@ fn run_compiled(
             let fence = case_fence(poly, c, angle, length);
             push_fence(model, pose, &fence, &settings, recorder)
         }
-        None => push(model, pose, start, &pin, &settings, recorder),
+        None => match c.pin_stop {
+            Some(s_stop) => {
+                let turn = Turn {
+                    s: s_stop * poly.radius(),
+                    w: 0.0,
+                };
+                let path = PinPath::new(c.pin_speed, vec![turn]).expect("checked by check_inputs");
+                push_path(model, pose, start, pin.radius, &path, &settings, recorder)
+            }
+            None => push(model, pose, start, &pin, &settings, recorder),
+        },
     };
     (out, trace)
 }
@@ -441,6 +475,7 @@ fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
         mu_s: c.mu_s,
         pin_radius: c.pin_radius,
         pin_speed: c.pin_speed,
+        pin_stop: c.pin_stop,
         contact: out.contact,
         theta_final_deg: wrap_deg(out.pose_final.theta.to_degrees()),
         rotation_deg: out.rotation.to_degrees(),
@@ -475,6 +510,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         model: parse_model(&args.model)?,
         pin_radius: args.pin_radius,
         pin_speed: args.pin_speed,
+        pin_stop: args.pin_stop,
         support: args.support.clone(),
         tol: args.tol,
         fence: args.fence.as_deref().map(parse_fence).transpose()?,
@@ -622,6 +658,7 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
             model,
             pin_radius: row.pin_radius.unwrap_or(args.pin_radius),
             pin_speed: args.pin_speed,
+            pin_stop: args.pin_stop,
             support: args.support.clone(),
             tol: args.tol,
             fence,

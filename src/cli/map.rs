@@ -274,6 +274,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         model,
         pin_radius: args.pin_radius,
         pin_speed: 0.0,
+        pin_stop: None,
         support: args.support.clone(),
         tol: args.tol,
         fence,
