@@ -7,6 +7,10 @@
 //! * `controller_rules`: the bundled rules (the pin moves; different pushes).
 //!
 //! `cargo bench --bench controller`; figures in `results/line-speed.md`.
+//!
+//! Also `ramp_pieces/N`: one push by a pin that accelerates across the belt during the contact,
+//! the acceleration phase resolved into N constant-speed pieces (the accuracy of each N against
+//! 256 pieces: `cargo test --release --test moving_pin piecewise -- --nocapture`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::engine::{self, RunOptions};
@@ -45,5 +49,36 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+fn ramp(c: &mut Criterion) {
+    use pinfeed::geometry::{part_from_spec, Pose, Vec2};
+    use pinfeed::mechanics::{
+        pin_first_touch, push_path, ContactSettings, PartModel, PinPath, Support, Turn,
+    };
+    let p = part_from_spec("tripoly2").unwrap();
+    let m = PartModel::new(&p, &Support::Uniform).unwrap();
+    let a = p.radius();
+    let pose = Pose::new(0.0, 0.0, 0.3);
+    let start = Vec2::new(1.5 * a, 0.15 * a);
+    let touch = pin_first_touch(&m, pose, start, 0.0, &PinPath::constant(0.0)).unwrap();
+    let settings = ContactSettings::default();
+    let mut g = c.benchmark_group("ramp_pieces");
+    for n in [1usize, 2, 8, 32, 256] {
+        // The same ramp as tests/moving_pin.rs: 0 → −0.6 belt speeds over a travel of a.
+        let (s0, len, w) = (touch + 0.05 * a, a, -0.6);
+        let turns = (0..n)
+            .map(|i| Turn {
+                s: s0 + len * i as f64 / n as f64,
+                w: w * (i as f64 + 0.5) / n as f64,
+            })
+            .chain(std::iter::once(Turn { s: s0 + len, w }))
+            .collect();
+        let path = PinPath::new(0.0, turns).unwrap();
+        g.bench_function(format!("{n}"), |b| {
+            b.iter(|| push_path(&m, pose, start, 0.0, &path, &settings, None).pose_final)
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, ramp);
 criterion_main!(benches);

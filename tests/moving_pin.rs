@@ -195,7 +195,9 @@ fn piecewise_constant_acceleration_converges() {
     let o = moving(&m, pose, start, 0.0, &ramp(8), &s).0;
     assert!(o.contact && o.status.is_ok(), "{:?}", o.status);
     let fine = th(256);
+    let one = (th(1) - fine).abs();
     let errs: Vec<f64> = [2, 8, 32].iter().map(|&n| (th(n) - fine).abs()).collect();
+    eprintln!("one piece: {one} rad");
     eprintln!("ramp errors against 256 pieces: {errs:?}");
     assert!(errs[0] > 0.0, "the ramp changes nothing: {errs:?}");
     assert!(errs[1] < errs[0] && errs[2] < errs[1], "{errs:?}");
