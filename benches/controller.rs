@@ -43,7 +43,12 @@ fn bench(c: &mut Criterion) {
         let mut opts = RunOptions::from_scene(&s);
         opts.parts = 150;
         g.bench_function(name, |b| {
-            b.iter(|| engine::run(&s, &opts, &mut |_| {}).unwrap().summary.outcomes)
+            b.iter(|| {
+                engine::run(&s, &opts, &mut |_| {})
+                    .unwrap()
+                    .summary
+                    .outcomes
+            })
         });
     }
     g.finish();
@@ -52,7 +57,7 @@ fn bench(c: &mut Criterion) {
 fn ramp(c: &mut Criterion) {
     use pinfeed::geometry::{part_from_spec, Pose, Vec2};
     use pinfeed::mechanics::{
-        pin_first_touch, push_path, ContactSettings, PartModel, PinPath, Support, Turn,
+        pin_first_touch, push_path, ContactSettings, PartModel, PinPath, Support,
     };
     let p = part_from_spec("tripoly2").unwrap();
     let m = PartModel::new(&p, &Support::Uniform).unwrap();
@@ -64,15 +69,7 @@ fn ramp(c: &mut Criterion) {
     let mut g = c.benchmark_group("ramp_pieces");
     for n in [1usize, 2, 8, 32, 256] {
         // The same ramp as tests/moving_pin.rs: 0 → −0.6 belt speeds over a travel of a.
-        let (s0, len, w) = (touch + 0.05 * a, a, -0.6);
-        let turns = (0..n)
-            .map(|i| Turn {
-                s: s0 + len * i as f64 / n as f64,
-                w: w * (i as f64 + 0.5) / n as f64,
-            })
-            .chain(std::iter::once(Turn { s: s0 + len, w }))
-            .collect();
-        let path = PinPath::new(0.0, turns).unwrap();
+        let path = PinPath::ramp(touch + 0.05 * a, a, -0.6, n).unwrap();
         g.bench_function(format!("{n}"), |b| {
             b.iter(|| push_path(&m, pose, start, 0.0, &path, &settings, None).pose_final)
         });

@@ -174,18 +174,7 @@ fn piecewise_constant_acceleration_converges() {
     let start = Vec2::new(1.5 * a, 0.15 * a);
     let touch = pin_first_touch(&m, pose, start, 0.0, &PinPath::constant(0.0)).unwrap();
     // The pin speeds up from 0 to w = −0.6 over a travel of a, starting just after it touches.
-    let ramp = |n: usize| -> PinPath {
-        let (s0, len, w) = (touch + 0.05 * a, a, -0.6);
-        let turns = (0..n)
-            .map(|i| Turn {
-                s: s0 + len * i as f64 / n as f64,
-                // Mean speed over the piece: positions agree at the piece ends.
-                w: w * (i as f64 + 0.5) / n as f64,
-            })
-            .chain(std::iter::once(Turn { s: s0 + len, w }))
-            .collect();
-        PinPath::new(0.0, turns).unwrap()
-    };
+    let ramp = |n: usize| PinPath::ramp(touch + 0.05 * a, a, -0.6, n).unwrap();
     let th = |n| {
         moving(&m, pose, start, 0.0, &ramp(n), &s)
             .0

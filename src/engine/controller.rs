@@ -182,13 +182,7 @@ impl Control {
     ) {
         let ok = outcome == PartOutcome::Success;
         for &(sensor, decision, truth) in decided {
-            let label = match (decision, &scene.obstacles[sensor]) {
-                (Some(h), Obstacle::Pin(p)) => p
-                    .sensor
-                    .as_ref()
-                    .map_or_else(|| "?".into(), |s| s.labels[h].clone()),
-                _ => "unknown".into(),
-            };
+            let label = decision_label(scene, sensor, decision);
             let wrong = decision.is_some() && truth.is_some() && decision != truth;
             let row = self
                 .summary
@@ -217,6 +211,17 @@ impl Control {
         }
         self.summary.late_actuations = self.summary.actuators.iter().map(|a| a.late).sum();
         self.summary.clone()
+    }
+}
+
+/// A decision of sensor pin `sensor` as its hypothesis label, or `unknown`.
+fn decision_label(scene: &Scene, sensor: usize, decision: Option<usize>) -> String {
+    match (decision, &scene.obstacles[sensor]) {
+        (Some(h), Obstacle::Pin(p)) => p
+            .sensor
+            .as_ref()
+            .map_or_else(|| "?".into(), |s| s.labels[h].clone()),
+        _ => "unknown".into(),
     }
 }
 
@@ -281,13 +286,7 @@ impl Line<'_> {
             return;
         };
         self.metrics.work.decisions += 1;
-        let label = match (decision, &self.scene.obstacles[sensor]) {
-            (Some(h), Obstacle::Pin(p)) => p
-                .sensor
-                .as_ref()
-                .map_or_else(|| "?".into(), |s| s.labels[h].clone()),
-            _ => "unknown".into(),
-        };
+        let label = decision_label(self.scene, sensor, decision);
         let name = self.scene.obstacles[sensor].name().to_string();
         c.log(ControlRecord {
             t,

@@ -82,6 +82,21 @@ impl PinPath {
         PinPath::new(w, vec![Turn { s, w: 0.0 }])
     }
 
+    /// A pin still until travel `s0`, then changing its lateral speed linearly from 0 to `w` over
+    /// a travel `len`, resolved into `pieces` constant-speed pieces (each at its mean speed, so
+    /// positions agree with the linear ramp at the piece ends), then moving at `w`.
+    pub fn ramp(s0: f64, len: f64, w: f64, pieces: usize) -> Result<PinPath, String> {
+        let n = pieces.max(1);
+        let turns = (0..n)
+            .map(|i| Turn {
+                s: s0 + len * i as f64 / n as f64,
+                w: w * (i as f64 + 0.5) / n as f64,
+            })
+            .chain(std::iter::once(Turn { s: s0 + len, w }))
+            .collect();
+        PinPath::new(0.0, turns)
+    }
+
     pub fn initial_speed(&self) -> f64 {
         self.w0
     }
