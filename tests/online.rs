@@ -338,3 +338,43 @@ fn a_policy_file_is_read_and_checked_against_the_part() {
     assert!(e.contains("p.toml:") && e.contains("rules[0].pin"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A pin in use never moves: with decisions so slow that they arrive while parts are being pushed
+/// by the moving pin (and late moves carried out), no move starts during a contact with it.
+#[test]
+fn a_pin_in_contact_never_starts_moving() {
+    use pinfeed::engine::event_queue::EventKind;
+    let text = with(&source(), "latency = 0.02 ", "latency = 2.1 ");
+    let text = with(&text, "on_late = \"skip\"", "on_late = \"move\"");
+    let text = text.replace("[model]", "[effects]\nevent_log = true\n\n[model]");
+    let r = run(&parse(&text), 80, false);
+    let c = r.summary.controller.as_ref().unwrap();
+    assert!(c.late_actuations > 0, "{c:?}");
+    assert!(c.actuators[0].utilisation <= 1.0);
+    // Contacts with the mover (obstacle 1): [begin, end] per part.
+    let mut open = std::collections::BTreeMap::new();
+    let mut contacts = Vec::new();
+    for e in &r.events {
+        match e.kind {
+            EventKind::ContactBegin { part, obstacle: 1 } => {
+                open.insert(part, e.time);
+            }
+            EventKind::ContactEnd { part, obstacle: 1 } => {
+                contacts.push((open.remove(&part).unwrap(), e.time));
+            }
+            _ => {}
+        }
+    }
+    assert!(contacts.len() > 40);
+    let moves: Vec<_> = r.control.iter().filter_map(|rec| rec.motion).collect();
+    assert!(!moves.is_empty());
+    for m in &moves {
+        for &(b, e) in &contacts {
+            assert!(
+                !(m.t_start > b && m.t_start < e),
+                "a move starts at {} during a contact [{b}, {e}]",
+                m.t_start
+            );
+        }
+    }
+}

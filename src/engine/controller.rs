@@ -338,6 +338,14 @@ impl Line<'_> {
         let Some((&part, &target)) = c.queues[j].first_key_value() else {
             return false;
         };
+        // No later part may be in contact with the pin (it came first: wait until it is done).
+        let later_in_use = self
+            .active
+            .range(part + 1..)
+            .any(|(_, q)| matches!(&q.motion, Motion::Held(plan) if plan.obstacle == j));
+        if later_in_use {
+            return false;
+        }
         // Every earlier part still within reach must be known to clear the pin.
         let mut t_free = now;
         for qp in self.active.range(..part).map(|(_, p)| p) {
@@ -373,9 +381,15 @@ impl Line<'_> {
             });
             return true;
         };
-        // The earliest time the part can reach the pin: riding the belt from where it is.
+        // The earliest time the part can reach the pin: riding the belt from where it is. A part
+        // already held by this pin is too late for any motion: a pin in use never moves.
         let x_part = p.motion.world_pose(now, v).x;
-        let t_reach = now + (x_pin - reach - x_part) / v;
+        let in_use = matches!(&p.motion, Motion::Held(plan) if plan.obstacle == j);
+        let t_reach = if in_use {
+            f64::NEG_INFINITY
+        } else {
+            now + (x_pin - reach - x_part) / v
+        };
         let track = c.tracks[j].as_mut().expect("a dynamic pin has a track");
         let t_start = t_free.max(track.ready_at());
         let (duration, travel) = track.cost(target);
@@ -388,7 +402,10 @@ impl Line<'_> {
             c.summary.actuators[k].late += 1;
             self.metrics.work.late_actuations += 1;
         }
-        let carry_out = duration > 0.0 && (!late || c.spec.on_late == OnLate::Move);
+        // A late move that could only start once the part is past the pin is pointless.
+        let passed_by_then = t_start >= t_reach + 2.0 * reach / v;
+        let carry_out = duration > 0.0
+            && (!late || (c.spec.on_late == OnLate::Move && !in_use && !passed_by_then));
         if carry_out {
             track.command(t_start, target);
             let a = &mut c.summary.actuators[k];
