@@ -401,8 +401,9 @@ def main():
       f"{ctl(ss[1])['actuators'][0]['moves']} and {ctl(ss[2])['actuators'][0]['moves']} moves in "
       "the whole run — so mostly the parts whose state suits where it stopped succeed. With `move` the pin still moves for every part, late, and parts meet it in "
       "motion or in the previous part's position; at the slowest speed its moves take longer "
-      "than the headway and the commands pile up (utilisation "
-      f"{pct(ctl(sm[0])['actuators'][0]['utilisation'])}, see the remarks at the end).\n")
+      "than the headway: moves that could only start after their part has passed the pin are "
+      f"not made (utilisation {pct(ctl(sm[0])['actuators'][0]['utilisation'])}, "
+      f"{ctl(sm[0])['actuators'][0]['moves']} moves for 2000 parts).\n")
 
     # (c) latency
     ls, lm = runs("latency", LATENCIES, "skip"), runs("latency", LATENCIES, "move")
@@ -522,19 +523,15 @@ def main():
     # ------------------------------------------------------------ remarks
     w("## Remarks on the engine's behaviour\n")
     s0 = ctl(sm[0])["actuators"][0]
-    w(f"* **Utilisation above 100%.** With on_late = \"move\" and a mover at "
-      f"{SPEEDS[0]} m/s, `mover` reports busy {s0['busy_s']:.0f} s in a run of "
-      f"{sm[0]['simulated_time_s']:.0f} s simulated (utilisation {pct(s0['utilisation'])}) and "
-      f"{s0['dropped']} dropped commands: a late command is queued on the pin's timeline behind "
-      "the moves already planned, so under a saturated actuator the backlog grows and moves are "
-      "still carried out (and counted) for parts that have left the line: a command is dropped only "
-      "if its part is gone when it is *served*, not when its motion would start "
-      "(`src/engine/controller.rs`, t_start = max(t_free, ready_at)), and the busy time includes "
-      "motions planned past the end of the run. Dropping commands whose part is gone by the time "
-      "the move could start would bound the backlog and keep utilisation ≤ 100%.")
+    w(f"* **A saturated actuator.** With on_late = \"move\" and a mover at "
+      f"{SPEEDS[0]} m/s, `mover` is busy {s0['busy_s']:.0f} s of {sm[0]['simulated_time_s']:.0f} s "
+      f"(utilisation {pct(s0['utilisation'])}): a late move that could only start once its part "
+      "has passed the pin is not made (an earlier version queued it behind the backlog and "
+      "reported utilisation above 100%).")
     w("* **No rule for `unknown`.** A reading the classifier cannot decide produces no command, "
-      "so the pin stays wherever the previous part left it; at high noise the line quietly "
-      "becomes the home-position line. `misclassified` does not count these parts.")
+      "so the pin stays wherever the previous part left it, unless a rule names `decides = "
+      "\"unknown\"`; at high noise the line becomes the home-position line. `misclassified` "
+      "does not count these parts (they are listed per decision as `probe=unknown`).")
     w("* **`skip` can strand the pin.** With a slow actuator the one move that happens to fit "
       "can park the pin at an extreme, after which every other move is late (see (b)).")
     w("")
