@@ -315,6 +315,7 @@ fn unused_effects_cost_nothing() {
     assert_eq!(w.part_part_narrow_checks, 0);
     assert_eq!(w.obstacle_sweep_checks, 0);
     assert_eq!(w.traces_recorded, 0);
+    assert_eq!(w.pushes_rerun, 0);
     assert_eq!(w.clearance_evaluations, 0);
     assert_eq!(w.tripods_drawn, 0);
     assert!(r.events.is_empty(), "no event log unless asked");

@@ -48,10 +48,13 @@ impl Line<'_> {
         };
         let (pusher, settings) = pusher_for(obstacle, &scene.contact, placed);
         let model = part.model.as_ref().unwrap_or(&scene.part.model);
-        // A sensor pin records the push's knots as it computes it (the only push of this pass).
+        // The push is recorded as it is computed when anything will look at its path: a sensor
+        // pin's signal, a neighbouring obstacle, a fence's edge crossing, a drawn path, or another
+        // part on the belt (its overlap check). Never computed twice.
         let sensor = sensor_of(obstacle);
+        let record = sensor.is_some() || self.will_look_at_path(j, &part);
         let mut knots = KnotRecorder::default();
-        let recorder: Option<&mut dyn Recorder> = sensor.map(|_| &mut knots as &mut dyn Recorder);
+        let recorder: Option<&mut dyn Recorder> = record.then_some(&mut knots as &mut dyn Recorder);
         let out = pusher.push(model, pose, &settings, recorder);
         self.metrics.work.contact_solves += 1;
         self.metrics.work.model_evaluations += out.evaluations;
@@ -72,8 +75,9 @@ impl Line<'_> {
             reading = Some(sensed);
         }
         let mut plan = plan_of(j, (t0, pose), pusher, settings, out, t, v);
-        if sensor.is_some() {
+        if record {
             plan.set_trace(&knots.samples);
+            self.metrics.work.traces_recorded += u64::from(sensor.is_none());
         }
         let capsules = |nb: usize| self.capsule_during(nb, plan.t_begin, plan.t_end);
         let capsules: Vec<Option<(Vec2, Vec2, f64)>> =
@@ -130,6 +134,20 @@ impl Line<'_> {
                 hypothesis: decision.map_or(u32::MAX, |h| h as u32),
             },
         );
+    }
+
+    /// Will anything look at the path of a push by obstacle `j` of this part (so that it is
+    /// recorded as it is computed)?
+    fn will_look_at_path(&self, j: usize, part: &ActivePart) -> bool {
+        let scene = self.scene;
+        let sweeps = scene.effects.obstacle_sweeps && !scene.neighbours[j].is_empty();
+        let fence_edge = matches!(scene.obstacles[j], Obstacle::Fence(_)) && {
+            let [y_min, y_max] = scene.obstacles[j].y_range();
+            let (half, a) = (scene.belt.width / 2.0, scene.part.radius);
+            y_min - a < -half || y_max + a > half
+        };
+        let others = scene.effects.collisions && !self.active.is_empty();
+        sweeps || fence_edge || part.path.is_some() || others
     }
 
     /// The model found only a grazing touch: the obstacle passes without pushing, and the part
@@ -260,10 +278,11 @@ fn plan_of(
     }
 }
 
-/// Record the push's trace if it is not yet recorded, counting the work.
+/// Record the push's trace if it was not recorded as it was computed (a second computation,
+/// counted).
 pub(super) fn ensure_trace(plan: &mut ContactPlan, model: &PartModel, work: &mut WorkCounters) {
     if plan.ensure_trace(model) {
-        work.traces_recorded += 1;
+        work.pushes_rerun += 1;
     }
 }
 

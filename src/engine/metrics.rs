@@ -34,8 +34,12 @@ pub struct WorkCounters {
     pub model_evaluations: u64,
     /// First-contact ray casts to find a part's next obstacle.
     pub ray_casts: u64,
-    /// Pushes re-run with a recorder because something needed intermediate poses.
+    /// Pushes recorded as they were computed because something was going to look at their path
+    /// (a neighbouring obstacle, a fence's edge crossing, a drawn path, another part on the belt).
     pub traces_recorded: u64,
+    /// Pushes computed a second time, with a recorder, because a path was needed that was not
+    /// foreseen when the push was computed (a part arriving during it); rare.
+    pub pushes_rerun: u64,
     /// Pairs of parts considered for overlap (only while two or more parts share the belt).
     pub part_part_checks: u64,
     /// Of those, pairs close enough to need a time-resolved check.
