@@ -429,7 +429,15 @@ pub fn run(args: &PlanArgs) -> Result<()> {
         let file = args.out.as_ref().map_or("plan.toml".to_string(), |p| {
             shell_word(&p.display().to_string())
         });
-        let toml = emit::scenario_toml(&problem, plan, stable_count, parts, &command, &file);
+        let toml = emit::scenario_toml(
+            &problem,
+            plan,
+            stable_count,
+            planner.compiled.symmetry,
+            parts,
+            &command,
+            &file,
+        );
         if args.check_parts > 0 {
             let started = std::time::Instant::now();
             let path = args

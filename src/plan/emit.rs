@@ -24,11 +24,12 @@ fn num(x: f64, digits: usize) -> String {
 }
 
 /// The scenario of a plan. `parts` is the feed's part count (the line check's), `command` the
-/// command line that wrote it, `file` the scenario's file name, `stable_count` the part's number of stable states.
+/// command line that wrote it, `symmetry` the order of the part's rotational symmetry, `file` the scenario's file name, `stable_count` the part's number of stable states.
 pub fn scenario_toml(
     problem: &Problem,
     plan: &Plan,
     stable_count: usize,
+    symmetry: u32,
     parts: u64,
     command: &str,
     file: &str,
@@ -125,9 +126,13 @@ pub fn scenario_toml(
             num(problem.pin_radius_m, 6),
         );
     }
+    // A symmetric part: the orientations one symmetry period apart are the same pose.
+    let goals: Vec<String> = (0..symmetry.max(1))
+        .map(|j| num(plan.window.centre_deg + j as f64 * 360.0 / symmetry.max(1) as f64, 3))
+        .collect();
     t += &format!(
         "\n[goal]\n[[goal.sets]]\nname = \"planned\"\norientations = [{}]\ntolerance = {}\n",
-        num(plan.window.centre_deg, 3),
+        goals.join(", "),
         num(problem.tolerance_deg, 6)
     );
     t += &format!(

@@ -1,8 +1,8 @@
 //! The search state: a weighted set of quantised particles, the feed it starts from, and the goal
 //! measures (best orientation window, number of orientation sets).
 //!
-//! A particle is a feed sample: orientation θ (in quanta of `theta_quantum_deg`, wrapped to one
-//! turn), lateral offset y of the centroid (in quanta of `y_quantum_m`, belt frame, SPEC §1) and the
+//! A particle is a feed sample: orientation θ (in quanta of `theta_quantum_deg`, wrapped to the
+//! part's symmetry period — 360° / its rotational symmetry order, so 90° for a square), lateral offset y of the centroid (in quanta of `y_quantum_m`, belt frame, SPEC §1) and the
 //! index of its physics sample (0 for all particles unless the problem asks for robustness against
 //! a μc range or tripod supports, when every feed sample carries its own). Particles that coincide
 //! after rounding are merged and their weights added; the state is sorted, so equal sets of
@@ -27,7 +27,7 @@ use rand::RngExt;
 pub struct Particle {
     /// Physics sample (index into the transition's samples).
     pub sample: u32,
-    /// Orientation in quanta, in [0, 360/quantum).
+    /// Orientation in quanta, in [0, period/quantum) (period = 360° / the part's symmetry order).
     pub theta_q: i32,
     /// Centroid's lateral offset in quanta (belt frame).
     pub y_q: i32,
@@ -75,7 +75,7 @@ impl State {
 /// The best orientation window of a state.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Window {
-    /// Centre (degrees, [0, 360)): the middle of the particles inside.
+    /// Centre (degrees, [0, period)): the middle of the particles inside.
     pub centre_deg: f64,
     /// Weight inside.
     pub inside: u32,
@@ -259,7 +259,7 @@ pub fn best_window(state: &State, tol_deg: f64, q_deg: f64, steps: i32) -> Windo
             let span = (b - a).rem_euclid(steps);
             let centre = (a as f64 + span as f64 / 2.0) * q_deg;
             Window {
-                centre_deg: crate::geometry::wrap_deg(centre),
+                centre_deg: centre.rem_euclid(steps as f64 * q_deg),
                 inside: w,
                 share: w as f64 / total as f64,
             }

@@ -288,6 +288,14 @@ impl Problem {
                 "must lie in (0, 0.01]",
             ));
         }
+        // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform
+        // support only: a tripod is fixed in the part frame and breaks the symmetry).
+        let mut symmetry = if self.tripod { 1 } else { rotational_symmetry(&polygon) };
+        let mut period_steps = 360.0 / symmetry as f64 / q;
+        if (period_steps - period_steps.round()).abs() > 1e-9 {
+            symmetry = 1;
+            period_steps = n;
+        }
         let stable: Vec<f64> = unit
             .stable_states()
             .iter()
@@ -304,7 +312,8 @@ impl Problem {
             polygon,
             radius: a,
             stable_deg: stable,
-            theta_steps: n as i32,
+            theta_steps: period_steps.round() as i32,
+            symmetry,
         })
     }
 }
@@ -318,8 +327,41 @@ pub struct Compiled {
     pub radius: f64,
     /// Stable states (degrees), as `pinfeed part` lists them.
     pub stable_deg: Vec<f64>,
-    /// Orientation quanta per turn (360 / theta_quantum_deg).
+    /// Orientation quanta per symmetry period (360 / symmetry / theta_quantum_deg): particle
+    /// orientations are kept modulo the period.
     pub theta_steps: i32,
+    /// Order of the part's rotational symmetry (1: none; 4 for a square; forced to 1 with tripod
+    /// supports, or when the period is not a whole number of quanta).
+    pub symmetry: u32,
+}
+
+impl Compiled {
+    /// The symmetry period (degrees).
+    pub fn period_deg(&self) -> f64 {
+        360.0 / self.symmetry as f64
+    }
+}
+
+/// The order k of the polygon's rotational symmetry about its centroid: the largest k ≥ 1 such
+/// that a rotation by 360°/k maps every vertex onto a vertex (to 1e-9·a).
+pub fn rotational_symmetry(poly: &Polygon) -> u32 {
+    let v = poly.vertices();
+    let n = v.len();
+    let eps = 1e-9 * poly.radius();
+    for k in (2..=n).rev() {
+        if n % k != 0 {
+            continue;
+        }
+        let (s, c) = (std::f64::consts::TAU / k as f64).sin_cos();
+        let all = v.iter().all(|p| {
+            let r = crate::geometry::Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y);
+            v.iter().any(|q| (*q - r).norm() < eps)
+        });
+        if all {
+            return k as u32;
+        }
+    }
+    1
 }
 
 #[cfg(test)]
@@ -332,6 +374,12 @@ mod tests {
         let c = p.compile().unwrap();
         assert_eq!(c.stable_deg.len(), 3);
         assert_eq!(c.theta_steps, 1440);
+        assert_eq!(c.symmetry, 1);
+        let sym = |part: &str| Problem::new(part).compile().unwrap().symmetry;
+        assert_eq!(sym("square"), 4);
+        assert_eq!(sym("rect:2:1"), 2);
+        assert_eq!(sym("lshape"), 1);
+        assert_eq!(sym("ngon:6"), 6);
         let bad = |f: &dyn Fn(&mut Problem), flag: &str| {
             let mut q = Problem::new("tripoly2");
             f(&mut q);

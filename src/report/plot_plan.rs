@@ -30,6 +30,7 @@ fn stage_dots(state: &State, q_deg: f64) -> Vec<(f64, u32)> {
 /// Draw a plan to `path`.
 pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<()> {
     let compiled = problem.compile()?;
+    let period = compiled.period_deg();
     let n = plan.steps.len();
     let stages = n + 1;
     let length = problem.spacing_m * (n as f64 + 1.0);
@@ -97,9 +98,13 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
         .margin(15)
         .x_label_area_size(35)
         .y_label_area_size(55)
-        .build_cartesian_2d(0.0..360.0, -0.5..(stages as f64 - 0.5))?;
+        .build_cartesian_2d(0.0..period, -0.5..(stages as f64 - 0.5))?;
     ch.configure_mesh()
-        .x_desc("orientation θ (degrees)")
+        .x_desc(if compiled.symmetry > 1 {
+            format!("orientation θ modulo the {period}° symmetry (degrees)")
+        } else {
+            "orientation θ (degrees)".to_string()
+        })
         .y_desc("after pin")
         .x_labels(13)
         .y_labels(stages.min(20))
@@ -114,8 +119,8 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
         .draw()?;
     let c = plan.window.centre_deg;
     let tol = problem.tolerance_deg;
-    for shift in [-360.0, 0.0, 360.0] {
-        let (a, b) = ((c - tol + shift).max(0.0), (c + tol + shift).min(360.0));
+    for shift in [-period, 0.0, period] {
+        let (a, b) = ((c - tol + shift).max(0.0), (c + tol + shift).min(period));
         if a < b {
             ch.draw_series(std::iter::once(Rectangle::new(
                 [(a, -0.5), (b, stages as f64 - 0.5)],
