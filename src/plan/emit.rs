@@ -128,7 +128,12 @@ pub fn scenario_toml(
     }
     // A symmetric part: the orientations one symmetry period apart are the same pose.
     let goals: Vec<String> = (0..symmetry.max(1))
-        .map(|j| num(plan.window.centre_deg + j as f64 * 360.0 / symmetry.max(1) as f64, 3))
+        .map(|j| {
+            num(
+                plan.window.centre_deg + j as f64 * 360.0 / symmetry.max(1) as f64,
+                3,
+            )
+        })
         .collect();
     t += &format!(
         "\n[goal]\n[[goal.sets]]\nname = \"planned\"\norientations = [{}]\ntolerance = {}\n",

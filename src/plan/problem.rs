@@ -290,7 +290,11 @@ impl Problem {
         }
         // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform
         // support only: a tripod is fixed in the part frame and breaks the symmetry).
-        let mut symmetry = if self.tripod { 1 } else { rotational_symmetry(&polygon) };
+        let mut symmetry = if self.tripod {
+            1
+        } else {
+            rotational_symmetry(&polygon)
+        };
         let mut period_steps = 360.0 / symmetry as f64 / q;
         if (period_steps - period_steps.round()).abs() > 1e-9 {
             symmetry = 1;
