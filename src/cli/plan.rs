@@ -405,7 +405,12 @@ pub fn run(args: &PlanArgs) -> Result<()> {
         Outcome::Exhausted { depth } => (
             "exhausted",
             format!(
-                "no sensorless plan at any depth: after {depth} pin(s) no new state is reachable in this action set"
+                "no sensorless plan at any depth: after {depth} pin(s) no new state is reachable in this action set{}",
+                if *depth == 0 {
+                    " (no pin position keeps every particle at least --min-margin from a band edge; try a smaller --min-margin)"
+                } else {
+                    ""
+                }
             ),
             None,
             None,

@@ -140,8 +140,6 @@ pub fn scenario_toml(
         goals.join(", "),
         num(problem.tolerance_deg, 6)
     );
-    t += &format!(
-        "\n[model]\nfidelity = \"exact\"\ntol = 1e-6\n\n[output]\ndir = \"results\"\nhistogram_svg = false\nhistogram_bin = 1\n"
-    );
+    t += "\n[model]\nfidelity = \"exact\"\ntol = 1e-6\n\n[output]\ndir = \"results\"\nhistogram_svg = false\nhistogram_bin = 1\n";
     t
 }

@@ -257,7 +257,7 @@ impl Problem {
         }
         let q = self.theta_quantum_deg;
         let n = (360.0 / q).round();
-        if !(q.is_finite() && q >= 0.01 && q <= 10.0) || (n * q - 360.0).abs() > 1e-9 {
+        if !(q.is_finite() && (0.01..=10.0).contains(&q)) || (n * q - 360.0).abs() > 1e-9 {
             return Err(PlanError::input(
                 "--theta-quantum",
                 q,
