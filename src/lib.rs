@@ -18,6 +18,7 @@ pub mod engine;
 pub mod geometry;
 pub mod maps;
 pub mod mechanics;
+pub mod plan;
 pub mod random;
 pub mod report;
 pub mod scenario;

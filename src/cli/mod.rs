@@ -10,6 +10,7 @@ pub mod map;
 pub mod mc;
 pub mod merge;
 pub mod part;
+pub mod plan;
 pub mod run;
 pub mod sense;
 pub mod stdout;
@@ -61,6 +62,9 @@ pub enum Command {
     Merge(merge::MergeArgs),
     /// What a sensorised pin can tell: classifiers' confusion, accuracy and information under noise.
     Sense(Box<sense::SenseArgs>),
+    /// Plan a pin layout: a shortest robust sequence of fixed pins that orients the part, written as
+    /// a scenario, drawn and checked on the line.
+    Plan(Box<plan::PlanArgs>),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
     /// Fuzz the inputs (scenario and study files, contacts, polygons) and write results/robustness.md.
@@ -78,6 +82,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Mc(a) => mc::run(&a),
         Command::Merge(a) => merge::run(&a),
         Command::Sense(a) => sense::run(&a),
+        Command::Plan(a) => plan::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Fuzz(a) => fuzz::run(&a),
     }

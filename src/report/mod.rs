@@ -12,5 +12,6 @@ pub mod plot_line;
 pub mod plot_map;
 pub mod plot_orientations;
 pub mod plot_part;
+pub mod plot_plan;
 pub mod plot_sensing;
 pub mod plot_sensitivity;

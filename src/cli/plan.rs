@@ -1,0 +1,546 @@
+//! `pinfeed plan`: the sensorless pin planner ([`crate::plan`]): a shortest robust sequence of
+//! fixed pins that orients a part, written as a runnable scenario, drawn, and checked on the line.
+//!
+//! Standard output gets the search statistics, the plan table and the line check (or, with
+//! `--json`, one JSON document). `--out FILE.toml` writes the scenario (headed by the command that
+//! wrote it) and, unless `--draw` names another file, its drawing beside it (`FILE.svg`). A search
+//! that finds no plan up to its depth reports so and succeeds (that is an answer); one stopped by a
+//! limit (`--max-states`, `--time-limit`) or a bad input exits non-zero with a message.
+
+use super::stdout::print_result;
+use crate::plan::search::{Planner, SearchStats};
+use crate::plan::{emit, Action, FeedKind, Outcome, Plan, Problem};
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `pinfeed plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, or vertices:"x,y x,y ...".
+    #[arg(long)]
+    pub part: String,
+    /// Metres per unit of the part's coordinates.
+    #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
+    pub scale: f64,
+    /// Feed orientation: stable (the stable states, equal weights, with --jitter) or uniform.
+    #[arg(long, default_value = "stable")]
+    pub feed: String,
+    /// Orientation jitter of a stable feed: standard deviation (degrees).
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    pub jitter: f64,
+    /// Lateral offset at entry: uniform in ±LATERAL (m).
+    #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
+    pub lateral: f64,
+    /// Particles per stable state: this many jitter quantiles …
+    #[arg(long, default_value_t = 5)]
+    pub jitter_samples: usize,
+    /// … times this many lateral offsets.
+    #[arg(long, default_value_t = 5)]
+    pub offset_samples: usize,
+    /// Orientations of a uniform feed (each times --offset-samples).
+    #[arg(long, default_value_t = 72)]
+    pub orientation_samples: usize,
+    /// Pin–part friction μc.
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub mu_c: f64,
+    /// Be robust against μc: each particle draws its own μc uniformly in LO:HI.
+    #[arg(long, value_name = "LO:HI")]
+    pub mu_c_range: Option<String>,
+    /// Be robust against the support: each particle gets its own random tripod.
+    #[arg(long)]
+    pub tripod: bool,
+    /// Pin radius (m; 0 = point pin).
+    #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
+    pub pin_radius: f64,
+    /// Belt width (m).
+    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
+    pub belt_width: f64,
+    /// Distance between pins along the belt (m).
+    #[arg(long, default_value_t = 0.15, allow_hyphen_values = true)]
+    pub spacing: f64,
+    /// Most pins (the search depth).
+    #[arg(long, alias = "depth", default_value_t = 8)]
+    pub max_pins: usize,
+    /// Goal: half-width of the orientation window (degrees).
+    #[arg(long, default_value_t = 3.0, allow_hyphen_values = true)]
+    pub tolerance: f64,
+    /// Goal: share of the parts inside one window.
+    #[arg(long, default_value_t = 0.99, allow_hyphen_values = true)]
+    pub target: f64,
+    /// Minimise the number of orientation sets instead (searches every depth unless one set is reached).
+    #[arg(long)]
+    pub fewest_sets: bool,
+    /// Smallest robustness margin of a pin position (mm).
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub min_margin: f64,
+    /// Lateral quantum of particles and pin grid (mm).
+    #[arg(long, default_value_t = 0.25, allow_hyphen_values = true)]
+    pub y_quantum: f64,
+    /// Orientation quantum of particles (degrees; divides 360).
+    #[arg(long, default_value_t = 0.25, allow_hyphen_values = true)]
+    pub theta_quantum: f64,
+    /// Sample each orientation's outcome every COARSE pin positions and bisect changes (1 = all).
+    #[arg(long, default_value_t = 4)]
+    pub coarse: usize,
+    /// Stop after this many distinct states.
+    #[arg(long, default_value_t = 100_000)]
+    pub max_states: usize,
+    /// Stop after this many seconds of search.
+    #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
+    pub time_limit: f64,
+    /// Integration tolerance of the contact model while planning.
+    #[arg(long, default_value_t = 1e-5, allow_hyphen_values = true)]
+    pub contact_tol: f64,
+    /// Seed of the particles (and of the line check).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write the plan as a scenario file.
+    #[arg(long, value_name = "FILE.toml")]
+    pub out: Option<PathBuf>,
+    /// Draw the plan (SVG) [default: beside --out, FILE.svg].
+    #[arg(long, value_name = "FILE.svg")]
+    pub draw: Option<PathBuf>,
+    /// Parts run through the line to check the plan (0: no check).
+    #[arg(long, default_value_t = 10_000)]
+    pub check_parts: u64,
+    /// Print one JSON document.
+    #[arg(long)]
+    pub json: bool,
+    /// Worker threads (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+fn parse_range(s: &str) -> Result<(f64, f64)> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| anyhow!("--mu-c-range '{s}': expected LO:HI, e.g. 0.3:0.7"))?;
+    let p = |t: &str| -> Result<f64> {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| anyhow!("--mu-c-range '{s}': '{t}' is not a number"))
+    };
+    Ok((p(a)?, p(b)?))
+}
+
+/// The problem described by the arguments.
+pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
+    let mut p = Problem::new(&args.part);
+    p.scale = args.scale;
+    p.feed = match args.feed.trim() {
+        "stable" => FeedKind::Stable,
+        "uniform" => FeedKind::Uniform,
+        other => bail!("--feed '{other}': expected 'stable' or 'uniform'"),
+    };
+    p.jitter_deg = args.jitter;
+    p.lateral_m = args.lateral;
+    p.jitter_samples = args.jitter_samples;
+    p.offset_samples = args.offset_samples;
+    p.orientation_samples = args.orientation_samples;
+    p.mu_c = args.mu_c;
+    p.mu_c_range = args.mu_c_range.as_deref().map(parse_range).transpose()?;
+    p.tripod = args.tripod;
+    p.pin_radius_m = args.pin_radius;
+    p.belt_width_m = args.belt_width;
+    p.spacing_m = args.spacing;
+    p.max_pins = args.max_pins;
+    p.tolerance_deg = args.tolerance;
+    p.target = args.target;
+    p.fewest_sets = args.fewest_sets;
+    p.min_margin_m = args.min_margin * 1e-3;
+    p.y_quantum_m = args.y_quantum * 1e-3;
+    p.theta_quantum_deg = args.theta_quantum;
+    p.coarse = args.coarse;
+    p.max_states = args.max_states;
+    p.time_limit_s = args.time_limit;
+    p.contact_tol = args.contact_tol;
+    p.seed = args.seed;
+    p.compile()?;
+    Ok(p)
+}
+
+/// Quote a shell word if it needs it.
+fn shell_word(s: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
+    if !s.is_empty() && s.chars().all(plain) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// The command line that reproduces a plan: the part and every setting that differs from its
+/// default, in a fixed order (the output file names are not part of it).
+pub fn command_line(args: &PlanArgs) -> String {
+    let mut w = vec!["pinfeed plan --part".to_string(), shell_word(&args.part)];
+    let d = Problem::new(&args.part);
+    fn opt_into(w: &mut Vec<String>, flag: &str, v: String, default: String) {
+        if v != default {
+            w.push(format!("{flag} {v}"));
+        }
+    }
+    macro_rules! opt {
+        ($f:expr, $v:expr, $d:expr) => {
+            opt_into(&mut w, $f, $v, $d)
+        };
+    }
+    opt!("--scale", args.scale.to_string(), d.scale.to_string());
+    opt!("--feed", shell_word(&args.feed), "stable".into());
+    opt!(
+        "--jitter",
+        args.jitter.to_string(),
+        d.jitter_deg.to_string()
+    );
+    opt!(
+        "--lateral",
+        args.lateral.to_string(),
+        d.lateral_m.to_string()
+    );
+    opt!(
+        "--jitter-samples",
+        args.jitter_samples.to_string(),
+        "5".into()
+    );
+    opt!(
+        "--offset-samples",
+        args.offset_samples.to_string(),
+        "5".into()
+    );
+    opt!(
+        "--orientation-samples",
+        args.orientation_samples.to_string(),
+        "72".into()
+    );
+    opt!("--mu-c", args.mu_c.to_string(), d.mu_c.to_string());
+    if let Some(r) = &args.mu_c_range {
+        w.push(format!("--mu-c-range {}", shell_word(r)));
+    }
+    if args.tripod {
+        w.push("--tripod".into());
+    }
+    opt!(
+        "--pin-radius",
+        args.pin_radius.to_string(),
+        d.pin_radius_m.to_string()
+    );
+    opt!(
+        "--belt-width",
+        args.belt_width.to_string(),
+        d.belt_width_m.to_string()
+    );
+    opt!(
+        "--spacing",
+        args.spacing.to_string(),
+        d.spacing_m.to_string()
+    );
+    opt!(
+        "--max-pins",
+        args.max_pins.to_string(),
+        d.max_pins.to_string()
+    );
+    opt!(
+        "--tolerance",
+        args.tolerance.to_string(),
+        d.tolerance_deg.to_string()
+    );
+    opt!("--target", args.target.to_string(), d.target.to_string());
+    if args.fewest_sets {
+        w.push("--fewest-sets".into());
+    }
+    opt!("--min-margin", args.min_margin.to_string(), "0.5".into());
+    opt!("--y-quantum", args.y_quantum.to_string(), "0.25".into());
+    opt!(
+        "--theta-quantum",
+        args.theta_quantum.to_string(),
+        "0.25".into()
+    );
+    opt!("--coarse", args.coarse.to_string(), "4".into());
+    opt!(
+        "--max-states",
+        args.max_states.to_string(),
+        d.max_states.to_string()
+    );
+    opt!(
+        "--time-limit",
+        args.time_limit.to_string(),
+        d.time_limit_s.to_string()
+    );
+    opt!(
+        "--contact-tol",
+        args.contact_tol.to_string(),
+        d.contact_tol.to_string()
+    );
+    opt!("--seed", args.seed.to_string(), "1".into());
+    w.join(" ")
+}
+
+/// The line check of a plan, as reported.
+#[derive(Debug, Serialize)]
+pub struct CheckReport {
+    pub parts: u64,
+    pub success_rate: f64,
+    pub success_ci95: [f64; 2],
+    pub outcomes: crate::engine::OutcomeCounts,
+    pub elapsed_s: f64,
+}
+
+/// The JSON document of `pinfeed plan --json`.
+#[derive(Debug, Serialize)]
+pub struct PlanReport<'a> {
+    pub command: String,
+    pub problem: &'a Problem,
+    /// found | none_up_to_depth | exhausted | limit
+    pub result: &'static str,
+    pub message: String,
+    pub plan: Option<&'a Plan>,
+    pub stats: &'a SearchStats,
+    pub check: Option<CheckReport>,
+    pub scenario: Option<String>,
+}
+
+fn mb(bytes: f64) -> String {
+    format!("{:.1} MB", bytes / 1e6)
+}
+
+fn stats_text(s: &SearchStats) -> String {
+    let mut t = String::new();
+    t += &format!(
+        "search      {} particles, {} physics sample(s); {:.3} s\n",
+        s.particles, s.physics_samples, s.elapsed_s
+    );
+    let levels: Vec<String> = s
+        .states_per_depth
+        .iter()
+        .enumerate()
+        .map(|(k, n)| format!("{k}:{n}"))
+        .collect();
+    t += &format!("  new states per depth  {}\n", levels.join("  "));
+    t += &format!(
+        "  expanded {}, generated {} ({} duplicates), {:.1} actions per state\n",
+        s.expanded, s.generated, s.duplicates, s.actions_per_expansion
+    );
+    t += &format!(
+        "  pushes computed {}, memo hits {}, orientation columns {}, memo entries {}\n",
+        s.pushes.computed, s.pushes.memo_hits, s.pushes.columns, s.memo_entries
+    );
+    t += &format!(
+        "  memory: states + memo ≈ {}, peak RSS {}\n",
+        mb(s.memory_estimate_bytes as f64),
+        s.peak_rss_bytes.map_or("n/a".into(), |b| mb(b as f64))
+    );
+    t
+}
+
+fn plan_text(problem: &Problem, plan: &Plan) -> String {
+    let mut t = String::new();
+    t += "plan        pin    x (m)   y (mm)   interval (mm)      margin (mm)  sets  best window\n";
+    t += &format!(
+        "            feed                                                  {:>4}  {:.3} at {:.2}°\n",
+        plan.initial_sets, plan.initial_window.share, plan.initial_window.centre_deg
+    );
+    for (k, s) in plan.steps.iter().enumerate() {
+        let Action::Pin(p) = s.action;
+        t += &format!(
+            "            pin{:<3} {:>5.3}  {:>+7.2}   [{:>+6.2}, {:>+6.2}]   {:>10.2}  {:>4}  {:.3} at {:.2}°\n",
+            k + 1,
+            problem.spacing_m * (k as f64 + 1.0),
+            p.y_m * 1e3,
+            p.lo_m * 1e3,
+            p.hi_m * 1e3,
+            p.margin_m * 1e3,
+            s.sets,
+            s.window.share,
+            s.window.centre_deg
+        );
+    }
+    t += &format!(
+        "goal        {:.2}° ± {}°: predicted success {:.4} ({} of {} particles)\n",
+        plan.window.centre_deg,
+        problem.tolerance_deg,
+        plan.predicted_success,
+        plan.window.inside,
+        plan.initial.total()
+    );
+    t
+}
+
+/// Run `pinfeed plan`.
+pub fn run(args: &PlanArgs) -> Result<()> {
+    let problem = problem_of(args)?;
+    let command = command_line(args);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads)
+        .build()
+        .context("starting the worker threads")?;
+    let mut planner = Planner::new(&problem)?;
+    let (outcome, stats) = pool.install(|| planner.search());
+    let stable_count = planner.compiled.stable_deg.len();
+    let (result, message, plan, failure) = match &outcome {
+        Outcome::Found(p) => (
+            "found",
+            if problem.fewest_sets {
+                format!(
+                    "found a plan of {} pin(s) to {} orientation set(s), the fewest up to depth {}",
+                    p.steps.len(),
+                    p.sets,
+                    stats.depth_completed.max(p.steps.len())
+                )
+            } else {
+                format!("found a shortest plan: {} pin(s)", p.steps.len())
+            },
+            Some(p),
+            None,
+        ),
+        Outcome::NoneUpTo { depth } => (
+            "none_up_to_depth",
+            format!(
+                "no sensorless plan up to depth {depth}: every plan of at most {depth} pins in this action set leaves less than {} of the parts in one ±{}° window",
+                problem.target, problem.tolerance_deg
+            ),
+            None,
+            None,
+        ),
+        Outcome::Exhausted { depth } => (
+            "exhausted",
+            format!(
+                "no sensorless plan at any depth: after {depth} pin(s) no new state is reachable in this action set{}",
+                if *depth == 0 {
+                    " (no pin position keeps every particle at least --min-margin from a band edge; try a smaller --min-margin)"
+                } else {
+                    ""
+                }
+            ),
+            None,
+            None,
+        ),
+        Outcome::LimitHit {
+            limit,
+            depth_completed,
+            best,
+        } => {
+            let msg = format!(
+                "search stopped by its {limit} after completing depth {depth_completed} ({} states kept): no plan of at most {depth_completed} pin(s) reaches the goal; deeper levels were not finished",
+                stats.states_per_depth.iter().sum::<usize>()
+            );
+            ("limit", msg.clone(), best.as_ref(), Some(msg))
+        }
+    };
+    let mut scenario = None;
+    let mut check = None;
+    if let Some(plan) = plan {
+        let parts = args.check_parts.max(1);
+        let file = args.out.as_ref().map_or("plan.toml".to_string(), |p| {
+            shell_word(&p.display().to_string())
+        });
+        let toml = emit::scenario_toml(
+            &problem,
+            plan,
+            stable_count,
+            planner.compiled.symmetry,
+            parts,
+            &command,
+            &file,
+        );
+        if args.check_parts > 0 {
+            let started = std::time::Instant::now();
+            let path = args
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("plan.toml"));
+            let summary = pool.install(|| {
+                crate::plan::check::check(&toml, &path, args.check_parts, problem.seed)
+            })?;
+            check = Some(CheckReport {
+                parts: summary.parts_in,
+                success_rate: summary.success_rate,
+                success_ci95: summary.success_ci95,
+                outcomes: summary.outcomes,
+                elapsed_s: started.elapsed().as_secs_f64(),
+            });
+        }
+        if let Some(out) = &args.out {
+            write_file(out, &toml)?;
+            let draw = args
+                .draw
+                .clone()
+                .unwrap_or_else(|| out.with_extension("svg"));
+            crate::report::plot_plan::plot_plan(&problem, plan, &draw)
+                .with_context(|| format!("drawing {}", draw.display()))?;
+        } else if let Some(draw) = &args.draw {
+            crate::report::plot_plan::plot_plan(&problem, plan, draw)
+                .with_context(|| format!("drawing {}", draw.display()))?;
+        }
+        scenario = Some(toml);
+    }
+    if args.json {
+        let report = PlanReport {
+            command: command.clone(),
+            problem: &problem,
+            result,
+            message: message.clone(),
+            plan,
+            stats: &stats,
+            check,
+            scenario,
+        };
+        print_result(&(serde_json::to_string_pretty(&report)? + "\n"))?;
+    } else {
+        let mut t = format!("{command}\n");
+        t += &stats_text(&stats);
+        t += &format!("result      {message}\n");
+        if let Some(plan) = plan {
+            t += &plan_text(&problem, plan);
+        }
+        if let Some(c) = &check {
+            t += &format!(
+                "line check  {} parts: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}; {} ({:.1} s)\n",
+                c.parts,
+                c.success_rate,
+                c.success_ci95[0],
+                c.success_ci95[1],
+                plan.map_or(0.0, |p| p.predicted_success),
+                outcome_mix(&c.outcomes),
+                c.elapsed_s
+            );
+        }
+        if let (Some(out), Some(_)) = (&args.out, plan) {
+            let draw = args
+                .draw
+                .clone()
+                .unwrap_or_else(|| out.with_extension("svg"));
+            t += &format!("wrote       {} and {}\n", out.display(), draw.display());
+        }
+        print_result(&t)?;
+    }
+    if let Some(msg) = failure {
+        bail!(msg);
+    }
+    Ok(())
+}
+
+fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
+    let parts = [
+        ("success", o.success),
+        ("wrong_orientation", o.wrong_orientation),
+        ("collision", o.collision),
+        ("multi_contact", o.multi_contact),
+        ("off_belt", o.off_belt),
+        ("jam", o.jam),
+        ("solver", o.solver),
+    ];
+    parts
+        .iter()
+        .filter(|(_, n)| *n > 0)
+        .map(|(k, n)| format!("{k} {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn write_file(path: &Path, text: &str) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}

@@ -1,0 +1,130 @@
+//! The actions of a state: not a blind grid, but one pin position per interval of the lateral
+//! grid over which no particle's pass changes qualitatively (issue 14; thesis ch. 4's band and
+//! no-contact edges).
+//!
+//! Every pin position on the grid (step = the lateral quantum) within reach of some particle and on
+//! the belt is a candidate. Its *signature vector* is each particle's qualitative outcome there (see
+//! [`super::transition`]); the positions where some particle's signature changes cut the grid into
+//! intervals. Each interval is one action: its representative is its middle (rounded down to the
+//! grid), its robustness margin the distance from the representative to the interval's nearer
+//! edge (edges lie half a grid step outside the interval's end positions), so a pin placed within
+//! ±margin of the representative meets every particle in the same qualitative way. Intervals with
+//! margin below `min_margin_m` are dropped (a design there breaks under a small pin error), and so
+//! are actions whose successor equals the state (no particle touched, or nothing changed).
+
+use super::particles::State;
+use super::transition::{PassKey, Transition, NO_CONTACT};
+use serde::Serialize;
+
+/// A fixed pin at one lateral position.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PinAction {
+    /// Lateral position (grid quanta).
+    pub y_q: i32,
+    /// Lateral position of the pin's centre (m).
+    pub y_m: f64,
+    /// The interval of positions (m) that act the same way qualitatively: [lo, hi].
+    pub lo_m: f64,
+    pub hi_m: f64,
+    /// Distance from `y_m` to the nearer edge of the interval (m).
+    pub margin_m: f64,
+}
+
+/// One step of a plan. Today only fixed pins; a fence, or a sensing branch of a contingent plan,
+/// joins this enum later.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Action {
+    Pin(PinAction),
+}
+
+/// The pin actions of `state` with their successors, in increasing lateral position.
+pub fn pin_actions(state: &State, tr: &mut Transition, min_margin_m: f64) -> Vec<(Action, State)> {
+    if state.particles.is_empty() {
+        return Vec::new();
+    }
+    let reach = tr.reach_q;
+    let limit = tr.belt_limit_q();
+    let q = tr.y_quantum();
+    let ymin = state.particles.iter().map(|p| p.y_q).min().unwrap();
+    let ymax = state.particles.iter().map(|p| p.y_q).max().unwrap();
+    let lo = (ymin - reach).max(-limit);
+    let hi = (ymax + reach).min(limit);
+    if lo > hi {
+        return Vec::new();
+    }
+    let cols: Vec<(u32, i32)> = state
+        .particles
+        .iter()
+        .map(|p| (p.sample, p.theta_q))
+        .collect();
+    tr.ensure_columns(&cols);
+    // Cuts: pin positions c where some particle's signature differs between c − 1 and c.
+    let mut cuts: Vec<i32> = Vec::new();
+    let columns: Vec<_> = cols.iter().map(|&(s, t)| tr.column_of(s, t)).collect();
+    for (p, col) in state.particles.iter().zip(&columns) {
+        let at = |i: i64| -> u32 {
+            if i < 0 || i >= col.len() as i64 {
+                NO_CONTACT
+            } else {
+                col[i as usize]
+            }
+        };
+        for i in 0..=col.len() as i64 {
+            if at(i) != at(i - 1) {
+                // Column index i is pin offset i − reach from the particle.
+                let c = p.y_q + i as i32 - reach;
+                if c > lo && c <= hi {
+                    cuts.push(c);
+                }
+            }
+        }
+    }
+    cuts.sort_unstable();
+    cuts.dedup();
+    let mut starts = vec![lo];
+    starts.extend(&cuts);
+    let mut intervals = Vec::new();
+    for (k, &s) in starts.iter().enumerate() {
+        let e = starts.get(k + 1).map_or(hi, |n| n - 1);
+        let rep = s + (e - s) / 2;
+        let margin = ((rep - s).min(e - rep) as f64 + 0.5) * q;
+        if margin + 1e-12 < min_margin_m {
+            continue;
+        }
+        // Skip intervals where no particle is touched at all.
+        let touched = state.particles.iter().zip(&columns).any(|(p, col)| {
+            let i = rep - p.y_q + reach;
+            i >= 0 && (i as usize) < col.len() && col[i as usize] != NO_CONTACT
+        });
+        if touched {
+            intervals.push((s, e, rep, margin));
+        }
+    }
+    let mut keys: Vec<PassKey> = Vec::new();
+    for &(_, _, rep, _) in &intervals {
+        for p in &state.particles {
+            let dy = rep - p.y_q;
+            if dy.abs() <= reach {
+                keys.push((p.sample, p.theta_q, dy));
+            }
+        }
+    }
+    tr.ensure(&keys);
+    let mut out = Vec::with_capacity(intervals.len());
+    for (s, e, rep, margin) in intervals {
+        let next = tr.apply(state, rep);
+        if &next == state {
+            continue;
+        }
+        let action = Action::Pin(PinAction {
+            y_q: rep,
+            y_m: rep as f64 * q,
+            lo_m: (s as f64 - 0.5) * q,
+            hi_m: (e as f64 + 0.5) * q,
+            margin_m: margin,
+        });
+        out.push((action, next));
+    }
+    out
+}

@@ -1,0 +1,145 @@
+//! A plan as a runnable scenario TOML (README "Scenario format"): the quickstart line's belt
+//! (5 cm/s, one part every 4 s) with the planned width, pins at x = spacing·k (k = 1 … n) and the
+//! belt ending one spacing after the last pin, the feed the plan was made for, and the goal = the
+//! final window's centre ± tol. The header names the command that wrote it and the prediction.
+
+use super::problem::{FeedKind, Problem};
+use super::search::Plan;
+use super::Action;
+
+/// Shortest decimal text of a number rounded to `digits` decimals.
+fn num(x: f64, digits: usize) -> String {
+    let s = format!("{:.*}", digits, x);
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    let s = if s == "-0" { "0".to_string() } else { s };
+    if s.contains('.') || s.contains('e') {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+/// The scenario of a plan. `parts` is the feed's part count (the line check's), `command` the
+/// command line that wrote it, `symmetry` the order of the part's rotational symmetry, `file` the scenario's file name, `stable_count` the part's number of stable states.
+pub fn scenario_toml(
+    problem: &Problem,
+    plan: &Plan,
+    stable_count: usize,
+    symmetry: u32,
+    parts: u64,
+    command: &str,
+    file: &str,
+) -> String {
+    let n = plan.steps.len();
+    let sp = problem.spacing_m;
+    let mut t = String::new();
+    let name = format!("plan_{}", crate::cli::part_folder(&problem.part));
+    t += &format!(
+        "# Written by `pinfeed plan` (sensorless pin planner, issue 14):\n#\n#   {command}\n#\n"
+    );
+    t += &format!(
+        "# {n} pin(s), a shortest plan for its action set (BFS over {} particle(s), θ rounded to {}°,\n",
+        plan.initial.total(),
+        problem.theta_quantum_deg
+    );
+    t += &format!(
+        "# y to {} mm, pin intervals with margin ≥ {} mm). Predicted success {:.4} ({} of {}\n",
+        problem.y_quantum_m * 1e3,
+        problem.min_margin_m * 1e3,
+        plan.predicted_success,
+        plan.window.inside,
+        plan.initial.total(),
+    );
+    t += &format!(
+        "# particles within {}° ± {}°).",
+        num(plan.window.centre_deg, 2),
+        problem.tolerance_deg
+    );
+    if let Some((lo, hi)) = problem.mu_c_range {
+        t += &format!(
+            " Planned against μc ∈ [{lo}, {hi}] per part (the line uses μc = {}).",
+            problem.mu_c
+        );
+    }
+    if problem.tripod {
+        t += " Planned against random tripod supports.";
+    }
+    t += &format!("\n#\n#   pinfeed run {file}\n\n");
+    t += &format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
+    t += "[belt]\nspeed = 0.05        # m/s\n";
+    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
+    t += &format!(
+        "length = {}        # m: one spacing after the last pin\n\n",
+        num(sp * (n as f64 + 1.0), 6)
+    );
+    t += "[part]\n";
+    if let Some(v) = problem.part.trim().strip_prefix("vertices:") {
+        let pts = crate::geometry::named::parse_vertex_list(v).unwrap_or_default();
+        let list: Vec<String> = pts
+            .iter()
+            .map(|p| format!("[{}, {}]", num(p.x, 9), num(p.y, 9)))
+            .collect();
+        t += &format!("vertices = [{}]\n", list.join(", "));
+    } else {
+        t += &format!("shape = \"{}\"\n", problem.part.trim());
+    }
+    t += &format!("scale = {}\n", num(problem.scale, 9));
+    t += &format!("mu_c = {}\n", num(problem.mu_c, 6));
+    t += &format!(
+        "support = \"{}\"\n\n",
+        if problem.tripod { "tripod" } else { "uniform" }
+    );
+    t += &format!("[feed]\nparts = {parts}\narrival = \"periodic\"\nheadway = 4.0\n");
+    match problem.feed {
+        FeedKind::Stable => {
+            let w = vec!["1"; stable_count].join(", ");
+            t += &format!(
+                "orientation = \"stable\"\nweights = [{w}]\njitter = {}\n",
+                num(problem.jitter_deg, 6)
+            );
+        }
+        FeedKind::Uniform => t += "orientation = \"uniform\"\n",
+    }
+    if problem.lateral_m > 0.0 {
+        t += &format!(
+            "\n[feed.lateral]\ndistribution = \"uniform\"\nmin = {}\nmax = {}\n",
+            num(-problem.lateral_m, 9),
+            num(problem.lateral_m, 9)
+        );
+    } else {
+        t += "\n[feed.lateral]\ndistribution = \"fixed\"\nvalue = 0.0\n";
+    }
+    for (k, step) in plan.steps.iter().enumerate() {
+        let Action::Pin(pin) = step.action;
+        t += &format!(
+            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{}\"\nx = {}\ny = {}\nradius = {}\n",
+            pin.margin_m * 1e3,
+            step.sets,
+            step.window.share,
+            k + 1,
+            num(sp * (k as f64 + 1.0), 6),
+            num(pin.y_m, 6),
+            num(problem.pin_radius_m, 6),
+        );
+    }
+    // A symmetric part: the orientations one symmetry period apart are the same pose.
+    let goals: Vec<String> = (0..symmetry.max(1))
+        .map(|j| {
+            num(
+                plan.window.centre_deg + j as f64 * 360.0 / symmetry.max(1) as f64,
+                3,
+            )
+        })
+        .collect();
+    t += &format!(
+        "\n[goal]\n[[goal.sets]]\nname = \"planned\"\norientations = [{}]\ntolerance = {}\n",
+        goals.join(", "),
+        num(problem.tolerance_deg, 6)
+    );
+    t += "\n[model]\nfidelity = \"exact\"\ntol = 1e-6\n\n[output]\ndir = \"results\"\nhistogram_svg = false\nhistogram_bin = 1\n";
+    t
+}

@@ -1,0 +1,78 @@
+//! Planning pin layouts (issue 14, thesis ch. 4 "Fixed Pins"): the **sensorless pin planner**.
+//!
+//! Given a part, a feed (its stable states with jitter and a lateral offset range, or any
+//! orientation), the physics (μc, pin radius, optionally a μc range and tripod supports to be
+//! robust against) and constraints (belt width, pin spacing, most pins), find a SHORTEST sequence of
+//! fixed pins that brings at least a target share of the parts into one orientation window of
+//! width 2·tol (or, with `fewest_sets`, into the fewest such windows).
+//!
+//! * [`problem`]: the inputs, their defaults and checks ([`Problem`]);
+//! * [`particles`]: the search state, a weighted set of quantised particles (θ, y, physics
+//!   sample), the feed it starts from and the goal measures (best window, number of sets);
+//! * [`transition`]: one pin pass over every particle, through the pure contact model
+//!   ([`crate::mechanics::push`] from [`crate::maps::pass_start`]), memoised per (physics sample,
+//!   θ, y_pin − y) and computed in parallel;
+//! * [`actions`]: the actions of a state — pin positions on a fine lateral grid merged into
+//!   intervals over which no particle's outcome changes qualitatively, one representative (the
+//!   middle) per interval with its robustness margin ([`Action`] is an enum a fence or a sensing
+//!   branch can join later);
+//! * [`search`]: breadth-first search with deduplication, limits and statistics;
+//! * [`emit`]: the plan as a runnable scenario TOML;
+//! * [`check`]: the plan run through the line ([`crate::engine::run`]).
+//!
+//! ## What "shortest" means here
+//!
+//! The search is exact over an abstraction, and the claim is exactly that strong:
+//! * particles: a finite, seeded set of feed samples (see [`particles::initial_state`]); a plan
+//!   reaches the goal for these particles, the line check measures what it does for the real feed;
+//! * quantisation: after every pin each particle's orientation is rounded to `theta_quantum_deg`
+//!   (default 0.25°) and its lateral offset to `y_quantum_m` (default 0.25 mm); the pin grid has the
+//!   same lateral step, so d = (y_pin − y)/a is exact on the grid and pushes recur exactly (memo);
+//!   two states are the same state iff their rounded particles coincide;
+//! * actions: one representative per interval of the fine pin grid (see [`actions`]), only
+//!   intervals with margin ≥ `min_margin_m`.
+//!
+//! Breadth-first search over these states with deduplication visits every state reachable in k
+//! pins before any reachable in k + 1, so the first goal state generated is reached by a plan of the
+//! fewest pins among all plans in this action set for this particle set and quantum; "no plan up
+//! to depth k" means none of those plans of ≤ k pins reaches the goal. A finer quantum or another
+//! action set may find a shorter plan; rounding can also make a reported plan slightly optimistic,
+//! which the line check measures.
+
+pub mod actions;
+pub mod check;
+pub mod emit;
+pub mod particles;
+pub mod problem;
+pub mod search;
+pub mod transition;
+
+pub use actions::{Action, PinAction};
+pub use particles::{Particle, State};
+pub use problem::{FeedKind, Problem};
+pub use search::{search, Outcome, Plan, PlanStep, SearchStats};
+
+/// Bad planner input, or a planner that cannot start.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    /// A value out of range; `flag` names the CLI flag (or problem field) it came from.
+    #[error("{flag} {value}: {reason}")]
+    Input {
+        flag: &'static str,
+        value: String,
+        reason: String,
+    },
+    /// The part could not be built or compiled.
+    #[error("part '{part}': {reason}")]
+    Part { part: String, reason: String },
+}
+
+impl PlanError {
+    pub(crate) fn input(flag: &'static str, value: impl ToString, reason: impl ToString) -> Self {
+        PlanError::Input {
+            flag,
+            value: value.to_string(),
+            reason: reason.to_string(),
+        }
+    }
+}

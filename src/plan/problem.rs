@@ -1,0 +1,401 @@
+//! The planner's inputs ([`Problem`]), their defaults (the quickstart line's belt, feed and pins)
+//! and their checks. Lengths are metres, angles degrees (SPEC §1).
+
+use super::PlanError;
+use crate::geometry::{part_from_spec, Polygon};
+
+/// How the parts arrive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeedKind {
+    /// In one of the part's stable states (equal weights), with normal jitter.
+    Stable,
+    /// At any orientation (uniform on the circle).
+    Uniform,
+}
+
+/// Everything the sensorless planner needs. [`Problem::new`] gives the defaults.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Problem {
+    /// Part specification (`tripoly2`, `rect:2:1`, `vertices:...`).
+    pub part: String,
+    /// Metres per unit of the part's coordinates.
+    pub scale: f64,
+    pub feed: FeedKind,
+    /// Standard deviation of the orientation jitter of a stable feed (degrees).
+    pub jitter_deg: f64,
+    /// Half-width of the uniform lateral offset range at entry (m): y ∈ [−lateral, lateral].
+    pub lateral_m: f64,
+    /// Particles per stable state: `jitter_samples` orientations × `offset_samples` offsets.
+    pub jitter_samples: usize,
+    pub offset_samples: usize,
+    /// Orientations of a uniform feed (each with `offset_samples` offsets).
+    pub orientation_samples: usize,
+    /// Pin–part friction (the nominal value; see `mu_c_range`).
+    pub mu_c: f64,
+    /// Robustness: each particle carries its own μc drawn uniformly from [lo, hi].
+    pub mu_c_range: Option<(f64, f64)>,
+    /// Robustness: each particle carries its own random tripod support.
+    pub tripod: bool,
+    /// Pin radius (m; 0 = point pin).
+    pub pin_radius_m: f64,
+    /// Belt width (m): pins and parts' centroids stay within ±width/2.
+    pub belt_width_m: f64,
+    /// Distance between consecutive pins along the belt (m).
+    pub spacing_m: f64,
+    /// Most pins (search depth).
+    pub max_pins: usize,
+    /// Goal: half-width of the orientation window (degrees).
+    pub tolerance_deg: f64,
+    /// Goal: share of the parts inside the window.
+    pub target: f64,
+    /// Minimise the number of orientation sets instead of requiring one.
+    pub fewest_sets: bool,
+    /// Smallest robustness margin of an action (m).
+    pub min_margin_m: f64,
+    /// Lateral quantum of particles and of the pin grid (m).
+    pub y_quantum_m: f64,
+    /// Orientation quantum of particles (degrees); must divide 360.
+    pub theta_quantum_deg: f64,
+    /// The per-orientation outcome over the pin grid is sampled every `coarse` grid steps and
+    /// bisected where the qualitative outcome changes (1 = every step).
+    pub coarse: usize,
+    /// Search limits: most distinct states, and wall time (s).
+    pub max_states: usize,
+    pub time_limit_s: f64,
+    /// Integration tolerance of the contact model while planning.
+    pub contact_tol: f64,
+    pub seed: u64,
+}
+
+impl Problem {
+    /// The defaults for a part (the quickstart line: 2 cm per unit, 10 cm belt, pins 15 cm apart).
+    pub fn new(part: &str) -> Problem {
+        Problem {
+            part: part.to_string(),
+            scale: 0.02,
+            feed: FeedKind::Stable,
+            jitter_deg: 2.0,
+            lateral_m: 0.002,
+            jitter_samples: 5,
+            offset_samples: 5,
+            orientation_samples: 72,
+            mu_c: 0.5,
+            mu_c_range: None,
+            tripod: false,
+            pin_radius_m: 0.002,
+            belt_width_m: 0.1,
+            spacing_m: 0.15,
+            max_pins: 8,
+            tolerance_deg: 3.0,
+            target: 0.99,
+            fewest_sets: false,
+            min_margin_m: 0.0005,
+            y_quantum_m: 0.00025,
+            theta_quantum_deg: 0.25,
+            coarse: 4,
+            max_states: 100_000,
+            time_limit_s: 600.0,
+            contact_tol: 1e-5,
+            seed: 1,
+        }
+    }
+
+    /// Check every value and build the part in metres. Errors name the flag.
+    pub fn compile(&self) -> Result<Compiled, PlanError> {
+        let finite_pos = |flag: &'static str, v: f64| -> Result<(), PlanError> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(PlanError::input(
+                    flag,
+                    v,
+                    "must be a positive finite number",
+                ))
+            }
+        };
+        finite_pos("--scale", self.scale)?;
+        let unit = part_from_spec(&self.part).map_err(|err| PlanError::Part {
+            part: self.part.clone(),
+            reason: err.to_string(),
+        })?;
+        let polygon = unit.try_scaled(self.scale).map_err(|err| PlanError::Part {
+            part: self.part.clone(),
+            reason: err.to_string(),
+        })?;
+        let a = polygon.radius();
+        if !(1e-4..=1.0).contains(&a) {
+            return Err(PlanError::input(
+                "--scale",
+                self.scale,
+                format!("gives a part of size a = {a} m; it must lie in [0.1 mm, 1 m]"),
+            ));
+        }
+        if !(self.jitter_deg.is_finite() && (0.0..=45.0).contains(&self.jitter_deg)) {
+            return Err(PlanError::input(
+                "--jitter",
+                self.jitter_deg,
+                "must lie in [0, 45] degrees",
+            ));
+        }
+        if !(self.lateral_m.is_finite() && self.lateral_m >= 0.0) {
+            return Err(PlanError::input(
+                "--lateral",
+                self.lateral_m,
+                "must be a finite length ≥ 0 (m)",
+            ));
+        }
+        for (flag, n) in [
+            ("--jitter-samples", self.jitter_samples),
+            ("--offset-samples", self.offset_samples),
+            ("--orientation-samples", self.orientation_samples),
+        ] {
+            if !(1..=2000).contains(&n) {
+                return Err(PlanError::input(flag, n, "must lie in 1..=2000"));
+            }
+        }
+        if !(self.mu_c.is_finite() && (0.0..=10.0).contains(&self.mu_c)) {
+            return Err(PlanError::input("--mu-c", self.mu_c, "must lie in [0, 10]"));
+        }
+        if let Some((lo, hi)) = self.mu_c_range {
+            if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo <= hi && hi <= 10.0) {
+                return Err(PlanError::input(
+                    "--mu-c-range",
+                    format!("{lo}:{hi}"),
+                    "must be LO:HI with 0 ≤ LO ≤ HI ≤ 10",
+                ));
+            }
+        }
+        if !(self.pin_radius_m.is_finite() && self.pin_radius_m >= 0.0 && self.pin_radius_m <= a) {
+            return Err(PlanError::input(
+                "--pin-radius",
+                self.pin_radius_m,
+                format!("must lie in [0, a = {a:.4} m] (m)"),
+            ));
+        }
+        finite_pos("--belt-width", self.belt_width_m)?;
+        if self.belt_width_m < 2.0 * a {
+            return Err(PlanError::input(
+                "--belt-width",
+                self.belt_width_m,
+                format!(
+                    "the belt is narrower than the part (2a = {:.4} m at --scale {})",
+                    2.0 * a,
+                    self.scale
+                ),
+            ));
+        }
+        if self.lateral_m + a > self.belt_width_m / 2.0 {
+            return Err(PlanError::input(
+                "--lateral",
+                self.lateral_m,
+                format!(
+                    "parts at ±{} m would overhang the belt (half-width {} m, a = {a:.4} m)",
+                    self.lateral_m,
+                    self.belt_width_m / 2.0
+                ),
+            ));
+        }
+        finite_pos("--spacing", self.spacing_m)?;
+        if self.spacing_m < 2.5 * a {
+            return Err(PlanError::input(
+                "--spacing",
+                self.spacing_m,
+                format!(
+                    "pins closer than 2.5a = {:.4} m can touch a part at once",
+                    2.5 * a
+                ),
+            ));
+        }
+        if self.max_pins == 0 {
+            return Err(PlanError::input(
+                "--depth",
+                0,
+                "the plan must be allowed at least one pin",
+            ));
+        }
+        if self.max_pins > 64 {
+            return Err(PlanError::input(
+                "--depth",
+                self.max_pins,
+                "at most 64 pins",
+            ));
+        }
+        if !(self.tolerance_deg.is_finite()
+            && self.tolerance_deg > 0.0
+            && self.tolerance_deg < 180.0)
+        {
+            return Err(PlanError::input(
+                "--tolerance",
+                self.tolerance_deg,
+                "the goal window would be empty: the tolerance must lie in (0, 180) degrees",
+            ));
+        }
+        if !(self.target.is_finite() && self.target > 0.0 && self.target <= 1.0) {
+            return Err(PlanError::input(
+                "--target",
+                self.target,
+                "must lie in (0, 1]",
+            ));
+        }
+        if !(self.min_margin_m.is_finite() && self.min_margin_m >= 0.0 && self.min_margin_m < a) {
+            return Err(PlanError::input(
+                "--min-margin",
+                self.min_margin_m,
+                format!("must lie in [0, a = {a:.4} m)"),
+            ));
+        }
+        if !(self.y_quantum_m.is_finite()
+            && self.y_quantum_m >= 1e-6
+            && self.y_quantum_m <= a / 4.0)
+        {
+            return Err(PlanError::input(
+                "--y-quantum",
+                self.y_quantum_m,
+                format!("must lie in [1 µm, a/4 = {:.4} m]", a / 4.0),
+            ));
+        }
+        let q = self.theta_quantum_deg;
+        let n = (360.0 / q).round();
+        if !(q.is_finite() && (0.01..=10.0).contains(&q)) || (n * q - 360.0).abs() > 1e-9 {
+            return Err(PlanError::input(
+                "--theta-quantum",
+                q,
+                "must lie in [0.01, 10] degrees and divide 360",
+            ));
+        }
+        if !(1..=64).contains(&self.coarse) {
+            return Err(PlanError::input(
+                "--coarse",
+                self.coarse,
+                "must lie in 1..=64",
+            ));
+        }
+        if self.max_states == 0 {
+            return Err(PlanError::input("--max-states", 0, "must be at least 1"));
+        }
+        if !(self.time_limit_s.is_finite() && self.time_limit_s > 0.0) {
+            return Err(PlanError::input(
+                "--time-limit",
+                self.time_limit_s,
+                "must be a positive number of seconds",
+            ));
+        }
+        if !(self.contact_tol.is_finite() && self.contact_tol > 0.0 && self.contact_tol <= 1e-2) {
+            return Err(PlanError::input(
+                "--contact-tol",
+                self.contact_tol,
+                "must lie in (0, 0.01]",
+            ));
+        }
+        // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform
+        // support only: a tripod is fixed in the part frame and breaks the symmetry).
+        let mut symmetry = if self.tripod {
+            1
+        } else {
+            rotational_symmetry(&polygon)
+        };
+        let mut period_steps = 360.0 / symmetry as f64 / q;
+        if (period_steps - period_steps.round()).abs() > 1e-9 {
+            symmetry = 1;
+            period_steps = n;
+        }
+        let stable: Vec<f64> = unit
+            .stable_states()
+            .iter()
+            .map(|s| s.theta.to_degrees())
+            .collect();
+        if self.feed == FeedKind::Stable && stable.is_empty() {
+            return Err(PlanError::input(
+                "--feed",
+                "stable",
+                "the part has no stable state",
+            ));
+        }
+        Ok(Compiled {
+            polygon,
+            radius: a,
+            stable_deg: stable,
+            theta_steps: period_steps.round() as i32,
+            symmetry,
+        })
+    }
+}
+
+/// A checked problem's derived data.
+#[derive(Debug, Clone)]
+pub struct Compiled {
+    /// The part in metres, part frame (centroid at the origin).
+    pub polygon: Polygon,
+    /// `a` (m).
+    pub radius: f64,
+    /// Stable states (degrees), as `pinfeed part` lists them.
+    pub stable_deg: Vec<f64>,
+    /// Orientation quanta per symmetry period (360 / symmetry / theta_quantum_deg): particle
+    /// orientations are kept modulo the period.
+    pub theta_steps: i32,
+    /// Order of the part's rotational symmetry (1: none; 4 for a square; forced to 1 with tripod
+    /// supports, or when the period is not a whole number of quanta).
+    pub symmetry: u32,
+}
+
+impl Compiled {
+    /// The symmetry period (degrees).
+    pub fn period_deg(&self) -> f64 {
+        360.0 / self.symmetry as f64
+    }
+}
+
+/// The order k of the polygon's rotational symmetry about its centroid: the largest k ≥ 1 such
+/// that a rotation by 360°/k maps every vertex onto a vertex (to 1e-9·a).
+pub fn rotational_symmetry(poly: &Polygon) -> u32 {
+    let v = poly.vertices();
+    let n = v.len();
+    let eps = 1e-9 * poly.radius();
+    for k in (2..=n).rev() {
+        if n % k != 0 {
+            continue;
+        }
+        let (s, c) = (std::f64::consts::TAU / k as f64).sin_cos();
+        let all = v.iter().all(|p| {
+            let r = crate::geometry::Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y);
+            v.iter().any(|q| (*q - r).norm() < eps)
+        });
+        if all {
+            return k as u32;
+        }
+    }
+    1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_compile_and_bad_values_name_their_flag() {
+        let p = Problem::new("tripoly2");
+        let c = p.compile().unwrap();
+        assert_eq!(c.stable_deg.len(), 3);
+        assert_eq!(c.theta_steps, 1440);
+        assert_eq!(c.symmetry, 1);
+        let sym = |part: &str| Problem::new(part).compile().unwrap().symmetry;
+        assert_eq!(sym("square"), 4);
+        assert_eq!(sym("rect:2:1"), 2);
+        assert_eq!(sym("lshape"), 1);
+        assert_eq!(sym("ngon:6"), 6);
+        let bad = |f: &dyn Fn(&mut Problem), flag: &str| {
+            let mut q = Problem::new("tripoly2");
+            f(&mut q);
+            let msg = q.compile().unwrap_err().to_string();
+            assert!(msg.starts_with(flag), "{msg}");
+        };
+        bad(&|q| q.belt_width_m = 0.03, "--belt-width");
+        bad(&|q| q.tolerance_deg = 0.0, "--tolerance");
+        bad(&|q| q.max_pins = 0, "--depth");
+        bad(&|q| q.mu_c = f64::NAN, "--mu-c");
+        bad(&|q| q.theta_quantum_deg = 0.7, "--theta-quantum");
+        bad(&|q| q.mu_c_range = Some((0.7, 0.3)), "--mu-c-range");
+        bad(&|q| q.part = "blob".into(), "part");
+    }
+}

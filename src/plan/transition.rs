@@ -1,0 +1,398 @@
+//! One pin pass over every particle of a state, through the pure contact model.
+//!
+//! A particle at (θ, y) met by a fixed pin at lateral position y_pin is pushed from the standard
+//! start of [`crate::maps::pass_start`] with d = (y_pin − y)/a (SPEC §1, belt frame: the part rests,
+//! the pin travels in −x); its orientation becomes θ + rotation and its offset y + Δy, Δy the
+//! centroid's lateral displacement (`pose_final.y`). The outcome depends only on (physics sample,
+//! θ, y_pin − y), all on the quantum grid, so outcomes are memoised under that key and reused by
+//! every state that meets the same sub-problem.
+//!
+//! A **column** is the outcome at one (physics sample, θ) over every pin offset of the grid within
+//! reach (|y_pin − y| ≤ a + ρ): a slice of the configuration map along d. The planner needs only
+//! its *qualitative signature* per offset (no contact; failed; or the sequence of part features the
+//! pin touched and the sense of rotation — what changes at the thesis's band and no-contact edges).
+//! It is sampled every `coarse` offsets and bisected wherever two neighbouring samples differ, down
+//! to single grid steps; offsets between two equal samples are taken to share their signature (a
+//! qualitative band narrower than `coarse` grid steps that starts and ends between two samples can
+//! be missed; `coarse = 1` samples every offset). Columns are computed in parallel (rayon, results
+//! collected in order, so the memo and the search do not depend on the thread count).
+
+use super::particles::{theta_quanta, y_quanta, Particle, State};
+use super::problem::{Compiled, Problem};
+use super::PlanError;
+use crate::geometry::{wrap_deg, Polygon};
+use crate::maps::pass_start;
+use crate::mechanics::{push, ContactSettings, ContactStatus, Fidelity, PartModel, Pin, Support};
+use rand::RngExt;
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Signature of a pass without contact.
+pub const NO_CONTACT: u32 = 0;
+/// Signature of a failed pass (non-ok contact status): the particle is lost.
+pub const FAILED: u32 = 1;
+
+/// The physics one particle carries.
+#[derive(Debug, Clone)]
+pub struct PhysicsSample {
+    pub model: Arc<PartModel>,
+    pub mu_c: f64,
+    /// The tripod's points (m, part frame) and weights, if any (for reports).
+    pub support: Support,
+}
+
+/// The outcome of one pass, as the planner keeps it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassOutcome {
+    pub signature: u32,
+    /// Final orientation (degrees, [0, 360)).
+    pub theta_deg: f64,
+    /// Lateral displacement of the centroid (m).
+    pub dy_m: f64,
+}
+
+/// Memo key: (physics sample, θ quanta, (y_pin − y) quanta).
+pub type PassKey = (u32, i32, i32);
+
+/// Work counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct PushCounters {
+    /// Contact-model passes computed.
+    pub computed: u64,
+    /// Look-ups answered by the memo.
+    pub memo_hits: u64,
+    /// Columns (θ slices) computed.
+    pub columns: u64,
+}
+
+/// The transition function with its memo.
+pub struct Transition {
+    polygon: Polygon,
+    radius: f64,
+    pin_radius: f64,
+    contact_tol: f64,
+    theta_quantum: f64,
+    theta_steps: i32,
+    y_quantum: f64,
+    half_width: f64,
+    coarse: usize,
+    /// Largest |y_pin − y| (quanta) at which the pin can touch.
+    pub reach_q: i32,
+    pub samples: Vec<PhysicsSample>,
+    memo: HashMap<PassKey, PassOutcome>,
+    columns: HashMap<(u32, i32), Arc<Vec<u32>>>,
+    pub counters: PushCounters,
+}
+
+/// Stream of the physics samples (each particle's own μc and tripod).
+const PHYSICS_STREAM: u64 = 0x7068_7973;
+
+impl Transition {
+    /// The physics samples: one (nominal) for all particles, or one per feed sample (`n`) drawn
+    /// from the seed when the problem asks for robustness.
+    pub fn new(problem: &Problem, compiled: &Compiled, n: usize) -> Result<Transition, PlanError> {
+        let part_err = |reason: String| PlanError::Part {
+            part: problem.part.clone(),
+            reason,
+        };
+        let uniform =
+            Arc::new(PartModel::new(&compiled.polygon, &Support::Uniform).map_err(part_err)?);
+        let robust = problem.tripod || problem.mu_c_range.is_some();
+        let mut samples = Vec::new();
+        if !robust {
+            samples.push(PhysicsSample {
+                model: uniform,
+                mu_c: problem.mu_c,
+                support: Support::Uniform,
+            });
+        } else {
+            for i in 0..n {
+                let mut rng = crate::random::stream(problem.seed ^ PHYSICS_STREAM, i as u64);
+                let mu_c = match problem.mu_c_range {
+                    Some((lo, hi)) => lo + (hi - lo) * rng.random::<f64>(),
+                    None => problem.mu_c,
+                };
+                let (model, support) = if problem.tripod {
+                    let s =
+                        Support::random_tripod(&compiled.polygon, &mut rng).map_err(part_err)?;
+                    (
+                        Arc::new(PartModel::new(&compiled.polygon, &s).map_err(part_err)?),
+                        s,
+                    )
+                } else {
+                    (uniform.clone(), Support::Uniform)
+                };
+                samples.push(PhysicsSample {
+                    model,
+                    mu_c,
+                    support,
+                });
+            }
+        }
+        let reach_q =
+            ((compiled.radius + problem.pin_radius_m) / problem.y_quantum_m).floor() as i32;
+        Ok(Transition {
+            polygon: compiled.polygon.clone(),
+            radius: compiled.radius,
+            pin_radius: problem.pin_radius_m,
+            contact_tol: problem.contact_tol,
+            theta_quantum: problem.theta_quantum_deg,
+            theta_steps: compiled.theta_steps,
+            y_quantum: problem.y_quantum_m,
+            half_width: problem.belt_width_m / 2.0,
+            coarse: problem.coarse,
+            reach_q,
+            samples,
+            memo: HashMap::new(),
+            columns: HashMap::new(),
+            counters: PushCounters::default(),
+        })
+    }
+
+    /// Lateral quantum (m).
+    pub fn y_quantum(&self) -> f64 {
+        self.y_quantum
+    }
+
+    /// Bytes held by the memo and the columns (estimate).
+    pub fn memo_bytes(&self) -> usize {
+        let entry = std::mem::size_of::<(PassKey, PassOutcome)>() + 8;
+        let col: usize = self.columns.values().map(|c| c.len() * 4 + 64).sum();
+        self.memo.capacity() * entry + col
+    }
+
+    /// Distinct passes in the memo.
+    pub fn memo_len(&self) -> usize {
+        self.memo.len()
+    }
+
+    /// One pass, computed (pure).
+    fn pass(&self, key: PassKey) -> PassOutcome {
+        let (sample, theta_q, dy_q) = key;
+        let phys = &self.samples[sample as usize];
+        let theta_deg = theta_q as f64 * self.theta_quantum;
+        let d = dy_q as f64 * self.y_quantum / self.radius;
+        let (pose, start) = pass_start(&self.polygon, theta_deg, d, self.pin_radius);
+        let settings = ContactSettings {
+            fidelity: Fidelity::Exact,
+            mu_c: phys.mu_c,
+            tol: self.contact_tol,
+            ..ContactSettings::default()
+        };
+        let pin = Pin {
+            radius: self.pin_radius,
+            lateral_speed: 0.0,
+        };
+        let out = push(&phys.model, pose, start, &pin, &settings, None);
+        if !out.contact {
+            return PassOutcome {
+                signature: NO_CONTACT,
+                theta_deg,
+                dy_m: 0.0,
+            };
+        }
+        let ok = matches!(
+            out.status,
+            ContactStatus::Ok | ContactStatus::Metastable { .. }
+        );
+        let theta_final = wrap_deg(theta_deg + out.rotation.to_degrees());
+        if !ok {
+            return PassOutcome {
+                signature: FAILED,
+                theta_deg: theta_final,
+                dy_m: out.pose_final.y,
+            };
+        }
+        // FNV-1a over the touched features (consecutive repeats dropped), the sense of rotation
+        // and whether the push rode an unstable equilibrium.
+        let mut h: u32 = 0x811c_9dc5;
+        let mut mix = |v: u32| {
+            for b in v.to_le_bytes() {
+                h ^= b as u32;
+                h = h.wrapping_mul(0x0100_0193);
+            }
+        };
+        let mut last = None;
+        for seg in &out.segments {
+            let f = (seg.feature.kind(), seg.feature.index());
+            if last != Some(f) {
+                mix(match f.0 {
+                    "edge" => 1,
+                    "vertex" => 2,
+                    _ => 3,
+                });
+                mix(f.1 as u32);
+                last = Some(f);
+            }
+        }
+        mix(if out.rotation >= 0.0 { 7 } else { 9 });
+        mix(matches!(out.status, ContactStatus::Metastable { .. }) as u32);
+        PassOutcome {
+            signature: h.max(2),
+            theta_deg: theta_final,
+            dy_m: out.pose_final.y,
+        }
+    }
+
+    /// Make sure every key has an outcome in the memo (missing ones computed in parallel).
+    pub fn ensure(&mut self, keys: &[PassKey]) {
+        let mut missing: Vec<PassKey> = Vec::new();
+        for k in keys {
+            if self.memo.contains_key(k) {
+                self.counters.memo_hits += 1;
+            } else {
+                missing.push(*k);
+            }
+        }
+        missing.sort_unstable();
+        missing.dedup();
+        let this = &*self;
+        let out: Vec<PassOutcome> = missing.par_iter().map(|&k| this.pass(k)).collect();
+        self.counters.computed += out.len() as u64;
+        self.memo.extend(missing.into_iter().zip(out));
+    }
+
+    /// The memoised outcome (call [`Transition::ensure`] first).
+    pub fn outcome(&self, key: PassKey) -> Option<&PassOutcome> {
+        self.memo.get(&key)
+    }
+
+    /// Signature of column (sample, θ) at offset index i (offset i − reach), computing it (and
+    /// recording it in `local`) when it is in neither memo.
+    fn column_sig(
+        &self,
+        sample: u32,
+        theta_q: i32,
+        i: usize,
+        local: &mut Vec<(PassKey, PassOutcome)>,
+        sig: &mut [u32],
+        hits: &mut u64,
+    ) -> u32 {
+        const UNKNOWN: u32 = u32::MAX;
+        if sig[i] != UNKNOWN {
+            return sig[i];
+        }
+        let key = (sample, theta_q, i as i32 - self.reach_q);
+        let s = match self.memo.get(&key) {
+            Some(o) => {
+                *hits += 1;
+                o.signature
+            }
+            None => {
+                let o = self.pass(key);
+                local.push((key, o));
+                o.signature
+            }
+        };
+        sig[i] = s;
+        s
+    }
+
+    /// Compute one column: coarse samples, bisected where neighbours differ.
+    fn column(&self, sample: u32, theta_q: i32) -> (Vec<u32>, Vec<(PassKey, PassOutcome)>, u64) {
+        const UNKNOWN: u32 = u32::MAX;
+        let len = (2 * self.reach_q + 1) as usize;
+        let mut sig = vec![UNKNOWN; len];
+        let mut local = Vec::new();
+        let mut hits = 0u64;
+        let mut coarse: Vec<usize> = (0..len).step_by(self.coarse).collect();
+        if *coarse.last().unwrap() != len - 1 {
+            coarse.push(len - 1);
+        }
+        for &i in &coarse {
+            self.column_sig(sample, theta_q, i, &mut local, &mut sig, &mut hits);
+        }
+        let mut stack: Vec<(usize, usize)> =
+            coarse.windows(2).map(|w| (w[0], w[1])).rev().collect();
+        while let Some((lo, hi)) = stack.pop() {
+            if hi - lo <= 1 {
+                continue;
+            }
+            if sig[lo] == sig[hi] {
+                let s = sig[lo];
+                for v in &mut sig[lo + 1..hi] {
+                    if *v == UNKNOWN {
+                        *v = s;
+                    }
+                }
+                continue;
+            }
+            let mid = (lo + hi) / 2;
+            self.column_sig(sample, theta_q, mid, &mut local, &mut sig, &mut hits);
+            stack.push((mid, hi));
+            stack.push((lo, mid));
+        }
+        (sig, local, hits)
+    }
+
+    /// Make sure every (sample, θ) column exists (missing ones computed in parallel).
+    pub fn ensure_columns(&mut self, cols: &[(u32, i32)]) {
+        let mut missing: Vec<(u32, i32)> = cols
+            .iter()
+            .filter(|c| !self.columns.contains_key(c))
+            .copied()
+            .collect();
+        missing.sort_unstable();
+        missing.dedup();
+        let this = &*self;
+        let out: Vec<_> = missing
+            .par_iter()
+            .map(|&(s, t)| this.column(s, t))
+            .collect();
+        for ((s, t), (sig, local, hits)) in missing.into_iter().zip(out) {
+            self.counters.columns += 1;
+            self.counters.memo_hits += hits;
+            self.counters.computed += local.len() as u64;
+            self.memo.extend(local);
+            self.columns.insert((s, t), Arc::new(sig));
+        }
+    }
+
+    /// The signature column of (sample, θ) (call [`Transition::ensure_columns`] first).
+    pub fn column_of(&self, sample: u32, theta_q: i32) -> Arc<Vec<u32>> {
+        self.columns[&(sample, theta_q)].clone()
+    }
+
+    /// The state after a pin at `pin_q` (quanta); every touched particle's pass must be in the
+    /// memo (see [`Transition::ensure`]).
+    pub fn apply(&self, state: &State, pin_q: i32) -> State {
+        let mut lost = state.lost;
+        let mut parts = Vec::with_capacity(state.particles.len());
+        for p in &state.particles {
+            let dy = pin_q - p.y_q;
+            if dy.abs() > self.reach_q {
+                parts.push(*p);
+                continue;
+            }
+            let o = self.memo[&(p.sample, p.theta_q, dy)];
+            match o.signature {
+                NO_CONTACT => parts.push(*p),
+                FAILED => lost += p.weight,
+                _ => {
+                    let y = p.y_q as f64 * self.y_quantum + o.dy_m;
+                    if y.abs() > self.half_width {
+                        lost += p.weight;
+                    } else {
+                        parts.push(Particle {
+                            sample: p.sample,
+                            theta_q: theta_quanta(
+                                o.theta_deg,
+                                self.theta_quantum,
+                                self.theta_steps,
+                            ),
+                            y_q: y_quanta(y, self.y_quantum),
+                            weight: p.weight,
+                        });
+                    }
+                }
+            }
+        }
+        State::canonical(parts, lost)
+    }
+
+    /// Largest pin position on the belt (quanta): pins stay within ±width/2.
+    pub fn belt_limit_q(&self) -> i32 {
+        (self.half_width / self.y_quantum + 1e-9).floor() as i32
+    }
+}

@@ -1,0 +1,144 @@
+//! `pinfeed plan` drawing (SVG): the planned line from above (pins at their positions, each with
+//! the interval of positions that act the same way, belt edges, the part at its goal orientation at
+//! the exit) and, below it, the orientation sets after each pin — one row per stage (feed, pin 1,
+//! …), a dot per particle orientation sized by its weight, the goal window shaded — as in the
+//! thesis's ch. 4 figures.
+
+use crate::geometry::{Pose, Vec2};
+use crate::plan::{Action, Plan, Problem, State};
+use plotters::prelude::*;
+use std::path::Path;
+
+fn stage_dots(state: &State, q_deg: f64) -> Vec<(f64, u32)> {
+    let mut h: Vec<(i32, u32)> = state
+        .particles
+        .iter()
+        .map(|p| (p.theta_q, p.weight))
+        .collect();
+    h.sort_unstable();
+    let mut out: Vec<(f64, u32)> = Vec::new();
+    for (t, w) in h {
+        let x = t as f64 * q_deg;
+        match out.last_mut() {
+            Some(l) if l.0 == x => l.1 += w,
+            _ => out.push((x, w)),
+        }
+    }
+    out
+}
+
+/// Draw a plan to `path`.
+pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<()> {
+    let compiled = problem.compile()?;
+    let period = compiled.period_deg();
+    let n = plan.steps.len();
+    let stages = n + 1;
+    let length = problem.spacing_m * (n as f64 + 1.0);
+    let half = problem.belt_width_m / 2.0 * 1e3;
+    let height = 330 + 40 * stages as u32 + 80;
+    let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (top, bottom) = root.split_vertically(330);
+    let mut ch = ChartBuilder::on(&top)
+        .caption(
+            format!(
+                "pinfeed plan: {} — {} pin(s), predicted success {:.3}",
+                problem.part, n, plan.predicted_success
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(15)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..length, -half..half)?;
+    ch.configure_mesh()
+        .x_desc("x along the belt (m)")
+        .y_desc("y (mm)")
+        .draw()?;
+    // Pixels per metre along each axis, to draw true shapes on stretched axes.
+    let (w_px, h_px) = ch.plotting_area().dim_in_pixel();
+    let px_per_m_x = w_px as f64 / length;
+    let px_per_m_y = h_px as f64 / (2.0 * half * 1e-3);
+    let pin_px = ((problem.pin_radius_m * px_per_m_y).round() as i32).max(2);
+    for (k, s) in plan.steps.iter().enumerate() {
+        let Action::Pin(p) = s.action;
+        let x = problem.spacing_m * (k as f64 + 1.0);
+        ch.draw_series(std::iter::once(Rectangle::new(
+            [(x - 0.004, p.lo_m * 1e3), (x + 0.004, p.hi_m * 1e3)],
+            BLUE.mix(0.2).filled(),
+        )))?;
+        ch.draw_series(std::iter::once(Circle::new(
+            (x, p.y_m * 1e3),
+            pin_px,
+            BLACK.filled(),
+        )))?;
+        ch.draw_series(std::iter::once(Text::new(
+            format!(
+                "pin{} y={:+.2} mm ±{:.2}",
+                k + 1,
+                p.y_m * 1e3,
+                p.margin_m * 1e3
+            ),
+            (x + 0.006, p.y_m * 1e3 + 2.0),
+            ("sans-serif", 12),
+        )))?;
+    }
+    // The part at its goal orientation near the exit (true shape, x stretched like the axes).
+    let pose = Pose::new(0.0, 0.0, plan.window.centre_deg.to_radians());
+    let verts: Vec<Vec2> = compiled.polygon.world_vertices(&pose);
+    let xs = px_per_m_y / px_per_m_x;
+    let cx = length - compiled.radius * xs - 0.01;
+    let outline: Vec<(f64, f64)> = verts.iter().map(|v| (cx + v.x * xs, v.y * 1e3)).collect();
+    ch.draw_series(std::iter::once(Polygon::new(
+        outline,
+        RGBColor(30, 150, 60).mix(0.5).filled(),
+    )))?;
+    // Orientation sets after each stage.
+    let mut ch = ChartBuilder::on(&bottom)
+        .margin(15)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..period, -0.5..(stages as f64 - 0.5))?;
+    ch.configure_mesh()
+        .x_desc(if compiled.symmetry > 1 {
+            format!("orientation θ modulo the {period}° symmetry (degrees)")
+        } else {
+            "orientation θ (degrees)".to_string()
+        })
+        .y_desc("after pin")
+        .x_labels(13)
+        .y_labels(stages.min(20))
+        .y_label_formatter(&|v| {
+            let k = v.round() as usize;
+            if k == 0 {
+                "feed".into()
+            } else {
+                format!("{k}")
+            }
+        })
+        .draw()?;
+    let c = plan.window.centre_deg;
+    let tol = problem.tolerance_deg;
+    for shift in [-period, 0.0, period] {
+        let (a, b) = ((c - tol + shift).max(0.0), (c + tol + shift).min(period));
+        if a < b {
+            ch.draw_series(std::iter::once(Rectangle::new(
+                [(a, -0.5), (b, stages as f64 - 0.5)],
+                GREEN.mix(0.15).filled(),
+            )))?;
+        }
+    }
+    let states: Vec<&State> = std::iter::once(&plan.initial)
+        .chain(plan.steps.iter().map(|s| &s.state))
+        .collect();
+    let total = plan.initial.total().max(1) as f64;
+    for (k, s) in states.iter().enumerate() {
+        let dots = stage_dots(s, problem.theta_quantum_deg);
+        ch.draw_series(dots.into_iter().map(|(x, w)| {
+            let r = (2.0 + 10.0 * (w as f64 / total).sqrt()) as i32;
+            Circle::new((x, k as f64), r, BLUE.mix(0.6).filled())
+        }))?;
+    }
+    root.present()?;
+    Ok(())
+}

@@ -1,0 +1,293 @@
+//! `pinfeed plan` (issue 14, the sensorless pin planner): the default tripoly2 plan orients ≥ 99%
+//! on the line; a returned plan is shortest (brute force over every action sequence of a small
+//! case); plans are deterministic for a seed; the emitted scenario parses and runs; bad inputs and
+//! searches that hit their limits end with a clear message and a non-zero exit; "no plan up to
+//! depth k" is a reported result.
+
+use pinfeed::plan::search::Planner;
+use pinfeed::plan::{Action, Outcome, Problem, State};
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn pinfeed(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(args)
+        .output()
+        .expect("run pinfeed")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pinfeed_plan_test_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn json_ok(args: &[&str]) -> Value {
+    let out = pinfeed(args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
+#[test]
+fn default_tripoly2_plan_orients_the_line() {
+    let out = tmp("tripoly2.toml");
+    let o = out.to_str().unwrap();
+    let v = json_ok(&[
+        "plan",
+        "--part",
+        "tripoly2",
+        "--out",
+        o,
+        "--check-parts",
+        "1000",
+        "--json",
+    ]);
+    assert_eq!(v["result"], "found");
+    let pins = v["plan"]["steps"].as_array().unwrap().len();
+    assert!((1..=8).contains(&pins), "{pins} pins");
+    assert!(v["plan"]["predicted_success"].as_f64().unwrap() >= 0.99);
+    let rate = v["check"]["success_rate"].as_f64().unwrap();
+    assert!(rate >= 0.99, "line success {rate}");
+    assert_eq!(v["check"]["parts"].as_u64(), Some(1000));
+    // The written scenario runs unchanged through `pinfeed run`.
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("pinfeed plan --part tripoly2"), "{text}");
+    assert_eq!(text.matches("kind = \"pin\"").count(), pins);
+    let run = pinfeed(&[
+        "run",
+        o,
+        "--parts",
+        "300",
+        "--json",
+        "--quiet",
+        "--out",
+        tmp("runs").to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let s: Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!(s["success_rate"].as_f64().unwrap() >= 0.99, "{s}");
+    assert!(out.with_extension("svg").exists());
+}
+
+#[test]
+fn plans_are_deterministic_for_a_seed_and_thread_count() {
+    let a = tmp("det_a.toml");
+    let b = tmp("det_b.toml");
+    for (f, threads) in [(&a, "1"), (&b, "2")] {
+        let out = pinfeed(&[
+            "plan",
+            "--part",
+            "square",
+            "--seed",
+            "7",
+            "--out",
+            f.to_str().unwrap(),
+            "--check-parts",
+            "0",
+            "--threads",
+            threads,
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    // Same file name in the header: compare with the name replaced.
+    let ta = std::fs::read_to_string(&a).unwrap().replace("det_a", "X");
+    let tb = std::fs::read_to_string(&b).unwrap().replace("det_b", "X");
+    assert_eq!(ta, tb);
+    assert!(ta.contains("--seed 7"));
+}
+
+/// Every state reachable by exactly `depth` actions from `state` (no deduplication).
+fn any_goal_within(p: &mut Planner, state: &State, depth: usize, visited: &mut u64) -> bool {
+    *visited += 1;
+    if p.is_goal(state) {
+        return true;
+    }
+    if depth == 0 {
+        return false;
+    }
+    for (_, next) in p.actions(state) {
+        if any_goal_within(p, &next, depth - 1, visited) {
+            return true;
+        }
+    }
+    false
+}
+
+#[test]
+fn returned_plan_is_shortest_by_brute_force() {
+    for part in ["tripoly2", "tripoly1"] {
+        let mut prob = Problem::new(part);
+        prob.jitter_samples = 2;
+        prob.offset_samples = 2;
+        prob.coarse = 1;
+        prob.min_margin_m = 0.001;
+        prob.max_pins = 6;
+        let mut planner = Planner::new(&prob).unwrap();
+        let (outcome, stats) = planner.search();
+        let Outcome::Found(plan) = outcome else {
+            panic!("{part}: no plan: {outcome:?}");
+        };
+        let len = plan.steps.len();
+        assert!(len >= 1, "{part}");
+        // Replaying the plan's actions reaches the goal through the same states.
+        let mut s = planner.initial.clone();
+        for step in &plan.steps {
+            let Action::Pin(pin) = step.action;
+            let next = planner
+                .actions(&s)
+                .into_iter()
+                .find(|(a, _)| matches!(a, Action::Pin(q) if q.y_q == pin.y_q))
+                .expect("the plan's action is an action of its state")
+                .1;
+            assert_eq!(next, step.state);
+            s = next;
+        }
+        assert!(planner.is_goal(&s));
+        // No sequence of fewer actions reaches the goal.
+        let init = planner.initial.clone();
+        let mut visited = 0;
+        assert!(
+            !any_goal_within(&mut planner, &init, len - 1, &mut visited),
+            "{part}: a plan shorter than {len} exists"
+        );
+        assert!(visited as usize >= stats.states_per_depth.iter().take(len).sum::<usize>());
+    }
+}
+
+#[test]
+fn none_up_to_depth_is_a_reported_result() {
+    // tripoly1 needs more than two pins (see results/plans.md): "none up to depth 2" is an
+    // answer, exit 0, no scenario written.
+    let out = tmp("none.toml");
+    let v = json_ok(&[
+        "plan",
+        "--part",
+        "tripoly1",
+        "--depth",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(v["result"], "none_up_to_depth");
+    assert!(v["message"]
+        .as_str()
+        .unwrap()
+        .contains("no sensorless plan up to depth 2"));
+    assert_eq!(v["stats"]["depth_completed"], 2);
+    assert!(v["plan"].is_null());
+    assert!(!out.exists());
+}
+
+#[test]
+fn tripoly1_sensorless_plan_to_one_set_up_to_depth_8() {
+    let v = json_ok(&[
+        "plan",
+        "--part",
+        "tripoly1",
+        "--check-parts",
+        "500",
+        "--json",
+    ]);
+    assert_eq!(v["result"], "found", "{}", v["message"]);
+    let pins = v["plan"]["steps"].as_array().unwrap().len();
+    assert!(pins <= 8);
+    assert!(
+        v["check"]["success_rate"].as_f64().unwrap() >= 0.97,
+        "{}",
+        v["check"]
+    );
+}
+
+#[test]
+fn limits_end_with_a_clear_message_and_nonzero_exit() {
+    for (args, expect) in [
+        (vec!["--max-states", "3"], "state limit 3"),
+        (vec!["--time-limit", "0.000001"], "time limit"),
+    ] {
+        let mut a = vec!["plan", "--part", "tripoly1"];
+        a.extend(args);
+        let out = pinfeed(&a);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{a:?}");
+        assert!(
+            err.contains(expect) && err.contains("after completing depth"),
+            "{err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn impossible_constraints_are_refused_with_the_flag_named() {
+    for (args, flag) in [
+        (vec!["--belt-width", "0.03"], "--belt-width"),
+        (vec!["--tolerance", "0"], "--tolerance"),
+        (vec!["--depth", "0"], "--depth"),
+        (vec!["--target", "1.5"], "--target"),
+        (vec!["--mu-c-range", "0.7:x"], "--mu-c-range"),
+        (vec!["--mu-c-range", "0.7:0.3"], "--mu-c-range"),
+        (vec!["--feed", "sideways"], "--feed"),
+        (vec!["--pin-radius", "-1"], "--pin-radius"),
+        (vec!["--theta-quantum", "0.7"], "--theta-quantum"),
+        (vec!["--scale", "nan"], "--scale"),
+    ] {
+        let mut a = vec!["plan", "--part", "tripoly2"];
+        a.extend(args.iter().copied());
+        let out = pinfeed(&a);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{a:?}");
+        assert!(err.contains(flag), "{a:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let out = pinfeed(&["plan", "--part", "blob"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown part"));
+}
+
+#[test]
+fn robust_plan_carries_its_uncertainty() {
+    // Each particle has its own μc and tripod: the plan is searched against them and says so.
+    let v = json_ok(&[
+        "plan",
+        "--part",
+        "tripoly2",
+        "--mu-c-range",
+        "0.3:0.7",
+        "--tripod",
+        "--jitter-samples",
+        "3",
+        "--offset-samples",
+        "3",
+        "--target",
+        "0.85",
+        "--depth",
+        "2",
+        "--check-parts",
+        "300",
+        "--json",
+    ]);
+    assert_eq!(v["stats"]["physics_samples"], 27);
+    assert!(
+        v["result"] == "found" || v["result"] == "none_up_to_depth",
+        "{}",
+        v["result"]
+    );
+    if v["result"] == "found" {
+        let toml = v["scenario"].as_str().unwrap();
+        assert!(toml.contains("support = \"tripod\"") && toml.contains("μc ∈ [0.3, 0.7]"));
+    }
+}
