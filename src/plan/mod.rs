@@ -41,6 +41,7 @@
 
 pub mod actions;
 pub mod check;
+pub mod contingent;
 pub mod emit;
 pub mod particles;
 pub mod problem;
