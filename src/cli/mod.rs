@@ -11,6 +11,7 @@ pub mod mc;
 pub mod merge;
 pub mod part;
 pub mod plan;
+pub mod plan_sensor;
 pub mod run;
 pub mod sense;
 pub mod stdout;

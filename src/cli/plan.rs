@@ -108,6 +108,15 @@ pub struct PlanArgs {
     /// Print one JSON document.
     #[arg(long)]
     pub json: bool,
+    /// Contingent plan with sensing: a sensor pin, then per-decision moving pins (a policy file).
+    #[arg(long)]
+    pub sensor: bool,
+    /// With --sensor: most moving pins after the sensor.
+    #[arg(long, default_value_t = 3)]
+    pub max_moving: usize,
+    /// With --sensor: sensor positions tried (the most robust pin intervals that touch every part).
+    #[arg(long, default_value_t = 6)]
+    pub sensor_candidates: usize,
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -162,7 +171,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
 }
 
 /// Quote a shell word if it needs it.
-fn shell_word(s: &str) -> String {
+pub(crate) fn shell_word(s: &str) -> String {
     let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
     if !s.is_empty() && s.chars().all(plain) {
         s.to_string()
@@ -273,6 +282,15 @@ pub fn command_line(args: &PlanArgs) -> String {
         d.contact_tol.to_string()
     );
     opt!("--seed", args.seed.to_string(), "1".into());
+    if args.sensor {
+        w.push("--sensor".into());
+        opt!("--max-moving", args.max_moving.to_string(), "3".into());
+        opt!(
+            "--sensor-candidates",
+            args.sensor_candidates.to_string(),
+            "6".into()
+        );
+    }
     w.join(" ")
 }
 
@@ -374,6 +392,9 @@ pub fn run(args: &PlanArgs) -> Result<()> {
         .num_threads(args.threads)
         .build()
         .context("starting the worker threads")?;
+    if args.sensor {
+        return super::plan_sensor::run(args, &problem, &command, &pool);
+    }
     let mut planner = Planner::new(&problem)?;
     let (outcome, stats) = pool.install(|| planner.search());
     let stable_count = planner.compiled.stable_deg.len();
@@ -520,7 +541,7 @@ pub fn run(args: &PlanArgs) -> Result<()> {
     Ok(())
 }
 
-fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
+pub(crate) fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
     let parts = [
         ("success", o.success),
         ("wrong_orientation", o.wrong_orientation),
@@ -538,7 +559,7 @@ fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
         .join(", ")
 }
 
-fn write_file(path: &Path, text: &str) -> Result<()> {
+pub(crate) fn write_file(path: &Path, text: &str) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

@@ -76,6 +76,27 @@ pub fn scenario_toml(
         "length = {}        # m: one spacing after the last pin\n\n",
         num(sp * (n as f64 + 1.0), 6)
     );
+    t += &part_feed_sections(problem, stable_count, parts);
+    for (k, step) in plan.steps.iter().enumerate() {
+        let Action::Pin(pin) = step.action;
+        t += &format!(
+            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{}\"\nx = {}\ny = {}\nradius = {}\n",
+            pin.margin_m * 1e3,
+            step.sets,
+            step.window.share,
+            k + 1,
+            num(sp * (k as f64 + 1.0), 6),
+            num(pin.y_m, 6),
+            num(problem.pin_radius_m, 6),
+        );
+    }
+    t += &goal_and_model(problem, plan.window.centre_deg, symmetry);
+    t
+}
+
+/// The `[part]`, `[feed]` and `[feed.lateral]` sections of a planned scenario.
+fn part_feed_sections(problem: &Problem, stable_count: usize, parts: u64) -> String {
+    let mut t = String::new();
     t += "[part]\n";
     if let Some(v) = problem.part.trim().strip_prefix("vertices:") {
         let pts = crate::geometry::named::parse_vertex_list(v).unwrap_or_default();
@@ -113,27 +134,16 @@ pub fn scenario_toml(
     } else {
         t += "\n[feed.lateral]\ndistribution = \"fixed\"\nvalue = 0.0\n";
     }
-    for (k, step) in plan.steps.iter().enumerate() {
-        let Action::Pin(pin) = step.action;
-        t += &format!(
-            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{}\"\nx = {}\ny = {}\nradius = {}\n",
-            pin.margin_m * 1e3,
-            step.sets,
-            step.window.share,
-            k + 1,
-            num(sp * (k as f64 + 1.0), 6),
-            num(pin.y_m, 6),
-            num(problem.pin_radius_m, 6),
-        );
-    }
+    t
+}
+
+/// The `[goal]` (the window centred at `centre_deg` ± tol, repeated over the part's symmetry),
+/// `[model]` and `[output]` sections.
+fn goal_and_model(problem: &Problem, centre_deg: f64, symmetry: u32) -> String {
+    let mut t = String::new();
     // A symmetric part: the orientations one symmetry period apart are the same pose.
     let goals: Vec<String> = (0..symmetry.max(1))
-        .map(|j| {
-            num(
-                plan.window.centre_deg + j as f64 * 360.0 / symmetry.max(1) as f64,
-                3,
-            )
-        })
+        .map(|j| num(centre_deg + j as f64 * 360.0 / symmetry.max(1) as f64, 3))
         .collect();
     t += &format!(
         "\n[goal]\n[[goal.sets]]\nname = \"planned\"\norientations = [{}]\ntolerance = {}\n",
@@ -142,4 +152,107 @@ pub fn scenario_toml(
     );
     t += "\n[model]\nfidelity = \"exact\"\ntol = 1e-6\n\n[output]\ndir = \"results\"\nhistogram_svg = false\nhistogram_bin = 1\n";
     t
+}
+
+/// The scenario and policy file of a contingent plan: (scenario TOML, policy TOML). `policy_file`
+/// is the policy's file name as the scenario refers to it (relative to the scenario).
+#[allow(clippy::too_many_arguments)]
+pub fn contingent_toml(
+    problem: &Problem,
+    plan: &super::contingent::ContingentPlan,
+    stable_count: usize,
+    symmetry: u32,
+    parts: u64,
+    command: &str,
+    file: &str,
+    policy_file: &str,
+) -> (String, String) {
+    let sp = problem.spacing_m;
+    let k = plan.k;
+    let half = problem.belt_width_m / 2.0;
+    let mut t = String::new();
+    let name = format!("plan_{}_sensing", crate::cli::part_folder(&problem.part));
+    t += &format!(
+        "# Written by `pinfeed plan --sensor` (contingent planner with sensing, issue 14):\n#\n#   {command}\n#\n"
+    );
+    t += &format!(
+        "# A force/torque sensor pin reads the stable state; {k} moving pin(s) then take, per part, the\n# lateral position the policy ({policy_file}) gives for the decision. The fewest moving pins for\n"
+    );
+    t += &format!(
+        "# its action set (BFS per branch over {} particle(s), θ rounded to {}°, y to {} mm, margins ≥ {} mm).\n",
+        plan.branches.iter().map(|b| b.total).sum::<u32>(),
+        problem.theta_quantum_deg,
+        problem.y_quantum_m * 1e3,
+        problem.min_margin_m * 1e3
+    );
+    t += &format!(
+        "# Predicted success {:.4} with a perfect classifier, within {}° ± {}°.\n#\n#   pinfeed run {file}\n\n",
+        plan.predicted_success,
+        num(plan.centre_deg, 2),
+        problem.tolerance_deg
+    );
+    t += &format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
+    t += "[belt]\nspeed = 0.05        # m/s\n";
+    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
+    t += &format!(
+        "length = {}        # m: one spacing after the last pin\n\n",
+        num(sp * (k as f64 + 2.0), 6)
+    );
+    t += &part_feed_sections(problem, stable_count, parts);
+    t += &format!(
+        "\n[[obstacles]]   # the sensor (margin {:.2} mm)\nkind = \"sensor_pin\"\nname = \"probe\"\nx = {}\ny = {}\nradius = {}\n",
+        plan.sensor.margin_m * 1e3,
+        num(sp, 6),
+        num(plan.sensor.y_m, 6),
+        num(problem.pin_radius_m, 6)
+    );
+    t += "\n[obstacles.sensor]\ntype = \"ft\"\nrate = 1000          # Hz\nheight = 0.02        # m\nclassifier = \"likelihood\"\ntemplates = 32       # per stable state\n";
+    let mut rules = String::new();
+    rules += &format!(
+        "# Policy of {file} (written by `pinfeed plan --sensor`): per decision of the sensor pin\n# `probe`, the lateral position of each moving pin.\n\npart = \"{}\"\n",
+        problem.part.trim()
+    );
+    for j in 0..k {
+        let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j]).collect();
+        let x = num(sp * (j as f64 + 2.0), 6);
+        let pname = format!("mover{}", j + 1);
+        if ys.iter().all(|&y| (y - ys[0]).abs() < 1e-12) {
+            // Every branch wants the same position: a fixed pin.
+            t += &format!(
+                "\n[[obstacles]]   # the same position for every decision\nkind = \"pin\"\nname = \"pin{}\"\nx = {x}\ny = {}\nradius = {}\n",
+                j + 2,
+                num(ys[0], 6),
+                num(problem.pin_radius_m, 6)
+            );
+            continue;
+        }
+        let lo = ys.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let lo = (lo - 0.001).max(-half);
+        let hi = (hi + 0.001).min(half);
+        t += &format!(
+            "\n[[obstacles]]\nkind = \"moving_pin\"\nname = \"{pname}\"\nx = {x}\ny = {}            # home (m)\nradius = {}\ntravel = [{}, {}]   # m\nspeed = 0.1          # m/s\naccel = 1.0          # m/s²\nsettle = 0.05        # s\n",
+            num(ys[0], 6),
+            num(problem.pin_radius_m, 6),
+            num(lo, 6),
+            num(hi, 6)
+        );
+        for b in &plan.branches {
+            let used = j < b.pins.len();
+            rules +=
+                &format!(
+                "\n[[rules]]{}\nsensor = \"probe\"\ndecides = \"{}\"\npin = \"{pname}\"\ny = {}\n",
+                if used { "" } else { "   # parked: touches none of this branch's parts" },
+                b.label,
+                num(b.targets_m[j], 6)
+            );
+        }
+    }
+    if rules.contains("[[rules]]") {
+        t += &format!(
+            "\n[controller]\nlatency = 0.02       # s, from the end of a reading to the command\non_late = \"skip\"\npolicy = \"{policy_file}\"\n"
+        );
+    }
+    t += &goal_and_model(problem, plan.centre_deg, symmetry);
+    (t, rules)
 }

@@ -17,7 +17,9 @@
 //!   middle) per interval with its robustness margin ([`Action`] is an enum a fence or a sensing
 //!   branch can join later);
 //! * [`search`]: breadth-first search with deduplication, limits and statistics;
-//! * [`emit`]: the plan as a runnable scenario TOML;
+//! * [`contingent`]: the contingent planner with sensing (a sensor pin, then per-decision moving
+//!   pins; AND-OR over the branches, which must share one goal window);
+//! * [`emit`]: the plan as a runnable scenario TOML (and a contingent plan's policy file);
 //! * [`check`]: the plan run through the line ([`crate::engine::run`]).
 //!
 //! ## What "shortest" means here
@@ -41,6 +43,7 @@
 
 pub mod actions;
 pub mod check;
+pub mod contingent;
 pub mod emit;
 pub mod particles;
 pub mod problem;

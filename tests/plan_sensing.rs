@@ -1,0 +1,109 @@
+//! `pinfeed plan --sensor` (issue 14 part 2, the contingent planner): tripoly1 gets a sensor pin
+//! and per-decision moving pins whose scenario and policy file `pinfeed run` executes unchanged
+//! and that orient ≥ 95% on the line; the policy names the part; plans are deterministic for a
+//! seed.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn pinfeed(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(args)
+        .output()
+        .expect("run pinfeed")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pinfeed_plan_sensing_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn plan(out: &str) -> Value {
+    let o = pinfeed(&[
+        "plan",
+        "--part",
+        "tripoly1",
+        "--sensor",
+        "--out",
+        out,
+        "--check-parts",
+        "500",
+        "--json",
+    ]);
+    assert!(
+        o.status.success(),
+        "plan failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_slice(&o.stdout).expect("stdout is JSON")
+}
+
+#[test]
+fn tripoly1_sensing_plan_runs_and_orients() {
+    let out = tmp("t1.toml");
+    let v = plan(out.to_str().unwrap());
+    assert_eq!(v["result"], "found");
+    let k = v["plan"]["k"].as_u64().unwrap();
+    assert!((1..=3).contains(&k), "{k} moving pins");
+    assert_eq!(v["plan"]["branches"].as_array().unwrap().len(), 3);
+    assert!(v["plan"]["predicted_success"].as_f64().unwrap() >= 0.99);
+    let rate = v["check"]["success_rate"].as_f64().unwrap();
+    assert!(rate >= 0.95, "line success {rate}");
+    assert!(v["predicted_with_confusion"].as_f64().is_some());
+    // The scenario and its policy file.
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("kind = \"sensor_pin\""), "{text}");
+    assert!(text.contains("policy = \"t1.policy.toml\""), "{text}");
+    let pol_path = out.with_file_name("t1.policy.toml");
+    let pol: toml::Value = toml::from_str(&std::fs::read_to_string(&pol_path).unwrap()).unwrap();
+    assert_eq!(pol["part"].as_str(), Some("tripoly1"));
+    let rules = pol["rules"].as_array().unwrap();
+    assert!(!rules.is_empty());
+    for r in rules {
+        let d = r["decides"].as_str().unwrap();
+        assert!(["0°", "135°", "225°"].contains(&d), "{d}");
+    }
+    // `pinfeed run` executes it unchanged.
+    let o = pinfeed(&["run", out.to_str().unwrap(), "--parts", "300", "--json"]);
+    assert!(
+        o.status.success(),
+        "run failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let s: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rate = s["success_rate"].as_f64().unwrap();
+    assert!(rate >= 0.95, "run success {rate}");
+}
+
+#[test]
+fn sensing_plans_are_deterministic() {
+    let a = plan(tmp("a.toml").to_str().unwrap());
+    let b = plan(tmp("b.toml").to_str().unwrap());
+    assert_eq!(a["plan"], b["plan"]);
+    assert_eq!(
+        a["policy"]
+            .as_str()
+            .unwrap()
+            .lines()
+            .skip(2)
+            .collect::<Vec<_>>(),
+        b["policy"]
+            .as_str()
+            .unwrap()
+            .lines()
+            .skip(2)
+            .collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn sensing_needs_a_stable_feed() {
+    let o = pinfeed(&[
+        "plan", "--part", "tripoly1", "--sensor", "--feed", "uniform",
+    ]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("--feed"), "{e}");
+}
