@@ -27,6 +27,7 @@ use super::fence::{first_touch, FenceGeom, FenceSpec, FenceTouch};
 use super::instant::{
     classify, push_margin, solve_in_mode, ContactGeom, Friction, Instant, Mode, Warm,
 };
+use super::ode::{self, dense, illinois, NonFinite, Step};
 use super::outcome::{
     ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
@@ -536,55 +537,11 @@ impl Ctx<'_, '_> {
     }
 }
 
-// Dormand–Prince 5(4) tableau.
-const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
-const A: [[f64; 6]; 7] = [
-    [0.0; 6],
-    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [
-        19372.0 / 6561.0,
-        -25360.0 / 2187.0,
-        64448.0 / 6561.0,
-        -212.0 / 729.0,
-        0.0,
-        0.0,
-    ],
-    [
-        9017.0 / 3168.0,
-        -355.0 / 33.0,
-        46732.0 / 5247.0,
-        49.0 / 176.0,
-        -5103.0 / 18656.0,
-        0.0,
-    ],
-    [
-        35.0 / 384.0,
-        0.0,
-        500.0 / 1113.0,
-        125.0 / 192.0,
-        -2187.0 / 6784.0,
-        11.0 / 84.0,
-    ],
-];
-const E: [f64; 7] = [
-    71.0 / 57600.0,
-    0.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-];
-
+/// A Dormand–Prince step of a contact: the scheme's step and what the contact adds to it.
 struct StepResult {
-    y1: [f64; 2],
-    f1: [f64; 2],
+    dp: Step<2>,
+    /// The instant at the end of the step.
     inst1: Instant,
-    err: f64,
-    /// The seven stage derivatives (for the dense output).
-    k: [[f64; 2]; 7],
     /// The first interior stage (as a fraction of the step) at which the mode's own margins were
     /// clearly violated: a mode switch that comes and goes inside the step.
     margin_dip: Option<f64>,
@@ -618,7 +575,7 @@ fn geometric_dip(
         return None;
     }
     (1..8).map(|k| k as f64 / 8.0).find(|&t| {
-        let yt = dense(y0, step.y1, &step.k, h, t);
+        let yt = step.dp.dense(y0, h, t);
         let g = ctx.geom(feat, yt);
         let dips = near
             && ctx
@@ -640,7 +597,8 @@ enum Trial {
     Invalid,
 }
 
-/// One Dormand–Prince step of size h from (y0, f0).
+/// One Dormand–Prince step of size h from (y0, f0) on `feat` in `mode`, watching the mode's
+/// margins at the interior stages.
 fn dp_step(
     ctx: &mut Ctx,
     feat: Feat,
@@ -649,115 +607,37 @@ fn dp_step(
     f0: [f64; 2],
     h: f64,
 ) -> Result<StepResult, SolveFailure> {
-    let mut k = [[0.0f64; 2]; 7];
-    k[0] = f0;
     let mut inst_last = None;
     let mut margin_dip = None;
-    for i in 1..7 {
-        let mut yi = y0;
-        for (j, kj) in k.iter().enumerate().take(i) {
-            let a = A[i][j];
-            if a != 0.0 {
-                yi[0] += h * a * kj[0];
-                yi[1] += h * a * kj[1];
+    let tol = ctx.tol;
+    let dp = ode::dp_step(
+        |c, yi| {
+            let (d, inst) = ctx.rhs(feat, mode, yi)?;
+            let broken = inst.margins[0] + ctx.band[1] < -MARGIN_DIP
+                || inst.margins[1] + ctx.band[2] < -MARGIN_DIP;
+            // Interior stages only (C < 1; stages 5 and 6 sit at the step's end).
+            if c < 1.0 && broken && margin_dip.is_none() {
+                margin_dip = Some(c);
             }
-        }
-        let (d, inst) = ctx.rhs(feat, mode, yi)?;
-        k[i] = d;
-        let broken = inst.margins[0] + ctx.band[1] < -MARGIN_DIP
-            || inst.margins[1] + ctx.band[2] < -MARGIN_DIP;
-        // Interior stages only (C < 1; stages 5 and 6 sit at the step's end).
-        if C[i] < 1.0 && broken && margin_dip.is_none() {
-            margin_dip = Some(C[i]);
-        }
-        inst_last = Some(inst);
-    }
-    // Stage 7 is evaluated at y1 (FSAL).
-    let mut y1 = y0;
-    for (j, kj) in k.iter().enumerate().take(6) {
-        y1[0] += h * A[6][j] * kj[0];
-        y1[1] += h * A[6][j] * kj[1];
-    }
-    let mut err: f64 = 0.0;
-    for c in 0..2 {
-        let mut e = 0.0;
-        for (j, kj) in k.iter().enumerate() {
-            e += E[j] * kj[c];
-        }
-        err = err.max((h * e).abs() / ctx.tol);
-    }
-    if !(y1[0].is_finite() && y1[1].is_finite() && err.is_finite()) {
-        return Err(SolveFailure::NonFinite);
-    }
+            inst_last = Some(inst);
+            Ok::<_, SolveFailure>(d)
+        },
+        y0,
+        f0,
+        h,
+        tol,
+    )?;
     Ok(StepResult {
-        y1,
-        f1: k[6],
+        dp,
         inst1: inst_last.expect("six stages ran"),
-        err,
-        k,
         margin_dip,
     })
 }
 
-// Dormand–Prince continuous extension (Hairer, Nørsett & Wanner, dopri5 `contd5`): 4th order.
-const D: [f64; 7] = [
-    -12715105075.0 / 11282082432.0,
-    0.0,
-    87487479700.0 / 32700410799.0,
-    -10690763975.0 / 1880347072.0,
-    701980252875.0 / 199316789632.0,
-    -1453857185.0 / 822651844.0,
-    69997945.0 / 29380423.0,
-];
-
-/// State at fraction `t` ∈ [0, 1] of a step of size `h` from `y0` that ended at `y1` with stages `k`.
-fn dense(y0: [f64; 2], y1: [f64; 2], k: &[[f64; 2]; 7], h: f64, t: f64) -> [f64; 2] {
-    let mut out = [0.0; 2];
-    for c in 0..2 {
-        let ydiff = y1[c] - y0[c];
-        let bspl = h * k[0][c] - ydiff;
-        let r4 = ydiff - h * k[6][c] - bspl;
-        let mut r5 = 0.0;
-        for (j, kj) in k.iter().enumerate() {
-            r5 += D[j] * kj[c];
-        }
-        r5 *= h;
-        out[c] = y0[c] + t * (ydiff + (1.0 - t) * (bspl + t * (r4 + (1.0 - t) * r5)));
+impl From<NonFinite> for SolveFailure {
+    fn from(_: NonFinite) -> SolveFailure {
+        SolveFailure::NonFinite
     }
-    out
-}
-
-/// Illinois root of g on [0, 1] with g(0) = ga > 0 ≥ g(1) = gb.
-fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64, tol: f64) -> f64 {
-    let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, ga, gb);
-    let mut side = 0;
-    let mut c = 1.0;
-    for _ in 0..80 {
-        c = (a * fb - b * fa) / (fb - fa);
-        if !c.is_finite() || c <= a || c >= b {
-            c = 0.5 * (a + b);
-        }
-        let fc = g(c);
-        if fc.abs() <= tol || b - a <= 1e-12 {
-            break;
-        }
-        if fc < 0.0 {
-            b = c;
-            fb = fc;
-            if side == -1 {
-                fa *= 0.5;
-            }
-            side = -1;
-        } else {
-            a = c;
-            fa = fc;
-            if side == 1 {
-                fb *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    c
 }
 
 /// The state after a point pin's instantaneous sweep round convex vertex `k`: onto the incoming edge
@@ -1107,12 +987,12 @@ fn integrate_contact(
                     continue;
                 }
             };
-            let guarded = !step_change_ok(feat, y, step.y1);
-            if step.err > 1.0 || guarded {
+            let guarded = !step_change_ok(feat, y, step.dp.y1);
+            if step.dp.err > 1.0 || guarded {
                 h *= if guarded {
                     0.25
                 } else {
-                    (0.9 * step.err.powf(-0.2)).max(0.2)
+                    (0.9 * step.dp.err.powf(-0.2)).max(0.2)
                 };
                 if h < h_min {
                     let p = ctx.pose(s, feat, y);
@@ -1124,7 +1004,7 @@ fn integrate_contact(
                 }
                 continue;
             }
-            let ev1 = ctx.events(feat, step.y1, &step.inst1);
+            let ev1 = ctx.events(feat, step.dp.y1, &step.inst1);
             let mode_dip = step.margin_dip.filter(|_| ev1[1] >= 0.0 && ev1[2] >= 0.0);
             if let Some(t_dip) = geometric_dip(ctx, feat, s, y, &step, h, &ev1, slack).or(mode_dip)
             {
@@ -1140,7 +1020,7 @@ fn integrate_contact(
             let crossed: Vec<usize> = (0..N_EVENTS)
                 .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -slack)
                 .collect();
-            let factor = (0.9 * step.err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
+            let factor = (0.9 * step.dp.err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
             if crossed.is_empty() {
                 // A bounced margin that has recovered gets its ordinary zero threshold back.
                 for (b, e) in ctx.band.iter_mut().zip(ev1) {
@@ -1148,11 +1028,11 @@ fn integrate_contact(
                         *b = 0.0;
                     }
                 }
-                segs.ride(ctx, feat, step.f1[0].abs().max(f0[0].abs()), h);
+                segs.ride(ctx, feat, step.dp.f1()[0].abs().max(f0[0].abs()), h);
                 s = if clipped { ctx.turn_at() } else { s + h };
-                y = step.y1;
+                y = step.dp.y1;
                 inst = step.inst1;
-                f0 = step.f1;
+                f0 = step.dp.f1();
                 ev0 = ev1;
                 segs.steps += 1;
                 ctx.record(s, feat, y, &inst);
@@ -1168,7 +1048,7 @@ fn integrate_contact(
                 continue;
             }
             // Locate the earliest crossing on the interpolant.
-            let (y0c, y1c, kc, hc) = (y, step.y1, step.k, h);
+            let (y0c, y1c, kc, hc) = (y, step.dp.y1, step.dp.k, h);
             let mut best = (2.0, 0usize);
             let warm_saved = ctx.warm;
             let root_tol = 1e-3 * ctx.tol;
@@ -1176,36 +1056,32 @@ fn integrate_contact(
             let band = ctx.band;
             for &i in &crossed {
                 let g0 = ev0[i].max(0.0);
-                let t = if g0 == 0.0 {
-                    0.0
-                } else {
-                    illinois(
-                        |t| {
-                            let yt = dense(y0c, y1c, &kc, hc, t);
-                            if i == 0 || i >= 3 {
-                                let dummy = inst;
-                                ctx.events(feat, yt, &dummy)[i]
-                            } else {
-                                let g = ctx.geom(feat, yt);
-                                match solve_in_mode(
-                                    ctx.model,
-                                    ctx.fid,
-                                    &g,
-                                    ctx.fr,
-                                    mode,
-                                    &mut ctx.warm,
-                                    &mut ctx.evals,
-                                ) {
-                                    Ok(it) => it.margins[i - 1] + band[i],
-                                    Err(_) => -1.0,
-                                }
+                let t = illinois(
+                    |t| {
+                        let yt = dense(y0c, y1c, &kc, hc, t);
+                        if i == 0 || i >= 3 {
+                            let dummy = inst;
+                            ctx.events(feat, yt, &dummy)[i]
+                        } else {
+                            let g = ctx.geom(feat, yt);
+                            match solve_in_mode(
+                                ctx.model,
+                                ctx.fid,
+                                &g,
+                                ctx.fr,
+                                mode,
+                                &mut ctx.warm,
+                                &mut ctx.evals,
+                            ) {
+                                Ok(it) => it.margins[i - 1] + band[i],
+                                Err(_) => -1.0,
                             }
-                        },
-                        g0,
-                        ev1[i],
-                        root_tol,
-                    )
-                };
+                        }
+                    },
+                    g0,
+                    ev1[i],
+                    root_tol,
+                );
                 if t < best.0 {
                     best = (t, i);
                 }
@@ -1216,7 +1092,8 @@ fn integrate_contact(
             // accurate to about tol; 1e3·tol leaves room for a mode boundary inside the step).
             let near_dense = |r: &StepResult, t: f64| {
                 let yd = dense(y0c, y1c, &kc, hc, t);
-                (r.y1[0] - yd[0]).abs() <= 1e3 * ctx_tol && (r.y1[1] - yd[1]).abs() <= 1e3 * ctx_tol
+                (r.dp.y1[0] - yd[0]).abs() <= 1e3 * ctx_tol
+                    && (r.dp.y1[1] - yd[1]).abs() <= 1e3 * ctx_tol
             };
             // Refine on real steps: g(t) = event i after a Dormand–Prince step of t·h from (s, y).
             // A trial step counts only if it is itself accurate (its own error estimate within 10×
@@ -1229,8 +1106,8 @@ fn integrate_contact(
                     return Trial::Start;
                 }
                 match dp_step(ctx, feat, mode, y, f0, t * h) {
-                    Ok(r) if step_change_ok(feat, y, r.y1) && near_dense(&r, t) => {
-                        let ev = ctx.events(feat, r.y1, &r.inst1);
+                    Ok(r) if step_change_ok(feat, y, r.dp.y1) && near_dense(&r, t) => {
+                        let ev = ctx.events(feat, r.dp.y1, &r.inst1);
                         if [0, 3, 4, 5, 6].iter().all(|&j| j == i || ev[j] >= -slack) {
                             Trial::Step(Box::new(r), ev[i])
                         } else {
@@ -1298,8 +1175,8 @@ fn integrate_contact(
             let (s_land, y_land, inst_land) = match landing {
                 Trial::Step(r, _) => {
                     segs.steps += 1;
-                    segs.ride(ctx, feat, r.f1[0].abs().max(f0[0].abs()), best_t * h);
-                    (s + best_t * h, r.y1, r.inst1)
+                    segs.ride(ctx, feat, r.dp.f1()[0].abs().max(f0[0].abs()), best_t * h);
+                    (s + best_t * h, r.dp.y1, r.inst1)
                 }
                 _ => (s, y, inst),
             };

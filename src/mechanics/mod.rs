@@ -6,6 +6,7 @@
 //!   sub-problems, at three fidelity levels (`tip`, `ellipsoid`, `exact`).
 //! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
 //! * [`integrate`]: one pin pass, integrated in pin travel with error control and event location.
+//! * `ode`: the Dormand–Prince 5(4) step, its dense output and the Illinois root finder.
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
 //! * [`pin_path`]: a moving pin's lateral speed profile over a pass (SPEC §5).
 //! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
@@ -18,6 +19,7 @@ pub mod fence;
 pub mod instant;
 pub mod integrate;
 pub mod limit_surface;
+mod ode;
 pub mod outcome;
 pub mod part_model;
 pub mod pin_path;
