@@ -12,7 +12,10 @@
 //! After separation the pin's path is cast again, so a concave part can be struck more than once.
 
 use super::contact_state::{initial_state, second_contact, Ctx, Feat, N_EVENTS, TURN};
-use super::fence::{first_touch, FenceGeom, FenceSpec, FenceTouch};
+use super::fence::{
+    edge_turns_flush, fence_vertex_event, first_touch, flush_pivot, next_fence_touch, settle_flush,
+    FenceGeom, FenceSpec, Flush,
+};
 use super::instant::{classify, push_margin, solve_in_mode, ContactGeom, Instant, Mode};
 use super::ode::{self, dense, illinois, NonFinite, Step};
 use super::outcome::{ContactOutcome, ContactStatus, Recorder, Segment};
@@ -54,97 +57,6 @@ fn max_step(feat: Feat) -> f64 {
     match feat {
         Feat::FenceEdge(_) => f64::INFINITY,
         _ => 2.0,
-    }
-}
-
-impl Ctx<'_, '_> {
-    /// The flush edge k's supported interval and the point where the force line through the
-    /// centroid meets the fence, all as fence coordinates relative to hull vertex k:
-    /// (lo, hi, where the force line meets the fence).
-    pub(super) fn flush_interval(&self, k: usize, y: [f64; 2], force_dir: Vec2) -> (f64, f64, f64) {
-        let f = self.fence_geom();
-        let vk = self.poly.vertex(k).rotate(y[0]);
-        let other = (self.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
-        let lo = other.min(0.0).max(-y[1]);
-        let hi = other.max(0.0).min(f.len - y[1]);
-        // Centroid relative to vertex k is −vk; the line c + λ·dir meets the fence line (through
-        // vertex k, normal n) at λ = vk·n / (dir·n).
-        let lambda = vk.dot(f.n) / force_dir.dot(f.n);
-        let meet = (-vk + force_dir * lambda).dot(f.e);
-        (lo, hi, meet)
-    }
-
-    /// A flush edge translates (SPEC §6): sliding with the force on a friction-cone edge, or, in
-    /// `Stick` mode, jammed (moving with the fence). The force passes through the centroid; the
-    /// margins say how far inside the supported interval it meets the fence.
-    pub(super) fn flush_instant(&self, k: usize, y: [f64; 2], mode: Mode) -> Instant {
-        let f = self.fence_geom();
-        let (dir, v_world) = match mode {
-            Mode::SlideLeft | Mode::SlideRight | Mode::Slide => {
-                let dir = match mode {
-                    Mode::SlideLeft => self.fr.left_edge(f.n),
-                    Mode::SlideRight => self.fr.right_edge(f.n),
-                    _ => f.n,
-                };
-                (dir, dir * (f.n.dot(self.vdir) / f.n.dot(dir)))
-            }
-            Mode::Stick => (self.vdir.normalized(), self.vdir),
-        };
-        let (lo, hi, meet) = self.flush_interval(k, y, dir);
-        let v = v_world.rotate(-y[0]);
-        Instant {
-            mode,
-            twist: [v.x, v.y, 0.0],
-            force: dir.rotate(-y[0]),
-            margins: [meet - lo, hi - meet],
-        }
-    }
-
-    /// The hull edge adjacent to vertex k that is flush to rounding (its other end within 1e-9 a of
-    /// the fence line), if any.
-    pub(super) fn flush_neighbour(&self, k: usize, y: [f64; 2]) -> Option<usize> {
-        let f = self.fence_geom();
-        let m = self.poly.len();
-        let v = self.poly.vertex(k);
-        let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
-        if dist(k + m - 1).abs() <= 1e-9 {
-            Some((k + m - 1) % m)
-        } else if dist(k + 1).abs() <= 1e-9 {
-            Some(k)
-        } else {
-            None
-        }
-    }
-
-    /// The orientation nearest `theta` at which hull edge k lies exactly flush on the fence (its
-    /// outward normal against the fence normal). Flush is a geometric fact at the event that finds
-    /// it; snapping removes the event's landing error (≤ 1e-2·tol).
-    pub(super) fn flush_angle(&self, k: usize, theta: f64) -> f64 {
-        let f = self.fence_geom();
-        let out = -self.poly.inward_normal(k);
-        let target = (-f.n).angle() - out.angle();
-        theta + crate::geometry::wrap_pi(target - theta)
-    }
-
-    /// The consistent translation mode of a flush edge: slide towards the side the belt's motion
-    /// leaves the friction cone on, or `Stick` (a jam) when it lies inside the cone (inclusive:
-    /// α + atan μf ≥ 90° jams).
-    pub(super) fn flush_mode(&self) -> Mode {
-        let f = self.fence_geom();
-        if self.fr.mu_c == 0.0 {
-            return Mode::Slide;
-        }
-        let (fl, fr) = (self.fr.left_edge(f.n), self.fr.right_edge(f.n));
-        // The cone boundary itself jams (α + atan μf = 90° exactly); 1e-12 absorbs the rounding
-        // of the angles so that the condition holds at exactly the predicted angle.
-        let v = self.vdir.normalized();
-        if fl.cross(v) > 1e-12 {
-            Mode::SlideLeft
-        } else if fr.cross(v) < -1e-12 {
-            Mode::SlideRight
-        } else {
-            Mode::Stick
-        }
     }
 }
 
@@ -282,23 +194,15 @@ enum Settle {
 fn settle(ctx: &mut Ctx, s: f64, mut feat: Feat, mut y: [f64; 2]) -> Settle {
     for _ in 0..6 {
         if let Feat::FenceEdge(k) = feat {
-            let mode = ctx.flush_mode();
-            let inst = ctx.flush_instant(k, y, mode);
-            // The supported interval is closed (the force may act at an end vertex): rounding-level
-            // negatives count as inside.
-            let (m0, m1) = (inst.margins[0] + ctx.band[1], inst.margins[1] + ctx.band[2]);
-            if m0 < -1e-12 || m1 < -1e-12 {
-                // The force line misses the supported interval: pivot about the nearer end.
-                ctx.band = [0.0; N_EVENTS];
-                let (f, yy) = flush_pivot(ctx, k, y, m1 < m0);
-                feat = f;
-                y = yy;
-                continue;
+            match settle_flush(ctx, k, y) {
+                Flush::Translate(inst) => return Settle::Go(feat, y, inst),
+                Flush::Pivot(f, yy) => {
+                    feat = f;
+                    y = yy;
+                    continue;
+                }
+                Flush::Jam => return Settle::Stop(ContactStatus::Jam { s: s * ctx.scale }),
             }
-            if mode == Mode::Stick {
-                return Settle::Stop(ContactStatus::Jam { s: s * ctx.scale });
-            }
-            return Settle::Go(feat, y, inst);
         }
         let g = ctx.geom(feat, y);
         let inst = match classify(
@@ -339,26 +243,6 @@ fn settle(ctx: &mut Ctx, s: f64, mut feat: Feat, mut y: [f64; 2]) -> Settle {
         }
     }
     Settle::Stop(ContactStatus::EventLimit { events: 6 })
-}
-
-/// A flush edge whose force line leaves its supported interval pivots about that end: a hull vertex
-/// (vertex on the fence line) or the fence's own end (which then acts as a point pin on the edge).
-fn flush_pivot(ctx: &mut Ctx, k: usize, y: [f64; 2], hi_end: bool) -> (Feat, [f64; 2]) {
-    let f = *ctx.fence_geom();
-    let m = ctx.poly.len();
-    let vk = ctx.poly.vertex(k).rotate(y[0]);
-    let other = (ctx.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
-    let (lo, hi, _) = ctx.flush_interval(k, y, f.n);
-    let end = if hi_end { hi } else { lo };
-    if end == 0.0 {
-        (Feat::FenceVertex(k), y)
-    } else if end == other {
-        (Feat::FenceVertex((k + 1) % m), [y[0], y[1] + other])
-    } else {
-        // A fence end inside the edge: that end pushes the edge like a point pin.
-        ctx.start = if end <= -y[1] + 1e-12 { f.p0 } else { f.p1() };
-        (Feat::Edge(k), [y[0], end.abs()])
-    }
 }
 
 /// Book-keeping of one pass: segments, events and steps so far.
@@ -803,12 +687,8 @@ fn integrate_contact(
                 // The mode changes just as an adjacent edge turns flush (the two events coincide,
                 // e.g. at exactly the jam angle): the edge's arrival decides.
                 let j = ctx.flush_neighbour(k, y).expect("checked by the guard");
-                let f = *ctx.fence_geom();
-                let th = ctx.flush_angle(j, y[0]);
-                let d = (ctx.poly.vertex(j) - ctx.poly.vertex(k))
-                    .rotate(th)
-                    .dot(f.e);
-                Some((Feat::FenceEdge(j), [th, y[1] + d], None))
+                let (f, yy) = edge_turns_flush(ctx, j, k, y);
+                Some((f, yy, None))
             }
             (1 | 2, _) => {
                 let new_mode = match (mode, i) {
@@ -861,24 +741,9 @@ fn integrate_contact(
                 Some((Feat::Edge(e), [y[0], (b - a).norm()], None))
             }
             (4, Feat::Vertex(k)) => Some((Feat::Edge(k), [y[0], 0.0], None)),
-            (3, Feat::FenceVertex(k)) => {
-                // The edge before vertex k turns flush: its start vertex k−1 reached the line.
-                let f = *ctx.fence_geom();
-                let j = (k + m - 1) % m;
-                let th = ctx.flush_angle(j, y[0]);
-                let d = (ctx.poly.vertex(j) - ctx.poly.vertex(k))
-                    .rotate(th)
-                    .dot(f.e);
-                Some((Feat::FenceEdge(j), [th, y[1] + d], None))
-            }
-            (4, Feat::FenceVertex(k)) => {
-                Some((Feat::FenceEdge(k), [ctx.flush_angle(k, y[0]), y[1]], None))
-            }
-            (5 | 6, Feat::FenceVertex(k)) => {
-                // The vertex slides off a fence end; that end now acts as a point pin on the part.
-                let f = *ctx.fence_geom();
-                ctx.start = if i == 5 { f.p0 } else { f.p1() };
-                Some((Feat::Vertex(k), [y[0], f.n.rotate(-y[0]).angle()], None))
+            (3..=6, Feat::FenceVertex(k)) => {
+                let (f, yy) = fence_vertex_event(ctx, i, k, y);
+                Some((f, yy, None))
             }
             _ => unreachable!("event index out of range"),
         };
@@ -961,20 +826,9 @@ fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touc
     let k = ctx.scale;
     if let Some(f) = ctx.fence {
         let s_from = if after_separation { s + 1e-9 } else { s };
-        return match first_touch(ctx.poly, cur, &f, ctx.vdir, s_from) {
+        return match next_fence_touch(ctx, &f, cur, s_from) {
             None => Touch::None,
-            Some((t, FenceTouch::LineVertex { k, sigma })) => {
-                Touch::At(t, Feat::FenceVertex(k), [cur.theta, sigma])
-            }
-            Some((t, FenceTouch::LineEdge { k, sigma })) => {
-                Touch::At(t, Feat::FenceEdge(k), [cur.theta, sigma])
-            }
-            Some((t, FenceTouch::End { end, feature })) => {
-                ctx.start = if end == 0 { f.p0 } else { f.p1() };
-                let n = ctx.vdir.normalized();
-                let (feat, y) = initial_state(ctx, cur, feature, n);
-                Touch::At(t, feat, y)
-            }
+            Some((t, feat, y)) => Touch::At(t, feat, y),
         };
     }
     let mut s = s;
