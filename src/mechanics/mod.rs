@@ -9,6 +9,8 @@
 //! * `contact_state`: the state of one contact (feature, reduced coordinates, pose, rates, events).
 //! * `ode`: the Dormand–Prince 5(4) step, its dense output and the Illinois root finder.
 //! * `settings`: the pin and the [`ContactSettings`].
+//! * `pass`: the pass loop — cast the obstacle's path, integrate each contact, cast again — and
+//!   the entry points [`push`], [`push_path`], [`push_fence`].
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
 //! * [`pin_path`]: a moving pin's lateral speed profile over a pass (SPEC §5).
 //! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
@@ -25,19 +27,18 @@ pub mod limit_surface;
 mod ode;
 pub mod outcome;
 pub mod part_model;
+mod pass;
 pub mod pin_path;
 mod settings;
 pub mod vote;
 
 pub use fence::FenceSpec;
 pub use instant::Mode;
-pub use integrate::{
-    fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path,
-};
 pub use outcome::{
     ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
+pub use pass::{fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path};
 pub use pin_path::{PinPath, Turn};
 pub use settings::{ContactSettings, Pin};
 pub use vote::mason_vote;
