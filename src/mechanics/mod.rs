@@ -5,7 +5,9 @@
 //! * [`part_model`]: the compiled part (normalised geometry + support) and the two convex
 //!   sub-problems, at three fidelity levels (`tip`, `ellipsoid`, `exact`).
 //! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
-//! * [`integrate`]: one pin pass, integrated in pin travel with error control and event location.
+//! * [`integrate`]: one contact, integrated in pin travel with error control and event location:
+//!   `contact_step` (one step of a contact), `event_locate` (finding and landing on the earliest
+//!   event in a step) and `event_apply` (what each event does).
 //! * `contact_state`: the state of one contact (feature, reduced coordinates, pose, rates, events).
 //! * `ode`: the Dormand–Prince 5(4) step, its dense output and the Illinois root finder.
 //! * `settings`: the pin and the [`ContactSettings`].
@@ -20,6 +22,9 @@
 //! → [`ContactOutcome`].
 
 mod contact_state;
+mod contact_step;
+mod event_apply;
+mod event_locate;
 pub mod fence;
 pub mod instant;
 pub mod integrate;

@@ -441,9 +441,12 @@ mod tests {
         (t, n)
     }
 
+    /// A named function with its root on [0, 1].
+    type RootCase = (&'static str, fn(f64) -> f64, f64);
+
     #[test]
     fn illinois_finds_known_roots_in_few_evaluations() {
-        let cases: [(&str, fn(f64) -> f64, f64); 5] = [
+        let cases: [RootCase; 5] = [
             ("linear", |t| 0.7 - t, 0.7),
             ("cosine", |t| (std::f64::consts::PI * t).cos(), 0.5),
             ("exponential", |t| (-3.0 * t).exp() - 0.2, 5f64.ln() / 3.0),
