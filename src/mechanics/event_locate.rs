@@ -12,44 +12,14 @@
 use super::contact_state::{second_contact, Ctx, Feat, N_EVENTS};
 use super::contact_step::{dp_step, step_change_ok, Cursor, StepResult};
 use super::instant::{push_margin, solve_in_mode};
-use super::ode::illinois;
-
-/// The geometric event functions (edge ends, normal cone, fence ends) depend on the state alone,
-/// so the dense output shows, without solving anything, an event that comes and goes inside one
-/// step — which the end-point signs miss; likewise a disc pin's brief second touch on a concave
-/// part. Returns the first of eight interior fractions of the step at which an event positive at
-/// both ends dips below −slack, or the pin overlaps another edge.
-fn geometric_dip(
-    ctx: &Ctx,
-    at: &Cursor,
-    step: &StepResult,
-    h: f64,
-    ev1: &[f64; N_EVENTS],
-) -> Option<f64> {
-    let (feat, s, y0, slack) = (at.feat, at.s, at.y, at.slack);
-    // Nothing to miss unless an event not yet crossed ends the step near zero (the guard keeps a
-    // step's change of the contact coordinate below 0.5) or a disc could touch a second edge.
-    let near = (3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j]));
-    let second = !ctx.poly.is_convex() && ctx.rho > 0.0 && ctx.fence.is_none();
-    if !near && !second {
-        return None;
-    }
-    (1..8).map(|k| k as f64 / 8.0).find(|&t| {
-        let yt = step.dp.dense(y0, h, t);
-        let g = ctx.geom(feat, yt);
-        let dips = near
-            && ctx
-                .feature_events(feat, yt, &g)
-                .iter()
-                .zip(&ev1[3..])
-                .any(|(&e, &e1)| e1 >= 0.0 && e < -slack);
-        dips || (second && second_contact(ctx, feat, &ctx.pose(s + t * h, feat, yt), s + t * h))
-    })
-}
+use super::ode::{illinois, Bracket};
 
 /// The first fraction of the step `step` of size `h` from `at` (event functions `ev1` at its end)
-/// at which an event comes and goes inside it: a geometric event or second touch seen on the dense
-/// output, or a mode that breaks at an interior stage and holds again at the end.
+/// at which an event comes and goes inside it, which the end-point signs miss: a mode that breaks
+/// at an interior stage and holds again at the end, or one of the geometric event functions (edge
+/// ends, normal cone, fence ends), which depend on the state alone, so that the dense output shows
+/// without solving anything whether one positive at both ends dips below −slack at one of eight
+/// interior fractions; likewise a disc pin's brief second touch on a concave part.
 pub(super) fn interior_dip(
     ctx: &Ctx,
     at: &Cursor,
@@ -58,7 +28,28 @@ pub(super) fn interior_dip(
     ev1: &[f64; N_EVENTS],
 ) -> Option<f64> {
     let mode_dip = step.margin_dip.filter(|_| ev1[1] >= 0.0 && ev1[2] >= 0.0);
-    geometric_dip(ctx, at, step, h, ev1).or(mode_dip)
+    let (feat, s, y0, slack) = (at.feat, at.s, at.y, at.slack);
+    // Nothing to miss unless an event not yet crossed ends the step near zero (the guard keeps a
+    // step's change of the contact coordinate below 0.5) or a disc could touch a second edge.
+    let near = (3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j]));
+    let second = !ctx.poly.is_convex() && ctx.rho > 0.0 && ctx.fence.is_none();
+    if !near && !second {
+        return mode_dip;
+    }
+    (1..8)
+        .map(|k| k as f64 / 8.0)
+        .find(|&t| {
+            let yt = step.dp.dense(y0, h, t);
+            let g = ctx.geom(feat, yt);
+            let dips = near
+                && ctx
+                    .feature_events(feat, yt, &g)
+                    .iter()
+                    .zip(&ev1[3..])
+                    .any(|(&e, &e1)| e1 >= 0.0 && e < -slack);
+            dips || (second && second_contact(ctx, feat, &ctx.pose(s + t * h, feat, yt), s + t * h))
+        })
+        .or(mode_dip)
 }
 
 /// The events that cross zero within a step from `at` ending with event functions `ev1` (those
@@ -182,13 +173,11 @@ pub(super) fn land(
             _ => Trial::Invalid,
         }
     };
-    let (mut a, mut b) = (0.0f64, 1.0f64);
-    let (mut ga, mut gb) = (at.ev0[i].max(0.0), ev1[i]);
+    let mut bracket = Bracket::new(at.ev0[i].max(0.0), ev1[i]);
     // The landing: the trial at the largest t with g ≥ 0 (or g just below 0 within the
     // landing tolerance), and its g.
     let mut best: (Trial, f64, f64) = (Trial::Start, 0.0, at.ev0[i].max(0.0));
     let mut t = t_est.clamp(0.0, 1.0);
-    let mut side = 0;
     let mut any_invalid = false;
     // Landing tolerance: far below the integration tolerance, far above rounding.
     let g_tol = at.land_tol;
@@ -199,42 +188,23 @@ pub(super) fn land(
             Trial::Step(_, g) => *g,
             Trial::Invalid => {
                 any_invalid = true;
-                b = t;
-                side = 0;
-                if (b - a) * h <= 1e-13 {
+                bracket.cut_above(t);
+                if bracket.width() * h <= 1e-13 {
                     break;
                 }
-                t = 0.5 * (a + b);
+                t = bracket.midpoint();
                 continue;
             }
         };
         let close = gt.abs() <= g_tol;
-        if gt < 0.0 {
-            b = t;
-            gb = gt;
-            if side == -1 {
-                ga *= 0.5;
-            }
-            side = -1;
-            if close {
-                best = (trial, t, gt);
-            }
-        } else {
-            a = t;
-            ga = gt;
+        let lower_end = bracket.narrow(t, gt);
+        if lower_end || close {
             best = (trial, t, gt);
-            if side == 1 {
-                gb *= 0.5;
-            }
-            side = 1;
         }
-        if close || (b - a) * h <= 1e-13 {
+        if close || bracket.width() * h <= 1e-13 {
             break;
         }
-        t = (a * gb - b * ga) / (gb - ga);
-        if !t.is_finite() || t <= a || t >= b {
-            t = 0.5 * (a + b);
-        }
+        t = bracket.next();
     }
     let (landing, best_t, best_g) = best;
     Landing {

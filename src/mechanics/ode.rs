@@ -169,6 +169,79 @@ pub(crate) fn dense<const N: usize>(
     out
 }
 
+/// A bracket [a, b] ⊆ [0, 1] of a sign change of some g, g(a) ≥ 0 > g(b), narrowed by the Illinois
+/// rule: regula falsi on the end values, halving the value kept at an end that stays put twice in
+/// a row (Dowell & Jarratt 1971).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Bracket {
+    pub a: f64,
+    pub b: f64,
+    ga: f64,
+    gb: f64,
+    /// The end that moved last: −1 the upper, 1 the lower, 0 neither (at the start or after a cut).
+    side: i8,
+}
+
+impl Bracket {
+    /// The bracket [0, 1] with g(0) = `ga`, g(1) = `gb`.
+    pub fn new(ga: f64, gb: f64) -> Bracket {
+        Bracket {
+            a: 0.0,
+            b: 1.0,
+            ga,
+            gb,
+            side: 0,
+        }
+    }
+
+    pub fn width(&self) -> f64 {
+        self.b - self.a
+    }
+
+    pub fn midpoint(&self) -> f64 {
+        0.5 * (self.a + self.b)
+    }
+
+    /// The next point to try: the regula falsi point, or the midpoint when that is not strictly
+    /// inside the bracket.
+    pub fn next(&self) -> f64 {
+        let c = (self.a * self.gb - self.b * self.ga) / (self.gb - self.ga);
+        if !c.is_finite() || c <= self.a || c >= self.b {
+            self.midpoint()
+        } else {
+            c
+        }
+    }
+
+    /// Narrow the bracket with the value `gt` = g(t) at a point `t` inside it. Returns whether `t`
+    /// became the lower end (g(t) not below zero).
+    pub fn narrow(&mut self, t: f64, gt: f64) -> bool {
+        if gt < 0.0 {
+            self.b = t;
+            self.gb = gt;
+            if self.side == -1 {
+                self.ga *= 0.5;
+            }
+            self.side = -1;
+            false
+        } else {
+            self.a = t;
+            self.ga = gt;
+            if self.side == 1 {
+                self.gb *= 0.5;
+            }
+            self.side = 1;
+            true
+        }
+    }
+
+    /// Move the upper end to `t`, where g has no trustworthy value (the end value is kept).
+    pub fn cut_above(&mut self, t: f64) {
+        self.b = t;
+        self.side = 0;
+    }
+}
+
 /// The Illinois root of `g` on [0, 1] given g(0) = `ga` ≥ 0 ≥ g(1) = `gb`: a t with |g(t)| ≤ `tol`
 /// (or a bracket narrower than 1e-12; at most 80 evaluations). A root at an end (`ga` or `gb`
 /// zero) is returned without evaluating `g`.
@@ -179,33 +252,15 @@ pub(crate) fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64, tol: f64
     if gb == 0.0 {
         return 1.0;
     }
-    let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, ga, gb);
-    let mut side = 0;
+    let mut bracket = Bracket::new(ga, gb);
     let mut c = 1.0;
     for _ in 0..80 {
-        c = (a * fb - b * fa) / (fb - fa);
-        if !c.is_finite() || c <= a || c >= b {
-            c = 0.5 * (a + b);
-        }
+        c = bracket.next();
         let fc = g(c);
-        if fc.abs() <= tol || b - a <= 1e-12 {
+        if fc.abs() <= tol || bracket.width() <= 1e-12 {
             break;
         }
-        if fc < 0.0 {
-            b = c;
-            fb = fc;
-            if side == -1 {
-                fa *= 0.5;
-            }
-            side = -1;
-        } else {
-            a = c;
-            fa = fc;
-            if side == 1 {
-                fb *= 0.5;
-            }
-            side = 1;
-        }
+        bracket.narrow(c, fc);
     }
     c
 }
@@ -231,13 +286,22 @@ mod tests {
     }
 
     type Rhs = fn(f64, [f64; 2]) -> Result<[f64; 2], NonFinite>;
+    type Exact = fn(f64) -> [f64; 2];
+
+    /// The test problems: (name, right-hand side, exact solution).
+    fn problems() -> [(&'static str, Rhs, Exact); 2] {
+        [
+            ("decay", decay, decay_exact),
+            ("rotation", rotation, rotation_exact),
+        ]
+    }
 
     fn max_diff(a: [f64; 2], b: [f64; 2]) -> f64 {
         (a[0] - b[0]).abs().max((a[1] - b[1]).abs())
     }
 
     /// Global error at t = `t_end` after `n` fixed steps from `y0`.
-    fn global_error(f: Rhs, exact: fn(f64) -> [f64; 2], t_end: f64, n: usize) -> f64 {
+    fn global_error(f: Rhs, exact: Exact, t_end: f64, n: usize) -> f64 {
         let h = t_end / n as f64;
         let mut y = exact(0.0);
         let mut f0 = f(0.0, y).unwrap();
@@ -249,28 +313,23 @@ mod tests {
         max_diff(y, exact(t_end))
     }
 
-    /// log2 of successive error ratios when the step halves.
-    fn observed_orders(errors: &[f64]) -> Vec<f64> {
-        errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+    /// Every observed order — log2 of successive error ratios as the step halves — lies in `range`.
+    fn assert_orders(name: &str, what: &str, errors: &[f64], range: std::ops::Range<f64>) {
+        for w in errors.windows(2) {
+            let p = (w[0] / w[1]).log2();
+            assert!(range.contains(&p), "{name}: {what} {errors:?}, order {p}");
+        }
     }
 
     #[test]
     fn global_error_is_fifth_order() {
-        for (name, f, exact) in [
-            ("decay", decay as Rhs, decay_exact as fn(f64) -> [f64; 2]),
-            ("rotation", rotation, rotation_exact),
-        ] {
+        for (name, f, exact) in problems() {
             // Steps of 1/4 down to 1/32 over four time units (hλ within the asymptotic range).
             let errors: Vec<f64> = [16, 32, 64, 128]
                 .iter()
                 .map(|&n| global_error(f, exact, 4.0, n))
                 .collect();
-            for p in observed_orders(&errors) {
-                assert!(
-                    (4.6..5.7).contains(&p),
-                    "{name}: errors {errors:?}, order {p}"
-                );
-            }
+            assert_orders(name, "errors", &errors, 4.6..5.7);
             // And the error is small in absolute terms at the finest step.
             assert!(errors[3] < 1e-10, "{name}: {errors:?}");
         }
@@ -280,10 +339,7 @@ mod tests {
     fn local_error_and_its_estimate_scale_as_expected() {
         // One step from t = 0: the true local error is O(h⁶) (a 5th-order method), the embedded
         // estimate (the 4th-order solution's difference) O(h⁵), and it bounds the true error.
-        for (name, f, exact) in [
-            ("decay", decay as Rhs, decay_exact as fn(f64) -> [f64; 2]),
-            ("rotation", rotation, rotation_exact),
-        ] {
+        for (name, f, exact) in problems() {
             let y0 = exact(0.0);
             let f0 = f(0.0, y0).unwrap();
             let hs = [0.4, 0.2, 0.1, 0.05];
@@ -297,18 +353,8 @@ mod tests {
                 .zip(hs)
                 .map(|(s, h)| max_diff(s.y1, exact(h)))
                 .collect();
-            for p in observed_orders(&estimates) {
-                assert!(
-                    (4.6..5.4).contains(&p),
-                    "{name}: estimates {estimates:?}, order {p}"
-                );
-            }
-            for p in observed_orders(&true_errors) {
-                assert!(
-                    (5.5..6.6).contains(&p),
-                    "{name}: errors {true_errors:?}, order {p}"
-                );
-            }
+            assert_orders(name, "estimates", &estimates, 4.6..5.4);
+            assert_orders(name, "errors", &true_errors, 5.5..6.6);
             for (e, t) in estimates.iter().zip(&true_errors) {
                 assert!(e > t, "{name}: estimate {e} below the true error {t}");
             }
@@ -380,10 +426,7 @@ mod tests {
 
     #[test]
     fn dense_output_matches_the_ends_and_is_fourth_order_inside() {
-        for (name, f, exact) in [
-            ("decay", decay as Rhs, decay_exact as fn(f64) -> [f64; 2]),
-            ("rotation", rotation, rotation_exact),
-        ] {
+        for (name, f, exact) in problems() {
             let y0 = exact(0.0);
             let f0 = f(0.0, y0).unwrap();
             let hs = [0.8, 0.4, 0.2, 0.1];
@@ -399,12 +442,7 @@ mod tests {
                 errors.push(worst);
             }
             // Local error of a 4th-order interpolant: O(h⁵).
-            for p in observed_orders(&errors) {
-                assert!(
-                    (4.6..6.2).contains(&p),
-                    "{name}: errors {errors:?}, order {p}"
-                );
-            }
+            assert_orders(name, "errors", &errors, 4.6..6.2);
             assert!(errors[3] < 1e-6, "{name}: {errors:?}");
         }
     }

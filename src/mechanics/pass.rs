@@ -281,17 +281,8 @@ pub fn first_instant(
 ) -> Option<(ContactGeom, Instant)> {
     let k = model.scale();
     let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    let mut ctx = Ctx::new(
-        model,
-        model.polygon(),
-        settings,
-        settings.mu_c,
-        pin.radius / k,
-        Vec2::new(-1.0, pin.lateral_speed),
-        pin_start / k,
-        None,
-        None,
-    );
+    let path = PinPath::constant(pin.lateral_speed);
+    let mut ctx = pin_ctx(model, pin_start, pin.radius, &path, settings, None);
     let dir = ctx.vdir.normalized();
     let hit = first_contact(ctx.poly, &pose_n, ctx.start, dir, ctx.rho, 0.0)?;
     if hit.grazing {
