@@ -19,7 +19,7 @@
 //!   with the fence, handled by the pin model; the part leaves when it separates.
 //!
 //! The contact model holds these states as features of its contact state
-//! ([`super::contact_state`]); this module gives their geometry and instants (flush edges in closed
+//! (`mechanics::contact_state`); this module gives their geometry and instants (flush edges in closed
 //! form), the transitions between them and the fence's first touch.
 //!
 //! Peshkin & Sanderson's COR-locus tip bounds the push distance needed to align an edge: the `tip`

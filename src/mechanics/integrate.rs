@@ -1,23 +1,23 @@
 //! Integration of one contact: from the first touch until separation, in pin travel, with error
 //! control and precise event location (SPEC §2, "Integration over a contact").
 //!
-//! The contact is held in reduced coordinates on its feature ([`super::contact_state`]). Each turn
-//! of the loop in [`integrate_contact`] is one of these named steps:
+//! The contact is held in reduced coordinates on its feature (`mechanics::contact_state`). Each turn
+//! of the loop in `integrate_contact` is one of these named steps:
 //!
-//! 1. **take a step** ([`take_step`]): Dormand–Prince 5(4) ([`super::contact_step`]) with absolute
+//! 1. **take a step** (`take_step`): Dormand–Prince 5(4) (`mechanics::contact_step`) with absolute
 //!    tolerance `tol` on θ (radians) and on ℓ, φ, σ (units of a), rejected and shrunk on a failed
 //!    solve, the error test or the step guard, shortened when an event comes and goes inside it,
 //!    and accepted when no event function crosses zero;
-//! 2. **locate the event** and **land on it** ([`land_on_event`], with [`super::event_locate`]):
+//! 2. **locate the event** and **land on it** (`land_on_event`, with `mechanics::event_locate`):
 //!    the earliest crossing on the dense output by the Illinois method, then a real sub-step onto it;
-//! 3. **apply it** ([`super::event_apply`]): separation (n·v_pin = 0), mode margins
+//! 3. **apply it** (`mechanics::event_apply`): separation (n·v_pin = 0), mode margins
 //!    (stick ↔ slide), edge ends, a disc's normal cone at a vertex, a fence's events
 //!    ([`super::fence`]), turns of the pin's path;
-//! 4. **open the next segment** ([`open_next`]): settle the mode on the new feature, reset the
+//! 4. **open the next segment** (`open_next`): settle the mode on the new feature, reset the
 //!    event bands, record the state just after the event.
 //!
 //! The pass loop around it (casting the obstacle's path again after a separation) is
-//! [`super::pass`].
+//! `mechanics::pass`.
 
 use super::contact_state::{second_contact, Ctx, Feat, N_EVENTS, TURN};
 use super::contact_step::{dp_step, max_step, step_change_ok, Cursor, StepResult};

@@ -32,7 +32,8 @@ pub struct ContactSettings {
     pub mu_s: f64,
     /// Absolute local error tolerance per step on θ (radians) and on contact coordinates (units of a).
     pub tol: f64,
-    /// Largest pin travel in contact, in units of a, before reporting [`ContactStatus::TravelLimit`].
+    /// Largest pin travel in contact, in units of a, before reporting
+    /// [`super::ContactStatus::TravelLimit`].
     pub max_travel: f64,
     /// Evaluation budget per pass.
     pub max_evaluations: u64,
