@@ -18,9 +18,15 @@
 //! * **past an end**: once the contact reaches a fence end, that end acts as a point pin moving
 //!   with the fence, handled by the pin model; the part leaves when it separates.
 //!
+//! The contact model holds these states as features of its contact state
+//! (`mechanics::contact_state`); this module gives their geometry and instants (flush edges in closed
+//! form), the transitions between them and the fence's first touch.
+//!
 //! Peshkin & Sanderson's COR-locus tip bounds the push distance needed to align an edge: the `tip`
 //! fidelity is that bound, and the exact model must rotate at least as fast (tested).
 
+use super::contact_state::{initial_state, Ctx, Feat, N_EVENTS};
+use super::instant::{Instant, Mode};
 use crate::geometry::{first_contact, Feature, Polygon, Pose, Vec2};
 use serde::Serialize;
 
@@ -154,6 +160,204 @@ pub(crate) fn first_touch(
         }
     }
     best
+}
+
+impl Ctx<'_, '_> {
+    /// The flush edge k's supported interval and the point where the force line through the
+    /// centroid meets the fence, all as fence coordinates relative to hull vertex k:
+    /// (lo, hi, where the force line meets the fence).
+    pub(super) fn flush_interval(&self, k: usize, y: [f64; 2], force_dir: Vec2) -> (f64, f64, f64) {
+        let f = self.fence_geom();
+        let vk = self.poly.vertex(k).rotate(y[0]);
+        let other = (self.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
+        let lo = other.min(0.0).max(-y[1]);
+        let hi = other.max(0.0).min(f.len - y[1]);
+        // Centroid relative to vertex k is −vk; the line c + λ·dir meets the fence line (through
+        // vertex k, normal n) at λ = vk·n / (dir·n).
+        let lambda = vk.dot(f.n) / force_dir.dot(f.n);
+        let meet = (-vk + force_dir * lambda).dot(f.e);
+        (lo, hi, meet)
+    }
+
+    /// A flush edge translates (SPEC §6): sliding with the force on a friction-cone edge, or, in
+    /// `Stick` mode, jammed (moving with the fence). The force passes through the centroid; the
+    /// margins say how far inside the supported interval it meets the fence.
+    pub(super) fn flush_instant(&self, k: usize, y: [f64; 2], mode: Mode) -> Instant {
+        let f = self.fence_geom();
+        let (dir, v_world) = match mode {
+            Mode::SlideLeft | Mode::SlideRight | Mode::Slide => {
+                let dir = match mode {
+                    Mode::SlideLeft => self.fr.left_edge(f.n),
+                    Mode::SlideRight => self.fr.right_edge(f.n),
+                    _ => f.n,
+                };
+                (dir, dir * (f.n.dot(self.vdir) / f.n.dot(dir)))
+            }
+            Mode::Stick => (self.vdir.normalized(), self.vdir),
+        };
+        let (lo, hi, meet) = self.flush_interval(k, y, dir);
+        let v = v_world.rotate(-y[0]);
+        Instant {
+            mode,
+            twist: [v.x, v.y, 0.0],
+            force: dir.rotate(-y[0]),
+            margins: [meet - lo, hi - meet],
+        }
+    }
+
+    /// The hull edge adjacent to vertex k that is flush to rounding (its other end within 1e-9 a of
+    /// the fence line), if any.
+    pub(super) fn flush_neighbour(&self, k: usize, y: [f64; 2]) -> Option<usize> {
+        let f = self.fence_geom();
+        let m = self.poly.len();
+        let v = self.poly.vertex(k);
+        let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
+        if dist(k + m - 1).abs() <= 1e-9 {
+            Some((k + m - 1) % m)
+        } else if dist(k + 1).abs() <= 1e-9 {
+            Some(k)
+        } else {
+            None
+        }
+    }
+
+    /// The orientation nearest `theta` at which hull edge k lies exactly flush on the fence (its
+    /// outward normal against the fence normal). Flush is a geometric fact at the event that finds
+    /// it; snapping removes the event's landing error (≤ 1e-2·tol).
+    pub(super) fn flush_angle(&self, k: usize, theta: f64) -> f64 {
+        let f = self.fence_geom();
+        let out = -self.poly.inward_normal(k);
+        let target = (-f.n).angle() - out.angle();
+        theta + crate::geometry::wrap_pi(target - theta)
+    }
+
+    /// The consistent translation mode of a flush edge: slide towards the side the belt's motion
+    /// leaves the friction cone on, or `Stick` (a jam) when it lies inside the cone (inclusive:
+    /// α + atan μf ≥ 90° jams).
+    pub(super) fn flush_mode(&self) -> Mode {
+        let f = self.fence_geom();
+        if self.fr.mu_c == 0.0 {
+            return Mode::Slide;
+        }
+        let (fl, fr) = (self.fr.left_edge(f.n), self.fr.right_edge(f.n));
+        // The cone boundary itself jams (α + atan μf = 90° exactly); 1e-12 absorbs the rounding
+        // of the angles so that the condition holds at exactly the predicted angle.
+        let v = self.vdir.normalized();
+        if fl.cross(v) > 1e-12 {
+            Mode::SlideLeft
+        } else if fr.cross(v) < -1e-12 {
+            Mode::SlideRight
+        } else {
+            Mode::Stick
+        }
+    }
+}
+
+/// A flush edge whose force line leaves its supported interval pivots about that end: a hull vertex
+/// (vertex on the fence line) or the fence's own end (which then acts as a point pin on the edge).
+pub(super) fn flush_pivot(ctx: &mut Ctx, k: usize, y: [f64; 2], hi_end: bool) -> (Feat, [f64; 2]) {
+    let f = *ctx.fence_geom();
+    let m = ctx.poly.len();
+    let vk = ctx.poly.vertex(k).rotate(y[0]);
+    let other = (ctx.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
+    let (lo, hi, _) = ctx.flush_interval(k, y, f.n);
+    let end = if hi_end { hi } else { lo };
+    if end == 0.0 {
+        (Feat::FenceVertex(k), y)
+    } else if end == other {
+        (Feat::FenceVertex((k + 1) % m), [y[0], y[1] + other])
+    } else {
+        // A fence end inside the edge: that end pushes the edge like a point pin.
+        ctx.start = if end <= -y[1] + 1e-12 { f.p0 } else { f.p1() };
+        (Feat::Edge(k), [y[0], end.abs()])
+    }
+}
+
+/// How a flush edge goes on.
+pub(super) enum Flush {
+    /// It translates along the fence in its consistent mode (this instant).
+    Translate(Instant),
+    /// The force line misses the supported interval: it pivots about the nearer end (new state).
+    Pivot(Feat, [f64; 2]),
+    /// The belt's motion lies inside the friction cone: the part jams.
+    Jam,
+}
+
+/// Decide how flush hull edge `k` in state `y` goes on (the event bands are reset on a pivot).
+pub(super) fn settle_flush(ctx: &mut Ctx, k: usize, y: [f64; 2]) -> Flush {
+    let mode = ctx.flush_mode();
+    let inst = ctx.flush_instant(k, y, mode);
+    // The supported interval is closed (the force may act at an end vertex): rounding-level
+    // negatives count as inside.
+    let (m0, m1) = (inst.margins[0] + ctx.band[1], inst.margins[1] + ctx.band[2]);
+    if m0 < -1e-12 || m1 < -1e-12 {
+        // The force line misses the supported interval: pivot about the nearer end.
+        ctx.band = [0.0; N_EVENTS];
+        let (f, yy) = flush_pivot(ctx, k, y, m1 < m0);
+        return Flush::Pivot(f, yy);
+    }
+    if mode == Mode::Stick {
+        return Flush::Jam;
+    }
+    Flush::Translate(inst)
+}
+
+/// Hull edge `j` (a neighbour of hull vertex `k`, which is on the fence line in state `y`) turns
+/// flush: the state on the flush edge, its orientation snapped to exactly flush.
+pub(super) fn edge_turns_flush(ctx: &Ctx, j: usize, k: usize, y: [f64; 2]) -> (Feat, [f64; 2]) {
+    let f = *ctx.fence_geom();
+    let th = ctx.flush_angle(j, y[0]);
+    let d = (ctx.poly.vertex(j) - ctx.poly.vertex(k))
+        .rotate(th)
+        .dot(f.e);
+    (Feat::FenceEdge(j), [th, y[1] + d])
+}
+
+/// Where a geometric event of hull vertex `k` on the fence line leads (event indices of
+/// [`Ctx::feature_events`]): 3 / 4, the edge before / after the vertex turns flush; 5 / 6, the
+/// vertex slides off the upstream / downstream end of the fence, which then acts as a point pin on
+/// the part.
+pub(super) fn fence_vertex_event(
+    ctx: &mut Ctx,
+    i: usize,
+    k: usize,
+    y: [f64; 2],
+) -> (Feat, [f64; 2]) {
+    let m = ctx.poly.len();
+    match i {
+        // The edge before vertex k turns flush: its start vertex k−1 reached the line.
+        3 => edge_turns_flush(ctx, (k + m - 1) % m, k, y),
+        4 => (Feat::FenceEdge(k), [ctx.flush_angle(k, y[0]), y[1]]),
+        5 | 6 => {
+            let f = *ctx.fence_geom();
+            ctx.start = if i == 5 { f.p0 } else { f.p1() };
+            (Feat::Vertex(k), [y[0], f.n.rotate(-y[0]).angle()])
+        }
+        _ => unreachable!("not a fence-vertex event"),
+    }
+}
+
+/// The contact state at the next touch of fence `f` on the part resting at `cur`, from travel
+/// `s_from` (normalised units): (travel, feature, state). A fence end that strikes first becomes
+/// the pin of the contact (`ctx.start`).
+pub(super) fn next_fence_touch(
+    ctx: &mut Ctx,
+    f: &FenceGeom,
+    cur: &Pose,
+    s_from: f64,
+) -> Option<(f64, Feat, [f64; 2])> {
+    match first_touch(ctx.poly, cur, f, ctx.vdir, s_from)? {
+        (t, FenceTouch::LineVertex { k, sigma }) => {
+            Some((t, Feat::FenceVertex(k), [cur.theta, sigma]))
+        }
+        (t, FenceTouch::LineEdge { k, sigma }) => Some((t, Feat::FenceEdge(k), [cur.theta, sigma])),
+        (t, FenceTouch::End { end, feature }) => {
+            ctx.start = if end == 0 { f.p0 } else { f.p1() };
+            let n = ctx.vdir.normalized();
+            let (feat, y) = initial_state(ctx, cur, feature, n);
+            Some((t, feat, y))
+        }
+    }
 }
 
 #[cfg(test)]

@@ -1,938 +1,59 @@
-//! Integration of one pin pass over a part: from first touch to separation, with error control and
-//! precise event location (SPEC §2, "Integration over a contact").
+//! Integration of one contact: from the first touch until separation, in pin travel, with error
+//! control and precise event location (SPEC §2, "Integration over a contact").
 //!
-//! Work happens in the belt frame, in normalised units (the part's `a` = 1, belt speed 1). The pin
-//! moves along v_pin = (−1, w) (w = lateral speed / belt speed) and its travel `s` relative to the belt
-//! parametrises the motion (time = s / V). A contact is held in reduced coordinates so the contact
-//! constraint never drifts:
+//! The contact is held in reduced coordinates on its feature (`mechanics::contact_state`). Each turn
+//! of the loop in `integrate_contact` is one of these named steps:
 //!
-//! * on edge k: y = (θ, ℓ), ℓ the distance of the contact point from vertex k along the edge;
-//! * on vertex k: y = (θ, φ), φ the part-frame angle of the normal from the pin centre to the vertex
-//!   (a disc pin rides round the vertex; for a point pin φ is frozen while the vertex sticks — the
-//!   ρ → 0 limit of the disc).
+//! 1. **take a step** (`take_step`): Dormand–Prince 5(4) (`mechanics::contact_step`) with absolute
+//!    tolerance `tol` on θ (radians) and on ℓ, φ, σ (units of a), rejected and shrunk on a failed
+//!    solve, the error test or the step guard, shortened when an event comes and goes inside it,
+//!    and accepted when no event function crosses zero;
+//! 2. **locate the event** and **land on it** (`land_on_event`, with `mechanics::event_locate`):
+//!    the earliest crossing on the dense output by the Illinois method, then a real sub-step onto it;
+//! 3. **apply it** (`mechanics::event_apply`): separation (n·v_pin = 0), mode margins
+//!    (stick ↔ slide), edge ends, a disc's normal cone at a vertex, a fence's events
+//!    ([`super::fence`]), turns of the pin's path;
+//! 4. **open the next segment** (`open_next`): settle the mode on the new feature, reset the
+//!    event bands, record the state just after the event.
 //!
-//! The pose follows from (s, θ, contact): c = P(s) + R(θ)(ρ n − p). The rates are
-//! dθ/ds = ω, dℓ/ds = ê·(v_pin + ρ ω ẑ×n − v_p) and dφ/ds = (ẑ×n)·(v_p − v_pin)/ρ − ω, with v_p the
-//! material velocity of the contact point (all in part axes); the twist comes from [`super::instant`].
-//!
-//! Steps: Dormand–Prince 5(4) with absolute tolerance `tol` on θ (radians) and on ℓ, φ (units of a).
-//! Events, located with a cubic Hermite interpolant and the Illinois method and then landed on with a
-//! real step: separation (n·v_pin = 0), mode margins (stick ↔ slide), edge ends and, for a disc on a
-//! vertex, the edges of the vertex's normal cone. At a convex vertex a point pin passes onto the next
-//! edge in its direction of sliding (or separates if that edge faces away); a reflex vertex means a
-//! second contact in a notch, which is reported as [`ContactStatus::MultiContact`], not simulated.
-//! After separation the pin's path is cast again, so a concave part can be struck more than once.
+//! The pass loop around it (casting the obstacle's path again after a separation) is
+//! `mechanics::pass`.
 
-use super::fence::{first_touch, FenceGeom, FenceSpec, FenceTouch};
-use super::instant::{
-    classify, push_margin, solve_in_mode, ContactGeom, Friction, Instant, Mode, Warm,
+use super::contact_state::{second_contact, Ctx, Feat, N_EVENTS, TURN};
+use super::contact_step::{dp_step, max_step, step_change_ok, Cursor, StepResult};
+use super::event_apply::{apply_event, enter, settle, Settle, Transition, BOUNCE_BAND};
+use super::event_locate::{crossed_events, earliest_crossing, interior_dip, land, landed_event};
+use super::instant::{Instant, Mode};
+use super::outcome::{ContactStatus, Segment};
+use crate::geometry::Pose;
+
+// The entry points, where they were before the pass loop had a module of its own.
+pub use super::pass::{
+    fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path,
 };
-use super::outcome::{
-    ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
-};
-use super::part_model::{Fidelity, PartModel, SolveFailure};
-use super::pin_path::{PinPath, Turn};
-use crate::geometry::{first_contact, Feature, Polygon, Pose, Vec2};
-use serde::Serialize;
+pub use super::settings::{ContactSettings, Pin, POINT_PIN_RADIUS};
 
-/// A pin as the contact model sees it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Pin {
-    /// Radius in the caller's units (0: the thesis's point pin).
-    pub radius: f64,
-    /// Lateral velocity as a fraction of the belt speed (0 for a fixed pin): v_pin = (−V, w·V).
-    pub lateral_speed: f64,
-}
-
-impl Pin {
-    pub fn point() -> Pin {
-        Pin {
-            radius: 0.0,
-            lateral_speed: 0.0,
-        }
-    }
-}
-
-/// Settings of the contact model.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ContactSettings {
-    pub fidelity: Fidelity,
-    /// Pin–part (contact) friction coefficient μc ≥ 0.
-    pub mu_c: f64,
-    /// Part–belt (support) friction coefficient μs > 0: scales forces only.
-    pub mu_s: f64,
-    /// Absolute local error tolerance per step on θ (radians) and on contact coordinates (units of a).
-    pub tol: f64,
-    /// Largest pin travel in contact, in units of a, before reporting [`ContactStatus::TravelLimit`].
-    pub max_travel: f64,
-    /// Evaluation budget per pass.
-    pub max_evaluations: u64,
-    /// Event budget per pass.
-    pub max_events: u32,
-}
-
-impl Default for ContactSettings {
-    fn default() -> Self {
-        ContactSettings {
-            fidelity: Fidelity::Exact,
-            mu_c: 0.5,
-            mu_s: 0.3,
-            tol: 1e-6,
-            max_travel: 50.0,
-            max_evaluations: 2_000_000,
-            max_events: 200,
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Feat {
-    /// Pin on polygon edge k; y = (θ, ℓ).
-    Edge(usize),
-    /// Pin on polygon vertex k; y = (θ, φ).
-    Vertex(usize),
-    /// Hull vertex k on the fence line; y = (θ, σ), σ the vertex's fence coordinate.
-    FenceVertex(usize),
-    /// Hull edge k flush on the fence line; y = (θ, σ), σ the fence coordinate of hull vertex k.
-    FenceEdge(usize),
-}
-
-impl Feat {
-    fn public(self) -> ContactFeature {
-        match self {
-            Feat::Edge(k) => ContactFeature::Edge(k),
-            Feat::Vertex(k) => ContactFeature::Vertex(k),
-            Feat::FenceVertex(k) => ContactFeature::FenceVertex(k),
-            Feat::FenceEdge(k) => ContactFeature::FenceEdge(k),
-        }
-    }
-}
-
-struct Ctx<'a, 'r> {
-    model: &'a PartModel,
-    poly: &'a Polygon,
-    fid: Fidelity,
-    fr: Friction,
-    rho: f64,
-    vdir: Vec2,
-    /// Where the pin (or the fence end acting as one) is at travel 0.
-    start: Vec2,
-    /// The fence, when the obstacle is one (`poly` is then the part's hull).
-    fence: Option<FenceGeom>,
-    tol: f64,
-    /// μs: the trace reports forces in units of m g (the model's are in units of μs m g).
-    mu_s: f64,
-    scale: f64,
-    evals: u64,
-    warm: Warm,
-    recorder: Option<&'r mut dyn Recorder>,
-    /// Per-event tolerance band: event i fires when its function drops below −band[i]. Zero except
-    /// for a mode margin that just bounced (see the ping-pong rule in `integrate_contact`).
-    band: [f64; N_EVENTS],
-    /// Changes of the pin's lateral speed still ahead (normalised travel), in order; `start` and
-    /// `vdir` describe the current piece of the path (see [`super::pin_path`]).
-    turns: Vec<Turn>,
-    next_turn: usize,
-}
-
-enum End {
+/// How a contact ended.
+pub(super) enum End {
     Separated,
     Stop(ContactStatus),
 }
 
-const N_EVENTS: usize = 7;
-/// Pseudo-event index of a turn of the pin's path (a change of its lateral speed).
-const TURN: usize = N_EVENTS;
-/// Tolerance band of a mode margin after a ping-pong (a sine: about 0.006°).
-const BOUNCE_BAND: f64 = 1e-4;
-/// Step acceptance guard: the most one accepted step may change θ (radians) or the contact
-/// coordinate ℓ (units of a) / φ (radians). The embedded error estimate is only asymptotic for
-/// small changes: near a singular instant (a sliding twist whose contact velocity turns tangential,
-/// so κ = n·v_pin / n·v_b blows up) all seven stages can agree on a huge rate and a step of 1e-4 a
-/// of travel passes the error test while turning the part by 900°. No real contact needs more
-/// than this per step at any tolerance: the guard shrinks the step instead. A flush fence edge
-/// translates at constant rates, so its fence coordinate is not limited.
-const MAX_STEP_CHANGE: f64 = 0.5;
-/// Disc pins below this radius (units of a) are point pins: the disc's ride round a vertex
-/// (φ turning at a rate ∝ 1/ρ) then lasts less than 1e-9 a of travel and changes the pose by
-/// O(ρ), far below any tolerance, while resolving it would need steps below the integrator's
-/// floor. So the model is continuous in ρ down to 0 (to O(ρ)).
-pub const POINT_PIN_RADIUS: f64 = 1e-9;
+/// Where a contact ends: how, at which (normalised) travel, and the part's pose there.
+pub(super) type Finish = (End, f64, Pose);
 
-/// Does a step from `y0` to `y1` on `feat` pass the acceptance guard?
-fn step_change_ok(feat: Feat, y0: [f64; 2], y1: [f64; 2]) -> bool {
-    let d_theta = (y1[0] - y0[0]).abs();
-    let d_contact = match feat {
-        Feat::FenceEdge(_) => 0.0,
-        _ => (y1[1] - y0[1]).abs(),
-    };
-    d_theta <= MAX_STEP_CHANGE && d_contact <= MAX_STEP_CHANGE
-}
-
-/// The largest step (units of a) on `feat`: a flush fence edge translates at constant rates, so a
-/// single step may take it along any length of fence (its events are monotone in the travel);
-/// elsewhere two units of a, so that no event can come and go within one step.
-fn max_step(feat: Feat) -> f64 {
-    match feat {
-        Feat::FenceEdge(_) => f64::INFINITY,
-        _ => 2.0,
-    }
-}
-
-impl<'a, 'r> Ctx<'a, 'r> {
-    /// A context for one obstacle pass: `poly` is the polygon the obstacle touches (the part, or
-    /// its hull for a fence); lengths are already normalised.
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        model: &'a PartModel,
-        poly: &'a Polygon,
-        settings: &ContactSettings,
-        mu: f64,
-        rho: f64,
-        vdir: Vec2,
-        start: Vec2,
-        fence: Option<FenceGeom>,
-        recorder: Option<&'r mut dyn Recorder>,
-    ) -> Self {
-        Ctx {
-            model,
-            poly,
-            fid: settings.fidelity,
-            fr: Friction::new(mu),
-            rho: if rho < POINT_PIN_RADIUS { 0.0 } else { rho },
-            vdir,
-            start,
-            fence,
-            tol: settings.tol,
-            mu_s: settings.mu_s,
-            scale: model.scale(),
-            evals: 0,
-            warm: Warm::default(),
-            recorder,
-            band: [0.0; N_EVENTS],
-            turns: Vec::new(),
-            next_turn: 0,
-        }
-    }
-
-    /// Let the pin follow `path` (its lateral speed changes at the path's turns).
-    fn with_path(mut self, path: &PinPath) -> Self {
-        self.vdir = Vec2::new(-1.0, path.initial_speed());
-        self.turns = path.scaled(self.scale).collect();
-        self
-    }
-}
-
-impl Ctx<'_, '_> {
-    fn pin_at(&self, s: f64) -> Vec2 {
-        self.start + self.vdir * s
-    }
-
-    /// Travel of the next change of the pin's lateral speed (∞ if none is left).
-    fn turn_at(&self) -> f64 {
-        self.turns
-            .get(self.next_turn)
-            .map_or(f64::INFINITY, |t| t.s)
-    }
-
-    /// Take the next turn: the pin, where it stands at the turn, goes on along its new direction
-    /// (`start` is moved so that `pin_at` stays continuous).
-    fn take_turn(&mut self) {
-        let t = self.turns[self.next_turn];
-        let at = self.pin_at(t.s);
-        self.vdir = Vec2::new(-1.0, t.w);
-        self.start = at - self.vdir * t.s;
-        self.next_turn += 1;
-    }
-
-    /// Is travel `s` at the next turn (to rounding)?
-    fn at_turn(&self, s: f64) -> bool {
-        self.turn_at() - s <= 1e-12 * (1.0 + s.abs())
-    }
-
-    fn geom(&self, feat: Feat, y: [f64; 2]) -> ContactGeom {
-        let v_pin = self.vdir.rotate(-y[0]);
-        match feat {
-            Feat::Edge(k) => {
-                let (a, b) = self.poly.edge(k);
-                let e = (b - a).normalized();
-                ContactGeom {
-                    p: a + e * y[1],
-                    n: e.perp(),
-                    v_pin,
-                }
-            }
-            Feat::Vertex(k) => ContactGeom {
-                p: self.poly.vertex(k),
-                n: Vec2::from_angle(y[1]),
-                v_pin,
-            },
-            Feat::FenceVertex(k) | Feat::FenceEdge(k) => ContactGeom {
-                p: self.poly.vertex(k),
-                n: self.fence_geom().n.rotate(-y[0]),
-                v_pin,
-            },
-        }
-    }
-
-    fn fence_geom(&self) -> &FenceGeom {
-        self.fence
-            .as_ref()
-            .expect("fence features only arise with a fence")
-    }
-
-    fn pose(&self, s: f64, feat: Feat, y: [f64; 2]) -> Pose {
-        let g = self.geom(feat, y);
-        let c = match feat {
-            Feat::FenceVertex(_) | Feat::FenceEdge(_) => {
-                let f = self.fence_geom();
-                f.p0 + self.vdir * s + f.e * y[1] - g.p.rotate(y[0])
-            }
-            _ => self.pin_at(s) + (g.n * self.rho - g.p).rotate(y[0]),
-        };
-        Pose::new(c.x, c.y, y[0])
-    }
-
-    fn rates(&self, feat: Feat, y: [f64; 2], g: &ContactGeom, inst: &Instant) -> [f64; 2] {
-        let xi = inst.twist;
-        let om = xi[2];
-        let vp = Vec2::new(xi[0], xi[1]) + g.p.perp() * om;
-        let dq = match feat {
-            Feat::Edge(k) => {
-                let (a, b) = self.poly.edge(k);
-                let e = (b - a).normalized();
-                e.dot(g.v_pin + g.n.perp() * (self.rho * om) - vp)
-            }
-            Feat::Vertex(_) => {
-                if self.rho > 0.0 {
-                    g.n.perp().dot(vp - g.v_pin) / self.rho - om
-                } else {
-                    0.0
-                }
-            }
-            // dσ/ds: the contact point's velocity relative to the fence, along the fence.
-            Feat::FenceVertex(_) | Feat::FenceEdge(_) => {
-                self.fence_geom().e.dot(vp.rotate(y[0]) - self.vdir)
-            }
-        };
-        [om, dq]
-    }
-
-    fn rhs(
-        &mut self,
-        feat: Feat,
-        mode: Mode,
-        y: [f64; 2],
-    ) -> Result<([f64; 2], Instant), SolveFailure> {
-        let g = self.geom(feat, y);
-        let inst = match feat {
-            Feat::FenceEdge(k) => self.flush_instant(k, y, mode),
-            _ => solve_in_mode(
-                self.model,
-                self.fid,
-                &g,
-                self.fr,
-                mode,
-                &mut self.warm,
-                &mut self.evals,
-            )?,
-        };
-        let d = self.rates(feat, y, &g, &inst);
-        if !(d[0].is_finite() && d[1].is_finite()) {
-            return Err(SolveFailure::NonFinite);
-        }
-        Ok((d, inst))
-    }
-
-    /// Event functions (positive while nothing happens): separation, the two mode margins, then
-    /// the geometric ones of [`Ctx::feature_events`].
-    fn events(&self, feat: Feat, y: [f64; 2], inst: &Instant) -> [f64; N_EVENTS] {
-        let g = self.geom(feat, y);
-        let [e3, e4, e5, e6] = self.feature_events(feat, y, &g);
-        let b = &self.band;
-        [
-            push_margin(&g) + b[0],
-            inst.margins[0] + b[1],
-            inst.margins[1] + b[2],
-            e3 + b[3],
-            e4 + b[4],
-            e5 + b[5],
-            e6 + b[6],
-        ]
-    }
-
-    /// The geometric event functions (positive while the contact stays on its feature): an edge's
-    /// two ends (units of a), a disc's normal cone at a vertex (sines), a fence vertex's
-    /// neighbours and the fence's two ends (units of a).
-    fn feature_events(&self, feat: Feat, y: [f64; 2], g: &ContactGeom) -> [f64; 4] {
-        let (mut e5, mut e6) = (1.0, 1.0);
-        let (e3, e4) = match feat {
-            Feat::Edge(k) => {
-                let (a, b) = self.poly.edge(k);
-                (y[1], (b - a).norm() - y[1])
-            }
-            Feat::Vertex(k) => {
-                if self.rho > 0.0 {
-                    let m = self.poly.len();
-                    let na = self.poly.inward_normal(k + m - 1);
-                    let nb = self.poly.inward_normal(k);
-                    (na.cross(g.n), g.n.cross(nb))
-                } else {
-                    (1.0, 1.0)
-                }
-            }
-            Feat::FenceVertex(k) => {
-                // Neighbouring hull vertices stay off the line (an edge turns flush at zero), and
-                // the vertex stays between the fence's ends.
-                let f = self.fence_geom();
-                let m = self.poly.len();
-                let v = self.poly.vertex(k);
-                let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
-                e5 = y[1];
-                e6 = f.len - y[1];
-                (dist(k + m - 1), dist(k + 1))
-            }
-            Feat::FenceEdge(_) => (1.0, 1.0),
-        };
-        [e3, e4, e5, e6]
-    }
-
-    /// The self-check at the end of a contact (a few event functions and one distance): the state
-    /// must still lie on its feature, and the pin must not overlap the part. Both hold by
-    /// construction in exact arithmetic and to the landing tolerance in a correct run; a failure
-    /// means an accepted step or landing went wrong.
-    fn self_check(&self, s: f64, feat: Feat, y: [f64; 2]) -> Option<SelfCheck> {
-        let limit = 10.0 * self.tol;
-        let g = self.geom(feat, y);
-        if self.feature_events(feat, y, &g).iter().any(|&e| e < -limit) {
-            return Some(SelfCheck::OffFeature);
-        }
-        if self.fence.is_none() {
-            let pose = self.pose(s, feat, y);
-            let centre = pose.apply_inverse(self.pin_at(s));
-            let (dist, _) = self.poly.distance_to_boundary(centre);
-            let depth = if self.poly.contains(centre) {
-                dist + self.rho
-            } else {
-                self.rho - dist
-            };
-            if depth > limit {
-                return Some(SelfCheck::Penetration);
-            }
-        }
-        None
-    }
-
-    /// The flush edge k's supported interval and the point where the force line through the
-    /// centroid meets the fence, all as fence coordinates relative to hull vertex k:
-    /// (lo, hi, where the force line meets the fence).
-    fn flush_interval(&self, k: usize, y: [f64; 2], force_dir: Vec2) -> (f64, f64, f64) {
-        let f = self.fence_geom();
-        let vk = self.poly.vertex(k).rotate(y[0]);
-        let other = (self.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
-        let lo = other.min(0.0).max(-y[1]);
-        let hi = other.max(0.0).min(f.len - y[1]);
-        // Centroid relative to vertex k is −vk; the line c + λ·dir meets the fence line (through
-        // vertex k, normal n) at λ = vk·n / (dir·n).
-        let lambda = vk.dot(f.n) / force_dir.dot(f.n);
-        let meet = (-vk + force_dir * lambda).dot(f.e);
-        (lo, hi, meet)
-    }
-
-    /// A flush edge translates (SPEC §6): sliding with the force on a friction-cone edge, or, in
-    /// `Stick` mode, jammed (moving with the fence). The force passes through the centroid; the
-    /// margins say how far inside the supported interval it meets the fence.
-    fn flush_instant(&self, k: usize, y: [f64; 2], mode: Mode) -> Instant {
-        let f = self.fence_geom();
-        let (dir, v_world) = match mode {
-            Mode::SlideLeft | Mode::SlideRight | Mode::Slide => {
-                let dir = match mode {
-                    Mode::SlideLeft => self.fr.left_edge(f.n),
-                    Mode::SlideRight => self.fr.right_edge(f.n),
-                    _ => f.n,
-                };
-                (dir, dir * (f.n.dot(self.vdir) / f.n.dot(dir)))
-            }
-            Mode::Stick => (self.vdir.normalized(), self.vdir),
-        };
-        let (lo, hi, meet) = self.flush_interval(k, y, dir);
-        let v = v_world.rotate(-y[0]);
-        Instant {
-            mode,
-            twist: [v.x, v.y, 0.0],
-            force: dir.rotate(-y[0]),
-            margins: [meet - lo, hi - meet],
-        }
-    }
-
-    /// The hull edge adjacent to vertex k that is flush to rounding (its other end within 1e-9 a of
-    /// the fence line), if any.
-    fn flush_neighbour(&self, k: usize, y: [f64; 2]) -> Option<usize> {
-        let f = self.fence_geom();
-        let m = self.poly.len();
-        let v = self.poly.vertex(k);
-        let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
-        if dist(k + m - 1).abs() <= 1e-9 {
-            Some((k + m - 1) % m)
-        } else if dist(k + 1).abs() <= 1e-9 {
-            Some(k)
-        } else {
-            None
-        }
-    }
-
-    /// The orientation nearest `theta` at which hull edge k lies exactly flush on the fence (its
-    /// outward normal against the fence normal). Flush is a geometric fact at the event that finds
-    /// it; snapping removes the event's landing error (≤ 1e-2·tol).
-    fn flush_angle(&self, k: usize, theta: f64) -> f64 {
-        let f = self.fence_geom();
-        let out = -self.poly.inward_normal(k);
-        let target = (-f.n).angle() - out.angle();
-        theta + crate::geometry::wrap_pi(target - theta)
-    }
-
-    /// The consistent translation mode of a flush edge: slide towards the side the belt's motion
-    /// leaves the friction cone on, or `Stick` (a jam) when it lies inside the cone (inclusive:
-    /// α + atan μf ≥ 90° jams).
-    fn flush_mode(&self) -> Mode {
-        let f = self.fence_geom();
-        if self.fr.mu_c == 0.0 {
-            return Mode::Slide;
-        }
-        let (fl, fr) = (self.fr.left_edge(f.n), self.fr.right_edge(f.n));
-        // The cone boundary itself jams (α + atan μf = 90° exactly); 1e-12 absorbs the rounding
-        // of the angles so that the condition holds at exactly the predicted angle.
-        let v = self.vdir.normalized();
-        if fl.cross(v) > 1e-12 {
-            Mode::SlideLeft
-        } else if fr.cross(v) < -1e-12 {
-            Mode::SlideRight
-        } else {
-            Mode::Stick
-        }
-    }
-
-    fn record(&mut self, s: f64, feat: Feat, y: [f64; 2], inst: &Instant) {
-        if self.recorder.is_none() {
-            return;
-        }
-        let pose = self.pose(s, feat, y);
-        let g = self.geom(feat, y);
-        let k = self.scale;
-        let sample = TraceSample {
-            s: s * k,
-            pose: Pose::new(pose.x * k, pose.y * k, pose.theta),
-            pin_centre: self.pin_at(s) * k,
-            contact_point: pose.apply(g.p) * k,
-            force: inst.force.rotate(y[0]) * self.mu_s,
-            normal: g.n.rotate(y[0]),
-            rotation_rate: inst.twist[2] / k,
-            mode: inst.mode,
-            feature: feat.public(),
-        };
-        if let Some(r) = self.recorder.as_deref_mut() {
-            r.record(&sample);
-        }
-    }
-}
-
-// Dormand–Prince 5(4) tableau.
-const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
-const A: [[f64; 6]; 7] = [
-    [0.0; 6],
-    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [
-        19372.0 / 6561.0,
-        -25360.0 / 2187.0,
-        64448.0 / 6561.0,
-        -212.0 / 729.0,
-        0.0,
-        0.0,
-    ],
-    [
-        9017.0 / 3168.0,
-        -355.0 / 33.0,
-        46732.0 / 5247.0,
-        49.0 / 176.0,
-        -5103.0 / 18656.0,
-        0.0,
-    ],
-    [
-        35.0 / 384.0,
-        0.0,
-        500.0 / 1113.0,
-        125.0 / 192.0,
-        -2187.0 / 6784.0,
-        11.0 / 84.0,
-    ],
-];
-const E: [f64; 7] = [
-    71.0 / 57600.0,
-    0.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-];
-
-struct StepResult {
-    y1: [f64; 2],
-    f1: [f64; 2],
-    inst1: Instant,
-    err: f64,
-    /// The seven stage derivatives (for the dense output).
-    k: [[f64; 2]; 7],
-    /// The first interior stage (as a fraction of the step) at which the mode's own margins were
-    /// clearly violated: a mode switch that comes and goes inside the step.
-    margin_dip: Option<f64>,
-}
-
-/// A stage's mode margin below −MARGIN_DIP (a sine) means the mode broke inside the step even if
-/// it holds again at both ends (stage states are approximations: a clear violation only).
-const MARGIN_DIP: f64 = 1e-3;
-
-/// The geometric event functions (edge ends, normal cone, fence ends) depend on the state alone,
-/// so the dense output shows, without solving anything, an event that comes and goes inside one
-/// step — which the end-point signs miss; likewise a disc pin's brief second touch on a concave
-/// part. Returns the first of eight interior fractions of the step at which an event positive at
-/// both ends dips below −slack, or the pin overlaps another edge.
-#[allow(clippy::too_many_arguments)]
-fn geometric_dip(
-    ctx: &Ctx,
-    feat: Feat,
-    s: f64,
-    y0: [f64; 2],
-    step: &StepResult,
-    h: f64,
-    ev1: &[f64; N_EVENTS],
-    slack: f64,
-) -> Option<f64> {
-    // Nothing to miss unless an event not yet crossed ends the step near zero (the guard keeps a
-    // step's change of the contact coordinate below 0.5) or a disc could touch a second edge.
-    let near = (3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j]));
-    let second = !ctx.poly.is_convex() && ctx.rho > 0.0 && ctx.fence.is_none();
-    if !near && !second {
-        return None;
-    }
-    (1..8).map(|k| k as f64 / 8.0).find(|&t| {
-        let yt = dense(y0, step.y1, &step.k, h, t);
-        let g = ctx.geom(feat, yt);
-        let dips = near
-            && ctx
-                .feature_events(feat, yt, &g)
-                .iter()
-                .zip(&ev1[3..])
-                .any(|(&e, &e1)| e1 >= 0.0 && e < -slack);
-        dips || (second && second_contact(ctx, feat, &ctx.pose(s + t * h, feat, yt), s + t * h))
-    })
-}
-
-/// A trial step while landing on an event.
-enum Trial {
-    /// No step: the state at the start of the step.
-    Start,
-    /// A valid step and the located event's function after it.
-    Step(Box<StepResult>, f64),
-    /// A step that failed, or whose result cannot be trusted.
-    Invalid,
-}
-
-/// One Dormand–Prince step of size h from (y0, f0).
-fn dp_step(
-    ctx: &mut Ctx,
-    feat: Feat,
-    mode: Mode,
-    y0: [f64; 2],
-    f0: [f64; 2],
-    h: f64,
-) -> Result<StepResult, SolveFailure> {
-    let mut k = [[0.0f64; 2]; 7];
-    k[0] = f0;
-    let mut inst_last = None;
-    let mut margin_dip = None;
-    for i in 1..7 {
-        let mut yi = y0;
-        for (j, kj) in k.iter().enumerate().take(i) {
-            let a = A[i][j];
-            if a != 0.0 {
-                yi[0] += h * a * kj[0];
-                yi[1] += h * a * kj[1];
-            }
-        }
-        let (d, inst) = ctx.rhs(feat, mode, yi)?;
-        k[i] = d;
-        let broken = inst.margins[0] + ctx.band[1] < -MARGIN_DIP
-            || inst.margins[1] + ctx.band[2] < -MARGIN_DIP;
-        // Interior stages only (C < 1; stages 5 and 6 sit at the step's end).
-        if C[i] < 1.0 && broken && margin_dip.is_none() {
-            margin_dip = Some(C[i]);
-        }
-        inst_last = Some(inst);
-    }
-    // Stage 7 is evaluated at y1 (FSAL).
-    let mut y1 = y0;
-    for (j, kj) in k.iter().enumerate().take(6) {
-        y1[0] += h * A[6][j] * kj[0];
-        y1[1] += h * A[6][j] * kj[1];
-    }
-    let mut err: f64 = 0.0;
-    for c in 0..2 {
-        let mut e = 0.0;
-        for (j, kj) in k.iter().enumerate() {
-            e += E[j] * kj[c];
-        }
-        err = err.max((h * e).abs() / ctx.tol);
-    }
-    if !(y1[0].is_finite() && y1[1].is_finite() && err.is_finite()) {
-        return Err(SolveFailure::NonFinite);
-    }
-    Ok(StepResult {
-        y1,
-        f1: k[6],
-        inst1: inst_last.expect("six stages ran"),
-        err,
-        k,
-        margin_dip,
-    })
-}
-
-// Dormand–Prince continuous extension (Hairer, Nørsett & Wanner, dopri5 `contd5`): 4th order.
-const D: [f64; 7] = [
-    -12715105075.0 / 11282082432.0,
-    0.0,
-    87487479700.0 / 32700410799.0,
-    -10690763975.0 / 1880347072.0,
-    701980252875.0 / 199316789632.0,
-    -1453857185.0 / 822651844.0,
-    69997945.0 / 29380423.0,
-];
-
-/// State at fraction `t` ∈ [0, 1] of a step of size `h` from `y0` that ended at `y1` with stages `k`.
-fn dense(y0: [f64; 2], y1: [f64; 2], k: &[[f64; 2]; 7], h: f64, t: f64) -> [f64; 2] {
-    let mut out = [0.0; 2];
-    for c in 0..2 {
-        let ydiff = y1[c] - y0[c];
-        let bspl = h * k[0][c] - ydiff;
-        let r4 = ydiff - h * k[6][c] - bspl;
-        let mut r5 = 0.0;
-        for (j, kj) in k.iter().enumerate() {
-            r5 += D[j] * kj[c];
-        }
-        r5 *= h;
-        out[c] = y0[c] + t * (ydiff + (1.0 - t) * (bspl + t * (r4 + (1.0 - t) * r5)));
-    }
-    out
-}
-
-/// Illinois root of g on [0, 1] with g(0) = ga > 0 ≥ g(1) = gb.
-fn illinois(mut g: impl FnMut(f64) -> f64, ga: f64, gb: f64, tol: f64) -> f64 {
-    let (mut a, mut b, mut fa, mut fb) = (0.0, 1.0, ga, gb);
-    let mut side = 0;
-    let mut c = 1.0;
-    for _ in 0..80 {
-        c = (a * fb - b * fa) / (fb - fa);
-        if !c.is_finite() || c <= a || c >= b {
-            c = 0.5 * (a + b);
-        }
-        let fc = g(c);
-        if fc.abs() <= tol || b - a <= 1e-12 {
-            break;
-        }
-        if fc < 0.0 {
-            b = c;
-            fb = fc;
-            if side == -1 {
-                fa *= 0.5;
-            }
-            side = -1;
-        } else {
-            a = c;
-            fa = fc;
-            if side == 1 {
-                fb *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    c
-}
-
-/// The state after a point pin's instantaneous sweep round convex vertex `k`: onto the incoming edge
-/// (direction left) or the outgoing edge (right), or separation if that edge faces away from the pin.
-fn sweep(ctx: &Ctx, k: usize, left: bool, theta: f64) -> Option<(Feat, [f64; 2])> {
-    let m = ctx.poly.len();
-    let (edge, ell) = if left {
-        let e = (k + m - 1) % m;
-        let (a, b) = ctx.poly.edge(e);
-        (e, (b - a).norm())
-    } else {
-        (k % m, 0.0)
-    };
-    let n = ctx.poly.inward_normal(edge);
-    let v_pin = ctx.vdir.rotate(-theta);
-    if n.dot(v_pin) / v_pin.norm() <= 1e-12 {
-        None
-    } else {
-        Some((Feat::Edge(edge), [theta, ell]))
-    }
-}
-
-/// Outcome of settling the mode at a new contact state: continue, or the contact ends.
-enum Settle {
-    Go(Feat, [f64; 2], Instant),
-    Separate,
-    Stop(ContactStatus),
-}
-
-/// Decide the mode at a (possibly new) contact state, resolving point-pin vertex sweeps.
-fn settle(ctx: &mut Ctx, s: f64, mut feat: Feat, mut y: [f64; 2]) -> Settle {
-    for _ in 0..6 {
-        if let Feat::FenceEdge(k) = feat {
-            let mode = ctx.flush_mode();
-            let inst = ctx.flush_instant(k, y, mode);
-            // The supported interval is closed (the force may act at an end vertex): rounding-level
-            // negatives count as inside.
-            let (m0, m1) = (inst.margins[0] + ctx.band[1], inst.margins[1] + ctx.band[2]);
-            if m0 < -1e-12 || m1 < -1e-12 {
-                // The force line misses the supported interval: pivot about the nearer end.
-                ctx.band = [0.0; N_EVENTS];
-                let (f, yy) = flush_pivot(ctx, k, y, m1 < m0);
-                feat = f;
-                y = yy;
-                continue;
-            }
-            if mode == Mode::Stick {
-                return Settle::Stop(ContactStatus::Jam { s: s * ctx.scale });
-            }
-            return Settle::Go(feat, y, inst);
-        }
-        let g = ctx.geom(feat, y);
-        let inst = match classify(
-            ctx.model,
-            ctx.fid,
-            &g,
-            ctx.fr,
-            &mut ctx.warm,
-            &mut ctx.evals,
-        ) {
-            Ok(Some(i)) => i,
-            Ok(None) => return Settle::Separate,
-            Err(failure) => {
-                return Settle::Stop(ContactStatus::Solver {
-                    failure,
-                    s: s * ctx.scale,
-                })
-            }
-        };
-        match (feat, ctx.rho > 0.0, inst.mode) {
-            (Feat::Vertex(k), false, Mode::SlideLeft | Mode::SlideRight | Mode::Slide) => {
-                // A point pin cannot slide on a vertex: it passes onto the edge it slides towards.
-                let left = match inst.mode {
-                    Mode::SlideLeft => true,
-                    Mode::SlideRight => false,
-                    _ => g.v_pin.dot(g.n.perp()) > 0.0,
-                };
-                match sweep(ctx, k, left, y[0]) {
-                    Some((f, yy)) => {
-                        feat = f;
-                        y = yy;
-                        continue;
-                    }
-                    None => return Settle::Separate,
-                }
-            }
-            _ => return Settle::Go(feat, y, inst),
-        }
-    }
-    Settle::Stop(ContactStatus::EventLimit { events: 6 })
-}
-
-/// A flush edge whose force line leaves its supported interval pivots about that end: a hull vertex
-/// (vertex on the fence line) or the fence's own end (which then acts as a point pin on the edge).
-fn flush_pivot(ctx: &mut Ctx, k: usize, y: [f64; 2], hi_end: bool) -> (Feat, [f64; 2]) {
-    let f = *ctx.fence_geom();
-    let m = ctx.poly.len();
-    let vk = ctx.poly.vertex(k).rotate(y[0]);
-    let other = (ctx.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
-    let (lo, hi, _) = ctx.flush_interval(k, y, f.n);
-    let end = if hi_end { hi } else { lo };
-    if end == 0.0 {
-        (Feat::FenceVertex(k), y)
-    } else if end == other {
-        (Feat::FenceVertex((k + 1) % m), [y[0], y[1] + other])
-    } else {
-        // A fence end inside the edge: that end pushes the edge like a point pin.
-        ctx.start = if end <= -y[1] + 1e-12 { f.p0 } else { f.p1() };
-        (Feat::Edge(k), [y[0], end.abs()])
-    }
-}
-
-/// The starting contact state for a first touch.
-fn initial_state(ctx: &Ctx, pose: &Pose, feature: Feature, normal_world: Vec2) -> (Feat, [f64; 2]) {
-    let theta = pose.theta;
-    match feature {
-        Feature::Edge { index, t } => {
-            let (a, b) = ctx.poly.edge(index);
-            (Feat::Edge(index), [theta, t * (b - a).norm()])
-        }
-        Feature::Vertex { index } => {
-            let n_part = if ctx.rho > 0.0 {
-                normal_world.rotate(-theta)
-            } else {
-                // Point pin: the ρ → 0 limit of a disc arriving along its path: the normal is the
-                // direction of travel, clamped into the vertex's normal cone.
-                let m = ctx.poly.len();
-                let na = ctx.poly.inward_normal(index + m - 1);
-                let nb = ctx.poly.inward_normal(index);
-                let d = ctx.vdir.rotate(-theta).normalized();
-                if na.cross(d) >= 0.0 && d.cross(nb) >= 0.0 {
-                    d
-                } else if d.dot(na) >= d.dot(nb) {
-                    na
-                } else {
-                    nb
-                }
-            };
-            (Feat::Vertex(index), [theta, n_part.angle()])
-        }
-    }
-}
-
-/// Minimum distance from the pin centre to edges not adjacent to the current feature (disc pins on
-/// concave parts): negative margin means a second contact.
-fn second_contact(ctx: &Ctx, feat: Feat, pose: &Pose, s: f64) -> bool {
-    if ctx.poly.is_convex() || ctx.rho == 0.0 || ctx.fence.is_some() {
-        return false;
-    }
-    let m = ctx.poly.len();
-    let centre = pose.apply_inverse(ctx.pin_at(s));
-    let (skip_a, skip_b) = match feat {
-        Feat::Edge(k) | Feat::FenceEdge(k) => (k, k),
-        Feat::Vertex(k) | Feat::FenceVertex(k) => ((k + m - 1) % m, k),
-    };
-    for i in 0..m {
-        if i == skip_a || i == skip_b {
-            continue;
-        }
-        let (a, b) = ctx.poly.edge(i);
-        let e = b - a;
-        let t = ((centre - a).dot(e) / e.norm2()).clamp(0.0, 1.0);
-        if (a + e * t - centre).norm() < ctx.rho * (1.0 - 1e-9) {
-            return true;
-        }
-    }
-    false
-}
+/// The smallest step (units of a) before the integrator gives up.
+const H_MIN: f64 = 1e-13;
 
 /// Book-keeping of one pass: segments, events and steps so far.
-struct Tally {
-    list: Vec<Segment>,
+#[derive(Default)]
+pub(super) struct Tally {
+    /// The closed segments (caller's units).
+    pub(super) list: Vec<Segment>,
     open: Option<(Feat, Mode, f64, f64)>,
     events: u32,
-    steps: u32,
+    /// Accepted steps (including landing steps).
+    pub(super) steps: u32,
     /// Pin travel (units of a) in the current contact during which a pin turned the part slower
     /// than [`NOISE_RATE`]·tol per unit of travel (see [`ContactStatus::Metastable`]).
     still: f64,
@@ -972,7 +93,8 @@ impl Tally {
     fn open(&mut self, feat: Feat, mode: Mode, s: f64, theta: f64) {
         self.open = Some((feat, mode, s, theta));
     }
-    fn close(&mut self, s: f64, theta: f64, scale: f64) {
+    /// Close the open segment at (s, θ) (normalised travel; `scale` converts).
+    pub(super) fn close(&mut self, s: f64, theta: f64, scale: f64) {
         if let Some((f, m, s0, t0)) = self.open.take() {
             self.list.push(Segment {
                 feature: f.public(),
@@ -986,18 +108,14 @@ impl Tally {
     }
 }
 
-/// After a pin separates from edge k (its path tangent to the edge at orientation `theta`), is the
-/// vertex it runs towards along the edge reflex?
-fn reflex_ahead(ctx: &Ctx, k: usize, theta: f64) -> bool {
-    let (a, b) = ctx.poly.edge(k);
-    let towards_b = (b - a).dot(ctx.vdir.rotate(-theta)) > 0.0;
-    let m = ctx.poly.len();
-    let v = if towards_b { (k + 1) % m } else { k };
-    !ctx.poly.vertex_is_convex(v)
+/// The contact stops with `status` at (s, feat, y).
+fn stop(ctx: &Ctx, status: ContactStatus, s: f64, feat: Feat, y: [f64; 2]) -> Finish {
+    let p = ctx.pose(s, feat, y);
+    (End::Stop(status), s, p)
 }
 
 /// The end of a contact that separated at (s, feat, y), after the self-check.
-fn separated(ctx: &Ctx, s: f64, feat: Feat, y: [f64; 2], segs: &Tally) -> (End, f64, Pose) {
+fn separated(ctx: &Ctx, s: f64, feat: Feat, y: [f64; 2], segs: &Tally) -> Finish {
     let p = ctx.pose(s, feat, y);
     if segs.still > METASTABLE_TRAVEL {
         let travel = segs.still * ctx.scale;
@@ -1017,815 +135,309 @@ fn separated(ctx: &Ctx, s: f64, feat: Feat, y: [f64; 2], segs: &Tally) -> (End, 
 }
 
 /// Integrate one contact from its first touch until separation. Returns the end and the final state.
-fn integrate_contact(
+pub(super) fn integrate_contact(
     ctx: &mut Ctx,
     settings: &ContactSettings,
     s_start: f64,
     feat0: Feat,
     y_start: [f64; 2],
     segs: &mut Tally,
-) -> (End, f64, Pose) {
-    let mut s = s_start;
+) -> Finish {
     segs.still = 0.0;
-    let (mut feat, mut y, mut inst) = match settle(ctx, s, feat0, y_start) {
+    let (feat, y, inst) = match settle(ctx, s_start, feat0, y_start) {
         Settle::Go(f, yy, i) => (f, yy, i),
         Settle::Separate => {
-            let p = ctx.pose(s, feat0, y_start);
-            return (End::Separated, s, p);
+            let p = ctx.pose(s_start, feat0, y_start);
+            return (End::Separated, s_start, p);
         }
-        Settle::Stop(st) => {
-            let p = ctx.pose(s, feat0, y_start);
-            return (End::Stop(st), s, p);
-        }
+        Settle::Stop(st) => return stop(ctx, st, s_start, feat0, y_start),
     };
-    let mut mode = inst.mode;
-    segs.open(feat, mode, s, y[0]);
-    ctx.record(s, feat, y, &inst);
-    let mut f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
-    let mut ev0 = ctx.events(feat, y, &inst);
-    let h_min = 1e-13;
-    // First step: a tenth of a, shrunk by the error control if the motion is fast.
-    let mut h = 0.1;
-    // Events are landed to |g| ≤ land_tol; a fresh segment treats |g| ≤ slack as "at the boundary"
-    // (the new mode's margin starts at zero up to the landing error), and only g < −slack at a
-    // segment start means the state is already past an event.
-    let land_tol = 1e-2 * ctx.tol;
-    let slack = 100.0 * land_tol;
+    let mut at = begin(ctx, s_start, feat, y, inst, segs);
     let mut last_switch: Option<(f64, Mode)> = None;
     // (travel, feature left, event index) of the last change of contact feature.
     let mut last_feature_change: Option<(f64, Feat, usize)> = None;
-    ctx.band = [0.0; N_EVENTS];
     loop {
-        if ctx.evals > settings.max_evaluations {
-            let p = ctx.pose(s, feat, y);
-            return (
-                End::Stop(ContactStatus::EvaluationLimit {
-                    evaluations: ctx.evals,
-                }),
-                s,
-                p,
-            );
-        }
-        if s - s_start > settings.max_travel {
-            let p = ctx.pose(s, feat, y);
-            return (
-                End::Stop(ContactStatus::TravelLimit {
-                    travel: (s - s_start) * ctx.scale,
-                }),
-                s,
-                p,
-            );
+        if let Some(finish) = over_budget(ctx, settings, &at, s_start) {
+            return finish;
         }
         // An event function already negative at the start of a step: the state is at an event.
-        let pending = (0..N_EVENTS).find(|&i| ev0[i] < -slack);
-        let (event, s_ev, y_ev, inst_ev) = if let Some(i) = pending {
-            (Some(i), s, y, inst)
-        } else if ctx.at_turn(s) {
-            (Some(TURN), s, y, inst)
+        let pending = (0..N_EVENTS).find(|&i| at.ev0[i] < -at.slack);
+        let (i, s_ev, y_ev, inst_ev) = if let Some(i) = pending {
+            (i, at.s, at.y, at.inst)
+        } else if ctx.at_turn(at.s) {
+            (TURN, at.s, at.y, at.inst)
         } else {
-            // A step never crosses a turn of the pin's path: it ends there.
-            let to_turn = ctx.turn_at() - s;
-            let clipped = h >= to_turn;
-            if clipped {
-                h = to_turn;
-            }
-            let step = match dp_step(ctx, feat, mode, y, f0, h) {
-                Ok(r) => r,
-                Err(failure) => {
-                    h *= 0.25;
-                    if h < h_min {
-                        let p = ctx.pose(s, feat, y);
-                        return (
-                            End::Stop(ContactStatus::Solver {
-                                failure,
-                                s: s * ctx.scale,
-                            }),
-                            s,
-                            p,
-                        );
-                    }
-                    continue;
-                }
-            };
-            let guarded = !step_change_ok(feat, y, step.y1);
-            if step.err > 1.0 || guarded {
-                h *= if guarded {
-                    0.25
-                } else {
-                    (0.9 * step.err.powf(-0.2)).max(0.2)
-                };
-                if h < h_min {
-                    let p = ctx.pose(s, feat, y);
-                    return (
-                        End::Stop(ContactStatus::StepTooSmall { s: s * ctx.scale }),
-                        s,
-                        p,
-                    );
-                }
-                continue;
-            }
-            let ev1 = ctx.events(feat, step.y1, &step.inst1);
-            let mode_dip = step.margin_dip.filter(|_| ev1[1] >= 0.0 && ev1[2] >= 0.0);
-            if let Some(t_dip) = geometric_dip(ctx, feat, s, y, &step, h, &ev1, slack).or(mode_dip)
-            {
-                // The contact runs off its feature and back (e.g. past an edge's end), or its mode
-                // breaks and recovers, within the step: shorten the step so that it ends beyond
-                // the first crossing, where the event is located as usual. (Below 1e-10 a a dip
-                // is the start state itself sitting on the boundary: the endpoint rule decides.)
-                if h * t_dip >= 1e-10 {
-                    h *= t_dip;
-                    continue;
-                }
-            }
-            let crossed: Vec<usize> = (0..N_EVENTS)
-                .filter(|&i| ev1[i] < 0.0 && ev0[i] >= -slack)
-                .collect();
-            let factor = (0.9 * step.err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
-            if crossed.is_empty() {
-                // A bounced margin that has recovered gets its ordinary zero threshold back.
-                for (b, e) in ctx.band.iter_mut().zip(ev1) {
-                    if *b > 0.0 && e - *b > slack {
-                        *b = 0.0;
+            match take_step(ctx, &mut at, segs) {
+                Stepped::Again => continue,
+                Stepped::Done(finish) => return finish,
+                Stepped::Crossed(step, ev1, crossed) => {
+                    match land_on_event(ctx, &at, &step, &ev1, &crossed, segs) {
+                        Ok(event) => event,
+                        Err(finish) => return finish,
                     }
                 }
-                segs.ride(ctx, feat, step.f1[0].abs().max(f0[0].abs()), h);
-                s = if clipped { ctx.turn_at() } else { s + h };
-                y = step.y1;
-                inst = step.inst1;
-                f0 = step.f1;
-                ev0 = ev1;
-                segs.steps += 1;
-                ctx.record(s, feat, y, &inst);
-                let pose = ctx.pose(s, feat, y);
-                if second_contact(ctx, feat, &pose, s) {
-                    return (
-                        End::Stop(ContactStatus::MultiContact { s: s * ctx.scale }),
-                        s,
-                        pose,
-                    );
-                }
-                h = (h * factor).min(max_step(feat));
-                continue;
-            }
-            // Locate the earliest crossing on the interpolant.
-            let (y0c, y1c, kc, hc) = (y, step.y1, step.k, h);
-            let mut best = (2.0, 0usize);
-            let warm_saved = ctx.warm;
-            let root_tol = 1e-3 * ctx.tol;
-            let ctx_tol = ctx.tol;
-            let band = ctx.band;
-            for &i in &crossed {
-                let g0 = ev0[i].max(0.0);
-                let t = if g0 == 0.0 {
-                    0.0
-                } else {
-                    illinois(
-                        |t| {
-                            let yt = dense(y0c, y1c, &kc, hc, t);
-                            if i == 0 || i >= 3 {
-                                let dummy = inst;
-                                ctx.events(feat, yt, &dummy)[i]
-                            } else {
-                                let g = ctx.geom(feat, yt);
-                                match solve_in_mode(
-                                    ctx.model,
-                                    ctx.fid,
-                                    &g,
-                                    ctx.fr,
-                                    mode,
-                                    &mut ctx.warm,
-                                    &mut ctx.evals,
-                                ) {
-                                    Ok(it) => it.margins[i - 1] + band[i],
-                                    Err(_) => -1.0,
-                                }
-                            }
-                        },
-                        g0,
-                        ev1[i],
-                        root_tol,
-                    )
-                };
-                if t < best.0 {
-                    best = (t, i);
-                }
-            }
-            ctx.warm = warm_saved;
-            let (t_est, i) = best;
-            // A sub-step of the accepted step must agree with its dense output (both are
-            // accurate to about tol; 1e3·tol leaves room for a mode boundary inside the step).
-            let near_dense = |r: &StepResult, t: f64| {
-                let yd = dense(y0c, y1c, &kc, hc, t);
-                (r.y1[0] - yd[0]).abs() <= 1e3 * ctx_tol && (r.y1[1] - yd[1]).abs() <= 1e3 * ctx_tol
-            };
-            // Refine on real steps: g(t) = event i after a Dormand–Prince step of t·h from (s, y).
-            // A trial step counts only if it is itself accurate (its own error estimate within 10×
-            // the tolerance: sub-steps of an accepted step may sit just above it), passes the step
-            // guard and crosses neither the separation nor another geometric event; otherwise its event
-            // value means nothing (the −880° case of issue 11 landed on such a step) and the
-            // bracket shrinks from above.
-            let real = |t: f64, ctx: &mut Ctx| -> Trial {
-                if t * h <= 1e-15 {
-                    return Trial::Start;
-                }
-                match dp_step(ctx, feat, mode, y, f0, t * h) {
-                    Ok(r) if step_change_ok(feat, y, r.y1) && near_dense(&r, t) => {
-                        let ev = ctx.events(feat, r.y1, &r.inst1);
-                        if [0, 3, 4, 5, 6].iter().all(|&j| j == i || ev[j] >= -slack) {
-                            Trial::Step(Box::new(r), ev[i])
-                        } else {
-                            Trial::Invalid
-                        }
-                    }
-                    _ => Trial::Invalid,
-                }
-            };
-            let (mut a, mut b) = (0.0f64, 1.0f64);
-            let (mut ga, mut gb) = (ev0[i].max(0.0), ev1[i]);
-            // The landing: the trial at the largest t with g ≥ 0 (or g just below 0 within the
-            // landing tolerance), and its g.
-            let mut best: (Trial, f64, f64) = (Trial::Start, 0.0, ev0[i].max(0.0));
-            let mut t = t_est.clamp(0.0, 1.0);
-            let mut side = 0;
-            let mut any_invalid = false;
-            // Landing tolerance: far below the integration tolerance, far above rounding.
-            let g_tol = land_tol;
-            for _ in 0..40 {
-                let trial = real(t, ctx);
-                let gt = match &trial {
-                    Trial::Start => ev0[i].max(0.0),
-                    Trial::Step(_, g) => *g,
-                    Trial::Invalid => {
-                        any_invalid = true;
-                        b = t;
-                        side = 0;
-                        if (b - a) * h <= 1e-13 {
-                            break;
-                        }
-                        t = 0.5 * (a + b);
-                        continue;
-                    }
-                };
-                let close = gt.abs() <= g_tol;
-                if gt < 0.0 {
-                    b = t;
-                    gb = gt;
-                    if side == -1 {
-                        ga *= 0.5;
-                    }
-                    side = -1;
-                    if close {
-                        best = (trial, t, gt);
-                    }
-                } else {
-                    a = t;
-                    ga = gt;
-                    best = (trial, t, gt);
-                    if side == 1 {
-                        gb *= 0.5;
-                    }
-                    side = 1;
-                }
-                if close || (b - a) * h <= 1e-13 {
-                    break;
-                }
-                t = (a * gb - b * ga) / (gb - ga);
-                if !t.is_finite() || t <= a || t >= b {
-                    t = 0.5 * (a + b);
-                }
-            }
-            let (landing, best_t, best_g) = best;
-            let (s_land, y_land, inst_land) = match landing {
-                Trial::Step(r, _) => {
-                    segs.steps += 1;
-                    segs.ride(ctx, feat, r.f1[0].abs().max(f0[0].abs()), best_t * h);
-                    (s + best_t * h, r.y1, r.inst1)
-                }
-                _ => (s, y, inst),
-            };
-            if any_invalid && best_g > slack {
-                // The event lies beyond a stretch the integrator cannot resolve (the rates blow up
-                // before it). Near a separation that is the triple point where the pin's path turns
-                // tangent while the sliding side's contact velocity does too (κ = n·v_pin / n·v_b →
-                // 0/0): the part is within asin(push margin) of letting go, so it separates here
-                // when that margin is below min(1e3·tol, 1e-3) (an orientation error below 0.06°).
-                // Anywhere else, say so rather than apply the event at a state short of it.
-                let g = ctx.geom(feat, y_land);
-                if push_margin(&g).abs() <= (1e3 * ctx.tol).min(1e-3) {
-                    (Some(0), s_land, y_land, inst_land)
-                } else {
-                    let p = ctx.pose(s, feat, y);
-                    return (
-                        End::Stop(ContactStatus::StepTooSmall { s: s * ctx.scale }),
-                        s,
-                        p,
-                    );
-                }
-            } else {
-                (Some(i), s_land, y_land, inst_land)
             }
         };
-        let i = event.expect("an event was found");
 
         // Turns of the pin's path are bounded by the path itself; only contact events count.
         segs.events += u32::from(i != TURN);
         if segs.events > settings.max_events {
-            let p = ctx.pose(s_ev, feat, y_ev);
-            return (
-                End::Stop(ContactStatus::EventLimit {
-                    events: segs.events,
-                }),
+            let events = segs.events;
+            return stop(
+                ctx,
+                ContactStatus::EventLimit { events },
                 s_ev,
-                p,
+                at.feat,
+                y_ev,
             );
         }
-        s = s_ev;
-        y = y_ev;
-        ctx.record(s, feat, y, &inst_ev);
-        segs.close(s, y[0], ctx.scale);
-        // Apply the event.
-        let m = ctx.poly.len();
-        let next: Option<(Feat, [f64; 2], Option<Mode>)> = match (i, feat) {
-            (TURN, _) => {
-                // The pin's lateral speed changes: same contact, mode settled again.
-                ctx.take_turn();
-                Some((feat, y, None))
+        at.s = s_ev;
+        at.y = y_ev;
+        ctx.record(at.s, at.feat, at.y, &inst_ev);
+        segs.close(at.s, at.y[0], ctx.scale);
+        let (s, feat, y) = (at.s, at.feat, at.y);
+        let next = match apply_event(ctx, i, s, feat, at.mode, y, &mut last_switch) {
+            Transition::To(nf, ny, forced) => (nf, ny, forced),
+            Transition::Separate => return separated(ctx, s, feat, y, segs),
+            Transition::Stop(st) => return stop(ctx, st, s, feat, y),
+            Transition::Bounce => {
+                // Stay in the mode: the segment just closed goes on.
+                segs.reopen(feat, at.mode, s, y[0], ctx.scale);
+                at.ev0 = ctx.events(feat, y, &inst_ev);
+                at.inst = inst_ev;
+                at.f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &at.inst);
+                continue;
             }
-            (0, Feat::Edge(k)) if ctx.fence.is_none() && reflex_ahead(ctx, k, y[0]) => {
-                // The edge let go by turning parallel to the pin's path, so the pin runs on along
-                // the edge's line into the reflex corner ahead, where the next edge blocks it: the
-                // pin touches two edges at once (as when it slides into the corner in contact).
-                // Casting the path again would decide that by rounding.
-                let p = ctx.pose(s, feat, y);
-                return (
-                    End::Stop(ContactStatus::MultiContact { s: s * ctx.scale }),
-                    s,
-                    p,
-                );
-            }
-            (0, _) => None,
-            (1 | 2, Feat::FenceEdge(k)) => {
-                let (f, yy) = flush_pivot(ctx, k, y, i == 2);
-                Some((f, yy, None))
-            }
-            (1 | 2, Feat::FenceVertex(k)) if ctx.flush_neighbour(k, y).is_some() => {
-                // The mode changes just as an adjacent edge turns flush (the two events coincide,
-                // e.g. at exactly the jam angle): the edge's arrival decides.
-                let j = ctx.flush_neighbour(k, y).expect("checked by the guard");
-                let f = *ctx.fence_geom();
-                let th = ctx.flush_angle(j, y[0]);
-                let d = (ctx.poly.vertex(j) - ctx.poly.vertex(k))
-                    .rotate(th)
-                    .dot(f.e);
-                Some((Feat::FenceEdge(j), [th, y[1] + d], None))
-            }
-            (1 | 2, _) => {
-                let new_mode = match (mode, i) {
-                    (Mode::Stick, 1) => Mode::SlideLeft,
-                    (Mode::Stick, _) => Mode::SlideRight,
-                    _ => Mode::Stick,
-                };
-                // Ping-pong: switching straight back to the mode we left at this very point means the
-                // state sits on the stick/slide boundary, where both modes give the same motion and
-                // their margins differ only by solver rounding. Stay, and let this margin run down to
-                // −BOUNCE_BAND before it counts (a real, sustained violation still switches).
-                if let Some((s_prev, from)) = last_switch {
-                    if (s - s_prev).abs() <= 1e-12 && from == new_mode && ctx.band[i] == 0.0 {
-                        ctx.band[i] = BOUNCE_BAND;
-                        segs.reopen(feat, mode, s, y[0], ctx.scale);
-                        ev0 = ctx.events(feat, y, &inst_ev);
-                        inst = inst_ev;
-                        f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
-                        continue;
-                    }
-                }
-                last_switch = Some((s, mode));
-                if let (Feat::Vertex(k), false) = (feat, ctx.rho > 0.0) {
-                    // Hooked point pin lets go: it sweeps onto the edge it now slides towards.
-                    sweep(ctx, k, new_mode == Mode::SlideLeft, y[0]).map(|(f, yy)| (f, yy, None))
-                } else {
-                    Some((feat, y, Some(new_mode)))
-                }
-            }
-            (3, Feat::Edge(k)) | (4, Feat::Edge(k)) => {
-                let v = if i == 3 { k } else { (k + 1) % m };
-                if !ctx.poly.vertex_is_convex(v) {
-                    let p = ctx.pose(s, feat, y);
-                    return (
-                        End::Stop(ContactStatus::MultiContact { s: s * ctx.scale }),
-                        s,
-                        p,
-                    );
-                }
-                if ctx.rho > 0.0 {
-                    let n = ctx.poly.inward_normal(k);
-                    Some((Feat::Vertex(v), [y[0], n.angle()], None))
-                } else {
-                    sweep(ctx, v, i == 3, y[0]).map(|(f, yy)| (f, yy, None))
-                }
-            }
-            (3, Feat::Vertex(k)) => {
-                let e = (k + m - 1) % m;
-                let (a, b) = ctx.poly.edge(e);
-                Some((Feat::Edge(e), [y[0], (b - a).norm()], None))
-            }
-            (4, Feat::Vertex(k)) => Some((Feat::Edge(k), [y[0], 0.0], None)),
-            (3, Feat::FenceVertex(k)) => {
-                // The edge before vertex k turns flush: its start vertex k−1 reached the line.
-                let f = *ctx.fence_geom();
-                let j = (k + m - 1) % m;
-                let th = ctx.flush_angle(j, y[0]);
-                let d = (ctx.poly.vertex(j) - ctx.poly.vertex(k))
-                    .rotate(th)
-                    .dot(f.e);
-                Some((Feat::FenceEdge(j), [th, y[1] + d], None))
-            }
-            (4, Feat::FenceVertex(k)) => {
-                Some((Feat::FenceEdge(k), [ctx.flush_angle(k, y[0]), y[1]], None))
-            }
-            (5 | 6, Feat::FenceVertex(k)) => {
-                // The vertex slides off a fence end; that end now acts as a point pin on the part.
-                let f = *ctx.fence_geom();
-                ctx.start = if i == 5 { f.p0 } else { f.p1() };
-                Some((Feat::Vertex(k), [y[0], f.n.rotate(-y[0]).angle()], None))
-            }
-            _ => unreachable!("event index out of range"),
         };
-        let Some((nf, ny, forced)) = next else {
-            return separated(ctx, s, feat, y, segs);
-        };
-        if nf != feat {
-            // Event indices mean different things on the new feature: start with no bands, except
-            // when this transition merely returns, at the same point, to the feature just left (a
-            // marginal geometry, e.g. a force line through an edge's end): then stay there and let
-            // the event that ejected it run down to −BOUNCE_BAND before it counts.
-            let cycle = matches!(last_feature_change, Some((s0, f0, _)) if (s - s0).abs() <= 1e-12 && f0 == nf);
-            let ejected_by = last_feature_change.map(|(_, _, i)| i);
-            ctx.band = [0.0; N_EVENTS];
-            if cycle {
-                if let Some(j) = ejected_by {
-                    ctx.band[j] = BOUNCE_BAND;
-                }
-            }
-            last_feature_change = Some((s, feat, i));
+        if let Some(finish) = open_next(ctx, &mut at, i, next, &mut last_feature_change, segs) {
+            return finish;
         }
-        let settled = match forced {
-            Some(md) => {
-                let g = ctx.geom(nf, ny);
-                match solve_in_mode(
-                    ctx.model,
-                    ctx.fid,
-                    &g,
-                    ctx.fr,
-                    md,
-                    &mut ctx.warm,
-                    &mut ctx.evals,
-                ) {
-                    Ok(it) => Settle::Go(nf, ny, it),
-                    Err(failure) => Settle::Stop(ContactStatus::Solver {
-                        failure,
-                        s: s * ctx.scale,
-                    }),
-                }
-            }
-            None => settle(ctx, s, nf, ny),
-        };
-        match settled {
-            Settle::Go(f, yy, it) => {
-                feat = f;
-                y = yy;
-                inst = it;
-                mode = it.mode;
-            }
-            Settle::Separate => return separated(ctx, s, nf, ny, segs),
-            Settle::Stop(st) => {
-                let p = ctx.pose(s, nf, ny);
-                return (End::Stop(st), s, p);
-            }
-        }
-        segs.open(feat, mode, s, y[0]);
-        // The state just after the event (the force may jump here): a recorder sees both sides.
-        ctx.record(s, feat, y, &inst);
-        f0 = ctx.rates(feat, y, &ctx.geom(feat, y), &inst);
-        ev0 = ctx.events(feat, y, &inst);
-        // Freshly started segments begin at their boundary: do not re-trigger on rounding.
-        for e in ev0.iter_mut() {
-            if e.abs() <= slack {
-                *e = 0.0;
-            }
-        }
-        h = h.clamp(1e-6, max_step(feat).max(1e-6));
     }
 }
 
-/// How the next contact of a pass begins.
-enum Touch {
-    None,
-    At(f64, Feat, [f64; 2]),
-    Stop(ContactStatus),
+/// Open the segment at the cursor's state: record it, and compute its rates and event functions.
+fn open_segment(ctx: &mut Ctx, at: &mut Cursor, segs: &mut Tally) {
+    segs.open(at.feat, at.mode, at.s, at.y[0]);
+    ctx.record(at.s, at.feat, at.y, &at.inst);
+    at.f0 = ctx.rates(at.feat, at.y, &ctx.geom(at.feat, at.y), &at.inst);
+    at.ev0 = ctx.events(at.feat, at.y, &at.inst);
 }
 
-/// The next touch between the obstacle and the part resting at `cur`, after travel `s`.
-fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touch {
-    let k = ctx.scale;
-    if let Some(f) = ctx.fence {
-        let s_from = if after_separation { s + 1e-9 } else { s };
-        return match first_touch(ctx.poly, cur, &f, ctx.vdir, s_from) {
-            None => Touch::None,
-            Some((t, FenceTouch::LineVertex { k, sigma })) => {
-                Touch::At(t, Feat::FenceVertex(k), [cur.theta, sigma])
-            }
-            Some((t, FenceTouch::LineEdge { k, sigma })) => {
-                Touch::At(t, Feat::FenceEdge(k), [cur.theta, sigma])
-            }
-            Some((t, FenceTouch::End { end, feature })) => {
-                ctx.start = if end == 0 { f.p0 } else { f.p1() };
-                let n = ctx.vdir.normalized();
-                let (feat, y) = initial_state(ctx, cur, feature, n);
-                Touch::At(t, feat, y)
-            }
-        };
-    }
-    let mut s = s;
-    let mut min_travel = if after_separation { 1e-9 } else { 0.0 };
-    // Piece by piece along the pin's path: a touch beyond the next turn is not on this piece.
-    loop {
-        let touch = cast_piece(ctx, cur, s, min_travel);
-        let s_turn = ctx.turn_at();
-        let beyond_turn = match &touch {
-            Touch::At(t, ..) => *t > s_turn,
-            Touch::Stop(ContactStatus::MultiContact { s: t }) => *t / k > s_turn,
-            Touch::Stop(_) => false,
-            Touch::None => s_turn.is_finite(),
-        };
-        if !beyond_turn {
-            return touch;
-        }
-        s = s_turn;
-        ctx.take_turn();
-        min_travel = 0.0;
-    }
-}
-
-/// The first touch of the pin on the current piece of its path (extended as a ray), after travel
-/// `s` plus `min_travel` along the path.
-fn cast_piece(ctx: &mut Ctx, cur: &Pose, s: f64, mut min_travel: f64) -> Touch {
-    let k = ctx.scale;
-    let dir_len = ctx.vdir.norm();
-    let dir = ctx.vdir / dir_len;
-    for _ in 0..8 {
-        let Some(hit) = first_contact(ctx.poly, cur, ctx.pin_at(s), dir, ctx.rho, min_travel)
-        else {
-            return Touch::None;
-        };
-        if hit.grazing {
-            // A touch that pushes nothing: continue along the path past it (a relative step:
-            // the travel can be 1e8 a).
-            min_travel = hit.travel + 1e-9 * (1.0 + hit.travel.abs());
-            continue;
-        }
-        let s_touch = s + hit.travel / dir_len;
-        if let Feature::Vertex { index } = hit.feature {
-            if !ctx.poly.vertex_is_convex(index) {
-                // The pin strikes a reflex corner: it touches both edges of the notch at once.
-                return Touch::Stop(ContactStatus::MultiContact { s: s_touch * k });
-            }
-        }
-        let (feat, y) = initial_state(ctx, cur, hit.feature, hit.normal);
-        // The contact state must put the part where it is: a ray that runs along an edge it has
-        // just left (the pin separated moving tangentially) can report a touch elsewhere on that
-        // edge, which would teleport the part. Such a touch pushes nothing: look past it.
-        let at = ctx.pose(s_touch, feat, y);
-        if (at.x - cur.x).abs() > 1e-9 || (at.y - cur.y).abs() > 1e-9 {
-            min_travel = hit.travel + 1e-9 * (1.0 + hit.travel.abs());
-            continue;
-        }
-        return Touch::At(s_touch, feat, y);
-    }
-    Touch::None
-}
-
-/// The outcome of a pass that never touched the part.
-fn untouched(pose: Pose, status: ContactStatus) -> ContactOutcome {
-    ContactOutcome {
-        contact: false,
-        pose_initial: pose,
-        pose_final: pose,
-        rotation: 0.0,
-        travel_to_contact: 0.0,
-        contact_length: 0.0,
-        contacts: 0,
-        segments: Vec::new(),
-        evaluations: 0,
-        steps: 0,
-        status,
-    }
-}
-
-/// Run the passes of one obstacle over the part until it no longer touches it.
-fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactOutcome {
-    let k = ctx.scale;
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    let mut out = untouched(pose, ContactStatus::Ok);
-    let mut s = 0.0;
-    let mut cur = pose_n;
-    let mut segs = Tally {
-        list: Vec::new(),
-        open: None,
-        events: 0,
-        still: 0.0,
-        steps: 0,
+/// The cursor at the first touch (state settled), its segment open and the event bands cleared.
+fn begin(
+    ctx: &mut Ctx,
+    s: f64,
+    feat: Feat,
+    y: [f64; 2],
+    inst: Instant,
+    segs: &mut Tally,
+) -> Cursor {
+    let land_tol = 1e-2 * ctx.tol;
+    let mut at = Cursor {
+        s,
+        feat,
+        mode: inst.mode,
+        y,
+        inst,
+        f0: [0.0; 2],
+        ev0: [0.0; N_EVENTS],
+        // First step: a tenth of a, shrunk by the error control if the motion is fast.
+        h: 0.1,
+        land_tol,
+        slack: 100.0 * land_tol,
     };
-    let mut after_separation = false;
-    for _pass in 0..16 {
-        let (s_touch, feat, y) = match next_touch(ctx, &cur, s, after_separation) {
-            Touch::None => break,
-            Touch::Stop(st) => {
-                out.status = st;
-                break;
-            }
-            Touch::At(t, f, y) => (t, f, y),
-        };
-        if out.contacts == 0 {
-            out.travel_to_contact = s_touch * k;
+    open_segment(ctx, &mut at, segs);
+    ctx.band = [0.0; N_EVENTS];
+    at
+}
+
+/// The contact's evaluation or travel budget is spent: it stops where it stands.
+fn over_budget(ctx: &Ctx, settings: &ContactSettings, at: &Cursor, s_start: f64) -> Option<Finish> {
+    let status = if ctx.evals > settings.max_evaluations {
+        ContactStatus::EvaluationLimit {
+            evaluations: ctx.evals,
         }
-        out.contacts += 1;
-        let (end, s_end, pose_end) = integrate_contact(ctx, settings, s_touch, feat, y, &mut segs);
-        segs.close(s_end, pose_end.theta, k);
-        out.contact_length += (s_end - s_touch) * k;
-        s = s_end;
-        cur = pose_end;
-        match end {
-            End::Separated => after_separation = true,
-            End::Stop(st) => {
-                out.status = st;
-                break;
-            }
+    } else if at.s - s_start > settings.max_travel {
+        ContactStatus::TravelLimit {
+            travel: (at.s - s_start) * ctx.scale,
         }
-    }
-    out.contact = out.contacts > 0;
-    out.segments = segs.list;
-    out.pose_final = Pose::new(cur.x * k, cur.y * k, cur.theta);
-    out.rotation = cur.theta - pose.theta;
-    out.evaluations = ctx.evals;
-    out.steps = segs.steps;
-    out
-}
-
-/// Push a part with one pin: the pin starts at `pin_start` (world, caller's units) and travels along
-/// (−1, w) relative to the belt past the part resting at `pose`. Pure function of its inputs.
-pub fn push(
-    model: &PartModel,
-    pose: Pose,
-    pin_start: Vec2,
-    pin: &Pin,
-    settings: &ContactSettings,
-    recorder: Option<&mut dyn Recorder>,
-) -> ContactOutcome {
-    let path = PinPath::constant(pin.lateral_speed);
-    push_path(
-        model, pose, pin_start, pin.radius, &path, settings, recorder,
-    )
-}
-
-/// Push a part with a pin of radius `radius` whose lateral speed follows `path` (SPEC §5: one push
-/// with the pin's true relative velocity (−V, w(s)), each change of w a step boundary). Pure.
-pub fn push_path(
-    model: &PartModel,
-    pose: Pose,
-    pin_start: Vec2,
-    radius: f64,
-    path: &PinPath,
-    settings: &ContactSettings,
-    recorder: Option<&mut dyn Recorder>,
-) -> ContactOutcome {
-    let k = model.scale();
-    let mut ctx = pin_ctx(model, pin_start, radius, path, settings, recorder);
-    // The pin must start clear of the part.
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    let local = pose_n.apply_inverse(ctx.start);
-    if ctx.poly.contains(local) || ctx.poly.distance_to_boundary(local).0 < ctx.rho * (1.0 - 1e-12)
-    {
-        return untouched(pose, ContactStatus::PinInsidePart);
-    }
-    run_passes(&mut ctx, settings, pose)
-}
-
-fn pin_ctx<'a, 'r>(
-    model: &'a PartModel,
-    pin_start: Vec2,
-    radius: f64,
-    path: &PinPath,
-    settings: &ContactSettings,
-    recorder: Option<&'r mut dyn Recorder>,
-) -> Ctx<'a, 'r> {
-    let k = model.scale();
-    Ctx::new(
-        model,
-        model.polygon(),
-        settings,
-        settings.mu_c,
-        radius / k,
-        Vec2::new(-1.0, 0.0),
-        pin_start / k,
-        None,
-        recorder,
-    )
-    .with_path(path)
-}
-
-/// Belt travel (caller's units) until a pin of radius `radius` starting at `pin_start` and
-/// following `path` first touches the part resting at `pose` so as to push it (grazes skipped; a
-/// strike into a reflex corner counts), or `None`: the same query the contact model starts with,
-/// for scheduling pin contacts in the line.
-pub fn pin_first_touch(
-    model: &PartModel,
-    pose: Pose,
-    pin_start: Vec2,
-    radius: f64,
-    path: &PinPath,
-) -> Option<f64> {
-    let k = model.scale();
-    let settings = ContactSettings::default();
-    let mut ctx = pin_ctx(model, pin_start, radius, path, &settings, None);
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    match next_touch(&mut ctx, &pose_n, 0.0, false) {
-        Touch::At(s, ..) => Some(s * k),
-        Touch::Stop(ContactStatus::MultiContact { s }) => Some(s),
-        _ => None,
-    }
-}
-
-/// Push a part resting at `pose` with a fence (SPEC §6; see [`super::fence`]): the fence travels at
-/// (−V, 0) relative to the belt past the part; its friction μf replaces μc in `settings`.
-/// Fence-contact features index the part's convex hull.
-pub fn push_fence(
-    model: &PartModel,
-    pose: Pose,
-    fence: &FenceSpec,
-    settings: &ContactSettings,
-    recorder: Option<&mut dyn Recorder>,
-) -> ContactOutcome {
-    let k = model.scale();
-    let geom = FenceGeom::new(fence, k);
-    let mut ctx = Ctx::new(
-        model,
-        model.hull(),
-        settings,
-        fence.mu_f,
-        0.0,
-        Vec2::new(-1.0, 0.0),
-        geom.p1(),
-        Some(geom),
-        recorder,
-    );
-    // Sliding along a steep fence is slow (it stops altogether at the jam angle): allow the belt
-    // travel a fence of this length can take before calling the part held.
-    let settings = ContactSettings {
-        max_travel: settings.max_travel + 50.0 * geom.len,
-        ..*settings
-    };
-    run_passes(&mut ctx, &settings, pose)
-}
-
-/// The mode and twist at the first instant of contact (for Mason's-vote checks and sensors).
-/// Returns (contact geometry in the part frame, the instant) or `None` without a pushing contact.
-pub fn first_instant(
-    model: &PartModel,
-    pose: Pose,
-    pin_start: Vec2,
-    pin: &Pin,
-    settings: &ContactSettings,
-) -> Option<(ContactGeom, Instant)> {
-    let k = model.scale();
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    let mut ctx = Ctx::new(
-        model,
-        model.polygon(),
-        settings,
-        settings.mu_c,
-        pin.radius / k,
-        Vec2::new(-1.0, pin.lateral_speed),
-        pin_start / k,
-        None,
-        None,
-    );
-    let dir = ctx.vdir.normalized();
-    let hit = first_contact(ctx.poly, &pose_n, ctx.start, dir, ctx.rho, 0.0)?;
-    if hit.grazing {
+    } else {
         return None;
-    }
-    let (feat, y) = initial_state(&ctx, &pose_n, hit.feature, hit.normal);
-    let g = ctx.geom(feat, y);
-    let inst = classify(model, ctx.fid, &g, ctx.fr, &mut ctx.warm, &mut ctx.evals).ok()??;
-    Some((g, inst))
+    };
+    Some(stop(ctx, status, at.s, at.feat, at.y))
 }
 
-/// Belt travel (caller's units) until a fence first touches the part resting at `pose`, or `None`
-/// if it never does (for scheduling fence contacts in the line).
-pub fn fence_first_touch(model: &PartModel, pose: Pose, fence: &FenceSpec) -> Option<f64> {
-    let k = model.scale();
-    let geom = FenceGeom::new(fence, k);
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
-    first_touch(model.hull(), &pose_n, &geom, Vec2::new(-1.0, 0.0), 0.0).map(|(s, _)| s * k)
+/// What one attempted step did.
+enum Stepped {
+    /// The step was rejected or shortened, or accepted with no event in it: go on from the cursor.
+    Again,
+    /// The step (event functions at its end, the events that crossed zero) passed every test but
+    /// crosses events: locate the earliest.
+    Crossed(Box<StepResult>, [f64; N_EVENTS], Vec<usize>),
+    /// The contact ends.
+    Done(Finish),
+}
+
+/// Take one step of size `at.h` from the cursor (ending at the next turn of the pin's path if it
+/// comes first): retry smaller on a failed solve, the error test or the step guard; shorten it
+/// when an event comes and goes inside it; accept it (advancing the cursor and growing the next
+/// step) when no event function crosses zero.
+fn take_step(ctx: &mut Ctx, at: &mut Cursor, segs: &mut Tally) -> Stepped {
+    // A step never crosses a turn of the pin's path: it ends there.
+    let to_turn = ctx.turn_at() - at.s;
+    let clipped = at.h >= to_turn;
+    if clipped {
+        at.h = to_turn;
+    }
+    let h = at.h;
+    let step = match dp_step(ctx, at.feat, at.mode, at.y, at.f0, h) {
+        Ok(r) => r,
+        Err(failure) => {
+            at.h *= 0.25;
+            if at.h < H_MIN {
+                let status = ContactStatus::Solver {
+                    failure,
+                    s: at.s * ctx.scale,
+                };
+                return Stepped::Done(stop(ctx, status, at.s, at.feat, at.y));
+            }
+            return Stepped::Again;
+        }
+    };
+    let guarded = !step_change_ok(at.feat, at.y, step.dp.y1);
+    if step.dp.err > 1.0 || guarded {
+        at.h *= if guarded {
+            0.25
+        } else {
+            (0.9 * step.dp.err.powf(-0.2)).max(0.2)
+        };
+        if at.h < H_MIN {
+            let status = ContactStatus::StepTooSmall {
+                s: at.s * ctx.scale,
+            };
+            return Stepped::Done(stop(ctx, status, at.s, at.feat, at.y));
+        }
+        return Stepped::Again;
+    }
+    let ev1 = ctx.events(at.feat, step.dp.y1, &step.inst1);
+    if let Some(t_dip) = interior_dip(ctx, at, &step, h, &ev1) {
+        // The contact runs off its feature and back (e.g. past an edge's end), or its mode
+        // breaks and recovers, within the step: shorten the step so that it ends beyond
+        // the first crossing, where the event is located as usual. (Below 1e-10 a a dip
+        // is the start state itself sitting on the boundary: the endpoint rule decides.)
+        if h * t_dip >= 1e-10 {
+            at.h *= t_dip;
+            return Stepped::Again;
+        }
+    }
+    let crossed = crossed_events(at, &ev1);
+    if !crossed.is_empty() {
+        return Stepped::Crossed(Box::new(step), ev1, crossed);
+    }
+    let factor = (0.9 * step.dp.err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0);
+    // A bounced margin that has recovered gets its ordinary zero threshold back.
+    for (b, e) in ctx.band.iter_mut().zip(ev1) {
+        if *b > 0.0 && e - *b > at.slack {
+            *b = 0.0;
+        }
+    }
+    segs.ride(ctx, at.feat, step.dp.f1()[0].abs().max(at.f0[0].abs()), h);
+    at.s = if clipped { ctx.turn_at() } else { at.s + h };
+    at.y = step.dp.y1;
+    at.inst = step.inst1;
+    at.f0 = step.dp.f1();
+    at.ev0 = ev1;
+    segs.steps += 1;
+    ctx.record(at.s, at.feat, at.y, &at.inst);
+    let pose = ctx.pose(at.s, at.feat, at.y);
+    if second_contact(ctx, at.feat, &pose, at.s) {
+        let status = ContactStatus::MultiContact {
+            s: at.s * ctx.scale,
+        };
+        return Stepped::Done((End::Stop(status), at.s, pose));
+    }
+    at.h = (h * factor).min(max_step(at.feat));
+    Stepped::Again
+}
+
+/// Locate the earliest of the `crossed` events in the accepted `step` (size `at.h`) and land on
+/// it: (event, travel, state, instant) there, counting the landing step; or the contact stops
+/// when the event cannot be reached.
+fn land_on_event(
+    ctx: &mut Ctx,
+    at: &Cursor,
+    step: &StepResult,
+    ev1: &[f64; N_EVENTS],
+    crossed: &[usize],
+    segs: &mut Tally,
+) -> Result<(usize, f64, [f64; 2], Instant), Finish> {
+    let h = at.h;
+    let estimate = earliest_crossing(ctx, at, step, h, ev1, crossed);
+    let landing = land(ctx, at, step, h, ev1, estimate);
+    let (s_land, y_land, inst_land) = match &landing.step {
+        Some((t, r)) => {
+            segs.steps += 1;
+            segs.ride(ctx, at.feat, r.dp.f1()[0].abs().max(at.f0[0].abs()), t * h);
+            (at.s + t * h, r.dp.y1, r.inst1)
+        }
+        None => (at.s, at.y, at.inst),
+    };
+    match landed_event(ctx, at.feat, y_land, &landing, at.slack) {
+        Some(i) => Ok((i, s_land, y_land, inst_land)),
+        None => {
+            let status = ContactStatus::StepTooSmall {
+                s: at.s * ctx.scale,
+            };
+            Err(stop(ctx, status, at.s, at.feat, at.y))
+        }
+    }
+}
+
+/// Open the next segment after event `i` at the cursor: settle the mode at the new state (`next`:
+/// feature, state, forced mode), set the event bands for the new feature, and record the state
+/// just after the event. The contact may end here instead.
+fn open_next(
+    ctx: &mut Ctx,
+    at: &mut Cursor,
+    i: usize,
+    (nf, ny, forced): (Feat, [f64; 2], Option<Mode>),
+    last_feature_change: &mut Option<(f64, Feat, usize)>,
+    segs: &mut Tally,
+) -> Option<Finish> {
+    let s = at.s;
+    if nf != at.feat {
+        // Event indices mean different things on the new feature: start with no bands, except
+        // when this transition merely returns, at the same point, to the feature just left (a
+        // marginal geometry, e.g. a force line through an edge's end): then stay there and let
+        // the event that ejected it run down to −BOUNCE_BAND before it counts.
+        let cycle = matches!(*last_feature_change, Some((s0, f0, _)) if (s - s0).abs() <= 1e-12 && f0 == nf);
+        let ejected_by = last_feature_change.map(|(_, _, i)| i);
+        ctx.band = [0.0; N_EVENTS];
+        if cycle {
+            if let Some(j) = ejected_by {
+                ctx.band[j] = BOUNCE_BAND;
+            }
+        }
+        *last_feature_change = Some((s, at.feat, i));
+    }
+    match enter(ctx, s, nf, ny, forced) {
+        Settle::Go(f, yy, it) => {
+            at.feat = f;
+            at.y = yy;
+            at.inst = it;
+            at.mode = it.mode;
+        }
+        Settle::Separate => return Some(separated(ctx, s, nf, ny, segs)),
+        Settle::Stop(st) => return Some(stop(ctx, st, s, nf, ny)),
+    }
+    // The state just after the event (the force may jump here): a recorder sees both sides.
+    open_segment(ctx, at, segs);
+    // Freshly started segments begin at their boundary: do not re-trigger on rounding.
+    for e in at.ev0.iter_mut() {
+        if e.abs() <= at.slack {
+            *e = 0.0;
+        }
+    }
+    at.h = at.h.clamp(1e-6, max_step(at.feat).max(1e-6));
+    None
 }

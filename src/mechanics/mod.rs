@@ -5,7 +5,14 @@
 //! * [`part_model`]: the compiled part (normalised geometry + support) and the two convex
 //!   sub-problems, at three fidelity levels (`tip`, `ellipsoid`, `exact`).
 //! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
-//! * [`integrate`]: one pin pass, integrated in pin travel with error control and event location.
+//! * [`integrate`]: one contact, integrated in pin travel with error control and event location:
+//!   `contact_step` (one step of a contact), `event_locate` (finding and landing on the earliest
+//!   event in a step) and `event_apply` (what each event does).
+//! * `contact_state`: the state of one contact (feature, reduced coordinates, pose, rates, events).
+//! * `ode`: the Dormand–Prince 5(4) step, its dense output and the Illinois root finder.
+//! * `settings`: the pin and the [`ContactSettings`].
+//! * `pass`: the pass loop — cast the obstacle's path, integrate each contact, cast again — and
+//!   the entry points [`push`], [`push_path`], [`push_fence`].
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
 //! * [`pin_path`]: a moving pin's lateral speed profile over a pass (SPEC §5).
 //! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
@@ -14,24 +21,29 @@
 //! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
 //! → [`ContactOutcome`].
 
+mod contact_state;
+mod contact_step;
+mod event_apply;
+mod event_locate;
 pub mod fence;
 pub mod instant;
 pub mod integrate;
 pub mod limit_surface;
+mod ode;
 pub mod outcome;
 pub mod part_model;
+mod pass;
 pub mod pin_path;
+mod settings;
 pub mod vote;
 
 pub use fence::FenceSpec;
 pub use instant::Mode;
-pub use integrate::{
-    fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path,
-    ContactSettings, Pin,
-};
 pub use outcome::{
     ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
+pub use pass::{fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path};
 pub use pin_path::{PinPath, Turn};
+pub use settings::{ContactSettings, Pin};
 pub use vote::mason_vote;

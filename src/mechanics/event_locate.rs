@@ -1,0 +1,246 @@
+//! Event location inside one step: finding the earliest event function that crosses zero within an
+//! accepted step, and landing on it with a real step.
+//!
+//! Events are located in two stages. First, for each event function that changed sign, the
+//! Illinois method ([`super::ode::illinois`]) finds its root on the step's dense output (geometric
+//! events and separation from the state alone; a mode margin by solving the instant in the
+//! current mode); the earliest root wins. Then the landing refines that estimate on real
+//! Dormand–Prince sub-steps from the step's start, so that the state handed to the event is a
+//! state the integrator produced, with the event function within the landing tolerance of zero.
+//! Before either, [`interior_dip`] shortens a step across which an event comes and goes.
+
+use super::contact_state::{second_contact, Ctx, Feat, N_EVENTS};
+use super::contact_step::{dp_step, step_change_ok, Cursor, StepResult};
+use super::instant::{push_margin, solve_in_mode};
+use super::ode::{illinois, Bracket};
+
+/// The first fraction of the step `step` of size `h` from `at` (event functions `ev1` at its end)
+/// at which an event comes and goes inside it, which the end-point signs miss: a mode that breaks
+/// at an interior stage and holds again at the end, or one of the geometric event functions (edge
+/// ends, normal cone, fence ends), which depend on the state alone, so that the dense output shows
+/// without solving anything whether one positive at both ends dips below −slack at one of eight
+/// interior fractions; likewise a disc pin's brief second touch on a concave part.
+pub(super) fn interior_dip(
+    ctx: &Ctx,
+    at: &Cursor,
+    step: &StepResult,
+    h: f64,
+    ev1: &[f64; N_EVENTS],
+) -> Option<f64> {
+    let mode_dip = step.margin_dip.filter(|_| ev1[1] >= 0.0 && ev1[2] >= 0.0);
+    let (feat, s, y0, slack) = (at.feat, at.s, at.y, at.slack);
+    // Nothing to miss unless an event not yet crossed ends the step near zero (the guard keeps a
+    // step's change of the contact coordinate below 0.5) or a disc could touch a second edge.
+    let near = (3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j]));
+    let second = !ctx.poly.is_convex() && ctx.rho > 0.0 && ctx.fence.is_none();
+    if !near && !second {
+        return mode_dip;
+    }
+    (1..8)
+        .map(|k| k as f64 / 8.0)
+        .find(|&t| {
+            let yt = step.dp.dense(y0, h, t);
+            let g = ctx.geom(feat, yt);
+            let dips = near
+                && ctx
+                    .feature_events(feat, yt, &g)
+                    .iter()
+                    .zip(&ev1[3..])
+                    .any(|(&e, &e1)| e1 >= 0.0 && e < -slack);
+            dips || (second && second_contact(ctx, feat, &ctx.pose(s + t * h, feat, yt), s + t * h))
+        })
+        .or(mode_dip)
+}
+
+/// The events that cross zero within a step from `at` ending with event functions `ev1` (those
+/// not already past their boundary at its start).
+pub(super) fn crossed_events(at: &Cursor, ev1: &[f64; N_EVENTS]) -> Vec<usize> {
+    (0..N_EVENTS)
+        .filter(|&i| ev1[i] < 0.0 && at.ev0[i] >= -at.slack)
+        .collect()
+}
+
+/// The earliest of the `crossed` events on the dense output of `step` (size `h`, from `at`):
+/// (fraction of the step, event index). The warm starts of the instant solve are left as they were.
+pub(super) fn earliest_crossing(
+    ctx: &mut Ctx,
+    at: &Cursor,
+    step: &StepResult,
+    h: f64,
+    ev1: &[f64; N_EVENTS],
+    crossed: &[usize],
+) -> (f64, usize) {
+    let (feat, mode, inst) = (at.feat, at.mode, at.inst);
+    let mut best = (2.0, 0usize);
+    let warm_saved = ctx.warm;
+    let root_tol = 1e-3 * ctx.tol;
+    let band = ctx.band;
+    for &i in crossed {
+        let g0 = at.ev0[i].max(0.0);
+        let t = illinois(
+            |t| {
+                let yt = step.dp.dense(at.y, h, t);
+                if i == 0 || i >= 3 {
+                    ctx.events(feat, yt, &inst)[i]
+                } else {
+                    let g = ctx.geom(feat, yt);
+                    match solve_in_mode(
+                        ctx.model,
+                        ctx.fid,
+                        &g,
+                        ctx.fr,
+                        mode,
+                        &mut ctx.warm,
+                        &mut ctx.evals,
+                    ) {
+                        Ok(it) => it.margins[i - 1] + band[i],
+                        Err(_) => -1.0,
+                    }
+                }
+            },
+            g0,
+            ev1[i],
+            root_tol,
+        );
+        if t < best.0 {
+            best = (t, i);
+        }
+    }
+    ctx.warm = warm_saved;
+    best
+}
+
+/// A trial step while landing on an event.
+enum Trial {
+    /// No step: the state at the start of the step.
+    Start,
+    /// A valid step and the located event's function after it.
+    Step(Box<StepResult>, f64),
+    /// A step that failed, or whose result cannot be trusted.
+    Invalid,
+}
+
+/// Where the landing on event `i` ended.
+pub(super) struct Landing {
+    /// The event landed on.
+    pub(super) i: usize,
+    /// The landing sub-step: its fraction of the step and the step itself, or `None` for the
+    /// start of the step.
+    pub(super) step: Option<(f64, Box<StepResult>)>,
+    /// The event function at the landing.
+    pub(super) g: f64,
+    /// Some trial step could not be trusted (the bracket shrank from above).
+    pub(super) any_invalid: bool,
+}
+
+/// Land on event `i`, estimated at fraction `t_est` of the accepted `step` of size `h` from `at`:
+/// the trial at the largest fraction with g ≥ 0 (or g just below 0 within the landing tolerance).
+pub(super) fn land(
+    ctx: &mut Ctx,
+    at: &Cursor,
+    step: &StepResult,
+    h: f64,
+    ev1: &[f64; N_EVENTS],
+    (t_est, i): (f64, usize),
+) -> Landing {
+    let (feat, mode, y, f0, slack) = (at.feat, at.mode, at.y, at.f0, at.slack);
+    let ctx_tol = ctx.tol;
+    // A sub-step of the accepted step must agree with its dense output (both are
+    // accurate to about tol; 1e3·tol leaves room for a mode boundary inside the step).
+    let near_dense = |r: &StepResult, t: f64| {
+        let yd = step.dp.dense(y, h, t);
+        (r.dp.y1[0] - yd[0]).abs() <= 1e3 * ctx_tol && (r.dp.y1[1] - yd[1]).abs() <= 1e3 * ctx_tol
+    };
+    // Refine on real steps: g(t) = event i after a Dormand–Prince step of t·h from (s, y).
+    // A trial step counts only if it is itself accurate (its own error estimate within 10×
+    // the tolerance: sub-steps of an accepted step may sit just above it), passes the step
+    // guard and crosses neither the separation nor another geometric event; otherwise its event
+    // value means nothing (the −880° case of issue 11 landed on such a step) and the
+    // bracket shrinks from above.
+    let real = |t: f64, ctx: &mut Ctx| -> Trial {
+        if t * h <= 1e-15 {
+            return Trial::Start;
+        }
+        match dp_step(ctx, feat, mode, y, f0, t * h) {
+            Ok(r) if step_change_ok(feat, y, r.dp.y1) && near_dense(&r, t) => {
+                let ev = ctx.events(feat, r.dp.y1, &r.inst1);
+                if [0, 3, 4, 5, 6].iter().all(|&j| j == i || ev[j] >= -slack) {
+                    Trial::Step(Box::new(r), ev[i])
+                } else {
+                    Trial::Invalid
+                }
+            }
+            _ => Trial::Invalid,
+        }
+    };
+    let mut bracket = Bracket::new(at.ev0[i].max(0.0), ev1[i]);
+    // The landing: the trial at the largest t with g ≥ 0 (or g just below 0 within the
+    // landing tolerance), and its g.
+    let mut best: (Trial, f64, f64) = (Trial::Start, 0.0, at.ev0[i].max(0.0));
+    let mut t = t_est.clamp(0.0, 1.0);
+    let mut any_invalid = false;
+    // Landing tolerance: far below the integration tolerance, far above rounding.
+    let g_tol = at.land_tol;
+    for _ in 0..40 {
+        let trial = real(t, ctx);
+        let gt = match &trial {
+            Trial::Start => at.ev0[i].max(0.0),
+            Trial::Step(_, g) => *g,
+            Trial::Invalid => {
+                any_invalid = true;
+                bracket.cut_above(t);
+                if bracket.width() * h <= 1e-13 {
+                    break;
+                }
+                t = bracket.midpoint();
+                continue;
+            }
+        };
+        let close = gt.abs() <= g_tol;
+        let lower_end = bracket.narrow(t, gt);
+        if lower_end || close {
+            best = (trial, t, gt);
+        }
+        if close || bracket.width() * h <= 1e-13 {
+            break;
+        }
+        t = bracket.next();
+    }
+    let (landing, best_t, best_g) = best;
+    Landing {
+        i,
+        step: match landing {
+            Trial::Step(r, _) => Some((best_t, r)),
+            _ => None,
+        },
+        g: best_g,
+        any_invalid,
+    }
+}
+
+/// The event to apply at the landing state `y_land` on `feat` (`None`: none can be trusted).
+///
+/// If a trial was invalid and the landing fell short of the event, the event lies beyond a
+/// stretch the integrator cannot resolve (the rates blow up before it). Near a separation that is
+/// the triple point where the pin's path turns tangent while the sliding side's contact velocity
+/// does too (κ = n·v_pin / n·v_b → 0/0): the part is within asin(push margin) of letting go, so it
+/// separates here when that margin is below min(1e3·tol, 1e-3) (an orientation error below 0.06°).
+/// Anywhere else the caller says so rather than apply the event at a state short of it.
+pub(super) fn landed_event(
+    ctx: &Ctx,
+    feat: Feat,
+    y_land: [f64; 2],
+    landing: &Landing,
+    slack: f64,
+) -> Option<usize> {
+    if landing.any_invalid && landing.g > slack {
+        let g = ctx.geom(feat, y_land);
+        if push_margin(&g).abs() <= (1e3 * ctx.tol).min(1e-3) {
+            Some(0)
+        } else {
+            None
+        }
+    } else {
+        Some(landing.i)
+    }
+}
