@@ -145,7 +145,9 @@ fn returned_plan_is_shortest_by_brute_force() {
         // Replaying the plan's actions reaches the goal through the same states.
         let mut s = planner.initial.clone();
         for step in &plan.steps {
-            let Action::Pin(pin) = step.action;
+            let Action::Pin(pin) = step.action else {
+                panic!("a pin plan has only pins")
+            };
             let next = planner
                 .actions(&s)
                 .into_iter()

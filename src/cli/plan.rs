@@ -117,6 +117,20 @@ pub struct PlanArgs {
     /// With --sensor: sensor positions tried (the most robust pin intervals that touch every part).
     #[arg(long, default_value_t = 6)]
     pub sensor_candidates: usize,
+    /// Fence plan: each action is a fence (angles ±15°…±60° in 5° steps below the jam limit).
+    #[arg(long)]
+    pub fences: bool,
+    /// With --fences: fence friction μf [default: --mu-c].
+    #[arg(long)]
+    pub mu_f: Option<f64>,
+    /// With --fences: downstream overhang of each fence past the parts' reach (units of a).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub fence_overhang: f64,
+    /// With --fences: largest |angle| tried (degrees; candidates ±15° … ±60°, always below the jam
+    /// limit). At 60° (3.4° from the jam limit at μf 0.5) the line parted from the plan (tripoly2:
+    /// 83% against 100%), hence 55.
+    #[arg(long, default_value_t = 55.0, allow_hyphen_values = true)]
+    pub max_fence_angle: f64,
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -282,6 +296,22 @@ pub fn command_line(args: &PlanArgs) -> String {
         d.contact_tol.to_string()
     );
     opt!("--seed", args.seed.to_string(), "1".into());
+    if args.fences {
+        w.push("--fences".into());
+        if let Some(m) = args.mu_f {
+            w.push(format!("--mu-f {m}"));
+        }
+        opt!(
+            "--fence-overhang",
+            args.fence_overhang.to_string(),
+            "0".into()
+        );
+        opt!(
+            "--max-fence-angle",
+            args.max_fence_angle.to_string(),
+            "55".into()
+        );
+    }
     if args.sensor {
         w.push("--sensor".into());
         opt!("--max-moving", args.max_moving.to_string(), "3".into());
@@ -359,7 +389,24 @@ fn plan_text(problem: &Problem, plan: &Plan) -> String {
         plan.initial_sets, plan.initial_window.share, plan.initial_window.centre_deg
     );
     for (k, s) in plan.steps.iter().enumerate() {
-        let Action::Pin(p) = s.action;
+        let p = match s.action {
+            Action::Pin(p) => p,
+            Action::Fence(f) => {
+                t += &format!(
+                    "            fence{:<1} {:>+5.0}°  y {:>+7.2} → {:>+7.2} mm, length {:.4} m, margin {:.2} mm  {:>4}  {:.3} at {:.2}°\n",
+                    k + 1,
+                    f.angle_deg,
+                    f.y0_m * 1e3,
+                    f.y1_m * 1e3,
+                    f.length_m,
+                    f.margin_m * 1e3,
+                    s.sets,
+                    s.window.share,
+                    s.window.centre_deg
+                );
+                continue;
+            }
+        };
         t += &format!(
             "            pin{:<3} {:>5.3}  {:>+7.2}   [{:>+6.2}, {:>+6.2}]   {:>10.2}  {:>4}  {:.3} at {:.2}°\n",
             k + 1,
@@ -392,10 +439,37 @@ pub fn run(args: &PlanArgs) -> Result<()> {
         .num_threads(args.threads)
         .build()
         .context("starting the worker threads")?;
+    if args.sensor && args.fences {
+        bail!("--sensor and --fences: the contingent planner uses pins; choose one");
+    }
     if args.sensor {
         return super::plan_sensor::run(args, &problem, &command, &pool);
     }
     let mut planner = Planner::new(&problem)?;
+    if args.fences {
+        let mu_f = args.mu_f.unwrap_or(problem.mu_c);
+        if !(mu_f.is_finite() && mu_f >= 0.0) {
+            bail!("--mu-f {mu_f}: must be a finite number ≥ 0");
+        }
+        if !(args.fence_overhang.is_finite() && args.fence_overhang >= 0.0) {
+            bail!(
+                "--fence-overhang {}: must be a finite number ≥ 0",
+                args.fence_overhang
+            );
+        }
+        let mut opts = crate::plan::FenceOptions::default_for(mu_f);
+        opts.overhang_a = args.fence_overhang;
+        opts.angles_deg
+            .retain(|a| a.abs() <= args.max_fence_angle + 1e-9);
+        if opts.angles_deg.is_empty() {
+            bail!(
+                "--max-fence-angle {}: no candidate angle (±15° … ±60° below the jam limit {:.1}° for μf {mu_f}) is left",
+                args.max_fence_angle,
+                90.0 - mu_f.atan().to_degrees()
+            );
+        }
+        planner.fences = Some(crate::plan::fences::FenceTransition::new(opts));
+    }
     let (outcome, stats) = pool.install(|| planner.search());
     let stable_count = planner.compiled.stable_deg.len();
     let (result, message, plan, failure) = match &outcome {
@@ -409,7 +483,11 @@ pub fn run(args: &PlanArgs) -> Result<()> {
                     stats.depth_completed.max(p.steps.len())
                 )
             } else {
-                format!("found a shortest plan: {} pin(s)", p.steps.len())
+                format!(
+                    "found a shortest plan: {} {}(s)",
+                    p.steps.len(),
+                    if args.fences { "fence" } else { "pin" }
+                )
             },
             Some(p),
             None,

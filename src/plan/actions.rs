@@ -30,12 +30,12 @@ pub struct PinAction {
     pub margin_m: f64,
 }
 
-/// One step of a plan. Today only fixed pins; a fence, or a sensing branch of a contingent plan,
-/// joins this enum later.
+/// One step of a plan: a fixed pin, or a fence (the fence planner, [`super::fences`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Action {
     Pin(PinAction),
+    Fence(super::fences::FenceAction),
 }
 
 /// The pin actions of `state` with their successors, in increasing lateral position.

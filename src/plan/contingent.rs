@@ -179,7 +179,9 @@ impl BranchSearch {
         for &id in &self.frontier.clone() {
             let state = self.nodes[id].state.clone();
             for (action, s) in planner.actions(&state) {
-                let Action::Pin(a) = action;
+                let Action::Pin(a) = action else {
+                    unreachable!("the contingent planner uses pins")
+                };
                 let s = Arc::new(s);
                 if !self.seen.insert(s.clone()) {
                     continue;
@@ -267,7 +269,9 @@ pub fn search(
         .actions(&root)
         .into_iter()
         .map(|(a, _)| {
-            let Action::Pin(a) = a;
+            let Action::Pin(a) = a else {
+                unreachable!("the contingent planner uses pins")
+            };
             a
         })
         .filter(|a| {

@@ -34,6 +34,13 @@ pub fn scenario_toml(
     command: &str,
     file: &str,
 ) -> String {
+    if plan
+        .steps
+        .iter()
+        .any(|s| matches!(s.action, Action::Fence(_)))
+    {
+        return fence_scenario_toml(problem, plan, stable_count, symmetry, parts, command, file);
+    }
     let n = plan.steps.len();
     let sp = problem.spacing_m;
     let mut t = String::new();
@@ -78,7 +85,9 @@ pub fn scenario_toml(
     );
     t += &part_feed_sections(problem, stable_count, parts);
     for (k, step) in plan.steps.iter().enumerate() {
-        let Action::Pin(pin) = step.action;
+        let Action::Pin(pin) = step.action else {
+            continue;
+        };
         t += &format!(
             "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{}\"\nx = {}\ny = {}\nradius = {}\n",
             pin.margin_m * 1e3,
@@ -88,6 +97,86 @@ pub fn scenario_toml(
             num(sp * (k as f64 + 1.0), 6),
             num(pin.y_m, 6),
             num(problem.pin_radius_m, 6),
+        );
+    }
+    t += &goal_and_model(problem, plan.window.centre_deg, symmetry);
+    t
+}
+
+/// The scenario of a fence plan (the fence planner, [`super::fences`]): fences one after another
+/// along the belt (the first upstream end one spacing in, then the gap of
+/// [`super::fences::layout`]), each a `kind = "fence"` obstacle from its upstream end, parts every
+/// [`super::fences::headway_s`] apart (a part sliding along a fence lags the belt).
+#[allow(clippy::too_many_arguments)]
+pub fn fence_scenario_toml(
+    problem: &Problem,
+    plan: &Plan,
+    stable_count: usize,
+    symmetry: u32,
+    parts: u64,
+    command: &str,
+    file: &str,
+) -> String {
+    let fences: Vec<super::FenceAction> = plan
+        .steps
+        .iter()
+        .filter_map(|s| match s.action {
+            Action::Fence(f) => Some(f),
+            Action::Pin(_) => None,
+        })
+        .collect();
+    let radius = problem.compile().map(|c| c.radius).unwrap_or(0.0);
+    let (xs, end) = super::fences::layout(&fences, radius, problem.spacing_m);
+    let n = fences.len();
+    let mut t = String::new();
+    let name = format!("plan_{}_fences", crate::cli::part_folder(&problem.part));
+    t += &format!(
+        "# Written by `pinfeed plan --fences` (sensorless fence planner, issue 14):\n#\n#   {command}\n#\n"
+    );
+    t += &format!(
+        "# {n} fence(s), a shortest plan for its action set (BFS over {} particle(s), θ rounded to {}°,\n",
+        plan.initial.total(),
+        problem.theta_quantum_deg
+    );
+    t += &format!(
+        "# y to {} mm; each fence's upstream end clear of every part's reach). Predicted success {:.4}\n",
+        problem.y_quantum_m * 1e3,
+        plan.predicted_success,
+    );
+    t += &format!(
+        "# ({} of {} particles within {}° ± {}°).\n#\n#   pinfeed run {file}\n\n",
+        plan.window.inside,
+        plan.initial.total(),
+        num(plan.window.centre_deg, 2),
+        problem.tolerance_deg
+    );
+    t += &format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
+    t += "[belt]\nspeed = 0.05        # m/s\n";
+    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
+    t += &format!(
+        "length = {}        # m: one spacing after the last fence\n\n",
+        num(end + problem.spacing_m, 6)
+    );
+    t += &part_feed_sections(problem, stable_count, parts).replace(
+        "headway = 4.0",
+        &format!(
+            "headway = {}        # s: parts lag the belt along the fences",
+            num(super::fences::headway_s(&fences, radius, 0.05), 3)
+        ),
+    );
+    for (k, (f, x)) in fences.iter().zip(&xs).enumerate() {
+        let step = &plan.steps[k];
+        t += &format!(
+            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"fence\"\nname = \"fence{}\"\nx = {}             # m: the upstream end\ny = {}\nangle = {}          # degrees\nlength = {}\nmu_f = {}\n",
+            f.margin_m * 1e3,
+            step.sets,
+            step.window.share,
+            k + 1,
+            num(*x, 6),
+            num(f.y0_m, 6),
+            num(f.angle_deg, 6),
+            num(f.length_m, 6),
+            num(f.mu_f, 6),
         );
     }
     t += &goal_and_model(problem, plan.window.centre_deg, symmetry);

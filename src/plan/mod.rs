@@ -16,6 +16,9 @@
 //!   intervals over which no particle's outcome changes qualitatively, one representative (the
 //!   middle) per interval with its robustness margin ([`Action`] is an enum a fence or a sensing
 //!   branch can join later);
+//! * [`fences`]: the fence planner's actions (`pinfeed plan --fences`): fences at candidate angles
+//!   below the jam limit, placed clear of every particle's reach, passes through
+//!   [`crate::mechanics::push_fence`]; the same search runs over them;
 //! * [`search`]: breadth-first search with deduplication, limits and statistics;
 //! * [`contingent`]: the contingent planner with sensing (a sensor pin, then per-decision moving
 //!   pins; AND-OR over the branches, which must share one goal window);
@@ -45,12 +48,14 @@ pub mod actions;
 pub mod check;
 pub mod contingent;
 pub mod emit;
+pub mod fences;
 pub mod particles;
 pub mod problem;
 pub mod search;
 pub mod transition;
 
 pub use actions::{Action, PinAction};
+pub use fences::{FenceAction, FenceOptions};
 pub use particles::{Particle, State};
 pub use problem::{FeedKind, Problem};
 pub use search::{search, Outcome, Plan, PlanStep, SearchStats};

@@ -101,6 +101,8 @@ pub struct Planner {
     pub compiled: Compiled,
     pub transition: Transition,
     pub initial: State,
+    /// With fences: the fence actions replace the pin actions.
+    pub fences: Option<super::fences::FenceTransition>,
 }
 
 struct Node {
@@ -121,11 +123,16 @@ impl Planner {
             compiled,
             transition,
             initial,
+            fences: None,
         })
     }
 
     /// The actions of a state and their successors.
     pub fn actions(&mut self, state: &State) -> Vec<(Action, State)> {
+        if let Some(f) = self.fences.as_mut() {
+            let steps = self.compiled.theta_steps;
+            return f.actions(state, &self.transition, &self.problem, steps);
+        }
         pin_actions(state, &mut self.transition, self.problem.min_margin_m)
     }
 
@@ -219,6 +226,10 @@ impl Planner {
         let finish = |s: &Self, mut stats: SearchStats, bytes: usize| {
             stats.pushes = s.transition.counters;
             stats.memo_entries = s.transition.memo_len();
+            if let Some(f) = &s.fences {
+                stats.pushes.computed += f.computed;
+                stats.memo_entries += f.memo_len();
+            }
             stats.elapsed_s = started.elapsed().as_secs_f64();
             stats.memory_estimate_bytes = bytes + s.transition.memo_bytes();
             stats.peak_rss_bytes = peak_rss_bytes();

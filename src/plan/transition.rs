@@ -150,6 +150,11 @@ impl Transition {
         })
     }
 
+    /// The part's radius a (m).
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
     /// Lateral quantum (m).
     pub fn y_quantum(&self) -> f64 {
         self.y_quantum

@@ -33,7 +33,21 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
     let period = compiled.period_deg();
     let n = plan.steps.len();
     let stages = n + 1;
-    let length = problem.spacing_m * (n as f64 + 1.0);
+    let fences: Vec<crate::plan::FenceAction> = plan
+        .steps
+        .iter()
+        .filter_map(|s| match s.action {
+            Action::Fence(f) => Some(f),
+            Action::Pin(_) => None,
+        })
+        .collect();
+    let (fence_x, fence_len) =
+        crate::plan::fences::layout(&fences, compiled.radius, problem.spacing_m);
+    let length = if fences.is_empty() {
+        problem.spacing_m * (n as f64 + 1.0)
+    } else {
+        fence_len + problem.spacing_m
+    };
     let half = problem.belt_width_m / 2.0 * 1e3;
     let height = 330 + 40 * stages as u32 + 80;
     let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
@@ -61,7 +75,28 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
     let px_per_m_y = h_px as f64 / (2.0 * half * 1e-3);
     let pin_px = ((problem.pin_radius_m * px_per_m_y).round() as i32).max(2);
     for (k, s) in plan.steps.iter().enumerate() {
-        let Action::Pin(p) = s.action;
+        let p = match s.action {
+            Action::Pin(p) => p,
+            Action::Fence(f) => {
+                let x0 = fence_x[k];
+                let x1 = x0 + f.x_extent_m();
+                ch.draw_series(std::iter::once(PathElement::new(
+                    vec![(x0, f.y0_m * 1e3), (x1, f.y1_m * 1e3)],
+                    BLACK.stroke_width(3),
+                )))?;
+                ch.draw_series(std::iter::once(Text::new(
+                    format!(
+                        "fence{} {:+}° ±{:.2} mm",
+                        k + 1,
+                        f.angle_deg,
+                        f.margin_m * 1e3
+                    ),
+                    (x0, f.y0_m * 1e3 + 2.0),
+                    ("sans-serif", 12),
+                )))?;
+                continue;
+            }
+        };
         let x = problem.spacing_m * (k as f64 + 1.0);
         ch.draw_series(std::iter::once(Rectangle::new(
             [(x - 0.004, p.lo_m * 1e3), (x + 0.004, p.hi_m * 1e3)],

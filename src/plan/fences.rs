@@ -1,0 +1,311 @@
+//! The **fence planner** (issue 14 part 3): the same breadth-first search, each action a fence
+//! (SPEC §6) instead of a pin.
+//!
+//! A fence action is an angle α from a candidate set (±15° … ±60° in 5° steps by default, only
+//! |α| + atan μf < 90°, the jam limit) and a lateral placement. For α > 0 the fence runs
+//! downstream to the left and slides parts to +y; its upstream end lies `gap` below every
+//! particle's reach (y0 = min y − a − gap: no particle can meet the upstream end, each meets the
+//! face), its downstream end `gap` above it (y1 = max y + a + gap, plus an optional overhang), so
+//! every particle slides along the face and leaves over the downstream end (mirrored for α < 0).
+//! Any y0 in [−width/2, min y − a] acts the same way qualitatively (the part meets the face, not
+//! the end): that is the action's interval, y0 its representative, `gap` its margin. Both ends
+//! must lie over the belt; angles whose fence would not fit are not actions of the state.
+//!
+//! Each particle's pass is one [`crate::mechanics::push_fence`] from rest, memoised per
+//! (physics sample, θ, angle, y0 − y, y1 − y) and computed in parallel. Along the belt the fences
+//! follow one another with 2a + 2 cm between one fence's downstream x and the next one's upstream
+//! x, so a part touches one obstacle at a time (see [`layout`]).
+
+use super::particles::{theta_quanta, y_quanta, Particle, State};
+use super::problem::Problem;
+use super::transition::Transition;
+use super::Action;
+use crate::geometry::{wrap_deg, Pose, Vec2};
+use crate::mechanics::{push_fence, ContactSettings, ContactStatus, FenceSpec, Fidelity};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// One fence of a plan.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FenceAction {
+    /// Angle from the belt direction (degrees; > 0 runs downstream to the left).
+    pub angle_deg: f64,
+    /// Lateral position of the upstream end (m) and of the downstream end (m).
+    pub y0_m: f64,
+    pub y1_m: f64,
+    /// Length along the fence (m).
+    pub length_m: f64,
+    /// Fence–part friction μf.
+    pub mu_f: f64,
+    /// The upstream end's positions that act the same way qualitatively: [lo, hi] (m).
+    pub lo_m: f64,
+    pub hi_m: f64,
+    /// Distance from `y0_m` to the interval's edge at the parts (m).
+    pub margin_m: f64,
+    /// Largest lag behind the belt a part takes on this fence (m, belt frame; see [`headway_s`]).
+    pub max_lag_m: f64,
+}
+
+impl FenceAction {
+    /// The fence's extent along the belt (m).
+    pub fn x_extent_m(&self) -> f64 {
+        self.length_m * self.angle_deg.to_radians().cos()
+    }
+}
+
+/// Settings of the fence actions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FenceOptions {
+    /// Candidate angles (degrees).
+    pub angles_deg: Vec<f64>,
+    /// Fence friction μf.
+    pub mu_f: f64,
+    /// Overhang of the downstream end past the parts' reach, in units of a.
+    pub overhang_a: f64,
+}
+
+impl FenceOptions {
+    /// ±15° … ±60° in 5° steps, kept below the jam limit |α| + atan μf < 90°.
+    pub fn default_for(mu_f: f64) -> FenceOptions {
+        let jam = 90.0 - mu_f.atan().to_degrees();
+        let mut angles = Vec::new();
+        for k in 3..=12 {
+            let a = 5.0 * k as f64;
+            if a < jam - 1e-9 {
+                angles.push(a);
+                angles.push(-a);
+            }
+        }
+        FenceOptions {
+            angles_deg: angles,
+            mu_f,
+            overhang_a: 0.0,
+        }
+    }
+}
+
+/// Largest integration tolerance of a fence pass (the line's, `[model] tol = 1e-6`).
+pub const FENCE_TOL: f64 = 1e-6;
+
+/// Memo key: (sample, θ quanta, angle index, y0 − y quanta, y1 − y quanta).
+type FenceKey = (u32, i32, u16, i32, i32);
+
+/// A fence pass as the planner keeps it: `None` = lost (not ok), else (θ final deg, Δy m,
+/// touched, lag behind the belt m).
+type FenceOutcome = Option<(f64, f64, bool, f64)>;
+
+/// Fence transitions with their memo.
+pub struct FenceTransition {
+    pub options: FenceOptions,
+    memo: HashMap<FenceKey, FenceOutcome>,
+    pub computed: u64,
+}
+
+impl FenceTransition {
+    pub fn new(options: FenceOptions) -> FenceTransition {
+        FenceTransition {
+            options,
+            memo: HashMap::new(),
+            computed: 0,
+        }
+    }
+
+    /// Distinct fence passes in the memo.
+    pub fn memo_len(&self) -> usize {
+        self.memo.len()
+    }
+
+    fn pass(&self, tr: &Transition, problem: &Problem, key: FenceKey) -> FenceOutcome {
+        let (sample, theta_q, ai, d0, d1) = key;
+        let phys = &tr.samples[sample as usize];
+        let q = problem.y_quantum_m;
+        let a = tr.radius();
+        let theta_deg = theta_q as f64 * problem.theta_quantum_deg;
+        let angle = self.options.angles_deg[ai as usize].to_radians();
+        let e = Vec2::from_angle(angle);
+        let mut n = e.perp();
+        if n.x > 0.0 {
+            n = -n;
+        }
+        let (y0, y1) = (d0 as f64 * q, d1 as f64 * q);
+        // The line 1.01a upstream of the centroid, through the upstream end at lateral y0.
+        let x0 = (1.01 * a + y0 * n.y) / (-n.x);
+        let length = (y1 - y0).abs() / angle.sin().abs();
+        let spec = FenceSpec {
+            start: Vec2::new(x0, y0),
+            angle,
+            length,
+            mu_f: self.options.mu_f,
+        };
+        let settings = ContactSettings {
+            fidelity: Fidelity::Exact,
+            mu_c: phys.mu_c,
+            // A slide along a fence is a long integration: at the planner's default 1e-5 its
+            // end state drifts from the line's (1e-6), so fences use at most the line's tolerance.
+            tol: problem.contact_tol.min(FENCE_TOL),
+            ..ContactSettings::default()
+        };
+        let pose = Pose::new(0.0, 0.0, theta_deg.to_radians());
+        let out = push_fence(&phys.model, pose, &spec, &settings, None);
+        if !out.contact {
+            return Some((theta_deg, 0.0, false, 0.0));
+        }
+        let ok = matches!(
+            out.status,
+            ContactStatus::Ok | ContactStatus::Metastable { .. }
+        );
+        if !ok {
+            return None;
+        }
+        Some((
+            wrap_deg(theta_deg + out.rotation.to_degrees()),
+            out.pose_final.y,
+            true,
+            (-out.pose_final.x).max(0.0),
+        ))
+    }
+
+    /// The fence actions of `state` with their successors.
+    pub fn actions(
+        &mut self,
+        state: &State,
+        tr: &Transition,
+        problem: &Problem,
+        theta_steps: i32,
+    ) -> Vec<(Action, State)> {
+        if state.particles.is_empty() {
+            return Vec::new();
+        }
+        let q = problem.y_quantum_m;
+        let a = tr.radius();
+        let half = problem.belt_width_m / 2.0;
+        let gap = problem.min_margin_m.max(0.001);
+        let ymin = state.particles.iter().map(|p| p.y_q).min().unwrap() as f64 * q;
+        let ymax = state.particles.iter().map(|p| p.y_q).max().unwrap() as f64 * q;
+        let over = self.options.overhang_a * a;
+        // (angle index, y0 quanta, y1 quanta, interval lo, hi)
+        let mut cands = Vec::new();
+        for (ai, &deg) in self.options.angles_deg.iter().enumerate() {
+            let (y0, y1, lo, hi) = if deg > 0.0 {
+                (
+                    (ymin - a - gap) / q,
+                    (ymax + a + gap + over) / q,
+                    -half,
+                    ymin - a,
+                )
+            } else {
+                (
+                    (ymax + a + gap) / q,
+                    (ymin - a - gap - over) / q,
+                    ymax + a,
+                    half,
+                )
+            };
+            let (y0q, y1q) = if deg > 0.0 {
+                (y0.floor() as i32, y1.ceil() as i32)
+            } else {
+                (y0.ceil() as i32, y1.floor() as i32)
+            };
+            let lim = half + 1e-12;
+            if (y0q as f64 * q).abs() > lim || (y1q as f64 * q).abs() > lim {
+                continue;
+            }
+            cands.push((ai as u16, y0q, y1q, lo, hi));
+        }
+        let mut missing: Vec<FenceKey> = Vec::new();
+        for &(ai, y0q, y1q, _, _) in &cands {
+            for p in &state.particles {
+                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q);
+                if !self.memo.contains_key(&k) {
+                    missing.push(k);
+                }
+            }
+        }
+        missing.sort_unstable();
+        missing.dedup();
+        let this = &*self;
+        let out: Vec<FenceOutcome> = missing
+            .par_iter()
+            .map(|&k| this.pass(tr, problem, k))
+            .collect();
+        self.computed += out.len() as u64;
+        self.memo.extend(missing.into_iter().zip(out));
+        let mut res = Vec::new();
+        for (ai, y0q, y1q, lo, hi) in cands {
+            let mut lost = state.lost;
+            let mut parts = Vec::with_capacity(state.particles.len());
+            let mut max_lag: f64 = 0.0;
+            for p in &state.particles {
+                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q);
+                match self.memo[&k] {
+                    None => lost += p.weight,
+                    Some((_, _, false, _)) => parts.push(*p),
+                    Some((th, dy, true, lag)) => {
+                        max_lag = max_lag.max(lag);
+                        let y = p.y_q as f64 * q + dy;
+                        if y.abs() > half {
+                            lost += p.weight;
+                        } else {
+                            parts.push(Particle {
+                                sample: p.sample,
+                                theta_q: theta_quanta(th, problem.theta_quantum_deg, theta_steps),
+                                y_q: y_quanta(y, q),
+                                weight: p.weight,
+                            });
+                        }
+                    }
+                }
+            }
+            let next = State::canonical(parts, lost);
+            if &next == state {
+                continue;
+            }
+            let deg = self.options.angles_deg[ai as usize];
+            let (y0, y1) = (y0q as f64 * q, y1q as f64 * q);
+            let margin = if deg > 0.0 { hi - y0 } else { y0 - lo };
+            res.push((
+                Action::Fence(FenceAction {
+                    angle_deg: deg,
+                    y0_m: y0,
+                    y1_m: y1,
+                    length_m: (y1 - y0).abs() / deg.to_radians().sin().abs(),
+                    mu_f: self.options.mu_f,
+                    lo_m: lo,
+                    hi_m: hi,
+                    margin_m: margin,
+                    max_lag_m: max_lag,
+                }),
+                next,
+            ));
+        }
+        res
+    }
+}
+
+/// Along-belt gap between one fence's downstream x and the next one's upstream x (m): the part's
+/// diameter plus 2 cm, so a part touches one obstacle at a time.
+pub fn fence_gap_m(radius_m: f64) -> f64 {
+    2.0 * radius_m + 0.02
+}
+
+/// The upstream-end x of each fence of a plan (the first one `first_x` along the belt) and the
+/// belt length (one gap past the last fence's downstream end).
+pub fn layout(fences: &[FenceAction], radius_m: f64, first_x: f64) -> (Vec<f64>, f64) {
+    let gap = fence_gap_m(radius_m);
+    let mut xs = Vec::new();
+    let mut x = first_x;
+    for f in fences {
+        xs.push(x);
+        x += f.x_extent_m() + gap;
+    }
+    (xs, x)
+}
+
+/// Headway (s) of the emitted line at belt speed `speed`: at least 6 s, and long enough that a
+/// part lagging the belt by every fence's largest lag stays a diameter plus 2 cm ahead of the next
+/// part (a fence near the jam limit holds parts long), rounded up to a whole second.
+pub fn headway_s(fences: &[FenceAction], radius_m: f64, speed: f64) -> f64 {
+    let lag: f64 = fences.iter().map(|f| f.max_lag_m).sum();
+    ((lag + fence_gap_m(radius_m)) / speed).ceil().max(6.0)
+}

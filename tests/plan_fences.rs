@@ -1,0 +1,163 @@
+//! `pinfeed plan --fences` (issue 14 part 3, the fence planner): the tripoly1 fence plan orients
+//! ≥ 99% on the line and runs unchanged through `pinfeed run`; the emitted fences respect the jam
+//! limit (|α| + atan μf < 90°) and lie over the belt; a belt too narrow for any fence (the pin
+//! planner's 10 cm) is a reported answer; plans are deterministic; `--fences` with `--sensor` is refused.
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn pinfeed(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(args)
+        .output()
+        .expect("run pinfeed")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pinfeed_plan_fences_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn json_ok(args: &[&str]) -> Value {
+    let out = pinfeed(args);
+    assert!(
+        out.status.success(),
+        "{args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
+#[test]
+fn tripoly1_fence_plan_orients_the_line_and_runs() {
+    let out = tmp("F.toml");
+    let o = out.to_str().unwrap();
+    let v = json_ok(&[
+        "plan",
+        "--part",
+        "tripoly1",
+        "--fences",
+        "--belt-width",
+        "0.18",
+        "--out",
+        o,
+        "--check-parts",
+        "500",
+        "--json",
+    ]);
+    assert_eq!(v["result"], "found", "{}", v["message"]);
+    let steps = v["plan"]["steps"].as_array().unwrap();
+    assert!((1..=8).contains(&steps.len()), "{} fences", steps.len());
+    for s in steps {
+        assert_eq!(s["action"]["kind"], "fence", "{s}");
+    }
+    assert!(v["plan"]["predicted_success"].as_f64().unwrap() >= 0.99);
+    let rate = v["check"]["success_rate"].as_f64().unwrap();
+    assert!(rate >= 0.99, "line success {rate}");
+
+    // The scenario: fences only, each below the jam limit and with both ends over the belt.
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.contains("pinfeed plan --part tripoly1 --belt-width 0.18 --fences"),
+        "{text}"
+    );
+    assert_eq!(text.matches("kind = \"fence\"").count(), steps.len());
+    assert_eq!(text.matches("kind = \"pin\"").count(), 0);
+    let doc: toml::Value = toml::from_str(&text).expect("scenario is TOML");
+    let half = doc["belt"]["width"].as_float().unwrap() / 2.0;
+    let belt_len = doc["belt"]["length"].as_float().unwrap();
+    let fences = doc["obstacles"].as_array().unwrap();
+    let mut last_x_end = f64::NEG_INFINITY;
+    for f in fences {
+        let num = |k: &str| f[k].as_float().unwrap();
+        let (x, y, angle, length, mu_f) =
+            (num("x"), num("y"), num("angle"), num("length"), num("mu_f"));
+        assert!(
+            angle.abs() + mu_f.atan().to_degrees() < 90.0,
+            "fence at {angle}° jams with μf {mu_f}"
+        );
+        assert!((15.0..=60.0).contains(&angle.abs()), "{angle}");
+        let (x1, y1) = (
+            x + length * angle.to_radians().cos(),
+            y + length * angle.to_radians().sin(),
+        );
+        for yy in [y, y1] {
+            assert!(
+                yy.abs() <= half + 1e-9,
+                "fence end y {yy} off a ±{half} belt"
+            );
+        }
+        assert!(x > 0.0 && x1 < belt_len, "fence x {x}..{x1} off the belt");
+        // One after another along the belt, with room for a part between them.
+        assert!(
+            x > last_x_end + 0.05,
+            "fences overlap along the belt: {x} after {last_x_end}"
+        );
+        last_x_end = x1;
+    }
+
+    // `pinfeed run` runs it unchanged.
+    let run = pinfeed(&[
+        "run",
+        o,
+        "--parts",
+        "300",
+        "--json",
+        "--quiet",
+        "--out",
+        tmp("runs").to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let s: Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!(s["success_rate"].as_f64().unwrap() >= 0.99, "{s}");
+    assert!(out.with_extension("svg").exists());
+}
+
+#[test]
+fn fence_plans_are_deterministic() {
+    let args = [
+        "plan",
+        "--part",
+        "tripoly1",
+        "--fences",
+        "--belt-width",
+        "0.18",
+        "--check-parts",
+        "0",
+        "--json",
+    ];
+    let a = json_ok(&args);
+    let b = json_ok(&args);
+    assert_eq!(a["plan"]["steps"], b["plan"]["steps"]);
+    assert_eq!(a["scenario"], b["scenario"]);
+}
+
+#[test]
+fn a_belt_too_narrow_for_any_fence_is_an_answer() {
+    let v = json_ok(&[
+        "plan",
+        "--part",
+        "tripoly1",
+        "--fences",
+        "--belt-width",
+        "0.1",
+        "--check-parts",
+        "0",
+        "--json",
+    ]);
+    assert_eq!(v["result"], "exhausted", "{v}");
+}
+
+#[test]
+fn fences_and_sensor_are_refused_together() {
+    let out = pinfeed(&["plan", "--part", "tripoly1", "--fences", "--sensor"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--fences"), "{err}");
+}
