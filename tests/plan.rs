@@ -4,34 +4,11 @@
 //! searches that hit their limits end with a clear message and a non-zero exit; "no plan up to
 //! depth k" is a reported result.
 
+mod plan_cli;
 use pinfeed::plan::search::Planner;
 use pinfeed::plan::{Action, Outcome, Problem, State};
+use plan_cli::*;
 use serde_json::Value;
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("pinfeed_plan_test_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn json_ok(args: &[&str]) -> Value {
-    let out = pinfeed(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
-}
 
 #[test]
 fn default_tripoly2_plan_orients_the_line() {

@@ -3,32 +3,9 @@
 //! limit (|α| + atan μf < 90°) and lie over the belt; a belt too narrow for any fence (the pin
 //! planner's 10 cm) is a reported answer; plans are deterministic; `--fences` with `--sensor` is refused.
 
+mod plan_cli;
+use plan_cli::*;
 use serde_json::Value;
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("pinfeed_plan_fences_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn json_ok(args: &[&str]) -> Value {
-    let out = pinfeed(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
-}
 
 #[test]
 fn tripoly1_fence_plan_orients_the_line_and_runs() {

@@ -3,22 +3,9 @@
 //! and that orient ≥ 95% on the line; the policy names the part; plans are deterministic for a
 //! seed.
 
+mod plan_cli;
+use plan_cli::*;
 use serde_json::Value;
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("pinfeed_plan_sensing_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
 
 fn plan(out: &str) -> Value {
     let o = pinfeed(&[
