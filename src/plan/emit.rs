@@ -76,14 +76,8 @@ pub fn scenario_toml(
         t += " Planned against random tripod supports.";
     }
     t += &format!("\n#\n#   pinfeed run {file}\n\n");
-    t += &format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
-    t += "[belt]\nspeed = 0.05        # m/s\n";
-    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
-    t += &format!(
-        "length = {}        # m: one spacing after the last pin\n\n",
-        num(sp * (n as f64 + 1.0), 6)
-    );
-    t += &part_feed_sections(problem, stable_count, parts);
+    let length = sp * (n as f64 + 1.0);
+    t += &line_sections(&name, problem, (length, "pin"), stable_count, parts, None);
     for (k, step) in plan.steps.iter().enumerate() {
         let Action::Pin(pin) = step.action else {
             continue;
@@ -150,19 +144,16 @@ pub fn fence_scenario_toml(
         num(plan.window.centre_deg, 2),
         problem.tolerance_deg
     );
-    t += &format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
-    t += "[belt]\nspeed = 0.05        # m/s\n";
-    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
-    t += &format!(
-        "length = {}        # m: one spacing after the last fence\n\n",
-        num(end + problem.spacing_m, 6)
-    );
-    t += &part_feed_sections(problem, stable_count, parts).replace(
-        "headway = 4.0",
-        &format!(
-            "headway = {}        # s: parts lag the belt along the fences",
-            num(super::fences::headway_s(&fences, radius, 0.05), 3)
-        ),
+    // Parts lag the belt along the fences: they are fed further apart.
+    let headway = super::fences::headway_s(&fences, radius, BELT_SPEED);
+    let length = end + problem.spacing_m;
+    t += &line_sections(
+        &name,
+        problem,
+        (length, "fence"),
+        stable_count,
+        parts,
+        Some(headway),
     );
     for (k, (f, x)) in fences.iter().zip(&xs).enumerate() {
         let step = &plan.steps[k];
@@ -184,8 +175,29 @@ pub fn fence_scenario_toml(
 }
 
 /// The `[part]`, `[feed]` and `[feed.lateral]` sections of a planned scenario.
-fn part_feed_sections(problem: &Problem, stable_count: usize, parts: u64) -> String {
-    let mut t = String::new();
+/// The belt speed of every planned line (m/s).
+const BELT_SPEED: f64 = 0.05;
+/// Seconds between parts on a planned pin line.
+const HEADWAY_S: f64 = 4.0;
+
+/// The name, `[belt]` (`length` m: one spacing after the last `obstacle`), `[part]`, `[feed]` and
+/// `[feed.lateral]` sections of a planned scenario; `headway` (s) replaces the default spacing of
+/// parts where the obstacles make them lag.
+fn line_sections(
+    name: &str,
+    problem: &Problem,
+    (length, obstacle): (f64, &str),
+    stable_count: usize,
+    parts: u64,
+    headway: Option<f64>,
+) -> String {
+    let mut t = format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
+    t += &format!("[belt]\nspeed = {BELT_SPEED}        # m/s\n");
+    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
+    t += &format!(
+        "length = {}        # m: one spacing after the last {obstacle}\n\n",
+        num(length, 6)
+    );
     t += "[part]\n";
     if let Some(v) = problem.part.trim().strip_prefix("vertices:") {
         let pts = crate::geometry::named::parse_vertex_list(v).unwrap_or_default();
@@ -203,7 +215,13 @@ fn part_feed_sections(problem: &Problem, stable_count: usize, parts: u64) -> Str
         "support = \"{}\"\n\n",
         if problem.tripod { "tripod" } else { "uniform" }
     );
-    t += &format!("[feed]\nparts = {parts}\narrival = \"periodic\"\nheadway = 4.0\n");
+    t += &match headway {
+        None => format!("[feed]\nparts = {parts}\narrival = \"periodic\"\nheadway = {HEADWAY_S:.1}\n"),
+        Some(h) => format!(
+            "[feed]\nparts = {parts}\narrival = \"periodic\"\nheadway = {}        # s: parts lag the belt along the fences\n",
+            num(h, 3)
+        ),
+    };
     match problem.feed {
         FeedKind::Stable => {
             let w = vec!["1"; stable_count].join(", ");
@@ -280,14 +298,8 @@ pub fn contingent_toml(
         num(plan.centre_deg, 2),
         problem.tolerance_deg
     );
-    t += &format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
-    t += "[belt]\nspeed = 0.05        # m/s\n";
-    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
-    t += &format!(
-        "length = {}        # m: one spacing after the last pin\n\n",
-        num(sp * (k as f64 + 2.0), 6)
-    );
-    t += &part_feed_sections(problem, stable_count, parts);
+    let length = sp * (k as f64 + 2.0);
+    t += &line_sections(&name, problem, (length, "pin"), stable_count, parts, None);
     t += &format!(
         "\n[[obstacles]]   # the sensor (margin {:.2} mm)\nkind = \"sensor_pin\"\nname = \"probe\"\nx = {}\ny = {}\nradius = {}\n",
         plan.sensor.margin_m * 1e3,
