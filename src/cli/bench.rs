@@ -61,6 +61,32 @@ pub enum BenchWhat {
         #[arg(long, default_value = "results/contact-model.md")]
         out: PathBuf,
     },
+    /// Which polygons can pins orient? The sensorless, sensing and fence planners on seeded random
+    /// polygons (`random:SEED`), each plan checked on the line; writes results/plans-survey.{md,svg}.
+    Plans {
+        /// Polygons random:FIRST … random:FIRST+N−1.
+        #[arg(long, default_value_t = 20)]
+        random: u64,
+        #[arg(long, default_value_t = 1)]
+        first: u64,
+        /// Search time limit of each plan (s).
+        #[arg(long, default_value_t = 30.0)]
+        time_limit: f64,
+        /// Parts of each line check.
+        #[arg(long, default_value_t = 10_000)]
+        check_parts: u64,
+        /// Belt width of the fence plans (m).
+        #[arg(long, default_value_t = 0.18)]
+        fence_belt: f64,
+        /// Share of the parts in one window that counts as oriented.
+        #[arg(long, default_value_t = 0.99)]
+        target: f64,
+        /// Worker threads (0: one per core); the results do not depend on it.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        #[arg(long, default_value = "results/plans-survey.md")]
+        out: PathBuf,
+    },
     /// Wall time of the 18 thesis configuration maps (d = ±0.1 … ±0.9, 360 θ0 each) per part,
     /// model and thread count; writes results/maps/timing.md.
     Maps {
@@ -157,6 +183,34 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             Ok(())
         }
         BenchWhat::Maps { repeats, out } => bench_maps(*repeats, out),
+        BenchWhat::Plans {
+            random,
+            first,
+            time_limit,
+            check_parts,
+            fence_belt,
+            target,
+            threads,
+            out,
+        } => {
+            if !(1..=10_000).contains(random) {
+                anyhow::bail!("--random must be between 1 and 10000, got {random}");
+            }
+            let command = format!(
+                "cargo run --release -- bench plans --random {random} --first {first} --time-limit {time_limit} --check-parts {check_parts} --fence-belt {fence_belt} --target {target} --out {}",
+                out.display()
+            );
+            super::bench_plans::run(&super::bench_plans::Survey {
+                seeds: (*first..first.saturating_add(*random)).collect(),
+                time_limit_s: *time_limit,
+                check_parts: *check_parts,
+                fence_belt_m: *fence_belt,
+                target: *target,
+                threads: *threads,
+                out: out.clone(),
+                command,
+            })
+        }
         BenchWhat::McPrecision {
             study,
             samples,

@@ -20,7 +20,7 @@ use std::path::PathBuf;
 /// Arguments of `pinfeed contact`.
 #[derive(Debug, Args)]
 pub struct ContactArgs {
-    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, or vertices:"x,y x,y ...".
+    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], or vertices:"x,y x,y ...".
     #[arg(long, required_unless_present = "cases")]
     pub part: Option<String>,
     /// Initial orientation θ0 (degrees).

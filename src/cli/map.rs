@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 /// Arguments of `pinfeed map`.
 #[derive(Debug, Args)]
 pub struct MapArgs {
-    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, or vertices:"x,y x,y ...".
+    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], or vertices:"x,y x,y ...".
     #[arg(long)]
     pub part: String,
     /// Contact parameters d = (y_pin − y_com)/a, comma-separated (e.g. -0.9,-0.5,0.3).

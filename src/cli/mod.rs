@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod bench_mc;
+pub mod bench_plans;
 pub mod compare;
 pub mod contact;
 pub mod fuzz;

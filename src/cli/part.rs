@@ -9,7 +9,7 @@ use std::path::PathBuf;
 /// Arguments of `pinfeed part`.
 #[derive(Debug, Args)]
 pub struct PartArgs {
-    /// Named part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape.
+    /// Named part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N].
     pub name: Option<String>,
     /// Vertex list instead of a name: "x1,y1 x2,y2 ..." (any orientation, any unit).
     // allow_hyphen_values: a list that starts with a negative coordinate ("-1.5,-0.5 ...") is a

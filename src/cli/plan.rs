@@ -8,6 +8,7 @@
 //! limit (`--max-states`, `--time-limit`) or a bad input exits non-zero with a message.
 
 use super::stdout::print_result;
+use crate::plan::fences::FenceTransition;
 use crate::plan::search::{Planner, SearchStats};
 use crate::plan::{emit, Action, FeedKind, Outcome, Plan, Problem};
 use anyhow::{anyhow, bail, Context, Result};
@@ -18,7 +19,7 @@ use std::path::{Path, PathBuf};
 /// Arguments of `pinfeed plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, or vertices:"x,y x,y ...".
+    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], or vertices:"x,y x,y ...".
     #[arg(long)]
     pub part: String,
     /// Metres per unit of the part's coordinates.
@@ -325,7 +326,7 @@ pub fn command_line(args: &PlanArgs) -> String {
 }
 
 /// The line check of a plan, as reported.
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct CheckReport {
     pub parts: u64,
     pub success_rate: f64,
@@ -342,10 +343,40 @@ pub struct PlanReport<'a> {
     /// found | none_up_to_depth | exhausted | limit
     pub result: &'static str,
     pub message: String,
+    /// The plan found, or (result ≠ found) the best effort: the shortest plan bringing the most
+    /// particles into one window.
     pub plan: Option<&'a Plan>,
     pub stats: &'a SearchStats,
     pub check: Option<CheckReport>,
     pub scenario: Option<String>,
+}
+
+/// What one planning run produced, whatever the planner (sensorless pins, fences, sensing): what
+/// `pinfeed bench plans` tabulates.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanSummary {
+    /// found | none_up_to_depth | exhausted | limit
+    pub result: &'static str,
+    pub message: String,
+    /// Obstacles of the plan (pins, fences, or the sensor pin plus the moving pins); with a
+    /// result other than found, of the best effort.
+    pub obstacles: Option<usize>,
+    pub predicted: Option<f64>,
+    pub check: Option<CheckReport>,
+    /// Belt length the layout occupies (m; [`crate::study::compare`]'s footprint).
+    pub footprint_m: Option<f64>,
+    /// Search depth completed (pins, fences or moving pins).
+    pub depth_completed: usize,
+    pub search_s: f64,
+}
+
+/// A planning run, ready to print.
+pub struct Executed {
+    /// The table (or, with `--json`, the JSON document).
+    pub output: String,
+    pub summary: PlanSummary,
+    /// A limit stopped the search: the command fails with this message after printing.
+    pub failure: Option<String>,
 }
 
 fn mb(bytes: f64) -> String {
@@ -433,6 +464,16 @@ fn plan_text(problem: &Problem, plan: &Plan) -> String {
 
 /// Run `pinfeed plan`.
 pub fn run(args: &PlanArgs) -> Result<()> {
+    let done = execute(args)?;
+    print_result(&done.output)?;
+    if let Some(msg) = done.failure {
+        bail!(msg);
+    }
+    Ok(())
+}
+
+/// Plan, write, draw and check as the arguments say; print nothing.
+pub fn execute(args: &PlanArgs) -> Result<Executed> {
     let problem = problem_of(args)?;
     let command = command_line(args);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -443,166 +484,88 @@ pub fn run(args: &PlanArgs) -> Result<()> {
         bail!("--sensor and --fences: the contingent planner uses pins; choose one");
     }
     if args.sensor {
-        return super::plan_sensor::run(args, &problem, &command, &pool);
+        return super::plan_sensor::execute(args, &problem, &command, &pool);
     }
     let mut planner = Planner::new(&problem)?;
     if args.fences {
-        let mu_f = args.mu_f.unwrap_or(problem.mu_c);
-        if !(mu_f.is_finite() && mu_f >= 0.0) {
-            bail!("--mu-f {mu_f}: must be a finite number ≥ 0");
-        }
-        if !(args.fence_overhang.is_finite() && args.fence_overhang >= 0.0) {
-            bail!(
-                "--fence-overhang {}: must be a finite number ≥ 0",
-                args.fence_overhang
-            );
-        }
-        let mut opts = crate::plan::FenceOptions::default_for(mu_f);
-        opts.overhang_a = args.fence_overhang;
-        opts.angles_deg
-            .retain(|a| a.abs() <= args.max_fence_angle + 1e-9);
-        if opts.angles_deg.is_empty() {
-            bail!(
-                "--max-fence-angle {}: no candidate angle (±15° … ±60° below the jam limit {:.1}° for μf {mu_f}) is left",
-                args.max_fence_angle,
-                90.0 - mu_f.atan().to_degrees()
-            );
-        }
-        planner.fences = Some(crate::plan::fences::FenceTransition::new(opts));
+        planner.fences = Some(fence_transition(args, &problem)?);
     }
     let (outcome, stats) = pool.install(|| planner.search());
-    let stable_count = planner.compiled.stable_deg.len();
-    let (result, message, plan, failure) = match &outcome {
-        Outcome::Found(p) => (
-            "found",
-            if problem.fewest_sets {
-                format!(
-                    "found a plan of {} pin(s) to {} orientation set(s), the fewest up to depth {}",
-                    p.steps.len(),
-                    p.sets,
-                    stats.depth_completed.max(p.steps.len())
-                )
-            } else {
-                format!(
-                    "found a shortest plan: {} {}(s)",
-                    p.steps.len(),
-                    if args.fences { "fence" } else { "pin" }
-                )
-            },
-            Some(p),
-            None,
-        ),
-        Outcome::NoneUpTo { depth } => (
-            "none_up_to_depth",
-            format!(
-                "no sensorless plan up to depth {depth}: every plan of at most {depth} pins in this action set leaves less than {} of the parts in one ±{}° window",
-                problem.target, problem.tolerance_deg
-            ),
-            None,
-            None,
-        ),
-        Outcome::Exhausted { depth } => (
-            "exhausted",
-            format!(
-                "no sensorless plan at any depth: after {depth} pin(s) no new state is reachable in this action set{}",
-                if *depth == 0 {
-                    " (no pin position keeps every particle at least --min-margin from a band edge; try a smaller --min-margin)"
-                } else {
-                    ""
-                }
-            ),
-            None,
-            None,
-        ),
-        Outcome::LimitHit {
-            limit,
-            depth_completed,
-            best,
-        } => {
-            let msg = format!(
-                "search stopped by its {limit} after completing depth {depth_completed} ({} states kept): no plan of at most {depth_completed} pin(s) reaches the goal; deeper levels were not finished",
-                stats.states_per_depth.iter().sum::<usize>()
-            );
-            ("limit", msg.clone(), best.as_ref(), Some(msg))
-        }
-    };
+    let what = if args.fences { "fence" } else { "pin" };
+    let (result, message, plan, failure) = describe(&problem, &outcome, &stats, what);
     let mut scenario = None;
     let mut check = None;
+    let mut footprint_m = None;
     if let Some(plan) = plan {
-        let parts = args.check_parts.max(1);
-        let file = args.out.as_ref().map_or("plan.toml".to_string(), |p| {
-            shell_word(&p.display().to_string())
-        });
+        let path = args
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("plan.toml"));
+        let file = shell_word(&path.display().to_string());
         let toml = emit::scenario_toml(
             &problem,
             plan,
-            stable_count,
+            planner.compiled.stable_deg.len(),
             planner.compiled.symmetry,
-            parts,
+            args.check_parts.max(1),
             &command,
             &file,
         );
+        footprint_m = crate::plan::check::footprint_m(&toml, &path);
         if args.check_parts > 0 {
             let started = std::time::Instant::now();
-            let path = args
-                .out
-                .clone()
-                .unwrap_or_else(|| PathBuf::from("plan.toml"));
             let summary = pool.install(|| {
                 crate::plan::check::check(&toml, &path, args.check_parts, problem.seed)
             })?;
-            check = Some(CheckReport {
-                parts: summary.parts_in,
-                success_rate: summary.success_rate,
-                success_ci95: summary.success_ci95,
-                outcomes: summary.outcomes,
-                elapsed_s: started.elapsed().as_secs_f64(),
-            });
+            check = Some(CheckReport::of(&summary, started));
         }
-        if let Some(out) = &args.out {
-            write_file(out, &toml)?;
-            let draw = args
-                .draw
-                .clone()
-                .unwrap_or_else(|| out.with_extension("svg"));
+        if let Some(draw) = args
+            .draw
+            .clone()
+            .or(args.out.as_ref().map(|o| o.with_extension("svg")))
+        {
+            if let Some(out) = &args.out {
+                write_file(out, &toml)?;
+            }
             crate::report::plot_plan::plot_plan(&problem, plan, &draw)
-                .with_context(|| format!("drawing {}", draw.display()))?;
-        } else if let Some(draw) = &args.draw {
-            crate::report::plot_plan::plot_plan(&problem, plan, draw)
                 .with_context(|| format!("drawing {}", draw.display()))?;
         }
         scenario = Some(toml);
     }
-    if args.json {
+    let summary = PlanSummary {
+        result,
+        message: message.clone(),
+        obstacles: plan.map(|p| p.steps.len()),
+        predicted: plan.map(|p| p.predicted_success),
+        check: check.clone(),
+        footprint_m,
+        depth_completed: stats.depth_completed,
+        search_s: stats.elapsed_s,
+    };
+    let output = if args.json {
         let report = PlanReport {
-            command: command.clone(),
+            command,
             problem: &problem,
             result,
-            message: message.clone(),
+            message,
             plan,
             stats: &stats,
             check,
             scenario,
         };
-        print_result(&(serde_json::to_string_pretty(&report)? + "\n"))?;
+        serde_json::to_string_pretty(&report)? + "\n"
     } else {
         let mut t = format!("{command}\n");
         t += &stats_text(&stats);
         t += &format!("result      {message}\n");
         if let Some(plan) = plan {
+            if result != "found" {
+                t += "best effort (does not reach the goal):\n";
+            }
             t += &plan_text(&problem, plan);
         }
         if let Some(c) = &check {
-            t += &format!(
-                "line check  {} parts: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}; {} ({:.1} s)\n",
-                c.parts,
-                c.success_rate,
-                c.success_ci95[0],
-                c.success_ci95[1],
-                plan.map_or(0.0, |p| p.predicted_success),
-                outcome_mix(&c.outcomes),
-                c.elapsed_s
-            );
+            t += &check_text(c, plan.map_or(0.0, |p| p.predicted_success), "");
         }
         if let (Some(out), Some(_)) = (&args.out, plan) {
             let draw = args
@@ -611,12 +574,139 @@ pub fn run(args: &PlanArgs) -> Result<()> {
                 .unwrap_or_else(|| out.with_extension("svg"));
             t += &format!("wrote       {} and {}\n", out.display(), draw.display());
         }
-        print_result(&t)?;
+        t
+    };
+    Ok(Executed {
+        output,
+        summary,
+        failure,
+    })
+}
+
+impl CheckReport {
+    pub(crate) fn of(summary: &crate::engine::Summary, started: std::time::Instant) -> Self {
+        CheckReport {
+            parts: summary.parts_in,
+            success_rate: summary.success_rate,
+            success_ci95: summary.success_ci95,
+            outcomes: summary.outcomes,
+            elapsed_s: started.elapsed().as_secs_f64(),
+        }
     }
-    if let Some(msg) = failure {
-        bail!(msg);
+}
+
+/// The line check's line of the table (`extra` follows the prediction).
+pub(crate) fn check_text(c: &CheckReport, predicted: f64, extra: &str) -> String {
+    format!(
+        "line check  {} parts: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}{extra}; {} ({:.1} s)\n",
+        c.parts,
+        c.success_rate,
+        c.success_ci95[0],
+        c.success_ci95[1],
+        predicted,
+        outcome_mix(&c.outcomes),
+        c.elapsed_s
+    )
+}
+
+/// The fence planner's transition from the arguments (`--fences`).
+fn fence_transition(args: &PlanArgs, problem: &Problem) -> Result<FenceTransition> {
+    let mu_f = args.mu_f.unwrap_or(problem.mu_c);
+    if !(mu_f.is_finite() && mu_f >= 0.0) {
+        bail!("--mu-f {mu_f}: must be a finite number ≥ 0");
     }
-    Ok(())
+    if !(args.fence_overhang.is_finite() && args.fence_overhang >= 0.0) {
+        bail!(
+            "--fence-overhang {}: must be a finite number ≥ 0",
+            args.fence_overhang
+        );
+    }
+    let mut opts = crate::plan::FenceOptions::default_for(mu_f);
+    opts.overhang_a = args.fence_overhang;
+    opts.angles_deg
+        .retain(|a| a.abs() <= args.max_fence_angle + 1e-9);
+    if opts.angles_deg.is_empty() {
+        bail!(
+            "--max-fence-angle {}: no candidate angle (±15° … ±60° below the jam limit {:.1}° for μf {mu_f}) is left",
+            args.max_fence_angle,
+            90.0 - mu_f.atan().to_degrees()
+        );
+    }
+    Ok(FenceTransition::new(opts))
+}
+
+/// The result word, the message, the plan to emit (found or best effort) and the failure message
+/// (a limit) of a search.
+fn describe<'a>(
+    problem: &Problem,
+    outcome: &'a Outcome,
+    stats: &SearchStats,
+    what: &str,
+) -> (&'static str, String, Option<&'a Plan>, Option<String>) {
+    let best_text = |best: &Option<Plan>| {
+        best.as_ref().map_or(
+            format!("; no {what} sequence brings more of them into one window than the feed"),
+            |b| {
+                format!(
+                    "; the best effort, {} {what}(s), brings {:.4} of them into one window",
+                    b.steps.len(),
+                    b.predicted_success
+                )
+            },
+        )
+    };
+    match outcome {
+        Outcome::Found(p) => {
+            let m = if problem.fewest_sets {
+                format!(
+                    "found a plan of {} {what}(s) to {} orientation set(s), the fewest up to depth {}",
+                    p.steps.len(),
+                    p.sets,
+                    stats.depth_completed.max(p.steps.len())
+                )
+            } else {
+                format!("found a shortest plan: {} {what}(s)", p.steps.len())
+            };
+            ("found", m, Some(p), None)
+        }
+        Outcome::NoneUpTo { depth, best } => (
+            "none_up_to_depth",
+            format!(
+                "no sensorless plan up to depth {depth}: every plan of at most {depth} {what}s in this action set leaves less than {} of the parts in one ±{}° window{}",
+                problem.target,
+                problem.tolerance_deg,
+                best_text(best)
+            ),
+            best.as_ref(),
+            None,
+        ),
+        Outcome::Exhausted { depth, best } => (
+            "exhausted",
+            format!(
+                "no sensorless plan at any depth: after {depth} {what}(s) no new state is reachable in this action set{}{}",
+                if *depth == 0 {
+                    " (no position keeps every particle at least --min-margin from a band edge; try a smaller --min-margin)"
+                } else {
+                    ""
+                },
+                best_text(best)
+            ),
+            best.as_ref(),
+            None,
+        ),
+        Outcome::LimitHit {
+            limit,
+            depth_completed,
+            best,
+        } => {
+            let msg = format!(
+                "search stopped by its {limit} after completing depth {depth_completed} ({} states kept): no plan of at most {depth_completed} {what}(s) reaches the goal; deeper levels were not finished{}",
+                stats.states_per_depth.iter().sum::<usize>(),
+                best_text(best)
+            );
+            ("limit", msg.clone(), best.as_ref(), Some(msg))
+        }
+    }
 }
 
 pub(crate) fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {

@@ -3,12 +3,13 @@
 //! (the real sensor and classifier), whose success is printed beside the prediction with a perfect
 //! classifier and with the confusion the line measured.
 
-use super::plan::{outcome_mix, shell_word, write_file, CheckReport, PlanArgs};
-use super::stdout::print_result;
+use super::plan::{
+    check_text, shell_word, write_file, CheckReport, Executed, PlanArgs, PlanSummary,
+};
 use crate::plan::contingent::{self, ContingentOutcome, ContingentPlan, ContingentStats};
 use crate::plan::search::Planner;
 use crate::plan::{emit, Problem};
-use anyhow::{bail, Result};
+use anyhow::Result;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -73,13 +74,13 @@ fn plan_text(problem: &Problem, plan: &ContingentPlan) -> String {
     t
 }
 
-/// Run `pinfeed plan --sensor`.
-pub fn run(
+/// Plan with sensing, write, check; print nothing (see [`super::plan::execute`]).
+pub fn execute(
     args: &PlanArgs,
     problem: &Problem,
     command: &str,
     pool: &rayon::ThreadPool,
-) -> Result<()> {
+) -> Result<Executed> {
     let mut planner = Planner::new(problem)?;
     let (outcome, stats) =
         pool.install(|| contingent::search(&mut planner, args.max_moving, args.sensor_candidates))?;
@@ -117,6 +118,7 @@ pub fn run(
     let mut check = None;
     let mut accuracy = None;
     let mut with_confusion = None;
+    let mut footprint_m = None;
     if let Some(plan) = plan {
         let out = args.out.clone().unwrap_or_else(|| {
             std::env::temp_dir()
@@ -169,14 +171,9 @@ pub fn run(
                     with_confusion = Some(plan.with_confusion(&counts));
                 }
             }
-            check = Some(CheckReport {
-                parts: summary.parts_in,
-                success_rate: summary.success_rate,
-                success_ci95: summary.success_ci95,
-                outcomes: summary.outcomes,
-                elapsed_s: started.elapsed().as_secs_f64(),
-            });
+            check = Some(CheckReport::of(&summary, started));
         }
+        footprint_m = crate::plan::check::footprint_m(&toml, &out);
         if args.out.is_none() {
             let _ = std::fs::remove_file(&out);
             let _ = std::fs::remove_file(&policy_path);
@@ -184,7 +181,17 @@ pub fn run(
         scenario = Some(toml);
         policy = Some(pol);
     }
-    if args.json {
+    let summary = PlanSummary {
+        result,
+        message: message.clone(),
+        obstacles: plan.map(|p| p.k + 1),
+        predicted: plan.map(|p| p.predicted_success),
+        check: check.clone(),
+        footprint_m,
+        depth_completed: stats.states_per_depth.len().saturating_sub(1),
+        search_s: stats.elapsed_s,
+    };
+    let output = if args.json {
         let report = SensorReport {
             command: command.to_string(),
             problem,
@@ -198,7 +205,7 @@ pub fn run(
             scenario,
             policy,
         };
-        print_result(&(serde_json::to_string_pretty(&report)? + "\n"))?;
+        serde_json::to_string_pretty(&report)? + "\n"
     } else {
         let mut t = format!("{command}\n");
         let levels: Vec<String> = stats
@@ -221,22 +228,13 @@ pub fn run(
             t += &plan_text(problem, plan);
         }
         if let Some(c) = &check {
-            t += &format!(
-                "line check  {} parts: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}{}; {} ({:.1} s)\n",
-                c.parts,
-                c.success_rate,
-                c.success_ci95[0],
-                c.success_ci95[1],
-                plan.map_or(0.0, |p| p.predicted_success),
-                match (accuracy, with_confusion) {
-                    (Some(a), Some(w)) => format!(
-                        " (perfect classifier), {w:.4} with the line's confusion (accuracy {a:.4})"
-                    ),
-                    _ => String::new(),
-                },
-                outcome_mix(&c.outcomes),
-                c.elapsed_s
-            );
+            let extra = match (accuracy, with_confusion) {
+                (Some(a), Some(w)) => format!(
+                    " (perfect classifier), {w:.4} with the line's confusion (accuracy {a:.4})"
+                ),
+                _ => String::new(),
+            };
+            t += &check_text(c, plan.map_or(0.0, |p| p.predicted_success), &extra);
         }
         if let (Some(out), Some(_)) = (&args.out, plan) {
             let stem = out
@@ -248,10 +246,11 @@ pub fn run(
                 out.with_file_name(format!("{stem}.policy.toml")).display()
             );
         }
-        print_result(&t)?;
-    }
-    if let Some(msg) = failure {
-        bail!(msg);
-    }
-    Ok(())
+        t
+    };
+    Ok(Executed {
+        output,
+        summary,
+        failure,
+    })
 }

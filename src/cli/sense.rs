@@ -38,7 +38,7 @@ fn dflt() -> SensorSettings {
 /// Arguments of `pinfeed sense`.
 #[derive(Debug, Args, Clone)]
 pub struct SenseArgs {
-    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, or vertices:"x,y x,y ...".
+    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], or vertices:"x,y x,y ...".
     #[arg(long)]
     pub part: String,
     /// Metres per part unit (the part's vertices are multiplied by it).

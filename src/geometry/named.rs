@@ -8,6 +8,7 @@
 //! | `rect:W:H` | W × H rectangle |
 //! | `ngon:N` | regular N-gon of circumradius 1 with a flat bottom edge (3 ≤ N ≤ 1000) |
 //! | `lshape` | concave L made of three unit squares |
+//! | `random:SEED` or `random:SEED:N` | a seeded random star-shaped polygon (see [`random_vertices`]) |
 //! | `vertices:x1,y1 x2,y2 …` | any simple polygon (also accepted by `--vertices`) |
 
 use super::polygon::{Polygon, PolygonError};
@@ -17,7 +18,7 @@ use thiserror::Error;
 /// Why a part specification could not be turned into a polygon.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PartSpecError {
-    #[error("unknown part '{0}'; expected one of tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, vertices:\"x1,y1 x2,y2 ...\"")]
+    #[error("unknown part '{0}'; expected one of tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], vertices:\"x1,y1 x2,y2 ...\"")]
     Unknown(String),
     #[error("bad part '{spec}': {reason}")]
     BadParameter { spec: String, reason: String },
@@ -29,7 +30,13 @@ pub enum PartSpecError {
 
 /// Names accepted by [`part_from_spec`] (for help texts).
 pub const PART_NAMES: &[&str] = &[
-    "tripoly1", "tripoly2", "square", "rect:W:H", "ngon:N", "lshape",
+    "tripoly1",
+    "tripoly2",
+    "square",
+    "rect:W:H",
+    "ngon:N",
+    "lshape",
+    "random:SEED[:N]",
 ];
 
 fn positive(spec: &str, what: &str, s: &str) -> Result<f64, PartSpecError> {
@@ -114,10 +121,65 @@ pub fn named_vertices(spec: &str) -> Result<Vec<Vec2>, PartSpecError> {
             .map(|k| Vec2::from_angle(start + step * k as f64))
             .collect());
     }
+    if let Some(rest) = lower.strip_prefix("random:") {
+        return random_spec(s, rest);
+    }
     if lower.starts_with("vertices:") {
         return parse_vertex_list(&s["vertices:".len()..]);
     }
     Err(PartSpecError::Unknown(s.into()))
+}
+
+fn random_spec(spec: &str, rest: &str) -> Result<Vec<Vec2>, PartSpecError> {
+    let bad = |reason: String| PartSpecError::BadParameter {
+        spec: spec.into(),
+        reason,
+    };
+    let mut it = rest.split(':');
+    let seed_text = it.next().unwrap_or("").trim();
+    let seed: u64 = seed_text
+        .parse()
+        .map_err(|_| bad(format!("seed '{seed_text}' is not a whole number ≥ 0")))?;
+    let n = match it.next() {
+        None => None,
+        Some(t) => {
+            let n: usize = t
+                .trim()
+                .parse()
+                .map_err(|_| bad(format!("'{t}' is not a whole number of vertices")))?;
+            if !(3..=64).contains(&n) {
+                return Err(bad(format!(
+                    "number of vertices must be between 3 and 64, got {n}"
+                )));
+            }
+            Some(n)
+        }
+    };
+    if it.next().is_some() {
+        return Err(bad("expected random:SEED or random:SEED:N".into()));
+    }
+    Ok(random_vertices(seed, n))
+}
+
+/// The vertices of `random:SEED[:N]`: a star-shaped polygon around the origin, drawn from the
+/// seed's own stream ([`crate::random::stream`]`(seed, 0x706f6c79)`), the same on every machine.
+/// N (default: drawn uniformly from 3…8) vertices at polar angles `φ0 + (k + u_k)·2π/N` with
+/// `u_k` uniform in ±0.3 (so consecutive angles stay at least 0.4·2π/N apart and the polygon is
+/// simple) and radii uniform in [0.6, 1.4]; φ0 uniform. About half the polygons of 5 or more
+/// vertices come out concave. The parts a survey of "which polygons can pins orient" runs over.
+pub fn random_vertices(seed: u64, n: Option<usize>) -> Vec<Vec2> {
+    use rand::RngExt;
+    let mut rng = crate::random::stream(seed, 0x706f_6c79);
+    let n = n.unwrap_or_else(|| rng.random_range(3..=8usize));
+    let step = std::f64::consts::TAU / n as f64;
+    let phase = rng.random_range(0.0..std::f64::consts::TAU);
+    (0..n)
+        .map(|k| {
+            let a = phase + step * (k as f64 + rng.random_range(-0.3..0.3));
+            let r = rng.random_range(0.6..1.4);
+            Vec2::from_angle(a) * r
+        })
+        .collect()
 }
 
 /// Parse `"x1,y1 x2,y2 ..."` (pairs separated by whitespace or semicolons).
@@ -171,6 +233,41 @@ mod tests {
         assert!(!part_from_spec("lshape").unwrap().is_convex());
         let tri = part_from_spec("tripoly2").unwrap();
         assert!(tri.offset().norm() < 1e-15);
+    }
+
+    #[test]
+    fn random_parts_are_seeded_valid_and_varied() {
+        let mut concave = 0;
+        let mut sizes = std::collections::BTreeSet::new();
+        for seed in 0..200u64 {
+            let spec = format!("random:{seed}");
+            let p = part_from_spec(&spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
+            assert_eq!(
+                named_vertices(&spec).unwrap(),
+                named_vertices(&spec).unwrap()
+            );
+            sizes.insert(p.vertices().len());
+            concave += usize::from(!p.is_convex());
+        }
+        assert_eq!(sizes, (3..=8).collect());
+        assert!((40..160).contains(&concave), "{concave} concave of 200");
+        assert_ne!(
+            named_vertices("random:1").unwrap(),
+            named_vertices("random:2").unwrap()
+        );
+        assert_eq!(named_vertices("random:5:12").unwrap().len(), 12);
+        for bad in [
+            "random:",
+            "random:x",
+            "random:1:2",
+            "random:1:65",
+            "random:1:5:6",
+        ] {
+            assert!(
+                matches!(part_from_spec(bad), Err(PartSpecError::BadParameter { .. })),
+                "{bad}"
+            );
+        }
     }
 
     #[test]

@@ -26,3 +26,13 @@ pub fn check(toml: &str, path: &Path, parts: u64, seed: u64) -> Result<Summary, 
     let res = run(&scene, &opts, &mut |_| {})?;
     Ok(res.summary)
 }
+
+/// The belt length the emitted layout occupies (m): [`crate::study::compare`]'s footprint, from
+/// the most upstream point of any obstacle (a moving pin's whole travel included) to the most
+/// downstream one, plus the part's length. None if the scenario does not compile (the check
+/// reports why) or has no obstacle.
+pub fn footprint_m(toml: &str, path: &Path) -> Option<f64> {
+    let scene = crate::scenario::parse(path, toml).ok()?;
+    let [a, b] = crate::study::compare::obstacle_span(&scene)?;
+    Some(b - a + crate::study::compare::part_length(&scene.part.polygon))
+}

@@ -48,8 +48,10 @@ pub fn scenario_toml(
     t += &format!(
         "# Written by `pinfeed plan` (sensorless pin planner, issue 14):\n#\n#   {command}\n#\n"
     );
+    t += &best_effort_note(problem, plan, "pin");
     t += &format!(
-        "# {n} pin(s), a shortest plan for its action set (BFS over {} particle(s), θ rounded to {}°,\n",
+        "# {n} pin(s), {} (BFS over {} particle(s), θ rounded to {}°,\n",
+        kind_of(problem, plan),
         plan.initial.total(),
         problem.theta_quantum_deg
     );
@@ -97,6 +99,30 @@ pub fn scenario_toml(
     t
 }
 
+/// Does the plan reach the problem's goal (or is it the best effort of a search that found none)?
+fn reaches_goal(problem: &Problem, plan: &Plan) -> bool {
+    problem.fewest_sets || plan.predicted_success >= problem.target - 1e-12
+}
+
+fn kind_of(problem: &Problem, plan: &Plan) -> &'static str {
+    if reaches_goal(problem, plan) {
+        "a shortest plan for its action set"
+    } else {
+        "the shortest of those bringing the most particles into one window"
+    }
+}
+
+/// The header line that marks a best-effort plan (none reaches the goal).
+fn best_effort_note(problem: &Problem, plan: &Plan, what: &str) -> String {
+    if reaches_goal(problem, plan) {
+        return String::new();
+    }
+    format!(
+        "# BEST EFFORT: no plan in the search reaches the goal ({} of the parts in one window); these\n# {what}s come closest.\n#\n",
+        problem.target
+    )
+}
+
 /// The scenario of a fence plan (the fence planner, [`super::fences`]): fences one after another
 /// along the belt (the first upstream end one spacing in, then the gap of
 /// [`super::fences::layout`]), each a `kind = "fence"` obstacle from its upstream end, parts every
@@ -127,8 +153,10 @@ pub fn fence_scenario_toml(
     t += &format!(
         "# Written by `pinfeed plan --fences` (sensorless fence planner, issue 14):\n#\n#   {command}\n#\n"
     );
+    t += &best_effort_note(problem, plan, "fence");
     t += &format!(
-        "# {n} fence(s), a shortest plan for its action set (BFS over {} particle(s), θ rounded to {}°,\n",
+        "# {n} fence(s), {} (BFS over {} particle(s), θ rounded to {}°,\n",
+        kind_of(problem, plan),
         plan.initial.total(),
         problem.theta_quantum_deg
     );

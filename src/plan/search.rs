@@ -51,11 +51,14 @@ pub struct Plan {
 pub enum Outcome {
     /// A shortest plan (with `fewest_sets`: the shortest among those with the fewest sets).
     Found(Plan),
-    /// Every plan of at most `depth` pins was tried; none reaches the goal.
-    NoneUpTo { depth: usize },
-    /// After `depth` pins no new state appeared: no plan exists at any depth in this action set.
-    Exhausted { depth: usize },
-    /// A limit ended the search after `depth_completed` full levels (`best` with `fewest_sets`).
+    /// Every plan of at most `depth` pins was tried; none reaches the goal. `best`: the shortest
+    /// of the plans that bring the most particles into one window (a best effort, if any pin helps).
+    NoneUpTo { depth: usize, best: Option<Plan> },
+    /// After `depth` pins no new state appeared: no plan exists at any depth in this action set
+    /// (`best` as for `NoneUpTo`).
+    Exhausted { depth: usize, best: Option<Plan> },
+    /// A limit ended the search after `depth_completed` full levels (`best`: with `fewest_sets`
+    /// the fewest sets so far, otherwise the most particles in one window so far).
     LimitHit {
         limit: String,
         depth_completed: usize,
@@ -214,8 +217,10 @@ impl Planner {
         seen.insert(root);
         stats.states_per_depth.push(1);
         let mut state_bytes = self.initial.bytes();
-        // Best so far for `fewest_sets`: (sets, node).
+        // Best so far: for `fewest_sets` (sets, node), otherwise the most particles in one window
+        // (inside, node); the first found (the shallowest) wins ties.
         let mut best: (usize, usize) = (self.sets(&self.initial), 0);
+        let mut most: (u32, usize) = (self.window(&self.initial).inside, 0);
         let done = |s: &Self, st: &State, best_sets: usize| -> bool {
             if p.fewest_sets {
                 best_sets <= 1
@@ -248,7 +253,8 @@ impl Planner {
             for &id in &frontier {
                 if started.elapsed().as_secs_f64() > p.time_limit_s {
                     let limit = format!("time limit {} s", p.time_limit_s);
-                    return self.limit(limit, depth - 1, &nodes, best, stats, finish, state_bytes);
+                    let best = self.best_of(&nodes, best, most);
+                    return self.limit(limit, depth - 1, best, stats, finish, state_bytes);
                 }
                 let state = nodes[id].state.clone();
                 let succ = self.actions(&state);
@@ -273,6 +279,11 @@ impl Planner {
                         if k < best.0 {
                             best = (k, nid);
                         }
+                    } else {
+                        let inside = self.window(&s).inside;
+                        if inside > most.0 {
+                            most = (inside, nid);
+                        }
                     }
                     if done(self, &s, best.0) {
                         stats.states_per_depth.push(next.len());
@@ -282,15 +293,8 @@ impl Planner {
                     if nodes.len() >= p.max_states {
                         stats.states_per_depth.push(next.len());
                         let limit = format!("state limit {} (--max-states)", p.max_states);
-                        return self.limit(
-                            limit,
-                            depth - 1,
-                            &nodes,
-                            best,
-                            stats,
-                            finish,
-                            state_bytes,
-                        );
+                        let best = self.best_of(&nodes, best, most);
+                        return self.limit(limit, depth - 1, best, stats, finish, state_bytes);
                     }
                 }
             }
@@ -301,7 +305,14 @@ impl Planner {
                 if p.fewest_sets {
                     return (Outcome::Found(self.plan_to(&nodes, best.1)), stats);
                 }
-                return (Outcome::Exhausted { depth: depth - 1 }, stats);
+                let best = self.best_of(&nodes, best, most);
+                return (
+                    Outcome::Exhausted {
+                        depth: depth - 1,
+                        best,
+                    },
+                    stats,
+                );
             }
             frontier = next;
         }
@@ -309,22 +320,38 @@ impl Planner {
         if p.fewest_sets {
             return (Outcome::Found(self.plan_to(&nodes, best.1)), stats);
         }
-        (Outcome::NoneUpTo { depth: p.max_pins }, stats)
+        let best = self.best_of(&nodes, best, most);
+        (
+            Outcome::NoneUpTo {
+                depth: p.max_pins,
+                best,
+            },
+            stats,
+        )
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// The best plan found so far when none reaches the goal: with `fewest_sets` the one to the
+    /// fewest sets, otherwise the one bringing the most particles into one window; none if no pin
+    /// improves on the feed.
+    fn best_of(&self, nodes: &[Node], sets: (usize, usize), most: (u32, usize)) -> Option<Plan> {
+        let node = if self.problem.fewest_sets {
+            sets.1
+        } else {
+            most.1
+        };
+        (node != 0).then(|| self.plan_to(nodes, node))
+    }
+
     fn limit(
         &self,
         limit: String,
         depth_completed: usize,
-        nodes: &[Node],
-        best: (usize, usize),
+        best: Option<Plan>,
         mut stats: SearchStats,
         finish: impl Fn(&Self, SearchStats, usize) -> SearchStats,
         bytes: usize,
     ) -> (Outcome, SearchStats) {
         stats.depth_completed = depth_completed;
-        let best = (self.problem.fewest_sets && best.1 != 0).then(|| self.plan_to(nodes, best.1));
         (
             Outcome::LimitHit {
                 limit,
