@@ -282,6 +282,7 @@ fn impossible_constraints_are_refused_with_the_flag_named() {
 #[test]
 fn robust_plan_carries_its_uncertainty() {
     // Each particle has its own μc and tripod: the plan is searched against them and says so.
+    let out = tmp("robust.toml");
     let v = json_ok(&[
         "plan",
         "--part",
@@ -299,18 +300,28 @@ fn robust_plan_carries_its_uncertainty() {
         "3",
         "--check-parts",
         "300",
+        "--out",
+        out.to_str().unwrap(),
         "--json",
     ]);
     assert_eq!(v["stats"]["physics_samples"], 27);
-    assert!(
-        v["result"] == "found" || v["result"] == "none_up_to_depth",
-        "{}",
-        v["result"]
+    // Found or not, the plan (or its best effort) is run under the uncertainty it was planned
+    // against, and the study written beside it reproduces that run under `pinfeed mc`.
+    assert!(v["result"] == "found" || v["result"] == "none_up_to_depth");
+    let toml = v["scenario"].as_str().expect("a plan or its best effort");
+    assert!(toml.contains("support = \"tripod\"") && toml.contains("μc ∈ [0.3, 0.7]"));
+    let u = &v["uncertain_check"];
+    assert_eq!(u["parts"], 300);
+    let study = out.with_file_name("robust.uncertain.toml");
+    let text = std::fs::read_to_string(&study).unwrap();
+    assert!(text.contains("min = 0.3") && text.contains("model = \"tripod\""));
+    let mc = json_ok(&["mc", study.to_str().unwrap(), "--json", "--quiet"]);
+    let ok = u["outcomes"]["success"].as_u64().unwrap();
+    assert_eq!(
+        mc["results"][0]["outcomes"]["success"].as_u64(),
+        Some(ok),
+        "{mc}"
     );
-    if v["result"] == "found" {
-        let toml = v["scenario"].as_str().unwrap();
-        assert!(toml.contains("support = \"tripod\"") && toml.contains("μc ∈ [0.3, 0.7]"));
-    }
 }
 
 #[test]

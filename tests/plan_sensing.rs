@@ -52,6 +52,12 @@ fn tripoly1_sensing_plan_runs_and_orients() {
         let d = r["decides"].as_str().unwrap();
         assert!(["0°", "135°", "225°"].contains(&d), "{d}");
     }
+    // The drawing beside it: one label per decision branch, a dot per moving pin target.
+    let svg = std::fs::read_to_string(out.with_extension("svg")).unwrap();
+    for label in ["decides 0°", "decides 135°", "decides 225°"] {
+        assert!(svg.contains(label), "{label} missing from the drawing");
+    }
+    assert!(svg.contains("mover1") && svg.contains("sensor y="));
     // `pinfeed run` executes it unchanged.
     let o = pinfeed(&["run", out.to_str().unwrap(), "--parts", "300", "--json"]);
     assert!(

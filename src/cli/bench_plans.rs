@@ -76,6 +76,7 @@ fn plan(spec: &str, extra: &[&str], s: &Survey) -> Result<PlanSummary> {
             obstacles: None,
             predicted: None,
             check: None,
+            uncertain_check: None,
             footprint_m: None,
             depth_completed: 0,
             search_s: 0.0,

@@ -348,6 +348,8 @@ pub struct PlanReport<'a> {
     pub plan: Option<&'a Plan>,
     pub stats: &'a SearchStats,
     pub check: Option<CheckReport>,
+    /// The plan under the uncertainty it was planned against (a Monte Carlo study).
+    pub uncertain_check: Option<CheckReport>,
     pub scenario: Option<String>,
 }
 
@@ -363,6 +365,7 @@ pub struct PlanSummary {
     pub obstacles: Option<usize>,
     pub predicted: Option<f64>,
     pub check: Option<CheckReport>,
+    pub uncertain_check: Option<CheckReport>,
     /// Belt length the layout occupies (m; [`crate::study::compare`]'s footprint).
     pub footprint_m: Option<f64>,
     /// Search depth completed (pins, fences or moving pins).
@@ -496,6 +499,7 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
     let mut scenario = None;
     let mut check = None;
     let mut footprint_m = None;
+    let mut uncertain_check = None;
     if let Some(plan) = plan {
         let path = args
             .out
@@ -518,6 +522,7 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
                 crate::plan::check::check(&toml, &path, args.check_parts, problem.seed)
             })?;
             check = Some(CheckReport::of(&summary, started));
+            uncertain_check = check_uncertain(args, &problem, &toml, &pool)?;
         }
         if let Some(draw) = args
             .draw
@@ -538,6 +543,7 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
         obstacles: plan.map(|p| p.steps.len()),
         predicted: plan.map(|p| p.predicted_success),
         check: check.clone(),
+        uncertain_check: uncertain_check.clone(),
         footprint_m,
         depth_completed: stats.depth_completed,
         search_s: stats.elapsed_s,
@@ -551,6 +557,7 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
             plan,
             stats: &stats,
             check,
+            uncertain_check,
             scenario,
         };
         serde_json::to_string_pretty(&report)? + "\n"
@@ -566,6 +573,11 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
         }
         if let Some(c) = &check {
             t += &check_text(c, plan.map_or(0.0, |p| p.predicted_success), "");
+        }
+        if let Some(c) = &uncertain_check {
+            t += &check_text(c, plan.map_or(0.0, |p| p.predicted_success), "")
+                .replacen("line check  ", "uncertain   ", 1)
+                .replacen(" parts:", " parts under the planned μc range / tripods:", 1);
         }
         if let (Some(out), Some(_)) = (&args.out, plan) {
             let draw = args
@@ -593,6 +605,48 @@ impl CheckReport {
             elapsed_s: started.elapsed().as_secs_f64(),
         }
     }
+}
+
+/// The plan run under the uncertainty it was planned against (`--mu-c-range`, `--tripod`): a
+/// Monte Carlo study of `--check-parts` samples, written beside `--out` as `STEM.uncertain.toml`
+/// (so `pinfeed mc` reruns it) or to a temporary folder.
+fn check_uncertain(
+    args: &PlanArgs,
+    problem: &Problem,
+    toml: &str,
+    pool: &rayon::ThreadPool,
+) -> Result<Option<CheckReport>> {
+    let (dir, file) = match &args.out {
+        Some(out) => (
+            out.parent().map_or(PathBuf::from("."), Path::to_path_buf),
+            out.file_name()
+                .map_or("plan.toml".into(), |f| f.to_string_lossy().to_string()),
+        ),
+        None => (
+            std::env::temp_dir().join(format!("pinfeed_plan_uncertain_{}", std::process::id())),
+            "plan.toml".to_string(),
+        ),
+    };
+    let stem = file.trim_end_matches(".toml");
+    let study_file = format!("{stem}.uncertain.toml");
+    let Some(study) =
+        crate::plan::check::uncertainty_study(problem, &file, &study_file, args.check_parts)
+    else {
+        return Ok(None);
+    };
+    let started = std::time::Instant::now();
+    let (outcomes, n) = pool
+        .install(|| crate::plan::check::check_uncertain(toml, &study, &dir, &file, &study_file))?;
+    if args.out.is_none() {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    Ok(Some(CheckReport {
+        parts: n,
+        success_rate: outcomes.success as f64 / n.max(1) as f64,
+        success_ci95: crate::statistics::wilson_interval(outcomes.success, n),
+        outcomes,
+        elapsed_s: started.elapsed().as_secs_f64(),
+    }))
 }
 
 /// The line check's line of the table (`extra` follows the prediction).

@@ -9,7 +9,7 @@ use super::plan::{
 use crate::plan::contingent::{self, ContingentOutcome, ContingentPlan, ContingentStats};
 use crate::plan::search::Planner;
 use crate::plan::{emit, Problem};
-use anyhow::Result;
+use anyhow::{Context, Result};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -174,6 +174,15 @@ pub fn execute(
             check = Some(CheckReport::of(&summary, started));
         }
         footprint_m = crate::plan::check::footprint_m(&toml, &out);
+        if let Some(draw) = args
+            .draw
+            .clone()
+            .or(args.out.as_ref().map(|o| o.with_extension("svg")))
+        {
+            let stages = contingent::stage_states(&mut planner, plan)?;
+            crate::report::plot_plan::plot_contingent(problem, plan, &stages, &draw)
+                .with_context(|| format!("drawing {}", draw.display()))?;
+        }
         if args.out.is_none() {
             let _ = std::fs::remove_file(&out);
             let _ = std::fs::remove_file(&policy_path);
@@ -187,6 +196,7 @@ pub fn execute(
         obstacles: plan.map(|p| p.k + 1),
         predicted: plan.map(|p| p.predicted_success),
         check: check.clone(),
+        uncertain_check: None,
         footprint_m,
         depth_completed: stats.states_per_depth.len().saturating_sub(1),
         search_s: stats.elapsed_s,
@@ -240,10 +250,15 @@ pub fn execute(
             let stem = out
                 .file_stem()
                 .map_or("plan".into(), |s| s.to_string_lossy().to_string());
+            let draw = args
+                .draw
+                .clone()
+                .unwrap_or_else(|| out.with_extension("svg"));
             t += &format!(
-                "wrote       {} and {}\n",
+                "wrote       {}, {} and {}\n",
                 out.display(),
-                out.with_file_name(format!("{stem}.policy.toml")).display()
+                out.with_file_name(format!("{stem}.policy.toml")).display(),
+                draw.display()
             );
         }
         t

@@ -36,3 +36,58 @@ pub fn footprint_m(toml: &str, path: &Path) -> Option<f64> {
     let [a, b] = crate::study::compare::obstacle_span(&scene)?;
     Some(b - a + crate::study::compare::part_length(&scene.part.polygon))
 }
+
+/// The Monte Carlo study that runs a plan under the uncertainty it was planned against
+/// (`--mu-c-range` → `[uncertain.mu_c]` uniform, `--tripod` → `[uncertain.support]` tripod):
+/// each sample sends one part through a freshly perturbed copy of the line, as `pinfeed mc`
+/// does. None for a plan without declared uncertainty.
+pub fn uncertainty_study(
+    problem: &super::Problem,
+    scenario_file: &str,
+    study_file: &str,
+    samples: u64,
+) -> Option<String> {
+    if problem.mu_c_range.is_none() && !problem.tripod {
+        return None;
+    }
+    let mut t = format!(
+        "# The plan {scenario_file} under the uncertainty it was planned against (written by\n# `pinfeed plan`):\n#\n#   pinfeed mc {study_file}\n\nscenario = \"{scenario_file}\"\nseed = {}\nsamples = {samples}\n",
+        problem.seed
+    );
+    if let Some((lo, hi)) = problem.mu_c_range {
+        t += &format!("\n[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = {lo}\nmax = {hi}\n");
+    }
+    if problem.tripod {
+        t += "\n[uncertain.support]\nmodel = \"tripod\"\n";
+    }
+    Some(t)
+}
+
+/// The outcomes and the number of samples of the study `study` (a study without sweeps; its
+/// scenario `scenario`; both written to `dir` under `scenario_file` and `study_file` first).
+pub fn check_uncertain(
+    scenario: &str,
+    study: &str,
+    dir: &Path,
+    scenario_file: &str,
+    study_file: &str,
+) -> Result<(crate::engine::OutcomeCounts, u64), UncertainCheckError> {
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(dir.join(scenario_file), scenario)?;
+    let path = dir.join(study_file);
+    std::fs::write(&path, study)?;
+    let study = crate::study::mc::load(&path, None)?;
+    let n = study.total_samples();
+    let tallies = crate::study::mc::run::run_range(&study, 0..n, &|| {})?;
+    let outcomes = tallies.into_values().next().map(|t| t.outcomes);
+    Ok((outcomes.unwrap_or_default(), n))
+}
+
+/// Why the plan could not be run under its uncertainty.
+#[derive(Debug, thiserror::Error)]
+pub enum UncertainCheckError {
+    #[error("writing the study: {0}")]
+    Io(#[from] std::io::Error),
+    #[error("the plan's uncertainty study failed: {0}")]
+    Study(#[from] crate::study::mc::StudyError),
+}

@@ -473,3 +473,25 @@ fn build(
         cross,
     }
 }
+
+/// The states a contingent plan leads each branch through (for the drawing): per branch, its
+/// particles at the feed, after the sensor pin, and after each moving pin at the branch's target
+/// (a parked pin touches none of them).
+pub fn stage_states(
+    planner: &mut Planner,
+    plan: &ContingentPlan,
+) -> Result<Vec<Vec<State>>, PlanError> {
+    let branches = branch_states(planner)?;
+    let q = planner.problem.y_quantum_m;
+    let mut out = Vec::with_capacity(branches.len());
+    for (state, b) in branches.iter().zip(&plan.branches) {
+        let mut stages = vec![state.clone(), run_pins(planner, state, &[plan.sensor.y_q])];
+        for &y in &b.targets_m {
+            let y_q = (y / q).round() as i32;
+            let next = run_pins(planner, stages.last().unwrap(), &[y_q]);
+            stages.push(next);
+        }
+        out.push(stages);
+    }
+    Ok(out)
+}

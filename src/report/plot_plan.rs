@@ -177,3 +177,155 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
     root.present()?;
     Ok(())
 }
+
+/// Colours of the decision branches (dark enough for text on white).
+fn branch_colour(b: usize) -> RGBColor {
+    const C: [RGBColor; 6] = [
+        RGBColor(200, 30, 60),
+        RGBColor(30, 140, 60),
+        RGBColor(30, 90, 200),
+        RGBColor(200, 110, 0),
+        RGBColor(130, 50, 170),
+        RGBColor(0, 140, 150),
+    ];
+    C[b % C.len()]
+}
+
+/// Draw a contingent plan (`pinfeed plan --sensor`) to `path`: the line from above (the sensor
+/// pin, then each moving pin's target per decision in the branch's colour, joined by the pin's
+/// travel) and, below, the orientation sets of every branch at the feed, after the sensor and
+/// after each moving pin, in the same colours, the goal window shaded. `stages[b]` are branch b's
+/// states ([`crate::plan::contingent::stage_states`]).
+pub fn plot_contingent(
+    problem: &Problem,
+    plan: &crate::plan::contingent::ContingentPlan,
+    stages: &[Vec<State>],
+    path: &Path,
+) -> anyhow::Result<()> {
+    let compiled = problem.compile()?;
+    let period = compiled.period_deg();
+    let k = plan.k;
+    let rows = k + 2;
+    let length = problem.spacing_m * (k as f64 + 2.0);
+    let half = problem.belt_width_m / 2.0 * 1e3;
+    let height = 330 + 40 * rows as u32 + 80;
+    let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (top, bottom) = root.split_vertically(330);
+    let mut ch = ChartBuilder::on(&top)
+        .caption(
+            format!(
+                "pinfeed plan --sensor: {} — sensor pin + {k} moving pin(s), predicted success {:.3}",
+                problem.part, plan.predicted_success
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(15)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..length, -half..half)?;
+    ch.configure_mesh()
+        .x_desc("x along the belt (m)")
+        .y_desc("y (mm)")
+        .draw()?;
+    let (_, h_px) = ch.plotting_area().dim_in_pixel();
+    let pin_px = ((problem.pin_radius_m * h_px as f64 / (2.0 * half * 1e-3)).round() as i32).max(3);
+    let s = plan.sensor;
+    let xs = problem.spacing_m;
+    ch.draw_series(std::iter::once(Rectangle::new(
+        [(xs - 0.004, s.lo_m * 1e3), (xs + 0.004, s.hi_m * 1e3)],
+        BLUE.mix(0.2).filled(),
+    )))?;
+    ch.draw_series(std::iter::once(Circle::new(
+        (xs, s.y_m * 1e3),
+        pin_px,
+        BLACK.filled(),
+    )))?;
+    ch.draw_series(std::iter::once(Text::new(
+        format!("sensor y={:+.2} mm ±{:.2}", s.y_m * 1e3, s.margin_m * 1e3),
+        (xs + 0.006, s.y_m * 1e3 + 2.0),
+        ("sans-serif", 12),
+    )))?;
+    for j in 0..k {
+        let x = problem.spacing_m * (j as f64 + 2.0);
+        let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j] * 1e3).collect();
+        let (lo, hi) = ys
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &y| (a.min(y), b.max(y)));
+        ch.draw_series(std::iter::once(PathElement::new(
+            vec![(x, lo), (x, hi)],
+            BLACK.mix(0.4).stroke_width(2),
+        )))?;
+        ch.draw_series(std::iter::once(Text::new(
+            format!("mover{}", j + 1),
+            (x + 0.006, hi + 3.0),
+            ("sans-serif", 12),
+        )))?;
+        for (b, y) in ys.iter().enumerate() {
+            // A parked pin (the branch needs fewer moving pins) is drawn hollow.
+            let parked = j >= plan.branches[b].pins.len();
+            let style = if parked {
+                branch_colour(b).stroke_width(2)
+            } else {
+                branch_colour(b).filled()
+            };
+            ch.draw_series(std::iter::once(Circle::new((x, *y), pin_px, style)))?;
+        }
+    }
+    for (b, br) in plan.branches.iter().enumerate() {
+        ch.draw_series(std::iter::once(Text::new(
+            format!("decides {}: {} of {} inside", br.label, br.inside, br.total),
+            (0.005, half - 5.0 - 5.0 * b as f64),
+            ("sans-serif", 12).into_font().color(&branch_colour(b)),
+        )))?;
+    }
+    let mut ch = ChartBuilder::on(&bottom)
+        .margin(15)
+        .x_label_area_size(35)
+        .y_label_area_size(75)
+        .build_cartesian_2d(0.0..period, -0.5..(rows as f64 - 0.5))?;
+    ch.configure_mesh()
+        .x_desc(if compiled.symmetry > 1 {
+            format!("orientation θ modulo the {period}° symmetry (degrees)")
+        } else {
+            "orientation θ (degrees)".to_string()
+        })
+        .y_desc("after")
+        .x_labels(13)
+        .y_labels(rows.min(20))
+        .y_label_formatter(&|v| match v.round() as usize {
+            0 => "feed".into(),
+            1 => "sensor".into(),
+            j => format!("mover{}", j - 1),
+        })
+        .draw()?;
+    let c = plan.centre_deg;
+    let tol = problem.tolerance_deg;
+    for shift in [-period, 0.0, period] {
+        let (a, b) = ((c - tol + shift).max(0.0), (c + tol + shift).min(period));
+        if a < b {
+            ch.draw_series(std::iter::once(Rectangle::new(
+                [(a, -0.5), (b, rows as f64 - 0.5)],
+                GREEN.mix(0.15).filled(),
+            )))?;
+        }
+    }
+    let total: u32 = plan.branches.iter().map(|b| b.total).sum();
+    let nb = stages.len().max(1) as f64;
+    for (b, branch) in stages.iter().enumerate() {
+        let dy = 0.3 * (b as f64 - (nb - 1.0) / 2.0) / nb;
+        for (r, st) in branch.iter().enumerate() {
+            let dots = stage_dots(st, problem.theta_quantum_deg);
+            ch.draw_series(dots.into_iter().map(|(x, w)| {
+                let rad = (2.0 + 10.0 * (w as f64 / total.max(1) as f64).sqrt()) as i32;
+                Circle::new(
+                    (x.rem_euclid(period), r as f64 + dy),
+                    rad,
+                    branch_colour(b).mix(0.7).filled(),
+                )
+            }))?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}
