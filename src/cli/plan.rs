@@ -132,6 +132,10 @@ pub struct PlanArgs {
     /// 83% against 100%), hence 55.
     #[arg(long, default_value_t = 55.0, allow_hyphen_values = true)]
     pub max_fence_angle: f64,
+    /// With --fences: step between candidate angles (degrees; from ±15°). A finer step is a larger
+    /// action set: shorter designs, longer searches.
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    pub fence_angle_step: f64,
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -311,6 +315,11 @@ pub fn command_line(args: &PlanArgs) -> String {
             "--max-fence-angle",
             args.max_fence_angle.to_string(),
             "55".into()
+        );
+        opt!(
+            "--fence-angle-step",
+            args.fence_angle_step.to_string(),
+            "5".into()
         );
     }
     if args.sensor {
@@ -675,13 +684,24 @@ fn fence_transition(args: &PlanArgs, problem: &Problem) -> Result<FenceTransitio
             args.fence_overhang
         );
     }
-    let mut opts = crate::plan::FenceOptions::default_for(mu_f);
+    if !args.max_fence_angle.is_finite() {
+        bail!(
+            "--max-fence-angle {}: must be a finite angle in degrees",
+            args.max_fence_angle
+        );
+    }
+    if !(args.fence_angle_step.is_finite() && (0.5..=45.0).contains(&args.fence_angle_step)) {
+        bail!(
+            "--fence-angle-step {}: must lie in [0.5, 45] degrees",
+            args.fence_angle_step
+        );
+    }
+    let mut opts =
+        crate::plan::FenceOptions::grid(mu_f, args.fence_angle_step, args.max_fence_angle);
     opts.overhang_a = args.fence_overhang;
-    opts.angles_deg
-        .retain(|a| a.abs() <= args.max_fence_angle + 1e-9);
     if opts.angles_deg.is_empty() {
         bail!(
-            "--max-fence-angle {}: no candidate angle (±15° … ±60° below the jam limit {:.1}° for μf {mu_f}) is left",
+            "--max-fence-angle {}: no candidate angle (from ±15°, below the jam limit {:.1}° for μf {mu_f}) is left",
             args.max_fence_angle,
             90.0 - mu_f.atan().to_degrees()
         );

@@ -68,14 +68,22 @@ pub struct FenceOptions {
 impl FenceOptions {
     /// ±15° … ±60° in 5° steps, kept below the jam limit |α| + atan μf < 90°.
     pub fn default_for(mu_f: f64) -> FenceOptions {
+        FenceOptions::grid(mu_f, 5.0, 60.0)
+    }
+
+    /// ±15°, ±(15 + step)°, … up to `max_deg`, kept below the jam limit |α| + atan μf < 90°.
+    pub fn grid(mu_f: f64, step_deg: f64, max_deg: f64) -> FenceOptions {
         let jam = 90.0 - mu_f.atan().to_degrees();
         let mut angles = Vec::new();
-        for k in 3..=12 {
-            let a = 5.0 * k as f64;
-            if a < jam - 1e-9 {
-                angles.push(a);
-                angles.push(-a);
+        let mut k = 0;
+        loop {
+            let a = 15.0 + step_deg * k as f64;
+            if a > max_deg + 1e-9 || a >= jam - 1e-9 {
+                break;
             }
+            angles.push(a);
+            angles.push(-a);
+            k += 1;
         }
         FenceOptions {
             angles_deg: angles,
