@@ -265,6 +265,9 @@ fn impossible_constraints_are_refused_with_the_flag_named() {
         (vec!["--pin-radius", "-1"], "--pin-radius"),
         (vec!["--theta-quantum", "0.7"], "--theta-quantum"),
         (vec!["--scale", "nan"], "--scale"),
+        (vec!["--fences", "--fence-angle-step", "0"], "--fence-angle-step"),
+        (vec!["--fences", "--max-fence-angle", "nan"], "--max-fence-angle"),
+        (vec!["--fences", "--max-fence-angle", "10"], "--max-fence-angle"),
     ] {
         let mut a = vec!["plan", "--part", "tripoly2"];
         a.extend(args.iter().copied());

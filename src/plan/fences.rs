@@ -317,3 +317,22 @@ pub fn headway_s(fences: &[FenceAction], radius_m: f64, speed: f64) -> f64 {
     let lag: f64 = fences.iter().map(|f| f.max_lag_m).sum();
     ((lag + fence_gap_m(radius_m)) / speed).ceil().max(6.0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angle_grid_steps_from_15_and_stays_below_the_jam_limit() {
+        let g = FenceOptions::grid(0.5, 2.0, 50.0);
+        let pos: Vec<f64> = g.angles_deg.iter().copied().filter(|a| *a > 0.0).collect();
+        assert_eq!(pos.first(), Some(&15.0));
+        assert_eq!(pos.last(), Some(&49.0));
+        assert!(pos.windows(2).all(|w| (w[1] - w[0] - 2.0).abs() < 1e-12));
+        assert_eq!(g.angles_deg.len(), 2 * pos.len());
+        // μf 1: jam limit 45°, so nothing at or above it.
+        let j = FenceOptions::grid(1.0, 5.0, 80.0);
+        assert!(j.angles_deg.iter().all(|a| a.abs() < 45.0));
+        assert_eq!(FenceOptions::default_for(0.5).angles_deg.len(), 20);
+    }
+}
