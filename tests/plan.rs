@@ -265,9 +265,18 @@ fn impossible_constraints_are_refused_with_the_flag_named() {
         (vec!["--pin-radius", "-1"], "--pin-radius"),
         (vec!["--theta-quantum", "0.7"], "--theta-quantum"),
         (vec!["--scale", "nan"], "--scale"),
-        (vec!["--fences", "--fence-angle-step", "0"], "--fence-angle-step"),
-        (vec!["--fences", "--max-fence-angle", "nan"], "--max-fence-angle"),
-        (vec!["--fences", "--max-fence-angle", "10"], "--max-fence-angle"),
+        (
+            vec!["--fences", "--fence-angle-step", "0"],
+            "--fence-angle-step",
+        ),
+        (
+            vec!["--fences", "--max-fence-angle", "nan"],
+            "--max-fence-angle",
+        ),
+        (
+            vec!["--fences", "--max-fence-angle", "10"],
+            "--max-fence-angle",
+        ),
     ] {
         let mut a = vec!["plan", "--part", "tripoly2"];
         a.extend(args.iter().copied());
@@ -380,4 +389,41 @@ fn survey_of_random_polygons_agrees_with_the_planner_it_runs() {
     assert!(md.contains("cargo run --release -- bench plans --random 1 --first 2"));
     let svg = std::fs::read_to_string(report.with_extension("svg")).unwrap();
     assert!(svg.contains("<polygon") && svg.contains("random:2"));
+}
+
+#[test]
+fn every_designed_bundled_scenario_names_the_plan_command_for_its_feed() {
+    // The scripts that designed the first bundled layouts are gone (issue 14); each designed
+    // scenario's header names the `pinfeed plan` command that designs its line today, and that
+    // command is a valid one (stopped here at once by a state limit of 1).
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    assert!(!root.join("scenarios/tools").exists());
+    for name in [
+        "quickstart",
+        "tripoly1",
+        "tripoly1_fences",
+        "tripoly1_fences_any",
+        "tripoly2_fences",
+        "tripoly2_fences_any",
+        "tripoly1_sensing",
+    ] {
+        let text = std::fs::read_to_string(root.join(format!("scenarios/{name}.toml"))).unwrap();
+        assert!(!text.contains("python3"), "{name} still names a script");
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("#   cargo run --release -- plan --part"))
+            .unwrap_or_else(|| panic!("{name}: no plan command in the header"));
+        let mut args: Vec<&str> = line["#   cargo run --release -- ".len()..]
+            .split_whitespace()
+            .collect();
+        let out_at = args.iter().position(|a| *a == "--out").unwrap();
+        args.drain(out_at..out_at + 2);
+        args.extend(["--max-states", "1", "--check-parts", "0"]);
+        let out = pinfeed(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("state limit 1") || out.status.success(),
+            "{name}: {args:?}: {err}"
+        );
+    }
 }
