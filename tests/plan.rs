@@ -327,7 +327,15 @@ fn robust_plan_carries_its_uncertainty() {
     let study = out.with_file_name("robust.uncertain.toml");
     let text = std::fs::read_to_string(&study).unwrap();
     assert!(text.contains("min = 0.3") && text.contains("model = \"tripod\""));
-    let mc = json_ok(&["mc", study.to_str().unwrap(), "--json", "--quiet"]);
+    let mc_dir = tmp("robust_mc");
+    let mc = json_ok(&[
+        "mc",
+        study.to_str().unwrap(),
+        "--json",
+        "--quiet",
+        "--out",
+        mc_dir.to_str().unwrap(),
+    ]);
     let ok = u["outcomes"]["success"].as_u64().unwrap();
     assert_eq!(
         mc["results"][0]["outcomes"]["success"].as_u64(),
