@@ -69,6 +69,12 @@ pub enum BenchWhat {
         random: u64,
         #[arg(long, default_value_t = 1)]
         first: u64,
+        /// Survey these parts instead (comma-separated specs, e.g. tripoly1,square,rect:2:1).
+        #[arg(long, value_delimiter = ',')]
+        parts: Vec<String>,
+        /// Run the sensing planner on every part (by default only where sensorless pins fail).
+        #[arg(long)]
+        sense_all: bool,
         /// Search time limit of each plan (s).
         #[arg(long, default_value_t = 30.0)]
         time_limit: f64,
@@ -186,6 +192,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         BenchWhat::Plans {
             random,
             first,
+            parts,
+            sense_all,
             time_limit,
             check_parts,
             fence_belt,
@@ -196,12 +204,26 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             if !(1..=10_000).contains(random) {
                 anyhow::bail!("--random must be between 1 and 10000, got {random}");
             }
+            let which = if parts.is_empty() {
+                format!("--random {random} --first {first}")
+            } else {
+                format!("--parts {}", parts.join(","))
+            };
             let command = format!(
-                "cargo run --release -- bench plans --random {random} --first {first} --time-limit {time_limit} --check-parts {check_parts} --fence-belt {fence_belt} --target {target} --out {}",
+                "cargo run --release -- bench plans {which}{} --time-limit {time_limit} --check-parts {check_parts} --fence-belt {fence_belt} --target {target} --out {}",
+                if *sense_all { " --sense-all" } else { "" },
                 out.display()
             );
+            let specs = if parts.is_empty() {
+                (*first..first.saturating_add(*random))
+                    .map(|s| format!("random:{s}"))
+                    .collect()
+            } else {
+                parts.clone()
+            };
             super::bench_plans::run(&super::bench_plans::Survey {
-                seeds: (*first..first.saturating_add(*random)).collect(),
+                specs,
+                sense_all: *sense_all,
                 time_limit_s: *time_limit,
                 check_parts: *check_parts,
                 fence_belt_m: *fence_belt,

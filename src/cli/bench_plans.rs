@@ -20,8 +20,10 @@ use std::path::{Path, PathBuf};
 /// Settings of a survey.
 #[derive(Debug, Clone)]
 pub struct Survey {
-    /// Seeds of the random polygons.
-    pub seeds: Vec<u64>,
+    /// The parts (`random:SEED` or any part spec).
+    pub specs: Vec<String>,
+    /// Run the sensing planner on every part, not only where sensorless pins fail.
+    pub sense_all: bool,
     pub time_limit_s: f64,
     pub check_parts: u64,
     /// Belt width of the fence plans (m).
@@ -91,12 +93,12 @@ fn oriented(p: &PlanSummary, target: f64) -> bool {
 /// Run the survey, rewriting the report after every polygon.
 pub fn run(s: &Survey) -> Result<()> {
     let mut rows: Vec<Row> = Vec::new();
-    for &seed in &s.seeds {
-        let spec = format!("random:{seed}");
+    for spec in &s.specs {
+        let spec = spec.clone();
         let poly = part_from_spec(&spec)?;
         eprintln!("bench plans: {spec} …");
         let pins = plan(&spec, &[], s)?;
-        let sensing = if oriented(&pins, s.target) {
+        let sensing = if oriented(&pins, s.target) && !s.sense_all {
             None
         } else {
             Some(plan(&spec, &["--sensor"], s)?)
@@ -119,7 +121,10 @@ pub fn run(s: &Survey) -> Result<()> {
 }
 
 fn cell(p: &PlanSummary, unit: &str) -> String {
-    let n = p.obstacles.map_or("–".into(), |k| format!("{k} {unit}"));
+    let n = p.obstacles.map_or("–".into(), |k| {
+        let unit = if k == 1 { unit.trim_end_matches('s') } else { unit };
+        format!("{k} {unit}")
+    });
     let sim = p.check.as_ref().map_or("–".into(), |c| {
         format!(
             "{:.4} ({:.4}–{:.4})",
@@ -152,16 +157,34 @@ fn share(rows: &[Row], f: impl Fn(&Row) -> bool) -> String {
 fn write_report(s: &Survey, rows: &[Row]) -> Result<()> {
     let t = s.target;
     let mut m = String::new();
+    let random = s.specs.iter().all(|p| p.starts_with("random:"));
+    let svg = s.out.with_extension("svg");
+    let svg_name = svg
+        .file_name()
+        .map_or(String::new(), |f| f.to_string_lossy().to_string());
+    if random {
+        writeln!(m, "# Which polygons can pins orient? A survey of random polygons (`pinfeed bench plans`)\n")?;
+    } else {
+        writeln!(
+            m,
+            "# Sensorless pins, one sensor, fences: {} (`pinfeed bench plans`)\n",
+            s.specs.join(", ")
+        )?;
+    }
     writeln!(
         m,
-        "# Which polygons can pins orient? A survey of random polygons (`pinfeed bench plans`)\n"
-    )?;
-    writeln!(
-        m,
-        "Regenerate (this file, `plans-survey.svg` beside it):\n\n    {}\n",
+        "Regenerate (this file, `{svg_name}` beside it):\n\n    {}\n",
         s.command
     )?;
-    writeln!(m, "Each polygon is `random:SEED` (a seeded star-shaped polygon, 3–8 vertices, radii 0.6–1.4 units, 2 cm per unit; `pinfeed part random:SEED` describes it). Every planner runs with `pinfeed plan`'s defaults (stable-state feed with equal weights, 2° jitter, ±2 mm lateral; μc 0.5, 2 mm pins, 10 cm belt, pins 15 cm apart; goal ≥ {t} in one ±3° window modulo the part's symmetry; min margin 0.5 mm; depth ≤ 8), a search limit of {} s each, and a line check of {} parts. Fences get an {:.0} cm belt. A planner **orients** a part when it finds a plan and the line confirms it (≥ {t} of the checked parts in the window). Sensing (a force/torque sensor pin, then up to 3 moving pins, `--sensor`) runs only where the sensorless pins do not orient the part. Cells: result: obstacles · predicted · simulated (95% CI) · belt footprint. A result other than \"shortest\" shows the best effort the search found (the shortest plan with the most particles in one window), checked on the line the same way.\n",
+    if random {
+        write!(m, "Each polygon is `random:SEED` (a seeded star-shaped polygon, 3–8 vertices, radii 0.6–1.4 units, 2 cm per unit; `pinfeed part random:SEED` describes it). ")?;
+    }
+    let sensing_runs = if s.sense_all {
+        "runs on every part"
+    } else {
+        "runs only where the sensorless pins do not orient the part"
+    };
+    writeln!(m, "Every planner runs with `pinfeed plan`'s defaults (stable-state feed with equal weights, 2° jitter, ±2 mm lateral; μc 0.5, 2 mm pins, 10 cm belt, pins 15 cm apart; goal ≥ {t} in one ±3° window modulo the part's symmetry; min margin 0.5 mm; depth ≤ 8), a search limit of {} s each, and a line check of {} parts. Fences get an {:.0} cm belt. A planner **orients** a part when it finds a plan and the line confirms it (≥ {t} of the checked parts in the window). Sensing (a force/torque sensor pin, then up to 3 moving pins, `--sensor`) {sensing_runs}. Cells: result: obstacles · predicted · simulated (95% CI) · belt footprint. A result other than \"shortest\" shows the best effort the search found (the shortest plan with the most particles in one window), checked on the line the same way.\n",
         s.time_limit_s, s.check_parts, s.fence_belt_m * 100.0)?;
     writeln!(m, "| part | vertices | convex | stable states | symmetry | sensorless pins | with one sensor | fences | search s (pins / sensor / fences) |")?;
     writeln!(m, "|---|---|---|---|---|---|---|---|---|")?;
@@ -222,7 +245,6 @@ fn write_report(s: &Survey, rows: &[Row]) -> Result<()> {
         share(rows, |r| sensing(r) || fences(r))
     )?;
     let dir = s.out.parent().unwrap_or(Path::new("."));
-    let svg = s.out.with_extension("svg");
     crate::report::plot_survey::plot_survey(
         &rows
             .iter()
