@@ -122,7 +122,11 @@ pub fn run(s: &Survey) -> Result<()> {
 
 fn cell(p: &PlanSummary, unit: &str) -> String {
     let n = p.obstacles.map_or("–".into(), |k| {
-        let unit = if k == 1 { unit.trim_end_matches('s') } else { unit };
+        let unit = if k == 1 {
+            unit.trim_end_matches('s')
+        } else {
+            unit
+        };
         format!("{k} {unit}")
     });
     let sim = p.check.as_ref().map_or("–".into(), |c| {

@@ -6,6 +6,7 @@
 
 use crate::geometry::{Pose, Vec2};
 use crate::plan::{Action, Plan, Problem, State};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -25,6 +26,97 @@ fn stage_dots(state: &State, q_deg: f64) -> Vec<(f64, u32)> {
         }
     }
     out
+}
+
+type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A fixed pin at belt position `x`: its interval of equivalent positions shaded, the pin, a label.
+fn draw_pin(
+    ch: &mut Chart<'_, '_>,
+    x: f64,
+    p: &crate::plan::PinAction,
+    pin_px: i32,
+    label: String,
+) -> anyhow::Result<()> {
+    ch.draw_series(std::iter::once(Rectangle::new(
+        [(x - 0.004, p.lo_m * 1e3), (x + 0.004, p.hi_m * 1e3)],
+        BLUE.mix(0.2).filled(),
+    )))?;
+    ch.draw_series(std::iter::once(Circle::new(
+        (x, p.y_m * 1e3),
+        pin_px,
+        BLACK.filled(),
+    )))?;
+    ch.draw_series(std::iter::once(Text::new(
+        label,
+        (x + 0.006, p.y_m * 1e3 + 2.0),
+        ("sans-serif", 12),
+    )))?;
+    Ok(())
+}
+
+/// The line from above: x along the belt (m) over `length`, y (mm) over ±`half`.
+fn belt_view<'a, 'b>(
+    area: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    caption: String,
+    length: f64,
+    half: f64,
+) -> anyhow::Result<Chart<'a, 'b>> {
+    let mut ch = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..length, -half..half)?;
+    ch.configure_mesh()
+        .x_desc("x along the belt (m)")
+        .y_desc("y (mm)")
+        .draw()?;
+    Ok(ch)
+}
+
+/// The orientation sets: one row per stage (`label(k)` names row k), θ over the part's period,
+/// the goal window (centre ± tol, repeated over the period) shaded.
+#[allow(clippy::too_many_arguments)]
+fn sets_view<'a, 'b>(
+    area: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    period: f64,
+    symmetry: u32,
+    rows: usize,
+    y_desc: &str,
+    label: &dyn Fn(usize) -> String,
+    centre: f64,
+    tol: f64,
+) -> anyhow::Result<Chart<'a, 'b>> {
+    let mut ch = ChartBuilder::on(area)
+        .margin(15)
+        .x_label_area_size(35)
+        .y_label_area_size(75)
+        .build_cartesian_2d(0.0..period, -0.5..(rows as f64 - 0.5))?;
+    ch.configure_mesh()
+        .x_desc(if symmetry > 1 {
+            format!("orientation θ modulo the {period}° symmetry (degrees)")
+        } else {
+            "orientation θ (degrees)".to_string()
+        })
+        .y_desc(y_desc)
+        .x_labels(13)
+        .y_labels(rows.min(20))
+        .y_label_formatter(&|v| label(v.round().max(0.0) as usize))
+        .draw()?;
+    for shift in [-period, 0.0, period] {
+        let (a, b) = (
+            (centre - tol + shift).max(0.0),
+            (centre + tol + shift).min(period),
+        );
+        if a < b {
+            ch.draw_series(std::iter::once(Rectangle::new(
+                [(a, -0.5), (b, rows as f64 - 0.5)],
+                GREEN.mix(0.15).filled(),
+            )))?;
+        }
+    }
+    Ok(ch)
 }
 
 /// Draw a plan to `path`.
@@ -53,22 +145,15 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
     let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(330);
-    let mut ch = ChartBuilder::on(&top)
-        .caption(
-            format!(
-                "pinfeed plan: {} — {} pin(s), predicted success {:.3}",
-                problem.part, n, plan.predicted_success
-            ),
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(35)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..length, -half..half)?;
-    ch.configure_mesh()
-        .x_desc("x along the belt (m)")
-        .y_desc("y (mm)")
-        .draw()?;
+    let mut ch = belt_view(
+        &top,
+        format!(
+            "pinfeed plan: {} — {} pin(s), predicted success {:.3}",
+            problem.part, n, plan.predicted_success
+        ),
+        length,
+        half,
+    )?;
     // Pixels per metre along each axis, to draw true shapes on stretched axes.
     let (w_px, h_px) = ch.plotting_area().dim_in_pixel();
     let px_per_m_x = w_px as f64 / length;
@@ -98,25 +183,13 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
             }
         };
         let x = problem.spacing_m * (k as f64 + 1.0);
-        ch.draw_series(std::iter::once(Rectangle::new(
-            [(x - 0.004, p.lo_m * 1e3), (x + 0.004, p.hi_m * 1e3)],
-            BLUE.mix(0.2).filled(),
-        )))?;
-        ch.draw_series(std::iter::once(Circle::new(
-            (x, p.y_m * 1e3),
-            pin_px,
-            BLACK.filled(),
-        )))?;
-        ch.draw_series(std::iter::once(Text::new(
-            format!(
-                "pin{} y={:+.2} mm ±{:.2}",
-                k + 1,
-                p.y_m * 1e3,
-                p.margin_m * 1e3
-            ),
-            (x + 0.006, p.y_m * 1e3 + 2.0),
-            ("sans-serif", 12),
-        )))?;
+        let label = format!(
+            "pin{} y={:+.2} mm ±{:.2}",
+            k + 1,
+            p.y_m * 1e3,
+            p.margin_m * 1e3
+        );
+        draw_pin(&mut ch, x, &p, pin_px, label)?;
     }
     // The part at its goal orientation near the exit (true shape, x stretched like the axes).
     let pose = Pose::new(0.0, 0.0, plan.window.centre_deg.to_radians());
@@ -129,40 +202,23 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
         RGBColor(30, 150, 60).mix(0.5).filled(),
     )))?;
     // Orientation sets after each stage.
-    let mut ch = ChartBuilder::on(&bottom)
-        .margin(15)
-        .x_label_area_size(35)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..period, -0.5..(stages as f64 - 0.5))?;
-    ch.configure_mesh()
-        .x_desc(if compiled.symmetry > 1 {
-            format!("orientation θ modulo the {period}° symmetry (degrees)")
+    let label = |k: usize| {
+        if k == 0 {
+            "feed".to_string()
         } else {
-            "orientation θ (degrees)".to_string()
-        })
-        .y_desc("after pin")
-        .x_labels(13)
-        .y_labels(stages.min(20))
-        .y_label_formatter(&|v| {
-            let k = v.round() as usize;
-            if k == 0 {
-                "feed".into()
-            } else {
-                format!("{k}")
-            }
-        })
-        .draw()?;
-    let c = plan.window.centre_deg;
-    let tol = problem.tolerance_deg;
-    for shift in [-period, 0.0, period] {
-        let (a, b) = ((c - tol + shift).max(0.0), (c + tol + shift).min(period));
-        if a < b {
-            ch.draw_series(std::iter::once(Rectangle::new(
-                [(a, -0.5), (b, stages as f64 - 0.5)],
-                GREEN.mix(0.15).filled(),
-            )))?;
+            format!("{k}")
         }
-    }
+    };
+    let mut ch = sets_view(
+        &bottom,
+        period,
+        compiled.symmetry,
+        stages,
+        "after pin",
+        &label,
+        plan.window.centre_deg,
+        problem.tolerance_deg,
+    )?;
     let states: Vec<&State> = std::iter::once(&plan.initial)
         .chain(plan.steps.iter().map(|s| &s.state))
         .collect();
@@ -212,40 +268,21 @@ pub fn plot_contingent(
     let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(330);
-    let mut ch = ChartBuilder::on(&top)
-        .caption(
-            format!(
-                "pinfeed plan --sensor: {} — sensor pin + {k} moving pin(s), predicted success {:.3}",
-                problem.part, plan.predicted_success
-            ),
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(35)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..length, -half..half)?;
-    ch.configure_mesh()
-        .x_desc("x along the belt (m)")
-        .y_desc("y (mm)")
-        .draw()?;
+    let mut ch = belt_view(
+        &top,
+        format!(
+            "pinfeed plan --sensor: {} — sensor pin + {k} moving pin(s), predicted success {:.3}",
+            problem.part, plan.predicted_success
+        ),
+        length,
+        half,
+    )?;
     let (_, h_px) = ch.plotting_area().dim_in_pixel();
     let pin_px = ((problem.pin_radius_m * h_px as f64 / (2.0 * half * 1e-3)).round() as i32).max(3);
     let s = plan.sensor;
     let xs = problem.spacing_m;
-    ch.draw_series(std::iter::once(Rectangle::new(
-        [(xs - 0.004, s.lo_m * 1e3), (xs + 0.004, s.hi_m * 1e3)],
-        BLUE.mix(0.2).filled(),
-    )))?;
-    ch.draw_series(std::iter::once(Circle::new(
-        (xs, s.y_m * 1e3),
-        pin_px,
-        BLACK.filled(),
-    )))?;
-    ch.draw_series(std::iter::once(Text::new(
-        format!("sensor y={:+.2} mm ±{:.2}", s.y_m * 1e3, s.margin_m * 1e3),
-        (xs + 0.006, s.y_m * 1e3 + 2.0),
-        ("sans-serif", 12),
-    )))?;
+    let label = format!("sensor y={:+.2} mm ±{:.2}", s.y_m * 1e3, s.margin_m * 1e3);
+    draw_pin(&mut ch, xs, &s, pin_px, label)?;
     for j in 0..k {
         let x = problem.spacing_m * (j as f64 + 2.0);
         let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j] * 1e3).collect();
@@ -279,37 +316,21 @@ pub fn plot_contingent(
             ("sans-serif", 12).into_font().color(&branch_colour(b)),
         )))?;
     }
-    let mut ch = ChartBuilder::on(&bottom)
-        .margin(15)
-        .x_label_area_size(35)
-        .y_label_area_size(75)
-        .build_cartesian_2d(0.0..period, -0.5..(rows as f64 - 0.5))?;
-    ch.configure_mesh()
-        .x_desc(if compiled.symmetry > 1 {
-            format!("orientation θ modulo the {period}° symmetry (degrees)")
-        } else {
-            "orientation θ (degrees)".to_string()
-        })
-        .y_desc("after")
-        .x_labels(13)
-        .y_labels(rows.min(20))
-        .y_label_formatter(&|v| match v.round() as usize {
-            0 => "feed".into(),
-            1 => "sensor".into(),
-            j => format!("mover{}", j - 1),
-        })
-        .draw()?;
-    let c = plan.centre_deg;
-    let tol = problem.tolerance_deg;
-    for shift in [-period, 0.0, period] {
-        let (a, b) = ((c - tol + shift).max(0.0), (c + tol + shift).min(period));
-        if a < b {
-            ch.draw_series(std::iter::once(Rectangle::new(
-                [(a, -0.5), (b, rows as f64 - 0.5)],
-                GREEN.mix(0.15).filled(),
-            )))?;
-        }
-    }
+    let label = |j: usize| match j {
+        0 => "feed".to_string(),
+        1 => "sensor".to_string(),
+        j => format!("mover{}", j - 1),
+    };
+    let mut ch = sets_view(
+        &bottom,
+        period,
+        compiled.symmetry,
+        rows,
+        "after",
+        &label,
+        plan.centre_deg,
+        problem.tolerance_deg,
+    )?;
     let total: u32 = plan.branches.iter().map(|b| b.total).sum();
     let nb = stages.len().max(1) as f64;
     for (b, branch) in stages.iter().enumerate() {
