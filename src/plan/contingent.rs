@@ -293,9 +293,9 @@ pub fn search(
     };
     if sensors.is_empty() {
         return Err(PlanError::input(
-            "--sensor",
-            "",
-            "no sensor pin position touches every part (with --min-margin): try a smaller --min-margin",
+            "--min-margin",
+            format!("{} mm", planner.problem.min_margin_m * 1e3),
+            "no sensor pin position touches every part with this margin from a band edge: try a smaller --min-margin",
         ));
     }
     let total: u32 = branches.iter().map(|b| b.total()).sum();
