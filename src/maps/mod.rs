@@ -22,6 +22,7 @@
 pub mod bands;
 pub mod runs;
 pub mod sample;
+pub mod tier;
 pub mod start;
 
 pub use bands::{circular_clusters, find_bands};
