@@ -35,9 +35,17 @@ pub struct ContactArgs {
     /// Part–belt friction coefficient μs (> 0; scales forces only).
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub mu_s: f64,
-    /// Fidelity: exact, ellipsoid or tip.
+    /// Fidelity: exact, ellipsoid or tip; or map (the certified map tier over exact, still pins).
     #[arg(long, default_value = "exact")]
     pub model: String,
+    /// With --model map: the folder of the map cache files (default $XDG_CACHE_HOME/pinfeed/maps
+    /// or ~/.cache/pinfeed/maps).
+    #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
+    pub cache_dir: Option<PathBuf>,
+    /// With --model map: the map's grid, θ0 base cells, d base cells, refinement depth
+    /// (default 36,12,4).
+    #[arg(long, value_name = "T,D,DEPTH")]
+    pub map_grid: Option<String>,
     /// Pin radius in part units (0: point pin).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
@@ -465,7 +473,7 @@ fn plot_title(c: &Case) -> String {
     }
 }
 
-fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
+pub(crate) fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
     ContactReport {
         part: c.part.clone(),
         model: c.model.name().into(),
@@ -500,6 +508,9 @@ pub(crate) fn parse_model(s: &str) -> Result<Fidelity> {
 pub fn run(args: &ContactArgs) -> Result<()> {
     if let Some(path) = &args.cases {
         return run_batch(args, path);
+    }
+    if args.model.trim() == "map" {
+        return super::contact_map::run(args);
     }
     let c = Case {
         part: args.part.clone().unwrap_or_default(),

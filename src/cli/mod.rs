@@ -5,6 +5,7 @@ pub mod bench;
 pub mod bench_mc;
 pub mod compare;
 pub mod contact;
+pub mod contact_map;
 pub mod fuzz;
 pub mod map;
 pub mod mc;

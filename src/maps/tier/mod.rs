@@ -58,9 +58,9 @@ pub struct TierSpec {
 impl Default for TierSpec {
     fn default() -> Self {
         TierSpec {
-            theta_cells: 90,
-            d_cells: 24,
-            max_depth: 3,
+            theta_cells: 36,
+            d_cells: 12,
+            max_depth: 4,
             check_deg: 0.0125,
             check_pos: 1e-3,
         }
