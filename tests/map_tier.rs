@@ -93,7 +93,9 @@ fn served_answers_are_within_0_05_degrees_of_exact_and_fallbacks_are_exact() {
             continue;
         }
         served += 1;
-        let err = (out.pose_final.theta - ex.pose_final.theta).abs().to_degrees();
+        let err = (out.pose_final.theta - ex.pose_final.theta)
+            .abs()
+            .to_degrees();
         assert!(err <= 0.05, "θ0 {theta} d {d}: θf off by {err}°");
         assert_eq!(out.travel_to_contact, ex.travel_to_contact);
         for (a, b) in [
@@ -106,7 +108,10 @@ fn served_answers_are_within_0_05_degrees_of_exact_and_fallbacks_are_exact() {
     }
     // The map must actually serve: most touching queries of this grid are certified.
     assert!(served > 100, "served {served}, fallbacks {fallbacks}");
-    assert!(missed > 30 && fallbacks > 5, "missed {missed}, fallbacks {fallbacks}");
+    assert!(
+        missed > 30 && fallbacks > 5,
+        "missed {missed}, fallbacks {fallbacks}"
+    );
 }
 
 /// Where θf jumps (d = 0.3: near θ0 = 27° the push switches the edge it ends on), the map hands
@@ -171,76 +176,121 @@ fn the_key_changes_with_every_input_and_only_then() {
     let tripod = Support::parse("tripod:3", model().polygon()).unwrap();
     let s = base.settings;
     let variants: Vec<(&str, TierInputs)> = vec![
-        ("part", TierInputs {
-            model: &other_part,
-            ..base
-        }),
-        ("support", TierInputs {
-            support: &tripod,
-            ..base
-        }),
-        ("radius", TierInputs { radius: 0.11, ..base }),
-        ("mu_c", TierInputs {
-            settings: ContactSettings { mu_c: 0.4, ..s },
-            ..base
-        }),
-        ("tol", TierInputs {
-            settings: ContactSettings { tol: 1e-7, ..s },
-            ..base
-        }),
-        ("max_travel", TierInputs {
-            settings: ContactSettings {
-                max_travel: 40.0,
-                ..s
+        (
+            "part",
+            TierInputs {
+                model: &other_part,
+                ..base
             },
-            ..base
-        }),
-        ("max_evaluations", TierInputs {
-            settings: ContactSettings {
-                max_evaluations: 1000,
-                ..s
+        ),
+        (
+            "support",
+            TierInputs {
+                support: &tripod,
+                ..base
             },
-            ..base
-        }),
-        ("max_events", TierInputs {
-            settings: ContactSettings {
-                max_events: 100,
-                ..s
+        ),
+        (
+            "radius",
+            TierInputs {
+                radius: 0.11,
+                ..base
             },
-            ..base
-        }),
-        ("theta_cells", TierInputs {
-            spec: TierSpec {
-                theta_cells: 5,
-                ..tiny()
+        ),
+        (
+            "mu_c",
+            TierInputs {
+                settings: ContactSettings { mu_c: 0.4, ..s },
+                ..base
             },
-            ..base
-        }),
-        ("d_cells", TierInputs {
-            spec: TierSpec { d_cells: 3, ..tiny() },
-            ..base
-        }),
-        ("max_depth", TierInputs {
-            spec: TierSpec {
-                max_depth: 1,
-                ..tiny()
+        ),
+        (
+            "tol",
+            TierInputs {
+                settings: ContactSettings { tol: 1e-7, ..s },
+                ..base
             },
-            ..base
-        }),
-        ("check_deg", TierInputs {
-            spec: TierSpec {
-                check_deg: 0.01,
-                ..tiny()
+        ),
+        (
+            "max_travel",
+            TierInputs {
+                settings: ContactSettings {
+                    max_travel: 40.0,
+                    ..s
+                },
+                ..base
             },
-            ..base
-        }),
-        ("check_pos", TierInputs {
-            spec: TierSpec {
-                check_pos: 1e-4,
-                ..tiny()
+        ),
+        (
+            "max_evaluations",
+            TierInputs {
+                settings: ContactSettings {
+                    max_evaluations: 1000,
+                    ..s
+                },
+                ..base
             },
-            ..base
-        }),
+        ),
+        (
+            "max_events",
+            TierInputs {
+                settings: ContactSettings {
+                    max_events: 100,
+                    ..s
+                },
+                ..base
+            },
+        ),
+        (
+            "theta_cells",
+            TierInputs {
+                spec: TierSpec {
+                    theta_cells: 5,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "d_cells",
+            TierInputs {
+                spec: TierSpec {
+                    d_cells: 3,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "max_depth",
+            TierInputs {
+                spec: TierSpec {
+                    max_depth: 1,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "check_deg",
+            TierInputs {
+                spec: TierSpec {
+                    check_deg: 0.01,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "check_pos",
+            TierInputs {
+                spec: TierSpec {
+                    check_pos: 1e-4,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
     ];
     for (name, v) in &variants {
         assert_ne!(TierKey::of(v), key, "changing {name} must change the key");
@@ -315,7 +365,9 @@ fn a_corrupted_file_is_refused_with_a_clear_message_and_rebuilt() {
         assert!(matches!(again.source, Source::Built { .. }), "byte {at}");
         let w = again.warnings.join("\n");
         assert!(
-            w.contains(&file.display().to_string()) && w.contains("corrupted") && w.contains(reason),
+            w.contains(&file.display().to_string())
+                && w.contains("corrupted")
+                && w.contains(reason),
             "byte {at}: {w}"
         );
         assert_eq!(*again.map, *built.map, "rebuilt to the same map");
@@ -327,7 +379,11 @@ fn a_corrupted_file_is_refused_with_a_clear_message_and_rebuilt() {
     let bytes = std::fs::read(&file).unwrap();
     std::fs::write(&file, &bytes[..bytes.len() / 3]).unwrap();
     let again = tier::load_or_build(&a, Some(&dir));
-    assert!(again.warnings[0].contains("corrupted"), "{:?}", again.warnings);
+    assert!(
+        again.warnings[0].contains("corrupted"),
+        "{:?}",
+        again.warnings
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -351,7 +407,8 @@ fn the_quickstart_on_the_map_tier_ends_every_part_in_the_exact_class() {
     };
     let ex = engine::run(&exact_scene, &opts(&exact_scene), &mut |_| {}).unwrap();
     let mp = engine::run(&map_scene, &opts(&map_scene), &mut |_| {}).unwrap();
-    let classes = |r: &engine::RunResult| -> Vec<&str> { r.records.iter().map(|p| p.outcome).collect() };
+    let classes =
+        |r: &engine::RunResult| -> Vec<&str> { r.records.iter().map(|p| p.outcome).collect() };
     assert_eq!(classes(&ex), classes(&mp));
     for (a, b) in ex.records.iter().zip(&mp.records) {
         assert!(
@@ -370,7 +427,9 @@ fn the_quickstart_on_the_map_tier_ends_every_part_in_the_exact_class() {
     assert!(w.model_evaluations < ex.summary.work.model_evaluations / 2);
     let json = serde_json::to_string(&ex.summary).unwrap();
     assert!(!json.contains("map_tier"), "an exact scene pays nothing");
-    assert!(serde_json::to_string(&mp.summary).unwrap().contains("fallback_uncertified"));
+    assert!(serde_json::to_string(&mp.summary)
+        .unwrap()
+        .contains("fallback_uncertified"));
 }
 
 #[test]
@@ -378,8 +437,14 @@ fn map_keys_in_a_scenario_are_checked() {
     let text = std::fs::read_to_string("scenarios/quickstart.toml").unwrap();
     let line = "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"";
     for (to, needle) in [
-        ("fidelity = \"exact\"\nmap_grid = [24, 12, 2]", "model.map_grid"),
-        ("fidelity = \"map\"\nmap_grid = [2, 12, 2]", "model.map_grid"),
+        (
+            "fidelity = \"exact\"\nmap_grid = [24, 12, 2]",
+            "model.map_grid",
+        ),
+        (
+            "fidelity = \"map\"\nmap_grid = [2, 12, 2]",
+            "model.map_grid",
+        ),
         ("fidelity = \"mapp\"", "fidelity"),
     ] {
         let bad = text.replace(line, to);

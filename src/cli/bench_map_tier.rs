@@ -40,10 +40,16 @@ fn write_section(path: &Path, section: &str) -> Result<()> {
 
 pub fn run(a: &MapTierArgs) -> Result<()> {
     if a.contacts == 0 || a.contacts > 1_000_000 {
-        bail!("--contacts must be between 1 and 1000000, got {}", a.contacts);
+        bail!(
+            "--contacts must be between 1 and 1000000, got {}",
+            a.contacts
+        );
     }
     if a.line_parts == 0 || a.line_parts > 10_000_000 {
-        bail!("--line-parts must be between 1 and 10000000, got {}", a.line_parts);
+        bail!(
+            "--line-parts must be between 1 and 10000000, got {}",
+            a.line_parts
+        );
     }
     let cmd = format!(
         "cargo run --release -- bench map-tier --parts {} --contacts {} --seed {} --scenario {} --line-parts {} --accuracy-out {} --line-out {}",

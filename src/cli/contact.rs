@@ -505,6 +505,24 @@ pub(crate) fn parse_model(s: &str) -> Result<Fidelity> {
         .with_context(|| format!("unknown model '{s}'; expected exact, ellipsoid or tip"))
 }
 
+/// The single case the arguments describe, with fidelity `model`.
+pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
+    Ok(Case {
+        part: args.part.clone().unwrap_or_default(),
+        theta0_deg: args.theta0.unwrap_or(0.0),
+        d: args.d.unwrap_or(0.0),
+        mu_c: args.mu_c,
+        mu_s: args.mu_s,
+        model,
+        pin_radius: args.pin_radius,
+        pin_speed: args.pin_speed,
+        pin_stop: args.pin_stop,
+        support: args.support.clone(),
+        tol: args.tol,
+        fence: args.fence.as_deref().map(parse_fence).transpose()?,
+    })
+}
+
 pub fn run(args: &ContactArgs) -> Result<()> {
     if let Some(path) = &args.cases {
         return run_batch(args, path);
@@ -512,20 +530,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     if args.model.trim() == "map" {
         return super::contact_map::run(args);
     }
-    let c = Case {
-        part: args.part.clone().unwrap_or_default(),
-        theta0_deg: args.theta0.unwrap_or(0.0),
-        d: args.d.unwrap_or(0.0),
-        mu_c: args.mu_c,
-        mu_s: args.mu_s,
-        model: parse_model(&args.model)?,
-        pin_radius: args.pin_radius,
-        pin_speed: args.pin_speed,
-        pin_stop: args.pin_stop,
-        support: args.support.clone(),
-        tol: args.tol,
-        fence: args.fence.as_deref().map(parse_fence).transpose()?,
-    };
+    let c = case_of(args, parse_model(&args.model)?)?;
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
     if let Some(path) = &args.trace {
@@ -547,13 +552,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         if !r.contact {
             println!("no contact: the pin passes the part");
         } else {
-            println!("final orientation   {:.4}°", r.theta_final_deg);
-            println!("rotation            {:+.4}°", r.rotation_deg);
-            println!(
-                "final centroid      ({:.5}, {:.5})",
-                r.com_final[0], r.com_final[1]
-            );
-            println!("contact length      {:.5}", r.contact_length);
+            print_motion(&r);
             let segs: Vec<String> = r
                 .segments
                 .iter()
@@ -575,6 +574,17 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         eprintln!("warning: contact ended with status {:?}", out.status);
     }
     Ok(())
+}
+
+/// The final pose, rotation and contact length of a push that touched.
+pub(crate) fn print_motion(r: &ContactReport) {
+    println!("final orientation   {:.4}°", r.theta_final_deg);
+    println!("rotation            {:+.4}°", r.rotation_deg);
+    println!(
+        "final centroid      ({:.5}, {:.5})",
+        r.com_final[0], r.com_final[1]
+    );
+    println!("contact length      {:.5}", r.contact_length);
 }
 
 fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {

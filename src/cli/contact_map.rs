@@ -3,7 +3,7 @@
 //! of its (part, support, pin radius, μc, tolerance), or exactly where the map cannot vouch for it,
 //! and says which.
 
-use super::contact::{check_geometry, check_inputs, compile_part, report, Case, ContactArgs};
+use super::contact::{case_of, check_geometry, check_inputs, compile_part, report, ContactArgs};
 use crate::engine::contact_map::prepare;
 use crate::maps::tier::{self, push_with_map, Loaded, Source, TierInputs, TierSpec};
 use crate::mechanics::{ContactSettings, Fidelity, Support};
@@ -52,11 +52,7 @@ pub fn prepare_maps(scene: &Scene, dir: Option<&Path>, quiet: bool) -> String {
             eprintln!("warning: {w}");
         }
         if seen.insert(loaded.map.key) {
-            text.push_str(&format!(
-                "map {}  {}\n",
-                loaded.map.key,
-                describe(loaded)
-            ));
+            text.push_str(&format!("map {}  {}\n", loaded.map.key, describe(loaded)));
         }
     }
     text.push_str(&format!(
@@ -75,20 +71,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     {
         bail!("--model map answers still-pin pushes only, without --trace or --plot (the map keeps no path); use --model exact for fences, moving pins, traces and plots");
     }
-    let c = Case {
-        part: args.part.clone().unwrap_or_default(),
-        theta0_deg: args.theta0.unwrap_or(0.0),
-        d: args.d.unwrap_or(0.0),
-        mu_c: args.mu_c,
-        mu_s: args.mu_s,
-        model: Fidelity::Exact,
-        pin_radius: args.pin_radius,
-        pin_speed: 0.0,
-        pin_stop: None,
-        support: args.support.clone(),
-        tol: args.tol,
-        fence: None,
-    };
+    let c = case_of(args, Fidelity::Exact)?;
     check_inputs(&c)?;
     let (poly, model) = compile_part(&c.part, &c.support)?;
     check_geometry(&c, &poly)?;
@@ -143,19 +126,17 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         r.part, r.theta0_deg, r.d, r.mu_c
     );
     if r.contact {
-        println!("final orientation   {:.4}°", r.theta_final_deg);
-        println!("rotation            {:+.4}°", r.rotation_deg);
-        println!(
-            "final centroid      ({:.5}, {:.5})",
-            r.com_final[0], r.com_final[1]
-        );
-        println!("contact length      {:.5}", r.contact_length);
+        super::contact::print_motion(&r);
     } else {
         println!("no contact: the pin passes the part");
     }
     println!("status              {}", r.status);
     println!("answered by         {served} in {:.1} µs", query_s * 1e6);
-    println!("map                 {}  {}", loaded.map.key, describe(&loaded));
+    println!(
+        "map                 {}  {}",
+        loaded.map.key,
+        describe(&loaded)
+    );
     if let Some(f) = file {
         println!("map file            {f}");
     }

@@ -105,6 +105,26 @@ impl MapTierCounters {
             + self.fallback_fence
             + self.fallback_part_support
     }
+    /// The fallbacks by reason, `name count` joined by commas (`none` without any).
+    pub fn fallback_reasons(&self) -> String {
+        let reasons: Vec<String> = [
+            ("uncertified", self.fallback_uncertified),
+            ("trace", self.fallback_trace),
+            ("pin_inside", self.fallback_pin_inside),
+            ("moving_pin", self.fallback_moving_pin),
+            ("fence", self.fallback_fence),
+            ("part_support", self.fallback_part_support),
+        ]
+        .iter()
+        .filter(|(_, k)| *k > 0)
+        .map(|(name, k)| format!("{name} {k}"))
+        .collect();
+        if reasons.is_empty() {
+            "none".into()
+        } else {
+            reasons.join(", ")
+        }
+    }
     /// Count a fallback by its reason.
     pub fn count(&mut self, why: crate::maps::tier::Fallback) {
         use crate::maps::tier::Fallback as F;

@@ -22,8 +22,8 @@
 pub mod bands;
 pub mod runs;
 pub mod sample;
-pub mod tier;
 pub mod start;
+pub mod tier;
 
 pub use bands::{circular_clusters, find_bands};
 pub use sample::{sample_maps, theta_grid};

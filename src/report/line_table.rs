@@ -131,25 +131,13 @@ fn map_tier_line(o: &mut String, m: &crate::engine::metrics::MapTierCounters) {
         return;
     }
     let total = (m.served + m.fallbacks()).max(1) as f64;
-    let reasons: Vec<String> = [
-        ("uncertified", m.fallback_uncertified),
-        ("trace", m.fallback_trace),
-        ("pin_inside", m.fallback_pin_inside),
-        ("moving_pin", m.fallback_moving_pin),
-        ("fence", m.fallback_fence),
-        ("part_support", m.fallback_part_support),
-    ]
-    .iter()
-    .filter(|(_, k)| *k > 0)
-    .map(|(name, k)| format!("{name} {k}"))
-    .collect();
     let _ = writeln!(
         o,
         "map tier                  {} served ({:.1}%), {} exact ({})",
         m.served,
         100.0 * m.served as f64 / total,
         m.fallbacks(),
-        if reasons.is_empty() { "none".into() } else { reasons.join(", ") }
+        m.fallback_reasons()
     );
 }
 

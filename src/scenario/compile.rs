@@ -17,8 +17,8 @@ use super::limits;
 use super::raw::*;
 use super::scene::*;
 use crate::geometry::{named, Polygon, StableState, Vec2};
-use crate::mechanics::{ContactSettings, PartModel, Support};
 use crate::maps::tier::TierSpec;
+use crate::mechanics::{ContactSettings, PartModel, Support};
 
 type R<T> = Result<T, ScenarioError>;
 
@@ -550,7 +550,9 @@ fn compile_model(c: &Checker, rm: &RawModel, part: &PartSpec) -> R<ContactSettin
         "units of a",
     )?;
     Ok(ContactSettings {
-        fidelity: rm.fidelity.map_or(Default::default(), |f| f.contact_fidelity()),
+        fidelity: rm
+            .fidelity
+            .map_or(Default::default(), |f| f.contact_fidelity()),
         mu_c: part.mu_c,
         mu_s: part.mu_s,
         tol,

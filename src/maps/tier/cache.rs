@@ -21,7 +21,9 @@ const MAGIC: &[u8; 16] = b"PINFEED-MAPTIER\n";
 /// Why a cache file was not used.
 #[derive(Debug, thiserror::Error)]
 pub enum CacheError {
-    #[error("map cache file {path} is corrupted or stale ({reason}); it is refused and the map rebuilt")]
+    #[error(
+        "map cache file {path} is corrupted or stale ({reason}); it is refused and the map rebuilt"
+    )]
     Refused { path: PathBuf, reason: String },
     #[error("map cache file {path}: {source}")]
     Io {
@@ -53,7 +55,11 @@ pub struct Loaded {
 
 /// The default cache directory (see the module docs).
 pub fn default_cache_dir() -> PathBuf {
-    let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
     if let Some(d) = env("PINFEED_CACHE") {
         return d;
     }
@@ -183,7 +189,9 @@ pub fn encode(map: &TierMap) -> Vec<u8> {
     for s in &map.samples {
         p.0.push(u8::from(s.servable));
         p.u32(s.feature);
-        [s.rotation, s.dx, s.dy, s.span].iter().for_each(|&x| p.f64(x));
+        [s.rotation, s.dx, s.dy, s.span]
+            .iter()
+            .for_each(|&x| p.f64(x));
     }
     let payload = p.0;
     let mut out = Writer(MAGIC.to_vec());
@@ -327,10 +335,14 @@ impl<'a> Reader<'a> {
         Ok(head)
     }
     fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().expect("4 bytes")))
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
     }
     fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().expect("8 bytes")))
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
     }
     fn f64(&mut self) -> Result<f64, String> {
         Ok(f64::from_bits(self.u64()?))

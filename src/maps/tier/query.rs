@@ -5,7 +5,8 @@ use super::build::interpolate;
 use super::{Node, TierMap};
 use crate::geometry::{wrap_2pi, Pose, Vec2};
 use crate::mechanics::{
-    pin_first_touch, push_path, ContactOutcome, ContactSettings, ContactStatus, PartModel, PinPath,
+    pin_first_touch, push_path, untouched, ContactOutcome, ContactSettings, ContactStatus,
+    PartModel, PinPath,
 };
 use serde::Serialize;
 
@@ -61,7 +62,7 @@ impl TierMap {
         }
         let path = PinPath::constant(0.0);
         let Some(touch) = pin_first_touch(model, pose, pin_start, radius, &path) else {
-            return Ok(missed(pose));
+            return Ok(untouched(pose, ContactStatus::Ok));
         };
         let d = (pin_start.y - pose.y) / k;
         let Some((node, u, v)) = self.leaf(wrap_2pi(pose.theta), d) else {
@@ -85,23 +86,6 @@ impl TierMap {
             steps: 0,
             status: ContactStatus::Ok,
         })
-    }
-}
-
-/// The outcome of a pass that never touches the part (as the exact model gives it).
-fn missed(pose: Pose) -> ContactOutcome {
-    ContactOutcome {
-        contact: false,
-        pose_initial: pose,
-        pose_final: pose,
-        rotation: 0.0,
-        travel_to_contact: 0.0,
-        contact_length: 0.0,
-        contacts: 0,
-        segments: Vec::new(),
-        evaluations: 0,
-        steps: 0,
-        status: ContactStatus::Ok,
     }
 }
 
