@@ -1,7 +1,7 @@
 //! The certified map tier (issue 15 item 3): answers within 0.05° of the exact model where it
 //! serves, the exact model near a jump, a cache keyed by every input, corrupted files refused and
-//! rebuilt, and a line with `fidelity = "map"` that ends every part in the class the exact line
-//! does.
+//! rebuilt, a build independent of the thread count, and a line with `fidelity = "map"` that
+//! ends every part in the class the exact line does.
 
 use pinfeed::engine::{self, contact_map, RunOptions};
 use pinfeed::geometry::{named, Pose, Vec2};
@@ -453,4 +453,24 @@ fn map_keys_in_a_scenario_are_checked() {
             .to_string();
         assert!(err.contains("q.toml:") && err.contains(needle), "{err}");
     }
+}
+
+#[test]
+fn the_build_does_not_depend_on_the_thread_count() {
+    let spec = TierSpec {
+        theta_cells: 6,
+        d_cells: 3,
+        max_depth: 1,
+        ..TierSpec::default()
+    };
+    let on = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| tier::cache::encode(&tier::build(&inputs(spec))))
+    };
+    let one = on(1);
+    assert!(one.len() > 1000);
+    assert_eq!(one, on(2), "same file byte for byte");
 }
