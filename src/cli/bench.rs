@@ -103,6 +103,9 @@ pub enum BenchWhat {
         #[arg(long, default_value = "results/maps/timing.md")]
         out: PathBuf,
     },
+    /// The certified map tier against the exact model: per contact (a section of
+    /// results/accuracy-vs-time.md) and on the line (a section of results/line-speed.md).
+    MapTier(super::bench_map_tier::MapTierArgs),
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
@@ -130,6 +133,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let old = std::fs::read_to_string(&p_md).unwrap_or_default();
             if let Some(section) = crate::study::mc::precision::existing(&old) {
                 md = crate::study::mc::precision::splice(&md, &section);
+            }
+            if let Some(section) = crate::study::map_tier::existing(&old) {
+                md = crate::study::map_tier::splice(&md, &section);
             }
             let p_csv = out.with_extension("csv");
             let p_svg = out.with_extension("svg");
@@ -239,6 +245,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             repeats,
             out,
         } => super::bench_mc::run(study, samples, *repeats, out),
+        BenchWhat::MapTier(a) => super::bench_map_tier::run(a),
     }
 }
 

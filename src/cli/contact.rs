@@ -35,9 +35,17 @@ pub struct ContactArgs {
     /// Part–belt friction coefficient μs (> 0; scales forces only).
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub mu_s: f64,
-    /// Fidelity: exact, ellipsoid or tip.
+    /// Fidelity: exact, ellipsoid or tip; or map (the certified map tier over exact, still pins).
     #[arg(long, default_value = "exact")]
     pub model: String,
+    /// With --model map: the folder of the map cache files (default $XDG_CACHE_HOME/pinfeed/maps
+    /// or ~/.cache/pinfeed/maps).
+    #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
+    pub cache_dir: Option<PathBuf>,
+    /// With --model map: the map's grid, θ0 base cells, d base cells, refinement depth
+    /// (default 36,12,4).
+    #[arg(long, value_name = "T,D,DEPTH")]
+    pub map_grid: Option<String>,
     /// Pin radius in part units (0: point pin).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
@@ -465,7 +473,7 @@ fn plot_title(c: &Case) -> String {
     }
 }
 
-fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
+pub(crate) fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
     ContactReport {
         part: c.part.clone(),
         model: c.model.name().into(),
@@ -497,24 +505,32 @@ pub(crate) fn parse_model(s: &str) -> Result<Fidelity> {
         .with_context(|| format!("unknown model '{s}'; expected exact, ellipsoid or tip"))
 }
 
-pub fn run(args: &ContactArgs) -> Result<()> {
-    if let Some(path) = &args.cases {
-        return run_batch(args, path);
-    }
-    let c = Case {
+/// The single case the arguments describe, with fidelity `model`.
+pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
+    Ok(Case {
         part: args.part.clone().unwrap_or_default(),
         theta0_deg: args.theta0.unwrap_or(0.0),
         d: args.d.unwrap_or(0.0),
         mu_c: args.mu_c,
         mu_s: args.mu_s,
-        model: parse_model(&args.model)?,
+        model,
         pin_radius: args.pin_radius,
         pin_speed: args.pin_speed,
         pin_stop: args.pin_stop,
         support: args.support.clone(),
         tol: args.tol,
         fence: args.fence.as_deref().map(parse_fence).transpose()?,
-    };
+    })
+}
+
+pub fn run(args: &ContactArgs) -> Result<()> {
+    if let Some(path) = &args.cases {
+        return run_batch(args, path);
+    }
+    if args.model.trim() == "map" {
+        return super::contact_map::run(args);
+    }
+    let c = case_of(args, parse_model(&args.model)?)?;
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
     if let Some(path) = &args.trace {
@@ -536,13 +552,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         if !r.contact {
             println!("no contact: the pin passes the part");
         } else {
-            println!("final orientation   {:.4}°", r.theta_final_deg);
-            println!("rotation            {:+.4}°", r.rotation_deg);
-            println!(
-                "final centroid      ({:.5}, {:.5})",
-                r.com_final[0], r.com_final[1]
-            );
-            println!("contact length      {:.5}", r.contact_length);
+            print_motion(&r);
             let segs: Vec<String> = r
                 .segments
                 .iter()
@@ -564,6 +574,17 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         eprintln!("warning: contact ended with status {:?}", out.status);
     }
     Ok(())
+}
+
+/// The final pose, rotation and contact length of a push that touched.
+pub(crate) fn print_motion(r: &ContactReport) {
+    println!("final orientation   {:.4}°", r.theta_final_deg);
+    println!("rotation            {:+.4}°", r.rotation_deg);
+    println!(
+        "final centroid      ({:.5}, {:.5})",
+        r.com_final[0], r.com_final[1]
+    );
+    println!("contact length      {:.5}", r.contact_length);
 }
 
 fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {

@@ -2,10 +2,12 @@
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
 pub mod bench;
+pub mod bench_map_tier;
 pub mod bench_mc;
 pub mod bench_plans;
 pub mod compare;
 pub mod contact;
+pub mod contact_map;
 pub mod fuzz;
 pub mod map;
 pub mod mc;

@@ -44,6 +44,10 @@ pub struct RunArgs {
     /// Simulated seconds per second of animation (default: the loop lasts 20–40 s).
     #[arg(long, value_name = "X", requires = "animate")]
     pub animate_speed: Option<f64>,
+    /// Folder of the map tier's cache files (`[model] fidelity = "map"`; default
+    /// $XDG_CACHE_HOME/pinfeed/maps or ~/.cache/pinfeed/maps).
+    #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
+    pub cache_dir: Option<PathBuf>,
 }
 
 /// How many of the first parts have their paths recorded when drawing.
@@ -89,6 +93,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
         );
         b
     };
+    let maps = super::contact_map::prepare_maps(&scene, args.cache_dir.as_deref(), args.quiet);
     let started = Instant::now();
     let result = engine::run(&scene, &opts, &mut |done| bar.set_position(done))
         .with_context(|| format!("running {}", args.scenario.display()))?;
@@ -158,6 +163,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
         text.push_str(&format!(
             "simulator speed           {parts_per_s:.0} parts/s, {contacts_per_s:.0} contacts/s ({wall:.2} s wall)\n"
         ));
+        text.push_str(&maps);
         text.push_str(&format!("results                   {}\n", dir.display()));
     }
     super::stdout::print_result(&text)

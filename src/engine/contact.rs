@@ -10,6 +10,7 @@
 //! edge ([`edge_crossing`], off the belt). A sample part's path records the push
 //! (`record_path`).
 
+use super::contact_map::PushRequest;
 use super::event_queue::EventKind;
 use super::line::{ActivePart, Line};
 use super::metrics::WorkCounters;
@@ -19,7 +20,7 @@ use super::overlap::{capsule_clearance, first_touch};
 use super::sensing::SensedPass;
 use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
-    ContactOutcome, ContactSettings, ContactStatus, PartModel, PinPath, Recorder, SolveFailure,
+    ContactOutcome, ContactSettings, ContactStatus, PartModel, PinPath, SolveFailure,
 };
 use crate::scenario::{Obstacle, Scene, SensorPin};
 use crate::sensing::classify::Decision;
@@ -47,15 +48,25 @@ impl Line<'_> {
             Obstacle::Fence(_) => None,
         };
         let (pusher, settings) = pusher_for(obstacle, &scene.contact, placed);
-        let model = part.model.as_ref().unwrap_or(&scene.part.model);
         // The push is recorded as it is computed when anything will look at its path: a sensor
         // pin's signal, a neighbouring obstacle, a fence's edge crossing, a drawn path, or another
-        // part on the belt (its overlap check). Never computed twice.
+        // part on the belt (its overlap check). Never computed twice — except that a push the map
+        // tier answers keeps no path, and the overlap check records it if it turns out to need it
+        // (see `contact_map`).
         let sensor = sensor_of(obstacle);
-        let record = sensor.is_some() || self.will_look_at_path(j, &part);
+        let must_record = sensor.is_some() || self.must_look_at_path(j, &part);
+        let record = must_record || self.may_look_at_path();
         let mut knots = KnotRecorder::default();
-        let recorder: Option<&mut dyn Recorder> = record.then_some(&mut knots as &mut dyn Recorder);
-        let out = pusher.push(model, pose, &settings, recorder);
+        let request = PushRequest {
+            j,
+            pusher: &pusher,
+            pose,
+            settings: &settings,
+            record,
+            must_record,
+        };
+        let (out, record) = self.push_contact(&part, request, &mut knots);
+        let model = part.model.as_ref().unwrap_or(&scene.part.model);
         self.metrics.work.contact_solves += 1;
         self.metrics.work.model_evaluations += out.evaluations;
         if matches!(out.status, ContactStatus::PinInsidePart) {
@@ -136,9 +147,9 @@ impl Line<'_> {
         );
     }
 
-    /// Will anything look at the path of a push by obstacle `j` of this part (so that it is
-    /// recorded as it is computed)?
-    fn will_look_at_path(&self, j: usize, part: &ActivePart) -> bool {
+    /// Will anything certainly look at the path of a push by obstacle `j` of this part (so that it
+    /// is recorded as it is computed)?
+    fn must_look_at_path(&self, j: usize, part: &ActivePart) -> bool {
         let scene = self.scene;
         let sweeps = scene.effects.obstacle_sweeps && !scene.neighbours[j].is_empty();
         let fence_edge = matches!(scene.obstacles[j], Obstacle::Fence(_)) && {
@@ -146,8 +157,12 @@ impl Line<'_> {
             let (half, a) = (scene.belt.width / 2.0, scene.part.radius);
             y_min - a < -half || y_max + a > half
         };
-        let others = scene.effects.collisions && !self.active.is_empty();
-        sweeps || fence_edge || part.path.is_some() || others
+        sweeps || fence_edge || part.path.is_some()
+    }
+
+    /// May the overlap check with another part on the belt look at the path of a push?
+    fn may_look_at_path(&self) -> bool {
+        self.scene.effects.collisions && !self.active.is_empty()
     }
 
     /// The model found only a grazing touch: the obstacle passes without pushing, and the part

@@ -40,6 +40,7 @@
 //! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it. What a
 //! run takes and gives is in [`super::results`].
 
+use super::contact_map::LineMaps;
 use super::controller::Control;
 use super::event_queue::{Event, EventKind, EventQueue};
 use super::metrics::Metrics;
@@ -99,6 +100,8 @@ pub(super) struct Line<'a> {
     sensor_pins: Vec<(usize, usize)>,
     /// The controller and the dynamic pins' timelines (None without dynamic pins).
     pub(super) control: Option<Control>,
+    /// The pins' maps (None unless `[model] fidelity = "map"`).
+    pub(super) maps: Option<LineMaps>,
 }
 
 /// Run the line: a pure function of (scene, options). `progress` is called with the number of
@@ -138,6 +141,7 @@ pub fn run(
         finished: 0,
         sensor_pins,
         control: Control::new(scene, scene.effects.event_log || opts.sample_paths > 0),
+        maps: LineMaps::for_scene(scene),
     };
     if opts.parts > 0 {
         line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
@@ -167,9 +171,11 @@ pub fn run(
         "conservation: every part that enters ends in exactly one class"
     );
     assert_eq!(line.metrics.parts_in, opts.parts);
-    let mut summary = line
-        .metrics
-        .summary(&scene.name, opts.seed, scene.contact.fidelity.name());
+    let fidelity = match scene.map_tier {
+        Some(_) => "map",
+        None => scene.contact.fidelity.name(),
+    };
+    let mut summary = line.metrics.summary(&scene.name, opts.seed, fidelity);
     let mut control_log = Vec::new();
     if let Some(c) = line.control.as_mut() {
         summary.controller = Some(c.finish(summary.simulated_time_s));

@@ -64,6 +64,79 @@ pub struct WorkCounters {
     pub late_actuations: u64,
     pub replans: u64,
     pub stale_events: u64,
+    /// Pushes answered by the map tier and pushes it handed to the exact model, by reason (only
+    /// with `[model] fidelity = "map"`; absent from the summary otherwise).
+    #[serde(skip_serializing_if = "MapTierCounters::is_unused")]
+    pub map_tier: MapTierCounters,
+}
+
+/// How the map tier answered the line's pushes (see [`crate::maps::tier`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct MapTierCounters {
+    /// Answered from the map: interpolated in a certified cell, or a miss found by the exact ray
+    /// cast.
+    pub served: u64,
+    /// Computed exactly because the query fell in an uncertified cell (near a jump).
+    pub fallback_uncertified: u64,
+    /// … because the pin started inside or against the part.
+    pub fallback_pin_inside: u64,
+    /// … because the push's path was recorded as it was computed (sensor pin, neighbouring
+    /// obstacle, drawn part).
+    pub fallback_trace: u64,
+    /// … because the pin moves.
+    pub fallback_moving_pin: u64,
+    /// … because a fence pushed.
+    pub fallback_fence: u64,
+    /// … because the part has its own support (a random tripod per part).
+    pub fallback_part_support: u64,
+}
+
+impl MapTierCounters {
+    /// No push went through the tier (a scene without the map tier).
+    pub fn is_unused(&self) -> bool {
+        *self == MapTierCounters::default()
+    }
+    /// Pushes handed to the exact model.
+    pub fn fallbacks(&self) -> u64 {
+        self.fallback_uncertified
+            + self.fallback_pin_inside
+            + self.fallback_trace
+            + self.fallback_moving_pin
+            + self.fallback_fence
+            + self.fallback_part_support
+    }
+    /// The fallbacks by reason, `name count` joined by commas (`none` without any).
+    pub fn fallback_reasons(&self) -> String {
+        let reasons: Vec<String> = [
+            ("uncertified", self.fallback_uncertified),
+            ("trace", self.fallback_trace),
+            ("pin_inside", self.fallback_pin_inside),
+            ("moving_pin", self.fallback_moving_pin),
+            ("fence", self.fallback_fence),
+            ("part_support", self.fallback_part_support),
+        ]
+        .iter()
+        .filter(|(_, k)| *k > 0)
+        .map(|(name, k)| format!("{name} {k}"))
+        .collect();
+        if reasons.is_empty() {
+            "none".into()
+        } else {
+            reasons.join(", ")
+        }
+    }
+    /// Count a fallback by its reason.
+    pub fn count(&mut self, why: crate::maps::tier::Fallback) {
+        use crate::maps::tier::Fallback as F;
+        *match why {
+            F::Uncertified => &mut self.fallback_uncertified,
+            F::PinInside => &mut self.fallback_pin_inside,
+            F::Trace => &mut self.fallback_trace,
+            F::MovingPin => &mut self.fallback_moving_pin,
+            F::Fence => &mut self.fallback_fence,
+            F::PartSupport => &mut self.fallback_part_support,
+        } += 1;
+    }
 }
 
 /// Per-obstacle statistics.

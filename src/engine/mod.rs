@@ -16,6 +16,7 @@
 
 pub mod actuator;
 pub mod contact;
+pub mod contact_map;
 pub mod controller;
 pub mod event_queue;
 pub mod line;

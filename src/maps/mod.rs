@@ -6,6 +6,8 @@
 //!   independent of the thread count), from the start convention of [`start`].
 //! * [`bands`]: bands B_j of final angles (eq. 2-15/2-16, circular-aware), their mean, standard
 //!   deviation and adjusted interval mean ± sd (eq. 3-2), and COM_j ranges (eq. 2-18).
+//! * [`tier`]: the certified map tier — whole pin pushes tabulated over θ0 × d, interpolated where
+//!   certified, the exact model elsewhere, cached on disk (`[model] fidelity = "map"`).
 //! * [`runs`]: maximal circular runs of θ0 samples: the initial-angle sets K_j of each band
 //!   (eq. 2-17, possibly several runs) and the no-contact intervals NC_j (eq. 3-1).
 //!
@@ -23,6 +25,7 @@ pub mod bands;
 pub mod runs;
 pub mod sample;
 pub mod start;
+pub mod tier;
 
 pub use bands::{circular_clusters, find_bands};
 pub use sample::{sample_maps, theta_grid};

@@ -43,6 +43,7 @@ pub use outcome::{
     ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
+pub(crate) use pass::untouched;
 pub use pass::{fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path};
 pub use pin_path::{PinPath, Turn};
 pub use settings::{ContactSettings, Pin};

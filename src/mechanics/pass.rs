@@ -94,7 +94,7 @@ fn cast_piece(ctx: &mut Ctx, cur: &Pose, s: f64, mut min_travel: f64) -> Touch {
 }
 
 /// The outcome of a pass that never touched the part.
-fn untouched(pose: Pose, status: ContactStatus) -> ContactOutcome {
+pub(crate) fn untouched(pose: Pose, status: ContactStatus) -> ContactOutcome {
     ContactOutcome {
         contact: false,
         pose_initial: pose,

@@ -121,7 +121,24 @@ pub fn table(s: &Summary) -> String {
         "simulated time            {:.1} s ({} events, {} contact solves)",
         s.simulated_time_s, s.work.events, s.work.contact_solves
     );
+    map_tier_line(&mut o, &s.work.map_tier);
     o
+}
+
+/// With the map tier: how many pushes the map served and why the others were computed exactly.
+fn map_tier_line(o: &mut String, m: &crate::engine::metrics::MapTierCounters) {
+    if m.is_unused() {
+        return;
+    }
+    let total = (m.served + m.fallbacks()).max(1) as f64;
+    let _ = writeln!(
+        o,
+        "map tier                  {} served ({:.1}%), {} exact ({})",
+        m.served,
+        100.0 * m.served as f64 / total,
+        m.fallbacks(),
+        m.fallback_reasons()
+    );
 }
 
 /// The controller's block: decisions and how their parts ended, misclassifications and the

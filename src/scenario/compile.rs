@@ -17,6 +17,7 @@ use super::limits;
 use super::raw::*;
 use super::scene::*;
 use crate::geometry::{named, Polygon, StableState, Vec2};
+use crate::maps::tier::TierSpec;
 use crate::mechanics::{ContactSettings, PartModel, Support};
 
 type R<T> = Result<T, ScenarioError>;
@@ -37,6 +38,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, part.radius, part.mu_c)?;
     let goal = compile_goal(&c, raw.goal.as_ref())?;
     let contact = compile_model(&c, &raw.model, &part)?;
+    let map_tier = compile_map_tier(&c, &raw.model)?;
     let effects = compile_effects(&raw.effects);
     let output = compile_output(&c, &raw.output)?;
     // Sensor pins: train each sensor's classifier on templates of this scene.
@@ -72,6 +74,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         effects,
         output,
         controller,
+        map_tier,
     })
 }
 
@@ -547,13 +550,38 @@ fn compile_model(c: &Checker, rm: &RawModel, part: &PartSpec) -> R<ContactSettin
         "units of a",
     )?;
     Ok(ContactSettings {
-        fidelity: rm.fidelity.unwrap_or_default(),
+        fidelity: rm
+            .fidelity
+            .map_or(Default::default(), |f| f.contact_fidelity()),
         mu_c: part.mu_c,
         mu_s: part.mu_s,
         tol,
         max_travel,
         ..defaults
     })
+}
+
+/// `[model] fidelity = "map"` and `map_grid`: the map tier's grid (None without the tier; a grid
+/// without the tier is an error, not silently ignored).
+fn compile_map_tier(c: &Checker, rm: &RawModel) -> R<Option<TierSpec>> {
+    if rm.fidelity != Some(RawFidelity::Map) {
+        if rm.map_grid.is_some() {
+            return Err(c.err("model.map_grid", "applies only with fidelity = \"map\""));
+        }
+        return Ok(None);
+    }
+    let mut spec = TierSpec::default();
+    if let Some([t, d, depth]) = rm.map_grid {
+        let ok = (4..=720).contains(&t) && (2..=200).contains(&d) && depth <= 8;
+        if !ok {
+            return Err(c.err(
+                "model.map_grid",
+                format!("[θ0 cells, d cells, depth] must lie in [4, 720] × [2, 200] × [0, 8], got [{t}, {d}, {depth}]"),
+            ));
+        }
+        (spec.theta_cells, spec.d_cells, spec.max_depth) = (t, d, depth);
+    }
+    Ok(Some(spec))
 }
 
 /// `[effects]`: the optional work the engine does (collisions and obstacle sweeps on by default,

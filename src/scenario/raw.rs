@@ -272,10 +272,35 @@ pub struct RawGoalSet {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawModel {
-    pub fidelity: Option<Fidelity>,
+    pub fidelity: Option<RawFidelity>,
+    /// The map tier's grid (`fidelity = "map"` only): [θ0 base cells, d base cells, refinement
+    /// depth].
+    pub map_grid: Option<[u32; 3]>,
     pub tol: Option<f64>,
     /// Largest pin travel in contact, in units of a, before a part counts as jammed.
     pub max_travel: Option<f64>,
+}
+
+/// `[model] fidelity`: a contact-model fidelity, or `map`: the certified map tier over the exact
+/// model (see `maps::tier`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RawFidelity {
+    Tip,
+    Ellipsoid,
+    Exact,
+    Map,
+}
+
+impl RawFidelity {
+    /// The contact model's fidelity (the map tier's table and fallbacks are the exact model's).
+    pub fn contact_fidelity(self) -> Fidelity {
+        match self {
+            RawFidelity::Tip => Fidelity::Tip,
+            RawFidelity::Ellipsoid => Fidelity::Ellipsoid,
+            RawFidelity::Exact | RawFidelity::Map => Fidelity::Exact,
+        }
+    }
 }
 
 /// `[effects]`: optional work the engine does only when switched on.

@@ -308,4 +308,7 @@ pub struct Scene {
     pub output: OutputOptions,
     /// The controller driving the dynamic pins (`[controller]` and `[[rules]]`), if any.
     pub controller: Option<Controller>,
+    /// `[model] fidelity = "map"`: the map tier's grid (None: the contact model answers every
+    /// push).
+    pub map_tier: Option<crate::maps::tier::TierSpec>,
 }

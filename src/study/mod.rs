@@ -7,5 +7,6 @@ pub mod accuracy;
 pub mod compare;
 pub mod contact_cost;
 pub mod map_cost;
+pub mod map_tier;
 pub mod mc;
 pub mod robustness;

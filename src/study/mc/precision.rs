@@ -185,9 +185,15 @@ pub fn section(
 
 /// Put `section` into `doc`: replace the marked section if there is one, else append it.
 pub fn splice(doc: &str, section: &str) -> String {
-    if let (Some(a), Some(b)) = (doc.find(BEGIN), doc.find(END)) {
+    splice_between(doc, section, (BEGIN, END))
+}
+
+/// Put `section` into `doc` in place of the section between the markers `(begin, end)` if there
+/// is one, else append it.
+pub fn splice_between(doc: &str, section: &str, (begin, end): (&str, &str)) -> String {
+    if let (Some(a), Some(b)) = (doc.find(begin), doc.find(end)) {
         if a < b {
-            let mut rest = &doc[b + END.len()..];
+            let mut rest = &doc[b + end.len()..];
             rest = rest.strip_prefix('\n').unwrap_or(rest);
             return format!("{}{}{}", &doc[..a], section, rest);
         }
@@ -203,9 +209,14 @@ pub fn splice(doc: &str, section: &str) -> String {
 
 /// The marked section of `doc`, if any (so `bench accuracy` can keep it when it rewrites the file).
 pub fn existing(doc: &str) -> Option<String> {
-    let a = doc.find(BEGIN)?;
-    let b = doc.find(END)?;
-    (a < b).then(|| format!("{}\n", &doc[a..b + END.len()]))
+    existing_between(doc, (BEGIN, END))
+}
+
+/// The section of `doc` between the markers `(begin, end)`, markers included, if any.
+pub fn existing_between(doc: &str, (begin, end): (&str, &str)) -> Option<String> {
+    let a = doc.find(begin)?;
+    let b = doc.find(end)?;
+    (a < b).then(|| format!("{}\n", &doc[a..b + end.len()]))
 }
 
 #[cfg(test)]

@@ -504,6 +504,7 @@ pub fn draw_scene(
             ..base.effects
         },
         output: base.output.clone(),
+        map_tier: base.map_tier,
     };
     // The scenario's feed draws the entry pose (its support is uniform here, so it draws no tripod).
     let entry = draw_part(&scene, st.feed_seed, 0)?;

@@ -1,0 +1,90 @@
+//! The map tier against the exact model on the same pushes (issue 15 item 3: ≥ 100× faster per
+//! contact). tripoly2, a pin of radius 0.1 a, μc 0.5, tol 1e-6, the default grid (read from the
+//! cache folder, built on the first run). Three measurements over 256 random pushes (θ0 uniform,
+//! d uniform in ±0.6): `served` — the pushes the map answers (ray cast + interpolation),
+//! `exact_served` — the same pushes by the exact model, `mixed` — every push through
+//! `push_with_map` (the exact model where the map is not certified), `exact_all` — every push
+//! exact. Run: `cargo bench --bench map_tier`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use pinfeed::geometry::{part_from_spec, Pose, Vec2};
+use pinfeed::maps::tier::{self, push_with_map, TierInputs, TierSpec};
+use pinfeed::mechanics::{push_path, ContactSettings, PartModel, PinPath, Support};
+use pinfeed::random::stream;
+use rand::RngExt;
+use std::hint::black_box;
+
+const RADIUS: f64 = 0.1;
+
+fn bench_map_tier(c: &mut Criterion) {
+    let poly = part_from_spec("tripoly2").unwrap();
+    let poly = poly.scaled(1.0 / poly.radius());
+    let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+    let settings = ContactSettings::default();
+    let inputs = TierInputs {
+        model: &model,
+        support: &Support::Uniform,
+        radius: RADIUS,
+        settings,
+        spec: TierSpec::default(),
+    };
+    let loaded = tier::shared(&inputs, Some(&tier::default_cache_dir()));
+    let map = loaded.map;
+    let mut rng = stream(7, 0);
+    let all: Vec<(Pose, Vec2)> = (0..256)
+        .map(|_| {
+            let pose = Pose::new(0.0, 0.0, rng.random::<f64>() * std::f64::consts::TAU);
+            let d = (rng.random::<f64>() * 2.0 - 1.0) * 0.6;
+            (pose, Vec2::new(2.5, d))
+        })
+        .collect();
+    let served: Vec<(Pose, Vec2)> = all
+        .iter()
+        .copied()
+        .filter(|&(pose, pin)| map.answer(&model, pose, pin, RADIUS).is_ok())
+        .collect();
+    println!(
+        "map_tier: {} of {} pushes served by the map",
+        served.len(),
+        all.len()
+    );
+    let path = PinPath::constant(0.0);
+    let exact = |set: &[(Pose, Vec2)]| {
+        let mut acc = 0.0;
+        for &(pose, pin) in set {
+            acc += push_path(&model, pose, pin, RADIUS, &path, &settings, None).rotation;
+        }
+        acc
+    };
+    let mut group = c.benchmark_group("map_tier");
+    group.bench_function("served", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &(pose, pin) in &served {
+                acc += map.answer(&model, pose, pin, RADIUS).unwrap().rotation;
+            }
+            black_box(acc)
+        })
+    });
+    group.bench_function("exact_served", |b| b.iter(|| black_box(exact(&served))));
+    group.bench_function("mixed", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &(pose, pin) in &all {
+                acc += push_with_map(&map, &model, pose, pin, RADIUS, &settings)
+                    .0
+                    .rotation;
+            }
+            black_box(acc)
+        })
+    });
+    group.bench_function("exact_all", |b| b.iter(|| black_box(exact(&all))));
+    group.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10).measurement_time(std::time::Duration::from_secs(3));
+    targets = bench_map_tier
+}
+criterion_main!(benches);

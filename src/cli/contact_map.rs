@@ -1,0 +1,165 @@
+//! The map tier at the command line: `pinfeed run` loads or builds a scene's maps before the run
+//! and says where they came from; `pinfeed contact --model map` answers one pin push from the map
+//! of its (part, support, pin radius, μc, tolerance), or exactly where the map cannot vouch for it,
+//! and says which.
+
+use super::contact::{case_of, check_geometry, check_inputs, compile_part, report, ContactArgs};
+use crate::engine::contact_map::prepare;
+use crate::maps::tier::{self, push_with_map, Loaded, Source, TierInputs, TierSpec};
+use crate::mechanics::{ContactSettings, Fidelity, Support};
+use crate::scenario::Scene;
+use anyhow::{bail, Result};
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The cache folder: the one given, else the default (see [`tier::default_cache_dir`]).
+fn cache_dir(dir: Option<&Path>) -> PathBuf {
+    dir.map_or_else(tier::default_cache_dir, Path::to_path_buf)
+}
+
+/// One line on where a map came from.
+fn describe(loaded: &Loaded) -> String {
+    let st = &loaded.map.stats;
+    let what = format!(
+        "{} exact pushes, {:.1}% of θ0 × d certified",
+        st.exact_samples,
+        100.0 * st.certified_area
+    );
+    match &loaded.source {
+        Source::Built { seconds } => format!("built in {seconds:.2} s ({what})"),
+        Source::Disk(p) => format!("read from {} ({what})", p.display()),
+        Source::Memory => format!("already loaded ({what})"),
+    }
+}
+
+/// For a scene with `fidelity = "map"`: load or build its maps into `dir` before the run and
+/// return the lines that say how (empty for any other scene, which pays nothing).
+pub fn prepare_maps(scene: &Scene, dir: Option<&Path>, quiet: bool) -> String {
+    if scene.map_tier.is_none() {
+        return String::new();
+    }
+    let dir = cache_dir(dir);
+    if !quiet {
+        eprintln!("map tier: loading or building maps in {}", dir.display());
+    }
+    let started = Instant::now();
+    let prepared = prepare(scene, Some(&dir));
+    let mut seen = BTreeSet::new();
+    let mut text = String::new();
+    for (_, loaded) in &prepared {
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        if seen.insert(loaded.map.key) {
+            text.push_str(&format!("map {}  {}\n", loaded.map.key, describe(loaded)));
+        }
+    }
+    text.push_str(&format!(
+        "map tier ready            {} map(s) for {} pin(s) in {:.2} s, cache {}\n",
+        seen.len(),
+        prepared.len(),
+        started.elapsed().as_secs_f64(),
+        dir.display()
+    ));
+    text
+}
+
+/// `pinfeed contact --model map`: one still-pin push from the map.
+pub fn run(args: &ContactArgs) -> Result<()> {
+    if args.fence.is_some() || args.pin_speed != 0.0 || args.trace.is_some() || args.plot.is_some()
+    {
+        bail!("--model map answers still-pin pushes only, without --trace or --plot (the map keeps no path); use --model exact for fences, moving pins, traces and plots");
+    }
+    let c = case_of(args, Fidelity::Exact)?;
+    check_inputs(&c)?;
+    let (poly, model) = compile_part(&c.part, &c.support)?;
+    check_geometry(&c, &poly)?;
+    let support = Support::parse(&c.support, &poly).map_err(anyhow::Error::msg)?;
+    let settings = ContactSettings {
+        mu_c: c.mu_c,
+        mu_s: c.mu_s,
+        tol: c.tol,
+        ..ContactSettings::default()
+    };
+    let spec = match args.map_grid.as_deref() {
+        Some(g) => parse_grid(g)?,
+        None => TierSpec::default(),
+    };
+    let inputs = TierInputs {
+        model: &model,
+        support: &support,
+        radius: c.pin_radius,
+        settings,
+        spec,
+    };
+    let dir = cache_dir(args.cache_dir.as_deref());
+    let loaded = tier::load_or_build(&inputs, Some(&dir));
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    let (pose, start) = super::contact::case_geometry(&poly, &c);
+    let started = Instant::now();
+    let (out, why) = push_with_map(&loaded.map, &model, pose, start, c.pin_radius, &settings);
+    let query_s = started.elapsed().as_secs_f64();
+    let mut r = report(&c, &out);
+    r.model = "map".into();
+    let served = match why {
+        None => "map".to_string(),
+        Some(w) => format!("exact ({})", w.name()),
+    };
+    let file = loaded.file.as_ref().map(|p| p.display().to_string());
+    if args.json {
+        let mut v = serde_json::to_value(&r)?;
+        v["map"] = serde_json::json!({
+            "answered_by": served,
+            "key": loaded.map.key.to_string(),
+            "file": file,
+            "source": describe(&loaded),
+            "query_s": query_s,
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    println!(
+        "part {}  model map  θ0 {}°  d {}  μc {}",
+        r.part, r.theta0_deg, r.d, r.mu_c
+    );
+    if r.contact {
+        super::contact::print_motion(&r);
+    } else {
+        println!("no contact: the pin passes the part");
+    }
+    println!("status              {}", r.status);
+    println!("answered by         {served} in {:.1} µs", query_s * 1e6);
+    println!(
+        "map                 {}  {}",
+        loaded.map.key,
+        describe(&loaded)
+    );
+    if let Some(f) = file {
+        println!("map file            {f}");
+    }
+    Ok(())
+}
+
+/// `--map-grid T,D,DEPTH`.
+pub fn parse_grid(s: &str) -> Result<TierSpec> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<u32>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| anyhow::anyhow!("--map-grid '{s}': expected T,D,DEPTH (whole numbers)"))?;
+    let [t, d, depth] = v[..] else {
+        bail!("--map-grid '{s}': expected three numbers T,D,DEPTH");
+    };
+    if !((4..=720).contains(&t) && (2..=200).contains(&d) && depth <= 8) {
+        bail!("--map-grid must lie in [4, 720] × [2, 200] × [0, 8], got {t},{d},{depth}");
+    }
+    Ok(TierSpec {
+        theta_cells: t,
+        d_cells: d,
+        max_depth: depth,
+        ..TierSpec::default()
+    })
+}

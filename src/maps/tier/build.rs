@@ -1,0 +1,272 @@
+//! Building a map: exact samples on a lattice, base cells refined as quadtrees where the
+//! interpolation does not certify (see the module docs of [`super`]).
+//!
+//! Every sample sits on a lattice of 2^(max_depth + 2) points per base cell and axis, so a point
+//! shared by neighbouring cells is computed once. Each refinement level computes all its missing
+//! points in one parallel, order-preserving batch (sorted lattice keys), then decides every cell in
+//! order: the result does not depend on the thread count.
+
+use super::key::TierKey;
+use super::{BuildStats, Node, Sample, TierInputs, TierMap};
+use crate::geometry::{Pose, Vec2};
+use crate::mechanics::{push_path, ContactFeature, PinPath};
+use rayon::prelude::*;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// A cell being decided: lower-left lattice point, side (lattice units), its node.
+#[derive(Debug, Clone, Copy)]
+struct Cell {
+    i: u64,
+    j: u64,
+    size: u64,
+    node: usize,
+}
+
+/// The lattice geometry of a map.
+#[derive(Debug, Clone, Copy)]
+pub struct Lattice {
+    /// Lattice points per base cell and axis.
+    pub per_cell: u64,
+    pub theta_points: u64,
+    pub d_points: u64,
+    pub reach: f64,
+}
+
+impl Lattice {
+    pub fn theta(&self, i: u64) -> f64 {
+        std::f64::consts::TAU * i as f64 / self.theta_points as f64
+    }
+    pub fn d(&self, j: u64) -> f64 {
+        -self.reach + 2.0 * self.reach * j as f64 / self.d_points as f64
+    }
+}
+
+fn lattice_key(i: u64, j: u64) -> u64 {
+    (i << 32) | j
+}
+
+/// The half-width r of the d range (units of a): beyond |d| > r the pin cannot touch the part.
+pub fn reach(inputs: &TierInputs) -> f64 {
+    let r = inputs
+        .model
+        .polygon()
+        .vertices()
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.norm()));
+    r + inputs.radius / inputs.model.scale()
+}
+
+/// One exact push at (θ0, d): the part at the origin, the pin well clear upstream.
+pub fn exact_sample(inputs: &TierInputs, reach: f64, theta: f64, d: f64) -> Sample {
+    let k = inputs.model.scale();
+    let start = Vec2::new((reach + 1.0) * k, d * k);
+    let path = PinPath::constant(0.0);
+    let out = push_path(
+        inputs.model,
+        Pose::new(0.0, 0.0, theta),
+        start,
+        inputs.radius,
+        &path,
+        &inputs.settings,
+        None,
+    );
+    let last = out.segments.last();
+    let span = last.map_or(0.0, |s| s.s_end - out.travel_to_contact) / k;
+    let single = out.contact && out.contacts == 1 && out.status.is_ok();
+    // The line takes the contact's end from the last segment; a single contact's length is that.
+    let consistent = (span - out.contact_length / k).abs() <= 1e-9;
+    Sample {
+        servable: single && consistent && last.is_some(),
+        feature: last.map_or(u32::MAX, |s| feature_code(s.feature)),
+        rotation: out.rotation,
+        dx: out.pose_final.x / k,
+        dy: out.pose_final.y / k,
+        span,
+    }
+}
+
+fn feature_code(f: ContactFeature) -> u32 {
+    let kind = match f {
+        ContactFeature::Edge(_) => 0,
+        ContactFeature::Vertex(_) => 1,
+        ContactFeature::FenceVertex(_) => 2,
+        ContactFeature::FenceEdge(_) => 3,
+    };
+    (kind << 16) | (f.index() as u32 & 0xffff)
+}
+
+/// Quadratic Lagrange weights on the nodes 0, ½, 1 at `u`.
+fn quadratic(u: f64) -> [f64; 3] {
+    [
+        2.0 * (u - 0.5) * (u - 1.0),
+        -4.0 * u * (u - 1.0),
+        2.0 * u * (u - 0.5),
+    ]
+}
+
+/// Biquadratic interpolation through the cell's 3 × 3 nodes (θ-major within each d row: node
+/// a + 3b sits at (a/2, b/2)) at (u, v) ∈ [0, 1]²: [rotation, Δx, Δy, span].
+pub fn interpolate(nodes: [&Sample; 9], u: f64, v: f64) -> [f64; 4] {
+    let (wu, wv) = (quadratic(u), quadratic(v));
+    let mut out = [0.0; 4];
+    for (k, s) in nodes.iter().enumerate() {
+        let w = wu[k % 3] * wv[k / 3];
+        out[0] += w * s.rotation;
+        out[1] += w * s.dx;
+        out[2] += w * s.dy;
+        out[3] += w * s.span;
+    }
+    out
+}
+
+impl Cell {
+    /// The 3 × 3 interpolation nodes (see [`interpolate`]).
+    fn nodes(&self) -> [(u64, u64); 9] {
+        let h = self.size / 2;
+        std::array::from_fn(|k| (self.i + (k as u64 % 3) * h, self.j + (k as u64 / 3) * h))
+    }
+    /// Check points with their local coordinates: the four quarter points inside and the two
+    /// quarter points of each edge (the nodes of the children that are not the cell's own).
+    fn checks(&self) -> [(u64, u64, f64, f64); 12] {
+        const AT: [(u64, u64); 12] = [
+            (1, 1),
+            (3, 1),
+            (1, 3),
+            (3, 3),
+            (1, 0),
+            (3, 0),
+            (1, 4),
+            (3, 4),
+            (0, 1),
+            (0, 3),
+            (4, 1),
+            (4, 3),
+        ];
+        let q = self.size / 4;
+        AT.map(|(a, b)| {
+            let (u, v) = (a as f64 / 4.0, b as f64 / 4.0);
+            (self.i + a * q, self.j + b * q, u, v)
+        })
+    }
+    fn points(&self) -> impl Iterator<Item = (u64, u64)> {
+        let checks = self.checks().map(|(i, j, ..)| (i, j));
+        self.nodes().into_iter().chain(checks)
+    }
+}
+
+/// Is the cell certified, given every sample it needs?
+fn certified(cell: &Cell, at: &BTreeMap<u64, Sample>, inputs: &TierInputs) -> bool {
+    let get = |(i, j): (u64, u64)| &at[&lattice_key(i, j)];
+    let c = cell.nodes().map(get);
+    let feature = c[0].feature;
+    let same = |s: &Sample| s.servable && s.feature == feature;
+    if !c.iter().all(|s| same(s)) {
+        return false;
+    }
+    let (tol_rot, tol_pos) = (inputs.spec.check_deg.to_radians(), inputs.spec.check_pos);
+    cell.checks().iter().all(|&(i, j, u, v)| {
+        let s = get((i, j));
+        let p = interpolate(c, u, v);
+        same(s)
+            && (p[0] - s.rotation).abs() <= tol_rot
+            && (p[1] - s.dx).abs() <= tol_pos
+            && (p[2] - s.dy).abs() <= tol_pos
+            && (p[3] - s.span).abs() <= tol_pos
+    })
+}
+
+/// Does any of the cell's points push the part once and pass (else there is nothing to
+/// tabulate in it: a miss is answered by the ray cast, anything else by the exact model)?
+fn any_servable(cell: &Cell, at: &BTreeMap<u64, Sample>) -> bool {
+    cell.points().any(|(i, j)| at[&lattice_key(i, j)].servable)
+}
+
+/// Compute, in parallel and in key order, every lattice point the cells need that is not known.
+fn fill(cells: &[Cell], at: &mut BTreeMap<u64, Sample>, inputs: &TierInputs, lat: &Lattice) {
+    let missing: BTreeSet<(u64, u64)> = cells
+        .iter()
+        .flat_map(|c| c.points())
+        .filter(|&(i, j)| !at.contains_key(&lattice_key(i, j)))
+        .collect();
+    let missing: Vec<(u64, u64)> = missing.into_iter().collect();
+    let computed: Vec<Sample> = missing
+        .par_iter()
+        .map(|&(i, j)| exact_sample(inputs, lat.reach, lat.theta(i), lat.d(j)))
+        .collect();
+    for ((i, j), s) in missing.into_iter().zip(computed) {
+        at.insert(lattice_key(i, j), s);
+    }
+}
+
+/// Build the map of `inputs` (deterministic; parallel over samples).
+pub fn build(inputs: &TierInputs) -> TierMap {
+    let spec = inputs.spec;
+    let per_cell = 1u64 << (spec.max_depth + 2);
+    let (nt, nd) = (u64::from(spec.theta_cells), u64::from(spec.d_cells));
+    let lat = Lattice {
+        per_cell,
+        theta_points: nt * per_cell,
+        d_points: nd * per_cell,
+        reach: reach(inputs),
+    };
+    let mut nodes = vec![Node::Fallback; (nt * nd) as usize];
+    let mut cells: Vec<Cell> = (0..nt)
+        .flat_map(|it| (0..nd).map(move |id| (it, id)))
+        .map(|(it, id)| Cell {
+            i: it * per_cell,
+            j: id * per_cell,
+            size: per_cell,
+            node: (it * nd + id) as usize,
+        })
+        .collect();
+    let mut at: BTreeMap<u64, Sample> = BTreeMap::new();
+    let mut samples: Vec<Sample> = Vec::new();
+    let mut index: BTreeMap<u64, u32> = BTreeMap::new();
+    let mut stats = BuildStats::default();
+    while !cells.is_empty() {
+        fill(&cells, &mut at, inputs, &lat);
+        let mut next = Vec::new();
+        for cell in &cells {
+            if certified(cell, &at, inputs) {
+                let points = cell.nodes().map(|(i, j)| {
+                    let key = lattice_key(i, j);
+                    *index.entry(key).or_insert_with(|| {
+                        samples.push(at[&key]);
+                        (samples.len() - 1) as u32
+                    })
+                });
+                nodes[cell.node] = Node::Certified { points };
+                stats.certified_cells += 1;
+                stats.certified_area += (cell.size as f64 / per_cell as f64).powi(2);
+            } else if cell.size > 4 && any_servable(cell, &at) {
+                let first = nodes.len();
+                nodes.extend([Node::Fallback; 4]);
+                nodes[cell.node] = Node::Split {
+                    first: first as u32,
+                };
+                let h = cell.size / 2;
+                for (k, (di, dj)) in [(0, 0), (h, 0), (0, h), (h, h)].into_iter().enumerate() {
+                    next.push(Cell {
+                        i: cell.i + di,
+                        j: cell.j + dj,
+                        size: h,
+                        node: first + k,
+                    });
+                }
+            } else {
+                stats.fallback_cells += 1;
+            }
+        }
+        cells = next;
+    }
+    stats.exact_samples = at.len() as u64;
+    stats.certified_area /= (nt * nd) as f64;
+    TierMap {
+        key: TierKey::of(inputs),
+        spec,
+        reach: lat.reach,
+        nodes,
+        samples,
+        stats,
+    }
+}

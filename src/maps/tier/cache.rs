@@ -1,0 +1,358 @@
+//! Maps on disk: one file per key, `<dir>/<key>.pfmap`, written atomically (temp + rename).
+//!
+//! Layout (little-endian): magic `PINFEED-MAPTIER\n` (16 bytes), format version (u32), key (16
+//! bytes), payload length (u64), payload, FNV-1a 64 checksum of everything before it (u64). The
+//! payload is the grid (spec, reach), the build statistics, the nodes and the corner samples. A
+//! file whose magic, version, key, length or checksum does not match is refused with a message
+//! naming the file and the reason, and the map is rebuilt and written again.
+//!
+//! The directory: `--cache-dir`, else `$PINFEED_CACHE`, else `$XDG_CACHE_HOME/pinfeed/maps`, else
+//! `$HOME/.cache/pinfeed/maps`, else `target/pinfeed-cache` ([`default_cache_dir`]).
+
+use super::key::{fnv1a64, TierKey, BASIS, FORMAT_VERSION};
+use super::{build, BuildStats, Node, Sample, TierInputs, TierMap, TierSpec};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
+
+const MAGIC: &[u8; 16] = b"PINFEED-MAPTIER\n";
+
+/// Why a cache file was not used.
+#[derive(Debug, thiserror::Error)]
+pub enum CacheError {
+    #[error(
+        "map cache file {path} is corrupted or stale ({reason}); it is refused and the map rebuilt"
+    )]
+    Refused { path: PathBuf, reason: String },
+    #[error("map cache file {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Where a map came from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Source {
+    /// Already in this process.
+    Memory,
+    /// Read from a cache file.
+    Disk(PathBuf),
+    /// Built now, in `seconds`.
+    Built { seconds: f64 },
+}
+
+/// A map ready for use, where it came from, and what went wrong on the way (a refused file, a
+/// file that could not be written): never fatal.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub map: Arc<TierMap>,
+    pub source: Source,
+    pub file: Option<PathBuf>,
+    pub warnings: Vec<String>,
+}
+
+/// The default cache directory (see the module docs).
+pub fn default_cache_dir() -> PathBuf {
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    if let Some(d) = env("PINFEED_CACHE") {
+        return d;
+    }
+    if let Some(d) = env("XDG_CACHE_HOME") {
+        return d.join("pinfeed").join("maps");
+    }
+    if let Some(d) = env("HOME") {
+        return d.join(".cache").join("pinfeed").join("maps");
+    }
+    PathBuf::from("target").join("pinfeed-cache")
+}
+
+/// The file of a key in `dir`.
+pub fn file_of(dir: &Path, key: &TierKey) -> PathBuf {
+    dir.join(format!("{key}.pfmap"))
+}
+
+/// Read the map of `inputs` from `dir` if a valid file is there, else build it and write it
+/// (`dir` None: build, no file).
+pub fn load_or_build(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
+    let key = TierKey::of(inputs);
+    let mut warnings = Vec::new();
+    let file = dir.map(|d| file_of(d, &key));
+    if let Some(path) = &file {
+        if path.exists() {
+            match read(path, &key) {
+                Ok(map) => {
+                    return Loaded {
+                        map: Arc::new(map),
+                        source: Source::Disk(path.clone()),
+                        file,
+                        warnings,
+                    }
+                }
+                Err(e) => warnings.push(e.to_string()),
+            }
+        }
+    }
+    let started = Instant::now();
+    let map = build(inputs);
+    let seconds = started.elapsed().as_secs_f64();
+    if let Some(path) = &file {
+        if let Err(e) = write(path, &map) {
+            warnings.push(e.to_string());
+        }
+    }
+    Loaded {
+        map: Arc::new(map),
+        source: Source::Built { seconds },
+        file,
+        warnings,
+    }
+}
+
+/// [`load_or_build`], remembered in this process by key (a map is built or read once per run).
+pub fn shared(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
+    static MEMO: OnceLock<Mutex<BTreeMap<TierKey, Arc<TierMap>>>> = OnceLock::new();
+    let memo = MEMO.get_or_init(|| Mutex::new(BTreeMap::new()));
+    let key = TierKey::of(inputs);
+    if let Some(map) = memo.lock().expect("map memo").get(&key) {
+        return Loaded {
+            map: map.clone(),
+            source: Source::Memory,
+            file: dir.map(|d| file_of(d, &key)),
+            warnings: Vec::new(),
+        };
+    }
+    let loaded = load_or_build(inputs, dir);
+    memo.lock()
+        .expect("map memo")
+        .insert(key, loaded.map.clone());
+    loaded
+}
+
+/// Write `map` to `path` atomically.
+pub fn write(path: &Path, map: &TierMap) -> Result<(), CacheError> {
+    let io = |source| CacheError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(io)?;
+    }
+    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
+    std::fs::write(&tmp, encode(map)).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+/// Read the map with key `key` from `path`, refusing anything that does not check out.
+pub fn read(path: &Path, key: &TierKey) -> Result<TierMap, CacheError> {
+    let bytes = std::fs::read(path).map_err(|source| CacheError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    decode(&bytes, key).map_err(|reason| CacheError::Refused {
+        path: path.to_path_buf(),
+        reason,
+    })
+}
+
+/// The file's bytes.
+pub fn encode(map: &TierMap) -> Vec<u8> {
+    let mut p = Writer(Vec::new());
+    let s = &map.spec;
+    p.u32(s.theta_cells);
+    p.u32(s.d_cells);
+    p.u32(s.max_depth);
+    p.f64(s.check_deg);
+    p.f64(s.check_pos);
+    p.f64(map.reach);
+    let st = &map.stats;
+    p.u64(st.exact_samples);
+    p.u64(st.certified_cells);
+    p.u64(st.fallback_cells);
+    p.f64(st.certified_area);
+    p.u64(map.nodes.len() as u64);
+    for n in &map.nodes {
+        let (tag, v) = match *n {
+            Node::Split { first } => (0u8, [first, 0, 0, 0, 0, 0, 0, 0, 0]),
+            Node::Certified { points } => (1, points),
+            Node::Fallback => (2, [0; 9]),
+        };
+        p.0.push(tag);
+        v.iter().for_each(|&x| p.u32(x));
+    }
+    p.u64(map.samples.len() as u64);
+    for s in &map.samples {
+        p.0.push(u8::from(s.servable));
+        p.u32(s.feature);
+        [s.rotation, s.dx, s.dy, s.span]
+            .iter()
+            .for_each(|&x| p.f64(x));
+    }
+    let payload = p.0;
+    let mut out = Writer(MAGIC.to_vec());
+    out.u32(FORMAT_VERSION);
+    out.0.extend_from_slice(&map.key.0);
+    out.u64(payload.len() as u64);
+    out.0.extend_from_slice(&payload);
+    let sum = fnv1a64(&out.0, BASIS);
+    out.u64(sum);
+    out.0
+}
+
+/// Parse a file's bytes (the reason it is refused, if it is).
+pub fn decode(bytes: &[u8], key: &TierKey) -> Result<TierMap, String> {
+    if bytes.len() < 16 + 4 + 16 + 8 + 8 || &bytes[..16] != MAGIC {
+        return Err("not a pinfeed map file".into());
+    }
+    let (body, sum) = bytes.split_at(bytes.len() - 8);
+    if fnv1a64(body, BASIS).to_le_bytes() != sum {
+        return Err("checksum mismatch".into());
+    }
+    let mut r = Reader(&body[16..]);
+    let version = r.u32()?;
+    if version != FORMAT_VERSION {
+        return Err(format!(
+            "format version {version}, expected {FORMAT_VERSION}"
+        ));
+    }
+    if r.take(16)? != key.0 {
+        return Err("its key does not match its inputs".into());
+    }
+    let len = r.u64()? as usize;
+    if len != r.0.len() {
+        return Err("payload length mismatch".into());
+    }
+    let map = payload(&mut r, *key)?;
+    if !r.0.is_empty() {
+        return Err("trailing bytes".into());
+    }
+    Ok(map)
+}
+
+fn payload(r: &mut Reader, key: TierKey) -> Result<TierMap, String> {
+    let spec = TierSpec {
+        theta_cells: r.u32()?,
+        d_cells: r.u32()?,
+        max_depth: r.u32()?,
+        check_deg: r.f64()?,
+        check_pos: r.f64()?,
+    };
+    let reach = r.f64()?;
+    let stats = BuildStats {
+        exact_samples: r.u64()?,
+        certified_cells: r.u64()?,
+        fallback_cells: r.u64()?,
+        certified_area: r.f64()?,
+    };
+    let n_nodes = r.count(37)?;
+    let mut nodes = Vec::with_capacity(n_nodes);
+    for _ in 0..n_nodes {
+        let tag = r.take(1)?[0];
+        let mut v = [0u32; 9];
+        for x in &mut v {
+            *x = r.u32()?;
+        }
+        nodes.push(match tag {
+            0 => Node::Split { first: v[0] },
+            1 => Node::Certified { points: v },
+            2 => Node::Fallback,
+            t => return Err(format!("unknown node tag {t}")),
+        });
+    }
+    let n_samples = r.count(37)?;
+    let mut samples = Vec::with_capacity(n_samples);
+    for _ in 0..n_samples {
+        let servable = r.take(1)?[0] != 0;
+        let feature = r.u32()?;
+        let [rotation, dx, dy, span] = [r.f64()?, r.f64()?, r.f64()?, r.f64()?];
+        samples.push(Sample {
+            servable,
+            feature,
+            rotation,
+            dx,
+            dy,
+            span,
+        });
+    }
+    let map = TierMap {
+        key,
+        spec,
+        reach,
+        nodes,
+        samples,
+        stats,
+    };
+    check_links(&map)?;
+    Ok(map)
+}
+
+/// Every node and corner index points inside the map, and the base grid is there.
+fn check_links(map: &TierMap) -> Result<(), String> {
+    let roots = map.spec.theta_cells as usize * map.spec.d_cells as usize;
+    if roots == 0 || map.nodes.len() < roots || !(map.reach > 0.0 && map.reach.is_finite()) {
+        return Err("inconsistent grid".into());
+    }
+    let ok = map.nodes.iter().enumerate().all(|(i, n)| match *n {
+        Node::Split { first } => (first as usize) > i && first as usize + 4 <= map.nodes.len(),
+        Node::Certified { points } => points.iter().all(|&c| (c as usize) < map.samples.len()),
+        Node::Fallback => true,
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err("a node points outside the map".into())
+    }
+}
+
+struct Writer(Vec<u8>);
+
+impl Writer {
+    fn u32(&mut self, x: u32) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn u64(&mut self, x: u64) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn f64(&mut self, x: f64) {
+        self.u64(x.to_bits());
+    }
+}
+
+struct Reader<'a>(&'a [u8]);
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        if self.0.len() < n {
+            return Err("truncated".into());
+        }
+        let (head, rest) = self.0.split_at(n);
+        self.0 = rest;
+        Ok(head)
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_bits(self.u64()?))
+    }
+    /// A count of items of `size` bytes each that must fit in what is left.
+    fn count(&mut self, size: usize) -> Result<usize, String> {
+        let n = self.u64()? as usize;
+        if n.checked_mul(size).is_none_or(|b| b > self.0.len()) {
+            return Err("truncated".into());
+        }
+        Ok(n)
+    }
+}

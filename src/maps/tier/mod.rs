@@ -1,0 +1,156 @@
+//! The certified map tier (issue 15, item 3): a pin's whole push, tabulated over initial
+//! orientation θ0 × contact parameter d for one (part, support, pin radius, μc, tolerance, travel
+//! and evaluation budgets, grid), answered by interpolation where the table is certified and by the
+//! exact model everywhere else, so that every answer is within 0.05° of exact or is exact.
+//!
+//! What a push gives the line (see `engine::contact`): whether it touched, its status class, the
+//! final pose (rotation and centroid displacement), the travel before first touch, the travel to
+//! the end of contact, and — only when something looks — the path. The tier tabulates, per sample
+//! of (θ0, d), in units of a: the signed rotation, the centroid displacement (Δx, Δy) and the
+//! contact span (pin travel from first touch to separation). The travel to first touch is not
+//! tabulated: it is the exact first-contact ray cast ([`crate::mechanics::pin_first_touch`]),
+//! cheap and kinked where the touching vertex changes. A query whose ray cast misses is answered
+//! exactly (no contact) without the table.
+//!
+//! Grid and refinement ([`build`]): θ0 ∈ [0, 2π) in `theta_cells` base cells, d ∈ [−r, r] with
+//! r = (largest vertex radius + ρ)/a in `d_cells` base cells. A cell is **certified** when its 3 × 3
+//! nodes (corners, edge midpoints, centre) and twelve check points (the quarter points inside and
+//! on its edges) are all single, ok contacts ending on the same feature, and biquadratic
+//! interpolation through the nodes reproduces the exact model at each check point within
+//! `check_deg` (rotation) and `check_pos` (Δx, Δy, span, units of a) — a quarter of the promised
+//! 0.05° by default. Otherwise the cell splits in four, down to `max_depth`; an
+//! uncertified cell at the floor is a **fallback** cell, where the exact model answers. This is a
+//! sampled certificate (a discontinuity island smaller than a cell and missed by all nine points
+//! would go unseen by all 21 points), not a proof.
+//!
+//! Cached on disk ([`cache`]) under a 128-bit hash of a canonical encoding of every input
+//! ([`key`]); the file carries a magic, a format version, the key and a checksum, so a stale or
+//! corrupted file is refused and rebuilt. Building is deterministic (rayon, order-preserving) and
+//! independent of the thread count.
+
+pub mod build;
+pub mod cache;
+pub mod key;
+pub mod query;
+
+pub use build::build;
+pub use cache::{default_cache_dir, load_or_build, shared, CacheError, Loaded, Source};
+pub use key::TierKey;
+pub use query::{push_with_map, Fallback};
+
+use crate::mechanics::{ContactSettings, PartModel, Support};
+
+/// Grid and certification settings of a map (part of its key).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TierSpec {
+    /// Base cells over θ0 ∈ [0, 360°).
+    pub theta_cells: u32,
+    /// Base cells over d ∈ [−r, r].
+    pub d_cells: u32,
+    /// Largest number of halvings of a base cell.
+    pub max_depth: u32,
+    /// Largest interpolation error of the rotation at a check point (degrees).
+    pub check_deg: f64,
+    /// Largest interpolation error of Δx, Δy and span at a check point (units of a).
+    pub check_pos: f64,
+}
+
+impl Default for TierSpec {
+    fn default() -> Self {
+        TierSpec {
+            theta_cells: 36,
+            d_cells: 12,
+            max_depth: 4,
+            check_deg: 0.0125,
+            check_pos: 1e-3,
+        }
+    }
+}
+
+/// Everything a map depends on: the part (normalised polygon and support), the pin radius (the
+/// caller's units, as the model takes it), the contact settings (μc, tolerance, budgets; μs and
+/// the fidelity do not enter: μs scales forces only and the table is always of the exact model)
+/// and the grid.
+#[derive(Debug, Clone, Copy)]
+pub struct TierInputs<'a> {
+    pub model: &'a PartModel,
+    pub support: &'a Support,
+    pub radius: f64,
+    pub settings: ContactSettings,
+    pub spec: TierSpec,
+}
+
+/// One exact sample of the push, in units of a.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Servable: an ok push with exactly one contact.
+    pub servable: bool,
+    /// The feature of the last segment (kind · 2¹⁶ + index), for servable samples.
+    pub feature: u32,
+    /// Signed rotation (radians).
+    pub rotation: f64,
+    /// Centroid displacement (units of a).
+    pub dx: f64,
+    pub dy: f64,
+    /// Pin travel from first touch to separation (units of a).
+    pub span: f64,
+}
+
+/// A node of a base cell's quadtree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Node {
+    /// Split in four: children at `first`..`first + 4` (θ-low d-low, θ-high d-low, θ-low d-high,
+    /// θ-high d-high).
+    Split { first: u32 },
+    /// Certified: interpolate through these 3 × 3 node samples (θ-major within each d row).
+    Certified { points: [u32; 9] },
+    /// Not certified at the finest level: the exact model answers here.
+    Fallback,
+}
+
+/// How a map was built.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BuildStats {
+    /// Exact pushes computed.
+    pub exact_samples: u64,
+    /// Certified and fallback leaves.
+    pub certified_cells: u64,
+    pub fallback_cells: u64,
+    /// Fraction of the (θ0, d) rectangle covered by certified cells.
+    pub certified_area: f64,
+}
+
+/// A built map: the base grid, the quadtrees (roots first, θ-major), the corner samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TierMap {
+    pub key: TierKey,
+    pub spec: TierSpec,
+    /// Half-width r of the d range (units of a).
+    pub reach: f64,
+    pub nodes: Vec<Node>,
+    pub samples: Vec<Sample>,
+    pub stats: BuildStats,
+}
+
+impl TierMap {
+    /// The leaf holding (θ0 ∈ [0, 2π), d ∈ [−r, r]) and the local coordinates (u, v) ∈ [0, 1]² in
+    /// it; None outside the d range.
+    pub fn leaf(&self, theta: f64, d: f64) -> Option<(Node, f64, f64)> {
+        let (nt, nd) = (self.spec.theta_cells as usize, self.spec.d_cells as usize);
+        let ft = theta / std::f64::consts::TAU * nt as f64;
+        let fd = (d + self.reach) / (2.0 * self.reach) * nd as f64;
+        if !(ft >= 0.0 && fd >= 0.0 && fd <= nd as f64 && ft <= nt as f64) {
+            return None;
+        }
+        let (it, id) = ((ft as usize).min(nt - 1), (fd as usize).min(nd - 1));
+        let (mut u, mut v) = (ft - it as f64, fd - id as f64);
+        let mut node = self.nodes[it * nd + id];
+        while let Node::Split { first } = node {
+            let (hu, hv) = (usize::from(u >= 0.5), usize::from(v >= 0.5));
+            u = 2.0 * u - hu as f64;
+            v = 2.0 * v - hv as f64;
+            node = self.nodes[first as usize + hu + 2 * hv];
+        }
+        Some((node, u, v))
+    }
+}

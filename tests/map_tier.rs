@@ -1,0 +1,476 @@
+//! The certified map tier (issue 15 item 3): answers within 0.05° of the exact model where it
+//! serves, the exact model near a jump, a cache keyed by every input, corrupted files refused and
+//! rebuilt, a build independent of the thread count, and a line with `fidelity = "map"` that
+//! ends every part in the class the exact line does.
+
+use pinfeed::engine::{self, contact_map, RunOptions};
+use pinfeed::geometry::{named, Pose, Vec2};
+use pinfeed::maps::tier::{
+    self, push_with_map, Fallback, Source, TierInputs, TierKey, TierMap, TierSpec,
+};
+use pinfeed::mechanics::{push_path, ContactSettings, PartModel, PinPath, Support};
+use pinfeed::random::stream;
+use rand::RngExt;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// tripoly2 (a = 1) with a pin of radius 0.1 a at μc 0.5, tolerance 1e-6.
+fn model() -> &'static PartModel {
+    static M: OnceLock<PartModel> = OnceLock::new();
+    M.get_or_init(|| {
+        let poly = named::part_from_spec("tripoly2").unwrap();
+        let poly = poly.scaled(1.0 / poly.radius());
+        PartModel::new(&poly, &Support::Uniform).unwrap()
+    })
+}
+
+const RADIUS: f64 = 0.1;
+
+fn inputs(spec: TierSpec) -> TierInputs<'static> {
+    static UNIFORM: Support = Support::Uniform;
+    TierInputs {
+        model: model(),
+        support: &UNIFORM,
+        radius: RADIUS,
+        settings: ContactSettings::default(),
+        spec,
+    }
+}
+
+/// The map the accuracy tests share (coarse: 15° × 0.18 a base cells, two halvings).
+fn shared_map() -> &'static TierMap {
+    static MAP: OnceLock<TierMap> = OnceLock::new();
+    MAP.get_or_init(|| {
+        tier::build(&inputs(TierSpec {
+            theta_cells: 24,
+            d_cells: 12,
+            max_depth: 2,
+            ..TierSpec::default()
+        }))
+    })
+}
+
+fn exact(pose: Pose, pin: Vec2) -> pinfeed::mechanics::ContactOutcome {
+    let path = PinPath::constant(0.0);
+    push_path(
+        model(),
+        pose,
+        pin,
+        RADIUS,
+        &path,
+        &ContactSettings::default(),
+        None,
+    )
+}
+
+/// A part at `pose` and a pin at offset d, well upstream.
+fn query(theta: f64, d: f64) -> (Pose, Vec2) {
+    let pose = Pose::new(0.37, -0.21, theta);
+    (pose, Vec2::new(pose.x + 3.1, pose.y + d))
+}
+
+#[test]
+fn served_answers_are_within_0_05_degrees_of_exact_and_fallbacks_are_exact() {
+    let map = shared_map();
+    let mut rng = stream(15, 0);
+    let (mut served, mut missed, mut fallbacks) = (0, 0, 0);
+    for _ in 0..300 {
+        let theta = rng.random::<f64>() * 720.0 - 360.0;
+        let d = (rng.random::<f64>() * 2.0 - 1.0) * 1.1;
+        let (pose, pin) = query(theta.to_radians(), d);
+        let ex = exact(pose, pin);
+        let (out, why) = push_with_map(map, model(), pose, pin, RADIUS, &Default::default());
+        if why.is_some() {
+            fallbacks += 1;
+            assert_eq!(out, ex, "a fallback is the exact model's answer");
+            continue;
+        }
+        assert_eq!(out.contact, ex.contact, "θ0 {theta} d {d}");
+        assert_eq!(out.status, ex.status);
+        if !out.contact {
+            missed += 1;
+            assert_eq!(out.pose_final, ex.pose_final);
+            continue;
+        }
+        served += 1;
+        let err = (out.pose_final.theta - ex.pose_final.theta)
+            .abs()
+            .to_degrees();
+        assert!(err <= 0.05, "θ0 {theta} d {d}: θf off by {err}°");
+        assert_eq!(out.travel_to_contact, ex.travel_to_contact);
+        for (a, b) in [
+            (out.pose_final.x, ex.pose_final.x),
+            (out.pose_final.y, ex.pose_final.y),
+            (out.contact_length, ex.contact_length),
+        ] {
+            assert!((a - b).abs() <= 4e-3, "θ0 {theta} d {d}: {a} vs {b}");
+        }
+    }
+    // The map must actually serve: most touching queries of this grid are certified.
+    assert!(served > 100, "served {served}, fallbacks {fallbacks}");
+    assert!(
+        missed > 30 && fallbacks > 5,
+        "missed {missed}, fallbacks {fallbacks}"
+    );
+}
+
+/// Where θf jumps (d = 0.3: near θ0 = 27° the push switches the edge it ends on), the map hands
+/// the push to the exact model.
+#[test]
+fn near_a_jump_the_exact_model_answers() {
+    let map = shared_map();
+    let d = 0.3;
+    let rot = |t: f64| {
+        let (pose, pin) = query(t.to_radians(), d);
+        exact(pose, pin).rotation.to_degrees()
+    };
+    let (mut lo, mut hi) = (20.0, 34.0);
+    assert!((rot(hi) - rot(lo)).abs() > 30.0, "no jump where expected");
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if (rot(mid) - rot(lo)).abs() > 30.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    for t in [lo - 1e-3, lo, hi, hi + 1e-3] {
+        let (pose, pin) = query(t.to_radians(), d);
+        assert_eq!(
+            map.answer(model(), pose, pin, RADIUS).err(),
+            Some(Fallback::Uncertified),
+            "θ0 {t}° sits at the jump"
+        );
+        let (out, why) = push_with_map(map, model(), pose, pin, RADIUS, &Default::default());
+        assert_eq!(why, Some(Fallback::Uncertified));
+        assert_eq!(out, exact(pose, pin));
+    }
+}
+
+/// A map small enough to build in milliseconds.
+fn tiny() -> TierSpec {
+    TierSpec {
+        theta_cells: 4,
+        d_cells: 2,
+        max_depth: 0,
+        ..TierSpec::default()
+    }
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pinfeed-map-tier-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn the_key_changes_with_every_input_and_only_then() {
+    let base = inputs(tiny());
+    let key = TierKey::of(&base);
+    assert_eq!(key, TierKey::of(&inputs(tiny())), "a pure function");
+    let other_part = PartModel::new(
+        &named::part_from_spec("tripoly1").unwrap(),
+        &Support::Uniform,
+    )
+    .unwrap();
+    let tripod = Support::parse("tripod:3", model().polygon()).unwrap();
+    let s = base.settings;
+    let variants: Vec<(&str, TierInputs)> = vec![
+        (
+            "part",
+            TierInputs {
+                model: &other_part,
+                ..base
+            },
+        ),
+        (
+            "support",
+            TierInputs {
+                support: &tripod,
+                ..base
+            },
+        ),
+        (
+            "radius",
+            TierInputs {
+                radius: 0.11,
+                ..base
+            },
+        ),
+        (
+            "mu_c",
+            TierInputs {
+                settings: ContactSettings { mu_c: 0.4, ..s },
+                ..base
+            },
+        ),
+        (
+            "tol",
+            TierInputs {
+                settings: ContactSettings { tol: 1e-7, ..s },
+                ..base
+            },
+        ),
+        (
+            "max_travel",
+            TierInputs {
+                settings: ContactSettings {
+                    max_travel: 40.0,
+                    ..s
+                },
+                ..base
+            },
+        ),
+        (
+            "max_evaluations",
+            TierInputs {
+                settings: ContactSettings {
+                    max_evaluations: 1000,
+                    ..s
+                },
+                ..base
+            },
+        ),
+        (
+            "max_events",
+            TierInputs {
+                settings: ContactSettings {
+                    max_events: 100,
+                    ..s
+                },
+                ..base
+            },
+        ),
+        (
+            "theta_cells",
+            TierInputs {
+                spec: TierSpec {
+                    theta_cells: 5,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "d_cells",
+            TierInputs {
+                spec: TierSpec {
+                    d_cells: 3,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "max_depth",
+            TierInputs {
+                spec: TierSpec {
+                    max_depth: 1,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "check_deg",
+            TierInputs {
+                spec: TierSpec {
+                    check_deg: 0.01,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+        (
+            "check_pos",
+            TierInputs {
+                spec: TierSpec {
+                    check_pos: 1e-4,
+                    ..tiny()
+                },
+                ..base
+            },
+        ),
+    ];
+    for (name, v) in &variants {
+        assert_ne!(TierKey::of(v), key, "changing {name} must change the key");
+    }
+    // μs scales forces only: the motion, and so the map, does not depend on it.
+    let mu_s = TierInputs {
+        settings: ContactSettings { mu_s: 0.9, ..s },
+        ..base
+    };
+    assert_eq!(TierKey::of(&mu_s), key);
+}
+
+#[test]
+fn a_changed_input_does_not_read_the_old_file() {
+    let dir = temp_dir("invalidate");
+    let a = inputs(tiny());
+    let first = tier::load_or_build(&a, Some(&dir));
+    assert!(matches!(first.source, Source::Built { .. }));
+    assert!(first.warnings.is_empty(), "{:?}", first.warnings);
+    let again = tier::load_or_build(&a, Some(&dir));
+    assert_eq!(again.source, Source::Disk(first.file.clone().unwrap()));
+    assert_eq!(*again.map, *first.map, "what is read is what was written");
+
+    let b = TierInputs {
+        settings: ContactSettings {
+            mu_c: 0.3,
+            ..a.settings
+        },
+        ..a
+    };
+    let other = tier::load_or_build(&b, Some(&dir));
+    assert!(matches!(other.source, Source::Built { .. }));
+    assert_ne!(other.map.key, first.map.key);
+    assert_ne!(other.file, first.file, "one file per key");
+    let a_again = tier::load_or_build(&a, Some(&dir));
+    assert_eq!(a_again.source, Source::Disk(first.file.clone().unwrap()));
+    // Even a file of other inputs put under this key's name is refused and rebuilt.
+    let b_file = other.file.clone().unwrap();
+    std::fs::copy(first.file.as_ref().unwrap(), &b_file).unwrap();
+    let refused = tier::load_or_build(&b, Some(&dir));
+    assert!(matches!(refused.source, Source::Built { .. }));
+    assert!(
+        refused.warnings[0].contains("its key does not match its inputs"),
+        "{:?}",
+        refused.warnings
+    );
+    assert_eq!(*refused.map, *other.map);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn corrupt(path: &Path, at: usize) {
+    let mut bytes = std::fs::read(path).unwrap();
+    let i = at.min(bytes.len() - 1);
+    bytes[i] ^= 0x5a;
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn a_corrupted_file_is_refused_with_a_clear_message_and_rebuilt() {
+    let dir = temp_dir("corrupt");
+    let a = inputs(tiny());
+    let built = tier::load_or_build(&a, Some(&dir));
+    let file = built.file.clone().unwrap();
+    let len = std::fs::metadata(&file).unwrap().len() as usize;
+    for (at, reason) in [
+        (len / 2, "checksum mismatch"),
+        (3, "not a pinfeed map file"),
+        (len - 1, "checksum mismatch"),
+    ] {
+        corrupt(&file, at);
+        let again = tier::load_or_build(&a, Some(&dir));
+        assert!(matches!(again.source, Source::Built { .. }), "byte {at}");
+        let w = again.warnings.join("\n");
+        assert!(
+            w.contains(&file.display().to_string())
+                && w.contains("corrupted")
+                && w.contains(reason),
+            "byte {at}: {w}"
+        );
+        assert_eq!(*again.map, *built.map, "rebuilt to the same map");
+        // The rebuilt file is valid again.
+        let read = tier::load_or_build(&a, Some(&dir));
+        assert_eq!(read.source, Source::Disk(file.clone()));
+    }
+    // A truncated file too.
+    let bytes = std::fs::read(&file).unwrap();
+    std::fs::write(&file, &bytes[..bytes.len() / 3]).unwrap();
+    let again = tier::load_or_build(&a, Some(&dir));
+    assert!(
+        again.warnings[0].contains("corrupted"),
+        "{:?}",
+        again.warnings
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The bundled quickstart with `fidelity = "map"` (a coarse grid, built in memory) against the
+/// same scenario exact: every part ends in the same class, and the summary says how many pushes
+/// the map served and why the others fell back. The exact scenario's summary has no map counters.
+#[test]
+fn the_quickstart_on_the_map_tier_ends_every_part_in_the_exact_class() {
+    let text = std::fs::read_to_string("scenarios/quickstart.toml").unwrap();
+    let line = "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"";
+    assert!(text.contains(line));
+    let map_text = text.replace(line, "fidelity = \"map\"\nmap_grid = [24, 12, 2]");
+    let exact_scene = pinfeed::scenario::parse(Path::new("q.toml"), &text).unwrap();
+    let map_scene = pinfeed::scenario::parse(Path::new("q.toml"), &map_text).unwrap();
+    let prepared = contact_map::prepare(&map_scene, None);
+    assert_eq!(prepared.len(), 3, "one map per pin (the three share it)");
+    let opts = |scene| RunOptions {
+        parts: 300,
+        keep_records: true,
+        ..RunOptions::from_scene(scene)
+    };
+    let ex = engine::run(&exact_scene, &opts(&exact_scene), &mut |_| {}).unwrap();
+    let mp = engine::run(&map_scene, &opts(&map_scene), &mut |_| {}).unwrap();
+    let classes =
+        |r: &engine::RunResult| -> Vec<&str> { r.records.iter().map(|p| p.outcome).collect() };
+    assert_eq!(classes(&ex), classes(&mp));
+    for (a, b) in ex.records.iter().zip(&mp.records) {
+        assert!(
+            (a.theta_out_deg - b.theta_out_deg).abs() < 0.5
+                || (a.theta_out_deg - b.theta_out_deg).abs() > 359.5,
+            "part {}: {} vs {}",
+            a.part,
+            a.theta_out_deg,
+            b.theta_out_deg
+        );
+    }
+    let w = mp.summary.work;
+    assert_eq!(mp.summary.fidelity, "map");
+    assert!(w.map_tier.served > 100, "{:?}", w.map_tier);
+    assert_eq!(w.map_tier.served + w.map_tier.fallbacks(), w.contact_solves);
+    assert!(w.model_evaluations < ex.summary.work.model_evaluations / 2);
+    let json = serde_json::to_string(&ex.summary).unwrap();
+    assert!(!json.contains("map_tier"), "an exact scene pays nothing");
+    assert!(serde_json::to_string(&mp.summary)
+        .unwrap()
+        .contains("fallback_uncertified"));
+}
+
+#[test]
+fn map_keys_in_a_scenario_are_checked() {
+    let text = std::fs::read_to_string("scenarios/quickstart.toml").unwrap();
+    let line = "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"";
+    for (to, needle) in [
+        (
+            "fidelity = \"exact\"\nmap_grid = [24, 12, 2]",
+            "model.map_grid",
+        ),
+        (
+            "fidelity = \"map\"\nmap_grid = [2, 12, 2]",
+            "model.map_grid",
+        ),
+        ("fidelity = \"mapp\"", "fidelity"),
+    ] {
+        let bad = text.replace(line, to);
+        let err = pinfeed::scenario::parse(Path::new("q.toml"), &bad)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("q.toml:") && err.contains(needle), "{err}");
+    }
+}
+
+#[test]
+fn the_build_does_not_depend_on_the_thread_count() {
+    let spec = TierSpec {
+        theta_cells: 6,
+        d_cells: 3,
+        max_depth: 1,
+        ..TierSpec::default()
+    };
+    let on = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| tier::cache::encode(&tier::build(&inputs(spec))))
+    };
+    let one = on(1);
+    assert!(one.len() > 1000);
+    assert_eq!(one, on(2), "same file byte for byte");
+}
