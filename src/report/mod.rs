@@ -15,3 +15,4 @@ pub mod plot_part;
 pub mod plot_plan;
 pub mod plot_sensing;
 pub mod plot_sensitivity;
+pub mod plot_validate;

@@ -31,7 +31,8 @@ pub fn validate(
     score: &ScoreSettings,
 ) -> Result<(Vec<RowScore>, Summary, Predictions), String> {
     let pred = predict::predict(measured, spec, seed, members, passes)?;
-    let rows = score::score_rows(measured, &pred, &vec![1.0; pred.members.len()], score);
+    let weights = vec![1.0; pred.members.len() * passes];
+    let rows = score::score_rows(measured, &pred.rows, &weights, score);
     let summary = score::summarise(&rows);
     Ok((rows, summary, pred))
 }

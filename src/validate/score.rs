@@ -22,9 +22,8 @@
 //! predicted bands cover.
 
 use super::measured::{Measured, MeasuredRow};
-use super::predict::Predictions;
-use crate::maps::arcs::{coverage_share, highest_density_arcs, signed_difference, Arc, MassArc};
-use crate::maps::ensemble::{InputState, BAND_BIN_DEG, BAND_MASS};
+use crate::maps::arcs::{signed_difference, Arc, MassArc};
+use crate::maps::ensemble::{InputState, PredictedBands};
 use serde::Serialize;
 
 /// Smoothing of the log score.
@@ -174,8 +173,8 @@ pub struct RowScore {
     pub centre_offset_deg: Option<f64>,
     pub predicted_probability: f64,
     pub log_score: f64,
-    pub predicted_bands: Vec<MassArc>,
-    pub coverage: f64,
+    /// The row's predicted bands and the share of the circle they cover.
+    pub predicted: PredictedBands,
 }
 
 /// Counts and totals over all rows.
@@ -190,30 +189,31 @@ pub struct Summary {
     pub mean_log_score: f64,
 }
 
-/// Score every row; `member_weights` weigh the members (all 1 for a plain ensemble).
+/// Score every row: `predicted[r]` are row r's passes (θf, degrees), `weights` one weight per pass
+/// (all 1 for a plain ensemble).
 pub fn score_rows(
     measured: &Measured,
-    pred: &Predictions,
-    member_weights: &[f64],
+    predicted: &[Vec<f64>],
+    weights: &[f64],
     s: &ScoreSettings,
 ) -> Vec<RowScore> {
-    let w = pred.pass_weights(member_weights);
-    let total: f64 = w.iter().sum();
+    let total: f64 = weights.iter().sum();
     measured
         .rows
         .iter()
-        .zip(&pred.rows)
+        .zip(predicted)
         .map(|(row, values)| {
             let kernel = RowKernel::new(row, values, s);
-            let log_score = kernel.log_likelihood(kernel.sums(&w), total, s);
-            judge(row, values, &w, log_score)
+            let log_score = kernel.log_likelihood(kernel.sums(weights), total, s);
+            judge(row, values, weights, log_score)
         })
         .collect()
 }
 
 /// Containment, overlap, offset and probability of one row.
 fn judge(row: &MeasuredRow, values: &[f64], w: &[f64], log_score: f64) -> RowScore {
-    let bands = highest_density_arcs(values, w, BAND_MASS, BAND_BIN_DEG);
+    let predicted = PredictedBands::of(row.d, row.input.label(), values, w);
+    let bands = &predicted.bands;
     let m = &row.band;
     let nearest = bands.iter().min_by(|a, b| {
         let key = |x: &MassArc| {
@@ -232,7 +232,6 @@ fn judge(row: &MeasuredRow, values: &[f64], w: &[f64], log_score: f64) -> RowSco
         .filter(|(v, _)| m.contains_angle(**v))
         .map(|(_, w)| w)
         .sum();
-    let arcs: Vec<Arc> = bands.iter().map(|b| b.arc).collect();
     RowScore {
         line: row.line,
         part: row.part.clone(),
@@ -246,8 +245,7 @@ fn judge(row: &MeasuredRow, values: &[f64], w: &[f64], log_score: f64) -> RowSco
         centre_offset_deg: nearest.map(|b| signed_difference(b.arc.centre(), m.centre())),
         predicted_probability: if total > 0.0 { inside / total } else { 0.0 },
         log_score,
-        coverage: coverage_share(&arcs),
-        predicted_bands: bands,
+        predicted,
     }
 }
 
@@ -259,7 +257,7 @@ pub fn summarise(rows: &[RowScore]) -> Summary {
         rows: n,
         contained: rows.iter().filter(|r| r.contained).count(),
         overlapping: rows.iter().filter(|r| r.overlapping).count(),
-        coverage: rows.iter().map(|r| r.coverage).sum::<f64>() / n.max(1) as f64,
+        coverage: rows.iter().map(|r| r.predicted.coverage).sum::<f64>() / n.max(1) as f64,
         log_score,
         mean_log_score: log_score / n.max(1) as f64,
     }
