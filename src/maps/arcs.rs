@@ -119,14 +119,16 @@ pub struct MassArc {
 
 /// The smallest set of arcs (to a resolution of `bin_deg`) that holds at least `mass` of the
 /// weighted angles `values` (degrees): bins of the circle are taken in decreasing weight (ties: lower
-/// bin first) until their total reaches `mass`, neighbouring taken bins join into arcs, and each arc
-/// is then shrunk to the angles it actually holds. Arcs are ordered by their lower end. Zero total
-/// weight gives no arcs.
+/// bin first) until their total reaches `mass`; gaps narrower than `join_deg` between taken bins
+/// are filled (like the band threshold T of a map, so that sampling noise does not split a band);
+/// neighbouring taken bins join into arcs, and each arc is then shrunk to the angles it actually
+/// holds. Arcs are ordered by their lower end. Zero total weight gives no arcs.
 pub fn highest_density_arcs(
     values: &[f64],
     weights: &[f64],
     mass: f64,
     bin_deg: f64,
+    join_deg: f64,
 ) -> Vec<MassArc> {
     let bins = (360.0 / bin_deg).round().max(1.0) as usize;
     let bin_of = |v: f64| ((wrap_deg(v) / 360.0 * bins as f64) as usize).min(bins - 1);
@@ -149,6 +151,7 @@ pub fn highest_density_arcs(
         taken[b] = true;
         sum += hist[b];
     }
+    fill_gaps(&mut taken, (join_deg / bin_deg).round() as usize);
     let runs = circular_runs(&taken);
     let mut run_of: Vec<Option<usize>> = vec![None; bins];
     for (r, &run) in runs.iter().enumerate() {
@@ -179,6 +182,23 @@ pub fn highest_density_arcs(
         .collect();
     out.sort_by(|a, b| a.arc.lo.total_cmp(&b.arc.lo));
     out
+}
+
+/// Mark as taken every circular run of untaken bins shorter than `max_gap` bins that lies between
+/// taken bins.
+fn fill_gaps(taken: &mut [bool], max_gap: usize) {
+    let gaps: Vec<bool> = taken.iter().map(|t| !t).collect();
+    if taken.iter().all(|t| !t) {
+        return;
+    }
+    for run in circular_runs(&gaps) {
+        let len = run_indices(run, taken.len()).count();
+        if len < max_gap {
+            for b in run_indices(run, taken.len()).collect::<Vec<_>>() {
+                taken[b] = true;
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -214,14 +234,16 @@ mod tests {
         v.extend((0..40).map(|k| 120.0 + k as f64 * 0.1));
         v.extend([200.0, 250.0]);
         let w = vec![1.0; v.len()];
-        let arcs = highest_density_arcs(&v, &w, 0.95, 1.0);
+        let arcs = highest_density_arcs(&v, &w, 0.95, 1.0, 0.0);
         assert_eq!(arcs.len(), 2, "{arcs:?}");
         assert!((arcs[0].arc.lo - 120.0).abs() < 1e-9);
         assert!((arcs[1].arc.lo - 355.0).abs() < 1e-9);
         assert!(arcs[1].arc.width > 9.0 && arcs[1].arc.width < 10.0);
         let held: f64 = arcs.iter().map(|a| a.mass).sum();
         assert!((held - 90.0 / 92.0).abs() < 1e-12, "{held}");
-        // At 90% one tied bin of the cluster across 0° is left out: it splits in two.
-        assert_eq!(highest_density_arcs(&v, &w, 0.9, 1.0).len(), 3);
+        // At 90% one tied bin of the cluster across 0° is left out: it splits in two, unless
+        // gaps of a bin are filled.
+        assert_eq!(highest_density_arcs(&v, &w, 0.9, 1.0, 0.0).len(), 3);
+        assert_eq!(highest_density_arcs(&v, &w, 0.9, 1.0, 2.0).len(), 2);
     }
 }

@@ -4,7 +4,7 @@
 //! Monte Carlo studies draw them: [`crate::study::mc::sample::draw_support`]), the pin radius — and
 //! every pass it makes adds a pose error (normal, `jitter_deg`) to θ0. The distribution of θf at
 //! (d, input state) is the pool of all members' passes; its predicted bands are the smallest set of
-//! arcs holding 90% of it ([`super::arcs::highest_density_arcs`]).
+//! arcs holding 90% of it, gaps under 5° closed ([`super::arcs::highest_density_arcs`]).
 //!
 //! Random streams (DESIGN.md "determinism"): member i of an ensemble seeded with s draws five
 //! sub-seeds from `random::stream(s, i)`, in the order μc, support share, support shape, pin radius,
@@ -32,6 +32,8 @@ use serde::Serialize;
 pub const BAND_MASS: f64 = 0.9;
 /// Resolution of the predicted bands (degrees).
 pub const BAND_BIN_DEG: f64 = 1.0;
+/// Gaps narrower than this between predicted bands are closed (degrees; the maps' default T).
+pub const BAND_JOIN_DEG: f64 = 5.0;
 
 /// What is uncertain, and how.
 #[derive(Debug, Clone, PartialEq)]
@@ -382,7 +384,13 @@ pub struct PredictedBands {
 impl PredictedBands {
     /// The predicted bands of the weighted angles `values` (degrees).
     pub fn of(d: f64, input: String, values: &[f64], weights: &[f64]) -> PredictedBands {
-        let bands = super::arcs::highest_density_arcs(values, weights, BAND_MASS, BAND_BIN_DEG);
+        let bands = super::arcs::highest_density_arcs(
+            values,
+            weights,
+            BAND_MASS,
+            BAND_BIN_DEG,
+            BAND_JOIN_DEG,
+        );
         let arcs: Vec<Arc> = bands.iter().map(|b| b.arc).collect();
         let mut histogram = vec![0.0; 360];
         let total: f64 = weights.iter().sum();

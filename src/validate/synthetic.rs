@@ -120,7 +120,8 @@ pub fn synthesize(design: &SyntheticDesign) -> Result<String, String> {
         "# Synthetic measured bands (pinfeed issue 16): part {}, {} trials a row, seed {}.\n",
         design.part, design.trials, design.seed
     ));
-    out.push_str("# Regenerate: pinfeed calibrate tests/fixtures/validate/synthetic.csv --synthesize\n");
+    out.push_str("# Regenerate: pinfeed calibrate tests/fixtures/validate/synthetic.csv --synthesize --jitter 3\n");
+    out.push_str("# (the jitter is known, not fitted: calibrate with --jitter 3)\n");
     out.push_str("# Drawn from (hidden from calibrate, which skips comments):\n");
     for line in design.truth.describe() {
         out.push_str(&format!("#   {line}\n"));
