@@ -110,7 +110,10 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
     let band = &rows[0].predicted.bands;
     assert_eq!(band.len(), 1, "{band:?}");
     // 90% takes 18 of the 20 bins; the 2° gap left at 358° is closed again.
-    assert!(band[0].arc.lo == 350.0 && (band[0].arc.width - 19.9).abs() < 1e-9, "{band:?}");
+    assert!(
+        band[0].arc.lo == 350.0 && (band[0].arc.width - 19.9).abs() < 1e-9,
+        "{band:?}"
+    );
     assert!(rows[0].contained && rows[0].overlapping);
     assert!(rows[0].centre_offset_deg.unwrap().abs() < 0.2);
     assert!((rows[0].predicted_probability - 0.8).abs() < 0.01);
@@ -122,7 +125,11 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
     assert!(rows[3].contained);
     let summary = summarise(&rows);
     assert_eq!((summary.contained, summary.overlapping), (2, 3));
-    assert!((summary.coverage - 20.0 / 360.0).abs() < 0.001, "{}", summary.coverage);
+    assert!(
+        (summary.coverage - 20.0 / 360.0).abs() < 0.001,
+        "{}",
+        summary.coverage
+    );
     // A prediction centred on the measured band scores better than one beside it, and better than
     // one spread over the whole circle (which contains everything).
     let row = hand_made("tripoly1,0.1,state:0,352,8,10\n");
@@ -130,7 +137,10 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
     let everywhere: Vec<f64> = (0..200).map(|k| k as f64 * 1.8).collect();
     let ls = |v: Vec<f64>| score_rows(&row, &[v], &vec![1.0; 200], &s)[0].log_score;
     let (right, beside, flat) = (ls(preds[0].clone()), ls(shifted), ls(everywhere.clone()));
-    assert!(right > beside + 10.0 && right > flat + 10.0, "{right} {beside} {flat}");
+    assert!(
+        right > beside + 10.0 && right > flat + 10.0,
+        "{right} {beside} {flat}"
+    );
     let spread = score_rows(&row, &[everywhere], &vec![1.0; 200], &s);
     assert!(spread[0].predicted.coverage > 0.85);
 }
@@ -139,11 +149,22 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
 fn the_same_inputs_and_seed_give_the_same_report_on_any_number_of_threads() {
     let run = |threads: &str| {
         let out = pinfeed(&[
-            "validate", FIXTURE, "--members", "40", "--uncertain",
-            "mu_c=normal:0.45:0.08,support=tripod:0.6,jitter=3", "--json", "--no-write",
-            "--threads", threads,
+            "validate",
+            FIXTURE,
+            "--members",
+            "40",
+            "--uncertain",
+            "mu_c=normal:0.45:0.08,support=tripod:0.6,jitter=3",
+            "--json",
+            "--no-write",
+            "--threads",
+            threads,
         ]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         out.stdout
     };
     assert_eq!(run("1"), run("3"));
@@ -171,18 +192,51 @@ fn the_same_inputs_and_seed_give_the_same_report_on_any_number_of_threads() {
 fn bad_measured_files_give_located_errors() {
     let header = "part,d,input,min_deg,max_deg,trials\n";
     let cases: [(&str, &str); 12] = [
-        ("tripoly1,0.1,state:0,370,10,5\n", "bad.csv:2: field `min_deg`: 370 is out of range"),
-        ("tripoly1,0.1,state:0,10,-5,5\n", "bad.csv:2: field `max_deg`: -5 is out of range"),
-        ("widget,0.1,state:0,10,20,5\n", "bad.csv:2: field `part`: unknown part 'widget'"),
-        ("tripoly1,1.5,state:0,10,20,5\n", "bad.csv:2: field `d`: d = 1.5 is out of range"),
-        ("tripoly1,x,state:0,10,20,5\n", "bad.csv:2: field `d`: 'x' is not a finite number"),
-        ("tripoly1,0.1,state:7,10,20,5\n", "bad.csv:2: field `input`: 'state:7'"),
-        ("tripoly1,0.1,side,10,20,5\n", "bad.csv:2: field `input`: 'side' must be"),
-        ("tripoly1,0.1,state:0,10,20,0\n", "bad.csv:2: field `trials`"),
-        ("tripoly1,0.1,state:0\n", "bad.csv:2: expected 6 comma-separated fields"),
+        (
+            "tripoly1,0.1,state:0,370,10,5\n",
+            "bad.csv:2: field `min_deg`: 370 is out of range",
+        ),
+        (
+            "tripoly1,0.1,state:0,10,-5,5\n",
+            "bad.csv:2: field `max_deg`: -5 is out of range",
+        ),
+        (
+            "widget,0.1,state:0,10,20,5\n",
+            "bad.csv:2: field `part`: unknown part 'widget'",
+        ),
+        (
+            "tripoly1,1.5,state:0,10,20,5\n",
+            "bad.csv:2: field `d`: d = 1.5 is out of range",
+        ),
+        (
+            "tripoly1,x,state:0,10,20,5\n",
+            "bad.csv:2: field `d`: 'x' is not a finite number",
+        ),
+        (
+            "tripoly1,0.1,state:7,10,20,5\n",
+            "bad.csv:2: field `input`: 'state:7'",
+        ),
+        (
+            "tripoly1,0.1,side,10,20,5\n",
+            "bad.csv:2: field `input`: 'side' must be",
+        ),
+        (
+            "tripoly1,0.1,state:0,10,20,0\n",
+            "bad.csv:2: field `trials`",
+        ),
+        (
+            "tripoly1,0.1,state:0\n",
+            "bad.csv:2: expected 6 comma-separated fields",
+        ),
         ("# only a comment\n", "bad.csv:1: no measurement rows"),
-        ("tripoly1,0.1,state:0,10,20,5\ntripoly1,0.1,state:0,10,20,5,9\n", "bad.csv:3: expected 6"),
-        ("tripoly1,0.1,state:0,10,NaN,5\n", "bad.csv:2: field `max_deg`: 'NaN' is not a finite number"),
+        (
+            "tripoly1,0.1,state:0,10,20,5\ntripoly1,0.1,state:0,10,20,5,9\n",
+            "bad.csv:3: expected 6",
+        ),
+        (
+            "tripoly1,0.1,state:0,10,NaN,5\n",
+            "bad.csv:2: field `max_deg`: 'NaN' is not a finite number",
+        ),
     ];
     for (rows, want) in cases {
         let e = measured::parse(Path::new("bad.csv"), &format!("{header}{rows}"), 0.0).unwrap_err();
@@ -200,7 +254,11 @@ fn bad_measured_files_give_located_errors() {
     let dir = std::env::temp_dir().join(format!("pinfeed-validate-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("bad.csv");
-    std::fs::write(&bad, format!("{header}tripoly1,0.1,state:0,10,20,5\ntripoly1,0.2,all,10,400,\n")).unwrap();
+    std::fs::write(
+        &bad,
+        format!("{header}tripoly1,0.1,state:0,10,20,5\ntripoly1,0.2,all,10,400,\n"),
+    )
+    .unwrap();
     let empty = dir.join("empty.csv");
     std::fs::write(&empty, "").unwrap();
     for (command, file, want) in [
@@ -212,7 +270,10 @@ fn bad_measured_files_give_located_errors() {
         let out = pinfeed(&[command, file.to_str().unwrap(), "--no-write"]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{command} {file:?}: {err}");
-        assert!(err.contains(file.to_str().unwrap()) && err.contains(want), "{err}");
+        assert!(
+            err.contains(file.to_str().unwrap()) && err.contains(want),
+            "{err}"
+        );
         assert!(!err.contains("panicked"), "{err}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -221,21 +282,42 @@ fn bad_measured_files_give_located_errors() {
 #[test]
 fn map_uncertain_prints_predicted_bands_and_refuses_bad_settings() {
     let ok = pinfeed(&[
-        "map", "--part", "tripoly1", "--d=0.3", "--theta-step", "30", "--uncertain",
+        "map",
+        "--part",
+        "tripoly1",
+        "--d=0.3",
+        "--theta-step",
+        "30",
+        "--uncertain",
         "mu_c=normal:0.5:0.1,support=tripod:0.5,pin_radius=uniform:0:0.1,jitter=2",
-        "--members", "4", "--no-write",
+        "--members",
+        "4",
+        "--no-write",
     ]);
     let out = String::from_utf8_lossy(&ok.stdout);
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     for want in ["| +0.3 | all | 48 |", "| +0.3 | state:2 | 4 |"] {
         assert!(out.contains(want), "{out}");
     }
     for bad in ["mu_c=-0.1", "glue=1", "support=tripod:2"] {
         let o = pinfeed(&[
-            "map", "--part", "tripoly1", "--d=0.3", "--uncertain", bad, "--no-write",
+            "map",
+            "--part",
+            "tripoly1",
+            "--d=0.3",
+            "--uncertain",
+            bad,
+            "--no-write",
         ]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{bad}: {err}");
-        assert!(err.contains("--uncertain") && !err.contains("panicked"), "{err}");
+        assert!(
+            err.contains("--uncertain") && !err.contains("panicked"),
+            "{err}"
+        );
     }
 }

@@ -120,7 +120,11 @@ fn parameter_table(c: &Calibration, hidden: Option<[f64; 4]>) -> String {
     for (k, p) in c.parameters.iter().enumerate() {
         let open = |o: bool| if o { " (open: grid end)" } else { "" };
         let truth = match hidden {
-            Some(h) => format!("{} ({})", h[k], if p.covers(h[k]) { "inside" } else { "OUTSIDE" }),
+            Some(h) => format!(
+                "{} ({})",
+                h[k],
+                if p.covers(h[k]) { "inside" } else { "OUTSIDE" }
+            ),
             None => "—".into(),
         };
         let _ = writeln!(
@@ -162,19 +166,35 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     let measured = load_measured(&args.measured, &s.proposal())?;
     let pool = pool(c.threads)?;
     let started = std::time::Instant::now();
-    let cal = pool.install(|| calibrate(&measured, &s)).map_err(anyhow::Error::msg)?;
+    let cal = pool
+        .install(|| calibrate(&measured, &s))
+        .map_err(anyhow::Error::msg)?;
     eprintln!("calibrated in {:.1} s", started.elapsed().as_secs_f64());
     let nominal = ensemble_spec(args.mu_c, 0.0, None, c)?;
     let fitted = s.spec_at(cal.estimate());
     let score = s.score;
     let run_score = |spec| {
-        pool.install(|| crate::validate::validate(&measured, spec, c.seed, args.score_members, c.passes, &score))
-            .map(|(_, summary, _)| summary)
-            .map_err(anyhow::Error::msg)
+        pool.install(|| {
+            crate::validate::validate(
+                &measured,
+                spec,
+                c.seed,
+                args.score_members,
+                c.passes,
+                &score,
+            )
+        })
+        .map(|(_, summary, _)| summary)
+        .map_err(anyhow::Error::msg)
     };
     let (nominal_score, fitted_score) = (run_score(&nominal)?, run_score(&fitted)?);
     let mut text = parameter_table(&cal, hidden);
-    let _ = writeln!(text, "\nnominal model ({}): {}", nominal.describe()[..3].join("; "), summary_text(&nominal_score));
+    let _ = writeln!(
+        text,
+        "\nnominal model ({}): {}",
+        nominal.describe()[..3].join("; "),
+        summary_text(&nominal_score)
+    );
     let _ = writeln!(text, "fitted ensemble: {}", summary_text(&fitted_score));
     let report = CalibrateReport {
         command: command_line(args),
@@ -234,4 +254,3 @@ fn write_report(report: &CalibrateReport, text: &str, out_dir: &Path) -> Result<
     std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
     Ok(())
 }
-

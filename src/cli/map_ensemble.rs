@@ -66,7 +66,9 @@ pub fn bands_text(p: &PredictedBands) -> String {
 
 /// The band table: one line per (d, input).
 fn table(predicted: &[PredictedBands]) -> String {
-    let mut s = String::from("| d | input | passes | predicted bands (90%) | circle covered |\n|---|---|---|---|---|\n");
+    let mut s = String::from(
+        "| d | input | passes | predicted bands (90%) | circle covered |\n|---|---|---|---|---|\n",
+    );
     for p in predicted {
         let _ = writeln!(
             s,
@@ -86,7 +88,10 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
         bail!("--support: with --uncertain the support is set by `support=` in the uncertain list; leave --support at uniform");
     }
     if !(1..=MAX_MEMBERS).contains(&args.members) {
-        bail!("--members must lie in [1, {MAX_MEMBERS}], got {}", args.members);
+        bail!(
+            "--members must lie in [1, {MAX_MEMBERS}], got {}",
+            args.members
+        );
     }
     let spec = EnsembleSpec::nominal(args.mu_c, args.pin_radius, model, args.tol)
         .with_settings(uncertain)
@@ -115,7 +120,10 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
     inputs.extend((0..states.len()).map(|index| InputState::State { index }));
     let predicted = maps.predicted(&inputs, &states);
     let text = table(&predicted);
-    println!("{}  ensemble of {} members, seed {}", args.part, args.members, args.seed);
+    println!(
+        "{}  ensemble of {} members, seed {}",
+        args.part, args.members, args.seed
+    );
     for line in spec.describe() {
         println!("  {line}");
     }
@@ -169,8 +177,11 @@ fn write_report(
     for input in inputs {
         let label = input.label();
         let name = format!("ensemble_{}.svg", label.replace(':', ""));
-        let of_input: Vec<&PredictedBands> =
-            report.predicted.iter().filter(|p| p.input == label).collect();
+        let of_input: Vec<&PredictedBands> = report
+            .predicted
+            .iter()
+            .filter(|p| p.input == label)
+            .collect();
         let title = format!("{}: predicted θf against d, input {label}", report.part);
         plot_band_distributions(&of_input, &[], &title, &plot_dir.join(&name))?;
         let _ = writeln!(md, "![{label}]({name})\n");

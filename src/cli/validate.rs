@@ -78,7 +78,11 @@ impl ModelArgs {
             bail!("--passes must lie in [1, 100], got {}", self.passes);
         }
         if self.threads > super::map::MAX_THREADS {
-            bail!("--threads must lie in [0, {}], got {}", super::map::MAX_THREADS, self.threads);
+            bail!(
+                "--threads must lie in [0, {}], got {}",
+                super::map::MAX_THREADS,
+                self.threads
+            );
         }
         Ok(ScoreSettings {
             kernel_deg: self.kernel,
@@ -100,7 +104,10 @@ impl ModelArgs {
             self.window
         );
         if let Some(d) = &self.out_dir {
-            s.push_str(&format!(" --out-dir {}", shell_word(&d.display().to_string())));
+            s.push_str(&format!(
+                " --out-dir {}",
+                shell_word(&d.display().to_string())
+            ));
         }
         s
     }
@@ -108,8 +115,13 @@ impl ModelArgs {
     /// The report directory for `command` and the measured file.
     pub fn out_dir(&self, command: &str, file: &Path) -> PathBuf {
         self.out_dir.clone().unwrap_or_else(|| {
-            let stem = file.file_stem().and_then(|s| s.to_str()).unwrap_or("measured");
-            Path::new("results").join(command).join(super::part_folder(stem))
+            let stem = file
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("measured");
+            Path::new("results")
+                .join(command)
+                .join(super::part_folder(stem))
         })
     }
 }
@@ -160,7 +172,9 @@ pub fn ensemble_spec(
     let spec = EnsembleSpec::nominal(mu_c, pin_radius, model, common.tol);
     match uncertain {
         None => Ok(spec),
-        Some(u) => spec.with_settings(u).map_err(|e| anyhow::anyhow!("--uncertain: {e}")),
+        Some(u) => spec
+            .with_settings(u)
+            .map_err(|e| anyhow::anyhow!("--uncertain: {e}")),
     }
 }
 
@@ -201,7 +215,8 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
             r.trials.map_or("—".into(), |n| n.to_string()),
             yes(r.contained),
             yes(r.overlapping),
-            r.centre_offset_deg.map_or("—".into(), |o| format!("{o:+.1}°")),
+            r.centre_offset_deg
+                .map_or("—".into(), |o| format!("{o:+.1}°")),
             r.predicted_probability,
             r.log_score,
             bands_text(&r.predicted)
@@ -232,11 +247,18 @@ pub fn load_measured(path: &Path, spec: &EnsembleSpec) -> Result<Measured> {
 pub fn run(args: &ValidateArgs) -> Result<()> {
     let score = args.common.score()?;
     check_members(args.members)?;
-    let spec = ensemble_spec(args.mu_c, args.pin_radius, args.uncertain.as_deref(), &args.common)?;
+    let spec = ensemble_spec(
+        args.mu_c,
+        args.pin_radius,
+        args.uncertain.as_deref(),
+        &args.common,
+    )?;
     let measured = load_measured(&args.measured, &spec)?;
     let c = &args.common;
     let (rows, summary, _) = pool(c.threads)?
-        .install(|| crate::validate::validate(&measured, &spec, c.seed, args.members, c.passes, &score))
+        .install(|| {
+            crate::validate::validate(&measured, &spec, c.seed, args.members, c.passes, &score)
+        })
         .map_err(anyhow::Error::msg)?;
     let mut command = format!(
         "pinfeed validate {} --mu-c {} --pin-radius {} --members {} {}",
@@ -283,7 +305,10 @@ pub fn write_figures(rows: &[RowScore], dir: &Path) -> Result<Vec<String>> {
     }
     let mut names = Vec::new();
     for (part, input) in groups {
-        let of: Vec<&RowScore> = rows.iter().filter(|r| r.part == part && r.input == input).collect();
+        let of: Vec<&RowScore> = rows
+            .iter()
+            .filter(|r| r.part == part && r.input == input)
+            .collect();
         let predicted: Vec<&PredictedBands> = of.iter().map(|r| &r.predicted).collect();
         let measured: Vec<(f64, Arc)> = of
             .iter()

@@ -435,7 +435,12 @@ impl EnsembleMaps {
         for (j, &d) in self.ds.iter().enumerate() {
             for input in inputs {
                 let v = self.pooled(j, input, states_deg);
-                out.push(PredictedBands::of(d, input.label(), &v, &vec![1.0; v.len()]));
+                out.push(PredictedBands::of(
+                    d,
+                    input.label(),
+                    &v,
+                    &vec![1.0; v.len()],
+                ));
             }
         }
         out
@@ -451,13 +456,21 @@ mod tests {
         let base = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6);
         let s = base
             .clone()
-            .with_settings("mu_c=normal:0.4:0.1, support=tripod:0.3, pin_radius=uniform:0:0.1, jitter=2")
+            .with_settings(
+                "mu_c=normal:0.4:0.1, support=tripod:0.3, pin_radius=uniform:0:0.1, jitter=2",
+            )
             .unwrap();
         assert_eq!(s.support, SupportChoice::Tripod);
         assert_eq!(s.support_share, 0.3);
         assert_eq!(s.jitter_deg, 2.0);
         assert_eq!(s.max_pin_radius(), 0.1);
-        for bad in ["mu_c=-1", "friction=0.3", "support=glue", "jitter=x", "mu_c=normal:1"] {
+        for bad in [
+            "mu_c=-1",
+            "friction=0.3",
+            "support=glue",
+            "jitter=x",
+            "mu_c=normal:1",
+        ] {
             assert!(base.clone().with_settings(bad).is_err(), "{bad}");
         }
     }
@@ -469,7 +482,10 @@ mod tests {
             .unwrap();
         let b = a.clone().with_settings("mu_c=normal:0.6:0.2").unwrap();
         for i in 0..20 {
-            let (x, y) = (draw_member(&a, 9, i).unwrap(), draw_member(&b, 9, i).unwrap());
+            let (x, y) = (
+                draw_member(&a, 9, i).unwrap(),
+                draw_member(&b, 9, i).unwrap(),
+            );
             if x.mu_c > 0.0 && y.mu_c > 0.0 {
                 assert!((y.mu_c - 0.6 - 2.0 * (x.mu_c - 0.5)).abs() < 1e-12);
             }

@@ -57,7 +57,8 @@ fn adjusted_arc(b: &Band) -> Vec<(f64, f64)> {
     arc_pieces(b.mean_deg - b.sd_deg, 2.0 * b.sd_deg)
 }
 
-pub(crate) type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+pub(crate) type Chart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// A white chart with a title, `x` across and orientations 0°…`y_top` up.
 pub(crate) fn degree_chart<'a, 'b>(

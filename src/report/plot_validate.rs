@@ -31,7 +31,11 @@ pub fn plot_band_distributions(
     title: &str,
     path: &Path,
 ) -> anyhow::Result<()> {
-    let ds: Vec<f64> = predicted.iter().map(|p| p.d).chain(measured.iter().map(|m| m.0)).collect();
+    let ds: Vec<f64> = predicted
+        .iter()
+        .map(|p| p.d)
+        .chain(measured.iter().map(|m| m.0))
+        .collect();
     let step = spacing(&ds);
     let lo = ds.iter().copied().fold(f64::INFINITY, f64::min) - step;
     let hi = ds.iter().copied().fold(f64::NEG_INFINITY, f64::max) + step;
@@ -39,12 +43,21 @@ pub fn plot_band_distributions(
     let mut ch = degree_chart(&root, title, lo..hi, 420.0)?;
     ch.configure_mesh()
         .y_labels(15)
-        .y_label_formatter(&|v| if *v <= 360.0 { format!("{v:.0}") } else { String::new() })
+        .y_label_formatter(&|v| {
+            if *v <= 360.0 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        })
         .light_line_style(WHITE)
         .x_desc("contact parameter d")
         .y_desc("final orientation θf (deg)")
         .draw()?;
-    ch.draw_series(LineSeries::new(vec![(lo, 360.0), (hi, 360.0)], BLACK.mix(0.6)))?;
+    ch.draw_series(LineSeries::new(
+        vec![(lo, 360.0), (hi, 360.0)],
+        BLACK.mix(0.6),
+    ))?;
     let top = predicted
         .iter()
         .flat_map(|p| p.histogram.iter().copied())
@@ -53,26 +66,41 @@ pub fn plot_band_distributions(
     let half = 0.32 * step;
     let blue = PALETTE[0];
     let violins = predicted.iter().flat_map(|p| {
-        p.histogram.iter().enumerate().filter(|(_, &s)| s > 0.0).map(move |(b, &s)| {
-            let w = half * (s / top).sqrt().max(0.04);
-            Rectangle::new([(p.d - w, b as f64), (p.d + w, b as f64 + 1.0)], blue.mix(0.55).filled())
-        })
+        p.histogram
+            .iter()
+            .enumerate()
+            .filter(|(_, &s)| s > 0.0)
+            .map(move |(b, &s)| {
+                let w = half * (s / top).sqrt().max(0.04);
+                Rectangle::new(
+                    [(p.d - w, b as f64), (p.d + w, b as f64 + 1.0)],
+                    blue.mix(0.55).filled(),
+                )
+            })
     });
     ch.draw_series(violins)?
         .label("predicted θf distribution (width ∝ √share per 1°)")
-        .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 14, y + 4)], blue.mix(0.55).filled()));
+        .legend(move |(x, y)| {
+            Rectangle::new([(x, y - 4), (x + 14, y + 4)], blue.mix(0.55).filled())
+        });
     let dark = RGBColor(20, 40, 110);
     for p in predicted {
         for b in &p.bands {
             for (y0, y1) in arc_pieces(b.arc.lo, b.arc.width.max(0.5)) {
                 let x = p.d - half - 0.08 * step;
-                ch.draw_series(LineSeries::new(vec![(x, y0), (x, y1)], dark.stroke_width(3)))?;
+                ch.draw_series(LineSeries::new(
+                    vec![(x, y0), (x, y1)],
+                    dark.stroke_width(3),
+                ))?;
             }
         }
     }
-    ch.draw_series(std::iter::once(PathElement::new(vec![(lo, -10.0), (lo, -10.0)], dark)))?
-        .label("90% predicted bands")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], dark.stroke_width(3)));
+    ch.draw_series(std::iter::once(PathElement::new(
+        vec![(lo, -10.0), (lo, -10.0)],
+        dark,
+    )))?
+    .label("90% predicted bands")
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], dark.stroke_width(3)));
     if !measured.is_empty() {
         let red = RGBColor(200, 30, 30);
         for &(d, arc) in measured {
@@ -82,12 +110,18 @@ pub fn plot_band_distributions(
             }
             for y in [arc.lo, arc.hi()] {
                 let t = 0.04 * step;
-                ch.draw_series(LineSeries::new(vec![(x - t, y), (x + t, y)], red.stroke_width(2)))?;
+                ch.draw_series(LineSeries::new(
+                    vec![(x - t, y), (x + t, y)],
+                    red.stroke_width(2),
+                ))?;
             }
         }
-        ch.draw_series(std::iter::once(PathElement::new(vec![(lo, -10.0), (lo, -10.0)], red)))?
-            .label("measured bands [min, max]")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], red.stroke_width(3)));
+        ch.draw_series(std::iter::once(PathElement::new(
+            vec![(lo, -10.0), (lo, -10.0)],
+            red,
+        )))?
+        .label("measured bands [min, max]")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], red.stroke_width(3)));
     }
     draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
     root.present()?;

@@ -215,8 +215,12 @@ fn shares_log_likelihood(
     let (wu, wt) = (split(false), split(true));
     let (pu, pt) = (pred.pass_weights(&wu), pred.pass_weights(&wt));
     let (tot_u, tot_t): (f64, f64) = (pu.iter().sum(), pt.iter().sum());
-    let (sq_u, sq_t): (f64, f64) = (wu.iter().map(|w| w * w).sum(), wt.iter().map(|w| w * w).sum());
-    let sums: Vec<([f64; 4], [f64; 4])> = kernels.iter().map(|k| (k.sums(&pu), k.sums(&pt))).collect();
+    let (sq_u, sq_t): (f64, f64) = (
+        wu.iter().map(|w| w * w).sum(),
+        wt.iter().map(|w| w * w).sum(),
+    );
+    let sums: Vec<([f64; 4], [f64; 4])> =
+        kernels.iter().map(|k| (k.sums(&pu), k.sums(&pt))).collect();
     shares
         .iter()
         .map(|&t| {
@@ -249,7 +253,11 @@ fn profile_interval(x: &[f64], p: &[f64], best: f64) -> (f64, f64, bool, bool) {
         let f = (p[i] - cut) / (p[i] - p[o]);
         x[i] + (x[o] - x[i]) * f.clamp(0.0, 1.0)
     };
-    let lo = if first == 0 { x[0] } else { cross(first, first - 1) };
+    let lo = if first == 0 {
+        x[0]
+    } else {
+        cross(first, first - 1)
+    };
     let hi = if last + 1 == x.len() {
         x[last]
     } else {

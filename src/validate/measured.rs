@@ -67,7 +67,12 @@ pub struct Measured {
 impl Measured {
     /// The polygon of a row's part.
     pub fn polygon(&self, part: &str) -> &Polygon {
-        &self.parts.iter().find(|(p, _)| p == part).expect("parsed").1
+        &self
+            .parts
+            .iter()
+            .find(|(p, _)| p == part)
+            .expect("parsed")
+            .1
     }
 }
 
@@ -133,7 +138,11 @@ pub fn parse(file: &Path, text: &str, max_pin_radius: f64) -> Result<Measured, M
         out.rows.push(row);
     }
     if out.rows.is_empty() {
-        return Err(err(hline, None, "no measurement rows after the header".into()));
+        return Err(err(
+            hline,
+            None,
+            "no measurement rows after the header".into(),
+        ));
     }
     Ok(out)
 }
@@ -150,7 +159,10 @@ fn number(field: &'static str, s: &str) -> FieldResult<f64> {
 fn angle(field: &'static str, s: &str) -> FieldResult<f64> {
     let v = number(field, s)?;
     if !(0.0..=360.0).contains(&v) {
-        return Err((field, format!("{v} is out of range: angles lie in [0, 360] degrees")));
+        return Err((
+            field,
+            format!("{v} is out of range: angles lie in [0, 360] degrees"),
+        ));
     }
     Ok(v)
 }
@@ -163,10 +175,15 @@ fn parse_row(
 ) -> FieldResult<MeasuredRow> {
     let part = f[0].to_string();
     if !parts.iter().any(|(p, _)| *p == part) {
-        let poly = part_from_spec(&part).map_err(|e| ("part", format!("unknown part '{part}': {e}")))?;
+        let poly =
+            part_from_spec(&part).map_err(|e| ("part", format!("unknown part '{part}': {e}")))?;
         parts.push((part.clone(), poly));
     }
-    let poly = &parts.iter().find(|(p, _)| *p == part).expect("just added").1;
+    let poly = &parts
+        .iter()
+        .find(|(p, _)| *p == part)
+        .expect("just added")
+        .1;
     let d = number("d", f[1])?;
     let limit = max_contact_parameter(poly, max_pin_radius);
     if d.abs() > limit {
@@ -210,7 +227,10 @@ fn parse_input(s: &str, states: usize) -> FieldResult<InputState> {
             Ok(index) if index < states => Ok(InputState::State { index }),
             _ => Err((
                 "input",
-                format!("'{s}': the part has {states} stable states, numbered 0 to {}", states.saturating_sub(1)),
+                format!(
+                    "'{s}': the part has {states} stable states, numbered 0 to {}",
+                    states.saturating_sub(1)
+                ),
             )),
         };
     }

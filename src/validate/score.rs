@@ -121,8 +121,14 @@ impl RowKernel {
             n,
             band_width: band.width,
             window_width: window.width,
-            at_min: values.iter().map(|&t| kernel_density(t, x_min, h)).collect(),
-            at_max: values.iter().map(|&t| kernel_density(t, x_max, h)).collect(),
+            at_min: values
+                .iter()
+                .map(|&t| kernel_density(t, x_min, h))
+                .collect(),
+            at_max: values
+                .iter()
+                .map(|&t| kernel_density(t, x_max, h))
+                .collect(),
             in_band: values.iter().map(|&t| kernel_mass(t, &band, h)).collect(),
             in_window: values.iter().map(|&t| kernel_mass(t, &window, h)).collect(),
         }

@@ -79,7 +79,10 @@ impl Default for SyntheticDesign {
 /// The smallest arc holding every angle (degrees): the complement of the widest gap between
 /// neighbours round the circle.
 pub fn smallest_arc(angles: &[f64]) -> Arc {
-    let mut a: Vec<f64> = angles.iter().map(|&x| crate::geometry::wrap_deg(x)).collect();
+    let mut a: Vec<f64> = angles
+        .iter()
+        .map(|&x| crate::geometry::wrap_deg(x))
+        .collect();
     a.sort_by(f64::total_cmp);
     let n = a.len();
     let gap = |k: usize| {
