@@ -8,7 +8,9 @@
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
 use super::map::shell_word;
-use super::validate::{check_members, ensemble_spec, load_measured, pool, summary_text, ModelArgs};
+use super::validate::{
+    check_members, emit, ensemble_spec, load_measured, pool, start_report, summary_text, ModelArgs,
+};
 use crate::study::mc::perturbations::{SmoothParams, SupportChoice};
 use crate::validate::calibrate::{calibrate, Calibration, CalibrationSettings};
 use crate::validate::score::Summary;
@@ -206,17 +208,9 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         fitted_score: &fitted_score,
         hidden,
     };
-    if c.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print!("{text}");
-    }
-    if !c.no_write {
-        let out_dir = c.out_dir("calibrate", &args.measured);
-        write_report(&report, &text, &out_dir)?;
-        eprintln!("report written to {}", out_dir.display());
-    }
-    Ok(())
+    emit(&report, &text, c, "calibrate", &args.measured, |dir| {
+        write_report(&report, &text, dir)
+    })
 }
 
 fn command_line(args: &CalibrateArgs) -> String {
@@ -237,18 +231,15 @@ fn command_line(args: &CalibrateArgs) -> String {
 }
 
 fn write_report(report: &CalibrateReport, text: &str, out_dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
-    let json = out_dir.join("calibration.json");
-    std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
-        .with_context(|| format!("writing {}", json.display()))?;
-    let mut md = format!(
-        "# Calibration: {}\n\nRegenerate with:\n\n```\n{}\n```\n\nFitted ensemble:\n\n",
-        report.measured, report.command
-    );
-    for line in &report.fitted {
-        let _ = writeln!(md, "* {line}");
-    }
-    md.push('\n');
+    let mut md = start_report(
+        out_dir,
+        "calibration.json",
+        report,
+        &format!("Calibration: {}", report.measured),
+        &report.command,
+        "Fitted ensemble:",
+        &report.fitted,
+    )?;
     md.push_str(text);
     let readme = out_dir.join("README.md");
     std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;

@@ -158,20 +158,21 @@ fn write_report(
     plot_dir: Option<&Path>,
 ) -> Result<()> {
     let plot_dir = plot_dir.unwrap_or(out_dir);
-    for dir in [out_dir, plot_dir] {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let json = out_dir.join("ensemble.json");
-    std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
-        .with_context(|| format!("writing {}", json.display()))?;
-    let mut md = format!(
-        "# Ensemble map: {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{} members, seed {}; uncertain:\n\n",
-        report.part, report.command, report.members, report.seed
-    );
-    for line in &report.uncertain {
-        let _ = writeln!(md, "* {line}");
-    }
-    md.push_str("\nPredicted bands: the smallest arcs (1° resolution, ends at the extreme passes they hold) that hold 90% of the passes pooled over the members and the input's θ0 (a stable state: the grid θ0 nearest it).\n\n");
+    let mut md = super::validate::start_report(
+        out_dir,
+        "ensemble.json",
+        report,
+        &format!("Ensemble map: {}", report.part),
+        &report.command,
+        &format!(
+            "{} members, seed {}; uncertain:",
+            report.members, report.seed
+        ),
+        &report.uncertain,
+    )?;
+    std::fs::create_dir_all(plot_dir)
+        .with_context(|| format!("creating {}", plot_dir.display()))?;
+    md.push_str("Predicted bands: the smallest arcs (1° resolution, ends at the extreme passes they hold) that hold 90% of the passes pooled over the members and the input's θ0 (a stable state: the grid θ0 nearest it).\n\n");
     md.push_str(table);
     md.push('\n');
     for input in inputs {

@@ -178,6 +178,52 @@ pub fn ensemble_spec(
     }
 }
 
+/// Print a report (`--json`: the document, else `text`) and, unless `--no-write`, have `write`
+/// write it into `results/<command>/<file stem>/` (or `--out-dir`).
+pub fn emit<T: Serialize>(
+    report: &T,
+    text: &str,
+    c: &ModelArgs,
+    command: &str,
+    file: &Path,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
+    if c.json {
+        println!("{}", serde_json::to_string_pretty(report)?);
+    } else {
+        print!("{text}");
+    }
+    if !c.no_write {
+        let out_dir = c.out_dir(command, file);
+        write(&out_dir)?;
+        eprintln!("report written to {}", out_dir.display());
+    }
+    Ok(())
+}
+
+/// Create `out_dir`, write `report` there as `json_name`, and return the head of its README.md:
+/// the title, the regenerating command and a bullet per line of `bullets` after `intro`.
+pub fn start_report<T: Serialize>(
+    out_dir: &Path,
+    json_name: &str,
+    report: &T,
+    title: &str,
+    command: &str,
+    intro: &str,
+    bullets: &[String],
+) -> Result<String> {
+    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    let json = out_dir.join(json_name);
+    std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
+        .with_context(|| format!("writing {}", json.display()))?;
+    let mut md = format!("# {title}\n\nRegenerate with:\n\n```\n{command}\n```\n\n{intro}\n\n");
+    for line in bullets {
+        let _ = writeln!(md, "* {line}");
+    }
+    md.push('\n');
+    Ok(md)
+}
+
 /// Check the member count.
 pub fn check_members(members: usize) -> Result<()> {
     if !(1..=MAX_MEMBERS).contains(&members) {
@@ -281,17 +327,9 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         rows: &rows,
     };
     let text = rows_text(&rows, &summary);
-    if c.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print!("{text}");
-    }
-    if !c.no_write {
-        let out_dir = c.out_dir("validate", &args.measured);
-        write_report(&report, &text, &out_dir)?;
-        eprintln!("report written to {}", out_dir.display());
-    }
-    Ok(())
+    emit(&report, &text, c, "validate", &args.measured, |dir| {
+        write_report(&report, &text, dir)
+    })
 }
 
 /// Figures of measured bands over predictions, one per (part, input): (file name, title) written.
@@ -327,18 +365,15 @@ pub fn write_figures(rows: &[RowScore], dir: &Path) -> Result<Vec<String>> {
 }
 
 fn write_report(report: &ValidateReport, text: &str, out_dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
-    let json = out_dir.join("validate.json");
-    std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
-        .with_context(|| format!("writing {}", json.display()))?;
-    let mut md = format!(
-        "# Validation: {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{} members; ensemble:\n\n",
-        report.measured, report.command, report.members
-    );
-    for line in &report.uncertain {
-        let _ = writeln!(md, "* {line}");
-    }
-    md.push('\n');
+    let mut md = start_report(
+        out_dir,
+        "validate.json",
+        report,
+        &format!("Validation: {}", report.measured),
+        &report.command,
+        &format!("{} members; ensemble:", report.members),
+        &report.uncertain,
+    )?;
     md.push_str(text);
     md.push('\n');
     for name in write_figures(report.rows, out_dir)? {

@@ -76,6 +76,24 @@ pub(crate) fn degree_chart<'a, 'b>(
         .build_cartesian_2d(x, 0.0..y_top)?)
 }
 
+/// The mesh of a chart of orientations (0°…360°, unlabelled above) against contact parameter d.
+pub(crate) fn d_axis_mesh(ch: &mut Chart, y_desc: &str) -> anyhow::Result<()> {
+    ch.configure_mesh()
+        .y_labels(15)
+        .y_label_formatter(&|v| {
+            if *v <= 360.0 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        })
+        .light_line_style(WHITE)
+        .x_desc("contact parameter d")
+        .y_desc(y_desc)
+        .draw()?;
+    Ok(())
+}
+
 pub(crate) fn draw_legend<'a, 'b: 'a>(
     ch: &mut Chart<'a, 'b>,
     position: SeriesLabelPosition,
@@ -217,23 +235,14 @@ pub fn plot_band_intervals(
     let root = SVGBackend::new(path, (900, 620)).into_drawing_area();
     // Room above 360° for the legend, so it never hides an interval.
     let mut ch = degree_chart(&root, title, (dmin - pad)..(dmax + pad), 420.0)?;
-    ch.configure_mesh()
-        .y_labels(15)
-        .y_label_formatter(&|v| {
-            if *v <= 360.0 {
-                format!("{v:.0}")
-            } else {
-                String::new()
-            }
-        })
-        .light_line_style(WHITE)
-        .x_desc("contact parameter d")
-        .y_desc(if adjusted {
+    d_axis_mesh(
+        &mut ch,
+        if adjusted {
             "adjusted band mean ± sd (deg)"
         } else {
             "final orientation band (deg)"
-        })
-        .draw()?;
+        },
+    )?;
     let blue = PALETTE[0];
     let grey = RGBColor(185, 185, 185);
     // The top of the circle: intervals above it continue from 0°.

@@ -4,7 +4,7 @@
 //! bars beside it, and optionally the measured bands as red bars with end ticks on the other side.
 //! Arcs straddling 0°/360° are drawn as two pieces (as in [`super::plot_map`]).
 
-use super::plot_map::{arc_pieces, degree_chart, draw_legend, PALETTE};
+use super::plot_map::{arc_pieces, d_axis_mesh, degree_chart, draw_legend, PALETTE};
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::PredictedBands;
 use plotters::prelude::*;
@@ -41,19 +41,7 @@ pub fn plot_band_distributions(
     let hi = ds.iter().copied().fold(f64::NEG_INFINITY, f64::max) + step;
     let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
     let mut ch = degree_chart(&root, title, lo..hi, 420.0)?;
-    ch.configure_mesh()
-        .y_labels(15)
-        .y_label_formatter(&|v| {
-            if *v <= 360.0 {
-                format!("{v:.0}")
-            } else {
-                String::new()
-            }
-        })
-        .light_line_style(WHITE)
-        .x_desc("contact parameter d")
-        .y_desc("final orientation θf (deg)")
-        .draw()?;
+    d_axis_mesh(&mut ch, "final orientation θf (deg)")?;
     ch.draw_series(LineSeries::new(
         vec![(lo, 360.0), (hi, 360.0)],
         BLACK.mix(0.6),
