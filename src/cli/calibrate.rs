@@ -9,7 +9,8 @@
 
 use super::map::shell_word;
 use super::validate::{
-    check_members, emit, ensemble_spec, load_measured, pool, start_report, summary_text, ModelArgs,
+    check_members, emit, ensemble_spec, load_measured, pool, summary_text, write_report_files,
+    ModelArgs, ReportHead,
 };
 use crate::study::mc::perturbations::{SmoothParams, SupportChoice};
 use crate::validate::calibrate::{calibrate, Calibration, CalibrationSettings};
@@ -231,17 +232,13 @@ fn command_line(args: &CalibrateArgs) -> String {
 }
 
 fn write_report(report: &CalibrateReport, text: &str, out_dir: &Path) -> Result<()> {
-    let mut md = start_report(
-        out_dir,
-        "calibration.json",
-        report,
-        &format!("Calibration: {}", report.measured),
-        &report.command,
-        "Fitted ensemble:",
-        &report.fitted,
-    )?;
-    md.push_str(text);
-    let readme = out_dir.join("README.md");
-    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
-    Ok(())
+    let head = ReportHead {
+        title: format!("Calibration: {}", report.measured),
+        command: &report.command,
+        intro: "Fitted ensemble:".into(),
+        bullets: &report.fitted,
+    };
+    write_report_files(out_dir, "calibration.json", report, head, |_| {
+        Ok(text.to_string())
+    })
 }

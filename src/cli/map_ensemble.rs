@@ -7,6 +7,7 @@
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
 use super::map::{command_line, default_out_dir_for, shell_word, MapArgs};
+use super::validate::{write_report_files, ReportHead};
 use crate::geometry::Polygon;
 use crate::maps::ensemble::{
     ensemble_maps, stable_states_deg, EnsembleSpec, InputState, MemberDraw, PredictedBands,
@@ -157,37 +158,32 @@ fn write_report(
     out_dir: &Path,
     plot_dir: Option<&Path>,
 ) -> Result<()> {
-    let plot_dir = plot_dir.unwrap_or(out_dir);
-    let mut md = super::validate::start_report(
-        out_dir,
-        "ensemble.json",
-        report,
-        &format!("Ensemble map: {}", report.part),
-        &report.command,
-        &format!(
+    let head = ReportHead {
+        title: format!("Ensemble map: {}", report.part),
+        command: &report.command,
+        intro: format!(
             "{} members, seed {}; uncertain:",
             report.members, report.seed
         ),
-        &report.uncertain,
-    )?;
-    std::fs::create_dir_all(plot_dir)
-        .with_context(|| format!("creating {}", plot_dir.display()))?;
-    md.push_str("Predicted bands: the smallest arcs (1° resolution, ends at the extreme passes they hold) that hold 90% of the passes pooled over the members and the input's θ0 (a stable state: the grid θ0 nearest it).\n\n");
-    md.push_str(table);
-    md.push('\n');
-    for input in inputs {
-        let label = input.label();
-        let name = format!("ensemble_{}.svg", label.replace(':', ""));
-        let of_input: Vec<&PredictedBands> = report
-            .predicted
-            .iter()
-            .filter(|p| p.input == label)
-            .collect();
-        let title = format!("{}: predicted θf against d, input {label}", report.part);
-        plot_band_distributions(&of_input, &[], &title, &plot_dir.join(&name))?;
-        let _ = writeln!(md, "![{label}]({name})\n");
-    }
-    let readme = out_dir.join("README.md");
-    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
-    Ok(())
+        bullets: &report.uncertain,
+    };
+    write_report_files(out_dir, "ensemble.json", report, head, |out_dir| {
+        let plot_dir = plot_dir.unwrap_or(out_dir);
+        std::fs::create_dir_all(plot_dir)
+            .with_context(|| format!("creating {}", plot_dir.display()))?;
+        let mut md = format!("Predicted bands: the smallest arcs (1° resolution, gaps under 5° closed, ends at the extreme passes they hold) that hold 90% of the passes pooled over the members and the input's θ0 (a stable state: the grid θ0 nearest it).\n\n{table}\n");
+        for input in inputs {
+            let label = input.label();
+            let name = format!("ensemble_{}.svg", label.replace(':', ""));
+            let of_input: Vec<&PredictedBands> = report
+                .predicted
+                .iter()
+                .filter(|p| p.input == label)
+                .collect();
+            let title = format!("{}: predicted θf against d, input {label}", report.part);
+            plot_band_distributions(&of_input, &[], &title, &plot_dir.join(&name))?;
+            let _ = writeln!(md, "![{label}]({name})\n");
+        }
+        Ok(md)
+    })
 }

@@ -201,27 +201,39 @@ pub fn emit<T: Serialize>(
     Ok(())
 }
 
-/// Create `out_dir`, write `report` there as `json_name`, and return the head of its README.md:
-/// the title, the regenerating command and a bullet per line of `bullets` after `intro`.
-pub fn start_report<T: Serialize>(
+/// The head of a report's README.md: title, regenerating command, a sentence and a bullet list.
+pub struct ReportHead<'a> {
+    pub title: String,
+    pub command: &'a str,
+    pub intro: String,
+    pub bullets: &'a [String],
+}
+
+/// Create `out_dir`, write `report` there as `json_name`, then README.md: the head followed by
+/// what `body` returns (it may write figures into `out_dir`).
+pub fn write_report_files<T: Serialize>(
     out_dir: &Path,
     json_name: &str,
     report: &T,
-    title: &str,
-    command: &str,
-    intro: &str,
-    bullets: &[String],
-) -> Result<String> {
+    head: ReportHead,
+    body: impl FnOnce(&Path) -> Result<String>,
+) -> Result<()> {
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let json = out_dir.join(json_name);
     std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
         .with_context(|| format!("writing {}", json.display()))?;
-    let mut md = format!("# {title}\n\nRegenerate with:\n\n```\n{command}\n```\n\n{intro}\n\n");
-    for line in bullets {
+    let mut md = format!(
+        "# {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{}\n\n",
+        head.title, head.command, head.intro
+    );
+    for line in head.bullets {
         let _ = writeln!(md, "* {line}");
     }
     md.push('\n');
-    Ok(md)
+    md.push_str(&body(out_dir)?);
+    let readme = out_dir.join("README.md");
+    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
+    Ok(())
 }
 
 /// Check the member count.
@@ -347,7 +359,13 @@ pub fn write_figures(rows: &[RowScore], dir: &Path) -> Result<Vec<String>> {
             .iter()
             .filter(|r| r.part == part && r.input == input)
             .collect();
-        let predicted: Vec<&PredictedBands> = of.iter().map(|r| &r.predicted).collect();
+        // One prediction per d (rows of a thesis-style table share theirs).
+        let mut predicted: Vec<&PredictedBands> = Vec::new();
+        for r in &of {
+            if !predicted.iter().any(|p| p.d == r.d) {
+                predicted.push(&r.predicted);
+            }
+        }
         let measured: Vec<(f64, Arc)> = of
             .iter()
             .map(|r| (r.d, Arc::from_ends(r.min_deg, r.max_deg)))
@@ -365,21 +383,17 @@ pub fn write_figures(rows: &[RowScore], dir: &Path) -> Result<Vec<String>> {
 }
 
 fn write_report(report: &ValidateReport, text: &str, out_dir: &Path) -> Result<()> {
-    let mut md = start_report(
-        out_dir,
-        "validate.json",
-        report,
-        &format!("Validation: {}", report.measured),
-        &report.command,
-        &format!("{} members; ensemble:", report.members),
-        &report.uncertain,
-    )?;
-    md.push_str(text);
-    md.push('\n');
-    for name in write_figures(report.rows, out_dir)? {
-        let _ = writeln!(md, "![{name}]({name})\n");
-    }
-    let readme = out_dir.join("README.md");
-    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
-    Ok(())
+    let head = ReportHead {
+        title: format!("Validation: {}", report.measured),
+        command: &report.command,
+        intro: format!("{} members; ensemble:", report.members),
+        bullets: &report.uncertain,
+    };
+    write_report_files(out_dir, "validate.json", report, head, |dir| {
+        let mut md = format!("{text}\n");
+        for name in write_figures(report.rows, dir)? {
+            let _ = writeln!(md, "![{name}]({name})\n");
+        }
+        Ok(md)
+    })
 }

@@ -4,7 +4,7 @@
 //! bars beside it, and optionally the measured bands as red bars with end ticks on the other side.
 //! Arcs straddling 0°/360° are drawn as two pieces (as in [`super::plot_map`]).
 
-use super::plot_map::{arc_pieces, d_axis_mesh, degree_chart, draw_legend, PALETTE};
+use super::plot_map::{arc_pieces, d_axis_mesh, degree_chart, draw_legend, Chart, PALETTE};
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::PredictedBands;
 use plotters::prelude::*;
@@ -22,6 +22,14 @@ fn spacing(ds: &[f64]) -> f64 {
         .map(|w| w[1] - w[0])
         .fold(f64::INFINITY, f64::min)
         .clamp(0.05, 0.4)
+}
+
+/// A legend entry: a thick line of `colour` (the series itself draws nothing).
+fn legend_line(ch: &mut Chart, label: &str, colour: RGBColor) -> anyhow::Result<()> {
+    ch.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], colour.stroke_width(3)));
+    Ok(())
 }
 
 /// Predicted θf distributions and bands against d; `measured` are (d, band) pairs to draw over them.
@@ -83,12 +91,7 @@ pub fn plot_band_distributions(
             }
         }
     }
-    ch.draw_series(std::iter::once(PathElement::new(
-        vec![(lo, -10.0), (lo, -10.0)],
-        dark,
-    )))?
-    .label("90% predicted bands")
-    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], dark.stroke_width(3)));
+    legend_line(&mut ch, "90% predicted bands", dark)?;
     if !measured.is_empty() {
         let red = RGBColor(200, 30, 30);
         for &(d, arc) in measured {
@@ -104,12 +107,7 @@ pub fn plot_band_distributions(
                 ))?;
             }
         }
-        ch.draw_series(std::iter::once(PathElement::new(
-            vec![(lo, -10.0), (lo, -10.0)],
-            red,
-        )))?
-        .label("measured bands [min, max]")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], red.stroke_width(3)));
+        legend_line(&mut ch, "measured bands [min, max]", red)?;
     }
     draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
     root.present()?;

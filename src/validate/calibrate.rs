@@ -120,14 +120,16 @@ impl CalibrationSettings {
     pub fn axes(&self) -> [Vec<f64>; 4] {
         let (lo, hi) = self.mu_c_range;
         let steps = ((hi - lo) / 0.025).round() as usize;
+        // Grid values rounded to 1e-9, so that 0.45 prints as 0.45.
+        let tidy = |x: f64| (x * 1e9).round() / 1e9;
         [
             (0..=steps)
-                .map(|k| lo + (hi - lo) * k as f64 / steps as f64)
+                .map(|k| tidy(lo + (hi - lo) * k as f64 / steps as f64))
                 .collect(),
             vec![0.02, 0.03, 0.045, 0.065, 0.09, 0.13, 0.18, 0.25],
             (0..=20).map(|k| k as f64 / 20.0).collect(),
             (0..=10)
-                .map(|k| self.pin_radius_max * k as f64 / 10.0)
+                .map(|k| tidy(self.pin_radius_max * k as f64 / 10.0))
                 .collect(),
         ]
     }
