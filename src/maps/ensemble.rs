@@ -376,8 +376,7 @@ pub struct PredictedBands {
     pub bands: Vec<MassArc>,
     /// Share of the circle they cover.
     pub coverage: f64,
-    /// Histogram of θf over 1° bins (shares).
-    #[serde(skip)]
+    /// The distribution of θf: shares of the passes in 1° bins [k°, k + 1°), k = 0 … 359.
     pub histogram: Vec<f64>,
 }
 
