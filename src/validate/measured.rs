@@ -31,13 +31,23 @@ pub const MAX_TRIALS: u32 = 1_000_000;
 
 /// A bad measured-bands file: where, which field, what.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{}:{line}: {}{message}", file.display(), field.as_ref().map(|f| format!("field `{f}`: ")).unwrap_or_default())]
+#[error("{}: {}{message}", self.place(), field.as_ref().map(|f| format!("field `{f}`: ")).unwrap_or_default())]
 pub struct MeasuredError {
     pub file: PathBuf,
     /// 1-based line number (0: the file as a whole).
     pub line: usize,
     pub field: Option<String>,
     pub message: String,
+}
+
+impl MeasuredError {
+    /// `FILE:LINE`, or `FILE` for the file as a whole.
+    fn place(&self) -> String {
+        match self.line {
+            0 => self.file.display().to_string(),
+            n => format!("{}:{n}", self.file.display()),
+        }
+    }
 }
 
 /// One measured band.
