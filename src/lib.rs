@@ -25,3 +25,4 @@ pub mod scenario;
 pub mod sensing;
 pub mod statistics;
 pub mod study;
+pub mod validate;

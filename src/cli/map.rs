@@ -85,6 +85,16 @@ pub struct MapArgs {
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Ensemble map under uncertain physics (README "Validating against measurements"), e.g.
+    /// `mu_c=normal:0.5:0.1,support=tripod:0.5,pin_radius=uniform:0:0.1,jitter=2`.
+    #[arg(long, value_name = "KEY=VALUE,...", conflicts_with_all = ["fence", "json", "csv"])]
+    pub uncertain: Option<String>,
+    /// Members of the ensemble (with --uncertain).
+    #[arg(long, default_value_t = 200)]
+    pub members: usize,
+    /// Seed of the ensemble (with --uncertain).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 /// The JSON document of `pinfeed map --json` (and `map.json`).
@@ -122,7 +132,7 @@ struct SampleRow {
 }
 
 /// Quote a shell word if it needs it.
-fn shell_word(s: &str) -> String {
+pub(crate) fn shell_word(s: &str) -> String {
     let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
     if !s.is_empty() && s.chars().all(plain) {
         s.to_string()
@@ -294,6 +304,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
                 &poly,
             )?;
         }
+    }
+    if let Some(uncertain) = &args.uncertain {
+        return super::map_ensemble::run(args, uncertain, model, &poly);
     }
     let (contact, pin) = settings_and_pin(&template);
     let settings = MapSettings {

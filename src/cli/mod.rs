@@ -5,11 +5,13 @@ pub mod bench;
 pub mod bench_map_tier;
 pub mod bench_mc;
 pub mod bench_plans;
+pub mod calibrate;
 pub mod compare;
 pub mod contact;
 pub mod contact_map;
 pub mod fuzz;
 pub mod map;
+pub mod map_ensemble;
 pub mod mc;
 pub mod merge;
 pub mod part;
@@ -18,6 +20,7 @@ pub mod plan_sensor;
 pub mod run;
 pub mod sense;
 pub mod stdout;
+pub mod validate;
 
 use clap::{Parser, Subcommand};
 
@@ -73,6 +76,10 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Fuzz the inputs (scenario and study files, contacts, polygons) and write results/robustness.md.
     Fuzz(fuzz::FuzzArgs),
+    /// Measured bands (CSV) against an ensemble's predicted bands: containment, overlap, log score.
+    Validate(validate::ValidateArgs),
+    /// Fit μc centre and spread, tripod share and pin radius to measured bands, with intervals.
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 /// Run a parsed command line.
@@ -89,5 +96,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Plan(a) => plan::run(&a),
         Command::Bench(a) => bench::run(&a),
         Command::Fuzz(a) => fuzz::run(&a),
+        Command::Validate(a) => validate::run(&a),
+        Command::Calibrate(a) => calibrate::run(&a),
     }
 }

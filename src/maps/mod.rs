@@ -21,7 +21,9 @@
 //! Angles are degrees, wrapped to [0°, 360°); an interval [a, b] with b < a straddles 0°/360°.
 //! Lengths (final centroid y, contact length) are in the part's units, belt frame.
 
+pub mod arcs;
 pub mod bands;
+pub mod ensemble;
 pub mod runs;
 pub mod sample;
 pub mod start;

@@ -16,3 +16,4 @@ pub mod plot_plan;
 pub mod plot_sensing;
 pub mod plot_sensitivity;
 pub mod plot_survey;
+pub mod plot_validate;

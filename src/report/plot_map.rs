@@ -18,7 +18,7 @@ use plotters::element::ComposedElement;
 use plotters::prelude::*;
 use std::path::Path;
 
-const PALETTE: [RGBColor; 8] = [
+pub(crate) const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
@@ -31,7 +31,7 @@ const PALETTE: [RGBColor; 8] = [
 
 /// The arc that starts at `start` (degrees) and runs `width` degrees counter-clockwise, as pieces
 /// inside [0, 360].
-fn arc_pieces(start: f64, width: f64) -> Vec<(f64, f64)> {
+pub(crate) fn arc_pieces(start: f64, width: f64) -> Vec<(f64, f64)> {
     if width >= 360.0 {
         return vec![(0.0, 360.0)];
     }
@@ -57,10 +57,11 @@ fn adjusted_arc(b: &Band) -> Vec<(f64, f64)> {
     arc_pieces(b.mean_deg - b.sd_deg, 2.0 * b.sd_deg)
 }
 
-type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+pub(crate) type Chart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// A white chart with a title, `x` across and orientations 0°…`y_top` up.
-fn degree_chart<'a, 'b>(
+pub(crate) fn degree_chart<'a, 'b>(
     root: &'a DrawingArea<SVGBackend<'b>, Shift>,
     title: &str,
     x: std::ops::Range<f64>,
@@ -75,7 +76,25 @@ fn degree_chart<'a, 'b>(
         .build_cartesian_2d(x, 0.0..y_top)?)
 }
 
-fn draw_legend<'a, 'b: 'a>(
+/// The mesh of a chart of orientations (0°…360°, unlabelled above) against contact parameter d.
+pub(crate) fn d_axis_mesh(ch: &mut Chart, y_desc: &str) -> anyhow::Result<()> {
+    ch.configure_mesh()
+        .y_labels(15)
+        .y_label_formatter(&|v| {
+            if *v <= 360.0 {
+                format!("{v:.0}")
+            } else {
+                String::new()
+            }
+        })
+        .light_line_style(WHITE)
+        .x_desc("contact parameter d")
+        .y_desc(y_desc)
+        .draw()?;
+    Ok(())
+}
+
+pub(crate) fn draw_legend<'a, 'b: 'a>(
     ch: &mut Chart<'a, 'b>,
     position: SeriesLabelPosition,
 ) -> anyhow::Result<()> {
@@ -216,23 +235,14 @@ pub fn plot_band_intervals(
     let root = SVGBackend::new(path, (900, 620)).into_drawing_area();
     // Room above 360° for the legend, so it never hides an interval.
     let mut ch = degree_chart(&root, title, (dmin - pad)..(dmax + pad), 420.0)?;
-    ch.configure_mesh()
-        .y_labels(15)
-        .y_label_formatter(&|v| {
-            if *v <= 360.0 {
-                format!("{v:.0}")
-            } else {
-                String::new()
-            }
-        })
-        .light_line_style(WHITE)
-        .x_desc("contact parameter d")
-        .y_desc(if adjusted {
+    d_axis_mesh(
+        &mut ch,
+        if adjusted {
             "adjusted band mean ± sd (deg)"
         } else {
             "final orientation band (deg)"
-        })
-        .draw()?;
+        },
+    )?;
     let blue = PALETTE[0];
     let grey = RGBColor(185, 185, 185);
     // The top of the circle: intervals above it continue from 0°.

@@ -341,7 +341,7 @@ fn draw_polygon(
 }
 
 /// The support of one sample on its (perturbed) polygon.
-fn draw_support(
+pub(crate) fn draw_support(
     polygon: &Polygon,
     choice: &SupportChoice,
     rng: &mut ChaCha8Rng,

@@ -1,0 +1,244 @@
+//! `pinfeed calibrate MEASURED.csv`: fit μc centre and spread, the tripod (or smooth-density)
+//! share and the pin radius to measured bands by maximum likelihood over one reweighted ensemble
+//! ([`crate::validate::calibrate`]), with 95% profile-likelihood intervals; then score the nominal
+//! model and the fitted ensemble on the same rows with `validate`'s scorer (fresh ensembles, the
+//! same seed). With `--synthesize` the file is first written: the bundled synthetic data set drawn
+//! from hidden parameters ([`crate::validate::synthetic`]), and the report says whether each
+//! interval holds the hidden value. Unless `--no-write`, `results/calibrate/<file stem>/` receives
+//! `README.md` headed by the regenerating command and `calibration.json`.
+
+use super::map::shell_word;
+use super::validate::{
+    check_members, emit, ensemble_spec, load_measured, pool, summary_text, write_report_files,
+    ModelArgs, ReportHead,
+};
+use crate::study::mc::perturbations::{SmoothParams, SupportChoice};
+use crate::validate::calibrate::{calibrate, Calibration, CalibrationSettings};
+use crate::validate::score::Summary;
+use crate::validate::synthetic::{synthesize, SyntheticDesign};
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `pinfeed calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// The measured-bands file (CSV; README "Validating against measurements").
+    pub measured: PathBuf,
+    /// First write the bundled synthetic data set (hidden parameters, seed 16) to MEASURED.
+    #[arg(long)]
+    pub synthesize: bool,
+    /// Members of the proposal ensemble.
+    #[arg(long, default_value_t = 2000)]
+    pub members: usize,
+    /// Random support model whose share is fitted: tripod or smooth.
+    #[arg(long, default_value = "tripod")]
+    pub support: String,
+    /// Pose jitter (sd of θ0 per pass, degrees): known, not fitted.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub jitter: f64,
+    /// Range of the μc mean searched (and of the proposal): MIN:MAX.
+    #[arg(long, default_value = "0.05:1", allow_hyphen_values = true)]
+    pub mu_c_range: String,
+    /// Largest pin radius searched (part units).
+    #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
+    pub pin_radius_max: f64,
+    /// σρ: spread of the pin radius under every fitted ensemble (part units).
+    #[arg(long, default_value_t = 0.03, allow_hyphen_values = true)]
+    pub pin_radius_sd: f64,
+    /// The nominal model scored beside the fit: its μc (uniform support, point pin).
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub mu_c: f64,
+    /// Members of the ensembles that score the nominal model and the fit.
+    #[arg(long, default_value_t = crate::validate::DEFAULT_MEMBERS)]
+    pub score_members: usize,
+    #[command(flatten)]
+    pub common: ModelArgs,
+}
+
+/// The calibration settings of the arguments, checked.
+fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
+    let (lo, hi) = args
+        .mu_c_range
+        .split_once(':')
+        .and_then(|(a, b)| Some((a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?)))
+        .ok_or_else(|| anyhow!("--mu-c-range must be MIN:MAX, got '{}'", args.mu_c_range))?;
+    if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo + 0.05 <= hi && hi <= 10.0) {
+        bail!("--mu-c-range: need 0 ≤ MIN, MIN + 0.05 ≤ MAX ≤ 10, got {lo}:{hi}");
+    }
+    let positive = [
+        ("--pin-radius-max", args.pin_radius_max),
+        ("--pin-radius-sd", args.pin_radius_sd),
+    ];
+    for (flag, v) in positive {
+        if !(v.is_finite() && v > 0.0 && v <= 1e3) {
+            bail!("{flag} must be a positive number, got {v}");
+        }
+    }
+    if !(args.jitter.is_finite() && (0.0..=90.0).contains(&args.jitter)) {
+        bail!("--jitter must lie in [0, 90] degrees, got {}", args.jitter);
+    }
+    let support = match args.support.as_str() {
+        "tripod" => SupportChoice::Tripod,
+        "smooth" => SupportChoice::Smooth(SmoothParams::default()),
+        s => bail!("--support must be tripod or smooth, got '{s}'"),
+    };
+    check_members(args.members)?;
+    check_members(args.score_members)?;
+    let c = &args.common;
+    Ok(CalibrationSettings {
+        members: args.members,
+        passes: c.passes,
+        seed: c.seed,
+        mu_c_range: (lo, hi),
+        pin_radius_max: args.pin_radius_max,
+        pin_radius_sd: args.pin_radius_sd,
+        support,
+        jitter_deg: args.jitter,
+        fidelity: super::contact::parse_model(&c.model)?,
+        tol: c.tol,
+        score: c.score()?,
+    })
+}
+
+/// The document `calibration.json`.
+#[derive(Debug, Serialize)]
+struct CalibrateReport<'a> {
+    command: String,
+    measured: String,
+    calibration: &'a Calibration,
+    nominal: Vec<String>,
+    nominal_score: &'a Summary,
+    fitted: Vec<String>,
+    fitted_score: &'a Summary,
+    /// With --synthesize: the hidden values, in the order of the parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hidden: Option<[f64; 4]>,
+}
+
+fn parameter_table(c: &Calibration, hidden: Option<[f64; 4]>) -> String {
+    let mut s = String::from("| parameter | estimate | 95% interval | searched | hidden value |\n|---|---|---|---|---|\n");
+    for (k, p) in c.parameters.iter().enumerate() {
+        let open = |o: bool| if o { " (open: grid end)" } else { "" };
+        let truth = match hidden {
+            Some(h) => format!(
+                "{} ({})",
+                h[k],
+                if p.covers(h[k]) { "inside" } else { "OUTSIDE" }
+            ),
+            None => "—".into(),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {:.3} | [{:.3}{}, {:.3}{}] | [{}, {}] | {truth} |",
+            p.name,
+            p.estimate,
+            p.lo,
+            open(p.open_low),
+            p.hi,
+            open(p.open_high),
+            p.grid_min,
+            p.grid_max
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nlog-likelihood at the estimate {:.2} ({} grid points); effective members {:.0} of {}",
+        c.log_likelihood, c.grid_points, c.effective_members, c.members
+    );
+    s
+}
+
+pub fn run(args: &CalibrateArgs) -> Result<()> {
+    let s = settings(args)?;
+    let c = &args.common;
+    let hidden = if args.synthesize {
+        let text = synthesize(&SyntheticDesign::default()).map_err(anyhow::Error::msg)?;
+        if let Some(dir) = args.measured.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        }
+        std::fs::write(&args.measured, text)
+            .with_context(|| format!("writing {}", args.measured.display()))?;
+        eprintln!("synthetic data set written to {}", args.measured.display());
+        Some(SyntheticDesign::TRUTH)
+    } else {
+        None
+    };
+    let measured = load_measured(&args.measured, &s.proposal())?;
+    let pool = pool(c.threads)?;
+    let started = std::time::Instant::now();
+    let cal = pool
+        .install(|| calibrate(&measured, &s))
+        .map_err(anyhow::Error::msg)?;
+    eprintln!("calibrated in {:.1} s", started.elapsed().as_secs_f64());
+    let nominal = ensemble_spec(args.mu_c, 0.0, None, c)?;
+    let fitted = s.spec_at(cal.estimate());
+    let score = s.score;
+    let run_score = |spec| {
+        pool.install(|| {
+            crate::validate::validate(
+                &measured,
+                spec,
+                c.seed,
+                args.score_members,
+                c.passes,
+                &score,
+            )
+        })
+        .map(|(_, summary, _)| summary)
+        .map_err(anyhow::Error::msg)
+    };
+    let (nominal_score, fitted_score) = (run_score(&nominal)?, run_score(&fitted)?);
+    let mut text = parameter_table(&cal, hidden);
+    let _ = writeln!(
+        text,
+        "\nnominal model ({}): {}",
+        nominal.describe()[..3].join("; "),
+        summary_text(&nominal_score)
+    );
+    let _ = writeln!(text, "fitted ensemble: {}", summary_text(&fitted_score));
+    let report = CalibrateReport {
+        command: command_line(args),
+        measured: args.measured.display().to_string(),
+        calibration: &cal,
+        nominal: nominal.describe(),
+        nominal_score: &nominal_score,
+        fitted: fitted.describe(),
+        fitted_score: &fitted_score,
+        hidden,
+    };
+    emit(&report, &text, c, "calibrate", &args.measured, |dir| {
+        write_report(&report, &text, dir)
+    })
+}
+
+fn command_line(args: &CalibrateArgs) -> String {
+    format!(
+        "pinfeed calibrate {}{} --members {} --support {} --jitter {} --mu-c-range {} --pin-radius-max {} --pin-radius-sd {} --mu-c {} --score-members {} {}",
+        shell_word(&args.measured.display().to_string()),
+        if args.synthesize { " --synthesize" } else { "" },
+        args.members,
+        shell_word(&args.support),
+        args.jitter,
+        shell_word(&args.mu_c_range),
+        args.pin_radius_max,
+        args.pin_radius_sd,
+        args.mu_c,
+        args.score_members,
+        args.common.words()
+    )
+}
+
+fn write_report(report: &CalibrateReport, text: &str, out_dir: &Path) -> Result<()> {
+    let head = ReportHead {
+        title: format!("Calibration: {}", report.measured),
+        command: &report.command,
+        intro: "Fitted ensemble:".into(),
+        bullets: &report.fitted,
+    };
+    write_report_files(out_dir, "calibration.json", report, head, |_| {
+        Ok(text.to_string())
+    })
+}

@@ -1,0 +1,399 @@
+//! `pinfeed validate MEASURED.csv`: measured bands against an ensemble's predictions (issue 16,
+//! [`crate::validate`]). Standard output gets one line per measured row (contained, overlapping,
+//! centre offset, predicted probability of the measured band, log score, predicted bands) and the
+//! summary; `--json` prints the whole report instead. Unless `--no-write`, the report directory
+//! (`results/validate/<file stem>/`) receives `README.md` headed by the regenerating command,
+//! `validate.json` and one figure per (part, input): the measured bands over the predicted
+//! distributions and bands against d.
+
+use super::map::shell_word;
+use super::map_ensemble::bands_text;
+use crate::maps::arcs::Arc;
+use crate::maps::ensemble::{EnsembleSpec, PredictedBands};
+use crate::report::plot_validate::plot_band_distributions;
+use crate::validate::measured::{self, Measured};
+use crate::validate::score::{RowScore, ScoreSettings, Summary};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Most members of a validation or calibration ensemble.
+pub const MAX_MEMBERS: usize = 1_000_000;
+
+/// The model and scoring options `validate` and `calibrate` share.
+#[derive(Debug, Args, Clone)]
+pub struct ModelArgs {
+    /// Fidelity: exact, ellipsoid or tip.
+    #[arg(long, default_value = "exact")]
+    pub model: String,
+    /// Integration tolerance.
+    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
+    pub tol: f64,
+    /// Passes per member and measured row.
+    #[arg(long, default_value_t = 1)]
+    pub passes: usize,
+    /// Seed of the ensemble.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Log score: kernel sd h in degrees (the measurement error of a band end).
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    pub kernel: f64,
+    /// Log score: weight of the uniform floor ε.
+    #[arg(long, default_value_t = 0.01, allow_hyphen_values = true)]
+    pub floor: f64,
+    /// Log score: window (degrees each side) for rows with input `all`.
+    #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
+    pub window: f64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Report directory [default: results/<command>/<file stem>].
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
+    /// Print only; write no files.
+    #[arg(long, conflicts_with = "out_dir")]
+    pub no_write: bool,
+    /// Worker threads (0: one per core); the result does not depend on it.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+impl ModelArgs {
+    /// The score settings, checked.
+    pub fn score(&self) -> Result<ScoreSettings> {
+        let checks = [
+            ("--kernel", self.kernel, 0.01, 90.0),
+            ("--floor", self.floor, 1e-9, 1.0),
+            ("--window", self.window, 0.0, 180.0),
+            ("--tol", self.tol, 1e-12, 1e-2),
+        ];
+        for (flag, v, lo, hi) in checks {
+            if !(v.is_finite() && v >= lo && v <= hi) {
+                bail!("{flag} must lie in [{lo}, {hi}], got {v}");
+            }
+        }
+        if !(1..=100).contains(&self.passes) {
+            bail!("--passes must lie in [1, 100], got {}", self.passes);
+        }
+        if self.threads > super::map::MAX_THREADS {
+            bail!(
+                "--threads must lie in [0, {}], got {}",
+                super::map::MAX_THREADS,
+                self.threads
+            );
+        }
+        Ok(ScoreSettings {
+            kernel_deg: self.kernel,
+            floor: self.floor,
+            window_deg: self.window,
+        })
+    }
+
+    /// The flags as they regenerate a report.
+    pub fn words(&self) -> String {
+        let mut s = format!(
+            "--model {} --tol {} --passes {} --seed {} --kernel {} --floor {} --window {}",
+            shell_word(&self.model),
+            self.tol,
+            self.passes,
+            self.seed,
+            self.kernel,
+            self.floor,
+            self.window
+        );
+        if let Some(d) = &self.out_dir {
+            s.push_str(&format!(
+                " --out-dir {}",
+                shell_word(&d.display().to_string())
+            ));
+        }
+        s
+    }
+
+    /// The report directory for `command` and the measured file.
+    pub fn out_dir(&self, command: &str, file: &Path) -> PathBuf {
+        self.out_dir.clone().unwrap_or_else(|| {
+            let stem = file
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("measured");
+            Path::new("results")
+                .join(command)
+                .join(super::part_folder(stem))
+        })
+    }
+}
+
+/// Arguments of `pinfeed validate`.
+#[derive(Debug, Args)]
+pub struct ValidateArgs {
+    /// The measured-bands file (CSV; README "Validating against measurements").
+    pub measured: PathBuf,
+    /// Uncertain parameters, as for `pinfeed map --uncertain` (none: the nominal model).
+    #[arg(long, value_name = "KEY=VALUE,...")]
+    pub uncertain: Option<String>,
+    /// Nominal pin–part friction μc (replaced by `mu_c=` in --uncertain).
+    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
+    pub mu_c: f64,
+    /// Nominal pin radius in part units (replaced by `pin_radius=` in --uncertain).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub pin_radius: f64,
+    /// Members of the ensemble.
+    #[arg(long, default_value_t = crate::validate::DEFAULT_MEMBERS)]
+    pub members: usize,
+    #[command(flatten)]
+    pub common: ModelArgs,
+}
+
+/// A worker pool of `threads` threads (0: one per core).
+pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the worker threads")
+}
+
+/// The ensemble of the nominal values with `uncertain` applied.
+pub fn ensemble_spec(
+    mu_c: f64,
+    pin_radius: f64,
+    uncertain: Option<&str>,
+    common: &ModelArgs,
+) -> Result<EnsembleSpec> {
+    let model = super::contact::parse_model(&common.model)?;
+    if !(mu_c.is_finite() && (0.0..=10.0).contains(&mu_c)) {
+        bail!("--mu-c must lie in [0, 10], got {mu_c}");
+    }
+    if !(pin_radius.is_finite() && pin_radius >= 0.0) {
+        bail!("--pin-radius must be a finite number ≥ 0, got {pin_radius}");
+    }
+    let spec = EnsembleSpec::nominal(mu_c, pin_radius, model, common.tol);
+    match uncertain {
+        None => Ok(spec),
+        Some(u) => spec
+            .with_settings(u)
+            .map_err(|e| anyhow::anyhow!("--uncertain: {e}")),
+    }
+}
+
+/// Print a report (`--json`: the document, else `text`) and, unless `--no-write`, have `write`
+/// write it into `results/<command>/<file stem>/` (or `--out-dir`).
+pub fn emit<T: Serialize>(
+    report: &T,
+    text: &str,
+    c: &ModelArgs,
+    command: &str,
+    file: &Path,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
+    if c.json {
+        println!("{}", serde_json::to_string_pretty(report)?);
+    } else {
+        print!("{text}");
+    }
+    if !c.no_write {
+        let out_dir = c.out_dir(command, file);
+        write(&out_dir)?;
+        eprintln!("report written to {}", out_dir.display());
+    }
+    Ok(())
+}
+
+/// The head of a report's README.md: title, regenerating command, a sentence and a bullet list.
+pub struct ReportHead<'a> {
+    pub title: String,
+    pub command: &'a str,
+    pub intro: String,
+    pub bullets: &'a [String],
+}
+
+/// Create `out_dir`, write `report` there as `json_name`, then README.md: the head followed by
+/// what `body` returns (it may write figures into `out_dir`).
+pub fn write_report_files<T: Serialize>(
+    out_dir: &Path,
+    json_name: &str,
+    report: &T,
+    head: ReportHead,
+    body: impl FnOnce(&Path) -> Result<String>,
+) -> Result<()> {
+    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    let json = out_dir.join(json_name);
+    std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
+        .with_context(|| format!("writing {}", json.display()))?;
+    let mut md = format!(
+        "# {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{}\n\n",
+        head.title, head.command, head.intro
+    );
+    for line in head.bullets {
+        let _ = writeln!(md, "* {line}");
+    }
+    md.push('\n');
+    md.push_str(&body(out_dir)?);
+    let readme = out_dir.join("README.md");
+    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
+    Ok(())
+}
+
+/// Check the member count.
+pub fn check_members(members: usize) -> Result<()> {
+    if !(1..=MAX_MEMBERS).contains(&members) {
+        bail!("--members must lie in [1, {MAX_MEMBERS}], got {members}");
+    }
+    Ok(())
+}
+
+/// The document `validate.json`.
+#[derive(Debug, Serialize)]
+pub struct ValidateReport<'a> {
+    pub command: String,
+    pub measured: String,
+    pub uncertain: Vec<String>,
+    pub members: usize,
+    pub score_settings: ScoreSettings,
+    pub summary: &'a Summary,
+    pub rows: &'a [RowScore],
+}
+
+/// One line per row, then the summary.
+pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
+    let mut s = String::from("| line | part | d | input | measured | trials | contained | overlapping | centre offset | P(measured) | log score | predicted bands (90%) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let yes = |b: bool| if b { "yes" } else { "no" };
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:+} | {} | [{}, {}] | {} | {} | {} | {} | {:.3} | {:.2} | {} |",
+            r.line,
+            r.part,
+            r.d,
+            r.input,
+            r.min_deg,
+            r.max_deg,
+            r.trials.map_or("—".into(), |n| n.to_string()),
+            yes(r.contained),
+            yes(r.overlapping),
+            r.centre_offset_deg
+                .map_or("—".into(), |o| format!("{o:+.1}°")),
+            r.predicted_probability,
+            r.log_score,
+            bands_text(&r.predicted)
+        );
+    }
+    let _ = writeln!(s, "\n{}", summary_text(summary));
+    s
+}
+
+/// The summary in one line.
+pub fn summary_text(s: &Summary) -> String {
+    format!(
+        "{} rows: {} contained, {} overlapping; predicted bands cover {:.1}% of the circle on average; log score {:.2} ({:.3} per row)",
+        s.rows,
+        s.contained,
+        s.overlapping,
+        100.0 * s.coverage,
+        s.log_score,
+        s.mean_log_score
+    )
+}
+
+/// Load the measured file for an ensemble (its largest pin radius sets the reach of d).
+pub fn load_measured(path: &Path, spec: &EnsembleSpec) -> Result<Measured> {
+    Ok(measured::load(path, spec.max_pin_radius())?)
+}
+
+pub fn run(args: &ValidateArgs) -> Result<()> {
+    let score = args.common.score()?;
+    check_members(args.members)?;
+    let spec = ensemble_spec(
+        args.mu_c,
+        args.pin_radius,
+        args.uncertain.as_deref(),
+        &args.common,
+    )?;
+    let measured = load_measured(&args.measured, &spec)?;
+    let c = &args.common;
+    let (rows, summary, _) = pool(c.threads)?
+        .install(|| {
+            crate::validate::validate(&measured, &spec, c.seed, args.members, c.passes, &score)
+        })
+        .map_err(anyhow::Error::msg)?;
+    let mut command = format!(
+        "pinfeed validate {} --mu-c {} --pin-radius {} --members {} {}",
+        shell_word(&args.measured.display().to_string()),
+        args.mu_c,
+        args.pin_radius,
+        args.members,
+        c.words()
+    );
+    if let Some(u) = &args.uncertain {
+        command.push_str(&format!(" --uncertain {}", shell_word(u)));
+    }
+    let report = ValidateReport {
+        command,
+        measured: args.measured.display().to_string(),
+        uncertain: spec.describe(),
+        members: args.members,
+        score_settings: score,
+        summary: &summary,
+        rows: &rows,
+    };
+    let text = rows_text(&rows, &summary);
+    emit(&report, &text, c, "validate", &args.measured, |dir| {
+        write_report(&report, &text, dir)
+    })
+}
+
+/// Figures of measured bands over predictions, one per (part, input): (file name, title) written.
+pub fn write_figures(rows: &[RowScore], dir: &Path) -> Result<Vec<String>> {
+    let mut groups: Vec<(String, String)> = Vec::new();
+    for r in rows {
+        let key = (r.part.clone(), r.input.clone());
+        if !groups.contains(&key) {
+            groups.push(key);
+        }
+    }
+    let mut names = Vec::new();
+    for (part, input) in groups {
+        let of: Vec<&RowScore> = rows
+            .iter()
+            .filter(|r| r.part == part && r.input == input)
+            .collect();
+        // One prediction per d (rows of a thesis-style table share theirs).
+        let mut predicted: Vec<&PredictedBands> = Vec::new();
+        for r in &of {
+            if !predicted.iter().any(|p| p.d == r.d) {
+                predicted.push(&r.predicted);
+            }
+        }
+        let measured: Vec<(f64, Arc)> = of
+            .iter()
+            .map(|r| (r.d, Arc::from_ends(r.min_deg, r.max_deg)))
+            .collect();
+        let name = format!(
+            "bands_{}_{}.svg",
+            super::part_folder(&part),
+            super::part_folder(&input)
+        );
+        let title = format!("{part}, input {input}: measured bands over predicted θf");
+        plot_band_distributions(&predicted, &measured, &title, &dir.join(&name))?;
+        names.push(name);
+    }
+    Ok(names)
+}
+
+fn write_report(report: &ValidateReport, text: &str, out_dir: &Path) -> Result<()> {
+    let head = ReportHead {
+        title: format!("Validation: {}", report.measured),
+        command: &report.command,
+        intro: format!("{} members; ensemble:", report.members),
+        bullets: &report.uncertain,
+    };
+    write_report_files(out_dir, "validate.json", report, head, |dir| {
+        let mut md = format!("{text}\n");
+        for name in write_figures(report.rows, dir)? {
+            let _ = writeln!(md, "![{name}]({name})\n");
+        }
+        Ok(md)
+    })
+}

@@ -1,0 +1,494 @@
+//! Ensemble maps (issue 16): configuration maps under uncertain physics. Each ensemble *member*
+//! is one draw of the uncertain parameters — pin–part friction μc, the support (uniform pressure,
+//! or with probability `support_share` a random tripod or random smooth density, drawn as the
+//! Monte Carlo studies draw them: [`crate::study::mc::sample::draw_support`]), the pin radius — and
+//! every pass it makes adds a pose error (normal, `jitter_deg`) to θ0. The distribution of θf at
+//! (d, input state) is the pool of all members' passes; its predicted bands are the smallest set of
+//! arcs holding 90% of it, gaps under 5° closed ([`super::arcs::highest_density_arcs`]).
+//!
+//! Random streams (DESIGN.md "determinism"): member i of an ensemble seeded with s draws five
+//! sub-seeds from `random::stream(s, i)`, in the order μc, support share, support shape, pin radius,
+//! pose jitter; pass number p of member i draws its jitter z (and, for a θ0 arc, its uniform u) from
+//! `random::stream(jitter sub-seed, p)`. A value is always `mean + sd·z`, `min + (max − min)·u` or
+//! `u < share` of its own stream, so member i sees the same underlying numbers under any parameters
+//! (common random numbers) — which is what lets calibration reweight one ensemble — and nothing
+//! depends on the thread count.
+
+use super::arcs::{Arc, MassArc};
+use super::sample::sample_one;
+use super::MapSettings;
+use crate::geometry::{wrap_deg, Polygon};
+use crate::mechanics::{ContactSettings, Fidelity, PartModel, Pin};
+use crate::random::distribution::Distribution;
+use crate::random::{stream, ChaCha8Rng};
+use crate::study::mc::perturbations::{SmoothParams, SupportChoice};
+use crate::study::mc::sample::draw_support;
+use rand::{RngExt, SeedableRng};
+use rand_distr::{Distribution as _, StandardNormal};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// Mass held by the predicted bands.
+pub const BAND_MASS: f64 = 0.9;
+/// Resolution of the predicted bands (degrees).
+pub const BAND_BIN_DEG: f64 = 1.0;
+/// Gaps narrower than this between predicted bands are closed (degrees; the maps' default T).
+pub const BAND_JOIN_DEG: f64 = 5.0;
+
+/// What is uncertain, and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnsembleSpec {
+    /// μc of each member.
+    pub mu_c: Distribution,
+    /// The non-uniform support model a member uses with probability `support_share`.
+    pub support: SupportChoice,
+    pub support_share: f64,
+    /// Pin radius of each member (the polygon's units).
+    pub pin_radius: Distribution,
+    /// Standard deviation of the θ0 error of each pass (degrees).
+    pub jitter_deg: f64,
+    pub fidelity: Fidelity,
+    pub tol: f64,
+}
+
+impl EnsembleSpec {
+    /// No uncertainty: one friction, uniform support, one pin radius, no jitter.
+    pub fn nominal(mu_c: f64, pin_radius: f64, fidelity: Fidelity, tol: f64) -> EnsembleSpec {
+        EnsembleSpec {
+            mu_c: Distribution::Fixed(mu_c),
+            support: SupportChoice::Uniform,
+            support_share: 0.0,
+            pin_radius: Distribution::Fixed(pin_radius),
+            jitter_deg: 0.0,
+            fidelity,
+            tol,
+        }
+    }
+
+    /// Apply a comma-separated list of `key=value` settings to `self`:
+    /// `mu_c=DIST`, `pin_radius=DIST` (DIST: a number, `uniform:MIN:MAX`, `normal:MEAN:SD`,
+    /// `triangular:MIN:MODE:MAX`), `support=uniform|tripod:SHARE|smooth:SHARE`, `jitter=SD_DEG`.
+    pub fn with_settings(mut self, text: &str) -> Result<EnsembleSpec, String> {
+        for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let (key, value) = item
+                .split_once('=')
+                .ok_or_else(|| format!("'{item}': expected KEY=VALUE"))?;
+            let (key, value) = (key.trim(), value.trim());
+            match key {
+                "mu_c" => self.mu_c = parse_distribution(value, "mu_c", 0.0, 10.0)?,
+                "pin_radius" => {
+                    self.pin_radius = parse_distribution(value, "pin_radius", 0.0, 1e6)?
+                }
+                "support" => (self.support, self.support_share) = parse_support(value)?,
+                "jitter" => self.jitter_deg = parse_number(value, "jitter", 0.0, 90.0)?,
+                _ => {
+                    return Err(format!(
+                        "unknown uncertain parameter '{key}'; expected mu_c, support, pin_radius or jitter"
+                    ))
+                }
+            }
+        }
+        Ok(self)
+    }
+
+    /// One line per parameter.
+    pub fn describe(&self) -> Vec<String> {
+        let support = match self.support {
+            SupportChoice::Uniform => "uniform pressure".to_string(),
+            other => format!(
+                "{} with probability {}, else uniform",
+                other.describe(),
+                self.support_share
+            ),
+        };
+        vec![
+            format!("mu_c: {}", self.mu_c.describe()),
+            format!("support: {support}"),
+            format!("pin_radius: {} (part units)", self.pin_radius.describe()),
+            format!("pose jitter: normal sd {}° per pass", self.jitter_deg),
+            format!("model: {}, tolerance {}", self.fidelity, self.tol),
+        ]
+    }
+
+    /// Largest pin radius any member can have.
+    pub fn max_pin_radius(&self) -> f64 {
+        self.pin_radius.range().1.max(0.0)
+    }
+}
+
+fn parse_number(s: &str, what: &str, lo: f64, hi: f64) -> Result<f64, String> {
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{what}: '{s}' is not a number"))?;
+    if !(v.is_finite() && (lo..=hi).contains(&v)) {
+        return Err(format!("{what}: {v} must lie in [{lo}, {hi}]"));
+    }
+    Ok(v)
+}
+
+/// A distribution written `V`, `uniform:MIN:MAX`, `normal:MEAN:SD` or `triangular:MIN:MODE:MAX`.
+fn parse_distribution(s: &str, what: &str, lo: f64, hi: f64) -> Result<Distribution, String> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let n = |k: usize| parse_number(parts[k], what, -hi, hi);
+    let d = match (parts[0], parts.len()) {
+        (_, 1) => Distribution::Fixed(parse_number(s, what, lo, hi)?),
+        ("uniform", 3) => Distribution::Uniform {
+            min: n(1)?,
+            max: n(2)?,
+        },
+        ("normal", 3) => Distribution::Normal {
+            mean: n(1)?,
+            sd: parse_number(parts[2], what, 0.0, hi)?,
+            lo,
+            hi,
+        },
+        ("triangular", 4) => Distribution::Triangular {
+            min: n(1)?,
+            mode: n(2)?,
+            max: n(3)?,
+        },
+        _ => {
+            return Err(format!(
+                "{what}: '{s}' is not a number, uniform:MIN:MAX, normal:MEAN:SD or triangular:MIN:MODE:MAX"
+            ))
+        }
+    };
+    let (a, b) = d.range();
+    if a > b || b < lo || a > hi {
+        return Err(format!(
+            "{what}: '{s}' has no values in [{lo}, {hi}] (or its minimum exceeds its maximum)"
+        ));
+    }
+    Ok(d)
+}
+
+/// `uniform`, `tripod:SHARE` or `smooth:SHARE` (default smooth-density parameters).
+fn parse_support(s: &str) -> Result<(SupportChoice, f64), String> {
+    let (kind, share) = match s.split_once(':') {
+        Some((k, v)) => (k, parse_number(v, "support share", 0.0, 1.0)?),
+        None => (s, 1.0),
+    };
+    match kind {
+        "uniform" => Ok((SupportChoice::Uniform, 0.0)),
+        "tripod" => Ok((SupportChoice::Tripod, share)),
+        "smooth" => Ok((SupportChoice::Smooth(SmoothParams::default()), share)),
+        _ => Err(format!(
+            "support: '{s}' must be uniform, tripod:SHARE or smooth:SHARE"
+        )),
+    }
+}
+
+/// The input of a pass: where θ0 comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum InputState {
+    /// Resting in stable state k (SPEC §1; the order of `pinfeed part`).
+    State { index: usize },
+    /// θ0 uniform on an arc.
+    Theta { arc: Arc },
+    /// θ0 uniform on the whole circle.
+    All,
+}
+
+impl InputState {
+    /// `state:K`, `theta:MIN:MAX` or `all`.
+    pub fn label(&self) -> String {
+        match self {
+            InputState::State { index } => format!("state:{index}"),
+            InputState::Theta { arc } => format!("theta:{}:{}", arc.lo, arc.hi()),
+            InputState::All => "all".into(),
+        }
+    }
+
+    /// The θ0 of a pass (degrees) given a uniform u ∈ [0, 1) and the stable states (degrees).
+    pub fn theta0(&self, u: f64, states_deg: &[f64]) -> f64 {
+        match self {
+            InputState::State { index } => states_deg[*index],
+            InputState::Theta { arc } => wrap_deg(arc.lo + u * arc.width),
+            InputState::All => u * 360.0,
+        }
+    }
+}
+
+/// The stable states of a part in degrees, in the order of `pinfeed part`.
+pub fn stable_states_deg(poly: &Polygon) -> Vec<f64> {
+    poly.stable_states()
+        .iter()
+        .map(|s| s.theta.to_degrees())
+        .collect()
+}
+
+/// The values member i drew.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MemberDraw {
+    pub mu_c: f64,
+    /// Does the member rest on the random support model (else uniform pressure)?
+    pub random_support: bool,
+    pub pin_radius: f64,
+    #[serde(skip)]
+    support_seed: u64,
+    #[serde(skip)]
+    jitter_seed: u64,
+}
+
+/// Draw member `i` of an ensemble seeded with `seed`.
+pub fn draw_member(spec: &EnsembleSpec, seed: u64, i: u64) -> Result<MemberDraw, String> {
+    let mut master = stream(seed, i);
+    let mut next = || ChaCha8Rng::seed_from_u64(master.random::<u64>());
+    let (mut mu, mut share, mut shape, mut radius, mut jitter) =
+        (next(), next(), next(), next(), next());
+    let (mu_c, _) = spec.mu_c.draw(&mut mu, |v| v >= 0.0)?;
+    let (pin_radius, _) = spec.pin_radius.draw(&mut radius, |v| v >= 0.0)?;
+    Ok(MemberDraw {
+        mu_c,
+        random_support: share.random::<f64>() < spec.support_share,
+        pin_radius,
+        support_seed: shape.random::<u64>(),
+        jitter_seed: jitter.random::<u64>(),
+    })
+}
+
+/// One member: its draw and its compiled part.
+pub struct Member {
+    pub draw: MemberDraw,
+    model: PartModel,
+}
+
+impl Member {
+    /// Compile member `i` (its support drawn on `poly`).
+    pub fn new(poly: &Polygon, spec: &EnsembleSpec, seed: u64, i: u64) -> Result<Member, String> {
+        let draw = draw_member(spec, seed, i)?;
+        let choice = if draw.random_support {
+            spec.support
+        } else {
+            SupportChoice::Uniform
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(draw.support_seed);
+        let support = draw_support(poly, &choice, &mut rng, &mut 0)?;
+        let model = PartModel::new(poly, &support)?;
+        Ok(Member { draw, model })
+    }
+
+    /// The uniform u and normal z of pass number `pass`.
+    fn pass_numbers(&self, pass: u64) -> (f64, f64) {
+        let mut rng = stream(self.draw.jitter_seed, pass);
+        let u = rng.random::<f64>();
+        let z: f64 = StandardNormal.sample(&mut rng);
+        (u, z)
+    }
+
+    /// θf (degrees, wrapped) of pass number `pass` from `input` at contact parameter `d`.
+    pub fn pass(
+        &self,
+        poly: &Polygon,
+        spec: &EnsembleSpec,
+        input: &InputState,
+        states_deg: &[f64],
+        d: f64,
+        pass: u64,
+    ) -> f64 {
+        let (u, z) = self.pass_numbers(pass);
+        let theta0 = input.theta0(u, states_deg) + spec.jitter_deg * z;
+        let settings = MapSettings {
+            theta_step_deg: 1.0,
+            threshold_deg: 5.0,
+            contact: ContactSettings {
+                fidelity: spec.fidelity,
+                mu_c: self.draw.mu_c,
+                tol: spec.tol,
+                ..ContactSettings::default()
+            },
+            pin: Pin {
+                radius: self.draw.pin_radius,
+                lateral_speed: 0.0,
+            },
+            fence: None,
+        };
+        wrap_deg(sample_one(poly, &self.model, theta0, d, &settings).theta_final_deg)
+    }
+}
+
+/// Compile members 0 … n − 1 in parallel (in index order).
+pub fn members(
+    poly: &Polygon,
+    spec: &EnsembleSpec,
+    seed: u64,
+    n: usize,
+) -> Result<Vec<Member>, String> {
+    (0..n as u64)
+        .into_par_iter()
+        .map(|i| Member::new(poly, spec, seed, i).map_err(|e| format!("ensemble member {i}: {e}")))
+        .collect()
+}
+
+/// An ensemble of maps: θf of every member at every (d, grid θ0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnsembleMaps {
+    pub ds: Vec<f64>,
+    pub grid: Vec<f64>,
+    pub members: Vec<MemberDraw>,
+    /// θf (degrees), index (member · ds + d) · grid + θ0.
+    pub theta_f: Vec<f64>,
+}
+
+/// Sample the ensemble maps: `n` members, each passing at every (d, θ0 on `grid`); pass number
+/// j · grid + k for d number j and θ0 number k (its jitter). Runs on the current rayon pool.
+pub fn ensemble_maps(
+    poly: &Polygon,
+    spec: &EnsembleSpec,
+    ds: &[f64],
+    grid: &[f64],
+    seed: u64,
+    n: usize,
+) -> Result<EnsembleMaps, String> {
+    let members = members(poly, spec, seed, n)?;
+    let (nd, nk) = (ds.len(), grid.len());
+    let states = stable_states_deg(poly);
+    let theta_f: Vec<f64> = (0..n * nd * nk)
+        .into_par_iter()
+        .map(|x| {
+            let (i, j, k) = (x / (nd * nk), (x / nk) % nd, x % nk);
+            let input = InputState::Theta {
+                arc: Arc {
+                    lo: grid[k],
+                    width: 0.0,
+                },
+            };
+            members[i].pass(poly, spec, &input, &states, ds[j], (j * nk + k) as u64)
+        })
+        .collect();
+    Ok(EnsembleMaps {
+        ds: ds.to_vec(),
+        grid: grid.to_vec(),
+        members: members.iter().map(|m| m.draw).collect(),
+        theta_f,
+    })
+}
+
+/// The predicted bands at one (d, input state).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PredictedBands {
+    pub d: f64,
+    pub input: String,
+    /// Passes pooled.
+    pub passes: usize,
+    /// The smallest arcs holding [`BAND_MASS`] of the passes.
+    pub bands: Vec<MassArc>,
+    /// Share of the circle they cover.
+    pub coverage: f64,
+    /// The distribution of θf: shares of the passes in 1° bins [k°, k + 1°), k = 0 … 359.
+    pub histogram: Vec<f64>,
+}
+
+impl PredictedBands {
+    /// The predicted bands of the weighted angles `values` (degrees).
+    pub fn of(d: f64, input: String, values: &[f64], weights: &[f64]) -> PredictedBands {
+        let bands = super::arcs::highest_density_arcs(
+            values,
+            weights,
+            BAND_MASS,
+            BAND_BIN_DEG,
+            BAND_JOIN_DEG,
+        );
+        let arcs: Vec<Arc> = bands.iter().map(|b| b.arc).collect();
+        let mut histogram = vec![0.0; 360];
+        let total: f64 = weights.iter().sum();
+        for (&v, &w) in values.iter().zip(weights) {
+            histogram[(wrap_deg(v) as usize).min(359)] += w / total.max(f64::MIN_POSITIVE);
+        }
+        PredictedBands {
+            d,
+            input,
+            passes: values.len(),
+            coverage: super::arcs::coverage_share(&arcs),
+            bands,
+            histogram,
+        }
+    }
+}
+
+impl EnsembleMaps {
+    /// θf of all members at d number `j` whose grid θ0 the input state covers (a stable state:
+    /// the grid θ0 nearest it).
+    pub fn pooled(&self, j: usize, input: &InputState, states_deg: &[f64]) -> Vec<f64> {
+        let (nd, nk) = (self.ds.len(), self.grid.len());
+        let ks: Vec<usize> = match input {
+            InputState::All => (0..nk).collect(),
+            InputState::Theta { arc } => (0..nk)
+                .filter(|&k| arc.contains_angle(self.grid[k]))
+                .collect(),
+            InputState::State { index } => {
+                let t = states_deg[*index];
+                let dist = |k: usize| super::arcs::signed_difference(self.grid[k], t).abs();
+                vec![(0..nk).fold(0, |b, k| if dist(k) < dist(b) { k } else { b })]
+            }
+        };
+        (0..self.members.len())
+            .flat_map(|i| ks.iter().map(move |&k| self.theta_f[(i * nd + j) * nk + k]))
+            .collect()
+    }
+
+    /// Predicted bands per d for each input state.
+    pub fn predicted(&self, inputs: &[InputState], states_deg: &[f64]) -> Vec<PredictedBands> {
+        let mut out = Vec::new();
+        for (j, &d) in self.ds.iter().enumerate() {
+            for input in inputs {
+                let v = self.pooled(j, input, states_deg);
+                out.push(PredictedBands::of(
+                    d,
+                    input.label(),
+                    &v,
+                    &vec![1.0; v.len()],
+                ));
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_parse_and_bad_ones_are_refused() {
+        let base = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6);
+        let s = base
+            .clone()
+            .with_settings(
+                "mu_c=normal:0.4:0.1, support=tripod:0.3, pin_radius=uniform:0:0.1, jitter=2",
+            )
+            .unwrap();
+        assert_eq!(s.support, SupportChoice::Tripod);
+        assert_eq!(s.support_share, 0.3);
+        assert_eq!(s.jitter_deg, 2.0);
+        assert_eq!(s.max_pin_radius(), 0.1);
+        for bad in [
+            "mu_c=-1",
+            "friction=0.3",
+            "support=glue",
+            "jitter=x",
+            "mu_c=normal:1",
+        ] {
+            assert!(base.clone().with_settings(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn members_draw_common_random_numbers() {
+        let a = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
+            .with_settings("mu_c=normal:0.5:0.1,support=tripod:0.5")
+            .unwrap();
+        let b = a.clone().with_settings("mu_c=normal:0.6:0.2").unwrap();
+        for i in 0..20 {
+            let (x, y) = (
+                draw_member(&a, 9, i).unwrap(),
+                draw_member(&b, 9, i).unwrap(),
+            );
+            if x.mu_c > 0.0 && y.mu_c > 0.0 {
+                assert!((y.mu_c - 0.6 - 2.0 * (x.mu_c - 0.5)).abs() < 1e-12);
+            }
+            assert_eq!(x.random_support, y.random_support);
+        }
+    }
+}

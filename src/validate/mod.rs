@@ -1,0 +1,38 @@
+//! Measured bands against the model (issue 16): `pinfeed validate` and `pinfeed calibrate`.
+//!
+//! * [`measured`]: the measured-bands CSV and its located errors;
+//! * [`predict`]: an ensemble's passes for every measured row ([`crate::maps::ensemble`]);
+//! * [`score`]: containment, overlap, centre offset, predicted probability, coverage, log score;
+//! * [`calibrate`]: maximum-likelihood fit of μc centre and spread, tripod share and pin radius
+//!   over one reweighted ensemble, with profile-likelihood intervals;
+//! * [`synthetic`]: a measured-bands file drawn from hidden parameters, to check the two against.
+
+pub mod calibrate;
+pub mod measured;
+pub mod predict;
+pub mod score;
+pub mod synthetic;
+
+use crate::maps::ensemble::EnsembleSpec;
+use measured::Measured;
+use predict::Predictions;
+use score::{RowScore, ScoreSettings, Summary};
+
+/// Default members of a validation ensemble.
+pub const DEFAULT_MEMBERS: usize = 500;
+
+/// Score `measured` against `members` members of the ensemble `spec` seeded with `seed`.
+pub fn validate(
+    measured: &Measured,
+    spec: &EnsembleSpec,
+    seed: u64,
+    members: usize,
+    passes: usize,
+    score: &ScoreSettings,
+) -> Result<(Vec<RowScore>, Summary, Predictions), String> {
+    let pred = predict::predict(measured, spec, seed, members, passes)?;
+    let weights = vec![1.0; pred.members.len() * passes];
+    let rows = score::score_rows(measured, &pred.rows, &weights, score);
+    let summary = score::summarise(&rows);
+    Ok((rows, summary, pred))
+}

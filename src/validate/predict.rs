@@ -1,0 +1,75 @@
+//! What an ensemble predicts for each measured row: `passes` passes of every member from the
+//! row's input state at the row's d ([`crate::maps::ensemble::Member::pass`]). Row r's pass q of
+//! member i is pass number r · passes + q of that member, so its jitter and θ0 draw are fixed by
+//! (seed, i, r, q) whatever the thread count. Members are compiled once per part; a member's draw
+//! (μc, support choice, pin radius) is the same for every part.
+
+use super::measured::Measured;
+use crate::maps::ensemble::{members, stable_states_deg, EnsembleSpec, Member, MemberDraw};
+use rayon::prelude::*;
+
+/// The predicted final orientations of every row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Predictions {
+    /// θf (degrees) per row, index member · passes + q.
+    pub rows: Vec<Vec<f64>>,
+    pub members: Vec<MemberDraw>,
+    pub passes: usize,
+}
+
+impl Predictions {
+    /// Member weights expanded to one weight per pass.
+    pub fn pass_weights(&self, member_weights: &[f64]) -> Vec<f64> {
+        member_weights
+            .iter()
+            .flat_map(|&w| std::iter::repeat_n(w, self.passes))
+            .collect()
+    }
+}
+
+/// Predict every row of `measured` with `n` members of the ensemble `spec` seeded with `seed`.
+pub fn predict(
+    measured: &Measured,
+    spec: &EnsembleSpec,
+    seed: u64,
+    n: usize,
+    passes: usize,
+) -> Result<Predictions, String> {
+    let compiled: Vec<(String, Vec<Member>, Vec<f64>)> = measured
+        .parts
+        .iter()
+        .map(|(name, poly)| {
+            let m = members(poly, spec, seed, n)?;
+            Ok((name.clone(), m, stable_states_deg(poly)))
+        })
+        .collect::<Result<_, String>>()?;
+    let rows = measured
+        .rows
+        .iter()
+        .enumerate()
+        .map(|(r, row)| {
+            let (_, ms, states) = compiled
+                .iter()
+                .find(|(p, _, _)| *p == row.part)
+                .expect("every row's part is compiled");
+            let poly = measured.polygon(&row.part);
+            (0..n * passes)
+                .into_par_iter()
+                .map(|x| {
+                    let (i, q) = (x / passes, x % passes);
+                    let pass = (r * passes + q) as u64;
+                    ms[i].pass(poly, spec, &row.input, states, row.d, pass)
+                })
+                .collect()
+        })
+        .collect();
+    let draws = compiled
+        .first()
+        .map(|(_, ms, _)| ms.iter().map(|m| m.draw).collect())
+        .unwrap_or_default();
+    Ok(Predictions {
+        rows,
+        members: draws,
+        passes,
+    })
+}
