@@ -474,3 +474,71 @@ fn the_build_does_not_depend_on_the_thread_count() {
     assert!(one.len() > 1000);
     assert_eq!(one, on(2), "same file byte for byte");
 }
+
+fn pinfeed_json(args: &[&str]) -> serde_json::Value {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(args)
+        .output()
+        .expect("run pinfeed");
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("JSON")
+}
+
+#[test]
+fn configuration_maps_from_the_map_tier_match_exact_and_refuse_what_it_cannot_tabulate() {
+    // `pinfeed map --model map`: every θf within 0.05° of the exact map (served answers by the
+    // certificate, fallbacks because they are exact), the same bands; fences refused.
+    let dir = temp_dir("cli-map");
+    let common = [
+        "map",
+        "--part",
+        "tripoly2",
+        "--d=-0.5,0.3",
+        "--theta-step",
+        "4",
+        "--json",
+        "--no-write",
+    ];
+    let mut a = common.to_vec();
+    a.extend(["--model", "map", "--map-grid", "24,8,2", "--cache-dir"]);
+    a.push(dir.to_str().unwrap());
+    let map = pinfeed_json(&a);
+    let exact = pinfeed_json(&common);
+    assert_eq!(map["model"], "map");
+    for (m, e) in map["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(exact["maps"].as_array().unwrap())
+    {
+        assert_eq!(
+            m["bands"].as_array().unwrap().len(),
+            e["bands"].as_array().unwrap().len()
+        );
+        for (sm, se) in m["samples"].as_array().unwrap().iter().zip(se_samples(e)) {
+            let (a, b) = (
+                sm["theta_final_deg"].as_f64().unwrap(),
+                se["theta_final_deg"].as_f64().unwrap(),
+            );
+            let diff = ((a - b + 180.0).rem_euclid(360.0) - 180.0).abs();
+            assert!(diff <= 0.05, "θ0 {}: map {a} exact {b}", sm["theta0_deg"]);
+        }
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args([
+            "map", "--part", "tripoly2", "--fence", "36", "--model", "map",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--model map"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn se_samples(e: &serde_json::Value) -> impl Iterator<Item = &serde_json::Value> {
+    e["samples"].as_array().unwrap().iter()
+}

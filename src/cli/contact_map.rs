@@ -5,8 +5,10 @@
 
 use super::contact::{case_of, check_geometry, check_inputs, compile_part, report, ContactArgs};
 use crate::engine::contact_map::prepare;
-use crate::maps::tier::{self, push_with_map, Loaded, Source, TierInputs, TierSpec};
-use crate::mechanics::{ContactSettings, Fidelity, Support};
+use crate::geometry::Polygon;
+use crate::maps::tier::{self, push_with_map, Loaded, Source, TierInputs, TierMap, TierSpec};
+use crate::maps::MapSettings;
+use crate::mechanics::{ContactSettings, Fidelity, PartModel, Support};
 use crate::scenario::Scene;
 use anyhow::{bail, Result};
 use std::collections::BTreeSet;
@@ -82,22 +84,14 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         tol: c.tol,
         ..ContactSettings::default()
     };
-    let spec = match args.map_grid.as_deref() {
-        Some(g) => parse_grid(g)?,
-        None => TierSpec::default(),
-    };
-    let inputs = TierInputs {
-        model: &model,
-        support: &support,
-        radius: c.pin_radius,
+    let loaded = load_tier(
+        &model,
+        &support,
+        c.pin_radius,
         settings,
-        spec,
-    };
-    let dir = cache_dir(args.cache_dir.as_deref());
-    let loaded = tier::load_or_build(&inputs, Some(&dir));
-    for w in &loaded.warnings {
-        eprintln!("warning: {w}");
-    }
+        args.map_grid.as_deref(),
+        args.cache_dir.as_deref(),
+    )?;
     let (pose, start) = super::contact::case_geometry(&poly, &c);
     let started = Instant::now();
     let (out, why) = push_with_map(&loaded.map, &model, pose, start, c.pin_radius, &settings);
@@ -141,6 +135,66 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         println!("map file            {f}");
     }
     Ok(())
+}
+
+/// The map of (part, support, pin radius, contact settings) on the grid `--map-grid` (default
+/// [`TierSpec::default`]), read from the cache folder or built and written there; its warnings
+/// (a stale or corrupted file) go to standard error.
+pub fn load_tier(
+    model: &PartModel,
+    support: &Support,
+    radius: f64,
+    settings: ContactSettings,
+    grid: Option<&str>,
+    dir: Option<&Path>,
+) -> Result<Loaded> {
+    let spec = match grid {
+        Some(g) => parse_grid(g)?,
+        None => TierSpec::default(),
+    };
+    let inputs = TierInputs {
+        model,
+        support,
+        radius,
+        settings,
+        spec,
+    };
+    let loaded = tier::load_or_build(&inputs, Some(&cache_dir(dir)));
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(loaded)
+}
+
+/// How many of a configuration map's passes (`pinfeed map --model map`) the map answered, how
+/// many the exact model computed and why.
+pub fn served_line(
+    map: &TierMap,
+    poly: &Polygon,
+    model: &PartModel,
+    ds: &[f64],
+    settings: &MapSettings,
+) -> String {
+    let grid = crate::maps::theta_grid(settings.theta_step_deg).unwrap_or_default();
+    let mut served = 0usize;
+    let mut why: std::collections::BTreeMap<&'static str, usize> = Default::default();
+    for &d in ds {
+        for &t in &grid {
+            let (pose, start) = crate::maps::pass_start(poly, t, d, settings.pin.radius);
+            match map.answer(model, pose, start, settings.pin.radius) {
+                Ok(_) => served += 1,
+                Err(w) => *why.entry(w.name()).or_default() += 1,
+            }
+        }
+    }
+    let total = ds.len() * grid.len();
+    let exact: Vec<String> = why.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    format!(
+        "map tier: {served} of {total} passes ({:.1}%) answered by the map (misses by the exact ray cast), {} exact ({})",
+        100.0 * served as f64 / total.max(1) as f64,
+        total - served,
+        if exact.is_empty() { "none".to_string() } else { exact.join(", ") }
+    )
 }
 
 /// `--map-grid T,D,DEPTH`.

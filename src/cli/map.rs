@@ -14,7 +14,7 @@ use super::contact::{
     case_fence, check_geometry, check_inputs, compile_part, num, parse_fence, parse_model,
     settings_and_pin, Case,
 };
-use crate::maps::{compute_maps, ConfigurationMap, MapFence, MapSettings};
+use crate::maps::{compute_maps_with, ConfigurationMap, MapFence, MapSettings};
 use crate::report::{map_table, plot_map};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
@@ -44,9 +44,17 @@ pub struct MapArgs {
     /// Spacing of the initial orientations θ0 (degrees; must divide 360).
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub theta_step: f64,
-    /// Fidelity: exact, ellipsoid or tip.
+    /// Fidelity: exact, ellipsoid or tip; or map (the certified map tier over exact, pins only).
     #[arg(long, default_value = "exact")]
     pub model: String,
+    /// With --model map: the folder of the map cache files (default $XDG_CACHE_HOME/pinfeed/maps
+    /// or ~/.cache/pinfeed/maps).
+    #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
+    pub cache_dir: Option<PathBuf>,
+    /// With --model map: the map's grid, θ0 base cells, d base cells, refinement depth
+    /// (default 36,12,4).
+    #[arg(long, value_name = "T,D,DEPTH")]
+    pub map_grid: Option<String>,
     /// Pin–part friction coefficient μc (≥ 0).
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
@@ -273,7 +281,12 @@ fn check_map_args(args: &MapArgs) -> Result<()> {
 }
 
 pub fn run(args: &MapArgs) -> Result<()> {
-    let model = parse_model(&args.model)?;
+    // The map tier answers over the exact model, which computes what it cannot vouch for.
+    let use_tier = args.model.trim() == "map";
+    if use_tier && (args.fence.is_some() || args.uncertain.is_some()) {
+        bail!("--model map: the map tier tabulates still pins with one support; use --model exact with --fence or --uncertain");
+    }
+    let model = parse_model(if use_tier { "exact" } else { &args.model })?;
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;
     let template = Case {
         part: args.part.clone(),
@@ -326,15 +339,46 @@ pub fn run(args: &MapArgs) -> Result<()> {
         .num_threads(args.threads)
         .build()
         .context("starting the worker threads")?;
+    let tier = if use_tier {
+        let support =
+            crate::mechanics::Support::parse(&args.support, &poly).map_err(anyhow::Error::msg)?;
+        let loaded = pool.install(|| {
+            super::contact_map::load_tier(
+                &part_model,
+                &support,
+                args.pin_radius,
+                contact,
+                args.map_grid.as_deref(),
+                args.cache_dir.as_deref(),
+            )
+        })?;
+        Some(loaded)
+    } else {
+        None
+    };
     let started = std::time::Instant::now();
-    let maps = pool.install(|| compute_maps(&poly, &part_model, &ds, &settings))?;
+    let maps = pool.install(|| {
+        compute_maps_with(
+            &poly,
+            &part_model,
+            &ds,
+            &settings,
+            tier.as_ref().map(|l| &*l.map),
+        )
+    })?;
     let elapsed = started.elapsed().as_secs_f64();
+    if let Some(l) = &tier {
+        eprintln!(
+            "{}",
+            super::contact_map::served_line(&l.map, &poly, &part_model, &ds, &settings)
+        );
+    }
     let contacts: usize = maps.iter().map(|m| m.samples.len()).sum();
     eprintln!(
         "computed {} maps × {} θ0 = {contacts} contacts ({}) in {elapsed:.3} s on {} threads",
         maps.len(),
         maps.first().map_or(0, |m| m.samples.len()),
-        model.name(),
+        if use_tier { "map" } else { model.name() },
         pool.current_num_threads()
     );
     let non_ok: usize = maps.iter().map(|m| m.non_ok_samples()).sum();
@@ -345,7 +389,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     let report = MapReport {
         command: command_line(args),
         part: &args.part,
-        model: model.name(),
+        model: if use_tier { "map" } else { model.name() },
         mu_c: args.mu_c,
         pin_radius: args.pin_radius,
         support: &args.support,

@@ -227,6 +227,18 @@ pub fn compute_maps(
     ds: &[f64],
     settings: &MapSettings,
 ) -> Result<Vec<ConfigurationMap>, MapError> {
+    compute_maps_with(poly, model, ds, settings, None)
+}
+
+/// [`compute_maps`] with a still pin's passes answered by the certified map `tier` where it can
+/// (`pinfeed map --model map`).
+pub fn compute_maps_with(
+    poly: &Polygon,
+    model: &PartModel,
+    ds: &[f64],
+    settings: &MapSettings,
+    tier: Option<&tier::TierMap>,
+) -> Result<Vec<ConfigurationMap>, MapError> {
     if ds.is_empty() {
         return Err(MapError::NoContactParameter);
     }
@@ -248,7 +260,7 @@ pub fn compute_maps(
         }
     }
     let grid = theta_grid(settings.theta_step_deg)?;
-    let rows = sample_maps(poly, model, ds, &grid, settings);
+    let rows = sample_maps(poly, model, ds, &grid, settings, tier);
     ds.iter()
         .zip(rows)
         .map(|(&d, row)| {

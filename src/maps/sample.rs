@@ -52,10 +52,26 @@ pub fn sample_one(
     d: f64,
     settings: &MapSettings,
 ) -> MapSample {
+    sample_one_with(poly, model, theta0_deg, d, settings, None)
+}
+
+/// [`sample_one`], a still pin's pass answered by the certified map `tier` where it can (the
+/// exact model elsewhere; see [`super::tier::push_with_map`]).
+pub fn sample_one_with(
+    poly: &Polygon,
+    model: &PartModel,
+    theta0_deg: f64,
+    d: f64,
+    settings: &MapSettings,
+    tier: Option<&super::tier::TierMap>,
+) -> MapSample {
     let (pin, contact) = (&settings.pin, &settings.contact);
     let (pose, start) = super::pass_start(poly, theta0_deg, d, pin.radius);
     let out = match settings.fence {
-        None => push(model, pose, start, pin, contact, None),
+        None => match tier {
+            Some(t) => super::tier::push_with_map(t, model, pose, start, pin.radius, contact).0,
+            None => push(model, pose, start, pin, contact, None),
+        },
         Some(f) => {
             let fence = super::fence_pass_start(poly, d, f.angle_deg, f.length, contact.mu_c);
             push_fence(model, pose, &fence, contact, None)
@@ -87,11 +103,12 @@ pub fn sample_maps(
     ds: &[f64],
     grid: &[f64],
     settings: &MapSettings,
+    tier: Option<&super::tier::TierMap>,
 ) -> Vec<Vec<MapSample>> {
     let n = grid.len();
     let flat: Vec<MapSample> = (0..ds.len() * n)
         .into_par_iter()
-        .map(|i| sample_one(poly, model, grid[i % n], ds[i / n], settings))
+        .map(|i| sample_one_with(poly, model, grid[i % n], ds[i / n], settings, tier))
         .collect();
     let mut rows = Vec::with_capacity(ds.len());
     let mut it = flat.into_iter();
