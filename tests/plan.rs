@@ -8,7 +8,6 @@ mod plan_cli;
 use pinfeed::plan::search::Planner;
 use pinfeed::plan::{Action, Outcome, Problem, State};
 use plan_cli::*;
-use serde_json::Value;
 
 #[test]
 fn default_tripoly2_plan_orients_the_line() {
@@ -35,22 +34,7 @@ fn default_tripoly2_plan_orients_the_line() {
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.contains("pinfeed plan --part tripoly2"), "{text}");
     assert_eq!(text.matches("kind = \"pin\"").count(), pins);
-    let run = pinfeed(&[
-        "run",
-        o,
-        "--parts",
-        "300",
-        "--json",
-        "--quiet",
-        "--out",
-        tmp("runs").to_str().unwrap(),
-    ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let s: Value = serde_json::from_slice(&run.stdout).unwrap();
+    let s = run_300(o);
     assert!(s["success_rate"].as_f64().unwrap() >= 0.99, "{s}");
     assert!(out.with_extension("svg").exists());
 }

@@ -5,7 +5,6 @@
 
 mod plan_cli;
 use plan_cli::*;
-use serde_json::Value;
 
 #[test]
 fn tripoly1_fence_plan_orients_the_line_and_runs() {
@@ -76,22 +75,7 @@ fn tripoly1_fence_plan_orients_the_line_and_runs() {
     }
 
     // `pinfeed run` runs it unchanged.
-    let run = pinfeed(&[
-        "run",
-        o,
-        "--parts",
-        "300",
-        "--json",
-        "--quiet",
-        "--out",
-        tmp("runs").to_str().unwrap(),
-    ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let s: Value = serde_json::from_slice(&run.stdout).unwrap();
+    let s = run_300(o);
     assert!(s["success_rate"].as_f64().unwrap() >= 0.99, "{s}");
     assert!(out.with_extension("svg").exists());
 }

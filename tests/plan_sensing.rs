@@ -59,13 +59,7 @@ fn tripoly1_sensing_plan_runs_and_orients() {
     }
     assert!(svg.contains("mover1") && svg.contains("sensor y="));
     // `pinfeed run` executes it unchanged.
-    let o = pinfeed(&["run", out.to_str().unwrap(), "--parts", "300", "--json"]);
-    assert!(
-        o.status.success(),
-        "run failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let s: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let s = run_300(out.to_str().unwrap());
     let rate = s["success_rate"].as_f64().unwrap();
     assert!(rate >= 0.95, "run success {rate}");
 }

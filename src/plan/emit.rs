@@ -45,20 +45,64 @@ pub fn scenario_toml(
     let sp = problem.spacing_m;
     let mut t = String::new();
     let name = format!("plan_{}", crate::cli::part_folder(&problem.part));
-    t += &format!(
-        "# Written by `pinfeed plan` (sensorless pin planner, issue 14):\n#\n#   {command}\n#\n"
+    t += &plan_header(
+        problem,
+        plan,
+        ("", "sensorless pin", "pin"),
+        &format!(
+            "pin intervals with margin ≥ {} mm",
+            problem.min_margin_m * 1e3
+        ),
+        command,
+        file,
     );
-    t += &best_effort_note(problem, plan, "pin");
+    let length = sp * (n as f64 + 1.0);
+    t += &line_sections(&name, problem, (length, "pin"), stable_count, parts, None);
+    for (k, step) in plan.steps.iter().enumerate() {
+        let Action::Pin(pin) = step.action else {
+            continue;
+        };
+        t += &format!(
+            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{}\"\nx = {}\ny = {}\nradius = {}\n",
+            pin.margin_m * 1e3,
+            step.sets,
+            step.window.share,
+            k + 1,
+            num(sp * (k as f64 + 1.0), 6),
+            num(pin.y_m, 6),
+            num(problem.pin_radius_m, 6),
+        );
+    }
+    t += &goal_and_model(problem, plan.window.centre_deg, symmetry);
+    t
+}
+
+/// The header of an emitted sensorless plan: the command that wrote it, what the plan claims (a
+/// shortest plan or a best effort) over which abstraction (`rule`: how its actions are placed),
+/// its prediction, the uncertainty it was planned against, and how to run it. `words`: the
+/// command's flag, the planner's name and the action's name.
+fn plan_header(
+    problem: &Problem,
+    plan: &Plan,
+    (flag, planner, what): (&str, &str, &str),
+    rule: &str,
+    command: &str,
+    file: &str,
+) -> String {
+    let mut t = format!(
+        "# Written by `pinfeed plan{flag}` ({planner} planner, issue 14):\n#\n#   {command}\n#\n"
+    );
+    t += &best_effort_note(problem, plan, what);
     t += &format!(
-        "# {n} pin(s), {} (BFS over {} particle(s), θ rounded to {}°,\n",
+        "# {} {what}(s), {} (BFS over {} particle(s), θ rounded to {}°,\n",
+        plan.steps.len(),
         kind_of(problem, plan),
         plan.initial.total(),
         problem.theta_quantum_deg
     );
     t += &format!(
-        "# y to {} mm, pin intervals with margin ≥ {} mm). Predicted success {:.4} ({} of {}\n",
+        "# y to {} mm; {rule}). Predicted success {:.4} ({} of {}\n",
         problem.y_quantum_m * 1e3,
-        problem.min_margin_m * 1e3,
         plan.predicted_success,
         plan.window.inside,
         plan.initial.total(),
@@ -78,24 +122,6 @@ pub fn scenario_toml(
         t += " Planned against random tripod supports.";
     }
     t += &format!("\n#\n#   pinfeed run {file}\n\n");
-    let length = sp * (n as f64 + 1.0);
-    t += &line_sections(&name, problem, (length, "pin"), stable_count, parts, None);
-    for (k, step) in plan.steps.iter().enumerate() {
-        let Action::Pin(pin) = step.action else {
-            continue;
-        };
-        t += &format!(
-            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{}\"\nx = {}\ny = {}\nradius = {}\n",
-            pin.margin_m * 1e3,
-            step.sets,
-            step.window.share,
-            k + 1,
-            num(sp * (k as f64 + 1.0), 6),
-            num(pin.y_m, 6),
-            num(problem.pin_radius_m, 6),
-        );
-    }
-    t += &goal_and_model(problem, plan.window.centre_deg, symmetry);
     t
 }
 
@@ -147,30 +173,15 @@ pub fn fence_scenario_toml(
         .collect();
     let radius = problem.compile().map(|c| c.radius).unwrap_or(0.0);
     let (xs, end) = super::fences::layout(&fences, radius, problem.spacing_m);
-    let n = fences.len();
     let mut t = String::new();
     let name = format!("plan_{}_fences", crate::cli::part_folder(&problem.part));
-    t += &format!(
-        "# Written by `pinfeed plan --fences` (sensorless fence planner, issue 14):\n#\n#   {command}\n#\n"
-    );
-    t += &best_effort_note(problem, plan, "fence");
-    t += &format!(
-        "# {n} fence(s), {} (BFS over {} particle(s), θ rounded to {}°,\n",
-        kind_of(problem, plan),
-        plan.initial.total(),
-        problem.theta_quantum_deg
-    );
-    t += &format!(
-        "# y to {} mm; each fence's upstream end clear of every part's reach). Predicted success {:.4}\n",
-        problem.y_quantum_m * 1e3,
-        plan.predicted_success,
-    );
-    t += &format!(
-        "# ({} of {} particles within {}° ± {}°).\n#\n#   pinfeed run {file}\n\n",
-        plan.window.inside,
-        plan.initial.total(),
-        num(plan.window.centre_deg, 2),
-        problem.tolerance_deg
+    t += &plan_header(
+        problem,
+        plan,
+        (" --fences", "sensorless fence", "fence"),
+        "each fence's upstream end clear of every part's reach",
+        command,
+        file,
     );
     // Parts lag the belt along the fences: they are fed further apart.
     let headway = super::fences::headway_s(&fences, radius, BELT_SPEED);

@@ -33,3 +33,23 @@ pub fn json_ok(args: &[&str]) -> Value {
     );
     serde_json::from_slice(&out.stdout).expect("stdout is JSON")
 }
+
+/// `pinfeed run FILE` on 300 parts (reports to a temporary folder): its JSON summary.
+pub fn run_300(file: &str) -> Value {
+    let out = pinfeed(&[
+        "run",
+        file,
+        "--parts",
+        "300",
+        "--json",
+        "--quiet",
+        "--out",
+        tmp("runs").to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "run {file} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
