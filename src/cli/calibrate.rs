@@ -7,7 +7,7 @@
 //! interval holds the hidden value. Unless `--no-write`, `results/calibrate/<file stem>/` receives
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
-use super::map::shell_word;
+use super::shell_word;
 use super::validate::{
     check_members, emit, ensemble_spec, load_measured, pool, summary_text, write_report_files,
     ModelArgs, ReportHead,

@@ -14,6 +14,7 @@ use super::contact::{
     case_fence, check_geometry, check_inputs, compile_part, num, parse_fence, parse_model,
     settings_and_pin, Case,
 };
+use super::shell_word;
 use crate::maps::{compute_maps_with, ConfigurationMap, MapFence, MapSettings};
 use crate::report::{map_table, plot_map};
 use anyhow::{anyhow, bail, Context, Result};
@@ -137,16 +138,6 @@ struct SampleRow {
     contact_length: f64,
     band: Option<usize>,
     status: &'static str,
-}
-
-/// Quote a shell word if it needs it.
-pub(crate) fn shell_word(s: &str) -> String {
-    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
-    if !s.is_empty() && s.chars().all(plain) {
-        s.to_string()
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
 }
 
 /// The command line that regenerates a report, every setting explicit.

@@ -6,7 +6,8 @@
 //! command, `ensemble.json` and one figure per input state (`ensemble_all.svg`,
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
-use super::map::{command_line, default_out_dir_for, shell_word, MapArgs};
+use super::map::{command_line, default_out_dir_for, MapArgs};
+use super::shell_word;
 use super::validate::{write_report_files, ReportHead};
 use crate::geometry::Polygon;
 use crate::maps::ensemble::{

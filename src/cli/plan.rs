@@ -7,6 +7,7 @@
 //! that finds no plan up to its depth reports so and succeeds (that is an answer); one stopped by a
 //! limit (`--max-states`, `--time-limit`) or a bad input exits non-zero with a message.
 
+use super::shell_word;
 use super::stdout::print_result;
 use crate::plan::fences::FenceTransition;
 use crate::plan::search::{Planner, SearchStats};
@@ -187,16 +188,6 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.seed = args.seed;
     p.compile()?;
     Ok(p)
-}
-
-/// Quote a shell word if it needs it.
-pub(crate) fn shell_word(s: &str) -> String {
-    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
-    if !s.is_empty() && s.chars().all(plain) {
-        s.to_string()
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
 }
 
 /// The command line that reproduces a plan: the part and every setting that differs from its

@@ -3,9 +3,8 @@
 //! (the real sensor and classifier), whose success is printed beside the prediction with a perfect
 //! classifier and with the confusion the line measured.
 
-use super::plan::{
-    check_text, shell_word, write_file, CheckReport, Executed, PlanArgs, PlanSummary,
-};
+use super::plan::{check_text, write_file, CheckReport, Executed, PlanArgs, PlanSummary};
+use super::shell_word;
 use crate::plan::contingent::{self, ContingentOutcome, ContingentPlan, ContingentStats};
 use crate::plan::search::Planner;
 use crate::plan::{emit, Problem};

@@ -13,6 +13,7 @@
 //! to standard error.
 
 use super::contact::{in_range, num, parse_model};
+use super::shell_word;
 use crate::geometry::named;
 use crate::mechanics::{PartModel, Support};
 use crate::random::distribution::Distribution;
@@ -233,16 +234,6 @@ pub struct SenseReport {
     pub evaluation: Evaluation,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub placement: Option<Placement>,
-}
-
-/// Quote a shell word if it needs it.
-fn shell_word(s: &str) -> String {
-    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
-    if !s.is_empty() && s.chars().all(plain) {
-        s.to_string()
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
 }
 
 fn list(v: &[f64]) -> String {

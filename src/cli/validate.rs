@@ -6,8 +6,8 @@
 //! `validate.json` and one figure per (part, input): the measured bands over the predicted
 //! distributions and bands against d.
 
-use super::map::shell_word;
 use super::map_ensemble::bands_text;
+use super::shell_word;
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::{EnsembleSpec, PredictedBands};
 use crate::report::plot_validate::plot_band_distributions;
