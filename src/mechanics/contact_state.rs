@@ -112,7 +112,7 @@ impl<'a, 'r> Ctx<'a, 'r> {
             mu_s: settings.mu_s,
             scale: model.scale(),
             evals: 0,
-            warm: Warm::default(),
+            warm: Warm::for_tolerance(settings.tol),
             recorder,
             band: [0.0; N_EVENTS],
             turns: Vec::new(),

@@ -4,14 +4,14 @@
 //! Events are located in two stages. First, for each event function that changed sign, the
 //! Illinois method ([`super::ode::illinois`]) finds its root on the step's dense output (geometric
 //! events and separation from the state alone; a mode margin by solving the instant in the
-//! current mode); the earliest root wins. Then the landing refines that estimate on real
-//! Dormand–Prince sub-steps from the step's start, so that the state handed to the event is a
-//! state the integrator produced, with the event function within the landing tolerance of zero.
+//! current mode); the earliest root wins. Then the landing solves the instant at that point of the
+//! dense output (refining it there if needed), so that the state handed to the event has its
+//! instant, its rates, and the event function within the landing tolerance of zero.
 //! Before either, [`interior_dip`] shortens a step across which an event comes and goes.
 
 use super::contact_state::{second_contact, Ctx, Feat, N_EVENTS};
-use super::contact_step::{dp_step, step_change_ok, Cursor, StepResult};
-use super::instant::{push_margin, solve_in_mode};
+use super::contact_step::{Cursor, StepResult};
+use super::instant::{push_margin, solve_in_mode, Instant};
 use super::ode::{illinois, Bracket};
 
 /// The first fraction of the step `step` of size `h` from `at` (event functions `ev1` at its end)
@@ -110,13 +110,21 @@ pub(super) fn earliest_crossing(
     best
 }
 
-/// A trial step while landing on an event.
+/// A state on the step's dense output where the landing stopped: the state, the instant solved
+/// there in the step's mode, and the rates it gives.
+pub(super) struct Landed {
+    pub(super) y: [f64; 2],
+    pub(super) inst: Instant,
+    pub(super) rates: [f64; 2],
+}
+
+/// A trial point while landing on an event.
 enum Trial {
-    /// No step: the state at the start of the step.
+    /// The start of the step.
     Start,
-    /// A valid step and the located event's function after it.
-    Step(Box<StepResult>, f64),
-    /// A step that failed, or whose result cannot be trusted.
+    /// A state on the dense output and the located event's function there.
+    At(Landed, f64),
+    /// A state whose instant could not be solved, or past another event.
     Invalid,
 }
 
@@ -124,17 +132,23 @@ enum Trial {
 pub(super) struct Landing {
     /// The event landed on.
     pub(super) i: usize,
-    /// The landing sub-step: its fraction of the step and the step itself, or `None` for the
-    /// start of the step.
-    pub(super) step: Option<(f64, Box<StepResult>)>,
+    /// The landing point: its fraction of the step and the state there, or `None` for the start
+    /// of the step.
+    pub(super) at: Option<(f64, Landed)>,
     /// The event function at the landing.
     pub(super) g: f64,
-    /// Some trial step could not be trusted (the bracket shrank from above).
+    /// Some trial could not be trusted (the bracket shrank from above).
     pub(super) any_invalid: bool,
 }
 
 /// Land on event `i`, estimated at fraction `t_est` of the accepted `step` of size `h` from `at`:
-/// the trial at the largest fraction with g ≥ 0 (or g just below 0 within the landing tolerance).
+/// the point of the step's dense output at the largest fraction with g ≥ 0 (or g just below 0
+/// within the landing tolerance), with the instant solved there.
+///
+/// The dense output is the step's own continuous extension (4th order, accurate to about the
+/// step's local error), so a landing on it is as accurate as the step: no sub-step is taken. The
+/// event functions are evaluated at the states the contact will continue from, so a landed mode
+/// margin or edge end is within the landing tolerance of zero at the state handed to the event.
 pub(super) fn land(
     ctx: &mut Ctx,
     at: &Cursor,
@@ -143,34 +157,26 @@ pub(super) fn land(
     ev1: &[f64; N_EVENTS],
     (t_est, i): (f64, usize),
 ) -> Landing {
-    let (feat, mode, y, f0, slack) = (at.feat, at.mode, at.y, at.f0, at.slack);
-    let ctx_tol = ctx.tol;
-    // A sub-step of the accepted step must agree with its dense output (both are
-    // accurate to about tol; 1e3·tol leaves room for a mode boundary inside the step).
-    let near_dense = |r: &StepResult, t: f64| {
-        let yd = step.dp.dense(y, h, t);
-        (r.dp.y1[0] - yd[0]).abs() <= 1e3 * ctx_tol && (r.dp.y1[1] - yd[1]).abs() <= 1e3 * ctx_tol
-    };
-    // Refine on real steps: g(t) = event i after a Dormand–Prince step of t·h from (s, y).
-    // A trial step counts only if it is itself accurate (its own error estimate within 10×
-    // the tolerance: sub-steps of an accepted step may sit just above it), passes the step
-    // guard and crosses neither the separation nor another geometric event; otherwise its event
-    // value means nothing (the −880° case of issue 11 landed on such a step) and the
-    // bracket shrinks from above.
-    let real = |t: f64, ctx: &mut Ctx| -> Trial {
+    let (feat, mode, y, slack) = (at.feat, at.mode, at.y, at.slack);
+    // The state at fraction t of the step, its instant in the step's mode and its event i. A
+    // trial past another event (separation or a geometric one) or whose instant cannot be
+    // solved cannot be trusted: the bracket shrinks from above.
+    let trial = |t: f64, ctx: &mut Ctx| -> Trial {
         if t * h <= 1e-15 {
             return Trial::Start;
         }
-        match dp_step(ctx, feat, mode, y, f0, t * h) {
-            Ok(r) if step_change_ok(feat, y, r.dp.y1) && near_dense(&r, t) => {
-                let ev = ctx.events(feat, r.dp.y1, &r.inst1);
+        let yt = step.dp.dense(y, h, t);
+        match ctx.rhs(feat, mode, yt) {
+            Ok((rates, inst)) => {
+                let ev = ctx.events(feat, yt, &inst);
                 if [0, 3, 4, 5, 6].iter().all(|&j| j == i || ev[j] >= -slack) {
-                    Trial::Step(Box::new(r), ev[i])
+                    let g = ev[i];
+                    Trial::At(Landed { y: yt, inst, rates }, g)
                 } else {
                     Trial::Invalid
                 }
             }
-            _ => Trial::Invalid,
+            Err(_) => Trial::Invalid,
         }
     };
     let mut bracket = Bracket::new(at.ev0[i].max(0.0), ev1[i]);
@@ -182,10 +188,10 @@ pub(super) fn land(
     // Landing tolerance: far below the integration tolerance, far above rounding.
     let g_tol = at.land_tol;
     for _ in 0..40 {
-        let trial = real(t, ctx);
-        let gt = match &trial {
+        let tr = trial(t, ctx);
+        let gt = match &tr {
             Trial::Start => at.ev0[i].max(0.0),
-            Trial::Step(_, g) => *g,
+            Trial::At(_, g) => *g,
             Trial::Invalid => {
                 any_invalid = true;
                 bracket.cut_above(t);
@@ -199,7 +205,7 @@ pub(super) fn land(
         let close = gt.abs() <= g_tol;
         let lower_end = bracket.narrow(t, gt);
         if lower_end || close {
-            best = (trial, t, gt);
+            best = (tr, t, gt);
         }
         if close || bracket.width() * h <= 1e-13 {
             break;
@@ -209,8 +215,8 @@ pub(super) fn land(
     let (landing, best_t, best_g) = best;
     Landing {
         i,
-        step: match landing {
-            Trial::Step(r, _) => Some((best_t, r)),
+        at: match landing {
+            Trial::At(l, _) => Some((best_t, l)),
             _ => None,
         },
         g: best_g,

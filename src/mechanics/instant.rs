@@ -19,7 +19,8 @@
 //! v_b and v_pin. The integrator locates the zero crossings of these as mode-switch events.
 
 use super::part_model::{
-    point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist, WarmTwist,
+    final_gap, point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist, WarmStick,
+    WarmTwist,
 };
 use crate::geometry::Vec2;
 use serde::Serialize;
@@ -70,13 +71,46 @@ pub struct Instant {
     pub margins: [f64; 2],
 }
 
-/// Warm starts carried from instant to instant.
-#[derive(Debug, Clone, Copy, Default)]
+/// Warm starts carried from instant to instant, and how accurately the exact solves need to
+/// converge for the contact's integration tolerance (`gap`, see [`final_gap`]).
+#[derive(Debug, Clone, Copy)]
 pub struct Warm {
     pub left: Option<WarmTwist>,
     pub right: Option<WarmTwist>,
     pub normal: Option<WarmTwist>,
-    pub stick_omega: Option<f64>,
+    pub stick: Option<WarmStick>,
+    pub gap: f64,
+}
+
+impl Warm {
+    /// No warm starts yet, for a contact integrated at tolerance `tol`.
+    pub fn for_tolerance(tol: f64) -> Warm {
+        Warm {
+            left: None,
+            right: None,
+            normal: None,
+            stick: None,
+            gap: final_gap(tol),
+        }
+    }
+}
+
+impl Warm {
+    /// The warm start of the sliding solve in `mode` (frictionless slide: the normal's).
+    fn slide_slot(&mut self, mode: Mode) -> &mut Option<WarmTwist> {
+        match mode {
+            Mode::SlideLeft => &mut self.left,
+            Mode::SlideRight => &mut self.right,
+            Mode::Slide | Mode::Stick => &mut self.normal,
+        }
+    }
+}
+
+impl Default for Warm {
+    /// As for the default integration tolerance (1e-6).
+    fn default() -> Warm {
+        Warm::for_tolerance(1e-6)
+    }
 }
 
 /// Friction settings of the contact: μc and the friction-cone half-angle's sine and cosine
@@ -122,11 +156,15 @@ fn slide_instant(
     fid: Fidelity,
     g: &ContactGeom,
     f_dir: Vec2,
-    warm: &mut Option<WarmTwist>,
+    warm: &mut Warm,
+    mode: Mode,
     evals: &mut u64,
 ) -> Result<(Twist, Vec2, Vec2), SolveFailure> {
-    let (s, next) = model.twist_for_wrench(fid, wrench_of(f_dir, g.p), warm.as_ref(), evals)?;
-    *warm = Some(next);
+    let gap = warm.gap;
+    let slot = warm.slide_slot(mode);
+    let (s, next) =
+        model.twist_for_wrench(fid, wrench_of(f_dir, g.p), slot.as_ref(), gap, evals)?;
+    *slot = Some(next);
     let vb = point_velocity(s.twist, g.p);
     Ok((s.twist, vb, Vec2::new(s.wrench[0], s.wrench[1])))
 }
@@ -148,8 +186,8 @@ fn stick_instant(
     warm: &mut Warm,
     evals: &mut u64,
 ) -> Result<Instant, SolveFailure> {
-    let s = model.stick_twist(fid, g.p, g.v_pin, warm.stick_omega, evals)?;
-    warm.stick_omega = Some(s.twist[2]);
+    let (s, next) = model.stick_twist(fid, g.p, g.v_pin, warm.stick.as_ref(), warm.gap, evals)?;
+    warm.stick = Some(next);
     let f = Vec2::new(s.wrench[0], s.wrench[1]);
     let t = g.n.perp();
     let (ln, lt) = (f.dot(g.n), f.dot(t));
@@ -176,10 +214,15 @@ fn slide_side(
     g: &ContactGeom,
     f_dir: Vec2,
     sign: f64,
-    warm: &mut Option<WarmTwist>,
+    warm: &mut Warm,
     evals: &mut u64,
 ) -> Result<Side, SolveFailure> {
-    let (xi, vb, f) = slide_instant(model, fid, g, f_dir, warm, evals)?;
+    let mode = if sign > 0.0 {
+        Mode::SlideLeft
+    } else {
+        Mode::SlideRight
+    };
+    let (xi, vb, f) = slide_instant(model, fid, g, f_dir, warm, mode, evals)?;
     let mut margin = sign * sine(vb, g.v_pin);
     if g.n.dot(vb) <= GUARD * vb.norm() {
         margin = margin.min(-1e-3);
@@ -208,7 +251,7 @@ pub fn solve_in_mode(
     match mode {
         Mode::Stick => stick_instant(model, fid, g, fr, warm, evals),
         Mode::Slide => {
-            let (xi, vb, f) = slide_instant(model, fid, g, g.n, &mut warm.normal, evals)?;
+            let (xi, vb, f) = slide_instant(model, fid, g, g.n, warm, mode, evals)?;
             Ok(Instant {
                 mode,
                 twist: scaled_slide(g, xi, vb),
@@ -218,7 +261,7 @@ pub fn solve_in_mode(
         }
         Mode::SlideLeft => {
             let f_dir = fr.left_edge(g.n);
-            let m = slide_side(model, fid, g, f_dir, 1.0, &mut warm.left, evals)?;
+            let m = slide_side(model, fid, g, f_dir, 1.0, warm, evals)?;
             Ok(Instant {
                 mode,
                 margins: [m.margin, 1.0],
@@ -227,7 +270,7 @@ pub fn solve_in_mode(
         }
         Mode::SlideRight => {
             let f_dir = fr.right_edge(g.n);
-            let m = slide_side(model, fid, g, f_dir, -1.0, &mut warm.right, evals)?;
+            let m = slide_side(model, fid, g, f_dir, -1.0, warm, evals)?;
             Ok(Instant {
                 mode,
                 margins: [1.0, m.margin],

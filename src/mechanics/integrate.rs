@@ -374,11 +374,10 @@ fn land_on_event(
     let h = at.h;
     let estimate = earliest_crossing(ctx, at, step, h, ev1, crossed);
     let landing = land(ctx, at, step, h, ev1, estimate);
-    let (s_land, y_land, inst_land) = match &landing.step {
-        Some((t, r)) => {
-            segs.steps += 1;
-            segs.ride(ctx, at.feat, r.dp.f1()[0].abs().max(at.f0[0].abs()), t * h);
-            (at.s + t * h, r.dp.y1, r.inst1)
+    let (s_land, y_land, inst_land) = match &landing.at {
+        Some((t, l)) => {
+            segs.ride(ctx, at.feat, l.rates[0].abs().max(at.f0[0].abs()), t * h);
+            (at.s + t * h, l.y, l.inst)
         }
         None => (at.s, at.y, at.inst),
     };
