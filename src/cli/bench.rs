@@ -106,6 +106,9 @@ pub enum BenchWhat {
     /// The certified map tier against the exact model: per contact (a section of
     /// results/accuracy-vs-time.md) and on the line (a section of results/line-speed.md).
     MapTier(super::bench_map_tier::MapTierArgs),
+    /// What the line adds to its contacts: each scenario's run against the same pushes as a bare
+    /// batch; writes a section of results/line-speed.md.
+    Line(super::bench_line::LineArgs),
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
@@ -246,6 +249,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             out,
         } => super::bench_mc::run(study, samples, *repeats, out),
         BenchWhat::MapTier(a) => super::bench_map_tier::run(a),
+        BenchWhat::Line(a) => super::bench_line::run(a),
     }
 }
 

@@ -2,6 +2,7 @@
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
 pub mod bench;
+pub mod bench_line;
 pub mod bench_map_tier;
 pub mod bench_mc;
 pub mod bench_plans;

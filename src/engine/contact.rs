@@ -17,6 +17,7 @@ use super::metrics::WorkCounters;
 use super::motion::{ContactPlan, Motion, Pusher, Stop};
 use super::outcome::PartOutcome;
 use super::overlap::{capsule_clearance, first_touch};
+use super::results::CapturedPush;
 use super::sensing::SensedPass;
 use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
@@ -65,6 +66,15 @@ impl Line<'_> {
             record,
             must_record,
         };
+        if let Some(list) = self.captured.as_mut() {
+            list.push(CapturedPush {
+                model: part.model.clone(),
+                pusher: pusher.clone(),
+                pose,
+                settings,
+                recorded: record,
+            });
+        }
         let (out, record) = self.push_contact(&part, request, &mut knots);
         let model = part.model.as_ref().unwrap_or(&scene.part.model);
         self.metrics.work.contact_solves += 1;

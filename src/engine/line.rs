@@ -47,7 +47,7 @@ use super::metrics::Metrics;
 use super::motion::{Motion, Stop};
 use super::outcome::PartOutcome;
 use super::part_stream::{arrival_gap, draw_part};
-use super::results::{EngineError, PartRecord, RunOptions, RunResult, SamplePath};
+use super::results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};
 use super::sensing::{describe, sense_pass, SensedPass, SensorStats};
 use crate::geometry::{wrap_deg, Pose};
 use crate::mechanics::{
@@ -102,6 +102,8 @@ pub(super) struct Line<'a> {
     pub(super) control: Option<Control>,
     /// The pins' maps (None unless `[model] fidelity = "map"`).
     pub(super) maps: Option<LineMaps>,
+    /// Every push as asked for, when the run captures them ([`run_capturing`]).
+    pub(super) captured: Option<Vec<CapturedPush>>,
 }
 
 /// Run the line: a pure function of (scene, options). `progress` is called with the number of
@@ -111,6 +113,24 @@ pub fn run(
     opts: &RunOptions,
     progress: &mut dyn FnMut(u64),
 ) -> Result<RunResult, EngineError> {
+    run_with(scene, opts, progress, None).map(|(r, _)| r)
+}
+
+/// As [`run`], also returning every push the line asked of the contact model (or the map tier),
+/// in order: what `pinfeed bench line` runs again as a bare batch to see what the line adds.
+pub fn run_capturing(
+    scene: &Scene,
+    opts: &RunOptions,
+) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
+    run_with(scene, opts, &mut |_| {}, Some(Vec::new()))
+}
+
+fn run_with(
+    scene: &Scene,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(u64),
+    captured: Option<Vec<CapturedPush>>,
+) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
     let names = scene
         .obstacles
         .iter()
@@ -142,6 +162,7 @@ pub fn run(
         sensor_pins,
         control: Control::new(scene, scene.effects.event_log || opts.sample_paths > 0),
         maps: LineMaps::for_scene(scene),
+        captured,
     };
     if opts.parts > 0 {
         line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
@@ -181,14 +202,15 @@ pub fn run(
         summary.controller = Some(c.finish(summary.simulated_time_s));
         control_log = c.log.take().unwrap_or_default();
     }
-    Ok(RunResult {
+    let result = RunResult {
         summary,
         metrics: line.metrics,
         records: line.records,
         events: line.events,
         paths: line.paths,
         control: control_log,
-    })
+    };
+    Ok((result, line.captured.unwrap_or_default()))
 }
 
 impl Line<'_> {

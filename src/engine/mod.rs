@@ -29,7 +29,7 @@ pub mod part_stream;
 pub mod results;
 pub mod sensing;
 
-pub use line::run;
+pub use line::{run, run_capturing};
 pub use metrics::Summary;
 pub use outcome::{OutcomeCounts, PartOutcome};
-pub use results::{EngineError, PartRecord, RunOptions, RunResult, SamplePath};
+pub use results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};

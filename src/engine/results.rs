@@ -4,8 +4,10 @@
 
 use super::event_queue::{Event, EventKind};
 use super::metrics::{Metrics, Summary};
+use super::motion::Pusher;
 use super::outcome::PartOutcome;
 use crate::geometry::Pose;
+use crate::mechanics::{ContactSettings, PartModel};
 use crate::scenario::Scene;
 use serde::Serialize;
 use thiserror::Error;
@@ -74,6 +76,18 @@ pub struct SamplePath {
     pub part: u64,
     pub outcome: PartOutcome,
     pub poses: Vec<(f64, Pose)>,
+}
+
+/// One push as the line asked for it (see [`super::line::run_capturing`]): the part's own model
+/// when it has one (a random tripod), the obstacle, the pose at the first touch and the settings,
+/// and whether the line recorded its path.
+#[derive(Clone)]
+pub struct CapturedPush {
+    pub model: Option<PartModel>,
+    pub pusher: Pusher,
+    pub pose: Pose,
+    pub settings: ContactSettings,
+    pub recorded: bool,
 }
 
 /// Everything a run produces.

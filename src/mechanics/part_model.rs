@@ -190,6 +190,7 @@ impl Support {
     }
 }
 
+#[derive(Clone)]
 enum SupportData {
     Uniform(UniformSurface),
     Points(PointSupport),
@@ -294,6 +295,7 @@ impl WarmStick {
 }
 
 /// The compiled part: normalised geometry and support data. Immutable; shared by all contacts.
+#[derive(Clone)]
 pub struct PartModel {
     poly: Polygon,
     /// The convex hull as a polygon (what a straight fence can touch), normalised units.

@@ -6,6 +6,7 @@
 pub mod accuracy;
 pub mod compare;
 pub mod contact_cost;
+pub mod line_cost;
 pub mod map_cost;
 pub mod map_tier;
 pub mod mc;

@@ -1,0 +1,69 @@
+//! `pinfeed bench line`: a scenario's line against its own pushes run as a bare batch; writes the
+//! marked section of results/line-speed.md ([`crate::study::line_cost`]).
+
+use crate::study::line_cost::{measure, section, MARKERS};
+use crate::study::mc::precision::splice_between;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct LineArgs {
+    /// Scenario files, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "scenarios/quickstart.toml,scenarios/crowded_belt.toml"
+    )]
+    pub scenarios: Vec<PathBuf>,
+    /// Parts per run.
+    #[arg(long, default_value_t = 20_000)]
+    pub parts: u64,
+    /// Alternating repeats of the line and the batches (the minimum of each is reported).
+    #[arg(long, default_value_t = 3)]
+    pub reps: usize,
+    #[arg(long, default_value = "results/line-speed.md")]
+    pub out: PathBuf,
+}
+
+pub fn run(a: &LineArgs) -> Result<()> {
+    if a.parts == 0 || a.parts > 10_000_000 {
+        bail!("--parts must be between 1 and 10000000, got {}", a.parts);
+    }
+    if a.reps == 0 || a.reps > 100 {
+        bail!("--reps must be between 1 and 100, got {}", a.reps);
+    }
+    let mut rows = Vec::new();
+    for path in &a.scenarios {
+        let scene = crate::scenario::load(path)?;
+        let row = measure(&scene, a.parts, a.reps)
+            .with_context(|| format!("measuring {}", path.display()))?;
+        eprintln!(
+            "{}: line {:.2} s, batch {:.2} s (recording {:.2} s), ratio {:.3}",
+            path.display(),
+            row.line_s,
+            row.bare_s,
+            row.bare_recorded_s,
+            row.ratio()
+        );
+        rows.push(row);
+    }
+    let list: Vec<String> = a
+        .scenarios
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let cmd = format!(
+        "cargo run --release -- bench line --scenarios {} --parts {} --reps {} --out {}",
+        list.join(","),
+        a.parts,
+        a.reps,
+        a.out.display()
+    );
+    let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, &cmd), MARKERS.1);
+    let old = std::fs::read_to_string(&a.out).unwrap_or_default();
+    std::fs::write(&a.out, splice_between(&old, &marked, MARKERS))
+        .with_context(|| format!("writing {}", a.out.display()))?;
+    eprintln!("wrote {}", a.out.display());
+    Ok(())
+}
