@@ -164,3 +164,148 @@ pub fn markdown(rows: &[ContactCostRow]) -> String {
     }
     s
 }
+
+/// How the exact model's cost grows with the vertex count (regular N-gons): the cost of one
+/// evaluation of D, ∇D and H with the centre of rotation near the part (closed form, per edge)
+/// and far from it (quadrature), and the cost of a whole contact.
+#[derive(Debug, Clone, Serialize)]
+pub struct ScalingRow {
+    pub vertices: usize,
+    /// ns per evaluation with the Hessian: centre of rotation within 2a, and at 8a.
+    pub near_ns: f64,
+    pub far_ns: f64,
+    /// The contact table's row for the exact model on this part.
+    pub contact: ContactCostRow,
+}
+
+/// Time `n` evaluations at twists whose centre of rotation lies at distance `r` (units of a) in
+/// directions spread round the part, returning ns per evaluation.
+fn eval_ns(model: &PartModel, r: f64, n: usize) -> f64 {
+    let twists: Vec<[f64; 3]> = (0..n)
+        .map(|k| {
+            let phi = k as f64 * 2.399_963; // golden angle
+            let rr = r * (0.25 + 0.75 * ((k * 7919) % 101) as f64 / 100.0);
+            let c = Vec2::new(phi.cos(), phi.sin()) * rr;
+            // ω = 1 about the centre c: v = −ẑ×c.
+            [c.y, -c.x, 1.0]
+        })
+        .collect();
+    let t0 = Instant::now();
+    let mut acc = 0.0;
+    for xi in &twists {
+        acc += model.dissipation(*xi, true).value;
+    }
+    std::hint::black_box(acc);
+    t0.elapsed().as_secs_f64() * 1e9 / n as f64
+}
+
+/// The vertex-count scaling for the regular N-gons of `vertices`.
+pub fn vertex_scaling(
+    vertices: &[usize],
+    n: usize,
+    tol: f64,
+    seed: u64,
+) -> anyhow::Result<Vec<ScalingRow>> {
+    let mut rows = Vec::new();
+    for &m in vertices {
+        let name = format!("ngon:{m}");
+        let model = PartModel::new(&part_from_spec(&name)?, &Support::Uniform)
+            .map_err(anyhow::Error::msg)?;
+        let near_ns = eval_ns(&model, 2.0, 20_000);
+        let far_ns = eval_ns(&model, 8.0, 20_000);
+        let contact = measure(&[name.as_str()], &[Fidelity::Exact], n, tol, seed)?
+            .pop()
+            .expect("one row per part and fidelity");
+        rows.push(ScalingRow {
+            vertices: m,
+            near_ns,
+            far_ns,
+            contact,
+        });
+    }
+    Ok(rows)
+}
+
+/// The scaling table as Markdown, with each cost relative to the first row's.
+pub fn scaling_markdown(rows: &[ScalingRow]) -> String {
+    let mut s = String::from(
+        "| vertices | evaluation, centre near (ns) | × | evaluation, centre far (ns) | × | contact median µs | × | evaluations per contact |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    let Some(first) = rows.first() else {
+        return s;
+    };
+    for r in rows {
+        s.push_str(&format!(
+            "| {} | {:.0} | {:.1} | {:.0} | {:.1} | {:.1} | {:.1} | {:.0} |\n",
+            r.vertices,
+            r.near_ns,
+            r.near_ns / first.near_ns,
+            r.far_ns,
+            r.far_ns / first.far_ns,
+            r.contact.median_us,
+            r.contact.median_us / first.contact.median_us,
+            r.contact.mean_evaluations
+        ));
+    }
+    s
+}
+
+/// Where the contact targets of issue 15 land, from the reference parts' rows.
+pub fn targets(rows: &[ContactCostRow], scaling: &[ScalingRow]) -> String {
+    let medians = |fid: &str| -> Vec<String> {
+        rows.iter()
+            .filter(|r| r.fidelity == fid)
+            .map(|r| format!("{} {:.1}", r.part, r.median_us))
+            .collect()
+    };
+    let worst = |fid: &str| {
+        rows.iter()
+            .filter(|r| r.fidelity == fid)
+            .map(|r| r.median_us)
+            .fold(0.0, f64::max)
+    };
+    let self_err = rows
+        .iter()
+        .filter(|r| r.fidelity == "exact")
+        .map(|r| r.self_error_p95_deg)
+        .fold(0.0, f64::max);
+    let self_max = rows
+        .iter()
+        .filter(|r| r.fidelity == "exact")
+        .map(|r| r.self_error_max_deg)
+        .fold(0.0, f64::max);
+    let growth = match (scaling.first(), scaling.last()) {
+        (Some(a), Some(b)) if b.vertices > a.vertices => format!(
+            "from {} to {} vertices ({:.0}×) one near-field evaluation costs {:.1}×, a far-field one {:.1}×, a whole contact {:.1}×",
+            a.vertices,
+            b.vertices,
+            b.vertices as f64 / a.vertices as f64,
+            b.near_ns / a.near_ns,
+            b.far_ns / a.far_ns,
+            b.contact.median_us / a.contact.median_us
+        ),
+        _ => "not measured".into(),
+    };
+    format!(
+        "## Targets (issue 15 item 1) and where they land\n\n\
+         | target | measured here | met |\n|---|---|---|\n\
+         | exact ≤ 20 µs median per contact | {} µs | {} |\n\
+         | at ≤ 1e-3° self-accuracy | p95 ≤ {:.1e}°, worst contact {:.1e}° | {} |\n\
+         | ellipsoid ≤ 3 µs | {} µs | {} |\n\
+         | tip ≤ 3 µs | {} µs | {} |\n\
+         | exact cost sub-linear in the vertex count up to 48 | {growth} | see the table below |\n",
+        medians("exact").join(", "),
+        if worst("exact") <= 20.0 { "yes" } else { "no" },
+        self_err,
+        self_max,
+        if self_err <= 1e-3 { "p95 yes" } else { "no" },
+        medians("ellipsoid").join(", "),
+        if worst("ellipsoid") <= 3.0 {
+            "yes"
+        } else {
+            "no"
+        },
+        medians("tip").join(", "),
+        if worst("tip") <= 3.0 { "yes" } else { "no" },
+    )
+}
