@@ -376,6 +376,8 @@ fn land_on_event(
     let landing = land(ctx, at, step, h, ev1, estimate);
     let (s_land, y_land, inst_land) = match &landing.at {
         Some((t, l)) => {
+            // The landing's sub-step (see `land`) counts as a step.
+            segs.steps += 1;
             segs.ride(ctx, at.feat, l.rates[0].abs().max(at.f0[0].abs()), t * h);
             (at.s + t * h, l.y, l.inst)
         }
