@@ -116,10 +116,9 @@ pub fn first_touch(
         }
         let cb = eval(tb, evaluations);
         if let Some(t) = bisect(
-            ta,
-            ca,
-            tb,
-            cb,
+            (ta, ca),
+            (tb, cb),
+            d,
             &mut |t| eval(t, evaluations),
             motion,
             resolution,
@@ -133,18 +132,17 @@ pub fn first_touch(
     None
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The first touch in [ta, tb] given the clearance at both ends and the motion bound `d` over
+/// the piece (the caller has it already).
 fn bisect(
-    ta: f64,
-    ca: f64,
-    tb: f64,
-    cb: f64,
+    (ta, ca): (f64, f64),
+    (tb, cb): (f64, f64),
+    d: f64,
     clearance: &mut dyn FnMut(f64) -> f64,
     motion: &dyn Fn(f64, f64) -> f64,
     resolution: f64,
     depth: u32,
 ) -> Option<f64> {
-    let d = motion(ta, tb);
     if cb > 0.0 && 0.5 * (ca + cb - d) > 0.0 {
         return None;
     }
@@ -153,13 +151,31 @@ fn bisect(
     }
     let tm = 0.5 * (ta + tb);
     let cm = clearance(tm);
-    if let Some(t) = bisect(ta, ca, tm, cm, clearance, motion, resolution, depth + 1) {
+    let d1 = motion(ta, tm);
+    if let Some(t) = bisect(
+        (ta, ca),
+        (tm, cm),
+        d1,
+        clearance,
+        motion,
+        resolution,
+        depth + 1,
+    ) {
         return Some(t);
     }
     if cm <= 0.0 {
         return Some(tm);
     }
-    bisect(tm, cm, tb, cb, clearance, motion, resolution, depth + 1)
+    let d2 = motion(tm, tb);
+    bisect(
+        (tm, cm),
+        (tb, cb),
+        d2,
+        clearance,
+        motion,
+        resolution,
+        depth + 1,
+    )
 }
 
 #[cfg(test)]

@@ -106,13 +106,6 @@ impl Warm {
     }
 }
 
-impl Default for Warm {
-    /// As for the default integration tolerance (1e-6).
-    fn default() -> Warm {
-        Warm::for_tolerance(1e-6)
-    }
-}
-
 /// Friction settings of the contact: μc and the friction-cone half-angle's sine and cosine
 /// (precomputed: the cone edges are needed at every instant).
 #[derive(Debug, Clone, Copy)]
@@ -356,7 +349,7 @@ mod tests {
         ] {
             let n = n.normalized();
             let g = ContactGeom { p, n, v_pin: vp };
-            let mut warm = Warm::default();
+            let mut warm = Warm::for_tolerance(1e-6);
             let inst = classify(
                 &m,
                 Fidelity::Ellipsoid,
@@ -411,7 +404,7 @@ mod tests {
             Fidelity::Tip,
             &g,
             Friction::new(0.5),
-            &mut Warm::default(),
+            &mut Warm::for_tolerance(1e-6),
             &mut ev
         )
         .unwrap()

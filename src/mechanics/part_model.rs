@@ -270,16 +270,7 @@ impl WarmStick {
         let Some(h) = self.hess else {
             return om;
         };
-        let d = [
-            xi[0] - self.twist[0],
-            xi[1] - self.twist[1],
-            xi[2] - self.twist[2],
-        ];
-        let grad = [
-            self.wrench[0] + dot3(h[0], d),
-            self.wrench[1] + dot3(h[1], d),
-            self.wrench[2] + dot3(h[2], d),
-        ];
+        let grad = linear_grad(self.wrench, &h, self.twist, xi);
         let g = dot3(e, grad);
         if g.abs() <= NEWTON_TOL * norm3(grad) * norm3(e) {
             return om;
@@ -545,7 +536,8 @@ impl PartModel {
             let h12 = quad3(&d.hess, e1, e2);
             let h22 = quad3(&d.hess, e2, e2);
             let det = h11 * h22 - h12 * h12;
-            let mut dz = if det > 0.0 && h11 > 0.0 && det.is_finite() {
+            let solvable = det > 0.0 && h11 > 0.0 && det.is_finite();
+            let mut dz = if solvable {
                 [
                     -(h22 * gr[0] - h12 * gr[1]) / det,
                     -(-h12 * gr[0] + h11 * gr[1]) / det,
@@ -554,8 +546,7 @@ impl PartModel {
                 [-gr[0], -gr[1]]
             };
             let slope = gr[0] * dz[0] + gr[1] * dz[1];
-            let newton = slope < 0.0 && det > 0.0 && h11 > 0.0 && det.is_finite();
-            if newton && residual <= gap {
+            if solvable && slope < 0.0 && residual <= gap {
                 let xin = at([z[0] + dz[0], z[1] + dz[1]]);
                 let dn = linearised(&d, xi, xin);
                 return Ok(done(xin, &dn));
@@ -759,17 +750,21 @@ fn predict_twist(p: &WarmTwist, w: Wrench) -> Option<Twist> {
 /// H (to − from); H is kept.
 fn linearised(d: &Dissipation, from: Twist, to: Twist) -> Dissipation {
     let dx = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
-    let h = &d.hess;
-    let grad = [
-        d.grad[0] + dot3(h[0], dx),
-        d.grad[1] + dot3(h[1], dx),
-        d.grad[2] + dot3(h[2], dx),
-    ];
     Dissipation {
         value: d.value + dot3(d.grad, dx),
-        grad,
+        grad: linear_grad(d.grad, &d.hess, from, to),
         hess: d.hess,
     }
+}
+
+/// ∇D at `to` to first order from ∇D = `grad` and H = `hess` at `from`.
+fn linear_grad(grad: Wrench, hess: &[[f64; 3]; 3], from: Twist, to: Twist) -> Wrench {
+    let dx = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
+    [
+        grad[0] + dot3(hess[0], dx),
+        grad[1] + dot3(hess[1], dx),
+        grad[2] + dot3(hess[2], dx),
+    ]
 }
 
 /// Two unit vectors orthogonal to the unit vector `w` and to each other.
