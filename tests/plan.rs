@@ -419,3 +419,70 @@ fn every_designed_bundled_scenario_names_the_plan_command_for_its_feed() {
         );
     }
 }
+
+/// The plan's pins, its window and its length, or the best effort's, with the outcome's kind.
+fn answer(o: &Outcome) -> (String, Vec<i32>, u32) {
+    let (kind, plan) = match o {
+        Outcome::Found(p) => ("found", Some(p)),
+        Outcome::NoneUpTo { best, .. } => ("none", best.as_ref()),
+        Outcome::Exhausted { best, .. } => ("exhausted", best.as_ref()),
+        Outcome::LimitHit { best, .. } => ("limit", best.as_ref()),
+    };
+    let pins = plan.map_or(vec![], |p| {
+        p.steps
+            .iter()
+            .map(|s| match s.action {
+                Action::Pin(a) => a.y_q,
+                Action::Fence(_) => i32::MIN,
+            })
+            .collect()
+    });
+    (kind.to_string(), pins, plan.map_or(0, |p| p.window.inside))
+}
+
+#[test]
+fn branch_and_bound_changes_the_work_not_the_answer() {
+    // A found plan (tripoly1, 4 pins; depth limit 8 and 4) and a none-up-to-depth with its best
+    // effort (random:5 to depth 4, which needs 8): the same answer with the bound on and off, for
+    // less work.
+    let mut cases = Vec::new();
+    let mut found = Problem::new("tripoly1");
+    found.jitter_samples = 3;
+    found.offset_samples = 3;
+    cases.push(found.clone());
+    // The same with the depth limit at the plan's length: the goal is then found among the
+    // deepest level's states, which the bounded search evaluates as their parents are generated.
+    found.max_pins = 4;
+    cases.push(found);
+    let mut none = Problem::new("random:5");
+    none.jitter_samples = 2;
+    none.offset_samples = 3;
+    none.max_pins = 4;
+    cases.push(none);
+    let mut kinds = Vec::new();
+    for prob in cases {
+        let mut off = prob.clone();
+        off.bound = false;
+        let (on_out, on) = Planner::new(&prob).unwrap().search();
+        let (off_out, off) = Planner::new(&off).unwrap().search();
+        assert_eq!(answer(&on_out), answer(&off_out), "{}", prob.part);
+        assert_eq!(off.pruned, 0);
+        assert!(on.generated <= off.generated);
+        kinds.push(answer(&on_out).0);
+        // Proving "none" is where the bound saves: it need not expand the last levels.
+        if kinds.last().unwrap() == "none" {
+            assert!(
+                on.pruned > 0
+                    && on.generated < off.generated
+                    && on.pushes.computed < off.pushes.computed,
+                "{}: {} successors and {} passes with the bound, {} and {} without",
+                prob.part,
+                on.generated,
+                on.pushes.computed,
+                off.generated,
+                off.pushes.computed
+            );
+        }
+    }
+    assert_eq!(kinds, ["found", "found", "none"]);
+}

@@ -86,9 +86,13 @@ pub struct PlanArgs {
     /// Sample each orientation's outcome every COARSE pin positions and bisect changes (1 = all).
     #[arg(long, default_value_t = 4)]
     pub coarse: usize,
-    /// Stop after this many distinct states.
-    #[arg(long, default_value_t = 100_000)]
+    /// Stop after this many distinct states kept (each ≈ 16 bytes per particle).
+    #[arg(long, default_value_t = 1_000_000)]
     pub max_states: usize,
+    /// Expand every state, even those that cannot beat the best effort within the pins left
+    /// (branch and bound off: same result, more work; for comparison).
+    #[arg(long)]
+    pub no_bound: bool,
     /// Stop after this many seconds of search.
     #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
     pub time_limit: f64,
@@ -178,6 +182,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.tolerance_deg = args.tolerance;
     p.target = args.target;
     p.fewest_sets = args.fewest_sets;
+    p.bound = !args.no_bound;
     p.min_margin_m = args.min_margin * 1e-3;
     p.y_quantum_m = args.y_quantum * 1e-3;
     p.theta_quantum_deg = args.theta_quantum;
@@ -265,6 +270,9 @@ pub fn command_line(args: &PlanArgs) -> String {
         d.tolerance_deg.to_string()
     );
     opt!("--target", args.target.to_string(), d.target.to_string());
+    if args.no_bound {
+        w.push("--no-bound".into());
+    }
     if args.fewest_sets {
         w.push("--fewest-sets".into());
     }
@@ -398,10 +406,14 @@ fn stats_text(s: &SearchStats) -> String {
         .enumerate()
         .map(|(k, n)| format!("{k}:{n}"))
         .collect();
-    t += &format!("  new states per depth  {}\n", levels.join("  "));
+    t += &format!("  new open states per depth  {}\n", levels.join("  "));
     t += &format!(
         "  expanded {}, generated {} ({} duplicates), {:.1} actions per state\n",
         s.expanded, s.generated, s.duplicates, s.actions_per_expansion
+    );
+    t += &format!(
+        "  bound: {} actions or states cut (cannot beat the best effort with the pins left)\n",
+        s.pruned
     );
     t += &format!(
         "  pushes computed {}, memo hits {}, orientation columns {}, memo entries {}\n",

@@ -12,7 +12,7 @@
 //! margin below `min_margin_m` are dropped (a design there breaks under a small pin error), and so
 //! are actions whose successor equals the state (no particle touched, or nothing changed).
 
-use super::particles::State;
+use super::particles::{Particle, State};
 use super::transition::{PassKey, Transition, NO_CONTACT};
 use serde::Serialize;
 
@@ -38,8 +38,19 @@ pub enum Action {
     Fence(super::fences::FenceAction),
 }
 
-/// The pin actions of `state` with their successors, in increasing lateral position.
-pub fn pin_actions(state: &State, tr: &mut Transition, min_margin_m: f64) -> Vec<(Action, State)> {
+/// Decides, before an action's passes are computed, whether its successor is worth having: called
+/// with the particles the pin cannot touch and the weight it may touch (see
+/// [`super::bound::may_exceed_parts`]).
+pub type Worth<'a> = &'a dyn Fn(&[Particle], u64) -> bool;
+
+/// The pin actions of `state` with their successors, in increasing lateral position; with
+/// `worth`, only the actions it accepts (the others' passes are never computed).
+pub fn pin_actions(
+    state: &State,
+    tr: &mut Transition,
+    min_margin_m: f64,
+    worth: Option<Worth>,
+) -> Vec<(Action, State)> {
     if state.particles.is_empty() {
         return Vec::new();
     }
@@ -97,7 +108,7 @@ pub fn pin_actions(state: &State, tr: &mut Transition, min_margin_m: f64) -> Vec
             let i = rep - p.y_q + reach;
             i >= 0 && (i as usize) < col.len() && col[i as usize] != NO_CONTACT
         });
-        if touched {
+        if touched && worth.is_none_or(|w| worth_it(state, &columns, reach, rep, w)) {
             intervals.push((s, e, rep, margin));
         }
     }
@@ -127,4 +138,26 @@ pub fn pin_actions(state: &State, tr: &mut Transition, min_margin_m: f64) -> Vec
         out.push((action, next));
     }
     out
+}
+
+/// Ask `worth` about a pin at `rep`: the particles it cannot touch (out of reach, or no contact in
+/// their column) and the weight of those it may touch.
+fn worth_it(
+    state: &State,
+    columns: &[std::sync::Arc<Vec<u32>>],
+    reach: i32,
+    rep: i32,
+    worth: Worth,
+) -> bool {
+    let mut untouched = Vec::with_capacity(state.particles.len());
+    let mut touched = 0u64;
+    for (p, col) in state.particles.iter().zip(columns) {
+        let i = rep - p.y_q + reach;
+        if i >= 0 && (i as usize) < col.len() && col[i as usize] != NO_CONTACT {
+            touched += p.weight as u64;
+        } else {
+            untouched.push(*p);
+        }
+    }
+    worth(&untouched, touched)
 }

@@ -20,6 +20,8 @@
 //!   below the jam limit, placed clear of every particle's reach, passes through
 //!   [`crate::mechanics::push_fence`]; the same search runs over them;
 //! * [`search`]: breadth-first search with deduplication, limits and statistics;
+//! * [`bound`]: its branch and bound — what r more pins can at most bring into one window, from
+//!   the pins' lateral reach alone;
 //! * [`contingent`]: the contingent planner with sensing (a sensor pin, then per-decision moving
 //!   pins; AND-OR over the branches, which must share one goal window);
 //! * [`emit`]: the plan as a runnable scenario TOML (and a contingent plan's policy file);
@@ -40,11 +42,13 @@
 //! Breadth-first search over these states with deduplication visits every state reachable in k
 //! pins before any reachable in k + 1, so the first goal state generated is reached by a plan of the
 //! fewest pins among all plans in this action set for this particle set and quantum; "no plan up
-//! to depth k" means none of those plans of ≤ k pins reaches the goal. A finer quantum or another
+//! to depth k" means none of those plans of ≤ k pins reaches the goal (the branch and bound skips
+//! only states and pins that provably cannot lead to the goal within k, [`bound`]). A finer quantum or another
 //! action set may find a shorter plan; rounding can also make a reported plan slightly optimistic,
 //! which the line check measures.
 
 pub mod actions;
+pub mod bound;
 pub mod check;
 pub mod contingent;
 pub mod emit;

@@ -60,7 +60,10 @@ pub struct Problem {
     /// The per-orientation outcome over the pin grid is sampled every `coarse` grid steps and
     /// bisected where the qualitative outcome changes (1 = every step).
     pub coarse: usize,
-    /// Search limits: most distinct states, and wall time (s).
+    /// Branch and bound ([`super::bound`]): do not expand states that cannot beat the best
+    /// effort within the pins left. Off, every state is expanded (same outcome, more work).
+    pub bound: bool,
+    /// Search limits: most distinct states kept, and wall time (s).
     pub max_states: usize,
     pub time_limit_s: f64,
     /// Integration tolerance of the contact model while planning.
@@ -94,7 +97,8 @@ impl Problem {
             y_quantum_m: 0.00025,
             theta_quantum_deg: 0.25,
             coarse: 4,
-            max_states: 100_000,
+            bound: true,
+            max_states: 1_000_000,
             time_limit_s: 600.0,
             contact_tol: 1e-5,
             seed: 1,

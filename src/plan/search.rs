@@ -1,16 +1,30 @@
-//! Breadth-first search over particle states (see the module docs of [`super`] for what the
-//! returned plan's "shortest" means).
+//! Breadth-first search over particle states, with branch and bound (see the module docs of
+//! [`super`] for what the returned plan's "shortest" means).
 //!
 //! Level k holds the states first reached with k pins; a state seen before (at any level) is not
 //! kept again, so every kept state is reached by a shortest action sequence. States of a level are
 //! expanded in order (their actions in increasing y), each expansion's pushes in parallel; the goal
 //! is tested as states are generated, so the search stops at the first goal state of the shallowest
 //! level that has one. Without a goal it ends with "none up to depth k" (every plan of ≤ k pins
-//! tried), "exhausted" (no new state at some level: no plan at any depth in this action set), or a
-//! limit (`max_states` kept states, `time_limit_s`), reporting the depth it completed.
+//! tried), "exhausted" (no new state at some level and nothing cut by the bound: no plan at any
+//! depth in this action set), or a limit (`max_states` kept states, `time_limit_s`), reporting the
+//! depth it completed.
+//!
+//! **Bound** ([`super::bound`], on unless `bound` is off, not with `fewest_sets`): a new state that
+//! cannot hold more weight in one window than the best state so far within the pins left is not
+//! expanded (nor kept, unless it is that best state), and a pin whose passes could not lead to such
+//! a state is not taken (its passes are never computed). Neither can hide a goal (which needs more
+//! weight than any non-goal state) nor a better best effort (ties go to the shallower plan), so the
+//! outcome — plan or best effort — is the one of the full search; only the work changes. The
+//! two deepest levels are not stored: each state of the level before the deepest is expanded as
+//! soon as it is generated (in the breadth-first order, so the first goal found there is still
+//! the breadth-first one, returned once the level is done unless a shallower goal turns up), and a
+//! deepest state is kept only as a goal or a new best effort. Memory then holds the levels up to
+//! depth − 2; a state repeated in the level before the deepest is expanded again.
 
-use super::actions::{pin_actions, Action};
-use super::particles::{best_window, initial_state, orientation_sets, State, Window};
+use super::actions::{pin_actions, Action, Worth};
+use super::bound::{may_exceed, may_exceed_parts, BoundGeometry};
+use super::particles::{best_window, initial_state, orientation_sets, Particle, State, Window};
 use super::problem::{Compiled, Problem};
 use super::transition::{PushCounters, Transition};
 use super::PlanError;
@@ -72,7 +86,8 @@ pub struct SearchStats {
     /// Particles of the initial state (before merging) and physics samples.
     pub particles: u32,
     pub physics_samples: usize,
-    /// New states per level (level 0 = the feed).
+    /// New states per level kept open for expansion (level 0 = the feed); states the bound cut
+    /// are counted in `pruned`.
     pub states_per_depth: Vec<usize>,
     /// Levels fully expanded.
     pub depth_completed: usize,
@@ -80,6 +95,9 @@ pub struct SearchStats {
     /// Successors generated (before deduplication) and those already seen.
     pub generated: u64,
     pub duplicates: u64,
+    /// Actions not taken and new states not expanded because they cannot beat the best effort
+    /// within the pins left (branch and bound, [`super::bound`]).
+    pub pruned: u64,
     pub actions_per_expansion: f64,
     pub pushes: PushCounters,
     pub memo_entries: usize,
@@ -132,11 +150,22 @@ impl Planner {
 
     /// The actions of a state and their successors.
     pub fn actions(&mut self, state: &State) -> Vec<(Action, State)> {
+        self.actions_worth(state, None)
+    }
+
+    /// The actions of a state and their successors; pin actions only where `worth` accepts them
+    /// (fences: all).
+    pub fn actions_worth(&mut self, state: &State, worth: Option<Worth>) -> Vec<(Action, State)> {
         if let Some(f) = self.fences.as_mut() {
             let steps = self.compiled.theta_steps;
             return f.actions(state, &self.transition, &self.problem, steps);
         }
-        pin_actions(state, &mut self.transition, self.problem.min_margin_m)
+        pin_actions(
+            state,
+            &mut self.transition,
+            self.problem.min_margin_m,
+            worth,
+        )
     }
 
     /// The best window of a state.
@@ -160,6 +189,17 @@ impl Planner {
             self.compiled.theta_steps,
             p.target,
         )
+    }
+
+    /// What the branch-and-bound of [`super::bound`] needs: the pins' reach (none for fences),
+    /// the goal window's span and the orientation quanta per period.
+    pub fn bound_geometry(&self) -> BoundGeometry {
+        let p = &self.problem;
+        BoundGeometry {
+            reach_q: self.fences.is_none().then_some(self.transition.reach_q),
+            width_q: ((2.0 * p.tolerance_deg / p.theta_quantum_deg) + 1e-9).floor() as i32,
+            steps: self.compiled.theta_steps,
+        }
     }
 
     /// Does a state reach the goal (one window holding the target share)?
@@ -200,166 +240,332 @@ impl Planner {
 
     /// Run the breadth-first search.
     pub fn search(&mut self) -> (Outcome, SearchStats) {
-        let started = Instant::now();
         let p = self.problem.clone();
-        let mut stats = SearchStats {
-            particles: self.initial.total(),
-            physics_samples: self.transition.samples.len(),
-            ..SearchStats::default()
-        };
-        let root = Arc::new(self.initial.clone());
-        let mut nodes = vec![Node {
-            state: root.clone(),
-            parent: None,
-            action: None,
-        }];
-        let mut seen: HashSet<Arc<State>> = HashSet::new();
-        seen.insert(root);
-        stats.states_per_depth.push(1);
-        let mut state_bytes = self.initial.bytes();
-        // Best so far: for `fewest_sets` (sets, node), otherwise the most particles in one window
-        // (inside, node); the first found (the shallowest) wins ties.
-        let mut best: (usize, usize) = (self.sets(&self.initial), 0);
-        let mut most: (u32, usize) = (self.window(&self.initial).inside, 0);
-        let done = |s: &Self, st: &State, best_sets: usize| -> bool {
-            if p.fewest_sets {
-                best_sets <= 1
-            } else {
-                s.is_goal(st)
-            }
-        };
-        let finish = |s: &Self, mut stats: SearchStats, bytes: usize| {
-            stats.pushes = s.transition.counters;
-            stats.memo_entries = s.transition.memo_len();
-            if let Some(f) = &s.fences {
-                stats.pushes.computed += f.computed;
-                stats.memo_entries += f.memo_len();
-            }
-            stats.elapsed_s = started.elapsed().as_secs_f64();
-            stats.memory_estimate_bytes = bytes + s.transition.memo_bytes();
-            stats.peak_rss_bytes = peak_rss_bytes();
-            if stats.expanded > 0 {
-                stats.actions_per_expansion = stats.generated as f64 / stats.expanded as f64;
-            }
-            stats
-        };
-        if done(self, &self.initial, best.0) {
-            let plan = self.plan_to(&nodes, 0);
-            return (Outcome::Found(plan), finish(self, stats, state_bytes));
+        let mut run = Run::new(self);
+        if self.fewest_done(&run) || (!p.fewest_sets && self.is_goal(&self.initial)) {
+            return (
+                Outcome::Found(self.plan_to(&run.nodes, 0)),
+                self.finish(run),
+            );
         }
         let mut frontier = vec![0usize];
         for depth in 1..=p.max_pins {
+            // With the bound, the level before the deepest is expanded as it is generated and
+            // neither level is stored (see `Planner::expand_deepest`).
+            let eager = p.bound && !p.fewest_sets && depth + 1 == p.max_pins;
             let mut next = Vec::new();
+            let mut open = 0usize;
             for &id in &frontier {
-                if started.elapsed().as_secs_f64() > p.time_limit_s {
+                if run.started.elapsed().as_secs_f64() > p.time_limit_s {
                     let limit = format!("time limit {} s", p.time_limit_s);
-                    let best = self.best_of(&nodes, best, most);
-                    return self.limit(limit, depth - 1, best, stats, finish, state_bytes);
+                    return self.limit(run, limit, depth - 1);
                 }
-                let state = nodes[id].state.clone();
-                let succ = self.actions(&state);
-                stats.expanded += 1;
-                for (action, s) in succ {
-                    stats.generated += 1;
-                    let s = Arc::new(s);
-                    if !seen.insert(s.clone()) {
-                        stats.duplicates += 1;
-                        continue;
-                    }
-                    state_bytes += s.bytes() + 64;
-                    nodes.push(Node {
-                        state: s.clone(),
-                        parent: Some(id),
-                        action: Some(action),
-                    });
-                    let nid = nodes.len() - 1;
-                    next.push(nid);
-                    if p.fewest_sets {
-                        let k = self.sets(&s);
-                        if k < best.0 {
-                            best = (k, nid);
+                let state = run.nodes[id].state.clone();
+                for (action, s) in self.successors(&mut run, &state, p.max_pins - depth) {
+                    match self.admit(&mut run, s, id, action, depth, eager) {
+                        Admit::Goal(nid) => {
+                            run.stats.states_per_depth.push(open + next.len());
+                            return (
+                                Outcome::Found(self.plan_to(&run.nodes, nid)),
+                                self.finish(run),
+                            );
                         }
-                    } else {
-                        let inside = self.window(&s).inside;
-                        if inside > most.0 {
-                            most = (inside, nid);
+                        Admit::Open(nid) => next.push(nid),
+                        Admit::Eager(s, node) => {
+                            open += 1;
+                            if run.goal_last.is_none() {
+                                self.expand_deepest(&mut run, s, node, (id, action));
+                            }
                         }
+                        Admit::Closed => {}
                     }
-                    if done(self, &s, best.0) {
-                        stats.states_per_depth.push(next.len());
-                        let plan = self.plan_to(&nodes, if p.fewest_sets { best.1 } else { nid });
-                        return (Outcome::Found(plan), finish(self, stats, state_bytes));
-                    }
-                    if nodes.len() >= p.max_states {
-                        stats.states_per_depth.push(next.len());
+                    if run.nodes.len() >= p.max_states {
+                        run.stats.states_per_depth.push(open + next.len());
                         let limit = format!("state limit {} (--max-states)", p.max_states);
-                        let best = self.best_of(&nodes, best, most);
-                        return self.limit(limit, depth - 1, best, stats, finish, state_bytes);
+                        return self.limit(run, limit, depth - 1);
                     }
                 }
             }
-            stats.states_per_depth.push(next.len());
-            stats.depth_completed = depth;
-            if next.is_empty() {
-                let stats = finish(self, stats, state_bytes);
-                if p.fewest_sets {
-                    return (Outcome::Found(self.plan_to(&nodes, best.1)), stats);
+            run.stats.states_per_depth.push(open + next.len());
+            run.stats.depth_completed = depth;
+            if eager {
+                run.stats.depth_completed = p.max_pins;
+                run.stats.states_per_depth.push(0);
+                if let Some(goal) = run.goal_last {
+                    return (
+                        Outcome::Found(self.plan_to(&run.nodes, goal)),
+                        self.finish(run),
+                    );
                 }
-                let best = self.best_of(&nodes, best, most);
-                return (
-                    Outcome::Exhausted {
-                        depth: depth - 1,
-                        best,
-                    },
-                    stats,
-                );
+            }
+            if next.is_empty() {
+                return self.no_plan(run, depth, open == 0);
             }
             frontier = next;
         }
-        let stats = finish(self, stats, state_bytes);
-        if p.fewest_sets {
-            return (Outcome::Found(self.plan_to(&nodes, best.1)), stats);
+        self.no_plan(run, p.max_pins, false)
+    }
+
+    /// The successors of `state` worth generating with `left` pins after this one (all of them
+    /// without the bound); counts the expansion and the pins the bound refused.
+    fn successors(&mut self, run: &mut Run, state: &State, left: usize) -> Vec<(Action, State)> {
+        run.stats.expanded += 1;
+        if self.problem.fewest_sets || !self.problem.bound {
+            return self.actions(state);
         }
-        let best = self.best_of(&nodes, best, most);
-        (
+        let (bar, geometry) = (run.bar(), self.bound_geometry());
+        let refused = std::cell::Cell::new(0u64);
+        let worth = |parts: &[Particle], free: u64| {
+            let ok = may_exceed_parts(parts, free, left, geometry, bar);
+            refused.set(refused.get() + u64::from(!ok));
+            ok
+        };
+        let succ = self.actions_worth(state, Some(&worth));
+        run.stats.pruned += refused.get();
+        succ
+    }
+
+    /// Has `fewest_sets` reached one set?
+    fn fewest_done(&self, run: &Run) -> bool {
+        self.problem.fewest_sets && run.fewest.0 <= 1
+    }
+
+    /// Take a successor generated at `depth` into the search: deduplicate it, test the goal,
+    /// update the best so far and decide whether it is expanded (the bound).
+    fn admit(
+        &self,
+        run: &mut Run,
+        s: State,
+        parent: usize,
+        action: Action,
+        depth: usize,
+        eager: bool,
+    ) -> Admit {
+        let p = &self.problem;
+        run.stats.generated += 1;
+        if run.seen.contains(&s) {
+            run.stats.duplicates += 1;
+            return Admit::Closed;
+        }
+        if p.fewest_sets {
+            let k = self.sets(&s);
+            let s = Arc::new(s);
+            run.seen.insert(s.clone());
+            let nid = run.push(s, parent, action);
+            if k < run.fewest.0 {
+                run.fewest = (k, nid);
+            }
+            return if self.fewest_done(run) {
+                Admit::Goal(run.fewest.1)
+            } else {
+                Admit::Open(nid)
+            };
+        }
+        let inside = self.window(&s).inside;
+        if self.is_goal(&s) {
+            return Admit::Goal(run.push(Arc::new(s), parent, action));
+        }
+        // Kept as the best effort if it holds the most so far at a stored level (the shallowest
+        // wins ties); expanded only if it may beat the best so far within the pins left.
+        let improves = inside > run.most.0;
+        let bar = run.bar().max(inside);
+        let open = !p.bound || may_exceed(&s, p.max_pins - depth, self.bound_geometry(), bar);
+        if !open {
+            run.stats.pruned += 1;
+        }
+        if !open && !improves {
+            return Admit::Closed;
+        }
+        let s = Arc::new(s);
+        if eager && !improves {
+            return Admit::Eager(s, None);
+        }
+        if open && !eager {
+            run.seen.insert(s.clone());
+        }
+        let nid = run.push(s.clone(), parent, action);
+        if improves {
+            run.most = (inside, nid);
+        }
+        match (open, eager) {
+            (false, _) => Admit::Closed,
+            (true, false) => Admit::Open(nid),
+            (true, true) => Admit::Eager(s, Some(nid)),
+        }
+    }
+
+    /// Expand a state of the level before the deepest as soon as it is generated: its successors
+    /// (the deepest level) are only tested — the first goal in breadth-first order, or a new most
+    /// in one window — and kept only then; so is the state itself (`node`, created on demand
+    /// under `via` = (parent, action)). Neither level is stored or deduplicated otherwise: a
+    /// repeated state is expanded again, finding nothing new.
+    fn expand_deepest(
+        &mut self,
+        run: &mut Run,
+        state: Arc<State>,
+        mut node: Option<usize>,
+        via: (usize, Action),
+    ) {
+        for (action, s) in self.successors(run, &state, 0) {
+            run.stats.generated += 1;
+            let inside = self.window(&s).inside;
+            let goal = self.is_goal(&s);
+            if !goal && inside <= run.bar() {
+                run.stats.pruned += 1;
+                continue;
+            }
+            let pid = *node.get_or_insert_with(|| run.push(state.clone(), via.0, via.1));
+            let nid = run.push(Arc::new(s), pid, action);
+            if goal {
+                run.goal_last = Some(nid);
+                return;
+            }
+            run.most_last = Some((inside, nid));
+        }
+    }
+
+    /// The search ended without a goal after `depth` levels; `empty`: the last level had no new
+    /// state at all.
+    fn no_plan(&self, run: Run, depth: usize, empty: bool) -> (Outcome, SearchStats) {
+        let p = &self.problem;
+        if p.fewest_sets {
+            let plan = self.plan_to(&run.nodes, run.fewest.1);
+            return (Outcome::Found(plan), self.finish(run));
+        }
+        let best = self.best_of(&run);
+        // The bound refutes plans up to the depth limit only.
+        let outcome = if empty && depth < p.max_pins && run.stats.pruned == 0 {
+            Outcome::Exhausted {
+                depth: depth - 1,
+                best,
+            }
+        } else {
             Outcome::NoneUpTo {
                 depth: p.max_pins,
                 best,
-            },
-            stats,
-        )
+            }
+        };
+        (outcome, self.finish(run))
     }
 
     /// The best plan found so far when none reaches the goal: with `fewest_sets` the one to the
-    /// fewest sets, otherwise the one bringing the most particles into one window; none if no pin
-    /// improves on the feed.
-    fn best_of(&self, nodes: &[Node], sets: (usize, usize), most: (u32, usize)) -> Option<Plan> {
+    /// fewest sets, otherwise the shallowest bringing the most particles into one window; none if
+    /// no pin improves on the feed.
+    fn best_of(&self, run: &Run) -> Option<Plan> {
         let node = if self.problem.fewest_sets {
-            sets.1
+            run.fewest.1
         } else {
-            most.1
+            match run.most_last {
+                Some((inside, nid)) if inside > run.most.0 => nid,
+                _ => run.most.1,
+            }
         };
-        (node != 0).then(|| self.plan_to(nodes, node))
+        (node != 0).then(|| self.plan_to(&run.nodes, node))
     }
 
-    fn limit(
-        &self,
-        limit: String,
-        depth_completed: usize,
-        best: Option<Plan>,
-        mut stats: SearchStats,
-        finish: impl Fn(&Self, SearchStats, usize) -> SearchStats,
-        bytes: usize,
-    ) -> (Outcome, SearchStats) {
-        stats.depth_completed = depth_completed;
-        (
-            Outcome::LimitHit {
-                limit,
-                depth_completed,
-                best,
-            },
-            finish(self, stats, bytes),
-        )
+    fn limit(&self, mut run: Run, limit: String, depth_completed: usize) -> (Outcome, SearchStats) {
+        run.stats.depth_completed = depth_completed;
+        let best = self.best_of(&run);
+        let outcome = Outcome::LimitHit {
+            limit,
+            depth_completed,
+            best,
+        };
+        (outcome, self.finish(run))
+    }
+
+    /// The statistics of a finished run.
+    fn finish(&self, run: Run) -> SearchStats {
+        let mut stats = run.stats;
+        stats.pushes = self.transition.counters;
+        stats.memo_entries = self.transition.memo_len();
+        if let Some(f) = &self.fences {
+            stats.pushes.computed += f.computed;
+            stats.memo_entries += f.memo_len();
+        }
+        stats.elapsed_s = run.started.elapsed().as_secs_f64();
+        stats.memory_estimate_bytes = run.bytes + self.transition.memo_bytes();
+        stats.peak_rss_bytes = peak_rss_bytes();
+        if stats.expanded > 0 {
+            stats.actions_per_expansion = stats.generated as f64 / stats.expanded as f64;
+        }
+        stats
+    }
+}
+
+/// What [`Planner::admit`] made of a successor.
+enum Admit {
+    /// A goal (kept as this node).
+    Goal(usize),
+    /// Kept and to be expanded at the next level.
+    Open(usize),
+    /// To be expanded now (the level before the deepest); kept as a node only if it is the best
+    /// effort so far.
+    Eager(Arc<State>, Option<usize>),
+    /// A duplicate, or cut by the bound (kept as a node if it is the best effort so far).
+    Closed,
+}
+
+/// A search in progress: its nodes, the states seen, the best so far and the statistics.
+struct Run {
+    started: Instant,
+    nodes: Vec<Node>,
+    seen: HashSet<Arc<State>>,
+    stats: SearchStats,
+    /// States' bytes (estimate).
+    bytes: usize,
+    /// With `fewest_sets`: (sets, node) of the fewest so far.
+    fewest: (usize, usize),
+    /// The most weight in one window so far, (inside, node), among the states of the stored
+    /// levels; the first found (the shallowest) wins ties.
+    most: (u32, usize),
+    /// The same among the deepest level's states when they are evaluated eagerly.
+    most_last: Option<(u32, usize)>,
+    /// The first goal (breadth-first order) among those.
+    goal_last: Option<usize>,
+}
+
+impl Run {
+    fn new(planner: &Planner) -> Run {
+        let root = Arc::new(planner.initial.clone());
+        let mut seen = HashSet::new();
+        seen.insert(root.clone());
+        let stats = SearchStats {
+            particles: planner.initial.total(),
+            physics_samples: planner.transition.samples.len(),
+            states_per_depth: vec![1],
+            ..SearchStats::default()
+        };
+        Run {
+            started: Instant::now(),
+            bytes: root.bytes(),
+            nodes: vec![Node {
+                state: root,
+                parent: None,
+                action: None,
+            }],
+            seen,
+            stats,
+            fewest: (planner.sets(&planner.initial), 0),
+            most: (planner.window(&planner.initial).inside, 0),
+            most_last: None,
+            goal_last: None,
+        }
+    }
+
+    /// The most weight in one window of any state so far: what a state must beat to matter.
+    fn bar(&self) -> u32 {
+        self.most.0.max(self.most_last.map_or(0, |m| m.0))
+    }
+
+    fn push(&mut self, state: Arc<State>, parent: usize, action: Action) -> usize {
+        self.bytes += state.bytes() + 64;
+        self.nodes.push(Node {
+            state,
+            parent: Some(parent),
+            action: Some(action),
+        });
+        self.nodes.len() - 1
     }
 }
 
