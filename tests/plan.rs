@@ -486,3 +486,31 @@ fn branch_and_bound_changes_the_work_not_the_answer() {
     }
     assert_eq!(kinds, ["found", "found", "none"]);
 }
+
+#[test]
+fn a_plan_the_line_does_not_confirm_is_replanned_with_more_particles() {
+    // random:9's shortest plan over 5 × 5 particles per stable state (6 pins) holds ≈ 93% on
+    // the line; re-planned over 7 × 7 the line confirms it. `--refine 0` keeps the first plan.
+    let args = [
+        "plan",
+        "--part",
+        "random:9",
+        "--check-parts",
+        "1000",
+        "--json",
+    ];
+    let once = json_ok(&[&args[..], &["--refine", "0"]].concat());
+    assert_eq!(once["refined"].as_array().unwrap().len(), 0);
+    let first = once["check"]["success_rate"].as_f64().unwrap();
+    assert!(first < 0.99, "the 5 × 5 plan holds {first} on the line");
+    let v = json_ok(&args);
+    let rounds = v["refined"].as_array().unwrap();
+    assert_eq!(rounds.len(), 1, "{rounds:?}");
+    assert_eq!(rounds[0]["particles"], "5×5 particles per stable state");
+    assert_eq!(rounds[0]["simulated"].as_f64().unwrap(), first);
+    assert_eq!(v["problem"]["jitter_samples"], 7);
+    assert_eq!(v["result"], "found");
+    let rate = v["check"]["success_rate"].as_f64().unwrap();
+    assert!(rate >= 0.99, "the re-planned plan holds {rate}");
+    assert!(v["command"].as_str().unwrap().ends_with("--part random:9"));
+}

@@ -82,6 +82,7 @@ fn plan(spec: &str, extra: &[&str], s: &Survey) -> Result<PlanSummary> {
             footprint_m: None,
             depth_completed: 0,
             search_s: 0.0,
+            refined: Vec::new(),
         },
     })
 }
@@ -137,7 +138,18 @@ fn cell(p: &PlanSummary, unit: &str) -> String {
     });
     let pred = p.predicted.map_or("–".into(), |x| format!("{x:.3}"));
     let what = match p.result {
-        "found" => "shortest".to_string(),
+        "found" if p.refined.is_empty() => "shortest".to_string(),
+        "found" => {
+            let first = &p.refined[0];
+            format!(
+                "shortest after {} re-plan(s) with more particles (planned with {}: {} · {:.3} · {:.4} on the line)",
+                p.refined.len(),
+                first.particles,
+                first.obstacles,
+                first.predicted,
+                first.simulated
+            )
+        }
         "none_up_to_depth" => format!("none ≤ {}; best", p.depth_completed),
         "exhausted" => format!("none at any depth (after {}); best", p.depth_completed),
         "refused" => return format!("refused: {}", p.message.replace('|', "/")),

@@ -141,6 +141,11 @@ pub struct PlanArgs {
     /// action set: shorter designs, longer searches.
     #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub fence_angle_step: f64,
+    /// When the line check holds less than --target of a found plan's parts, re-plan with more
+    /// particles (2 more jitter and offset samples; a uniform feed 1.5× the orientations), at most
+    /// this many times (0: never). Not with --sensor.
+    #[arg(long, default_value_t = 2)]
+    pub refine: usize,
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -284,6 +289,7 @@ pub fn command_line(args: &PlanArgs) -> String {
         "0.25".into()
     );
     opt!("--coarse", args.coarse.to_string(), "4".into());
+    opt!("--refine", args.refine.to_string(), "2".into());
     opt!(
         "--max-states",
         args.max_states.to_string(),
@@ -343,6 +349,93 @@ pub struct CheckReport {
     pub elapsed_s: f64,
 }
 
+/// A found plan the line did not confirm (below `--target`), with the particles it was planned
+/// with; the planner then re-planned with more (`--refine`).
+#[derive(Debug, Clone, Serialize)]
+pub struct RefineRound {
+    /// Particles per stable state (jitter × offset samples), or orientations × offsets.
+    pub particles: String,
+    pub obstacles: usize,
+    pub predicted: f64,
+    /// The line check's success.
+    pub simulated: f64,
+}
+
+/// The particles of a problem, as printed.
+fn particles_text(p: &Problem) -> String {
+    match p.feed {
+        FeedKind::Stable => format!(
+            "{}×{} particles per stable state",
+            p.jitter_samples, p.offset_samples
+        ),
+        FeedKind::Uniform => format!(
+            "{} orientations × {} offsets (particles)",
+            p.orientation_samples, p.offset_samples
+        ),
+    }
+}
+
+/// The same problem with more particles: 2 more jitter and offset samples (a uniform feed: 1.5×
+/// the orientations and 2 more offsets).
+fn denser(p: &Problem) -> Problem {
+    let mut q = p.clone();
+    match q.feed {
+        FeedKind::Stable => q.jitter_samples += 2,
+        FeedKind::Uniform => q.orientation_samples += q.orientation_samples.div_ceil(2),
+    }
+    q.offset_samples += 2;
+    q
+}
+
+/// A plan written as a scenario and checked on the line.
+struct Checked {
+    toml: String,
+    footprint_m: Option<f64>,
+    check: Option<CheckReport>,
+    uncertain: Option<CheckReport>,
+}
+
+/// Emit `plan` as a scenario and run it through the line (with `--check-parts` > 0), and under
+/// the planned uncertainty if any.
+fn emit_and_check(
+    args: &PlanArgs,
+    problem: &Problem,
+    planner: &Planner,
+    plan: &Plan,
+    command: &str,
+    pool: &rayon::ThreadPool,
+) -> Result<Checked> {
+    let path = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("plan.toml"));
+    let file = shell_word(&path.display().to_string());
+    let toml = emit::scenario_toml(
+        problem,
+        plan,
+        planner.compiled.stable_deg.len(),
+        planner.compiled.symmetry,
+        args.check_parts.max(1),
+        command,
+        &file,
+    );
+    let footprint_m = crate::plan::check::footprint_m(&toml, &path);
+    let (mut check, mut uncertain) = (None, None);
+    if args.check_parts > 0 {
+        let started = std::time::Instant::now();
+        let summary = pool
+            .install(|| crate::plan::check::check(&toml, &path, args.check_parts, problem.seed))?;
+        check = Some(CheckReport::of(&summary, started));
+        uncertain = check_uncertain(args, problem, &toml, pool)?;
+    }
+    Ok(Checked {
+        toml,
+        footprint_m,
+        check,
+        uncertain,
+    })
+}
+
 /// The JSON document of `pinfeed plan --json`.
 #[derive(Debug, Serialize)]
 pub struct PlanReport<'a> {
@@ -351,6 +444,8 @@ pub struct PlanReport<'a> {
     /// found | none_up_to_depth | exhausted | limit
     pub result: &'static str,
     pub message: String,
+    /// Found plans the line did not confirm, before this one (`--refine`).
+    pub refined: Vec<RefineRound>,
     /// The plan found, or (result ≠ found) the best effort: the shortest plan bringing the most
     /// particles into one window.
     pub plan: Option<&'a Plan>,
@@ -379,6 +474,8 @@ pub struct PlanSummary {
     /// Search depth completed (pins, fences or moving pins).
     pub depth_completed: usize,
     pub search_s: f64,
+    /// Found plans the line did not confirm, re-planned with more particles (`--refine`).
+    pub refined: Vec<RefineRound>,
 }
 
 /// A planning run, ready to print.
@@ -501,53 +598,65 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
     if args.sensor {
         return super::plan_sensor::execute(args, &problem, &command, &pool);
     }
-    let mut planner = Planner::new(&problem)?;
-    if args.fences {
-        planner.fences = Some(fence_transition(args, &problem)?);
-    }
-    let (outcome, stats) = pool.install(|| planner.search());
+    // Plan, check on the line, and re-plan with more particles while the line does not confirm a
+    // found plan (`--refine`).
+    let mut problem = problem;
+    let mut refined: Vec<RefineRound> = Vec::new();
+    let (outcome, stats, checked) = loop {
+        let mut planner = Planner::new(&problem)?;
+        if args.fences {
+            planner.fences = Some(fence_transition(args, &problem)?);
+        }
+        let (outcome, stats) = pool.install(|| planner.search());
+        let plan = match &outcome {
+            Outcome::Found(p) => Some(p),
+            Outcome::NoneUpTo { best, .. }
+            | Outcome::Exhausted { best, .. }
+            | Outcome::LimitHit { best, .. } => best.as_ref(),
+        };
+        let checked = match plan {
+            Some(plan) => Some(emit_and_check(
+                args, &problem, &planner, plan, &command, &pool,
+            )?),
+            None => None,
+        };
+        let short = match (&outcome, &checked) {
+            (Outcome::Found(plan), Some(Checked { check: Some(c), .. })) => {
+                (c.success_rate < problem.target).then(|| RefineRound {
+                    particles: particles_text(&problem),
+                    obstacles: plan.steps.len(),
+                    predicted: plan.predicted_success,
+                    simulated: c.success_rate,
+                })
+            }
+            _ => None,
+        };
+        match short {
+            Some(round) if refined.len() < args.refine => {
+                refined.push(round);
+                problem = denser(&problem);
+            }
+            _ => break (outcome, stats, checked),
+        }
+    };
     let what = if args.fences { "fence" } else { "pin" };
     let (result, message, plan, failure) = describe(&problem, &outcome, &stats, what);
-    let mut scenario = None;
-    let mut check = None;
-    let mut footprint_m = None;
-    let mut uncertain_check = None;
-    if let Some(plan) = plan {
-        let path = args
-            .out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from("plan.toml"));
-        let file = shell_word(&path.display().to_string());
-        let toml = emit::scenario_toml(
-            &problem,
-            plan,
-            planner.compiled.stable_deg.len(),
-            planner.compiled.symmetry,
-            args.check_parts.max(1),
-            &command,
-            &file,
-        );
-        footprint_m = crate::plan::check::footprint_m(&toml, &path);
-        if args.check_parts > 0 {
-            let started = std::time::Instant::now();
-            let summary = pool.install(|| {
-                crate::plan::check::check(&toml, &path, args.check_parts, problem.seed)
-            })?;
-            check = Some(CheckReport::of(&summary, started));
-            uncertain_check = check_uncertain(args, &problem, &toml, &pool)?;
-        }
+    let (scenario, check, footprint_m, uncertain_check) = match checked {
+        Some(c) => (Some(c.toml), c.check, c.footprint_m, c.uncertain),
+        None => (None, None, None, None),
+    };
+    if let (Some(plan), Some(toml)) = (plan, &scenario) {
         if let Some(draw) = args
             .draw
             .clone()
             .or(args.out.as_ref().map(|o| o.with_extension("svg")))
         {
             if let Some(out) = &args.out {
-                write_file(out, &toml)?;
+                write_file(out, toml)?;
             }
             crate::report::plot_plan::plot_plan(&problem, plan, &draw)
                 .with_context(|| format!("drawing {}", draw.display()))?;
         }
-        scenario = Some(toml);
     }
     let summary = PlanSummary {
         result,
@@ -559,6 +668,7 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
         footprint_m,
         depth_completed: stats.depth_completed,
         search_s: stats.elapsed_s,
+        refined: refined.clone(),
     };
     let output = if args.json {
         let report = PlanReport {
@@ -566,6 +676,7 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
             problem: &problem,
             result,
             message,
+            refined,
             plan,
             stats: &stats,
             check,
@@ -575,6 +686,15 @@ pub fn execute(args: &PlanArgs) -> Result<Executed> {
         serde_json::to_string_pretty(&report)? + "\n"
     } else {
         let mut t = format!("{command}\n");
+        for r in &refined {
+            t += &format!(
+                "refined     planned with {}, a plan of {} obstacle(s) (predicted {:.4}) held {:.4} on the line, below --target {}: re-planned with more particles\n",
+                r.particles, r.obstacles, r.predicted, r.simulated, problem.target
+            );
+        }
+        if !refined.is_empty() {
+            t += &format!("particles   {}\n", particles_text(&problem));
+        }
         t += &stats_text(&stats);
         t += &format!("result      {message}\n");
         if let Some(plan) = plan {

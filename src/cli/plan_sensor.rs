@@ -199,6 +199,7 @@ pub fn execute(
         footprint_m,
         depth_completed: stats.states_per_depth.len().saturating_sub(1),
         search_s: stats.elapsed_s,
+        refined: Vec::new(),
     };
     let output = if args.json {
         let report = SensorReport {
