@@ -880,7 +880,7 @@ fn describe<'a>(
         Outcome::Exhausted { depth, best } => (
             "exhausted",
             format!(
-                "no sensorless plan at any depth: after {depth} {what}(s) no new state is reachable in this action set{}{}",
+                "no sensorless plan at any depth: after {depth} {what}(s) no new state that could still reach the goal is reachable in this action set{}{}",
                 if *depth == 0 {
                     " (no position keeps every particle at least --min-margin from a band edge; try a smaller --min-margin)"
                 } else {

@@ -66,6 +66,11 @@ impl State {
         self.lost + self.particles.iter().map(|p| p.weight).sum::<u32>()
     }
 
+    /// Weight not lost.
+    pub fn live(&self) -> u32 {
+        self.particles.iter().map(|p| p.weight).sum()
+    }
+
     /// Bytes held by this state (for the memory estimate).
     pub fn bytes(&self) -> usize {
         std::mem::size_of::<State>() + self.particles.capacity() * std::mem::size_of::<Particle>()

@@ -6,8 +6,8 @@
 //! expanded in order (their actions in increasing y), each expansion's pushes in parallel; the goal
 //! is tested as states are generated, so the search stops at the first goal state of the shallowest
 //! level that has one. Without a goal it ends with "none up to depth k" (every plan of ≤ k pins
-//! tried), "exhausted" (no new state at some level and nothing cut by the bound: no plan at any
-//! depth in this action set), or a limit (`max_states` kept states, `time_limit_s`), reporting the
+//! tried), "exhausted" (no new state worth expanding at some level, and no cut relied on the depth
+//! limit: no plan at any depth in this action set), or a limit (`max_states` kept states, `time_limit_s`), reporting the
 //! depth it completed.
 //!
 //! **Bound** ([`super::bound`], on unless `bound` is off, not with `fewest_sets`): a new state that
@@ -322,6 +322,7 @@ impl Planner {
         };
         let succ = self.actions_worth(state, Some(&worth));
         run.stats.pruned += refused.get();
+        run.depth_bounded |= refused.get() > 0;
         succ
     }
 
@@ -372,6 +373,8 @@ impl Planner {
         let open = !p.bound || may_exceed(&s, p.max_pins - depth, self.bound_geometry(), bar);
         if !open {
             run.stats.pruned += 1;
+            // A cut that needed the depth limit (not just the weight already lost).
+            run.depth_bounded |= s.live() > bar;
         }
         if !open && !improves {
             return Admit::Closed;
@@ -434,7 +437,7 @@ impl Planner {
         }
         let best = self.best_of(&run);
         // The bound refutes plans up to the depth limit only.
-        let outcome = if empty && depth < p.max_pins && run.stats.pruned == 0 {
+        let outcome = if empty && depth < p.max_pins && !run.depth_bounded {
             Outcome::Exhausted {
                 depth: depth - 1,
                 best,
@@ -523,6 +526,9 @@ struct Run {
     most_last: Option<(u32, usize)>,
     /// The first goal (breadth-first order) among those.
     goal_last: Option<usize>,
+    /// Some cut relied on the depth limit (then an empty level proves "none up to the depth
+    /// limit", not "none at any depth").
+    depth_bounded: bool,
 }
 
 impl Run {
@@ -550,6 +556,7 @@ impl Run {
             most: (planner.window(&planner.initial).inside, 0),
             most_last: None,
             goal_last: None,
+            depth_bounded: false,
         }
     }
 
