@@ -1,6 +1,7 @@
 //! The sensorless pin planner (issue 14): tripoly2's shortest plan with the CLI's defaults (the
-//! target is < 1 s on 2 cores), from a cold memo each iteration. The exhaustive depth-8 searches
-//! are measured by `pinfeed plan` itself and reported in results/plans.md.
+//! target is < 1 s on 2 cores), and an exhaustive depth-8 search (random:18, whose answer is
+//! "none up to depth 8"; the target is < 30 s), each from a cold memo every iteration. The other
+//! exhaustive searches are measured by `pinfeed plan` itself and reported in results/plans.md.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::plan::search::Planner;
@@ -24,5 +25,24 @@ fn shortest_tripoly2(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, shortest_tripoly2);
+fn exhaustive_random18(c: &mut Criterion) {
+    let problem = Problem::new("random:18");
+    let mut g = c.benchmark_group("plan");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(180));
+    g.bench_function(
+        "random:18 exhaustive depth-8 search (defaults, none up to depth 8)",
+        |b| {
+            b.iter(|| {
+                let mut planner = Planner::new(&problem).unwrap();
+                let (outcome, _) = planner.search();
+                assert!(matches!(outcome, Outcome::NoneUpTo { depth: 8, .. }));
+            })
+        },
+    );
+    g.finish();
+}
+
+criterion_group!(benches, shortest_tripoly2, exhaustive_random18);
 criterion_main!(benches);
