@@ -41,6 +41,16 @@ fn tiers_are_ordered() {
     );
     assert!(evals(tip) < evals(default) && evals(ell) < evals(default));
     assert!(evals(tip) > 0.0 && evals(ell) > 0.0);
+    // The slide tables serve (fewer evaluations) without changing the accuracy.
+    let tabled = row("exact+tables tol=1e-6");
+    assert!(
+        evals(tabled) < 0.75 * evals(default),
+        "{} vs {}",
+        evals(tabled),
+        evals(default)
+    );
+    assert!((tabled.error_mean_deg - default.error_mean_deg).abs() < 1e-6);
+    assert!((tabled.error_max_deg - default.error_max_deg).abs() < 1e-6);
     // Every tier, the map's included, is scored on the same contacts.
     row("map");
     assert!(st.rows.iter().all(|r| r.contacts == st.contacts));

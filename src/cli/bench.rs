@@ -170,7 +170,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             }
             let parts = ["tripoly1", "tripoly2", "square", "lshape"];
             let fids = [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact];
-            let rows = contact_cost::measure(&parts, &fids, *contacts, *tol, *seed)?;
+            let rows = contact_cost::measure(&parts, &fids, *contacts, *tol, *seed, true)?;
             let table = contact_cost::markdown(&rows);
             let scaling = contact_cost::vertex_scaling(
                 &[3, 6, 12, 24, 48],
@@ -179,6 +179,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 *seed,
             )?;
             let targets = contact_cost::targets(&rows, &scaling);
+            let tables = contact_cost::tables_markdown(&rows);
             let scaling_table = contact_cost::scaling_markdown(&scaling);
             let cmd = format!(
                 "cargo run --release -- bench contact --contacts {contacts} --tol {tol:e} --seed {seed} --out {}",
@@ -194,7 +195,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                  inside the Newton solves; tip/ellipsoid: closed-form solves). *Self-error* is \
                  |θf(tol) − θf(tol/1000)| with the same model: the integration error at the \
                  default tolerance, not the model error (see the accuracy-vs-time report for that).\n\n\
-                 {table}\n{targets}\n\
+                 `exact+tables` is the exact model with its slide tables (the default for a \
+                 scene's, a map's and a planner's model): a pin sliding on an edge gets the exact \
+                 twist from per-(μc, edge, side) tables of certified cubic Hermite pieces instead \
+                 of a Newton solve (`src/mechanics/slide_table.rs`). Its tables are built before \
+                 the timed runs; the build is in the table below, with what the tables change \
+                 against the solves at the same tolerance.\n\n\
+                 {table}\n### Slide tables (exact+tables rows)\n\n{tables}\n{targets}\n\
                  ### Cost against the vertex count (exact model, regular N-gons)\n\n\
                  One evaluation of D, ∇D and H (20 000 twists, the centre of rotation within 2a: the \
                  closed form, one term per edge; at 8a: the far-field quadrature, 64 nodes per \

@@ -71,6 +71,21 @@ pub struct Polygon {
     radius: f64,
     convex: bool,
     hull: Vec<Vec2>,
+    /// Per edge i (vertex i → i + 1): unit direction and length, computed once (the contact
+    /// model asks for them at every right-hand side).
+    edge_dirs: Vec<Vec2>,
+    edge_lens: Vec<f64>,
+}
+
+/// Unit directions and lengths of the edges of a closed vertex list (edge i: vertex i → i + 1).
+fn edge_data(vertices: &[Vec2]) -> (Vec<Vec2>, Vec<f64>) {
+    let m = vertices.len();
+    (0..m)
+        .map(|i| {
+            let d = vertices[(i + 1) % m] - vertices[i];
+            (d.normalized(), d.norm())
+        })
+        .unzip()
 }
 
 /// A stable state of a part: orientation and the hull edge it rests on.
@@ -373,14 +388,18 @@ impl Polygon {
                 a: approx_decimal(unit.radius, e),
             });
         }
+        let vertices: Vec<Vec2> = unit.vertices.iter().map(|&v| back(v)).collect();
+        let (edge_dirs, edge_lens) = edge_data(&vertices);
         Ok(Polygon {
-            vertices: unit.vertices.iter().map(|&v| back(v)).collect(),
+            vertices,
             offset,
             area,
             polar_moment: polar,
             radius: a,
             convex: unit.convex,
             hull: unit.hull.iter().map(|&v| back(v)).collect(),
+            edge_dirs,
+            edge_lens,
         })
     }
 
@@ -403,7 +422,30 @@ impl Polygon {
     /// Vertex `i` (indices wrap around).
     #[inline]
     pub fn vertex(&self, i: usize) -> Vec2 {
-        self.vertices[i % self.vertices.len()]
+        self.vertices[self.wrap(i)]
+    }
+    /// `i` modulo the vertex count (the callers' indices exceed it by at most a few turns; the
+    /// common case, one past the end, costs no division).
+    #[inline]
+    fn wrap(&self, i: usize) -> usize {
+        let m = self.vertices.len();
+        if i < m {
+            i
+        } else if i < 2 * m {
+            i - m
+        } else {
+            i % m
+        }
+    }
+    /// Unit direction of edge `i` (vertex i → i + 1), the same as `(b − a).normalized()`.
+    #[inline]
+    pub fn edge_dir(&self, i: usize) -> Vec2 {
+        self.edge_dirs[self.wrap(i)]
+    }
+    /// Length of edge `i`, the same as `(b − a).norm()`.
+    #[inline]
+    pub fn edge_len(&self, i: usize) -> f64 {
+        self.edge_lens[self.wrap(i)]
     }
     /// Edge `i` runs from vertex `i` to vertex `i + 1`.
     #[inline]
@@ -413,8 +455,7 @@ impl Polygon {
     /// Unit inward normal of edge `i` (part frame): the edge direction rotated by +90°.
     #[inline]
     pub fn inward_normal(&self, i: usize) -> Vec2 {
-        let (a, b) = self.edge(i);
-        (b - a).normalized().perp()
+        self.edge_dir(i).perp()
     }
     /// Is vertex `i` convex (interior angle < 180°)?
     pub fn vertex_is_convex(&self, i: usize) -> bool {
@@ -477,14 +518,18 @@ impl Polygon {
         let a = check(self.radius * k, "size a")?;
         let area = check(self.area * k * k, "area (∝ a²)")?;
         let polar = check(self.polar_moment * k * k * k * k, "polar moment (∝ a⁴)")?;
+        let vertices: Vec<Vec2> = self.vertices.iter().map(|&p| p * k).collect();
+        let (edge_dirs, edge_lens) = edge_data(&vertices);
         Ok(Polygon {
-            vertices: self.vertices.iter().map(|&p| p * k).collect(),
+            vertices,
             offset: Vec2::ZERO,
             area,
             polar_moment: polar,
             radius: a,
             convex: self.convex,
             hull: self.hull.iter().map(|&p| p * k).collect(),
+            edge_dirs,
+            edge_lens,
         })
     }
 

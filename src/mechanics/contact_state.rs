@@ -161,23 +161,27 @@ impl Ctx<'_, '_> {
         let v_pin = self.vdir.rotate(-y[0]);
         match feat {
             Feat::Edge(k) => {
-                let (a, b) = self.poly.edge(k);
-                let e = (b - a).normalized();
+                let e = self.poly.edge_dir(k);
                 ContactGeom {
-                    p: a + e * y[1],
+                    p: self.poly.vertex(k) + e * y[1],
                     n: e.perp(),
                     v_pin,
+                    // The model's tables are for the part's own edges (a fence and its ends
+                    // touch the hull's).
+                    edge: std::ptr::eq(self.poly, self.model.polygon()).then_some((k, y[1])),
                 }
             }
             Feat::Vertex(k) => ContactGeom {
                 p: self.poly.vertex(k),
                 n: Vec2::from_angle(y[1]),
                 v_pin,
+                edge: None,
             },
             Feat::FenceVertex(k) | Feat::FenceEdge(k) => ContactGeom {
                 p: self.poly.vertex(k),
                 n: self.fence_geom().n.rotate(-y[0]),
                 v_pin,
+                edge: None,
             },
         }
     }
@@ -215,8 +219,7 @@ impl Ctx<'_, '_> {
         let vp = Vec2::new(xi[0], xi[1]) + g.p.perp() * om;
         let dq = match feat {
             Feat::Edge(k) => {
-                let (a, b) = self.poly.edge(k);
-                let e = (b - a).normalized();
+                let e = self.poly.edge_dir(k);
                 e.dot(g.v_pin + g.n.perp() * (self.rho * om) - vp)
             }
             Feat::Vertex(_) => {
@@ -241,7 +244,7 @@ impl Ctx<'_, '_> {
         feat: Feat,
         mode: Mode,
         y: [f64; 2],
-    ) -> Result<([f64; 2], Instant), SolveFailure> {
+    ) -> Result<([f64; 2], Instant, ContactGeom), SolveFailure> {
         let g = self.geom(feat, y);
         let inst = match feat {
             Feat::FenceEdge(k) => self.flush_instant(k, y, mode),
@@ -259,17 +262,27 @@ impl Ctx<'_, '_> {
         if !(d[0].is_finite() && d[1].is_finite()) {
             return Err(SolveFailure::NonFinite);
         }
-        Ok((d, inst))
+        Ok((d, inst, g))
     }
 
     /// Event functions (positive while nothing happens): separation, the two mode margins, then
     /// the geometric ones of [`Ctx::feature_events`].
     pub(super) fn events(&self, feat: Feat, y: [f64; 2], inst: &Instant) -> [f64; N_EVENTS] {
-        let g = self.geom(feat, y);
-        let [e3, e4, e5, e6] = self.feature_events(feat, y, &g);
+        self.events_at(feat, y, &self.geom(feat, y), inst)
+    }
+
+    /// [`Ctx::events`] with the contact geometry at (feat, y) already at hand.
+    pub(super) fn events_at(
+        &self,
+        feat: Feat,
+        y: [f64; 2],
+        g: &ContactGeom,
+        inst: &Instant,
+    ) -> [f64; N_EVENTS] {
+        let [e3, e4, e5, e6] = self.feature_events(feat, y);
         let b = &self.band;
         [
-            push_margin(&g) + b[0],
+            push_margin(g) + b[0],
             inst.margins[0] + b[1],
             inst.margins[1] + b[2],
             e3 + b[3],
@@ -282,19 +295,18 @@ impl Ctx<'_, '_> {
     /// The geometric event functions (positive while the contact stays on its feature): an edge's
     /// two ends (units of a), a disc's normal cone at a vertex (sines), a fence vertex's
     /// neighbours and the fence's two ends (units of a).
-    pub(super) fn feature_events(&self, feat: Feat, y: [f64; 2], g: &ContactGeom) -> [f64; 4] {
+    pub(super) fn feature_events(&self, feat: Feat, y: [f64; 2]) -> [f64; 4] {
         let (mut e5, mut e6) = (1.0, 1.0);
         let (e3, e4) = match feat {
-            Feat::Edge(k) => {
-                let (a, b) = self.poly.edge(k);
-                (y[1], (b - a).norm() - y[1])
-            }
+            Feat::Edge(k) => (y[1], self.poly.edge_len(k) - y[1]),
             Feat::Vertex(k) => {
                 if self.rho > 0.0 {
                     let m = self.poly.len();
                     let na = self.poly.inward_normal(k + m - 1);
                     let nb = self.poly.inward_normal(k);
-                    (na.cross(g.n), g.n.cross(nb))
+                    // The normal of `geom` on a vertex.
+                    let n = Vec2::from_angle(y[1]);
+                    (na.cross(n), n.cross(nb))
                 } else {
                     (1.0, 1.0)
                 }
@@ -321,8 +333,7 @@ impl Ctx<'_, '_> {
     /// means an accepted step or landing went wrong.
     pub(super) fn self_check(&self, s: f64, feat: Feat, y: [f64; 2]) -> Option<SelfCheck> {
         let limit = 10.0 * self.tol;
-        let g = self.geom(feat, y);
-        if self.feature_events(feat, y, &g).iter().any(|&e| e < -limit) {
+        if self.feature_events(feat, y).iter().any(|&e| e < -limit) {
             return Some(SelfCheck::OffFeature);
         }
         if self.fence.is_none() {
@@ -402,10 +413,15 @@ pub(super) fn initial_state(
     }
 }
 
+/// Can the pin touch a second edge at all? Only a disc pin on a concave part.
+pub(super) fn second_contact_possible(ctx: &Ctx) -> bool {
+    !ctx.poly.is_convex() && ctx.rho > 0.0 && ctx.fence.is_none()
+}
+
 /// Minimum distance from the pin centre to edges not adjacent to the current feature (disc pins on
 /// concave parts): negative margin means a second contact.
 pub(super) fn second_contact(ctx: &Ctx, feat: Feat, pose: &Pose, s: f64) -> bool {
-    if ctx.poly.is_convex() || ctx.rho == 0.0 || ctx.fence.is_some() {
+    if !second_contact_possible(ctx) {
         return false;
     }
     let m = ctx.poly.len();

@@ -4,7 +4,7 @@
 //! ([`Cursor`]).
 
 use super::contact_state::{Ctx, Feat, N_EVENTS};
-use super::instant::{Instant, Mode};
+use super::instant::{ContactGeom, Instant, Mode};
 use super::ode::{self, NonFinite, Step};
 use super::part_model::SolveFailure;
 
@@ -63,6 +63,8 @@ pub(super) struct StepResult {
     pub(super) dp: Step<2>,
     /// The instant at the end of the step.
     pub(super) inst1: Instant,
+    /// The contact geometry at the end of the step (the last stage is evaluated at `dp.y1`).
+    pub(super) g1: ContactGeom,
     /// The first interior stage (as a fraction of the step) at which the mode's own margins were
     /// clearly violated: a mode switch that comes and goes inside the step.
     pub(super) margin_dip: Option<f64>,
@@ -82,19 +84,19 @@ pub(super) fn dp_step(
     f0: [f64; 2],
     h: f64,
 ) -> Result<StepResult, SolveFailure> {
-    let mut inst_last = None;
+    let mut last = None;
     let mut margin_dip = None;
     let tol = ctx.tol;
     let dp = ode::dp_step(
         |c, yi| {
-            let (d, inst) = ctx.rhs(feat, mode, yi)?;
+            let (d, inst, g) = ctx.rhs(feat, mode, yi)?;
             let broken = inst.margins[0] + ctx.band[1] < -MARGIN_DIP
                 || inst.margins[1] + ctx.band[2] < -MARGIN_DIP;
             // Interior stages only (C < 1; stages 5 and 6 sit at the step's end).
             if c < 1.0 && broken && margin_dip.is_none() {
                 margin_dip = Some(c);
             }
-            inst_last = Some(inst);
+            last = Some((inst, g));
             Ok::<_, SolveFailure>(d)
         },
         y0,
@@ -102,9 +104,11 @@ pub(super) fn dp_step(
         h,
         tol,
     )?;
+    let (inst1, g1) = last.expect("six stages ran");
     Ok(StepResult {
         dp,
-        inst1: inst_last.expect("six stages ran"),
+        inst1,
+        g1,
         margin_dip,
     })
 }

@@ -10,7 +10,7 @@
 //! tolerance of zero.
 //! Before either, [`interior_dip`] shortens a step across which an event comes and goes.
 
-use super::contact_state::{second_contact, Ctx, Feat, N_EVENTS};
+use super::contact_state::{second_contact, second_contact_possible, Ctx, Feat, N_EVENTS};
 use super::contact_step::{dp_step, step_change_ok, Cursor, StepResult};
 use super::instant::{push_margin, solve_in_mode, Instant};
 use super::ode::{illinois, Bracket};
@@ -33,7 +33,7 @@ pub(super) fn interior_dip(
     // Nothing to miss unless an event not yet crossed ends the step near zero (the guard keeps a
     // step's change of the contact coordinate below 0.5) or a disc could touch a second edge.
     let near = (3..N_EVENTS).any(|j| (0.0..1.0).contains(&ev1[j]));
-    let second = !ctx.poly.is_convex() && ctx.rho > 0.0 && ctx.fence.is_none();
+    let second = second_contact_possible(ctx);
     if !near && !second {
         return mode_dip;
     }
@@ -41,10 +41,9 @@ pub(super) fn interior_dip(
         .map(|k| k as f64 / 8.0)
         .find(|&t| {
             let yt = step.dp.dense(y0, h, t);
-            let g = ctx.geom(feat, yt);
             let dips = near
                 && ctx
-                    .feature_events(feat, yt, &g)
+                    .feature_events(feat, yt)
                     .iter()
                     .zip(&ev1[3..])
                     .any(|(&e, &e1)| e1 >= 0.0 && e < -slack);
@@ -211,8 +210,8 @@ pub(super) fn land(
             _ => step.dp.dense(y, h, t),
         };
         match ctx.rhs(feat, mode, yt) {
-            Ok((rates, inst)) => {
-                let ev = ctx.events(feat, yt, &inst);
+            Ok((rates, inst, g)) => {
+                let ev = ctx.events_at(feat, yt, &g, &inst);
                 if [0, 3, 4, 5, 6].iter().all(|&j| j == i || ev[j] >= -slack) {
                     let g = ev[i];
                     Trial::At(Landed { y: yt, inst, rates }, g)

@@ -22,6 +22,7 @@ use super::part_model::{
     final_gap, point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist, WarmStick,
     WarmTwist,
 };
+use super::slide_table::{Side, TableTwist};
 use crate::geometry::Vec2;
 use serde::Serialize;
 
@@ -56,6 +57,9 @@ pub struct ContactGeom {
     pub p: Vec2,
     pub n: Vec2,
     pub v_pin: Vec2,
+    /// On an edge: (edge index, distance ℓ of `p` from the edge's first vertex), so that a slide
+    /// can be served by the model's slide table (`mechanics::slide_table`); `None` elsewhere.
+    pub edge: Option<(usize, f64)>,
 }
 
 /// The solved instant.
@@ -144,15 +148,53 @@ pub fn push_margin(g: &ContactGeom) -> f64 {
     g.n.dot(g.v_pin) / g.v_pin.norm()
 }
 
+/// The exact sliding twist from the model's slide table, where it has one for this edge, side
+/// and μc and serves this ℓ (see `mechanics::slide_table`).
+fn tabled_slide(
+    model: &PartModel,
+    fid: Fidelity,
+    g: &ContactGeom,
+    mu_c: f64,
+    mode: Mode,
+) -> Option<TableTwist> {
+    if fid != Fidelity::Exact {
+        return None;
+    }
+    let (edge, ell) = g.edge?;
+    let side = match mode {
+        Mode::SlideLeft => Side::Left,
+        Mode::SlideRight => Side::Right,
+        // The frictionless force is the left table's (R(+atan 0) n = n).
+        Mode::Slide if mu_c == 0.0 => Side::Left,
+        _ => return None,
+    };
+    model.slide_table(mu_c, edge, side)?.at(ell)
+}
+
+/// Slide with the force along `f_dir` (a cone edge, or the normal when frictionless): the twist
+/// normalised to w·ξ = 1, the contact velocity it gives, and the force (units of μs m g).
+#[allow(clippy::too_many_arguments)]
 fn slide_instant(
     model: &PartModel,
     fid: Fidelity,
     g: &ContactGeom,
     f_dir: Vec2,
+    mu_c: f64,
     warm: &mut Warm,
     mode: Mode,
     evals: &mut u64,
 ) -> Result<(Twist, Vec2, Vec2), SolveFailure> {
+    if let Some(t) = tabled_slide(model, fid, g, mu_c, mode) {
+        // ∇D = λ w at the tabled twist: the force is λ f; the slot's warm start stays usable by
+        // a later solve the table does not serve.
+        *warm.slide_slot(mode) = Some(WarmTwist {
+            twist: t.twist,
+            wrench: wrench_of(f_dir, g.p),
+            lambda: t.lambda,
+            hess: Some(t.hess),
+        });
+        return Ok((t.twist, point_velocity(t.twist, g.p), f_dir * t.lambda));
+    }
     let gap = warm.gap;
     let slot = warm.slide_slot(mode);
     let (s, next) =
@@ -193,7 +235,8 @@ fn stick_instant(
     })
 }
 
-struct Side {
+/// One side's slide: its instant and its margin.
+struct SideSlide {
     instant: Instant,
     margin: f64,
 }
@@ -201,26 +244,28 @@ struct Side {
 /// Sliding on one cone edge (`sign` +1 left, −1 right): the scaled twist, the force, and the
 /// margin — the signed sine between v_b and v_pin, forced negative when n·v_b ≤ ε (that side can
 /// never slide: SPEC's guard for large μc).
+#[allow(clippy::too_many_arguments)]
 fn slide_side(
     model: &PartModel,
     fid: Fidelity,
     g: &ContactGeom,
     f_dir: Vec2,
+    mu_c: f64,
     sign: f64,
     warm: &mut Warm,
     evals: &mut u64,
-) -> Result<Side, SolveFailure> {
+) -> Result<SideSlide, SolveFailure> {
     let mode = if sign > 0.0 {
         Mode::SlideLeft
     } else {
         Mode::SlideRight
     };
-    let (xi, vb, f) = slide_instant(model, fid, g, f_dir, warm, mode, evals)?;
+    let (xi, vb, f) = slide_instant(model, fid, g, f_dir, mu_c, warm, mode, evals)?;
     let mut margin = sign * sine(vb, g.v_pin);
     if g.n.dot(vb) <= GUARD * vb.norm() {
         margin = margin.min(-1e-3);
     }
-    Ok(Side {
+    Ok(SideSlide {
         instant: Instant {
             mode: Mode::Slide,
             twist: scaled_slide(g, xi, vb),
@@ -244,7 +289,7 @@ pub fn solve_in_mode(
     match mode {
         Mode::Stick => stick_instant(model, fid, g, fr, warm, evals),
         Mode::Slide => {
-            let (xi, vb, f) = slide_instant(model, fid, g, g.n, warm, mode, evals)?;
+            let (xi, vb, f) = slide_instant(model, fid, g, g.n, fr.mu_c, warm, mode, evals)?;
             Ok(Instant {
                 mode,
                 twist: scaled_slide(g, xi, vb),
@@ -254,7 +299,7 @@ pub fn solve_in_mode(
         }
         Mode::SlideLeft => {
             let f_dir = fr.left_edge(g.n);
-            let m = slide_side(model, fid, g, f_dir, 1.0, warm, evals)?;
+            let m = slide_side(model, fid, g, f_dir, fr.mu_c, 1.0, warm, evals)?;
             Ok(Instant {
                 mode,
                 margins: [m.margin, 1.0],
@@ -263,7 +308,7 @@ pub fn solve_in_mode(
         }
         Mode::SlideRight => {
             let f_dir = fr.right_edge(g.n);
-            let m = slide_side(model, fid, g, f_dir, -1.0, warm, evals)?;
+            let m = slide_side(model, fid, g, f_dir, fr.mu_c, -1.0, warm, evals)?;
             Ok(Instant {
                 mode,
                 margins: [1.0, m.margin],
@@ -348,7 +393,12 @@ mod tests {
             ),
         ] {
             let n = n.normalized();
-            let g = ContactGeom { p, n, v_pin: vp };
+            let g = ContactGeom {
+                p,
+                n,
+                v_pin: vp,
+                edge: None,
+            };
             let mut warm = Warm::for_tolerance(1e-6);
             let inst = classify(
                 &m,
@@ -397,6 +447,7 @@ mod tests {
             p: Vec2::new(0.5, 0.0),
             n: Vec2::new(1.0, 0.0),
             v_pin: Vec2::new(-1.0, 0.0),
+            edge: None,
         };
         let mut ev = 0;
         assert!(classify(

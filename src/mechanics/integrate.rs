@@ -19,7 +19,7 @@
 //! The pass loop around it (casting the obstacle's path again after a separation) is
 //! `mechanics::pass`.
 
-use super::contact_state::{second_contact, Ctx, Feat, N_EVENTS, TURN};
+use super::contact_state::{second_contact, second_contact_possible, Ctx, Feat, N_EVENTS, TURN};
 use super::contact_step::{dp_step, max_step, step_change_ok, Cursor, StepResult};
 use super::event_apply::{apply_event, enter, settle, Settle, Transition, BOUNCE_BAND};
 use super::event_locate::{crossed_events, earliest_crossing, interior_dip, land, landed_event};
@@ -319,7 +319,7 @@ fn take_step(ctx: &mut Ctx, at: &mut Cursor, segs: &mut Tally) -> Stepped {
         }
         return Stepped::Again;
     }
-    let ev1 = ctx.events(at.feat, step.dp.y1, &step.inst1);
+    let ev1 = ctx.events_at(at.feat, step.dp.y1, &step.g1, &step.inst1);
     if let Some(t_dip) = interior_dip(ctx, at, &step, h, &ev1) {
         // The contact runs off its feature and back (e.g. past an edge's end), or its mode
         // breaks and recovers, within the step: shorten the step so that it ends beyond
@@ -349,12 +349,14 @@ fn take_step(ctx: &mut Ctx, at: &mut Cursor, segs: &mut Tally) -> Stepped {
     at.ev0 = ev1;
     segs.steps += 1;
     ctx.record(at.s, at.feat, at.y, &at.inst);
-    let pose = ctx.pose(at.s, at.feat, at.y);
-    if second_contact(ctx, at.feat, &pose, at.s) {
-        let status = ContactStatus::MultiContact {
-            s: at.s * ctx.scale,
-        };
-        return Stepped::Done((End::Stop(status), at.s, pose));
+    if second_contact_possible(ctx) {
+        let pose = ctx.pose(at.s, at.feat, at.y);
+        if second_contact(ctx, at.feat, &pose, at.s) {
+            let status = ContactStatus::MultiContact {
+                s: at.s * ctx.scale,
+            };
+            return Stepped::Done((End::Stop(status), at.s, pose));
+        }
     }
     at.h = (h * factor).min(max_step(at.feat));
     Stepped::Again

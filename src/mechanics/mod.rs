@@ -16,6 +16,8 @@
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
 //! * [`pin_path`]: a moving pin's lateral speed profile over a pass (SPEC §5).
 //! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
+//! * [`slide_table`]: the exact model's sliding twists on each edge, tabulated per (μc, edge,
+//!   side) for models many contacts share.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!
 //! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
@@ -35,6 +37,7 @@ pub mod part_model;
 mod pass;
 pub mod pin_path;
 mod settings;
+pub mod slide_table;
 pub mod vote;
 
 pub use fence::FenceSpec;

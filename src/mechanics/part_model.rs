@@ -26,9 +26,11 @@
 use super::limit_surface::points::PointSupport;
 use super::limit_surface::uniform::UniformSurface;
 use super::limit_surface::Dissipation;
+use super::slide_table::{EdgeTable, Side, SlideTables, TableStats};
 use crate::geometry::{Polygon, Vec2};
 use serde::{Deserialize, Serialize};
 use std::fmt;
+use std::sync::Arc;
 
 /// A twist (vx, vy, ω) in the part frame: centroid velocity and angular rate.
 pub type Twist = [f64; 3];
@@ -295,6 +297,9 @@ pub struct PartModel {
     support: SupportData,
     /// m_max / f_max of the ellipsoid approximation (normalised units).
     c_ellipsoid: f64,
+    /// The exact model's slide tables, for the μc values given to
+    /// [`PartModel::with_slide_tables`] (shared by clones: their content depends only on the part).
+    slide_tables: Option<Arc<SlideTables>>,
 }
 
 impl fmt::Debug for PartModel {
@@ -347,7 +352,53 @@ impl PartModel {
             scale,
             support: data,
             c_ellipsoid: c,
+            slide_tables: None,
         })
+    }
+
+    /// Serve the exact model's slides on edges from tables (`mechanics::slide_table`) for contacts
+    /// with these μc values: for a model that many contacts share (a scene's, a planner's, a
+    /// map's). Only uniform pressure is tabulated; a model with point supports (a part's own
+    /// tripod, used for a few contacts) is returned unchanged. Contacts with another μc, and the
+    /// tip and ellipsoid fidelities, solve as before.
+    pub fn with_slide_tables(mut self, mu_values: &[f64]) -> PartModel {
+        if matches!(self.support, SupportData::Uniform(_)) {
+            let tables = SlideTables::new(self.poly.len(), mu_values);
+            self.slide_tables = (!tables.is_empty()).then(|| Arc::new(tables));
+        }
+        self
+    }
+
+    /// The slide table of (μc, edge, side), built on first use; `None` when the model has none for
+    /// that μc.
+    #[inline]
+    pub fn slide_table(&self, mu_c: f64, edge: usize, side: Side) -> Option<&EdgeTable> {
+        self.slide_tables.as_ref()?.table(self, mu_c, edge, side)
+    }
+
+    /// Build every slide table now (all μc values, edges and sides) rather than on first use:
+    /// for timing contacts without their tables' build.
+    pub fn build_all_slide_tables(&self) {
+        if let Some(t) = &self.slide_tables {
+            t.build_all(self);
+        }
+    }
+
+    /// What the slide tables hold so far (`None`: the model has none).
+    pub fn slide_table_stats(&self) -> Option<TableStats> {
+        self.slide_tables.as_ref().map(|t| t.stats())
+    }
+
+    /// A slide solve converged as far as the solver goes (no unevaluated last step), for the slide
+    /// tables' nodes: the normalised twist and what a warm start needs (λ, Hessian).
+    pub(crate) fn converged_slide(
+        &self,
+        w: Wrench,
+        warm: Option<&WarmTwist>,
+        evals: &mut u64,
+    ) -> Result<(Twist, WarmTwist), SolveFailure> {
+        self.exact_twist_for_wrench(w, warm, 0.0, evals)
+            .map(|(solved, next)| (solved.twist, next))
     }
 
     /// The polygon in normalised units (a = 1).
@@ -710,10 +761,24 @@ impl PartModel {
 /// First-order prediction of the twist for wrench `w` from the previous solution (see
 /// [`WarmTwist`]), normalised to w·ξ = 1; `None` without a Hessian or if the system is singular.
 fn predict_twist(p: &WarmTwist, w: Wrench) -> Option<Twist> {
-    let h = p.hess?;
     let dw = [w[0] - p.wrench[0], w[1] - p.wrench[1], w[2] - p.wrench[2]];
+    let (dxi, _) = kkt_delta(p, dw)?;
+    let xi = [
+        p.twist[0] + dxi[0],
+        p.twist[1] + dxi[1],
+        p.twist[2] + dxi[2],
+    ];
+    let c = dot3(w, xi);
+    (c > 0.0 && c.is_finite()).then(|| scale3(xi, 1.0 / c))
+}
+
+/// The first-order change (dξ, dλ) of a solution `p` of ∇D(ξ) = λ w, w·ξ = 1 when its wrench
+/// changes by `dw`: [H −w; wᵀ 0] [dξ; dλ] = [λ dw; −dw·ξ] (Gaussian elimination with pivoting);
+/// `None` without a Hessian or if the system is singular. The predictor of the warm starts and the
+/// derivatives of the slide tables (`mechanics::slide_table`).
+pub(crate) fn kkt_delta(p: &WarmTwist, dw: [f64; 3]) -> Option<(Twist, f64)> {
+    let h = p.hess?;
     let w0 = p.wrench;
-    // [H −w0; w0ᵀ 0] [dξ; dλ] = [λ dw; −dw·ξ0], solved by Gaussian elimination with pivoting.
     let mut a = [
         [h[0][0], h[0][1], h[0][2], -w0[0], p.lambda * dw[0]],
         [h[1][0], h[1][1], h[1][2], -w0[1], p.lambda * dw[1]],
@@ -737,13 +802,7 @@ fn predict_twist(p: &WarmTwist, w: Wrench) -> Option<Twist> {
         }
     }
     let dxi = [a[0][4] / a[0][0], a[1][4] / a[1][1], a[2][4] / a[2][2]];
-    let xi = [
-        p.twist[0] + dxi[0],
-        p.twist[1] + dxi[1],
-        p.twist[2] + dxi[2],
-    ];
-    let c = dot3(w, xi);
-    (c > 0.0 && c.is_finite()).then(|| scale3(xi, 1.0 / c))
+    Some((dxi, a[3][4] / a[3][3]))
 }
 
 /// D, ∇D and H at `to`, to first order from their values `d` at `from`: ∇D(to) ≈ ∇D(from) +

@@ -96,8 +96,12 @@ impl Transition {
             part: problem.part.clone(),
             reason,
         };
-        let uniform =
-            Arc::new(PartModel::new(&compiled.polygon, &Support::Uniform).map_err(part_err)?);
+        // Every pass at the nominal μc shares this model: its exact slides come from tables.
+        let uniform = Arc::new(
+            PartModel::new(&compiled.polygon, &Support::Uniform)
+                .map_err(part_err)?
+                .with_slide_tables(&[problem.mu_c]),
+        );
         let robust = problem.tripod || problem.mu_c_range.is_some();
         let mut samples = Vec::new();
         if !robust {

@@ -32,10 +32,11 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
     let name = scene_name(&c, raw.name.as_deref(), default_name)?;
     let seed = raw.seed.unwrap_or(1);
     let belt = compile_belt(&c, raw.belt.as_ref())?;
-    let part = compile_part(&c, raw.part.as_ref())?;
+    let mut part = compile_part(&c, raw.part.as_ref())?;
     let feed = compile_feed(&c, raw.feed.as_ref(), &belt, &part)?;
     let (mut obstacles, neighbours, sensor_drafts) =
         super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, part.radius, part.mu_c)?;
+    part.model = part.model.with_slide_tables(&pin_mu_values(&obstacles));
     let goal = compile_goal(&c, raw.goal.as_ref())?;
     let contact = compile_model(&c, &raw.model, &part)?;
     let map_tier = compile_map_tier(&c, &raw.model)?;
@@ -76,6 +77,19 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         controller,
         map_tier,
     })
+}
+
+/// The μc values the scene's pins push with: the shared part model tabulates its exact slides
+/// for these (built lazily, so a scene that never slides on an edge, or runs another fidelity,
+/// builds nothing; see `mechanics::slide_table`). Fences touch the hull and are not tabulated.
+fn pin_mu_values(obstacles: &[Obstacle]) -> Vec<f64> {
+    obstacles
+        .iter()
+        .filter_map(|o| match o {
+            Obstacle::Pin(p) => Some(p.mu_c),
+            Obstacle::Fence(_) => None,
+        })
+        .collect()
 }
 
 /// `name`: the scene's name (it names the results folder), else `default_name`.
