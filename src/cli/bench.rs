@@ -196,9 +196,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                  |θf(tol) − θf(tol/1000)| with the same model: the integration error at the \
                  default tolerance, not the model error (see the accuracy-vs-time report for that).\n\n\
                  `exact+tables` is the exact model with its slide tables (the default for a \
-                 scene's, a map's and a planner's model): a pin sliding on an edge gets the exact \
-                 twist from per-(μc, edge, side) tables of certified cubic Hermite pieces instead \
-                 of a Newton solve (`src/mechanics/slide_table.rs`). Its tables are built before \
+                 scene's, a map's and a planner's model): a pin sliding on an edge (or a disc \
+                 riding a vertex) gets the exact twist from per-(μc, edge or vertex, side) tables \
+                 of certified cubic Hermite pieces instead of a Newton solve \
+                 (`src/mechanics/slide_table.rs`; these point-pin contacts use the edges' tables). Its tables are built before \
                  the timed runs; the build is in the table below, with what the tables change \
                  against the solves at the same tolerance.\n\n\
                  {table}\n### Slide tables (exact+tables rows)\n\n{tables}\n{targets}\n\

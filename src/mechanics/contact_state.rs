@@ -24,6 +24,7 @@ use super::outcome::{ContactFeature, Recorder, SelfCheck, TraceSample};
 use super::part_model::{Fidelity, PartModel, SolveFailure};
 use super::pin_path::{PinPath, Turn};
 use super::settings::{ContactSettings, POINT_PIN_RADIUS};
+use super::slide_table::SlideAt;
 use crate::geometry::{Feature, Polygon, Pose, Vec2};
 
 /// The feature in contact, and what its second coordinate y[1] means.
@@ -166,24 +167,28 @@ impl Ctx<'_, '_> {
                     p: self.poly.vertex(k) + e * y[1],
                     n: e.perp(),
                     v_pin,
-                    // The model's tables are for the part's own edges (a fence and its ends
-                    // touch the hull's).
-                    edge: std::ptr::eq(self.poly, self.model.polygon()).then_some((k, y[1])),
+                    slide_at: self.own_polygon().then_some(SlideAt::Edge(k, y[1])),
                 }
             }
             Feat::Vertex(k) => ContactGeom {
                 p: self.poly.vertex(k),
                 n: Vec2::from_angle(y[1]),
                 v_pin,
-                edge: None,
+                slide_at: self.own_polygon().then_some(SlideAt::Vertex(k, y[1])),
             },
             Feat::FenceVertex(k) | Feat::FenceEdge(k) => ContactGeom {
                 p: self.poly.vertex(k),
                 n: self.fence_geom().n.rotate(-y[0]),
                 v_pin,
-                edge: None,
+                slide_at: None,
             },
         }
+    }
+
+    /// Does the obstacle touch the part's own polygon (a pin), not its hull (a fence and its
+    /// ends)? The model's slide tables are for the part's own edges and vertices.
+    fn own_polygon(&self) -> bool {
+        std::ptr::eq(self.poly, self.model.polygon())
     }
 
     /// The fence (fence features only arise with one).

@@ -22,7 +22,7 @@ use super::part_model::{
     final_gap, point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist, WarmStick,
     WarmTwist,
 };
-use super::slide_table::{Side, TableTwist};
+use super::slide_table::{Side, SlideAt, TableTwist};
 use crate::geometry::Vec2;
 use serde::Serialize;
 
@@ -57,9 +57,10 @@ pub struct ContactGeom {
     pub p: Vec2,
     pub n: Vec2,
     pub v_pin: Vec2,
-    /// On an edge: (edge index, distance ℓ of `p` from the edge's first vertex), so that a slide
-    /// can be served by the model's slide table (`mechanics::slide_table`); `None` elsewhere.
-    pub edge: Option<(usize, f64)>,
+    /// Where on the part the contact is, for the model's slide tables (`mechanics::slide_table`):
+    /// an edge and ℓ, or a vertex and the normal's angle; `None` where no table applies (a
+    /// fence's features, which are the hull's).
+    pub slide_at: Option<SlideAt>,
 }
 
 /// The solved instant.
@@ -148,8 +149,8 @@ pub fn push_margin(g: &ContactGeom) -> f64 {
     g.n.dot(g.v_pin) / g.v_pin.norm()
 }
 
-/// The exact sliding twist from the model's slide table, where it has one for this edge, side
-/// and μc and serves this ℓ (see `mechanics::slide_table`).
+/// The exact sliding twist from the model's slide table, where it has one for this place, side
+/// and μc and serves this coordinate (see `mechanics::slide_table`).
 fn tabled_slide(
     model: &PartModel,
     fid: Fidelity,
@@ -160,7 +161,7 @@ fn tabled_slide(
     if fid != Fidelity::Exact {
         return None;
     }
-    let (edge, ell) = g.edge?;
+    let (place, t) = g.slide_at?.split();
     let side = match mode {
         Mode::SlideLeft => Side::Left,
         Mode::SlideRight => Side::Right,
@@ -168,7 +169,7 @@ fn tabled_slide(
         Mode::Slide if mu_c == 0.0 => Side::Left,
         _ => return None,
     };
-    model.slide_table(mu_c, edge, side)?.at(ell)
+    model.slide_table(mu_c, place, side)?.at(t)
 }
 
 /// Slide with the force along `f_dir` (a cone edge, or the normal when frictionless): the twist
@@ -397,7 +398,7 @@ mod tests {
                 p,
                 n,
                 v_pin: vp,
-                edge: None,
+                slide_at: None,
             };
             let mut warm = Warm::for_tolerance(1e-6);
             let inst = classify(
@@ -440,6 +441,81 @@ mod tests {
         }
     }
 
+    /// A slide on an edge or round a vertex of a model with slide tables is served by them (no
+    /// evaluation) and agrees with the solve the table stands for; the same contact without a
+    /// place (a fence's feature) is solved.
+    #[test]
+    fn slides_on_edges_and_vertices_come_from_the_tables() {
+        let plain = model("tripoly1");
+        let tabled = plain.clone().with_slide_tables(&[0.5]);
+        let poly = plain.polygon().clone();
+        for k in 0..poly.len() {
+            let (na, nb) = (
+                poly.inward_normal(k + poly.len() - 1),
+                poly.inward_normal(k),
+            );
+            let phi = na.angle() + 0.4 * na.cross(nb).atan2(na.dot(nb));
+            let e = poly.edge_dir(k);
+            for (p, n, at) in [
+                (
+                    poly.vertex(k),
+                    Vec2::from_angle(phi),
+                    SlideAt::Vertex(k, phi),
+                ),
+                (
+                    poly.vertex(k) + e * (0.3 * poly.edge_len(k)),
+                    e.perp(),
+                    SlideAt::Edge(k, 0.3 * poly.edge_len(k)),
+                ),
+            ] {
+                // Mostly across the normal: outside the friction cone's motions, a slide.
+                let v_pin = n * 0.3 - n.perp() * 1.0;
+                let g = ContactGeom {
+                    p,
+                    n,
+                    v_pin,
+                    slide_at: Some(at),
+                };
+                let run = |m: &PartModel, g: &ContactGeom| {
+                    let mut ev = 0;
+                    let i = classify(
+                        m,
+                        Fidelity::Exact,
+                        g,
+                        Friction::new(0.5),
+                        &mut Warm::for_tolerance(1e-6),
+                        &mut ev,
+                    )
+                    .unwrap()
+                    .unwrap();
+                    (i, ev)
+                };
+                let (solved, ev_solved) = run(&plain, &g);
+                let (served, ev_served) = run(&tabled, &g);
+                assert!(matches!(solved.mode, Mode::SlideLeft | Mode::SlideRight));
+                assert_eq!(solved.mode, served.mode, "{at:?}");
+                assert_eq!(ev_served, 0, "{at:?}: the tables serve both cone edges");
+                assert!(ev_solved > 0);
+                let scale = solved.twist.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                for (a, b) in solved.twist.iter().zip(served.twist) {
+                    assert!(
+                        (a - b).abs() < 1e-8 * scale,
+                        "{at:?}: {solved:?} {served:?}"
+                    );
+                }
+                // Without a place on the part the tabled model solves like the plain one.
+                let (_, ev_off) = run(
+                    &tabled,
+                    &ContactGeom {
+                        slide_at: None,
+                        ..g
+                    },
+                );
+                assert!(ev_off > 0);
+            }
+        }
+    }
+
     #[test]
     fn separation_when_not_pushing() {
         let m = model("square");
@@ -447,7 +523,7 @@ mod tests {
             p: Vec2::new(0.5, 0.0),
             n: Vec2::new(1.0, 0.0),
             v_pin: Vec2::new(-1.0, 0.0),
-            edge: None,
+            slide_at: None,
         };
         let mut ev = 0;
         assert!(classify(

@@ -16,7 +16,7 @@
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
 //! * [`pin_path`]: a moving pin's lateral speed profile over a pass (SPEC §5).
 //! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
-//! * [`slide_table`]: the exact model's sliding twists on each edge, tabulated per (μc, edge,
+//! * [`slide_table`]: the exact model's sliding twists on each edge and vertex, tabulated per (μc, place,
 //!   side) for models many contacts share.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!

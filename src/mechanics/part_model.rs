@@ -26,7 +26,7 @@
 use super::limit_surface::points::PointSupport;
 use super::limit_surface::uniform::UniformSurface;
 use super::limit_surface::Dissipation;
-use super::slide_table::{EdgeTable, Side, SlideTables, TableStats};
+use super::slide_table::{Place, Side, SlideTables, Table, TableStats};
 use crate::geometry::{Polygon, Vec2};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -369,11 +369,11 @@ impl PartModel {
         self
     }
 
-    /// The slide table of (μc, edge, side), built on first use; `None` when the model has none for
-    /// that μc.
+    /// The slide table of (μc, edge or vertex, side), built on first use; `None` when the model
+    /// has none for that μc.
     #[inline]
-    pub fn slide_table(&self, mu_c: f64, edge: usize, side: Side) -> Option<&EdgeTable> {
-        self.slide_tables.as_ref()?.table(self, mu_c, edge, side)
+    pub fn slide_table(&self, mu_c: f64, place: Place, side: Side) -> Option<&Table> {
+        self.slide_tables.as_ref()?.table(self, mu_c, place, side)
     }
 
     /// Build every slide table now (all μc values, edges and sides) rather than on first use:

@@ -1,46 +1,52 @@
-//! Tabulated sliding twists on a part's edges: the exact model's slide solves without solving
-//! (issue 15, "per-part precomputed" data for the exact contact).
+//! Tabulated sliding twists: the exact model's slide solves without solving (issue 15, "per-part
+//! precomputed" data for the exact contact).
 //!
-//! While a pin slides on edge k the contact force lies on one edge of the friction cone,
-//! f = R(±atan μc) n_k (the normal n_k itself when μc = 0), and the contact point is
-//! p = a_k + ℓ e_k (vertex a_k, unit direction e_k; the same for a point pin and a disc, whose
-//! contact normal on an edge is the edge's). The contact wrench
+//! While a pin slides on a part, the contact force lies on one edge of the friction cone,
+//! f = R(±atan μc) n (the normal n itself when μc = 0), at the contact point p, and the wrench is
+//! w = (f, p × f). Two kinds of slide leave a single free coordinate t:
 //!
-//!   w(ℓ) = (f, p × f) = (f, a_k × f + ℓ e_k × f)
+//! * **on edge k** (point pin or disc): n is the edge's inward normal, p = a_k + ℓ e_k, so
+//!   w(ℓ) = (f, a_k × f + ℓ e_k × f) is a straight line in wrench space (t = ℓ ∈ [0, |edge|]);
+//! * **on vertex k**: p is the vertex and n = (cos φ, sin φ) turns through the vertex's normal cone
+//!   (a disc riding round the vertex; for a point pin φ stays where it arrived), so w(φ) is an arc
+//!   (t = φ − φ_a ∈ [0, cone angle], φ_a the inward normal of the edge before the vertex).
 //!
-//! is therefore a straight line in wrench space, and the sliding twist — the limit surface's normal
-//! at w, normalised so that w·ξ = 1, with its multiplier λ (∇D(ξ) = λ w, the force being λ f) — is
-//! a function of ℓ alone. It does not depend on the part's orientation, the pin's velocity, its
-//! radius or the belt: one table per (μc, edge, side) serves every slide on that edge. The table
-//! stores ξ, λ and their derivatives in ℓ at nodes and interpolates with cubic Hermite
-//! polynomials. The derivatives come from the optimality conditions ∇D(ξ) = λ w, w·ξ = 1
-//! differentiated along the line (dw/dℓ = (0, 0, e_k × f)):
+//! The sliding twist — the limit surface's normal at w, normalised so that w·ξ = 1, with its
+//! multiplier λ (∇D(ξ) = λ w, the force being λ f) — is then a function of t alone: it does not
+//! depend on the part's orientation, the pin's velocity or the belt, and one table per
+//! (μc, edge or vertex, side) serves every such slide. The table stores ξ, λ and their derivatives
+//! in t at nodes and interpolates with cubic Hermite polynomials. The derivatives come from the
+//! optimality conditions ∇D(ξ) = λ w, w·ξ = 1 differentiated along the path:
 //!
-//!   [H −w; wᵀ 0] [dξ; dλ] = [λ dw; −dw·ξ]    (the system [`super::part_model`] warm-starts with).
+//!   [H −w; wᵀ 0] [dξ; dλ] = [λ dw; −dw·ξ]    (the system [`super::part_model`] warm-starts with),
 //!
-//! **Certified refinement.** An edge starts with [`START_INTERVALS`] equal intervals; each interval
+//! with dw/dℓ = (0, 0, e_k × f) on an edge and dw/dφ = (ẑ×f, p × (ẑ×f)) on a vertex.
+//!
+//! **Certified refinement.** A table starts with [`START_INTERVALS`] equal intervals; each interval
 //! is checked at its midpoint against a full solve (converged to the solver's own limit) and
 //! accepted when the interpolated ξ and λ agree with it to [`TABLE_TOL`] relative; otherwise it is
-//! split there (the midpoint becomes a node). For a smooth ξ(ℓ) the cubic Hermite error is
-//! ∝ t²(1 − t)² ξ'''' h⁴/24 on t ∈ [0, 1], largest at the midpoint, so the midpoint check bounds the
-//! interval. Where ξ(ℓ) is less smooth (the centre of rotation crossing the part's boundary makes
-//! the third derivative of D singular) the refinement goes on down to [`MIN_INTERVAL`]; an interval
-//! not certified there is left to the solver, and so is any ℓ outside [0, |edge|] (a stage of a
-//! step that overshoots an edge's end) and any solve that failed while building.
+//! split there (the midpoint becomes a node). For a smooth ξ(t) the cubic Hermite error on an
+//! interval of length h is u²(1 − u)² h⁴/24 times the fourth derivative, at fraction u: largest at
+//! the midpoint, so the midpoint check bounds the interval. Where ξ(t) is less smooth (the centre
+//! of rotation crossing the part's boundary makes the third derivative of D singular) the
+//! refinement goes on down to [`MIN_INTERVAL`]; an interval not certified there is left to the
+//! solver, and so is any t outside its range (a stage of a step that overshoots an edge's end or a
+//! cone's side), a reflex vertex (a pin cannot slide there) and any table whose nodes could not be
+//! solved.
 //!
 //! The accuracy this gives is that of the live solve: a live slide solve stops at a relative
 //! optimality gap g ≤ √(1e-6·tol) and takes an unevaluated last Newton step, which leaves a twist
 //! error of about 100 g² ≈ 1e-10 at the default tolerance (see `part_model::final_gap`);
 //! [`TABLE_TOL`] is 1e-10.
 //!
-//! **Opt-in, deterministic.** Tables are built lazily, one (μc, edge, side) at a time, on the first
-//! slide that needs one, and only for models that ask for them with the μc values they will see
-//! ([`super::PartModel::with_slide_tables`]: a scene's shared model, a planner's, the contact
-//! benchmark's). A table's content is a fixed function of (part, μc, edge, side), built in a fixed
-//! order, so which thread builds it first changes nothing; and a served solve never depends on
-//! what was solved before it. The evaluations a build spends are the table's, not the contact's
-//! that happened to need it first ([`SlideTables::stats`]), so a contact's evaluation count is
-//! the same on any number of threads.
+//! **Opt-in, deterministic.** Tables are built lazily, one (μc, place, side) at a time, on the
+//! first slide that needs one, and only for models that ask for them with the μc values they will
+//! see ([`super::PartModel::with_slide_tables`]: a scene's shared model, a planner's, a map's, the
+//! contact benchmark's). A table's content is a fixed function of (part, μc, place, side), built
+//! in a fixed order, so which thread builds it first changes nothing; and a served solve never
+//! depends on what was solved before it. The evaluations a build spends are the table's, not the
+//! contact's that happened to need it first ([`SlideTables::stats`]), so a contact's evaluation
+//! count is the same on any number of threads.
 
 use super::part_model::{kkt_delta, wrench_of, PartModel, Twist, WarmTwist};
 use crate::geometry::Vec2;
@@ -63,9 +69,36 @@ pub enum Side {
     Right = 1,
 }
 
-/// One node of an edge table.
+/// Where a slide's force acts, with the coordinate the tables are indexed by.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SlideAt {
+    /// On edge k at ℓ (units of a from its first vertex).
+    Edge(usize, f64),
+    /// On vertex k with the contact normal at part-frame angle φ (radians, any turn).
+    Vertex(usize, f64),
+}
+
+/// A table's place on the part: an edge or a vertex (by index).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Place {
+    Edge(usize),
+    Vertex(usize),
+}
+
+impl SlideAt {
+    /// The place and the coordinate along it.
+    pub fn split(self) -> (Place, f64) {
+        match self {
+            SlideAt::Edge(k, ell) => (Place::Edge(k), ell),
+            SlideAt::Vertex(k, phi) => (Place::Vertex(k), phi),
+        }
+    }
+}
+
+/// One node of a table.
 #[derive(Debug, Clone, Copy)]
 struct Node {
+    /// The path coordinate from the table's origin (ℓ, or φ − φ_a).
     ell: f64,
     twist: Twist,
     dtwist: Twist,
@@ -83,11 +116,16 @@ pub struct TableTwist {
     pub hess: [[f64; 3]; 3],
 }
 
-/// The table of one (μc, edge, side): nodes in increasing ℓ and, per interval, whether it was
-/// certified; plus a uniform index over ℓ (the first interval of each of [`INDEX_BUCKETS`] equal
-/// pieces of the edge) so that a lookup scans a few intervals instead of bisecting a thousand.
+/// The table of one (μc, place, side): nodes in increasing path coordinate and, per interval,
+/// whether it was certified; plus a uniform index (the first interval of each of [`INDEX_BUCKETS`]
+/// equal pieces of the range) so that a lookup scans a few intervals instead of bisecting a
+/// thousand.
 #[derive(Debug)]
-pub struct EdgeTable {
+pub struct Table {
+    /// Where the path coordinate starts (0 on an edge, φ_a on a vertex) and whether queries are
+    /// angles, taken modulo a turn.
+    origin: f64,
+    periodic: bool,
     nodes: Vec<Node>,
     certified: Vec<bool>,
     bucket_first: Vec<u32>,
@@ -98,11 +136,16 @@ pub struct EdgeTable {
 /// Buckets of the uniform index over an edge's ℓ.
 const INDEX_BUCKETS: usize = 512;
 
-impl EdgeTable {
-    /// The sliding twist at ℓ (units of a from the edge's first vertex), or `None` where the table
-    /// does not serve (outside the edge, or an interval that was not certified).
+impl Table {
+    /// The sliding twist at the place's coordinate `t` (ℓ on an edge, φ on a vertex), or `None`
+    /// where the table does not serve (outside its range, or an interval not certified).
     #[inline]
-    pub fn at(&self, ell: f64) -> Option<TableTwist> {
+    pub fn at(&self, t: f64) -> Option<TableTwist> {
+        let ell = if self.periodic {
+            (t - self.origin).rem_euclid(std::f64::consts::TAU)
+        } else {
+            t - self.origin
+        };
         let n = &self.nodes;
         let (first, last) = (n.first()?, n.last()?);
         if !(ell >= first.ell && ell <= last.ell) || n.len() < 2 {
@@ -129,7 +172,7 @@ impl EdgeTable {
     }
 
     /// The table over these nodes and intervals, with its uniform index.
-    fn indexed(nodes: Vec<Node>, certified: Vec<bool>) -> EdgeTable {
+    fn indexed(path: &WrenchPath, nodes: Vec<Node>, certified: Vec<bool>) -> Table {
         let (lo, hi) = match (nodes.first(), nodes.last()) {
             (Some(a), Some(b)) if b.ell > a.ell => (a.ell, b.ell),
             _ => (0.0, 1.0),
@@ -146,7 +189,10 @@ impl EdgeTable {
             }
             bucket_first.push(i as u32);
         }
-        EdgeTable {
+        let (origin, periodic) = path.origin();
+        Table {
+            origin,
+            periodic,
             nodes,
             certified,
             bucket_first,
@@ -154,9 +200,15 @@ impl EdgeTable {
         }
     }
 
-    /// The nodes' ℓ, in increasing order (for reports and tests).
+    /// The nodes' place coordinates (ℓ, or φ), in increasing order (for reports and tests).
     pub fn breakpoints(&self) -> Vec<f64> {
-        self.nodes.iter().map(|n| n.ell).collect()
+        self.nodes.iter().map(|n| self.origin + n.ell).collect()
+    }
+
+    /// The range of place coordinates the table covers (`None` when it serves nothing).
+    pub fn range(&self) -> Option<(f64, f64)> {
+        let (a, b) = (self.nodes.first()?, self.nodes.last()?);
+        Some((self.origin + a.ell, self.origin + b.ell))
     }
 
     /// Nodes and certified intervals (for the build statistics and tests).
@@ -184,38 +236,73 @@ fn hermite(a: &Node, b: &Node, t: f64) -> (Twist, f64) {
     (xi, lambda)
 }
 
-/// The line of wrenches along one edge for one force direction.
-struct EdgeLine {
-    a: Vec2,
-    e: Vec2,
-    f: Vec2,
-    len: f64,
+/// The wrenches of one (place, force direction) as its coordinate runs from 0 to its span.
+enum WrenchPath {
+    /// Edge from `a` along unit `e`, force `f` fixed.
+    Edge { a: Vec2, e: Vec2, f: Vec2, len: f64 },
+    /// Vertex `p`; the normal turns from angle `phi0` through `span`, the force at the cone angle
+    /// whose sine and cosine are (`s`, `c`) from it.
+    Vertex {
+        p: Vec2,
+        phi0: f64,
+        span: f64,
+        s: f64,
+        c: f64,
+    },
 }
 
-impl EdgeLine {
-    fn wrench(&self, ell: f64) -> [f64; 3] {
-        wrench_of(self.f, self.a + self.e * ell)
+impl WrenchPath {
+    fn span(&self) -> f64 {
+        match self {
+            WrenchPath::Edge { len, .. } => *len,
+            WrenchPath::Vertex { span, .. } => *span,
+        }
     }
-    /// dw/dℓ.
-    fn dwrench(&self) -> [f64; 3] {
-        [0.0, 0.0, self.e.cross(self.f)]
+    /// The place coordinate at 0 and whether it is an angle.
+    fn origin(&self) -> (f64, bool) {
+        match self {
+            WrenchPath::Edge { .. } => (0.0, false),
+            WrenchPath::Vertex { phi0, .. } => (*phi0, true),
+        }
+    }
+    /// The force on a vertex with the normal at angle `phi` (as the live solve forms it: the cone
+    /// edge of that normal).
+    fn vertex_force(phi: f64, s: f64, c: f64) -> Vec2 {
+        Vec2::from_angle(phi).rotate_sc(s, c)
+    }
+    fn wrench(&self, t: f64) -> [f64; 3] {
+        match self {
+            WrenchPath::Edge { a, e, f, .. } => wrench_of(*f, *a + *e * t),
+            WrenchPath::Vertex { p, phi0, s, c, .. } => {
+                wrench_of(WrenchPath::vertex_force(phi0 + t, *s, *c), *p)
+            }
+        }
+    }
+    /// dw/dt.
+    fn dwrench(&self, t: f64) -> [f64; 3] {
+        match self {
+            WrenchPath::Edge { e, f, .. } => [0.0, 0.0, e.cross(*f)],
+            WrenchPath::Vertex { p, phi0, s, c, .. } => {
+                wrench_of(WrenchPath::vertex_force(phi0 + t, *s, *c).perp(), *p)
+            }
+        }
     }
 }
 
-/// Builds one edge table, counting the evaluations it spends.
+/// Builds one table, counting the evaluations it spends.
 struct Builder<'a> {
     model: &'a PartModel,
-    line: EdgeLine,
+    path: WrenchPath,
     evaluations: u64,
 }
 
 impl Builder<'_> {
     /// A full solve at ℓ (warm-started from a neighbouring node) with its derivatives.
     fn node(&mut self, ell: f64, near: Option<&Node>) -> Option<Node> {
-        let w = self.line.wrench(ell);
+        let w = self.path.wrench(ell);
         let warm = near.map(|n| WarmTwist {
             twist: n.twist,
-            wrench: self.line.wrench(n.ell),
+            wrench: self.path.wrench(n.ell),
             lambda: n.lambda,
             hess: Some(n.hess),
         });
@@ -224,7 +311,7 @@ impl Builder<'_> {
             .converged_slide(w, warm.as_ref(), &mut self.evaluations);
         let (twist, warm_next) = solved.ok()?;
         let hess = warm_next.hess?;
-        let (dtwist, dlambda) = kkt_delta(&warm_next, self.line.dwrench())?;
+        let (dtwist, dlambda) = kkt_delta(&warm_next, self.path.dwrench(ell))?;
         Some(Node {
             ell,
             twist,
@@ -259,16 +346,22 @@ impl Builder<'_> {
         }
     }
 
-    fn build(mut self) -> (EdgeTable, u64) {
-        let len = self.line.len;
+    fn build(mut self) -> (Table, u64) {
+        let len = self.path.span();
+        if !(len > 0.0 && len.is_finite()) {
+            return (Table::indexed(&self.path, Vec::new(), Vec::new()), 0);
+        }
         let mut nodes: Vec<Node> = Vec::new();
         let mut certified = Vec::new();
         let mut prev: Option<Node> = None;
         for j in 0..=START_INTERVALS {
             let ell = len * j as f64 / START_INTERVALS as f64;
             let Some(node) = self.node(ell, prev.as_ref()) else {
-                // A node that cannot be solved: the table serves nothing on this edge.
-                return (EdgeTable::indexed(Vec::new(), Vec::new()), self.evaluations);
+                // A node that cannot be solved: the table serves nothing.
+                return (
+                    Table::indexed(&self.path, Vec::new(), Vec::new()),
+                    self.evaluations,
+                );
             };
             match prev {
                 None => nodes.push(node),
@@ -276,17 +369,61 @@ impl Builder<'_> {
             }
             prev = Some(node);
         }
-        (EdgeTable::indexed(nodes, certified), self.evaluations)
+        (
+            Table::indexed(&self.path, nodes, certified),
+            self.evaluations,
+        )
     }
 }
 
-/// The tables of one μc: per edge, one lazily built table per side.
+/// The tables of one μc: per edge and per vertex, one lazily built table per side.
 #[derive(Debug)]
 struct MuTables {
     mu_c: f64,
     sin_phi: f64,
     cos_phi: f64,
-    edges: Vec<[OnceLock<EdgeTable>; 2]>,
+    edges: Vec<[OnceLock<Table>; 2]>,
+    vertices: Vec<[OnceLock<Table>; 2]>,
+}
+
+/// Two empty slots per place.
+fn slots(n: usize) -> Vec<[OnceLock<Table>; 2]> {
+    (0..n).map(|_| [OnceLock::new(), OnceLock::new()]).collect()
+}
+
+/// The wrench path of `place` for the force at the cone angle with sine `s` and cosine `c` from
+/// the normal. A reflex vertex (no normal cone) gets an empty path.
+fn wrench_path(model: &PartModel, place: Place, s: f64, c: f64) -> WrenchPath {
+    let poly = model.polygon();
+    match place {
+        Place::Edge(k) => {
+            let e = poly.edge_dir(k);
+            WrenchPath::Edge {
+                a: poly.vertex(k),
+                e,
+                f: e.perp().rotate_sc(s, c),
+                len: poly.edge_len(k),
+            }
+        }
+        Place::Vertex(k) => {
+            let m = poly.len();
+            let (na, nb) = (poly.inward_normal(k + m - 1), poly.inward_normal(k));
+            // The cone runs counter-clockwise from na to nb (the event functions of a disc at a
+            // vertex, `Ctx::feature_events`); at a reflex vertex it is empty.
+            let span = if poly.vertex_is_convex(k) {
+                na.cross(nb).atan2(na.dot(nb))
+            } else {
+                0.0
+            };
+            WrenchPath::Vertex {
+                p: poly.vertex(k),
+                phi0: na.angle(),
+                span,
+                s,
+                c,
+            }
+        }
+    }
 }
 
 /// A model's slide tables for the μc values it was given (see the module docs).
@@ -299,7 +436,7 @@ pub struct SlideTables {
 /// What the tables of a model hold so far.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct TableStats {
-    /// (μc, edge, side) tables built.
+    /// (μc, place, side) tables built (a reflex vertex's, which serves nothing, included).
     pub tables: usize,
     /// Nodes over all tables.
     pub nodes: usize,
@@ -323,9 +460,8 @@ impl SlideTables {
                 mu_c: mu,
                 sin_phi: mu * c,
                 cos_phi: c,
-                edges: (0..edges)
-                    .map(|_| [OnceLock::new(), OnceLock::new()])
-                    .collect(),
+                edges: slots(edges),
+                vertices: slots(edges),
             });
         }
         SlideTables {
@@ -339,32 +475,22 @@ impl SlideTables {
         self.by_mu.is_empty()
     }
 
-    /// The table of (μc, edge, side), built on first use; `None` for a μc the model was not given.
-    pub fn table(
-        &self,
-        model: &PartModel,
-        mu_c: f64,
-        edge: usize,
-        side: Side,
-    ) -> Option<&EdgeTable> {
+    /// The table of (μc, place, side), built on first use; `None` for a μc the model was not
+    /// given or a place the part does not have.
+    pub fn table(&self, model: &PartModel, mu_c: f64, place: Place, side: Side) -> Option<&Table> {
         let mt = self.by_mu.iter().find(|t| t.mu_c == mu_c)?;
-        let slot = mt.edges.get(edge)?;
+        let slot = match place {
+            Place::Edge(k) => mt.edges.get(k)?,
+            Place::Vertex(k) => mt.vertices.get(k)?,
+        };
         Some(slot[side as usize].get_or_init(|| {
-            let poly = model.polygon();
-            let e = poly.edge_dir(edge);
-            let n = e.perp();
             let s = match side {
                 Side::Left => mt.sin_phi,
                 Side::Right => -mt.sin_phi,
             };
             let builder = Builder {
                 model,
-                line: EdgeLine {
-                    a: poly.vertex(edge),
-                    e,
-                    f: n.rotate_sc(s, mt.cos_phi),
-                    len: poly.edge_len(edge),
-                },
+                path: wrench_path(model, place, s, mt.cos_phi),
                 evaluations: 0,
             };
             let (table, evals) = builder.build();
@@ -373,12 +499,14 @@ impl SlideTables {
         }))
     }
 
-    /// Build every table (each μc, edge and side) now.
+    /// Build every table (each μc, edge and vertex, and side) now.
     pub fn build_all(&self, model: &PartModel) {
         for mt in &self.by_mu {
-            for edge in 0..mt.edges.len() {
-                for side in [Side::Left, Side::Right] {
-                    self.table(model, mt.mu_c, edge, side);
+            for k in 0..mt.edges.len() {
+                for place in [Place::Edge(k), Place::Vertex(k)] {
+                    for side in [Side::Left, Side::Right] {
+                        self.table(model, mt.mu_c, place, side);
+                    }
                 }
             }
         }
@@ -391,7 +519,8 @@ impl SlideTables {
             ..TableStats::default()
         };
         for mt in &self.by_mu {
-            for t in mt.edges.iter().flatten().filter_map(OnceLock::get) {
+            let all = mt.edges.iter().chain(&mt.vertices).flatten();
+            for t in all.filter_map(OnceLock::get) {
                 let (nodes, ok) = t.size();
                 s.tables += 1;
                 s.nodes += nodes;
@@ -414,14 +543,18 @@ mod tests {
             .with_slide_tables(&[mu])
     }
 
-    /// The converged solve the table stands for, at ℓ on (edge, side).
-    fn solved(m: &PartModel, mu: f64, edge: usize, side: Side, ell: f64) -> (Twist, f64) {
+    /// The converged solve the table stands for, at coordinate `t` of (place, side).
+    fn solved(m: &PartModel, mu: f64, place: Place, side: Side, t: f64) -> (Twist, f64) {
         let poly = m.polygon();
-        let e = poly.edge_dir(edge);
         let c = 1.0 / (1.0 + mu * mu).sqrt();
         let s = if side == Side::Left { mu * c } else { -mu * c };
-        let f = e.perp().rotate_sc(s, c);
-        let w = wrench_of(f, poly.vertex(edge) + e * ell);
+        let w = match place {
+            Place::Edge(k) => {
+                let e = poly.edge_dir(k);
+                wrench_of(e.perp().rotate_sc(s, c), poly.vertex(k) + e * t)
+            }
+            Place::Vertex(k) => wrench_of(Vec2::from_angle(t).rotate_sc(s, c), poly.vertex(k)),
+        };
         let mut ev = 0;
         let (xi, warm) = m.converged_slide(w, None, &mut ev).unwrap();
         (xi, warm.lambda)
@@ -430,6 +563,7 @@ mod tests {
     #[test]
     fn tables_agree_with_converged_solves_between_their_nodes() {
         let mut worst: f64 = 0.0;
+        let mut vertices = 0;
         for (name, mu) in [
             ("tripoly1", 0.5),
             ("lshape", 0.3),
@@ -437,24 +571,33 @@ mod tests {
             ("ngon:7", 1.2),
         ] {
             let m = tabled(name, mu);
-            for edge in 0..m.polygon().len() {
-                for side in [Side::Left, Side::Right] {
-                    let t = m.slide_table(mu, edge, side).unwrap();
-                    let len = m.polygon().edge_len(edge);
-                    // Off the nodes: irrational fractions of the edge.
-                    for j in 0..23 {
-                        let ell = len * ((j as f64 * 0.618_033_988_7 + 0.0123) % 1.0);
-                        let got = t.at(ell).expect("certified everywhere on these parts");
-                        let (xi, lambda) = solved(&m, mu, edge, side, ell);
-                        let scale = xi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-                        for (g, x) in got.twist.iter().zip(xi) {
-                            worst = worst.max((g - x).abs() / scale);
+            for k in 0..m.polygon().len() {
+                for place in [Place::Edge(k), Place::Vertex(k)] {
+                    for side in [Side::Left, Side::Right] {
+                        let t = m.slide_table(mu, place, side).unwrap();
+                        let Some((lo, hi)) = t.range() else {
+                            // Only a reflex vertex has no range (the L's inner corner).
+                            assert!(matches!(place, Place::Vertex(_)));
+                            assert!(!m.polygon().vertex_is_convex(k));
+                            continue;
+                        };
+                        vertices += usize::from(matches!(place, Place::Vertex(_)));
+                        // Off the nodes: irrational fractions of the range.
+                        for j in 0..23 {
+                            let x = lo + (hi - lo) * ((j as f64 * 0.618_033_988_7 + 0.0123) % 1.0);
+                            let got = t.at(x).expect("certified everywhere on these parts");
+                            let (xi, lambda) = solved(&m, mu, place, side, x);
+                            let scale = xi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                            for (g, x) in got.twist.iter().zip(xi) {
+                                worst = worst.max((g - x).abs() / scale);
+                            }
+                            worst = worst.max((got.lambda - lambda).abs() / lambda);
                         }
-                        worst = worst.max((got.lambda - lambda).abs() / lambda);
                     }
                 }
             }
         }
+        assert_eq!(vertices, 2 * (3 + 5 + 4 + 7));
         // The midpoint certificate is TABLE_TOL = 1e-10; between nodes the cubic's error is no
         // larger, and the reference solve itself is converged to about 1e-12.
         assert!(worst < 5e-10, "worst relative error {worst:e}");
@@ -463,17 +606,33 @@ mod tests {
     #[test]
     fn a_table_serves_only_its_edge_and_mu() {
         let m = tabled("tripoly2", 0.5);
-        let t = m.slide_table(0.5, 1, Side::Right).unwrap();
+        let t = m.slide_table(0.5, Place::Edge(1), Side::Right).unwrap();
         let len = m.polygon().edge_len(1);
         assert!(t.at(0.0).is_some() && t.at(len).is_some());
         assert!(t.at(-1e-9).is_none() && t.at(len * (1.0 + 1e-9)).is_none());
         assert!(t.at(f64::NAN).is_none());
-        assert!(m.slide_table(0.4, 1, Side::Right).is_none());
-        assert!(m.slide_table(0.5, 3, Side::Left).is_none());
+        assert!(m.slide_table(0.4, Place::Edge(1), Side::Right).is_none());
+        assert!(m.slide_table(0.5, Place::Edge(3), Side::Left).is_none());
+        assert!(m.slide_table(0.5, Place::Vertex(3), Side::Left).is_none());
+        // A vertex's table covers its normal cone, from the normal of the edge before it to the
+        // normal of the edge after it, whichever turn the angle is given in.
+        let v = m.slide_table(0.5, Place::Vertex(1), Side::Left).unwrap();
+        let (na, nb) = (m.polygon().inward_normal(0), m.polygon().inward_normal(1));
+        let (lo, hi) = v.range().unwrap();
+        assert!((lo - na.angle()).abs() < 1e-12);
+        assert!((Vec2::from_angle(hi) - nb).norm() < 1e-12);
+        let mid = 0.5 * (lo + hi);
+        assert!(v.at(mid).is_some());
+        let turned = v.at(mid + 2.0 * std::f64::consts::TAU).unwrap();
+        let here = v.at(mid).unwrap();
+        for (a, b) in turned.twist.iter().zip(here.twist) {
+            assert!((a - b).abs() < 1e-12, "{turned:?} {here:?}");
+        }
+        assert!(v.at(lo - 1e-9).is_none() && v.at(hi + 1e-9).is_none());
         // Without tables, or with point supports, there are none.
         let plain =
             PartModel::new(&part_from_spec("tripoly2").unwrap(), &Support::Uniform).unwrap();
-        assert!(plain.slide_table(0.5, 0, Side::Left).is_none());
+        assert!(plain.slide_table(0.5, Place::Edge(0), Side::Left).is_none());
         assert!(plain.slide_table_stats().is_none());
         let tripod = Support::parse("tripod:3", &part_from_spec("tripoly2").unwrap()).unwrap();
         let pts = PartModel::new(&part_from_spec("tripoly2").unwrap(), &tripod)
@@ -487,19 +646,25 @@ mod tests {
         let a = tabled("square", 0.5);
         assert_eq!(a.slide_table_stats().unwrap().tables, 0);
         let b = a.clone();
-        let ta = a.slide_table(0.5, 2, Side::Left).unwrap().breakpoints();
+        let ta = a
+            .slide_table(0.5, Place::Edge(2), Side::Left)
+            .unwrap()
+            .breakpoints();
         // The clone sees the table its original built.
         let st = b.slide_table_stats().unwrap();
         assert_eq!((st.tables, st.nodes), (1, ta.len()));
         assert!(st.evaluations > 0 && st.uncertified == 0);
         // An independent model builds the same nodes, bit for bit (in another order, too).
         let c = tabled("square", 0.5);
-        c.slide_table(0.5, 0, Side::Right).unwrap();
-        let tc = c.slide_table(0.5, 2, Side::Left).unwrap();
+        c.slide_table(0.5, Place::Vertex(0), Side::Right).unwrap();
+        let tc = c.slide_table(0.5, Place::Edge(2), Side::Left).unwrap();
         assert_eq!(ta, tc.breakpoints());
         let ell = 0.377;
         let (x, y) = (
-            a.slide_table(0.5, 2, Side::Left).unwrap().at(ell).unwrap(),
+            a.slide_table(0.5, Place::Edge(2), Side::Left)
+                .unwrap()
+                .at(ell)
+                .unwrap(),
             tc.at(ell).unwrap(),
         );
         assert_eq!((x.twist, x.lambda), (y.twist, y.lambda));
@@ -511,8 +676,8 @@ mod tests {
         // the right (ℓ measured from the other end), with ω and vx reversed.
         let m = tabled("tripoly1", 0.5);
         let l1 = m.polygon().edge_len(1);
-        let t1 = m.slide_table(0.5, 1, Side::Left).unwrap();
-        let t2 = m.slide_table(0.5, 2, Side::Right).unwrap();
+        let t1 = m.slide_table(0.5, Place::Edge(1), Side::Left).unwrap();
+        let t2 = m.slide_table(0.5, Place::Edge(2), Side::Right).unwrap();
         for j in 1..10 {
             let ell = l1 * j as f64 / 10.3;
             let a = t1.at(ell).unwrap();

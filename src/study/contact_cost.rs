@@ -46,7 +46,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 /// The exact model's slide tables in a [`ContactCostRow`] of model `exact+tables`.
 #[derive(Debug, Clone, Serialize)]
 pub struct TableCost {
-    /// Wall time to build every (edge, side) table of the part at μc (ms), before the timed runs.
+    /// Wall time to build every (edge or vertex, side) table of the part at μc (ms), before the timed runs.
     pub build_ms: f64,
     /// Nodes over the part's tables, and dissipation evaluations spent building them.
     pub nodes: usize,
