@@ -6,10 +6,18 @@
 //! w = (f, p × f). Two kinds of slide leave a single free coordinate t:
 //!
 //! * **on edge k** (point pin or disc): n is the edge's inward normal, p = a_k + ℓ e_k, so
-//!   w(ℓ) = (f, a_k × f + ℓ e_k × f) is a straight line in wrench space (t = ℓ ∈ [0, |edge|]);
+//!   w(ℓ) = (f, a_k × f + ℓ e_k × f) is a straight line in wrench space (t = ℓ, on the edge for
+//!   ℓ ∈ [0, |edge|]);
 //! * **on vertex k**: p is the vertex and n = (cos φ, sin φ) turns through the vertex's normal cone
 //!   (a disc riding round the vertex; for a point pin φ stays where it arrived), so w(φ) is an arc
-//!   (t = φ − φ_a ∈ [0, cone angle], φ_a the inward normal of the edge before the vertex).
+//!   (t = φ − φ_a, inside the cone for t ∈ [0, cone angle], φ_a the inward normal of the edge
+//!   before the vertex).
+//!
+//! The tables reach beyond where the pin can physically be: an edge's by [`EDGE_REACH`] of its
+//! length past each end, a convex vertex's round the whole turn of normals. The integrator's
+//! stages go there within a step that ends on the edge's end or the cone's side (an event); the
+//! live solve at such a stage is the same function continued, and serving it from the table
+//! saves about a quarter of a line's evaluations.
 //!
 //! The sliding twist — the limit surface's normal at w, normalised so that w·ξ = 1, with its
 //! multiplier λ (∇D(ξ) = λ w, the force being λ f) — is then a function of t alone: it does not
@@ -30,8 +38,8 @@
 //! the midpoint, so the midpoint check bounds the interval. Where ξ(t) is less smooth (the centre
 //! of rotation crossing the part's boundary makes the third derivative of D singular) the
 //! refinement goes on down to [`MIN_INTERVAL`]; an interval not certified there is left to the
-//! solver, and so is any t outside its range (a stage of a step that overshoots an edge's end or a
-//! cone's side), a reflex vertex (a pin cannot slide there) and any table whose nodes could not be
+//! solver, and so is any t outside its range (a stage more than [`EDGE_REACH`] past an edge's
+//! end), a reflex vertex (a pin cannot slide there) and any table whose nodes could not be
 //! solved.
 //!
 //! The accuracy this gives is that of the live solve: a live slide solve stops at a relative
@@ -60,6 +68,12 @@ pub const START_INTERVALS: usize = 8;
 /// The shortest interval (units of a) refinement makes; one not certified there is left to the
 /// solver.
 pub const MIN_INTERVAL: f64 = 1e-5;
+
+/// How far beyond each end of an edge (as a fraction of its length) its tables reach. The
+/// integrator's stages overshoot an edge's end within the step that lands on it; the sliding
+/// twist there is the same function of ℓ continued (the live solve computes exactly that), and
+/// 25% holds 99% of the overshoots on the bundled lines.
+pub const EDGE_REACH: f64 = 0.25;
 
 /// The slide sides a table exists for: the force on the counter-clockwise cone edge R(+atan μc) n
 /// (also the frictionless normal force when μc = 0) and on the clockwise one.
@@ -236,11 +250,12 @@ fn hermite(a: &Node, b: &Node, t: f64) -> (Twist, f64) {
     (xi, lambda)
 }
 
-/// The wrenches of one (place, force direction) as its coordinate runs from 0 to its span.
+/// The wrenches of one (place, force direction) as its coordinate runs over the table's range.
 enum WrenchPath {
     /// Edge from `a` along unit `e`, force `f` fixed.
     Edge { a: Vec2, e: Vec2, f: Vec2, len: f64 },
-    /// Vertex `p`; the normal turns from angle `phi0` through `span`, the force at the cone angle
+    /// Vertex `p`; the normal turns from angle `phi0` (through `span` inside the vertex's normal
+    /// cone, on round the whole turn beyond it), the force at the cone angle
     /// whose sine and cosine are (`s`, `c`) from it.
     Vertex {
         p: Vec2,
@@ -252,10 +267,13 @@ enum WrenchPath {
 }
 
 impl WrenchPath {
-    fn span(&self) -> f64 {
+    /// The coordinates the table covers: the edge and [`EDGE_REACH`] of its length beyond each
+    /// end; a convex vertex's whole turn of normals; nothing at a reflex vertex.
+    fn range(&self) -> (f64, f64) {
         match self {
-            WrenchPath::Edge { len, .. } => *len,
-            WrenchPath::Vertex { span, .. } => *span,
+            WrenchPath::Edge { len, .. } => (-EDGE_REACH * len, (1.0 + EDGE_REACH) * len),
+            WrenchPath::Vertex { span, .. } if *span > 0.0 => (0.0, std::f64::consts::TAU),
+            WrenchPath::Vertex { .. } => (0.0, 0.0),
         }
     }
     /// The place coordinate at 0 and whether it is an angle.
@@ -347,7 +365,8 @@ impl Builder<'_> {
     }
 
     fn build(mut self) -> (Table, u64) {
-        let len = self.path.span();
+        let (lo, hi) = self.path.range();
+        let len = hi - lo;
         if !(len > 0.0 && len.is_finite()) {
             return (Table::indexed(&self.path, Vec::new(), Vec::new()), 0);
         }
@@ -355,7 +374,7 @@ impl Builder<'_> {
         let mut certified = Vec::new();
         let mut prev: Option<Node> = None;
         for j in 0..=START_INTERVALS {
-            let ell = len * j as f64 / START_INTERVALS as f64;
+            let ell = lo + len * j as f64 / START_INTERVALS as f64;
             let Some(node) = self.node(ell, prev.as_ref()) else {
                 // A node that cannot be solved: the table serves nothing.
                 return (
@@ -608,27 +627,36 @@ mod tests {
         let m = tabled("tripoly2", 0.5);
         let t = m.slide_table(0.5, Place::Edge(1), Side::Right).unwrap();
         let len = m.polygon().edge_len(1);
+        // The edge and EDGE_REACH of its length past each end (where stages overshoot).
+        let r = EDGE_REACH * len;
         assert!(t.at(0.0).is_some() && t.at(len).is_some());
-        assert!(t.at(-1e-9).is_none() && t.at(len * (1.0 + 1e-9)).is_none());
+        assert!(t.at(-r).is_some() && t.at(len + r).is_some());
+        assert!(t.at(-r * (1.0 + 1e-9)).is_none() && t.at(len + r * (1.0 + 1e-9)).is_none());
         assert!(t.at(f64::NAN).is_none());
         assert!(m.slide_table(0.4, Place::Edge(1), Side::Right).is_none());
         assert!(m.slide_table(0.5, Place::Edge(3), Side::Left).is_none());
         assert!(m.slide_table(0.5, Place::Vertex(3), Side::Left).is_none());
-        // A vertex's table covers its normal cone, from the normal of the edge before it to the
-        // normal of the edge after it, whichever turn the angle is given in.
+        // A vertex's table starts at the normal of the edge before it and goes round the whole
+        // turn (its cone ends at the normal of the edge after it), whichever turn the angle is
+        // given in.
         let v = m.slide_table(0.5, Place::Vertex(1), Side::Left).unwrap();
-        let (na, nb) = (m.polygon().inward_normal(0), m.polygon().inward_normal(1));
+        let na = m.polygon().inward_normal(0);
         let (lo, hi) = v.range().unwrap();
         assert!((lo - na.angle()).abs() < 1e-12);
-        assert!((Vec2::from_angle(hi) - nb).norm() < 1e-12);
-        let mid = 0.5 * (lo + hi);
-        assert!(v.at(mid).is_some());
-        let turned = v.at(mid + 2.0 * std::f64::consts::TAU).unwrap();
-        let here = v.at(mid).unwrap();
-        for (a, b) in turned.twist.iter().zip(here.twist) {
-            assert!((a - b).abs() < 1e-12, "{turned:?} {here:?}");
+        assert!((hi - lo - std::f64::consts::TAU).abs() < 1e-12);
+        for k in 0..16 {
+            let phi = lo + std::f64::consts::TAU * (k as f64 + 0.37) / 16.0;
+            let turned = v.at(phi + 2.0 * std::f64::consts::TAU).unwrap();
+            let here = v.at(phi).unwrap();
+            let back = v.at(phi - 3.0 * std::f64::consts::TAU).unwrap();
+            for ((a, b), c) in turned.twist.iter().zip(here.twist).zip(back.twist) {
+                assert!(
+                    (a - b).abs() < 1e-12 && (c - b).abs() < 1e-12,
+                    "{turned:?} {here:?}"
+                );
+            }
         }
-        assert!(v.at(lo - 1e-9).is_none() && v.at(hi + 1e-9).is_none());
+        assert!(v.at(f64::NAN).is_none());
         // Without tables, or with point supports, there are none.
         let plain =
             PartModel::new(&part_from_spec("tripoly2").unwrap(), &Support::Uniform).unwrap();
