@@ -216,3 +216,49 @@ fn a_line_builds_tables_only_for_the_exact_model_and_keeps_its_outcomes() {
         assert!((w.end_s - s.end_s).abs() < 1e-6);
     }
 }
+
+/// A pass's work budget counts the integrator's right-hand sides, not only limit-surface
+/// evaluations: a contact the tables serve costs few evaluations, and a pass that crawls (steps
+/// shrinking near an edge's end, as a planner met on random:18) must still stop at the budget
+/// instead of running on.
+#[test]
+fn the_work_budget_bounds_a_pass_the_tables_serve() {
+    use pinfeed::mechanics::ContactStatus;
+    let poly = part_from_spec("tripoly1").unwrap();
+    let a = poly.radius();
+    let tabled = PartModel::new(&poly, &Support::Uniform)
+        .unwrap()
+        .with_slide_tables(&[0.0]);
+    // Frictionless: every instant is a slide, and the tables serve nearly all of them.
+    let free = ContactSettings {
+        mu_c: 0.0,
+        ..ContactSettings::default()
+    };
+    let tight = ContactSettings {
+        max_evaluations: 40,
+        ..free
+    };
+    let mut checked = 0;
+    for (th, d) in cases(40, 7) {
+        let pose = Pose::new(0.0, 0.0, th.to_radians());
+        let start = Vec2::new(1.2 * a, d * a);
+        let full = push(&tabled, pose, start, &Pin::point(), &free, None);
+        // Contacts that need more than 40 right-hand sides but fewer than 40 evaluations: only
+        // a budget that counts the right-hand sides stops them.
+        if !(full.status == ContactStatus::Ok && full.evaluations < 40 && full.steps >= 8) {
+            continue;
+        }
+        let cut = push(&tabled, pose, start, &Pin::point(), &tight, None);
+        assert!(
+            matches!(cut.status, ContactStatus::EvaluationLimit { evaluations } if evaluations > 40),
+            "θ0 {th} d {d}: {:?} after {} evaluations",
+            cut.status,
+            cut.evaluations
+        );
+        checked += 1;
+    }
+    assert!(
+        checked >= 5,
+        "only {checked} contacts served mostly by the tables"
+    );
+}

@@ -70,6 +70,10 @@ pub(super) struct Ctx<'a, 'r> {
     pub(super) mu_s: f64,
     pub(super) scale: f64,
     pub(super) evals: u64,
+    /// Right-hand sides evaluated, with the evaluations the pass's work budget (a right-hand
+    /// side a slide table serves costs no evaluation, so evaluations alone would not bound a
+    /// pass whose steps crawl).
+    pub(super) rhs_calls: u64,
     pub(super) warm: Warm,
     pub(super) recorder: Option<&'r mut dyn Recorder>,
     /// Per-event tolerance band: event i fires when its function drops below −band[i]. Zero except
@@ -113,6 +117,7 @@ impl<'a, 'r> Ctx<'a, 'r> {
             mu_s: settings.mu_s,
             scale: model.scale(),
             evals: 0,
+            rhs_calls: 0,
             warm: Warm::for_tolerance(settings.tol),
             recorder,
             band: [0.0; N_EVENTS],
@@ -250,6 +255,7 @@ impl Ctx<'_, '_> {
         mode: Mode,
         y: [f64; 2],
     ) -> Result<([f64; 2], Instant, ContactGeom), SolveFailure> {
+        self.rhs_calls += 1;
         let g = self.geom(feat, y);
         let inst = match feat {
             Feat::FenceEdge(k) => self.flush_instant(k, y, mode),

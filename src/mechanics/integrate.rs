@@ -253,10 +253,9 @@ fn begin(
 
 /// The contact's evaluation or travel budget is spent: it stops where it stands.
 fn over_budget(ctx: &Ctx, settings: &ContactSettings, at: &Cursor, s_start: f64) -> Option<Finish> {
-    let status = if ctx.evals > settings.max_evaluations {
-        ContactStatus::EvaluationLimit {
-            evaluations: ctx.evals,
-        }
+    let work = ctx.evals + ctx.rhs_calls;
+    let status = if work > settings.max_evaluations {
+        ContactStatus::EvaluationLimit { evaluations: work }
     } else if at.s - s_start > settings.max_travel {
         ContactStatus::TravelLimit {
             travel: (at.s - s_start) * ctx.scale,

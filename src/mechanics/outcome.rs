@@ -66,7 +66,8 @@ pub enum ContactStatus {
     /// The part was still being pushed after the travel limit (e.g. a metastable push through the
     /// centroid that never turns): the part rides on the pin.
     TravelLimit { travel: f64 },
-    /// Too many model evaluations (the budget is a setting).
+    /// Too much work in one pass: limit-surface evaluations plus right-hand sides (the budget is
+    /// a setting; a right-hand side served by a slide table costs no evaluation but counts here).
     EvaluationLimit { evaluations: u64 },
     /// Too many contact events (mode chattering).
     EventLimit { events: u32 },

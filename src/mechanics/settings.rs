@@ -35,7 +35,7 @@ pub struct ContactSettings {
     /// Largest pin travel in contact, in units of a, before reporting
     /// [`super::ContactStatus::TravelLimit`].
     pub max_travel: f64,
-    /// Evaluation budget per pass.
+    /// Work budget per pass: limit-surface evaluations plus right-hand sides of the integrator.
     pub max_evaluations: u64,
     /// Event budget per pass.
     pub max_events: u32,
