@@ -3,6 +3,7 @@
 
 use crate::study::accuracy::AccuracyStudy;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 pub fn plot_accuracy(st: &AccuracyStudy, path: &Path) -> anyhow::Result<()> {
@@ -60,17 +61,14 @@ pub fn plot_accuracy(st: &AccuracyStudy, path: &Path) -> anyhow::Result<()> {
     .label("95th percentile")
     .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, RED.filled()));
     for p in &pts {
-        // The tables' tiers sit left of the solves' at the same errors: label them below their
-        // mean marker so that the two labels do not overlap.
-        let (label, at) = match p.3.strip_prefix("exact+tables ") {
-            Some(tol) => (format!("+tables {tol}"), (p.0 * 1.08, p.1 * 0.35)),
-            None => (p.3.to_string(), (p.0 * 1.08, p.2 * 1.4)),
+        // The tables' tiers sit left of the solves' at the same errors: label them on their left
+        // (right-aligned, level with the 95th-percentile marker), the others on their right.
+        let (label, at, h) = match p.3.strip_prefix("exact+tables ") {
+            Some(tol) => (format!("+tables {tol}"), (p.0 / 1.12, p.2), HPos::Right),
+            None => (p.3.to_string(), (p.0 * 1.08, p.2 * 1.4), HPos::Left),
         };
-        ch.draw_series(std::iter::once(Text::new(
-            label,
-            at,
-            ("sans-serif", 12).into_font(),
-        )))?;
+        let style = TextStyle::from(("sans-serif", 12).into_font()).pos(Pos::new(h, VPos::Center));
+        ch.draw_series(std::iter::once(Text::new(label, at, style)))?;
     }
     ch.configure_series_labels()
         .position(SeriesLabelPosition::LowerLeft)
