@@ -605,3 +605,42 @@ fn tripod_map_sweep() {
         bad.join("\n")
     );
 }
+
+/// A disc pin whose force line runs through an edge's end (found by `pinfeed plan --part
+/// random:18`): the contact leaves the edge for the vertex and comes back at the same point, and
+/// the edge-end event then gets a band (`BOUNCE_BAND`) so that the state may run a little past the
+/// end before it counts. The step's dip check once ignored that band, saw a dip in every step and
+/// cut each one to 1e-10 a: about 190 000 steps until the pass's budget stopped it
+/// (`evaluation_limit`). It now ends `ok` in a few dozen steps, with and without slide tables.
+#[test]
+fn force_line_through_an_edge_end_does_not_crawl() {
+    let unit = pinfeed::geometry::part_from_spec("random:18").unwrap();
+    let part = unit.scaled(0.02);
+    let plain = PartModel::new(&part, &Support::Uniform).unwrap();
+    let tabled = plain.clone().with_slide_tables(&[0.5]);
+    let pin = Pin {
+        radius: 0.002,
+        ..Pin::point()
+    };
+    let settings = ContactSettings::default();
+    for (theta, y) in [
+        (6.261368691529658, 0.0075),
+        (4.95237175253391, -0.01175),
+        (5.240351079112974, -0.007),
+    ] {
+        for (name, model) in [("solves", &plain), ("tables", &tabled)] {
+            let o = push(
+                model,
+                Pose::new(0.0, 0.0, theta),
+                Vec2::new(0.02477848977635797, y),
+                &pin,
+                &settings,
+                None,
+            );
+            let what = format!("θ0 {theta} y {y} ({name})");
+            check(&o, &what);
+            assert_eq!(o.status, ContactStatus::Ok, "{what}");
+            assert!(o.steps < 1000, "{what}: {} steps", o.steps);
+        }
+    }
+}

@@ -41,12 +41,16 @@ pub(super) fn interior_dip(
         .map(|k| k as f64 / 8.0)
         .find(|&t| {
             let yt = step.dp.dense(y0, h, t);
+            // The event functions as `ev1` has them: with their bands (an edge's end a bounce
+            // let the state run past, see `ctx.band`), else a banded state below zero looks like
+            // a dip in every step and the steps shrink without end.
             let dips = near
                 && ctx
                     .feature_events(feat, yt)
                     .iter()
+                    .zip(&ctx.band[3..])
                     .zip(&ev1[3..])
-                    .any(|(&e, &e1)| e1 >= 0.0 && e < -slack);
+                    .any(|((&e, &b), &e1)| e1 >= 0.0 && e + b < -slack);
             dips || (second && second_contact(ctx, feat, &ctx.pose(s + t * h, feat, yt), s + t * h))
         })
         .or(mode_dip)
