@@ -199,8 +199,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                  scene's, a map's and a planner's model): a pin sliding on an edge (or a disc \
                  riding a vertex) gets the exact twist from per-(μc, edge or vertex, side) tables \
                  of certified cubic Hermite pieces instead of a Newton solve \
-                 (`src/mechanics/slide_table.rs`; these point-pin contacts use the edges' tables). Its tables are built before \
-                 the timed runs; the build is in the table below, with what the tables change \
+                 (`src/mechanics/slide_table.rs`). Its tables are built before the timed runs; the build is in the table below, with what the tables change \
                  against the solves at the same tolerance.\n\n\
                  {table}\n### Slide tables (exact+tables rows)\n\n{tables}\n{targets}\n\
                  ### Cost against the vertex count (exact model, regular N-gons)\n\n\

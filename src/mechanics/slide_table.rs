@@ -63,7 +63,7 @@ use std::sync::OnceLock;
 
 /// Relative agreement (twist and multiplier) an interval must show at its midpoint.
 pub const TABLE_TOL: f64 = 1e-10;
-/// Equal intervals an edge starts with.
+/// Equal intervals a table starts with.
 pub const START_INTERVALS: usize = 8;
 /// The shortest interval (units of a) refinement makes; one not certified there is left to the
 /// solver.
@@ -147,7 +147,7 @@ pub struct Table {
     bucket_scale: f64,
 }
 
-/// Buckets of the uniform index over an edge's ℓ.
+/// Buckets of the uniform index over a table's range.
 const INDEX_BUCKETS: usize = 512;
 
 impl Table {
@@ -254,13 +254,14 @@ fn hermite(a: &Node, b: &Node, t: f64) -> (Twist, f64) {
 enum WrenchPath {
     /// Edge from `a` along unit `e`, force `f` fixed.
     Edge { a: Vec2, e: Vec2, f: Vec2, len: f64 },
-    /// Vertex `p`; the normal turns from angle `phi0` (through `span` inside the vertex's normal
-    /// cone, on round the whole turn beyond it), the force at the cone angle
-    /// whose sine and cosine are (`s`, `c`) from it.
+    /// Vertex `p`; the normal turns from angle `phi0` (the inward normal of the edge before it)
+    /// round the whole turn, the force at the cone angle whose sine and cosine are (`s`, `c`)
+    /// from it. A reflex vertex (`convex` false: no normal cone, a pin cannot slide there) gets
+    /// no table.
     Vertex {
         p: Vec2,
         phi0: f64,
-        span: f64,
+        convex: bool,
         s: f64,
         c: f64,
     },
@@ -272,7 +273,7 @@ impl WrenchPath {
     fn range(&self) -> (f64, f64) {
         match self {
             WrenchPath::Edge { len, .. } => (-EDGE_REACH * len, (1.0 + EDGE_REACH) * len),
-            WrenchPath::Vertex { span, .. } if *span > 0.0 => (0.0, std::f64::consts::TAU),
+            WrenchPath::Vertex { convex: true, .. } => (0.0, std::f64::consts::TAU),
             WrenchPath::Vertex { .. } => (0.0, 0.0),
         }
     }
@@ -425,19 +426,13 @@ fn wrench_path(model: &PartModel, place: Place, s: f64, c: f64) -> WrenchPath {
             }
         }
         Place::Vertex(k) => {
-            let m = poly.len();
-            let (na, nb) = (poly.inward_normal(k + m - 1), poly.inward_normal(k));
-            // The cone runs counter-clockwise from na to nb (the event functions of a disc at a
-            // vertex, `Ctx::feature_events`); at a reflex vertex it is empty.
-            let span = if poly.vertex_is_convex(k) {
-                na.cross(nb).atan2(na.dot(nb))
-            } else {
-                0.0
-            };
+            // The cone runs counter-clockwise from the normal of the edge before the vertex (the
+            // event functions of a disc at a vertex, `Ctx::feature_events`).
+            let na = poly.inward_normal(k + poly.len() - 1);
             WrenchPath::Vertex {
                 p: poly.vertex(k),
                 phi0: na.angle(),
-                span,
+                convex: poly.vertex_is_convex(k),
                 s,
                 c,
             }
