@@ -19,8 +19,8 @@
 //! v_b and v_pin. The integrator locates the zero crossings of these as mode-switch events.
 
 use super::part_model::{
-    final_gap, point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Twist, WarmStick,
-    WarmTwist,
+    final_gap, point_velocity, wrench_of, Fidelity, PartModel, SolveFailure, Solved, Twist,
+    WarmStick, WarmTwist,
 };
 use super::slide_table::{Side, SlideAt, TableTwist};
 use crate::geometry::Vec2;
@@ -172,6 +172,15 @@ fn tabled_slide(
     model.slide_table(mu_c, place, side)?.at(t)
 }
 
+/// The exact sticking twist from the model's stick table for this edge, where it serves this
+/// contact point and pin velocity (see `mechanics::stick_table`).
+fn tabled_stick(model: &PartModel, fid: Fidelity, g: &ContactGeom) -> Option<(Solved, WarmStick)> {
+    match (fid, g.slide_at?) {
+        (Fidelity::Exact, SlideAt::Edge(k, ell)) => model.tabled_stick(k, ell, g.v_pin),
+        _ => None,
+    }
+}
+
 /// Slide with the force along `f_dir` (a cone edge, or the normal when frictionless): the twist
 /// normalised to w·ξ = 1, the contact velocity it gives, and the force (units of μs m g).
 #[allow(clippy::too_many_arguments)]
@@ -222,7 +231,10 @@ fn stick_instant(
     warm: &mut Warm,
     evals: &mut u64,
 ) -> Result<Instant, SolveFailure> {
-    let (s, next) = model.stick_twist(fid, g.p, g.v_pin, warm.stick.as_ref(), warm.gap, evals)?;
+    let (s, next) = match tabled_stick(model, fid, g) {
+        Some(served) => served,
+        None => model.stick_twist(fid, g.p, g.v_pin, warm.stick.as_ref(), warm.gap, evals)?,
+    };
     warm.stick = Some(next);
     let f = Vec2::new(s.wrench[0], s.wrench[1]);
     let t = g.n.perp();
@@ -447,7 +459,7 @@ mod tests {
     #[test]
     fn slides_on_edges_and_vertices_come_from_the_tables() {
         let plain = model("tripoly1");
-        let tabled = plain.clone().with_slide_tables(&[0.5]);
+        let tabled = plain.clone().with_tables(&[0.5]);
         let poly = plain.polygon().clone();
         for k in 0..poly.len() {
             let (na, nb) = (
@@ -513,6 +525,76 @@ mod tests {
                 );
                 assert!(ev_off > 0);
             }
+        }
+    }
+
+    /// A stick on an edge of a model with tables is served by its stick table (no evaluation)
+    /// and agrees with the solve; a stick at a vertex, where no stick table applies, is solved.
+    #[test]
+    fn sticks_on_edges_come_from_the_tables() {
+        let plain = model("lshape");
+        let tabled = plain.clone().with_tables(&[0.8]);
+        let poly = plain.polygon().clone();
+        let run = |m: &PartModel, g: &ContactGeom| {
+            let mut ev = 0;
+            let i = classify(
+                m,
+                Fidelity::Exact,
+                g,
+                Friction::new(0.8),
+                &mut Warm::for_tolerance(1e-6),
+                &mut ev,
+            )
+            .unwrap()
+            .unwrap();
+            (i, ev)
+        };
+        for k in 0..poly.len() {
+            let (e, ell) = (poly.edge_dir(k), 0.45 * poly.edge_len(k));
+            let n = e.perp();
+            // Nearly along the normal: inside the friction cone's motions, a stick.
+            let g = ContactGeom {
+                p: poly.vertex(k) + e * ell,
+                n,
+                v_pin: n * 0.9 + e * 0.05,
+                slide_at: Some(SlideAt::Edge(k, ell)),
+            };
+            let (solved, ev_solved) = run(&plain, &g);
+            let (served, ev_served) = run(&tabled, &g);
+            assert_eq!(solved.mode, Mode::Stick, "edge {k}");
+            assert_eq!(served.mode, Mode::Stick, "edge {k}");
+            assert!(ev_solved > 0);
+            assert_eq!(
+                ev_served, 0,
+                "edge {k}: slides and stick all from the tables"
+            );
+            let scale = solved.twist.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for (a, b) in solved.twist.iter().zip(served.twist) {
+                assert!(
+                    (a - b).abs() < 1e-8 * scale,
+                    "edge {k}: {solved:?} {served:?}"
+                );
+            }
+            assert!((solved.force - served.force).norm() < 1e-8 * solved.force.norm());
+            // The same stick at the edge's start vertex: no stick table there.
+            let at_vertex = ContactGeom {
+                p: poly.vertex(k),
+                slide_at: Some(SlideAt::Vertex(k, n.angle())),
+                ..g
+            };
+            let mut ev_vertex = 0;
+            let stick = solve_in_mode(
+                &tabled,
+                Fidelity::Exact,
+                &at_vertex,
+                Friction::new(0.8),
+                Mode::Stick,
+                &mut Warm::for_tolerance(1e-6),
+                &mut ev_vertex,
+            )
+            .unwrap();
+            assert_eq!(stick.mode, Mode::Stick);
+            assert!(ev_vertex > 0, "edge {k}");
         }
     }
 

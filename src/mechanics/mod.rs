@@ -38,6 +38,7 @@ mod pass;
 pub mod pin_path;
 mod settings;
 pub mod slide_table;
+pub mod stick_table;
 pub mod vote;
 
 pub use fence::FenceSpec;

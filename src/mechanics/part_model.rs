@@ -27,6 +27,7 @@ use super::limit_surface::points::PointSupport;
 use super::limit_surface::uniform::UniformSurface;
 use super::limit_surface::Dissipation;
 use super::slide_table::{Place, Side, SlideTables, Table, TableStats};
+use super::stick_table::{StickStats, StickTables};
 use crate::geometry::{Polygon, Vec2};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -298,8 +299,10 @@ pub struct PartModel {
     /// m_max / f_max of the ellipsoid approximation (normalised units).
     c_ellipsoid: f64,
     /// The exact model's slide tables, for the μc values given to
-    /// [`PartModel::with_slide_tables`] (shared by clones: their content depends only on the part).
+    /// [`PartModel::with_tables`] (shared by clones: their content depends only on the part).
     slide_tables: Option<Arc<SlideTables>>,
+    /// The exact model's stick tables (any μc), made with the slide tables.
+    stick_tables: Option<Arc<StickTables>>,
 }
 
 impl fmt::Debug for PartModel {
@@ -353,20 +356,46 @@ impl PartModel {
             support: data,
             c_ellipsoid: c,
             slide_tables: None,
+            stick_tables: None,
         })
     }
 
-    /// Serve the exact model's slides on edges from tables (`mechanics::slide_table`) for contacts
-    /// with these μc values: for a model that many contacts share (a scene's, a planner's, a
-    /// map's). Only uniform pressure is tabulated; a model with point supports (a part's own
-    /// tripod, used for a few contacts) is returned unchanged. Contacts with another μc, and the
-    /// tip and ellipsoid fidelities, solve as before.
-    pub fn with_slide_tables(mut self, mu_values: &[f64]) -> PartModel {
+    /// Serve the exact model's slides from tables (`mechanics::slide_table`) for contacts with
+    /// these μc values, and its sticks on edges from tables at any μc (`mechanics::stick_table`):
+    /// for a model that many contacts share (a scene's, a planner's, a map's). Only uniform
+    /// pressure is tabulated; a model with point supports (a part's own tripod, used for a few
+    /// contacts) is returned unchanged. Slides at another μc, and the tip and ellipsoid
+    /// fidelities, solve as before.
+    pub fn with_tables(mut self, mu_values: &[f64]) -> PartModel {
         if matches!(self.support, SupportData::Uniform(_)) {
             let tables = SlideTables::new(self.poly.len(), mu_values);
             self.slide_tables = (!tables.is_empty()).then(|| Arc::new(tables));
+            self.stick_tables = Some(Arc::new(StickTables::new(self.poly.len())));
         }
         self
+    }
+
+    /// The exact stick solve on edge `k` at ℓ for pin velocity `v` (part frame) from the model's
+    /// stick tables (`mechanics::stick_table`), where they serve it.
+    #[inline]
+    pub fn tabled_stick(&self, k: usize, ell: f64, v: Vec2) -> Option<(Solved, WarmStick)> {
+        self.stick_tables.as_ref()?.at(self, k, ell, v)
+    }
+
+    /// What the stick tables hold so far (`None`: the model has none).
+    pub fn stick_table_stats(&self) -> Option<StickStats> {
+        self.stick_tables.as_ref().map(|t| t.stats())
+    }
+
+    /// A stick solve converged as far as the solver goes, for the stick tables' nodes.
+    pub(crate) fn converged_stick(
+        &self,
+        p: Vec2,
+        v: Vec2,
+        warm: Option<&WarmStick>,
+        evals: &mut u64,
+    ) -> Result<(Solved, WarmStick), SolveFailure> {
+        self.exact_stick(p, v, warm, 0.0, evals)
     }
 
     /// The slide table of (μc, edge or vertex, side), built on first use; `None` when the model
@@ -376,10 +405,13 @@ impl PartModel {
         self.slide_tables.as_ref()?.table(self, mu_c, place, side)
     }
 
-    /// Build every slide table now (all μc values, edges and sides) rather than on first use:
-    /// for timing contacts without their tables' build.
-    pub fn build_all_slide_tables(&self) {
+    /// Build every slide table (all μc values, edges and sides) and every stick table's cells now
+    /// rather than on first use: for timing contacts without their tables' build.
+    pub fn build_all_tables(&self) {
         if let Some(t) = &self.slide_tables {
+            t.build_all(self);
+        }
+        if let Some(t) = &self.stick_tables {
             t.build_all(self);
         }
     }

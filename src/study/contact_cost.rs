@@ -31,7 +31,7 @@ pub struct ContactCostRow {
     pub self_error_max_deg: f64,
     /// Contacts whose status was not ok, by status name.
     pub non_ok: Vec<(String, usize)>,
-    /// The slide tables (`exact+tables` rows only).
+    /// The slide and stick tables (`exact+tables` rows only).
     pub tables: Option<TableCost>,
 }
 
@@ -43,16 +43,22 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[idx]
 }
 
-/// The exact model's slide tables in a [`ContactCostRow`] of model `exact+tables`.
+/// The exact model's slide and stick tables in a [`ContactCostRow`] of model `exact+tables`.
 #[derive(Debug, Clone, Serialize)]
 pub struct TableCost {
-    /// Wall time to build every (edge or vertex, side) table of the part at μc (ms), before the timed runs.
+    /// Wall time to build every slide table (edge or vertex, side) of the part at μc and every
+    /// cell of its stick tables (ms), before the timed runs.
     pub build_ms: f64,
-    /// Nodes over the part's tables, and dissipation evaluations spent building them.
+    /// Nodes over the part's slide tables, and dissipation evaluations spent building them.
     pub nodes: usize,
     pub build_evaluations: u64,
-    /// Intervals left to the solver (not certified).
+    /// Slide-table intervals left to the solver (not certified).
     pub uncertified: usize,
+    /// Certified pieces of the stick tables, pieces left to the solver, and dissipation
+    /// evaluations spent building them.
+    pub stick_pieces: usize,
+    pub stick_open: usize,
+    pub stick_evaluations: u64,
     /// max and mean |θf(tables) − θf(solves)| over the touching contacts at the same tolerance (°):
     /// what the tables change.
     pub vs_solves_max_deg: f64,
@@ -60,7 +66,8 @@ pub struct TableCost {
 }
 
 /// Measure the contact cost table: per part, one row per fidelity, and after the exact row one
-/// for the exact model with its slide tables (`exact+tables`, see `mechanics::slide_table`) when
+/// for the exact model with its tables (`exact+tables`, see `mechanics::slide_table` and
+/// `mechanics::stick_table`) when
 /// `tables` is set.
 pub fn measure(
     parts: &[&str],
@@ -97,9 +104,9 @@ pub fn measure(
             };
             rows.push(bench.row(&model, fid.name(), None));
             if tables && fid == Fidelity::Exact {
-                let tabled = model.clone().with_slide_tables(&[s.mu_c]);
+                let tabled = model.clone().with_tables(&[s.mu_c]);
                 let t0 = Instant::now();
-                tabled.build_all_slide_tables();
+                tabled.build_all_tables();
                 let build_ms = t0.elapsed().as_secs_f64() * 1e3;
                 rows.push(bench.row(&tabled, "exact+tables", Some((&model, build_ms))));
             }
@@ -179,11 +186,15 @@ impl Bench<'_> {
         let k = touching.max(1) as f64;
         let tables = solves.map(|(_, build_ms)| {
             let st = model.slide_table_stats().unwrap_or_default();
+            let sticks = model.stick_table_stats().unwrap_or_default();
             TableCost {
                 build_ms,
                 nodes: st.nodes,
                 build_evaluations: st.evaluations,
                 uncertified: st.uncertified,
+                stick_pieces: sticks.pieces,
+                stick_open: sticks.open,
+                stick_evaluations: sticks.evaluations,
                 vs_solves_max_deg: table_diffs.iter().copied().fold(0.0, f64::max),
                 vs_solves_mean_deg: table_diffs.iter().sum::<f64>()
                     / table_diffs.len().max(1) as f64,
@@ -242,20 +253,23 @@ pub fn markdown(rows: &[ContactCostRow]) -> String {
     s
 }
 
-/// The slide tables' own table: build time and size, and what they change against the solves.
+/// The tables' own table: build time and size, and what they change against the solves.
 pub fn tables_markdown(rows: &[ContactCostRow]) -> String {
     let mut s = String::from(
-        "| part | tables built (ms) | nodes | evaluations to build | intervals left to the solver | max \\|θf(tables) − θf(solves)\\| ° | mean ° |\n|---|---|---|---|---|---|---|\n",
+        "| part | tables built (ms) | slide: nodes | evaluations to build | intervals left to the solver | stick: pieces | evaluations to build | pieces left to the solver | max \\|θf(tables) − θf(solves)\\| ° | mean ° |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         if let Some(t) = &r.tables {
             s.push_str(&format!(
-                "| {} | {:.1} | {} | {} | {} | {:.2e} | {:.2e} |\n",
+                "| {} | {:.1} | {} | {} | {} | {} | {} | {} | {:.2e} | {:.2e} |\n",
                 r.part,
                 t.build_ms,
                 t.nodes,
                 t.build_evaluations,
                 t.uncertified,
+                t.stick_pieces,
+                t.stick_evaluations,
+                t.stick_open,
                 t.vs_solves_max_deg,
                 t.vs_solves_mean_deg
             ));
