@@ -18,6 +18,8 @@
 //! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
 //! * [`slide_table`]: the exact model's sliding twists on each edge and vertex, tabulated per (μc, place,
 //!   side) for models many contacts share.
+//! * [`stick_table`]: the exact model's sticking twists on each edge, tabulated per edge over (ℓ,
+//!   direction of the pin's velocity) for the same models.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!
 //! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
@@ -52,3 +54,12 @@ pub use pass::{fence_first_touch, first_instant, pin_first_touch, push, push_fen
 pub use pin_path::{PinPath, Turn};
 pub use settings::{ContactSettings, Pin};
 pub use vote::mason_vote;
+
+/// The version of the contact model's answers: bumped whenever a change moves them beyond
+/// rounding of the previous ones (a new table, a changed integrator rule). Whatever is cached from
+/// the model's answers keys on it (the map tier, `maps::tier::key`), so that a cache written by an
+/// older model is rebuilt, not reused.
+///
+/// * 1: the exact model with slide tables on edges and vertices (up to `4db9b7c`).
+/// * 2: stick tables on edges.
+pub const MODEL_VERSION: u32 = 2;

@@ -1,10 +1,10 @@
 //! The key of a map: a canonical little-endian encoding of every input that changes its answer
-//! (format version, normalised polygon, support, pin radius in units of a, μc, tolerance, travel
+//! (format version, the contact model's version, normalised polygon, support, pin radius in units of a, μc, tolerance, travel
 //! limit, budgets, grid), hashed with two FNV-1a 64-bit streams (a 128-bit key; not
 //! cryptographic — it names cache files and detects stale ones).
 
 use super::{TierInputs, TierSpec};
-use crate::mechanics::Support;
+use crate::mechanics::{Support, MODEL_VERSION};
 use std::fmt;
 
 /// Bumped whenever the tier's sampling, certification or file layout changes meaning.
@@ -38,11 +38,17 @@ pub fn fnv1a64(bytes: &[u8], basis: u64) -> u64 {
 pub const BASIS: u64 = 0xcbf2_9ce4_8422_2325;
 const BASIS_2: u64 = 0x6c62_272e_07bb_0142;
 
-/// Canonical bytes of a map's inputs.
+/// Canonical bytes of a map's inputs, for the current contact model.
 pub fn encode(inputs: &TierInputs) -> Vec<u8> {
+    encode_for_model(inputs, MODEL_VERSION)
+}
+
+/// Canonical bytes of a map's inputs as a contact model of version `model_version` would key them.
+fn encode_for_model(inputs: &TierInputs, model_version: u32) -> Vec<u8> {
     let mut b = Vec::with_capacity(512);
     b.extend_from_slice(b"pinfeed-map-tier");
     b.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    b.extend_from_slice(&model_version.to_le_bytes());
     let model = inputs.model;
     let k = model.scale();
     let verts = model.polygon().vertices();
@@ -91,10 +97,48 @@ fn put_f64(b: &mut Vec<u8>, x: f64) {
 impl TierKey {
     /// The key of a map's inputs.
     pub fn of(inputs: &TierInputs) -> TierKey {
-        let bytes = encode(inputs);
+        TierKey::of_bytes(&encode(inputs))
+    }
+
+    fn of_bytes(bytes: &[u8]) -> TierKey {
         let mut key = [0u8; 16];
-        key[..8].copy_from_slice(&fnv1a64(&bytes, BASIS).to_le_bytes());
-        key[8..].copy_from_slice(&fnv1a64(&bytes, BASIS_2).to_le_bytes());
+        key[..8].copy_from_slice(&fnv1a64(bytes, BASIS).to_le_bytes());
+        key[8..].copy_from_slice(&fnv1a64(bytes, BASIS_2).to_le_bytes());
         TierKey(key)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::part_from_spec;
+    use crate::mechanics::{ContactSettings, PartModel};
+
+    /// A map cached by an older contact model is keyed apart from the current one's (so it is
+    /// rebuilt, not reused), and the key of the current model is the one `TierKey::of` gives.
+    #[test]
+    fn the_key_carries_the_contact_models_version() {
+        let model =
+            PartModel::new(&part_from_spec("tripoly2").unwrap(), &Support::Uniform).unwrap();
+        let inputs = TierInputs {
+            model: &model,
+            support: &Support::Uniform,
+            radius: 0.002,
+            settings: ContactSettings::default(),
+            spec: TierSpec::default(),
+        };
+        let now = TierKey::of(&inputs);
+        assert_eq!(
+            now,
+            TierKey::of_bytes(&encode_for_model(&inputs, MODEL_VERSION))
+        );
+        assert_ne!(
+            now,
+            TierKey::of_bytes(&encode_for_model(&inputs, MODEL_VERSION - 1))
+        );
+        assert_ne!(
+            now,
+            TierKey::of_bytes(&encode_for_model(&inputs, MODEL_VERSION + 1))
+        );
     }
 }

@@ -23,8 +23,9 @@
 //! sampled certificate (a discontinuity island smaller than a cell and missed by all nine points
 //! would go unseen by all 21 points), not a proof.
 //!
-//! Cached on disk ([`cache`]) under a 128-bit hash of a canonical encoding of every input
-//! ([`key`]); the file carries a magic, a format version, the key and a checksum, so a stale or
+//! Cached on disk ([`cache`]) under a 128-bit hash of a canonical encoding of every input and of
+//! the contact model's version ([`key`], [`crate::mechanics::MODEL_VERSION`]: a map an older
+//! model built is rebuilt, not reused); the file carries a magic, a format version, the key and a checksum, so a stale or
 //! corrupted file is refused and rebuilt. Building is deterministic (rayon, order-preserving) and
 //! independent of the thread count.
 
