@@ -586,3 +586,62 @@ fn a_study_without_uncertainty_reproduces_the_nominal_line() {
     assert_eq!(r["results"][0]["shares"]["success"]["ci95"][1], 1.0);
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// A study over a map-tier scene: samples that share a map's inputs share one map (built once,
+/// cached); where μc varies from sample to sample each sample would need its own map, so those
+/// samples run the exact model, build no map, and the report says so.
+#[test]
+fn a_map_scene_builds_one_map_per_input_not_per_sample() {
+    let d = tmp("map-scene");
+    let text = std::fs::read_to_string(scenario()).unwrap().replace(
+        "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"",
+        "fidelity = \"map\"\nmap_grid = [8, 2, 0]",
+    );
+    assert!(text.contains("map_grid"));
+    let scene = d.join("map.toml");
+    std::fs::write(&scene, text).unwrap();
+    let study = |name: &str, mu: &str| {
+        let p = d.join(format!("{name}.toml"));
+        let body = format!(
+            "scenario = \"{}\"\nname = \"{name}\"\nsamples = 6\n\n[uncertain.mu_c]\n{mu}\n\n[uncertain.pose_theta]\ndistribution = \"normal\"\nsd = 2.0\n",
+            s(&scene)
+        );
+        std::fs::write(&p, body).unwrap();
+        p
+    };
+    let run = |p: &Path, cache: &Path| {
+        let out = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+            .args(["mc", s(p), "--json", "--quiet", "--out", s(&d.join("o"))])
+            .env("PINFEED_CACHE", cache)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let maps = std::fs::read_dir(cache).map_or(0, |r| r.count());
+        (r, maps)
+    };
+    // μc fixed: one map per pin (the quickstart's pins share radius and μc: one file).
+    let (fixed, maps) = run(
+        &study("fixed", "distribution = \"fixed\"\nvalue = 0.45"),
+        &d.join("cache-fixed"),
+    );
+    assert_eq!(fixed["fidelity"], "map", "{fixed}");
+    assert_eq!(maps, 1);
+    // μc drawn per sample: no map at all, the samples run the exact model.
+    let (varied, maps) = run(
+        &study("varied", "distribution = \"uniform\"\nmin = 0.4\nmax = 0.6"),
+        &d.join("cache-varied"),
+    );
+    let fidelity = varied["fidelity"].as_str().unwrap();
+    assert!(
+        fidelity.starts_with("exact (map tier off: `mu_c` varies"),
+        "{fidelity}"
+    );
+    assert_eq!(maps, 0);
+    assert_eq!(varied["results"][0]["samples"], 6, "{varied}");
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -86,6 +86,24 @@ impl Perturbations {
             || self.sensor_jitter.is_some()
     }
 
+    /// The first parameter that gives samples different map-tier inputs (a map is per part,
+    /// support, pin radius and μc: `maps::tier::TierInputs`), if any: with it each sample would
+    /// build a map for its few contacts, so samples run the exact model instead.
+    pub fn varies_map_inputs(&self) -> Option<&'static str> {
+        let varies = |d: &Option<Distribution>| d.is_some_and(|d| !d.is_fixed());
+        if varies(&self.mu_c) {
+            Some("mu_c")
+        } else if varies(&self.shape) {
+            Some("shape")
+        } else if varies(&self.pin_radius) {
+            Some("pin_radius")
+        } else if self.support != SupportChoice::Uniform {
+            Some("support")
+        } else {
+            None
+        }
+    }
+
     /// One line per parameter that is not nominal, e.g. `mu_c: uniform [0.3, 0.7]`.
     pub fn describe(&self) -> Vec<String> {
         let mut out = Vec::new();

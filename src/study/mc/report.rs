@@ -38,6 +38,30 @@ pub struct StudyHeader {
     pub sensors: Vec<String>,
 }
 
+/// The model the samples run: the scene's fidelity, or the map tier — unless a parameter gives
+/// samples different maps at some sweep point, in which case the samples run the exact model and
+/// the report says why.
+fn fidelity(study: &Study) -> String {
+    if study.scene.map_tier.is_none() {
+        return study.scene.contact.fidelity.name().to_string();
+    }
+    let varying: Vec<&str> = study
+        .points
+        .iter()
+        .filter_map(|p| p.varies_map_inputs())
+        .collect();
+    let Some(why) = varying.first() else {
+        return "map".to_string();
+    };
+    let reason =
+        format!("`{why}` varies per sample, and a map is per part, support, pin radius and μc");
+    if varying.len() == study.points.len() {
+        format!("exact (map tier off: {reason})")
+    } else {
+        format!("map, exact at the sweep points where {reason}")
+    }
+}
+
 /// A swept parameter in the report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepOut {
@@ -54,7 +78,7 @@ impl StudyHeader {
             study_file: file.clone(),
             scenario_file: study.scenario_file.display().to_string(),
             scenario: study.scene.name.clone(),
-            fidelity: study.scene.contact.fidelity.name().to_string(),
+            fidelity: fidelity(study),
             study_hash: super::hash::hex(study.study_hash),
             scenario_hash: super::hash::hex(study.scenario_hash),
             pinfeed_version: env!("CARGO_PKG_VERSION").to_string(),

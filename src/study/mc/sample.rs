@@ -504,7 +504,8 @@ pub fn draw_scene(
             ..base.effects
         },
         output: base.output.clone(),
-        map_tier: base.map_tier,
+        // One map per sample would cost far more than the sample's few exact contacts.
+        map_tier: base.map_tier.filter(|_| p.varies_map_inputs().is_none()),
     };
     // The scenario's feed draws the entry pose (its support is uniform here, so it draws no tripod).
     let entry = draw_part(&scene, st.feed_seed, 0)?;
