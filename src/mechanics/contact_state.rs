@@ -26,6 +26,7 @@ use super::pin_path::{PinPath, Turn};
 use super::settings::{ContactSettings, POINT_PIN_RADIUS};
 use super::slide_table::SlideAt;
 use crate::geometry::{Feature, Polygon, Pose, Vec2};
+use std::cell::Cell;
 
 /// The feature in contact, and what its second coordinate y[1] means.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,6 +84,11 @@ pub(super) struct Ctx<'a, 'r> {
     /// `vdir` describe the current piece of the path (see [`super::pin_path`]).
     pub(super) turns: Vec<Turn>,
     pub(super) next_turn: usize,
+    /// The part's last orientation θ (bits) with its sine and cosine: the geometry, the pose, the
+    /// record and the events all turn vectors by ±θ of the same state, and one `sin_cos` serves
+    /// them (sin(−θ) = −sin θ and cos(−θ) = cos θ bit for bit, so the result is that of rotating
+    /// by ±θ directly).
+    trig: Cell<(u64, f64, f64)>,
 }
 
 /// Number of event functions (see [`Ctx::events`]).
@@ -123,6 +129,7 @@ impl<'a, 'r> Ctx<'a, 'r> {
             band: [0.0; N_EVENTS],
             turns: Vec::new(),
             next_turn: 0,
+            trig: Cell::new((f64::NAN.to_bits(), f64::NAN, f64::NAN)),
         }
     }
 
@@ -162,9 +169,35 @@ impl Ctx<'_, '_> {
         self.turn_at() - s <= 1e-12 * (1.0 + s.abs())
     }
 
+    /// (sin θ, cos θ), from the last call's if θ is the same.
+    #[inline]
+    fn sin_cos(&self, theta: f64) -> (f64, f64) {
+        let (bits, s, c) = self.trig.get();
+        if bits == theta.to_bits() {
+            return (s, c);
+        }
+        let (s, c) = theta.sin_cos();
+        self.trig.set((theta.to_bits(), s, c));
+        (s, c)
+    }
+
+    /// `v` (part axes) in world axes for the part at orientation θ: `v.rotate(θ)`.
+    #[inline]
+    pub(super) fn to_world(&self, v: Vec2, theta: f64) -> Vec2 {
+        let (s, c) = self.sin_cos(theta);
+        v.rotate_sc(s, c)
+    }
+
+    /// `v` (world axes) in part axes for the part at orientation θ: `v.rotate(−θ)`.
+    #[inline]
+    pub(super) fn to_part(&self, v: Vec2, theta: f64) -> Vec2 {
+        let (s, c) = self.sin_cos(theta);
+        v.rotate_sc(-s, c)
+    }
+
     /// The contact geometry in part axes: contact point, normal into the part, pin velocity.
     pub(super) fn geom(&self, feat: Feat, y: [f64; 2]) -> ContactGeom {
-        let v_pin = self.vdir.rotate(-y[0]);
+        let v_pin = self.to_part(self.vdir, y[0]);
         match feat {
             Feat::Edge(k) => {
                 let e = self.poly.edge_dir(k);
@@ -183,7 +216,7 @@ impl Ctx<'_, '_> {
             },
             Feat::FenceVertex(k) | Feat::FenceEdge(k) => ContactGeom {
                 p: self.poly.vertex(k),
-                n: self.fence_geom().n.rotate(-y[0]),
+                n: self.to_part(self.fence_geom().n, y[0]),
                 v_pin,
                 slide_at: None,
             },
@@ -209,9 +242,9 @@ impl Ctx<'_, '_> {
         let c = match feat {
             Feat::FenceVertex(_) | Feat::FenceEdge(_) => {
                 let f = self.fence_geom();
-                f.p0 + self.vdir * s + f.e * y[1] - g.p.rotate(y[0])
+                f.p0 + self.vdir * s + f.e * y[1] - self.to_world(g.p, y[0])
             }
-            _ => self.pin_at(s) + (g.n * self.rho - g.p).rotate(y[0]),
+            _ => self.pin_at(s) + self.to_world(g.n * self.rho - g.p, y[0]),
         };
         Pose::new(c.x, c.y, y[0])
     }
@@ -241,7 +274,7 @@ impl Ctx<'_, '_> {
             }
             // dσ/ds: the contact point's velocity relative to the fence, along the fence.
             Feat::FenceVertex(_) | Feat::FenceEdge(_) => {
-                self.fence_geom().e.dot(vp.rotate(y[0]) - self.vdir)
+                self.fence_geom().e.dot(self.to_world(vp, y[0]) - self.vdir)
             }
         };
         [om, dq]
@@ -328,7 +361,7 @@ impl Ctx<'_, '_> {
                 let f = self.fence_geom();
                 let m = self.poly.len();
                 let v = self.poly.vertex(k);
-                let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
+                let dist = |j: usize| self.to_world(self.poly.vertex(j) - v, y[0]).dot(f.n);
                 e5 = y[1];
                 e6 = f.len - y[1];
                 (dist(k + m - 1), dist(k + 1))
@@ -376,8 +409,8 @@ impl Ctx<'_, '_> {
             pose: Pose::new(pose.x * k, pose.y * k, pose.theta),
             pin_centre: self.pin_at(s) * k,
             contact_point: pose.apply(g.p) * k,
-            force: inst.force.rotate(y[0]) * self.mu_s,
-            normal: g.n.rotate(y[0]),
+            force: self.to_world(inst.force, y[0]) * self.mu_s,
+            normal: self.to_world(g.n, y[0]),
             rotation_rate: inst.twist[2] / k,
             mode: inst.mode,
             feature: feat.public(),
@@ -403,14 +436,14 @@ pub(super) fn initial_state(
         }
         Feature::Vertex { index } => {
             let n_part = if ctx.rho > 0.0 {
-                normal_world.rotate(-theta)
+                ctx.to_part(normal_world, theta)
             } else {
                 // Point pin: the ρ → 0 limit of a disc arriving along its path: the normal is the
                 // direction of travel, clamped into the vertex's normal cone.
                 let m = ctx.poly.len();
                 let na = ctx.poly.inward_normal(index + m - 1);
                 let nb = ctx.poly.inward_normal(index);
-                let d = ctx.vdir.rotate(-theta).normalized();
+                let d = ctx.to_part(ctx.vdir, theta).normalized();
                 if na.cross(d) >= 0.0 && d.cross(nb) >= 0.0 {
                     d
                 } else if d.dot(na) >= d.dot(nb) {
@@ -453,4 +486,53 @@ pub(super) fn second_contact(ctx: &Ctx, feat: Feat, pose: &Pose, s: f64) -> bool
         }
     }
     false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::part_from_spec;
+    use crate::mechanics::part_model::Support;
+
+    /// Turning by ±θ through the context's remembered sine and cosine gives the bits of
+    /// `Vec2::rotate(±θ)`, whether θ repeats (remembered) or changes (computed), so that the
+    /// contact's answers do not depend on the cache.
+    #[test]
+    fn turns_by_the_remembered_angle_equal_rotate_bit_for_bit() {
+        let model =
+            PartModel::new(&part_from_spec("tripoly2").unwrap(), &Support::Uniform).unwrap();
+        let settings = ContactSettings::default();
+        let ctx = Ctx::new(
+            &model,
+            model.polygon(),
+            &settings,
+            0.5,
+            0.0,
+            Vec2::new(-1.0, 0.0),
+            Vec2::new(0.0, 0.0),
+            None,
+            None,
+        );
+        let v = Vec2::new(0.37, -1.21);
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        for k in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let scale = [1e-9, 1e-3, 1.0, 40.0][k % 4];
+            let theta = ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * scale;
+            for _ in 0..2 {
+                let (w, p) = (ctx.to_world(v, theta), ctx.to_part(v, theta));
+                let (rw, rp) = (v.rotate(theta), v.rotate(-theta));
+                assert_eq!(
+                    (w.x.to_bits(), w.y.to_bits()),
+                    (rw.x.to_bits(), rw.y.to_bits())
+                );
+                assert_eq!(
+                    (p.x.to_bits(), p.y.to_bits()),
+                    (rp.x.to_bits(), rp.y.to_bits())
+                );
+            }
+        }
+    }
 }

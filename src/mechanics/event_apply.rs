@@ -162,7 +162,7 @@ pub(super) fn sweep(ctx: &Ctx, k: usize, left: bool, theta: f64) -> Option<(Feat
         (k % m, 0.0)
     };
     let n = ctx.poly.inward_normal(edge);
-    let v_pin = ctx.vdir.rotate(-theta);
+    let v_pin = ctx.to_part(ctx.vdir, theta);
     if n.dot(v_pin) / v_pin.norm() <= 1e-12 {
         None
     } else {
@@ -236,7 +236,7 @@ pub(super) fn settle(ctx: &mut Ctx, s: f64, mut feat: Feat, mut y: [f64; 2]) -> 
 /// vertex it runs towards along the edge reflex?
 fn reflex_ahead(ctx: &Ctx, k: usize, theta: f64) -> bool {
     let (a, b) = ctx.poly.edge(k);
-    let towards_b = (b - a).dot(ctx.vdir.rotate(-theta)) > 0.0;
+    let towards_b = (b - a).dot(ctx.to_part(ctx.vdir, theta)) > 0.0;
     let m = ctx.poly.len();
     let v = if towards_b { (k + 1) % m } else { k };
     !ctx.poly.vertex_is_convex(v)

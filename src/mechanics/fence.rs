@@ -168,8 +168,8 @@ impl Ctx<'_, '_> {
     /// (lo, hi, where the force line meets the fence).
     pub(super) fn flush_interval(&self, k: usize, y: [f64; 2], force_dir: Vec2) -> (f64, f64, f64) {
         let f = self.fence_geom();
-        let vk = self.poly.vertex(k).rotate(y[0]);
-        let other = (self.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
+        let vk = self.to_world(self.poly.vertex(k), y[0]);
+        let other = (self.to_world(self.poly.vertex(k + 1), y[0]) - vk).dot(f.e);
         let lo = other.min(0.0).max(-y[1]);
         let hi = other.max(0.0).min(f.len - y[1]);
         // Centroid relative to vertex k is −vk; the line c + λ·dir meets the fence line (through
@@ -196,11 +196,11 @@ impl Ctx<'_, '_> {
             Mode::Stick => (self.vdir.normalized(), self.vdir),
         };
         let (lo, hi, meet) = self.flush_interval(k, y, dir);
-        let v = v_world.rotate(-y[0]);
+        let v = self.to_part(v_world, y[0]);
         Instant {
             mode,
             twist: [v.x, v.y, 0.0],
-            force: dir.rotate(-y[0]),
+            force: self.to_part(dir, y[0]),
             margins: [meet - lo, hi - meet],
         }
     }
@@ -211,7 +211,7 @@ impl Ctx<'_, '_> {
         let f = self.fence_geom();
         let m = self.poly.len();
         let v = self.poly.vertex(k);
-        let dist = |j: usize| (self.poly.vertex(j) - v).rotate(y[0]).dot(f.n);
+        let dist = |j: usize| self.to_world(self.poly.vertex(j) - v, y[0]).dot(f.n);
         if dist(k + m - 1).abs() <= 1e-9 {
             Some((k + m - 1) % m)
         } else if dist(k + 1).abs() <= 1e-9 {
@@ -258,8 +258,8 @@ impl Ctx<'_, '_> {
 pub(super) fn flush_pivot(ctx: &mut Ctx, k: usize, y: [f64; 2], hi_end: bool) -> (Feat, [f64; 2]) {
     let f = *ctx.fence_geom();
     let m = ctx.poly.len();
-    let vk = ctx.poly.vertex(k).rotate(y[0]);
-    let other = (ctx.poly.vertex(k + 1).rotate(y[0]) - vk).dot(f.e);
+    let vk = ctx.to_world(ctx.poly.vertex(k), y[0]);
+    let other = (ctx.to_world(ctx.poly.vertex(k + 1), y[0]) - vk).dot(f.e);
     let (lo, hi, _) = ctx.flush_interval(k, y, f.n);
     let end = if hi_end { hi } else { lo };
     if end == 0.0 {
