@@ -510,3 +510,24 @@ fn a_part_the_pin_never_releases_is_a_jam() {
     assert_eq!(r.summary.outcomes.jam, 3, "{:?}", r.summary.outcomes);
     assert!(r.summary.latency_s.is_none(), "no part reached the end");
 }
+
+/// A free part casts its path only towards the obstacles that can come first: once a touch is
+/// found, an obstacle whose near side lies farther ahead than that touch is skipped. On the
+/// quickstart line (three pins in a row; the first two push every part, the third two parts in
+/// three) a part casts once on arrival (towards the first pin) and once after each of the first
+/// two pins (towards the next): three casts, where casting towards every pin in reach would make
+/// six.
+#[test]
+fn a_free_part_casts_only_towards_the_obstacle_it_can_reach_first() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/quickstart.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = scenario::parse(Path::new(path), &text).unwrap();
+    let opts = RunOptions {
+        parts: 200,
+        ..RunOptions::from_scene(&s)
+    };
+    let r = engine::run(&s, &opts, &mut |_| {}).unwrap();
+    assert_eq!(r.summary.outcomes.success, 200);
+    assert!(r.summary.contacts_per_part > 2.0);
+    assert_eq!(r.summary.work.ray_casts, 3 * 200);
+}

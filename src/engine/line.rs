@@ -317,8 +317,14 @@ impl Line<'_> {
                 continue;
             }
             // Out of lateral reach, or already behind the part: the obstacle's path misses it.
-            let ([_, x_max], [y_min, y_max]) = (ob.x_range(), ob.y_range());
+            let ([x_min, x_max], [y_min, y_max]) = (ob.x_range(), ob.y_range());
             if y_min > pose.y + a || y_max < pose.y - a || x_max < pose.x - a {
+                continue;
+            }
+            // Farther ahead than the earliest touch found so far: the part must ride at least
+            // x_min − (x + a) of belt before it can touch (an obstacle moves across the belt
+            // only), so this one cannot come first, nor tie.
+            if best.is_some_and(|(b, _)| x_min - (pose.x + a) > b) {
                 continue;
             }
             self.metrics.work.ray_casts += 1;
