@@ -531,3 +531,45 @@ fn a_free_part_casts_only_towards_the_obstacle_it_can_reach_first() {
     assert!(r.summary.contacts_per_part > 2.0);
     assert_eq!(r.summary.work.ray_casts, 3 * 200);
 }
+
+/// `pinfeed run` says what the exact model's tables cost to build in the run (slide tables, stick
+/// cells and the evaluations they took); a scene on a closed-form fidelity builds none and the
+/// line is absent.
+#[test]
+fn the_run_table_reports_the_tables_the_exact_model_built() {
+    let quickstart = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/quickstart.toml");
+    let out = tmpdir("tables-line");
+    let text = |file: &str| {
+        let o = pinfeed(&["run", file, "--parts", "30", "--out", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let exact = text(quickstart);
+    let line = exact
+        .lines()
+        .find(|l| l.starts_with("exact model's tables"))
+        .unwrap_or_else(|| panic!("no tables line:\n{exact}"));
+    let numbers: Vec<u64> = line
+        .split(|c: char| !c.is_ascii_digit())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    // slide tables, nodes, stick cells, pieces, left to the solver, evaluations.
+    assert_eq!(numbers.len(), 6, "{line}");
+    assert!(
+        numbers[0] > 0 && numbers[1] > 0 && numbers[2] > 0 && numbers[5] > 0,
+        "{line}"
+    );
+    let tip_file = out.join("tip.toml");
+    let tip = std::fs::read_to_string(quickstart).unwrap().replace(
+        "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"",
+        "fidelity = \"tip\"",
+    );
+    assert!(tip.contains("fidelity = \"tip\""));
+    std::fs::write(&tip_file, tip).unwrap();
+    let closed = text(tip_file.to_str().unwrap());
+    assert!(closed.contains("simulator speed"), "{closed}");
+    assert!(
+        !closed.contains("exact model's tables"),
+        "a tip scene builds no table:\n{closed}"
+    );
+}

@@ -163,8 +163,30 @@ pub fn run(args: &RunArgs) -> Result<()> {
         text.push_str(&format!(
             "simulator speed           {parts_per_s:.0} parts/s, {contacts_per_s:.0} contacts/s ({wall:.2} s wall)\n"
         ));
+        text.push_str(&tables_line(&scene.part.model));
         text.push_str(&maps);
         text.push_str(&format!("results                   {}\n", dir.display()));
     }
     super::stdout::print_result(&text)
+}
+
+/// What the exact model's tables built during the run (they are built on first use and serve
+/// every later contact; the line's own work counters leave them out): nothing for a model without
+/// tables (tip or ellipsoid fidelity, a part with its own tripod).
+fn tables_line(model: &crate::mechanics::PartModel) -> String {
+    let (Some(slide), Some(stick)) = (model.slide_table_stats(), model.stick_table_stats()) else {
+        return String::new();
+    };
+    if slide.tables == 0 && stick.cells == 0 {
+        return String::new();
+    }
+    format!(
+        "exact model's tables      {} slide tables ({} nodes), {} stick cells ({} pieces, {} left to the solver); {} evaluations to build\n",
+        slide.tables,
+        slide.nodes,
+        stick.cells,
+        stick.pieces,
+        stick.open,
+        slide.evaluations + stick.evaluations
+    )
 }
