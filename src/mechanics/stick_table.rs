@@ -487,6 +487,77 @@ mod tests {
         })
     }
 
+    /// The interpolant through the Lobatto points reproduces any polynomial of degree ≤ DEGREE in
+    /// each variable (to rounding), and its coefficients are the polynomial's Chebyshev ones.
+    #[test]
+    fn the_interpolant_reproduces_tensor_polynomials() {
+        let f = |x: f64, y: f64| {
+            let (tx, ty) = (chebyshev(x), chebyshev(y));
+            [
+                0.5 + tx[3] * ty[7],
+                -2.0 * tx[DEGREE] * ty[1] + x * y,
+                tx[5] * ty[DEGREE] - 0.25 * y,
+            ]
+        };
+        let xs = lobatto();
+        let vals: [[[f64; 3]; NP]; NP] =
+            std::array::from_fn(|i| std::array::from_fn(|j| f(xs[i], xs[j])));
+        let coef = coefficients(&vals);
+        assert!((coef[0][0][0] - 0.5).abs() < 1e-14 && (coef[3][7][0] - 1.0).abs() < 1e-14);
+        assert!((coef[DEGREE][1][1] + 2.0).abs() < 1e-14 && (coef[1][1][1] - 1.0).abs() < 1e-14);
+        assert!((coef[5][DEGREE][2] - 1.0).abs() < 1e-14 && (coef[0][1][2] + 0.25).abs() < 1e-14);
+        let piece = Piece {
+            l0: 2.0,
+            b0: -1.0,
+            hl: 0.5,
+            hb: 0.25,
+            coef: Box::new(coef),
+            hess: [[0.0; 3]; 3],
+        };
+        for k in 0..50 {
+            let (x, y) = (
+                ((k as f64 * 0.618_033_988_7) % 1.0) * 2.0 - 1.0,
+                ((k as f64 * 0.754_877_666_2) % 1.0) * 2.0 - 1.0,
+            );
+            let (ell, b) = (2.0 + 0.5 * (x + 1.0) * 0.5, -1.0 + 0.5 * (y + 1.0) * 0.25);
+            let (lx, ly) = piece.local(ell, b);
+            let (got, want) = (piece.eval(lx, ly), f(x, y));
+            for c in 0..3 {
+                assert!((got[c] - want[c]).abs() < 1e-13, "{k}: {got:?} {want:?}");
+            }
+        }
+    }
+
+    /// Mirror symmetry: tripoly1 is symmetric about the y axis, which maps edge 1 onto edge 2 (ℓ
+    /// measured from the other end) and a pin velocity at angle b from edge 1's normal onto one at
+    /// −b from edge 2's. The mirrored stick has vx, ω and Fx reversed, vy and Fy kept.
+    #[test]
+    fn mirrored_sticks_have_mirrored_tables() {
+        let m = plain("tripoly1").with_tables(&[0.5]);
+        let poly = m.polygon().clone();
+        let l1 = poly.edge_len(1);
+        assert!((l1 - poly.edge_len(2)).abs() < 1e-12);
+        let mut compared = 0;
+        for (ell, b) in probes(l1, 60) {
+            let mirror = |v: Vec2| Vec2::new(-v.x, v.y);
+            let v = velocity(&m, 1, b, 0.7);
+            let (Some((a, _)), Some((c, _))) = (
+                m.tabled_stick(1, ell, v),
+                m.tabled_stick(2, l1 - ell, mirror(v)),
+            ) else {
+                continue;
+            };
+            compared += 1;
+            let (sa, sc) = (a.twist, c.twist);
+            assert!((sa[0] + sc[0]).abs() < 1e-9, "{a:?} {c:?}");
+            assert!((sa[1] - sc[1]).abs() < 1e-9, "{a:?} {c:?}");
+            assert!((sa[2] + sc[2]).abs() < 1e-9, "{a:?} {c:?}");
+            assert!((a.wrench[0] + c.wrench[0]).abs() < 1e-9, "{a:?} {c:?}");
+            assert!((a.wrench[1] - c.wrench[1]).abs() < 1e-9, "{a:?} {c:?}");
+        }
+        assert!(compared >= 50, "{compared}");
+    }
+
     /// Where the table serves, its twist and force are those of a converged solve to about
     /// STICK_TOL; and it serves nearly everywhere in its range.
     #[test]
