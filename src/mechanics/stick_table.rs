@@ -28,11 +28,14 @@
 //! of a geometrically converging series to within a small factor) and (b) its disagreement with
 //! full solves (converged to the solver's own limit) at the four points (±½, ±½) of the cell — not
 //! interpolation points — are both below [`STICK_TOL`] relative to the cell's smallest twist and
-//! force. Otherwise the cell is split in four, down to [`MAX_DEPTH`] levels; a piece not certified
-//! there, a query outside the table's range, and a piece whose points cannot all be solved are
-//! left to the solver. [`STICK_TOL`] is the accuracy of a live stick solve at the default
-//! tolerance (its last Newton step is taken unevaluated: `part_model::final_gap`), as for the slide
-//! tables.
+//! force. Otherwise the cell is split in four, down to [`MAX_DEPTH`] levels, as long as each
+//! halving cuts the tail by [`SPLIT_GAIN`] or more: the tail falls geometrically where the
+//! function is analytic, only algebraically across a kink, where halving further would cost 125
+//! solves a piece for answers the solver gives anyway (stopping there halves the build of a
+//! planner's tables, at no cost in a line's speed). A piece not certified, a query outside the
+//! table's range, and a piece whose points cannot all be solved are left to the solver.
+//! [`STICK_TOL`] is the accuracy of a live stick solve at the default tolerance (its last Newton
+//! step is taken unevaluated: `part_model::final_gap`), as for the slide tables.
 //!
 //! **Pure translations are solved.** A stick whose Ω is within [`TRANSLATION_BAND`] of zero (a push
 //! through the centroid, an equilibrium the part may ride) is left to the solver: there the sign
@@ -66,6 +69,10 @@ pub const B_REACH: f64 = 0.6 * PI;
 pub const DEGREE: usize = 10;
 /// Levels of four-way splitting below a grid cell before a piece is left to the solver.
 pub const MAX_DEPTH: u32 = 3;
+
+/// How much halving a piece must cut its tail for its halves to be halved again (see
+/// `Builder::refine`).
+pub const SPLIT_GAIN: f64 = 16.0;
 
 const NP: usize = DEGREE + 1;
 
@@ -197,7 +204,7 @@ impl EdgeTable {
             };
             let l0 = self.l_lo + i as f64 * self.cell_l;
             let b0 = -B_REACH + j as f64 * self.cell_b;
-            let cell = builder.refine(l0, b0, self.cell_l, self.cell_b, 0);
+            let cell = builder.refine(l0, b0, self.cell_l, self.cell_b, 0, f64::INFINITY);
             spent.fetch_add(builder.evaluations, Ordering::Relaxed);
             cell
         })
@@ -289,13 +296,20 @@ impl Builder<'_> {
         })
     }
 
-    /// The piece over [l0, l0 + hl] × [b0, b0 + hb], or its refinement.
-    fn refine(&mut self, l0: f64, b0: f64, hl: f64, hb: f64, depth: u32) -> Cell {
+    /// The piece over [l0, l0 + hl] × [b0, b0 + hb], or its refinement. `parent_tail` is the
+    /// tail of the piece this one halves (relative to the certificate's bound; infinite for a
+    /// grid cell).
+    fn refine(&mut self, l0: f64, b0: f64, hl: f64, hb: f64, depth: u32, parent_tail: f64) -> Cell {
         match self.piece(l0, b0, hl, hb) {
-            Some((piece, true)) => Cell::Piece(piece),
+            Some((piece, true, _)) => Cell::Piece(piece),
             None => Cell::Open,
-            Some((_, false)) if depth >= MAX_DEPTH => Cell::Open,
-            Some(_) => {
+            Some((_, false, _)) if depth >= MAX_DEPTH => Cell::Open,
+            // Where the function is analytic, halving a piece cuts its tail by far more than
+            // SPLIT_GAIN (geometric convergence in the degree, faster as the piece shrinks);
+            // across a kink the tail falls only algebraically, and halving further would spend
+            // 125 solves a piece on what the solver answers anyway.
+            Some((_, false, tail)) if tail * SPLIT_GAIN > parent_tail => Cell::Open,
+            Some((_, false, tail)) => {
                 let (hl2, hb2) = (0.5 * hl, 0.5 * hb);
                 let quads = [
                     (l0, b0),
@@ -305,15 +319,17 @@ impl Builder<'_> {
                 ];
                 Cell::Split {
                     mid: (l0 + hl2, b0 + hb2),
-                    quads: Box::new(quads.map(|(l, b)| self.refine(l, b, hl2, hb2, depth + 1))),
+                    quads: Box::new(
+                        quads.map(|(l, b)| self.refine(l, b, hl2, hb2, depth + 1, tail)),
+                    ),
                 }
             }
         }
     }
 
-    /// The interpolant over the rectangle and whether it is certified; `None` when a point cannot
-    /// be solved.
-    fn piece(&mut self, l0: f64, b0: f64, hl: f64, hb: f64) -> Option<(Piece, bool)> {
+    /// The interpolant over the rectangle, whether it is certified, and its tail (its largest
+    /// highest coefficient over the certificate's bound); `None` when a point cannot be solved.
+    fn piece(&mut self, l0: f64, b0: f64, hl: f64, hb: f64) -> Option<(Piece, bool, f64)> {
         let xs = lobatto();
         let at = |x: f64, h: f64, o: f64| o + 0.5 * (x + 1.0) * h;
         let mut vals = [[[0.0; 3]; NP]; NP];
@@ -350,12 +366,16 @@ impl Builder<'_> {
             .iter()
             .map(|&l| (self.table.a + self.table.e * l).norm())
             .fold(1.0f64, f64::max);
-        let within = |d: [f64; 3]| {
-            d[0].abs() * q_max <= STICK_TOL * twist_min && d[1].hypot(d[2]) <= STICK_TOL * force_min
+        // A difference (ΔΩ, ΔFx, ΔFy) over the certificate's bound (≤ 1 passes).
+        let ratio = |d: [f64; 3]| {
+            (d[0].abs() * q_max / (STICK_TOL * twist_min))
+                .max(d[1].hypot(d[2]) / (STICK_TOL * force_min))
         };
-        let tail_ok =
-            (0..NP).all(|k| within(piece.coef[k][DEGREE]) && within(piece.coef[DEGREE][k]));
-        let mut ok = tail_ok;
+        let within = |d: [f64; 3]| ratio(d) <= 1.0;
+        let tail = (0..NP)
+            .map(|k| ratio(piece.coef[k][DEGREE]).max(ratio(piece.coef[DEGREE][k])))
+            .fold(0.0f64, f64::max);
+        let mut ok = tail <= 1.0;
         if ok {
             for (x, y) in [(-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)] {
                 let pt = self.solve(at(x, hl, l0), at(y, hb, b0), centre.as_ref())?;
@@ -363,7 +383,7 @@ impl Builder<'_> {
                 ok &= within([v[0] - pt.f[0], v[1] - pt.f[1], v[2] - pt.f[2]]);
             }
         }
-        Some((piece, ok))
+        Some((piece, ok, tail))
     }
 }
 
