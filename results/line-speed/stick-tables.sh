@@ -1,6 +1,6 @@
 #!/bin/sh
 # Before/after the stick tables (issue 15 item 1), both measured in one run:
 #   sh results/line-speed/stick-tables.sh
-# 4db9b7c (before: slide tables only) against 1789f5b (after: stick tables as well); see
+# 4db9b7c (before: slide tables only) against 7d8d287 (after: stick tables as well); see
 # compare-commits.sh.
-exec sh "$(dirname "$0")/compare-commits.sh" 4db9b7c 1789f5b
+exec sh "$(dirname "$0")/compare-commits.sh" 4db9b7c 7d8d287
