@@ -210,6 +210,24 @@ impl EdgeTable {
         })
     }
 
+    /// The certified piece holding (ℓ, b), its cell built on first use; `None` outside the range
+    /// or in a piece left to the solver.
+    fn piece_at(&self, model: &PartModel, ell: f64, b: f64, spent: &AtomicU64) -> Option<&Piece> {
+        let mut cell = self.cell(model, self.cell_index(ell, b)?, spent);
+        loop {
+            match cell {
+                Cell::Piece(p) => return Some(p),
+                Cell::Open => return None,
+                Cell::Split { mid, quads } => {
+                    let hi_l = usize::from(ell >= mid.0);
+                    let hi_b = usize::from(b >= mid.1);
+                    cell = &quads[hi_l + 2 * hi_b];
+                }
+            }
+        }
+    }
+
+    /// The stick at ℓ for pin velocity `v` (part frame) from the table, where it serves.
     fn at(&self, model: &PartModel, ell: f64, v: Vec2, spent: &AtomicU64) -> Option<Served> {
         let speed = v.norm();
         if !(speed > 0.0 && speed.is_finite()) {
@@ -222,18 +240,7 @@ impl EdgeTable {
         } else if b <= -PI {
             b += TAU;
         }
-        let mut cell = self.cell(model, self.cell_index(ell, b)?, spent);
-        let piece = loop {
-            match cell {
-                Cell::Piece(p) => break p,
-                Cell::Open => return None,
-                Cell::Split { mid, quads } => {
-                    let hi_l = usize::from(ell >= mid.0);
-                    let hi_b = usize::from(b >= mid.1);
-                    cell = &quads[hi_l + 2 * hi_b];
-                }
-            }
-        };
+        let piece = self.piece_at(model, ell, b, spent)?;
         let (x, y) = piece.local(ell, b);
         let [om, fx, fy] = piece.eval(x, y);
         let p = self.a + self.e * ell;
