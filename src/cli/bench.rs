@@ -198,12 +198,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                  `exact+tables` is the exact model with its tables (the default for a scene's, a \
                  map's and a planner's model): a pin sliding on an edge (or a disc riding a \
                  vertex) gets the exact twist from per-(μc, edge or vertex, side) tables of \
-                 certified cubic Hermite pieces (`src/mechanics/slide_table.rs`), and a pin \
-                 sticking on an edge from per-edge tables over (ℓ, direction of the pin's \
-                 velocity) of certified Chebyshev pieces (`src/mechanics/stick_table.rs`), \
-                 instead of a Newton solve. Its tables are built before the timed runs (a line \
-                 builds them on first use); the build is in the table below, with what the tables \
-                 change against the solves at the same tolerance.\n\n\
+                 certified cubic Hermite pieces (`src/mechanics/slide_table.rs`) instead of a \
+                 Newton solve. `exact+sticks` adds what a map tier's build uses: a pin sticking on \
+                 an edge gets its twist from per-edge tables over (ℓ, direction of the pin's \
+                 velocity) of certified Chebyshev pieces (`src/mechanics/stick_table.rs`). The \
+                 tables are built before the timed runs (a line or a map build builds them on \
+                 first use); the build is in the table below, with what the tables change against \
+                 the solves at the same tolerance.\n\n\
                  {table}\n### Tables (exact+tables rows)\n\n{tables}\n{targets}\n\
                  ### Cost against the vertex count (exact model, regular N-gons)\n\n\
                  One evaluation of D, ∇D and H (20 000 twists, the centre of rotation within 2a: the \

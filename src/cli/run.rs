@@ -174,19 +174,24 @@ pub fn run(args: &RunArgs) -> Result<()> {
 /// every later contact; the line's own work counters leave them out): nothing for a model without
 /// tables (tip or ellipsoid fidelity, a part with its own tripod).
 fn tables_line(model: &crate::mechanics::PartModel) -> String {
-    let (Some(slide), Some(stick)) = (model.slide_table_stats(), model.stick_table_stats()) else {
+    let Some(slide) = model.slide_table_stats() else {
         return String::new();
     };
-    if slide.tables == 0 && stick.cells == 0 {
+    let stick = model.stick_table_stats();
+    let cells = stick.map_or(0, |s| s.cells);
+    if slide.tables == 0 && cells == 0 {
         return String::new();
     }
+    let sticks = stick.map_or(String::new(), |s| {
+        format!(
+            ", {} stick cells ({} pieces, {} left to the solver)",
+            s.cells, s.pieces, s.open
+        )
+    });
     format!(
-        "exact model's tables      {} slide tables ({} nodes), {} stick cells ({} pieces, {} left to the solver); {} evaluations to build\n",
+        "exact model's tables      {} slide tables ({} nodes){sticks}; {} evaluations to build\n",
         slide.tables,
         slide.nodes,
-        stick.cells,
-        stick.pieces,
-        stick.open,
-        slide.evaluations + stick.evaluations
+        slide.evaluations + stick.map_or(0, |s| s.evaluations)
     )
 }

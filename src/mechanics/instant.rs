@@ -533,7 +533,7 @@ mod tests {
     #[test]
     fn sticks_on_edges_come_from_the_tables() {
         let plain = model("lshape");
-        let tabled = plain.clone().with_tables(&[0.8]);
+        let tabled = plain.clone().with_tables(&[0.8]).with_stick_tables();
         let poly = plain.polygon().clone();
         let run = |m: &PartModel, g: &ContactGeom| {
             let mut ev = 0;

@@ -19,7 +19,7 @@
 //! * [`slide_table`]: the exact model's sliding twists on each edge and vertex, tabulated per (μc, place,
 //!   side) for models many contacts share.
 //! * [`stick_table`]: the exact model's sticking twists on each edge, tabulated per edge over (ℓ,
-//!   direction of the pin's velocity) for the same models.
+//!   direction of the pin's velocity), for a map tier's build.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!
 //! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
@@ -61,5 +61,5 @@ pub use vote::mason_vote;
 /// older model is rebuilt, not reused.
 ///
 /// * 1: the exact model with slide tables on edges and vertices (up to `4db9b7c`).
-/// * 2: stick tables on edges.
+/// * 2: stick tables on edges in a map tier's build.
 pub const MODEL_VERSION: u32 = 2;

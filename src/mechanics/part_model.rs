@@ -301,7 +301,7 @@ pub struct PartModel {
     /// The exact model's slide tables, for the μc values given to
     /// [`PartModel::with_tables`] (shared by clones: their content depends only on the part).
     slide_tables: Option<Arc<SlideTables>>,
-    /// The exact model's stick tables (any μc), made with the slide tables.
+    /// The exact model's stick tables (any μc), when asked for ([`PartModel::with_stick_tables`]).
     stick_tables: Option<Arc<StickTables>>,
 }
 
@@ -361,8 +361,7 @@ impl PartModel {
     }
 
     /// Serve the exact model's slides from tables (`mechanics::slide_table`) for contacts with
-    /// these μc values, and its sticks on edges from tables at any μc (`mechanics::stick_table`):
-    /// for a model that many contacts share (a scene's, a planner's, a map's). Only uniform
+    /// these μc values: for a model that many contacts share (a scene's, a planner's, a map's). Only uniform
     /// pressure is tabulated; a model with point supports (a part's own tripod, used for a few
     /// contacts) is returned unchanged. Slides at another μc, and the tip and ellipsoid
     /// fidelities, solve as before.
@@ -370,6 +369,18 @@ impl PartModel {
         if matches!(self.support, SupportData::Uniform(_)) {
             let tables = SlideTables::new(self.poly.len(), mu_values);
             self.slide_tables = (!tables.is_empty()).then(|| Arc::new(tables));
+        }
+        self
+    }
+
+    /// Also serve the exact model's sticks on edges from tables at any μc
+    /// (`mechanics::stick_table`): for a batch of contacts large enough to pay for the cells it
+    /// visits (a map tier's build). A stick cell costs ~10³ evaluations to build and saves ~1.7 per
+    /// stick it serves, so a line of a few thousand parts, or of a part with many edges, runs
+    /// slower with them (`results/line-speed.md`, "Stick tables"); scenes and the planner do not
+    /// use them. Only uniform pressure is tabulated, as for [`PartModel::with_tables`].
+    pub fn with_stick_tables(mut self) -> PartModel {
+        if matches!(self.support, SupportData::Uniform(_)) {
             self.stick_tables = Some(Arc::new(StickTables::new(self.poly.len())));
         }
         self

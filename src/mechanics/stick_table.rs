@@ -12,6 +12,11 @@
 //! and F depend neither on μc nor on the part's orientation or the belt: one table per edge serves
 //! every stick on it, at any μc.
 //!
+//! **Who builds them.** A cell costs about 10³ evaluations and saves about 1.7 per stick it serves;
+//! a map tier's build (about 10⁵ exact pushes of one part) pays for them many times over, a line
+//! of a few thousand parts or of a part with many edges does not (`results/line-speed.md`). They
+//! are made by [`PartModel::with_stick_tables`], which the map tier's build calls.
+//!
 //! **The table** covers ℓ from [`EDGE_REACH`] of the edge's length before its start to as much
 //! past its end (the integrator's stages overshoot an edge's end inside the step that lands there)
 //! and |b| ≤ [`B_REACH`] (the pin pushing, n·v > 0, and a margin for stages beyond). It is a grid
@@ -560,7 +565,7 @@ mod tests {
     /// −b from edge 2's. The mirrored stick has vx, ω and Fx reversed, vy and Fy kept.
     #[test]
     fn mirrored_sticks_have_mirrored_tables() {
-        let m = plain("tripoly1").with_tables(&[0.5]);
+        let m = plain("tripoly1").with_tables(&[0.5]).with_stick_tables();
         let poly = m.polygon().clone();
         let l1 = poly.edge_len(1);
         assert!((l1 - poly.edge_len(2)).abs() < 1e-12);
@@ -591,7 +596,7 @@ mod tests {
     fn tables_agree_with_converged_solves_where_they_serve() {
         let (mut worst, mut served, mut asked) = (0.0f64, 0, 0);
         for name in ["tripoly1", "lshape", "ngon:7"] {
-            let m = plain(name).with_tables(&[0.5]);
+            let m = plain(name).with_tables(&[0.5]).with_stick_tables();
             let poly = m.polygon().clone();
             for k in 0..poly.len() {
                 for (ell, b) in probes(poly.edge_len(k), 40) {
@@ -626,8 +631,8 @@ mod tests {
     #[test]
     fn served_sticks_are_pure_functions_of_the_query() {
         let (a, b) = (
-            plain("tripoly2").with_tables(&[0.3]),
-            plain("tripoly2").with_tables(&[0.7]),
+            plain("tripoly2").with_tables(&[0.3]).with_stick_tables(),
+            plain("tripoly2").with_stick_tables(),
         );
         let poly = a.polygon().clone();
         let queries: Vec<(usize, f64, Vec2)> = (0..poly.len())
@@ -674,6 +679,9 @@ mod tests {
         assert!(a.tabled_stick(0, f64::NAN, v).is_none());
         assert!(a.tabled_stick(poly.len(), 0.5 * len, v).is_none());
         assert!(plain("tripoly2").tabled_stick(0, 0.5 * len, v).is_none());
+        // A scene's model (slide tables only) has none.
+        let scene_model = plain("tripoly2").with_tables(&[0.5]);
+        assert!(scene_model.tabled_stick(0, 0.5 * len, v).is_none());
     }
 
     /// Where the centre of rotation crosses the part's boundary the stick twist is not smooth
@@ -681,7 +689,7 @@ mod tests {
     /// of the table is certified.
     #[test]
     fn pieces_across_a_kink_are_left_to_the_solver() {
-        let m = plain("tripoly2").with_tables(&[0.5]);
+        let m = plain("tripoly2").with_stick_tables();
         m.build_all_tables();
         let st = m.stick_table_stats().unwrap();
         assert_eq!(st.cells, m.polygon().len() * CELLS_L * CELLS_B);

@@ -6,7 +6,7 @@
 //!
 //! * `tip` and `ellipsoid` at the default tolerance (model error dominates);
 //! * `exact` at tolerances 1e-3 … 1e-8 (integration error only);
-//! * `exact+tables` at 1e-4, 1e-6, 1e-8: the exact model with its slide and stick tables
+//! * `exact+tables` at 1e-4, 1e-6, 1e-8: the exact model with its slide tables
 //!   (`mechanics::slide_table`, built before the timing), as a scene's model runs;
 //! * `map` — a precomputed configuration map of the exact model (1° × 0.05 grid in θ0 × d) read by
 //!   nearest grid point: the fastest tier, whose error is the map's resolution across band edges.
@@ -92,7 +92,7 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
             });
         }
     }
-    // The exact model with its slide and stick tables (built here, before any timing).
+    // The exact model with its slide tables (built here, before any timing).
     let mu_c = ContactSettings::default().mu_c;
     let tabled: Vec<PartModel> = models
         .iter()
@@ -387,10 +387,10 @@ pub fn report_markdown(st: &AccuracyStudy, cmd: &str) -> String {
     let tabled_default = st.rows.iter().find(|r| r.tier == "exact+tables tol=1e-6");
     if let (Some(t), Some(ex)) = (tabled_default, exact_default) {
         s.push_str(&format!(
-            "- **exact+tables** (the exact model with its slide and stick tables, as a scene's, a \
+            "- **exact+tables** (the exact model with its slide tables, as a scene's, a \
              map's and a planner's model run): at 1e-6 {:.1} µs median ({:.1}× faster than the \
              solves), {:.0} evaluations per contact, error mean {:.1e}°, max {:.1e}°: the same \
-             accuracy, since a table serves a slide or a stick to 1e-10 of its converged solve.\n",
+             accuracy, since a table serves a slide to 1e-10 of its converged solve.\n",
             t.median_us,
             ex.median_us / t.median_us.max(1e-9),
             t.mean_evaluations,

@@ -31,7 +31,7 @@ pub struct ContactCostRow {
     pub self_error_max_deg: f64,
     /// Contacts whose status was not ok, by status name.
     pub non_ok: Vec<(String, usize)>,
-    /// The slide and stick tables (`exact+tables` rows only).
+    /// The tables (`exact+tables` and `exact+sticks` rows only).
     pub tables: Option<TableCost>,
 }
 
@@ -43,7 +43,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[idx]
 }
 
-/// The exact model's slide and stick tables in a [`ContactCostRow`] of model `exact+tables`.
+/// The exact model's tables in a [`ContactCostRow`] of model `exact+tables` or `exact+sticks`.
 #[derive(Debug, Clone, Serialize)]
 pub struct TableCost {
     /// Wall time to build every slide table (edge or vertex, side) of the part at μc and every
@@ -109,6 +109,13 @@ pub fn measure(
                 tabled.build_all_tables();
                 let build_ms = t0.elapsed().as_secs_f64() * 1e3;
                 rows.push(bench.row(&tabled, "exact+tables", Some((&model, build_ms))));
+                // With stick tables as well (as a map tier's build has them), every cell built
+                // before the timed runs.
+                let sticks = tabled.clone().with_stick_tables();
+                let t0 = Instant::now();
+                sticks.build_all_tables();
+                let build_ms = t0.elapsed().as_secs_f64() * 1e3;
+                rows.push(bench.row(&sticks, "exact+sticks", Some((&model, build_ms))));
             }
         }
     }
@@ -413,14 +420,14 @@ pub fn targets(rows: &[ContactCostRow], scaling: &[ScalingRow]) -> String {
         medians("exact").join(", "),
         if worst("exact") <= 20.0 { "yes" } else { "no" },
         if tabled {
+            let met = |fid: &str| if worst(fid) <= 20.0 { "yes" } else { "no" };
             format!(
-                "| exact ≤ 20 µs median per contact (slides from the tables) | {} µs | {} |\n",
+                "| exact ≤ 20 µs median per contact (slides from the tables: a scene's model) | {} µs | {} |\n\
+                 | exact ≤ 20 µs median per contact (slides and sticks from the tables: a map build's model) | {} µs | {} |\n",
                 medians("exact+tables").join(", "),
-                if worst("exact+tables") <= 20.0 {
-                    "yes"
-                } else {
-                    "no"
-                }
+                met("exact+tables"),
+                medians("exact+sticks").join(", "),
+                met("exact+sticks"),
             )
         } else {
             String::new()

@@ -200,6 +200,12 @@ fn fill(cells: &[Cell], at: &mut BTreeMap<u64, Sample>, inputs: &TierInputs, lat
 
 /// Build the map of `inputs` (deterministic; parallel over samples).
 pub fn build(inputs: &TierInputs) -> TierMap {
+    // A map's build is a batch of ~10⁵ exact pushes over one part: its sticks pay for stick tables.
+    let model = inputs.model.clone().with_stick_tables();
+    let inputs = &TierInputs {
+        model: &model,
+        ..*inputs
+    };
     let spec = inputs.spec;
     let per_cell = 1u64 << (spec.max_depth + 2);
     let (nt, nd) = (u64::from(spec.theta_cells), u64::from(spec.d_cells));
