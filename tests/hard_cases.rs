@@ -617,7 +617,7 @@ fn force_line_through_an_edge_end_does_not_crawl() {
     let unit = pinfeed::geometry::part_from_spec("random:18").unwrap();
     let part = unit.scaled(0.02);
     let plain = PartModel::new(&part, &Support::Uniform).unwrap();
-    let tabled = plain.clone().with_tables(&[0.5]);
+    let tabled = plain.clone().with_slide_tables(&[0.5]);
     let pin = Pin {
         radius: 0.002,
         ..Pin::point()

@@ -32,7 +32,7 @@ fn contacts_with_tables_match_the_solves_they_replace() {
         let a = poly.radius();
         let plain = PartModel::new(&poly, &Support::Uniform).unwrap();
         for mu_c in [0.0, 0.5, 1.0] {
-            let tabled = plain.clone().with_tables(&[mu_c]);
+            let tabled = plain.clone().with_slide_tables(&[mu_c]);
             let settings = ContactSettings {
                 fidelity: Fidelity::Exact,
                 mu_c,
@@ -112,7 +112,7 @@ fn other_fidelities_and_other_mu_build_and_use_no_table() {
     let a = poly.radius();
     let tabled = PartModel::new(&poly, &Support::Uniform)
         .unwrap()
-        .with_tables(&[0.5]);
+        .with_slide_tables(&[0.5]);
     for (fid, mu_c) in [
         (Fidelity::Tip, 0.5),
         (Fidelity::Ellipsoid, 0.5),
@@ -228,7 +228,7 @@ fn the_work_budget_bounds_a_pass_the_tables_serve() {
     let a = poly.radius();
     let tabled = PartModel::new(&poly, &Support::Uniform)
         .unwrap()
-        .with_tables(&[0.0]);
+        .with_slide_tables(&[0.0]);
     // Frictionless: every instant is a slide, and the tables serve nearly all of them.
     let free = ContactSettings {
         mu_c: 0.0,

@@ -314,7 +314,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
     let (contact, pin) = settings_and_pin(&template);
     // Every pass of the maps shares the model: its exact slides come from tables.
-    let part_model = part_model.with_tables(&[contact.mu_c]);
+    let part_model = part_model.with_slide_tables(&[contact.mu_c]);
     let settings = MapSettings {
         theta_step_deg: args.theta_step,
         threshold_deg: args.threshold,

@@ -459,7 +459,7 @@ mod tests {
     #[test]
     fn slides_on_edges_and_vertices_come_from_the_tables() {
         let plain = model("tripoly1");
-        let tabled = plain.clone().with_tables(&[0.5]);
+        let tabled = plain.clone().with_slide_tables(&[0.5]);
         let poly = plain.polygon().clone();
         for k in 0..poly.len() {
             let (na, nb) = (
@@ -533,7 +533,7 @@ mod tests {
     #[test]
     fn sticks_on_edges_come_from_the_tables() {
         let plain = model("lshape");
-        let tabled = plain.clone().with_tables(&[0.8]).with_stick_tables();
+        let tabled = plain.clone().with_slide_tables(&[0.8]).with_stick_tables();
         let poly = plain.polygon().clone();
         let run = |m: &PartModel, g: &ContactGeom| {
             let mut ev = 0;

@@ -299,7 +299,7 @@ pub struct PartModel {
     /// m_max / f_max of the ellipsoid approximation (normalised units).
     c_ellipsoid: f64,
     /// The exact model's slide tables, for the μc values given to
-    /// [`PartModel::with_tables`] (shared by clones: their content depends only on the part).
+    /// [`PartModel::with_slide_tables`] (shared by clones: their content depends only on the part).
     slide_tables: Option<Arc<SlideTables>>,
     /// The exact model's stick tables (any μc), when asked for ([`PartModel::with_stick_tables`]).
     stick_tables: Option<Arc<StickTables>>,
@@ -365,7 +365,7 @@ impl PartModel {
     /// pressure is tabulated; a model with point supports (a part's own tripod, used for a few
     /// contacts) is returned unchanged. Slides at another μc, and the tip and ellipsoid
     /// fidelities, solve as before.
-    pub fn with_tables(mut self, mu_values: &[f64]) -> PartModel {
+    pub fn with_slide_tables(mut self, mu_values: &[f64]) -> PartModel {
         if matches!(self.support, SupportData::Uniform(_)) {
             let tables = SlideTables::new(self.poly.len(), mu_values);
             self.slide_tables = (!tables.is_empty()).then(|| Arc::new(tables));
@@ -378,7 +378,7 @@ impl PartModel {
     /// visits (a map tier's build). A stick cell costs ~10³ evaluations to build and saves ~1.7 per
     /// stick it serves, so a line of a few thousand parts, or of a part with many edges, runs
     /// slower with them (`results/line-speed.md`, "Stick tables"); scenes and the planner do not
-    /// use them. Only uniform pressure is tabulated, as for [`PartModel::with_tables`].
+    /// use them. Only uniform pressure is tabulated, as for [`PartModel::with_slide_tables`].
     pub fn with_stick_tables(mut self) -> PartModel {
         if matches!(self.support, SupportData::Uniform(_)) {
             self.stick_tables = Some(Arc::new(StickTables::new(self.poly.len())));

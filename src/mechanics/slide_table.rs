@@ -49,7 +49,7 @@
 //!
 //! **Opt-in, deterministic.** Tables are built lazily, one (μc, place, side) at a time, on the
 //! first slide that needs one, and only for models that ask for them with the μc values they will
-//! see ([`super::PartModel::with_tables`]: a scene's shared model, a planner's, a map's, the
+//! see ([`super::PartModel::with_slide_tables`]: a scene's shared model, a planner's, a map's, the
 //! contact benchmark's). A table's content is a fixed function of (part, μc, place, side), built
 //! in a fixed order, so which thread builds it first changes nothing; and a served solve never
 //! depends on what was solved before it. The evaluations a build spends are the table's, not the
@@ -554,7 +554,7 @@ mod tests {
     fn tabled(name: &str, mu: f64) -> PartModel {
         PartModel::new(&part_from_spec(name).unwrap(), &Support::Uniform)
             .unwrap()
-            .with_tables(&[mu])
+            .with_slide_tables(&[mu])
     }
 
     /// The converged solve the table stands for, at coordinate `t` of (place, side).
@@ -660,7 +660,7 @@ mod tests {
         let tripod = Support::parse("tripod:3", &part_from_spec("tripoly2").unwrap()).unwrap();
         let pts = PartModel::new(&part_from_spec("tripoly2").unwrap(), &tripod)
             .unwrap()
-            .with_tables(&[0.5]);
+            .with_slide_tables(&[0.5]);
         assert!(pts.slide_table_stats().is_none());
     }
 

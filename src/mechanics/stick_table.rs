@@ -565,7 +565,9 @@ mod tests {
     /// −b from edge 2's. The mirrored stick has vx, ω and Fx reversed, vy and Fy kept.
     #[test]
     fn mirrored_sticks_have_mirrored_tables() {
-        let m = plain("tripoly1").with_tables(&[0.5]).with_stick_tables();
+        let m = plain("tripoly1")
+            .with_slide_tables(&[0.5])
+            .with_stick_tables();
         let poly = m.polygon().clone();
         let l1 = poly.edge_len(1);
         assert!((l1 - poly.edge_len(2)).abs() < 1e-12);
@@ -596,7 +598,7 @@ mod tests {
     fn tables_agree_with_converged_solves_where_they_serve() {
         let (mut worst, mut served, mut asked) = (0.0f64, 0, 0);
         for name in ["tripoly1", "lshape", "ngon:7"] {
-            let m = plain(name).with_tables(&[0.5]).with_stick_tables();
+            let m = plain(name).with_slide_tables(&[0.5]).with_stick_tables();
             let poly = m.polygon().clone();
             for k in 0..poly.len() {
                 for (ell, b) in probes(poly.edge_len(k), 40) {
@@ -631,7 +633,9 @@ mod tests {
     #[test]
     fn served_sticks_are_pure_functions_of_the_query() {
         let (a, b) = (
-            plain("tripoly2").with_tables(&[0.3]).with_stick_tables(),
+            plain("tripoly2")
+                .with_slide_tables(&[0.3])
+                .with_stick_tables(),
             plain("tripoly2").with_stick_tables(),
         );
         let poly = a.polygon().clone();
@@ -680,7 +684,7 @@ mod tests {
         assert!(a.tabled_stick(poly.len(), 0.5 * len, v).is_none());
         assert!(plain("tripoly2").tabled_stick(0, 0.5 * len, v).is_none());
         // A scene's model (slide tables only) has none.
-        let scene_model = plain("tripoly2").with_tables(&[0.5]);
+        let scene_model = plain("tripoly2").with_slide_tables(&[0.5]);
         assert!(scene_model.tabled_stick(0, 0.5 * len, v).is_none());
     }
 

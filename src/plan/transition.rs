@@ -100,7 +100,7 @@ impl Transition {
         let uniform = Arc::new(
             PartModel::new(&compiled.polygon, &Support::Uniform)
                 .map_err(part_err)?
-                .with_tables(&[problem.mu_c]),
+                .with_slide_tables(&[problem.mu_c]),
         );
         let robust = problem.tripod || problem.mu_c_range.is_some();
         let mut samples = Vec::new();

@@ -36,7 +36,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
     let feed = compile_feed(&c, raw.feed.as_ref(), &belt, &part)?;
     let (mut obstacles, neighbours, sensor_drafts) =
         super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, part.radius, part.mu_c)?;
-    part.model = part.model.with_tables(&pin_mu_values(&obstacles));
+    part.model = part.model.with_slide_tables(&pin_mu_values(&obstacles));
     let goal = compile_goal(&c, raw.goal.as_ref())?;
     let contact = compile_model(&c, &raw.model, &part)?;
     let map_tier = compile_map_tier(&c, &raw.model)?;

@@ -96,7 +96,7 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
     let mu_c = ContactSettings::default().mu_c;
     let tabled: Vec<PartModel> = models
         .iter()
-        .map(|m| m.clone().with_tables(&[mu_c]))
+        .map(|m| m.clone().with_slide_tables(&[mu_c]))
         .collect();
     tabled.iter().for_each(PartModel::build_all_tables);
     let run_with = |c: &Case, fid: Fidelity, tol: f64, tables: bool| {

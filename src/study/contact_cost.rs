@@ -104,7 +104,7 @@ pub fn measure(
             };
             rows.push(bench.row(&model, fid.name(), None));
             if tables && fid == Fidelity::Exact {
-                let tabled = model.clone().with_tables(&[s.mu_c]);
+                let tabled = model.clone().with_slide_tables(&[s.mu_c]);
                 let t0 = Instant::now();
                 tabled.build_all_tables();
                 let build_ms = t0.elapsed().as_secs_f64() * 1e3;
