@@ -170,28 +170,16 @@ pub fn run(args: &RunArgs) -> Result<()> {
     super::stdout::print_result(&text)
 }
 
-/// What the exact model's tables built during the run (they are built on first use and serve
-/// every later contact; the line's own work counters leave them out): nothing for a model without
-/// tables (tip or ellipsoid fidelity, a part with its own tripod).
+/// What the exact model's slide tables built during the run (they are built on first use and
+/// serve every later contact; the line's own work counters leave them out): nothing for a model
+/// without tables (tip or ellipsoid fidelity, a part with its own tripod). A scene's model has no
+/// stick tables (`PartModel::with_stick_tables`: a map tier's build makes them).
 fn tables_line(model: &crate::mechanics::PartModel) -> String {
-    let Some(slide) = model.slide_table_stats() else {
-        return String::new();
-    };
-    let stick = model.stick_table_stats();
-    let cells = stick.map_or(0, |s| s.cells);
-    if slide.tables == 0 && cells == 0 {
-        return String::new();
+    match model.slide_table_stats() {
+        Some(slide) if slide.tables > 0 => format!(
+            "exact model's tables      {} slide tables ({} nodes); {} evaluations to build\n",
+            slide.tables, slide.nodes, slide.evaluations
+        ),
+        _ => String::new(),
     }
-    let sticks = stick.map_or(String::new(), |s| {
-        format!(
-            ", {} stick cells ({} pieces, {} left to the solver)",
-            s.cells, s.pieces, s.open
-        )
-    });
-    format!(
-        "exact model's tables      {} slide tables ({} nodes){sticks}; {} evaluations to build\n",
-        slide.tables,
-        slide.nodes,
-        slide.evaluations + stick.map_or(0, |s| s.evaluations)
-    )
 }
