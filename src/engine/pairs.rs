@@ -112,15 +112,15 @@ fn first_overlap(
         let d = q.position() - p.position() - Vec2::new(v * (tb - ta), 0.0);
         d.norm() + a * (q.theta - p.theta).abs()
     };
+    let (mut wa, mut wb) = (Vec::new(), Vec::new());
     first_touch(
         now,
         end,
         &breaks,
         &mut |tau| {
-            polygon_clearance(
-                &poly.world_vertices(&first.world_pose(tau, v)),
-                &poly.world_vertices(&second.world_pose(tau, v)),
-            )
+            poly.world_vertices_into(&first.world_pose(tau, v), &mut wa);
+            poly.world_vertices_into(&second.world_pose(tau, v), &mut wb);
+            polygon_clearance(&wa, &wb)
         },
         &|ta, tb| belt_motion(first, ta, tb) + belt_motion(second, ta, tb),
         1e-6 * a,
