@@ -75,6 +75,8 @@ pub(super) struct Ctx<'a, 'r> {
     /// side a slide table serves costs no evaluation, so evaluations alone would not bound a
     /// pass whose steps crawl).
     pub(super) rhs_calls: u64,
+    /// Steps refused by the acceptance guard (`contact_step::step_change_ok`).
+    pub(super) guard_refusals: u64,
     pub(super) warm: Warm,
     pub(super) recorder: Option<&'r mut dyn Recorder>,
     /// Per-event tolerance band: event i fires when its function drops below −band[i]. Zero except
@@ -124,6 +126,7 @@ impl<'a, 'r> Ctx<'a, 'r> {
             scale: model.scale(),
             evals: 0,
             rhs_calls: 0,
+            guard_refusals: 0,
             warm: Warm::for_tolerance(settings.tol),
             recorder,
             band: [0.0; N_EVENTS],

@@ -20,7 +20,7 @@
 //! `mechanics::pass`.
 
 use super::contact_state::{second_contact, second_contact_possible, Ctx, Feat, N_EVENTS, TURN};
-use super::contact_step::{dp_step, max_step, step_change_ok, Cursor, StepResult};
+use super::contact_step::{dp_step, first_step, max_step, step_change_ok, Cursor, StepResult};
 use super::event_apply::{apply_event, enter, settle, Settle, Transition, BOUNCE_BAND};
 use super::event_locate::{crossed_events, earliest_crossing, interior_dip, land, landed_event};
 use super::instant::{Instant, Mode};
@@ -304,6 +304,7 @@ fn take_step(ctx: &mut Ctx, at: &mut Cursor, segs: &mut Tally) -> Stepped {
         }
     };
     let guarded = !step_change_ok(at.feat, at.y, step.dp.y1);
+    ctx.guard_refusals += u64::from(guarded);
     if step.dp.err > 1.0 || guarded {
         at.h *= if guarded {
             0.25
@@ -440,6 +441,6 @@ fn open_next(
             *e = 0.0;
         }
     }
-    at.h = at.h.clamp(1e-6, max_step(at.feat).max(1e-6));
+    at.h = first_step(at.feat, at.f0, at.h.clamp(1e-6, max_step(at.feat).max(1e-6)), 1e-6);
     None
 }
