@@ -14,7 +14,8 @@
 //!    (stick ↔ slide), edge ends, a disc's normal cone at a vertex, a fence's events
 //!    ([`super::fence`]), turns of the pin's path;
 //! 4. **open the next segment** (`open_next`): settle the mode on the new feature, reset the
-//!    event bands, record the state just after the event.
+//!    event bands, record the state just after the event, and size the first step from the new
+//!    segment's rates (`contact_step::first_step`).
 //!
 //! The pass loop around it (casting the obstacle's path again after a separation) is
 //! `mechanics::pass`.
@@ -441,6 +442,11 @@ fn open_next(
             *e = 0.0;
         }
     }
-    at.h = first_step(at.feat, at.f0, at.h.clamp(1e-6, max_step(at.feat).max(1e-6)), 1e-6);
+    at.h = first_step(
+        at.feat,
+        at.f0,
+        at.h.clamp(1e-6, max_step(at.feat).max(1e-6)),
+        1e-6,
+    );
     None
 }
