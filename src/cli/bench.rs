@@ -190,7 +190,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                  Regenerate with:\n\n```\n{cmd}\n```\n\n\
                  Machine: {} cores. Each row: {contacts} random contacts (θ0 uniform, d uniform in \
                  [−0.9, 0.9], point pin, μc = 0.5, uniform pressure). Times are wall-clock per contact \
-                 (single thread), including contacts where the pin misses. *Evaluations* are \
+                 (single thread; each contact's fastest of three passes over them all, so that the \
+                 machine's spread stays out of the medians), including contacts where the pin misses. *Evaluations* are \
                  limit-surface evaluations per touching contact (exact: dissipation evaluations \
                  inside the Newton solves; tip/ellipsoid: closed-form solves). *Self-error* is \
                  |θf(tol) − θf(tol/1000)| with the same model: the integration error at the \
