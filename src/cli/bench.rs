@@ -191,8 +191,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                  Machine: {} cores. Each row: {contacts} random contacts (θ0 uniform, d uniform in \
                  [−0.9, 0.9], point pin, μc = 0.5, uniform pressure). Times are wall-clock per contact \
                  (single thread; each contact's fastest of three passes over them all, so that the \
-                 machine's spread stays out of the medians), including contacts where the pin misses. *Evaluations* are \
-                 limit-surface evaluations per touching contact (exact: dissipation evaluations \
+                 machine's spread stays out of the medians), including contacts where the pin \
+                 misses. *Evaluations* are limit-surface evaluations per touching contact (exact: dissipation evaluations \
                  inside the Newton solves; tip/ellipsoid: closed-form solves). *Self-error* is \
                  |θf(tol) − θf(tol/1000)| with the same model: the integration error at the \
                  default tolerance, not the model error (see the accuracy-vs-time report for that).\n\n\
