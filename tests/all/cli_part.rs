@@ -1,32 +1,9 @@
 //! End-to-end tests of `pinfeed part` through the built binary: JSON output for the named parts,
 //! user vertex lists, refusal of bad input (non-zero exit, reason on stderr) and the SVG plot.
 
+use crate::support::{pinfeed, pinfeed_json};
 use serde_json::Value;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
-
-/// Run a command that must succeed and print JSON; return the parsed object.
-fn json(args: &[&str]) -> Value {
-    let out = pinfeed(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
-        panic!(
-            "{args:?}: stdout is not JSON ({e}): {}",
-            String::from_utf8_lossy(&out.stdout)
-        )
-    })
-}
 
 /// Run a command that must fail; return its stderr.
 fn refused(args: &[&str]) -> String {
@@ -84,7 +61,7 @@ fn centroid(v: &Value) -> (f64, f64) {
 
 #[test]
 fn tripoly1_json() {
-    let v = json(&["part", "tripoly1", "--json"]);
+    let v = pinfeed_json(&["part", "tripoly1", "--json"]);
     assert!((f(&v, "area") - 2.25).abs() < 1e-12);
     assert!((f(&v, "a") - 2.5f64.sqrt()).abs() < 1e-12);
     assert_eq!(v["convex"], Value::Bool(true));
@@ -95,7 +72,7 @@ fn tripoly1_json() {
 
 #[test]
 fn tripoly2_json() {
-    let v = json(&["part", "tripoly2", "--json"]);
+    let v = pinfeed_json(&["part", "tripoly2", "--json"]);
     assert!((f(&v, "area") - 1.0).abs() < 1e-12);
     assert!((f(&v, "a") - 17f64.sqrt() / 3.0).abs() < 1e-12);
     assert_eq!(v["convex"], Value::Bool(true));
@@ -107,7 +84,7 @@ fn tripoly2_json() {
 
 #[test]
 fn lshape_json_is_concave() {
-    let v = json(&["part", "lshape", "--json"]);
+    let v = pinfeed_json(&["part", "lshape", "--json"]);
     assert_eq!(v["convex"], Value::Bool(false));
     assert!((f(&v, "area") - 3.0).abs() < 1e-12);
     let (cx, cy) = centroid(&v);
@@ -117,11 +94,11 @@ fn lshape_json_is_concave() {
 
 #[test]
 fn parametrised_parts_json() {
-    let v = json(&["part", "rect:4:2", "--json"]);
+    let v = pinfeed_json(&["part", "rect:4:2", "--json"]);
     assert!((f(&v, "area") - 8.0).abs() < 1e-12);
     assert!((f(&v, "a") - 5f64.sqrt()).abs() < 1e-12);
     assert_states(&v, &[0.0, 90.0, 180.0, 270.0]);
-    let v = json(&["part", "ngon:5", "--json"]);
+    let v = pinfeed_json(&["part", "ngon:5", "--json"]);
     assert!((f(&v, "a") - 1.0).abs() < 1e-12);
     assert_states(&v, &[0.0, 72.0, 144.0, 216.0, 288.0]);
 }
@@ -129,16 +106,16 @@ fn parametrised_parts_json() {
 #[test]
 fn vertex_list_json() {
     // tripoly1 typed shifted by (10, 20) and clockwise: same answers, centroid (10, 20).
-    let v = json(&["part", "--vertices", "10,21 11.5,19.5 8.5,19.5", "--json"]);
+    let v = pinfeed_json(&["part", "--vertices", "10,21 11.5,19.5 8.5,19.5", "--json"]);
     let (cx, cy) = centroid(&v);
     assert!((cx - 10.0).abs() < 1e-12 && (cy - 20.0).abs() < 1e-12);
     assert_states(&v, &[0.0, 135.0, 225.0]);
     // A list starting with a negative number must not be taken for a command-line flag.
-    let v = json(&["part", "--vertices", "-1.5,-0.5 1.5,-0.5 0,1", "--json"]);
+    let v = pinfeed_json(&["part", "--vertices", "-1.5,-0.5 1.5,-0.5 0,1", "--json"]);
     assert!((f(&v, "area") - 2.25).abs() < 1e-12);
     assert_states(&v, &[0.0, 135.0, 225.0]);
     // Semicolons separate vertices too, and the `vertices:` spec works as a NAME.
-    let v = json(&["part", "vertices:0,0; 3,0; 0,3", "--json"]);
+    let v = pinfeed_json(&["part", "vertices:0,0; 3,0; 0,3", "--json"]);
     let (cx, cy) = centroid(&v);
     assert!((cx - 1.0).abs() < 1e-12 && (cy - 1.0).abs() < 1e-12);
     assert!((f(&v, "area") - 4.5).abs() < 1e-12);
@@ -147,8 +124,8 @@ fn vertex_list_json() {
 #[test]
 fn vertex_list_scale_free_through_cli() {
     // Scaling the typed vertices by 1000 multiplies a by 1000, area by 10⁶, keeps stable states.
-    let small = json(&["part", "--vertices", "0,0 2,0 0,1", "--json"]);
-    let big = json(&["part", "--vertices", "0,0 2000,0 0,1000", "--json"]);
+    let small = pinfeed_json(&["part", "--vertices", "0,0 2,0 0,1", "--json"]);
+    let big = pinfeed_json(&["part", "--vertices", "0,0 2000,0 0,1000", "--json"]);
     assert!((f(&big, "a") - 1000.0 * f(&small, "a")).abs() < 1e-9);
     assert!((f(&big, "area") - 1e6 * f(&small, "area")).abs() < 1e-6);
     let (s, b) = (states(&small), states(&big));
@@ -306,7 +283,7 @@ fn plot_writes_svg() {
 #[test]
 fn plot_with_json_still_prints_json() {
     let path = tmp_file("cli_part_json_plot.svg");
-    let v = json(&[
+    let v = pinfeed_json(&[
         "part",
         "tripoly1",
         "--json",

@@ -1,6 +1,7 @@
 //! Measured bands against the model (issue 16): the synthetic recovery, scoring on hand-made cases
 //! (bands across 0°/360° included), thread-count independence, located errors for bad files.
 
+use crate::support::pinfeed;
 use pinfeed::maps::ensemble::{ensemble_maps, EnsembleSpec};
 use pinfeed::mechanics::Fidelity;
 use pinfeed::validate::calibrate::{calibrate, CalibrationSettings};
@@ -8,7 +9,6 @@ use pinfeed::validate::measured::{self, Measured};
 use pinfeed::validate::score::{score_rows, summarise, ScoreSettings};
 use pinfeed::validate::synthetic::{synthesize, SyntheticDesign};
 use std::path::Path;
-use std::process::Command;
 
 const FIXTURE: &str = "tests/fixtures/validate/synthetic.csv";
 
@@ -20,13 +20,6 @@ fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .unwrap()
-}
-
-fn pinfeed(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
         .unwrap()
 }
 

@@ -1,29 +1,12 @@
 //! `pinfeed contact` through the binary: JSON fields, trace and plot files, batch CSV, bad input.
 
-use std::process::Command;
-
-fn pinfeed(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = pinfeed(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
-}
+use crate::support::{pinfeed, pinfeed_json};
 
 /// The JSON object carries the documented keys with sensible values, for every model.
 #[test]
 fn json_has_required_fields() {
     for model in ["exact", "ellipsoid", "tip"] {
-        let v = json(&[
+        let v = pinfeed_json(&[
             "contact", "--part", "tripoly2", "--theta0", "90", "--d", "0.3", "--model", model,
             "--json",
         ]);
@@ -58,7 +41,7 @@ fn json_has_required_fields() {
 /// A pin that passes the part reports no contact and an unchanged orientation.
 #[test]
 fn miss_reports_no_contact() {
-    let v = json(&[
+    let v = pinfeed_json(&[
         "contact", "--part", "square", "--theta0", "0", "--d", "0.9", "--json",
     ]);
     assert_eq!(v["contact"], false);
@@ -218,7 +201,7 @@ fn batch_cases_csv() {
         rows[3]
     );
     // Same numbers as the single-case command.
-    let single = json(&[
+    let single = pinfeed_json(&[
         "contact",
         "--part",
         "tripoly2",
@@ -300,7 +283,7 @@ fn bad_inputs_are_refused() {
 /// A random tripod support runs through the CLI (exact point sums).
 #[test]
 fn tripod_support_runs() {
-    let v = json(&[
+    let v = pinfeed_json(&[
         "contact",
         "--part",
         "tripoly2",
@@ -324,7 +307,7 @@ fn pin_stop_after_spans_still_and_moving_pins() {
             "contact", "--part", "tripoly2", "--theta0", "40", "--d=-0.2", "--json",
         ];
         args.extend_from_slice(extra);
-        json(&args)["theta_final_deg"].as_f64().unwrap()
+        pinfeed_json(&args)["theta_final_deg"].as_f64().unwrap()
     };
     let still = th(&[]);
     let moving = th(&["--pin-speed", "0.5"]);

@@ -3,8 +3,7 @@
 //! limit (|α| + atan μf < 90°) and lie over the belt; a belt too narrow for any fence (the pin
 //! planner's 10 cm) is a reported answer; plans are deterministic; `--fences` with `--sensor` is refused.
 
-mod plan_cli;
-use plan_cli::*;
+use crate::plan_cli::*;
 
 #[test]
 fn tripoly1_fence_plan_orients_the_line_and_runs() {

@@ -6,7 +6,7 @@ use pinfeed::engine::{run, RunOptions};
 use pinfeed::scenario::{parse, InvalidScenario, Scene};
 use std::path::Path;
 
-const SCENE: &str = include_str!("../scenarios/tripoly1_sensor.toml");
+const SCENE: &str = include_str!("../../scenarios/tripoly1_sensor.toml");
 
 fn compile(src: &str) -> Result<Scene, InvalidScenario> {
     parse(Path::new("sensor.toml"), src).map_err(|e| e.invalid().expect("located error").clone())
@@ -165,7 +165,7 @@ fn sensor_scene_reads_every_part_and_is_reproducible() {
 /// carries no `sensors` key (reports of passive scenes are unchanged).
 #[test]
 fn passive_scene_pays_nothing_for_sensing() {
-    let quick = include_str!("../scenarios/quickstart.toml");
+    let quick = include_str!("../../scenarios/quickstart.toml");
     let scene = parse(Path::new("quickstart.toml"), quick).unwrap();
     let opts = RunOptions {
         parts: 40,

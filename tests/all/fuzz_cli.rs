@@ -22,7 +22,7 @@ use pinfeed::mechanics::Fidelity;
 use proptest::prelude::*;
 use std::process::Command;
 
-mod shapes;
+use crate::shapes;
 
 // ---------------------------------------------------------------------------------------------
 // Strategies.

@@ -2,18 +2,11 @@
 //! tripoly2 into a few narrow bands — the orientations in which each stable flush edge leaves the
 //! fence's end — with no no-contact run; the report names the fence and regenerates itself.
 
+use crate::support::pinfeed;
 use pinfeed::geometry::{part_from_spec, wrap_deg, Pose};
 use pinfeed::maps::{compute_maps, fence_pass_start, MapFence, MapSettings};
 use pinfeed::mechanics::{push_fence, ContactSettings, Fidelity, PartModel, Support};
 use serde_json::Value;
-use std::process::Command;
-
-fn pinfeed(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
 
 fn ang_diff(a: f64, b: f64) -> f64 {
     (a - b + 540.0).rem_euclid(360.0) - 180.0

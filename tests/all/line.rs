@@ -2,11 +2,11 @@
 //! bundled scenarios, an empty belt, a pin every part hits, collisions against headway, the cost
 //! of unused effects, multi-contacts and off-belt parts, and the `pinfeed run` command's outputs.
 
+use crate::support::pinfeed;
 use pinfeed::engine::{self, RunOptions, RunResult};
 use pinfeed::scenario::{self, Scene};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// A small line: tripoly2 (scale 2 cm) on a 5 cm/s belt, one 2 mm pin at y = 0, goal "any".
 /// `extra` is appended; `replace` swaps whole lines of the base.
@@ -57,13 +57,6 @@ fn scene(text: &str) -> Scene {
 
 fn run(scene: &Scene) -> RunResult {
     engine::run(scene, &RunOptions::from_scene(scene), &mut |_| {}).unwrap()
-}
-
-fn pinfeed(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
 }
 
 fn tmpdir(tag: &str) -> PathBuf {

@@ -5,10 +5,11 @@
 //! as the noise factor grows, and merges exactly from shards; a study without sensor parameters
 //! writes the same bytes as before sensor parameters existed.
 
+use crate::support::{assert_success, pinfeed_in};
 use pinfeed::scenario::scene::{Obstacle, PinObstacle};
 use pinfeed::study::mc::{self, sample};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use std::sync::Arc;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -36,23 +37,10 @@ fn write_study(dir: &Path, body: &str) -> PathBuf {
     p
 }
 
-/// `pinfeed ARGS` run from the crate's root (so relative paths in reports are the committed ones).
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .current_dir(ROOT)
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
-
+/// `pinfeed ARGS` run from the crate's root (so relative paths in reports are the committed ones)
+/// must succeed; returns its output.
 fn ok(args: &[&str]) -> Output {
-    let out = pinfeed(args);
-    assert!(
-        out.status.success(),
-        "pinfeed {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+    assert_success(args, pinfeed_in(ROOT, args))
 }
 
 fn s(p: &Path) -> &str {
@@ -146,7 +134,7 @@ values = [1.0, 4.0]
 /// `pinfeed mc FIXTURE` fails with `FILE:LINE:COLUMN: key `KEY`: ...` containing every word.
 fn assert_located(name: &str, line: usize, column: usize, key: &str, words: &[&str]) {
     let d = tmp(&format!("bad-{name}"));
-    let out = pinfeed(&["mc", &fixture(name), "--out", s(&d)]);
+    let out = pinfeed_in(ROOT, &["mc", &fixture(name), "--out", s(&d)]);
     let e = String::from_utf8_lossy(&out.stderr).to_string();
     assert_eq!(out.status.code(), Some(1), "{name}: {e}");
     assert!(out.stdout.is_empty(), "{name} printed a result");

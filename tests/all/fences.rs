@@ -1,8 +1,7 @@
 //! Fences (SPEC §6): flush stable orientations, the jam angle, the COR-tip bound, μs invariance,
 //! short fences, mirror symmetry — for the contact model's fence path.
 
-mod common;
-use common::*;
+use crate::common::*;
 use pinfeed::geometry::{wrap_deg, Polygon, Pose};
 use pinfeed::maps::fence_pass_start;
 use pinfeed::mechanics::{

@@ -4,10 +4,9 @@
 //! searches that hit their limits end with a clear message and a non-zero exit; "no plan up to
 //! depth k" is a reported result.
 
-mod plan_cli;
+use crate::plan_cli::*;
 use pinfeed::plan::search::Planner;
 use pinfeed::plan::{Action, Outcome, Problem, State};
-use plan_cli::*;
 
 #[test]
 fn default_tripoly2_plan_orients_the_line() {

@@ -3,10 +3,9 @@
 //! pushes, convergence under tolerance refinement, continuity as the pin radius goes to 0, and the
 //! fence jam rule for both signs of the fence angle. Each property says how it would fail.
 
-mod common;
-mod shapes;
+use crate::shapes;
 
-use common::*;
+use crate::common::*;
 use pinfeed::geometry::{Polygon, Pose, Vec2};
 use pinfeed::maps::fence_pass_start;
 use pinfeed::mechanics::{

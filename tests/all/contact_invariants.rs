@@ -1,7 +1,6 @@
 //! Physics invariants of the contact model (SPEC §2), for every fidelity level.
 
-mod common;
-use common::*;
+use crate::common::*;
 use pinfeed::geometry::{Polygon, Pose, Vec2};
 use pinfeed::mechanics::{first_instant, mason_vote, ContactStatus, Fidelity, Pin};
 

@@ -6,7 +6,7 @@ use pinfeed::geometry::polygon::convex_hull;
 use pinfeed::geometry::{part_from_spec, PartSpecError, Polygon, PolygonError, Vec2};
 use proptest::prelude::*;
 
-mod shapes;
+use crate::shapes;
 
 const DEG_TOL: f64 = 1e-6;
 

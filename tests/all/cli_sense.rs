@@ -1,13 +1,6 @@
 //! `pinfeed sense` end to end: the default command's JSON, and bad input refused with the flag named.
 
-use std::process::Command;
-
-fn pinfeed(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
+use crate::support::pinfeed;
 
 #[test]
 fn default_command_prints_matrices_and_accuracies_per_classifier() {

@@ -2,8 +2,7 @@
 //! finite numbers and a bounded evaluation count, or with a named status — never NaN, a panic or a
 //! hang. All run at every fidelity level.
 
-mod common;
-use common::*;
+use crate::common::*;
 use pinfeed::geometry::{Polygon, Pose, Vec2};
 use pinfeed::mechanics::{
     push, ContactFeature, ContactOutcome, ContactSettings, ContactStatus, Fidelity, PartModel, Pin,

@@ -3,12 +3,12 @@
 //! results do not depend on the thread count, a known no-contact geometry, and the `pinfeed map`
 //! command (JSON keys, report files, refusals).
 
+use crate::support::pinfeed;
 use pinfeed::geometry::{part_from_spec, wrap_deg, Polygon};
 use pinfeed::maps::runs::{circular_runs, run_indices};
 use pinfeed::maps::{compute_maps, ConfigurationMap, MapSample, MapSettings};
 use pinfeed::mechanics::{ContactStatus, Fidelity, PartModel, Support};
 use serde_json::Value;
-use std::process::{Command, Output};
 
 fn settings(fidelity: Fidelity, step: f64) -> MapSettings {
     MapSettings::point_pin(fidelity, 0.5, step, 5.0)
@@ -311,13 +311,6 @@ fn tripoly1_maps_at_plus_and_minus_d_are_mirror_images() {
 }
 
 // ---- the command line ----
-
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
 
 #[test]
 fn cli_json_has_the_required_keys() {

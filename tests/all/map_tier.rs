@@ -3,6 +3,7 @@
 //! rebuilt, a build independent of the thread count, and a line with `fidelity = "map"` that
 //! ends every part in the class the exact line does.
 
+use crate::support::pinfeed_json;
 use pinfeed::engine::{self, contact_map, RunOptions};
 use pinfeed::geometry::{named, Pose, Vec2};
 use pinfeed::maps::tier::{
@@ -481,19 +482,6 @@ fn the_build_does_not_depend_on_the_thread_count() {
     let one = on(1);
     assert!(one.len() > 1000);
     assert_eq!(one, on(2), "same file byte for byte");
-}
-
-fn pinfeed_json(args: &[&str]) -> serde_json::Value {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed");
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
 }
 
 #[test]

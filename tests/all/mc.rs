@@ -3,6 +3,7 @@
 //! leaves no shard file, bad study files give located errors, and perturbations are reproducible
 //! per sample index.
 
+use crate::support::{pinfeed, pinfeed_ok};
 use pinfeed::study::mc::{self, sample};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -84,23 +85,6 @@ fn write_study(dir: &Path, body: &str) -> PathBuf {
     p
 }
 
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
-
-fn ok(args: &[&str]) -> Output {
-    let out = pinfeed(args);
-    assert!(
-        out.status.success(),
-        "pinfeed {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
 /// The command must fail with exit code 1, print nothing on stdout, and not panic; returns stderr.
 fn refused(args: &[&str]) -> String {
     let out = pinfeed(args);
@@ -122,10 +106,10 @@ fn four_merged_shards_give_the_same_bytes_as_one_run() {
     let d = tmp("shards");
     let study = write_study(&d, GRID_STUDY);
     let full = d.join("full");
-    let one = ok(&["mc", s(&study), "--json", "--quiet", "--out", s(&full)]);
+    let one = pinfeed_ok(&["mc", s(&study), "--json", "--quiet", "--out", s(&full)]);
     let shards = d.join("shards");
     for k in 0..4 {
-        ok(&[
+        pinfeed_ok(&[
             "mc",
             s(&study),
             "--shard",
@@ -143,7 +127,7 @@ fn four_merged_shards_give_the_same_bytes_as_one_run() {
     let merged = d.join("merged");
     let mut args = vec!["merge", "--json", "--quiet", "--out", s(&merged)];
     args.extend(files.iter().map(String::as_str));
-    let m = ok(&args);
+    let m = pinfeed_ok(&args);
     assert_eq!(one.stdout, m.stdout, "JSON on stdout differs");
     for f in REPORT_FILES {
         let a = std::fs::read(full.join(f)).unwrap();
@@ -158,10 +142,10 @@ fn four_merged_shards_give_the_same_bytes_as_one_run() {
     assert_eq!(r["total_samples"], 30);
     assert_eq!(r["results"].as_array().unwrap().len(), 6);
     // The table (not JSON) is the same too.
-    let t1 = ok(&["mc", s(&study), "--out", s(&full)]);
+    let t1 = pinfeed_ok(&["mc", s(&study), "--out", s(&full)]);
     let mut args = vec!["merge", "--out", s(&merged)];
     args.extend(files.iter().map(String::as_str));
-    let t2 = ok(&args);
+    let t2 = pinfeed_ok(&args);
     let table = |o: &Output| {
         String::from_utf8_lossy(&o.stdout)
             .lines()
@@ -190,8 +174,8 @@ points = 24
 "#;
     let study = write_study(&d, body);
     let (a, b) = (d.join("a"), d.join("b"));
-    ok(&["mc", s(&study), "--threads", "1", "--quiet", "--out", s(&a)]);
-    ok(&["mc", s(&study), "--threads", "2", "--quiet", "--out", s(&b)]);
+    pinfeed_ok(&["mc", s(&study), "--threads", "1", "--quiet", "--out", s(&a)]);
+    pinfeed_ok(&["mc", s(&study), "--threads", "2", "--quiet", "--out", s(&b)]);
     for f in REPORT_FILES {
         assert_eq!(
             std::fs::read(a.join(f)).unwrap(),
@@ -239,7 +223,7 @@ fn merge_refuses_shards_that_do_not_fit() {
             s(&dir),
         ];
         args.extend_from_slice(extra);
-        ok(&args);
+        pinfeed_ok(&args);
         let k: Vec<&str> = spec.split('/').collect();
         dir.join(format!(
             "shard-{:04}-of-{:04}.json",
@@ -374,7 +358,7 @@ fn an_interrupted_shard_job_leaves_no_shard_file() {
         names_in(&out)
     );
     // 2. A rerun writes it whole: the same bytes the killed job had complete in its temporary file.
-    ok(&args);
+    pinfeed_ok(&args);
     let shard_path = out.join(final_name);
     let whole = std::fs::read(&shard_path).expect("the rerun wrote the shard");
     assert_eq!(
@@ -390,7 +374,7 @@ fn an_interrupted_shard_job_leaves_no_shard_file() {
     killed_run(&earlier);
     assert_eq!(std::fs::read(&shard_path).unwrap(), b"earlier shard");
     // ... and a rerun replaces it whole.
-    ok(&args);
+    pinfeed_ok(&args);
     assert_eq!(std::fs::read(&shard_path).unwrap(), whole);
     std::fs::remove_dir_all(&d).unwrap();
 }
@@ -579,7 +563,7 @@ fn invalid_perturbed_polygons_are_redrawn_or_reported() {
 fn a_study_without_uncertainty_reproduces_the_nominal_line() {
     let d = tmp("nominal");
     let p = write_study(&d, "samples = 40\n");
-    let out = ok(&["mc", s(&p), "--json", "--quiet", "--out", s(&d.join("o"))]);
+    let out = pinfeed_ok(&["mc", s(&p), "--json", "--quiet", "--out", s(&d.join("o"))]);
     let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     // The quickstart layout brings every part to 16° ± 3° (scenarios/quickstart.toml).
     assert_eq!(r["results"][0]["outcomes"]["success"], 40, "{r}");

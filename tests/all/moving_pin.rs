@@ -1,9 +1,7 @@
 //! Moving pins in the contact model (SPEC §5): one push with the pin's true relative velocity,
 //! its lateral speed piecewise constant in travel.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use pinfeed::geometry::{Pose, Vec2};
 use pinfeed::mechanics::{
     pin_first_touch, push_path, ContactOutcome, ContactSettings, PartModel, PinPath, TraceSample,

@@ -4,15 +4,8 @@
 //! Each test runs the reproducer from the issue and asserts the clean outcome: a refusal naming the
 //! cause (exit status 1, no panic, nothing on stdout) or a correct, finite answer.
 
+use crate::support::pinfeed;
 use pinfeed::geometry::{part_from_spec, Polygon, PolygonError, Vec2};
-use std::process::{Command, Output};
-
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
 
 /// The command must fail with exit status 1, print nothing on stdout, not panic, and say every
 /// one of `words` (case-insensitive) on stderr. Returns stderr.

@@ -3,8 +3,7 @@
 //! and that orient ≥ 95% on the line; the policy names the part; plans are deterministic for a
 //! seed.
 
-mod plan_cli;
-use plan_cli::*;
+use crate::plan_cli::*;
 use serde_json::Value;
 
 fn plan(out: &str) -> Value {

@@ -1,11 +1,9 @@
 //! Named regressions for the contact model: issue 11's reproducers and the cases the independent
-//! slow reference (tests/slow_reference.rs) and the contact fuzz (`pinfeed fuzz contacts`) found.
+//! slow reference (the `slow_reference` module) and the contact fuzz (`pinfeed fuzz contacts`) found.
 //! Each says what went wrong and asserts what must hold now, against an independent quantity: the
 //! same contact at a 1000× tighter tolerance, the point pin, or the part's own geometry.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use pinfeed::engine::{self, RunOptions};
 use pinfeed::geometry::{part_from_spec, Polygon};
 use pinfeed::mechanics::{ContactOutcome, ContactStatus, Fidelity, PartModel, Pin, Support};

@@ -1,18 +1,11 @@
 //! `pinfeed compare` (issue 5): several designs on the same part stream, one row each, the same
 //! JSON byte for byte on every run; scenarios that cannot share the stream are refused.
 
+use crate::support::pinfeed;
 use serde_json::Value;
-use std::process::Command;
 
 fn scenario(name: &str) -> String {
     format!("{}/scenarios/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn pinfeed(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
 }
 
 #[test]

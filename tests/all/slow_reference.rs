@@ -1,4 +1,4 @@
-//! The independent slow reference (`tests/reference`) checked on its own, then compared with the
+//! The independent slow reference (module `reference`) checked on its own, then compared with the
 //! production contact model (`pinfeed::mechanics::push`, exact fidelity, default tolerance) over
 //! random whole pushes (issue 11, "an independent slow reference inside the tests").
 //!
@@ -21,8 +21,8 @@
 //! A control test runs the same comparison against the ellipsoid fidelity and requires most pushes
 //! to disagree, so the comparison is shown to be able to fail.
 
-mod common;
-mod reference;
+use crate::common;
+use crate::reference;
 
 use pinfeed::geometry::{Polygon, Pose, Vec2};
 use pinfeed::mechanics::{
@@ -126,7 +126,7 @@ fn ill_conditioned(part: &Part, c: &Case) -> Option<&'static str> {
     None
 }
 
-/// The production model on a case, the CLI's way (tests/common `run`).
+/// The production model on a case, the CLI's way (`common::run`).
 fn run_production(c: &Case, poly: &Polygon, settings: &ContactSettings) -> ContactOutcome {
     let model = PartModel::new(poly, &Support::Uniform).unwrap();
     common::run(
@@ -676,8 +676,8 @@ fn env_u64(name: &str, default: u64) -> u64 {
         .unwrap_or(default)
 }
 
-/// A single push, for debugging one case: `SLOW_REF_CASE=<seed> cargo test --release --test
-/// slow_reference one_case -- --ignored --nocapture`.
+/// A single push, for debugging one case: `SLOW_REF_CASE=<seed> cargo test --release --test all
+/// slow_reference::one_case -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn one_case() {
@@ -711,7 +711,7 @@ fn one_case() {
     }
 }
 
-/// A deeper run: `SLOW_REF_CASES=5000 cargo test --release --test slow_reference many_cases --
+/// A deeper run: `SLOW_REF_CASES=5000 cargo test --release --test all slow_reference::many_cases --
 /// --ignored --nocapture` (default 5 000 cases, seeds from `SLOW_REF_FIRST`, default 0;
 /// `SLOW_REF_NO_SKIP=1` also compares the ill-conditioned cases, to see what the skips hide;
 /// `SLOW_REF_MU_MAX=2` draws μc from [0, 2] instead of [0, 1.5]).

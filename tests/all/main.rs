@@ -1,0 +1,57 @@
+//! pinfeed's integration tests, built as one test binary (`cargo test --release --test all`): one
+//! module per area, and the shared helpers (`support`: running the built `pinfeed`; `common`: the
+//! contact-model helpers; `plan_cli`: the `pinfeed plan` helpers; `shapes`: random polygons;
+//! `reference`: the independent slow contact reference). One binary links the crate once instead
+//! of once per file. A single test is selected by its module path, e.g.
+//! `cargo test --release --test all slow_reference::many_cases -- --ignored`.
+//!
+//! Tests in different modules run in parallel threads of one process: scratch files go under
+//! names that no other test uses (every module's folders carry its own name and the process id).
+//! proptest keeps each module's failure seeds in `tests/proptest-regressions/<module>.txt` (its
+//! default, `SourceParallel`, for a source file beside a `main.rs`).
+
+mod common;
+mod plan_cli;
+mod reference;
+mod shapes;
+mod support;
+
+mod accuracy_study;
+mod animate;
+mod cli_contact;
+mod cli_part;
+mod cli_sense;
+mod compare;
+mod contact_invariants;
+mod contact_regressions;
+mod fences;
+mod first_contact;
+mod fuzz_cli;
+mod fuzz_files;
+mod geometry;
+mod hard_cases;
+mod input_regressions;
+mod invariant_properties;
+mod limit_surface;
+mod line;
+mod line_cost;
+mod line_fences;
+mod map_fence;
+mod map_tier;
+mod maps;
+mod mc;
+mod mc_sensing;
+mod moving_pin;
+mod online;
+mod plan;
+mod plan_fences;
+mod plan_sensing;
+mod scenario_errors;
+mod sensing_classify;
+mod sensing_evaluate;
+mod sensing_signal;
+mod sensor_scenario;
+mod slide_tables;
+mod slow_reference;
+mod slurm_example;
+mod validate;
