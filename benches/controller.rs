@@ -10,7 +10,7 @@
 //!
 //! Also `ramp_pieces/N`: one push by a pin that accelerates across the belt during the contact,
 //! the acceleration phase resolved into N constant-speed pieces (the accuracy of each N against
-//! 256 pieces: `cargo test --release --test moving_pin piecewise -- --nocapture`).
+//! 256 pieces: `cargo test --release --test all moving_pin::piecewise -- --nocapture`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::engine::{self, RunOptions};
@@ -68,7 +68,7 @@ fn ramp(c: &mut Criterion) {
     let settings = ContactSettings::default();
     let mut g = c.benchmark_group("ramp_pieces");
     for n in [1usize, 2, 8, 32, 256] {
-        // The same ramp as tests/moving_pin.rs: 0 → −0.6 belt speeds over a travel of a.
+        // The same ramp as tests/all/moving_pin.rs: 0 → −0.6 belt speeds over a travel of a.
         let path = PinPath::ramp(touch + 0.05 * a, a, -0.6, n).unwrap();
         g.bench_function(format!("{n}"), |b| {
             b.iter(|| push_path(&m, pose, start, 0.0, &path, &settings, None).pose_final)
