@@ -61,36 +61,34 @@ pub enum BenchWhat {
         #[arg(long, default_value = "results/contact-model.md")]
         out: PathBuf,
     },
-    /// Which polygons can pins orient? The sensorless, sensing and fence planners on seeded random
-    /// polygons (`random:SEED`), each plan checked on the line; writes results/plans-survey.{md,svg}.
-    Plans {
-        /// Polygons random:FIRST … random:FIRST+N−1.
+    /// Designs for many parts: each mode alone and all modes together, every verdict from the
+    /// line; writes results/designs.md (or --out).
+    Designs {
+        /// Polygons random:FIRST … random:FIRST+N−1 (0: none).
         #[arg(long, default_value_t = 20)]
         random: u64,
         #[arg(long, default_value_t = 1)]
         first: u64,
-        /// Survey these parts instead (comma-separated specs, e.g. tripoly1,square,rect:2:1).
-        #[arg(long, value_delimiter = ',')]
+        /// More parts (`;`-separated specs, each `SPEC` or `SPEC@SCALE`, e.g.
+        /// "tripoly1;vertices:0,0 40,0 20,30@0.001").
+        #[arg(long, value_delimiter = ';')]
         parts: Vec<String>,
-        /// Run the sensing planner on every part (by default only where sensorless pins fail).
-        #[arg(long)]
-        sense_all: bool,
-        /// Search time limit of each plan (s).
-        #[arg(long, default_value_t = 30.0)]
+        /// Each design's time limit (s).
+        #[arg(long, default_value_t = 110.0)]
         time_limit: f64,
         /// Parts of each line check.
         #[arg(long, default_value_t = 10_000)]
         check_parts: u64,
-        /// Belt width of the fence plans (m).
-        #[arg(long, default_value_t = 0.18)]
-        fence_belt: f64,
-        /// Share of the parts in one window that counts as oriented.
-        #[arg(long, default_value_t = 0.99)]
-        target: f64,
+        /// Robust designs: μc uniform in LO:HI per part, checked the same way.
+        #[arg(long, value_name = "LO:HI")]
+        mu_c_range: Option<String>,
+        /// Robust designs: random tripod supports.
+        #[arg(long)]
+        tripod: bool,
         /// Worker threads (0: one per core); the results do not depend on it.
         #[arg(long, default_value_t = 0)]
         threads: usize,
-        #[arg(long, default_value = "results/plans-survey.md")]
+        #[arg(long, default_value = "pinfeed-out/designs.md")]
         out: PathBuf,
     },
     /// Wall time of the 18 thesis configuration maps (d = ±0.1 … ±0.9, 360 θ0 each) per part,
@@ -224,50 +222,27 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             Ok(())
         }
         BenchWhat::Maps { repeats, out } => bench_maps(*repeats, out),
-        BenchWhat::Plans {
+        BenchWhat::Designs {
             random,
             first,
             parts,
-            sense_all,
             time_limit,
             check_parts,
-            fence_belt,
-            target,
+            mu_c_range,
+            tripod,
             threads,
             out,
-        } => {
-            if !(1..=10_000).contains(random) {
-                anyhow::bail!("--random must be between 1 and 10000, got {random}");
-            }
-            let which = if parts.is_empty() {
-                format!("--random {random} --first {first}")
-            } else {
-                format!("--parts {}", parts.join(","))
-            };
-            let command = format!(
-                "cargo run --release -- bench plans {which}{} --time-limit {time_limit} --check-parts {check_parts} --fence-belt {fence_belt} --target {target} --out {}",
-                if *sense_all { " --sense-all" } else { "" },
-                out.display()
-            );
-            let specs = if parts.is_empty() {
-                (*first..first.saturating_add(*random))
-                    .map(|s| format!("random:{s}"))
-                    .collect()
-            } else {
-                parts.clone()
-            };
-            super::bench_plans::run(&super::bench_plans::Survey {
-                specs,
-                sense_all: *sense_all,
-                time_limit_s: *time_limit,
-                check_parts: *check_parts,
-                fence_belt_m: *fence_belt,
-                target: *target,
-                threads: *threads,
-                out: out.clone(),
-                command,
-            })
-        }
+        } => super::bench_designs::run(&super::bench_designs::DesignsArgs {
+            random: *random,
+            first: *first,
+            parts: parts.clone(),
+            time_limit: *time_limit,
+            check_parts: *check_parts,
+            mu_c_range: mu_c_range.clone(),
+            tripod: *tripod,
+            threads: *threads,
+            out: out.clone(),
+        }),
         BenchWhat::McPrecision {
             study,
             samples,

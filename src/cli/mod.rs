@@ -2,10 +2,10 @@
 //! parses and dispatches; everything a command does lives here so it can be tested.
 
 pub mod bench;
+pub mod bench_designs;
 pub mod bench_line;
 pub mod bench_map_tier;
 pub mod bench_mc;
-pub mod bench_plans;
 pub mod calibrate;
 pub mod compare;
 pub mod contact;
@@ -17,7 +17,6 @@ pub mod mc;
 pub mod merge;
 pub mod part;
 pub mod plan;
-pub mod plan_sensor;
 pub mod run;
 pub mod sense;
 pub mod stdout;
@@ -70,8 +69,8 @@ pub enum Command {
     Merge(merge::MergeArgs),
     /// What a sensorised pin can tell: classifiers' confusion, accuracy and information under noise.
     Sense(Box<sense::SenseArgs>),
-    /// Plan a pin layout: a shortest robust sequence of fixed pins that orients the part, written as
-    /// a scenario, drawn and checked on the line.
+    /// Design a line for a part (pins, fences, both, or a sensor with moving pins), checked on the
+    /// line: the best design the line confirms, written as a scenario and drawn.
     Plan(Box<plan::PlanArgs>),
     /// Measurements that write the reports in results/ (e.g. `bench contact`).
     Bench(bench::BenchArgs),
@@ -101,6 +100,19 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => calibrate::run(&a),
     }
 }
+
+/// A command that ends with a non-zero status it has already explained on standard output (e.g.
+/// `pinfeed plan`: 3 a design the line does not confirm, 4 no design).
+#[derive(Debug)]
+pub struct Exit(pub i32);
+
+impl std::fmt::Display for Exit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "exit status {}", self.0)
+    }
+}
+
+impl std::error::Error for Exit {}
 
 /// Quote a shell word if it needs it (for the command lines written at the top of reports).
 pub(crate) fn shell_word(s: &str) -> String {

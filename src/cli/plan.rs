@@ -1,20 +1,22 @@
-//! `pinfeed plan`: the sensorless pin planner ([`crate::plan`]): a shortest robust sequence of
-//! fixed pins that orients a part, written as a runnable scenario, drawn, and checked on the line.
+//! `pinfeed plan`: maps its arguments to [`crate::plan::design`] (the design workflow: searches,
+//! line checks, refinement, the line's headway) and prints the result; writes the chosen design.
 //!
-//! Standard output gets the search statistics, the plan table and the line check (or, with
-//! `--json`, one JSON document). `--out FILE.toml` writes the scenario (headed by the command that
-//! wrote it) and, unless `--draw` names another file, its drawing beside it (`FILE.svg`). A search
-//! that finds no plan up to its depth reports so and succeeds (that is an answer); one stopped by a
-//! limit (`--max-states`, `--time-limit`) or a bad input exits non-zero with a message.
+//! Exit status: 0 confirmed (the line check holds the target); 3 a design was written but the
+//! line does not confirm it (or, with `--check-parts 0`, it was not checked); 4 no design (no
+//! obstacle improves on the feed; nothing written); 1 an error, or a time limit that left no
+//! confirmed design.
 
 use super::shell_word;
 use super::stdout::print_result;
-use crate::plan::fences::FenceTransition;
-use crate::plan::search::{Planner, SearchStats};
-use crate::plan::{emit, Action, FeedKind, Outcome, Plan, Problem};
+use crate::plan::design::{
+    self, describe_obstacles, Candidate, Design, DesignOptions, FenceSettings, Layout, Mode,
+    Objective, Status,
+};
+use crate::plan::{FeedKind, Problem};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `pinfeed plan`.
@@ -23,9 +25,25 @@ pub struct PlanArgs {
     /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], or vertices:"x,y x,y ...".
     #[arg(long)]
     pub part: String,
-    /// Metres per unit of the part's coordinates.
+    /// Metres per unit of the part's coordinates (0.001 for vertices in mm).
     #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
     pub scale: f64,
+    /// Name of the design: its scenario's name and its files' stem [default: from the part; a
+    /// vertex list gets custom-HASH].
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Restrict the design to fixed pins (may be combined with --fences and --sensor).
+    #[arg(long)]
+    pub pins: bool,
+    /// Restrict the design to fences (with --pins: also lines that mix pins and fences).
+    #[arg(long)]
+    pub fences: bool,
+    /// Restrict the design to a sensor pin with moving pins.
+    #[arg(long)]
+    pub sensor: bool,
+    /// What the best confirmed design minimises: belt-length, obstacles, actuators, throughput.
+    #[arg(long, default_value = "belt-length")]
+    pub objective: String,
     /// Feed orientation: stable (the stable states, equal weights, with --jitter) or uniform.
     #[arg(long, default_value = "stable")]
     pub feed: String,
@@ -56,19 +74,19 @@ pub struct PlanArgs {
     /// Pin radius (m; 0 = point pin).
     #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
     pub pin_radius: f64,
-    /// Belt width (m).
-    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
-    pub belt_width: f64,
+    /// Belt width (m) [default: 0.1; without it fence designs may use a wider belt, reported].
+    #[arg(long, allow_hyphen_values = true)]
+    pub belt_width: Option<f64>,
     /// Distance between pins along the belt (m).
     #[arg(long, default_value_t = 0.15, allow_hyphen_values = true)]
     pub spacing: f64,
-    /// Most pins (the search depth).
+    /// Most obstacles in a line (the search depth).
     #[arg(long, alias = "depth", default_value_t = 8)]
     pub max_pins: usize,
     /// Goal: half-width of the orientation window (degrees).
     #[arg(long, default_value_t = 3.0, allow_hyphen_values = true)]
     pub tolerance: f64,
-    /// Goal: share of the parts inside one window.
+    /// Goal: share of the parts inside one window, on the line.
     #[arg(long, default_value_t = 0.99, allow_hyphen_values = true)]
     pub target: f64,
     /// Minimise the number of orientation sets instead (searches every depth unless one set is reached).
@@ -86,64 +104,64 @@ pub struct PlanArgs {
     /// Sample each orientation's outcome every COARSE pin positions and bisect changes (1 = all).
     #[arg(long, default_value_t = 4)]
     pub coarse: usize,
-    /// Stop after this many distinct states kept (each ≈ 16 bytes per particle).
+    /// Stop a search after this many distinct states kept (each ≈ 16 bytes per particle).
     #[arg(long, default_value_t = 1_000_000)]
     pub max_states: usize,
     /// Expand every state, even those that cannot beat the best effort within the pins left
     /// (branch and bound off: same result, more work; for comparison).
     #[arg(long)]
     pub no_bound: bool,
-    /// Stop after this many seconds of search.
-    #[arg(long, default_value_t = 600.0, allow_hyphen_values = true)]
+    /// Wall-time limit of the whole command: searches, line checks and refinements (s).
+    #[arg(long, default_value_t = 110.0, allow_hyphen_values = true)]
     pub time_limit: f64,
     /// Integration tolerance of the contact model while planning.
     #[arg(long, default_value_t = 1e-5, allow_hyphen_values = true)]
     pub contact_tol: f64,
-    /// Seed of the particles (and of the line check).
+    /// Seed of the particles and of the line checks.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Write the plan as a scenario file.
+    /// Write the design here (FILE.toml; its policy and drawing beside it) [default:
+    /// pinfeed-out/plans/NAME.toml].
     #[arg(long, value_name = "FILE.toml")]
     pub out: Option<PathBuf>,
-    /// Draw the plan (SVG) [default: beside --out, FILE.svg].
+    /// Draw the design (SVG) [default: beside the scenario, NAME.svg].
     #[arg(long, value_name = "FILE.svg")]
     pub draw: Option<PathBuf>,
-    /// Parts run through the line to check the plan (0: no check).
+    /// Write nothing (print only).
+    #[arg(long)]
+    pub no_write: bool,
+    /// Parts of the full line check, the verdict (0: no check; the design is unchecked).
     #[arg(long, default_value_t = 10_000)]
     pub check_parts: u64,
+    /// Parts of each candidate's first line run and of each headway probe.
+    #[arg(long, default_value_t = 2_000)]
+    pub screen_parts: u64,
     /// Print one JSON document.
     #[arg(long)]
     pub json: bool,
-    /// Contingent plan with sensing: a sensor pin, then per-decision moving pins (a policy file).
+    /// No progress display.
     #[arg(long)]
-    pub sensor: bool,
-    /// With --sensor: most moving pins after the sensor.
+    pub quiet: bool,
+    /// Sensor designs: most moving pins after the sensor.
     #[arg(long, default_value_t = 3)]
     pub max_moving: usize,
-    /// With --sensor: sensor positions tried (the most robust pin intervals that touch every part).
+    /// Sensor designs: sensor positions tried.
     #[arg(long, default_value_t = 6)]
     pub sensor_candidates: usize,
-    /// Fence plan: each action is a fence (angles ±15°…±60° in 5° steps below the jam limit).
-    #[arg(long)]
-    pub fences: bool,
-    /// With --fences: fence friction μf [default: --mu-c].
+    /// Fence designs: fence friction μf [default: --mu-c].
     #[arg(long)]
     pub mu_f: Option<f64>,
-    /// With --fences: downstream overhang of each fence past the parts' reach (units of a).
+    /// Fence designs: downstream overhang of each fence past the parts' reach (units of a).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub fence_overhang: f64,
-    /// With --fences: largest |angle| tried (degrees; candidates ±15° … ±60°, always below the jam
-    /// limit). At 60° (3.4° from the jam limit at μf 0.5) the line parted from the plan (tripoly2:
-    /// 83% against 100%), hence 55.
+    /// Fence designs: largest |angle| tried (degrees; always below the jam limit).
     #[arg(long, default_value_t = 55.0, allow_hyphen_values = true)]
     pub max_fence_angle: f64,
-    /// With --fences: step between candidate angles (degrees; from ±15°). A finer step is a larger
-    /// action set: shorter designs, longer searches.
+    /// Fence designs: step between candidate angles (degrees; from ±15°).
     #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub fence_angle_step: f64,
-    /// When the line check holds less than --target of a found plan's parts, re-plan with more
-    /// particles (2 more jitter and offset samples; a uniform feed 1.5× the orientations), at most
-    /// this many times (0: never). Not with --sensor.
+    /// Search rounds after the first while the line does not hold the target, each with the
+    /// parts the line got wrong added to the particles (0: never).
     #[arg(long, default_value_t = 2)]
     pub refine: usize,
     /// Worker threads (0: one per core).
@@ -181,7 +199,9 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.mu_c_range = args.mu_c_range.as_deref().map(parse_range).transpose()?;
     p.tripod = args.tripod;
     p.pin_radius_m = args.pin_radius;
-    p.belt_width_m = args.belt_width;
+    if let Some(w) = args.belt_width {
+        p.belt_width_m = w;
+    }
     p.spacing_m = args.spacing;
     p.max_pins = args.max_pins;
     p.tolerance_deg = args.tolerance;
@@ -200,712 +220,528 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     Ok(p)
 }
 
-/// The command line that reproduces a plan: the part and every setting that differs from its
-/// default, in a fixed order (the output file names are not part of it).
+/// The design options of the arguments.
+pub fn options_of(args: &PlanArgs) -> Result<DesignOptions> {
+    let problem = problem_of(args)?;
+    let mut o = DesignOptions::new(problem);
+    let mut modes = Vec::new();
+    if args.pins {
+        modes.push(Mode::Pins);
+    }
+    if args.fences {
+        modes.push(Mode::Fences);
+    }
+    if args.pins && args.fences {
+        modes.push(Mode::Hybrid);
+    }
+    if args.sensor {
+        modes.push(Mode::Sensor);
+    }
+    if !modes.is_empty() {
+        o.modes = modes;
+    }
+    o.objective = args
+        .objective
+        .parse::<Objective>()
+        .map_err(|e| anyhow!("--objective {e}"))?;
+    o.check_parts = args.check_parts;
+    o.screen_parts = args.screen_parts.min(args.check_parts.max(1));
+    o.refine = args.refine;
+    o.time_limit_s = args.time_limit;
+    o.fences = FenceSettings {
+        mu_f: args.mu_f,
+        overhang_a: args.fence_overhang,
+        max_angle_deg: args.max_fence_angle,
+        angle_step_deg: args.fence_angle_step,
+    };
+    o.max_moving = args.max_moving;
+    o.sensor_candidates = args.sensor_candidates;
+    o.belt_width_given = args.belt_width.is_some();
+    o.name = match (&args.name, &args.out) {
+        (Some(n), _) => n.clone(),
+        (None, Some(out)) => out
+            .file_stem()
+            .map_or(o.name.clone(), |s| s.to_string_lossy().to_string()),
+        (None, None) => o.name,
+    };
+    o.command = command_line(args);
+    Ok(o)
+}
+
+/// The command line that reproduces a design: the part and every setting given (the output
+/// options are not part of it).
 pub fn command_line(args: &PlanArgs) -> String {
     let mut w = vec!["pinfeed plan --part".to_string(), shell_word(&args.part)];
     let d = Problem::new(&args.part);
-    fn opt_into(w: &mut Vec<String>, flag: &str, v: String, default: String) {
+    let mut opt = |flag: &str, v: String, default: String| {
         if v != default {
-            w.push(format!("{flag} {v}"));
+            w.push(format!("{flag} {}", shell_word(&v)));
         }
-    }
-    macro_rules! opt {
-        ($f:expr, $v:expr, $d:expr) => {
-            opt_into(&mut w, $f, $v, $d)
-        };
-    }
-    opt!("--scale", args.scale.to_string(), d.scale.to_string());
-    opt!("--feed", shell_word(&args.feed), "stable".into());
-    opt!(
+    };
+    opt("--scale", args.scale.to_string(), d.scale.to_string());
+    opt("--objective", args.objective.clone(), "belt-length".into());
+    opt("--feed", args.feed.clone(), "stable".into());
+    opt(
         "--jitter",
         args.jitter.to_string(),
-        d.jitter_deg.to_string()
+        d.jitter_deg.to_string(),
     );
-    opt!(
+    opt(
         "--lateral",
         args.lateral.to_string(),
-        d.lateral_m.to_string()
+        d.lateral_m.to_string(),
     );
-    opt!(
+    opt(
         "--jitter-samples",
         args.jitter_samples.to_string(),
-        "5".into()
+        "5".into(),
     );
-    opt!(
+    opt(
         "--offset-samples",
         args.offset_samples.to_string(),
-        "5".into()
+        "5".into(),
     );
-    opt!(
+    opt(
         "--orientation-samples",
         args.orientation_samples.to_string(),
-        "72".into()
+        "72".into(),
     );
-    opt!("--mu-c", args.mu_c.to_string(), d.mu_c.to_string());
-    if let Some(r) = &args.mu_c_range {
-        w.push(format!("--mu-c-range {}", shell_word(r)));
-    }
-    if args.tripod {
-        w.push("--tripod".into());
-    }
-    opt!(
+    opt("--mu-c", args.mu_c.to_string(), d.mu_c.to_string());
+    opt(
+        "--mu-c-range",
+        args.mu_c_range.clone().unwrap_or_default(),
+        String::new(),
+    );
+    opt(
         "--pin-radius",
         args.pin_radius.to_string(),
-        d.pin_radius_m.to_string()
+        d.pin_radius_m.to_string(),
     );
-    opt!(
+    opt(
         "--belt-width",
-        args.belt_width.to_string(),
-        d.belt_width_m.to_string()
+        args.belt_width.map_or(String::new(), |b| b.to_string()),
+        String::new(),
     );
-    opt!(
+    opt(
         "--spacing",
         args.spacing.to_string(),
-        d.spacing_m.to_string()
+        d.spacing_m.to_string(),
     );
-    opt!(
+    opt(
         "--max-pins",
         args.max_pins.to_string(),
-        d.max_pins.to_string()
+        d.max_pins.to_string(),
     );
-    opt!(
+    opt(
         "--tolerance",
         args.tolerance.to_string(),
-        d.tolerance_deg.to_string()
+        d.tolerance_deg.to_string(),
     );
-    opt!("--target", args.target.to_string(), d.target.to_string());
-    if args.no_bound {
-        w.push("--no-bound".into());
-    }
-    if args.fewest_sets {
-        w.push("--fewest-sets".into());
-    }
-    opt!("--min-margin", args.min_margin.to_string(), "0.5".into());
-    opt!("--y-quantum", args.y_quantum.to_string(), "0.25".into());
-    opt!(
+    opt("--target", args.target.to_string(), d.target.to_string());
+    opt("--min-margin", args.min_margin.to_string(), "0.5".into());
+    opt("--y-quantum", args.y_quantum.to_string(), "0.25".into());
+    opt(
         "--theta-quantum",
         args.theta_quantum.to_string(),
-        "0.25".into()
+        "0.25".into(),
     );
-    opt!("--coarse", args.coarse.to_string(), "4".into());
-    opt!("--refine", args.refine.to_string(), "2".into());
-    opt!(
+    opt("--coarse", args.coarse.to_string(), "4".into());
+    opt("--refine", args.refine.to_string(), "2".into());
+    opt(
         "--max-states",
         args.max_states.to_string(),
-        d.max_states.to_string()
+        d.max_states.to_string(),
     );
-    opt!(
-        "--time-limit",
-        args.time_limit.to_string(),
-        d.time_limit_s.to_string()
-    );
-    opt!(
+    opt("--time-limit", args.time_limit.to_string(), "110".into());
+    opt(
         "--contact-tol",
         args.contact_tol.to_string(),
-        d.contact_tol.to_string()
+        d.contact_tol.to_string(),
     );
-    opt!("--seed", args.seed.to_string(), "1".into());
-    if args.fences {
-        w.push("--fences".into());
-        if let Some(m) = args.mu_f {
-            w.push(format!("--mu-f {m}"));
+    opt("--seed", args.seed.to_string(), "1".into());
+    opt(
+        "--check-parts",
+        args.check_parts.to_string(),
+        "10000".into(),
+    );
+    opt(
+        "--screen-parts",
+        args.screen_parts.to_string(),
+        "2000".into(),
+    );
+    opt(
+        "--mu-f",
+        args.mu_f.map_or(String::new(), |m| m.to_string()),
+        String::new(),
+    );
+    opt(
+        "--fence-overhang",
+        args.fence_overhang.to_string(),
+        "0".into(),
+    );
+    opt(
+        "--max-fence-angle",
+        args.max_fence_angle.to_string(),
+        "55".into(),
+    );
+    opt(
+        "--fence-angle-step",
+        args.fence_angle_step.to_string(),
+        "5".into(),
+    );
+    opt("--max-moving", args.max_moving.to_string(), "3".into());
+    opt(
+        "--sensor-candidates",
+        args.sensor_candidates.to_string(),
+        "6".into(),
+    );
+    for (on, flag) in [
+        (args.tripod, "--tripod"),
+        (args.fewest_sets, "--fewest-sets"),
+        (args.no_bound, "--no-bound"),
+        (args.pins, "--pins"),
+        (args.fences, "--fences"),
+        (args.sensor, "--sensor"),
+    ] {
+        if on {
+            w.push(flag.into());
         }
-        opt!(
-            "--fence-overhang",
-            args.fence_overhang.to_string(),
-            "0".into()
-        );
-        opt!(
-            "--max-fence-angle",
-            args.max_fence_angle.to_string(),
-            "55".into()
-        );
-        opt!(
-            "--fence-angle-step",
-            args.fence_angle_step.to_string(),
-            "5".into()
-        );
-    }
-    if args.sensor {
-        w.push("--sensor".into());
-        opt!("--max-moving", args.max_moving.to_string(), "3".into());
-        opt!(
-            "--sensor-candidates",
-            args.sensor_candidates.to_string(),
-            "6".into()
-        );
     }
     w.join(" ")
 }
 
-/// The line check of a plan, as reported.
-#[derive(Debug, Clone, Serialize)]
-pub struct CheckReport {
-    pub parts: u64,
-    pub success_rate: f64,
-    pub success_ci95: [f64; 2],
-    pub outcomes: crate::engine::OutcomeCounts,
-    pub elapsed_s: f64,
-}
-
-/// A found plan the line did not confirm (below `--target`), with the particles it was planned
-/// with; the planner then re-planned with more (`--refine`).
-#[derive(Debug, Clone, Serialize)]
-pub struct RefineRound {
-    /// Particles per stable state (jitter × offset samples), or orientations × offsets.
-    pub particles: String,
-    pub obstacles: usize,
-    pub predicted: f64,
-    /// The line check's success.
-    pub simulated: f64,
-}
-
-/// The particles of a problem, as printed.
-fn particles_text(p: &Problem) -> String {
-    match p.feed {
-        FeedKind::Stable => format!(
-            "{}×{} particles per stable state",
-            p.jitter_samples, p.offset_samples
-        ),
-        FeedKind::Uniform => format!(
-            "{} orientations × {} offsets (particles)",
-            p.orientation_samples, p.offset_samples
-        ),
-    }
-}
-
-/// The same problem with more particles: 2 more jitter and offset samples (a uniform feed: 1.5×
-/// the orientations and 2 more offsets).
-fn denser(p: &Problem) -> Problem {
-    let mut q = p.clone();
-    match q.feed {
-        FeedKind::Stable => q.jitter_samples += 2,
-        FeedKind::Uniform => q.orientation_samples += q.orientation_samples.div_ceil(2),
-    }
-    q.offset_samples += 2;
-    q
-}
-
-/// A plan written as a scenario and checked on the line.
-struct Checked {
-    toml: String,
-    footprint_m: Option<f64>,
-    check: Option<CheckReport>,
-    uncertain: Option<CheckReport>,
-}
-
-/// Emit `plan` as a scenario and run it through the line (with `--check-parts` > 0), and under
-/// the planned uncertainty if any.
-fn emit_and_check(
-    args: &PlanArgs,
-    problem: &Problem,
-    planner: &Planner,
-    plan: &Plan,
-    command: &str,
-    pool: &rayon::ThreadPool,
-) -> Result<Checked> {
-    let path = args
-        .out
+/// The files a design writes: (scenario, policy if any, drawing).
+fn paths(args: &PlanArgs, o: &DesignOptions, sensor: bool) -> (PathBuf, Option<PathBuf>, PathBuf) {
+    let scenario = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from("pinfeed-out")
+            .join("plans")
+            .join(format!("{}.toml", o.name))
+    });
+    let policy = sensor.then(|| scenario.with_file_name(format!("{}.policy.toml", o.name)));
+    let draw = args
+        .draw
         .clone()
-        .unwrap_or_else(|| PathBuf::from("plan.toml"));
-    let file = shell_word(&path.display().to_string());
-    let toml = emit::scenario_toml(
-        problem,
-        plan,
-        planner.compiled.stable_deg.len(),
-        planner.compiled.symmetry,
-        args.check_parts.max(1),
-        command,
-        &file,
-    );
-    let footprint_m = crate::plan::check::footprint_m(&toml, &path);
-    let (mut check, mut uncertain) = (None, None);
-    if args.check_parts > 0 {
-        let started = std::time::Instant::now();
-        let summary = pool
-            .install(|| crate::plan::check::check(&toml, &path, args.check_parts, problem.seed))?;
-        check = Some(CheckReport::of(&summary, started));
-        uncertain = check_uncertain(args, problem, &toml, pool)?;
-    }
-    Ok(Checked {
-        toml,
-        footprint_m,
-        check,
-        uncertain,
-    })
+        .unwrap_or_else(|| scenario.with_extension("svg"));
+    (scenario, policy, draw)
 }
 
 /// The JSON document of `pinfeed plan --json`.
 #[derive(Debug, Serialize)]
-pub struct PlanReport<'a> {
-    pub command: String,
-    pub problem: &'a Problem,
-    /// found | none_up_to_depth | exhausted | limit
-    pub result: &'static str,
-    pub message: String,
-    /// Found plans the line did not confirm, before this one (`--refine`).
-    pub refined: Vec<RefineRound>,
-    /// The plan found, or (result ≠ found) the best effort: the shortest plan bringing the most
-    /// particles into one window.
-    pub plan: Option<&'a Plan>,
-    pub stats: &'a SearchStats,
-    pub check: Option<CheckReport>,
-    /// The plan under the uncertainty it was planned against (a Monte Carlo study).
-    pub uncertain_check: Option<CheckReport>,
-    pub scenario: Option<String>,
-}
-
-/// What one planning run produced, whatever the planner (sensorless pins, fences, sensing): what
-/// `pinfeed bench plans` tabulates.
-#[derive(Debug, Clone, Serialize)]
-pub struct PlanSummary {
-    /// found | none_up_to_depth | exhausted | limit
-    pub result: &'static str,
-    pub message: String,
-    /// Obstacles of the plan (pins, fences, or the sensor pin plus the moving pins); with a
-    /// result other than found, of the best effort.
-    pub obstacles: Option<usize>,
-    pub predicted: Option<f64>,
-    pub check: Option<CheckReport>,
-    pub uncertain_check: Option<CheckReport>,
-    /// Belt length the layout occupies (m; [`crate::study::compare`]'s footprint).
-    pub footprint_m: Option<f64>,
-    /// Search depth completed (pins, fences or moving pins).
-    pub depth_completed: usize,
-    pub search_s: f64,
-    /// Found plans the line did not confirm, re-planned with more particles (`--refine`).
-    pub refined: Vec<RefineRound>,
-}
-
-/// A planning run, ready to print.
-pub struct Executed {
-    /// The table (or, with `--json`, the JSON document).
-    pub output: String,
-    pub summary: PlanSummary,
-    /// A limit stopped the search: the command fails with this message after printing.
-    pub failure: Option<String>,
-}
-
-fn mb(bytes: f64) -> String {
-    format!("{:.1} MB", bytes / 1e6)
-}
-
-fn stats_text(s: &SearchStats) -> String {
-    let mut t = String::new();
-    t += &format!(
-        "search      {} particles, {} physics sample(s); {:.3} s\n",
-        s.particles, s.physics_samples, s.elapsed_s
-    );
-    let levels: Vec<String> = s
-        .states_per_depth
-        .iter()
-        .enumerate()
-        .map(|(k, n)| format!("{k}:{n}"))
-        .collect();
-    t += &format!("  new open states per depth  {}\n", levels.join("  "));
-    t += &format!(
-        "  expanded {}, generated {} ({} duplicates), {:.1} actions per state\n",
-        s.expanded, s.generated, s.duplicates, s.actions_per_expansion
-    );
-    t += &format!(
-        "  bound: {} actions or states cut (cannot beat the best effort with the pins left)\n",
-        s.pruned
-    );
-    t += &format!(
-        "  pushes computed {}, memo hits {}, orientation columns {}, memo entries {}\n",
-        s.pushes.computed, s.pushes.memo_hits, s.pushes.columns, s.memo_entries
-    );
-    t += &format!(
-        "  memory: states + memo ≈ {}, peak RSS {}\n",
-        mb(s.memory_estimate_bytes as f64),
-        s.peak_rss_bytes.map_or("n/a".into(), |b| mb(b as f64))
-    );
-    t
-}
-
-fn plan_text(problem: &Problem, plan: &Plan) -> String {
-    let mut t = String::new();
-    t += "plan        pin    x (m)   y (mm)   interval (mm)      margin (mm)  sets  best window\n";
-    t += &format!(
-        "            feed                                                  {:>4}  {:.3} at {:.2}°\n",
-        plan.initial_sets, plan.initial_window.share, plan.initial_window.centre_deg
-    );
-    for (k, s) in plan.steps.iter().enumerate() {
-        let p = match s.action {
-            Action::Pin(p) => p,
-            Action::Fence(f) => {
-                t += &format!(
-                    "            fence{:<1} {:>+5.0}°  y {:>+7.2} → {:>+7.2} mm, length {:.4} m, margin {:.2} mm  {:>4}  {:.3} at {:.2}°\n",
-                    k + 1,
-                    f.angle_deg,
-                    f.y0_m * 1e3,
-                    f.y1_m * 1e3,
-                    f.length_m,
-                    f.margin_m * 1e3,
-                    s.sets,
-                    s.window.share,
-                    s.window.centre_deg
-                );
-                continue;
-            }
-        };
-        t += &format!(
-            "            pin{:<3} {:>5.3}  {:>+7.2}   [{:>+6.2}, {:>+6.2}]   {:>10.2}  {:>4}  {:.3} at {:.2}°\n",
-            k + 1,
-            problem.spacing_m * (k as f64 + 1.0),
-            p.y_m * 1e3,
-            p.lo_m * 1e3,
-            p.hi_m * 1e3,
-            p.margin_m * 1e3,
-            s.sets,
-            s.window.share,
-            s.window.centre_deg
-        );
-    }
-    t += &format!(
-        "goal        {:.2}° ± {}°: predicted success {:.4} ({} of {} particles)\n",
-        plan.window.centre_deg,
-        problem.tolerance_deg,
-        plan.predicted_success,
-        plan.window.inside,
-        plan.initial.total()
-    );
-    t
+struct PlanJson<'a> {
+    schema_version: u32,
+    pinfeed_version: &'static str,
+    command: &'a str,
+    /// confirmed | not_confirmed | unchecked | no_design
+    status: Status,
+    message: &'a str,
+    name: &'a str,
+    mode: Option<Mode>,
+    predicted_success: Option<f64>,
+    line_check: Option<&'a design::LineCheck>,
+    uncertain_check: Option<&'a design::LineCheck>,
+    obstacles: Option<&'a [design::ObstacleInfo]>,
+    belt_length_m: Option<f64>,
+    belt_width_m: Option<f64>,
+    headway_s: Option<f64>,
+    oriented_per_min: Option<f64>,
+    files: Vec<String>,
+    limit: Option<&'a str>,
+    elapsed_s: f64,
+    candidates: &'a [Candidate],
+    /// The chosen candidate (also in `candidates`).
+    chosen: Option<&'a Candidate>,
+    problem: &'a Problem,
+    objective: Objective,
+    scenario: Option<&'a str>,
 }
 
 /// Run `pinfeed plan`.
 pub fn run(args: &PlanArgs) -> Result<()> {
-    let done = execute(args)?;
-    print_result(&done.output)?;
-    if let Some(msg) = done.failure {
-        bail!(msg);
-    }
-    Ok(())
-}
-
-/// Plan, write, draw and check as the arguments say; print nothing.
-pub fn execute(args: &PlanArgs) -> Result<Executed> {
-    let problem = problem_of(args)?;
-    let command = command_line(args);
+    let o = options_of(args)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
         .context("starting the worker threads")?;
-    if args.sensor && args.fences {
-        bail!("--sensor and --fences: the contingent planner uses pins; choose one");
-    }
-    if args.sensor {
-        return super::plan_sensor::execute(args, &problem, &command, &pool);
-    }
-    // Plan, check on the line, and re-plan with more particles while the line does not confirm a
-    // found plan (`--refine`).
-    let mut problem = problem;
-    let mut refined: Vec<RefineRound> = Vec::new();
-    let (outcome, stats, checked) = loop {
-        let mut planner = Planner::new(&problem)?;
-        if args.fences {
-            planner.fences = Some(fence_transition(args, &problem)?);
-        }
-        let (outcome, stats) = pool.install(|| planner.search());
-        let plan = match &outcome {
-            Outcome::Found(p) => Some(p),
-            Outcome::NoneUpTo { best, .. }
-            | Outcome::Exhausted { best, .. }
-            | Outcome::LimitHit { best, .. } => best.as_ref(),
-        };
-        let checked = match plan {
-            Some(plan) => Some(emit_and_check(
-                args, &problem, &planner, plan, &command, &pool,
-            )?),
-            None => None,
-        };
-        let short = match (&outcome, &checked) {
-            (Outcome::Found(plan), Some(Checked { check: Some(c), .. })) => {
-                (c.success_rate < problem.target).then(|| RefineRound {
-                    particles: particles_text(&problem),
-                    obstacles: plan.steps.len(),
-                    predicted: plan.predicted_success,
-                    simulated: c.success_rate,
-                })
-            }
-            _ => None,
-        };
-        match short {
-            Some(round) if refined.len() < args.refine => {
-                refined.push(round);
-                problem = denser(&problem);
-            }
-            _ => break (outcome, stats, checked),
-        }
-    };
-    let what = if args.fences { "fence" } else { "pin" };
-    let (result, message, plan, failure) = describe(&problem, &outcome, &stats, what);
-    let (scenario, check, footprint_m, uncertain_check) = match checked {
-        Some(c) => (Some(c.toml), c.check, c.footprint_m, c.uncertain),
-        None => (None, None, None, None),
-    };
-    if let (Some(plan), Some(toml)) = (plan, &scenario) {
-        if let Some(draw) = args
-            .draw
-            .clone()
-            .or(args.out.as_ref().map(|o| o.with_extension("svg")))
-        {
-            if let Some(out) = &args.out {
-                write_file(out, toml)?;
-            }
-            crate::report::plot_plan::plot_plan(&problem, plan, &draw)
-                .with_context(|| format!("drawing {}", draw.display()))?;
-        }
-    }
-    let summary = PlanSummary {
-        result,
-        message: message.clone(),
-        obstacles: plan.map(|p| p.steps.len()),
-        predicted: plan.map(|p| p.predicted_success),
-        check: check.clone(),
-        uncertain_check: uncertain_check.clone(),
-        footprint_m,
-        depth_completed: stats.depth_completed,
-        search_s: stats.elapsed_s,
-        refined: refined.clone(),
-    };
-    let output = if args.json {
-        let report = PlanReport {
-            command,
-            problem: &problem,
-            result,
-            message,
-            refined,
-            plan,
-            stats: &stats,
-            check,
-            uncertain_check,
-            scenario,
-        };
-        serde_json::to_string_pretty(&report)? + "\n"
-    } else {
-        let mut t = format!("{command}\n");
-        for r in &refined {
-            t += &format!(
-                "refined     planned with {}, a plan of {} obstacle(s) (predicted {:.4}) held {:.4} on the line, below --target {}: re-planned with more particles\n",
-                r.particles, r.obstacles, r.predicted, r.simulated, problem.target
-            );
-        }
-        if !refined.is_empty() {
-            t += &format!("particles   {}\n", particles_text(&problem));
-        }
-        t += &stats_text(&stats);
-        t += &format!("result      {message}\n");
-        if let Some(plan) = plan {
-            if result != "found" {
-                t += "best effort (does not reach the goal):\n";
-            }
-            t += &plan_text(&problem, plan);
-        }
-        if let Some(c) = &check {
-            t += &check_text(c, plan.map_or(0.0, |p| p.predicted_success), "");
-        }
-        if let Some(c) = &uncertain_check {
-            t += &check_text(c, plan.map_or(0.0, |p| p.predicted_success), "")
-                .replacen("line check  ", "uncertain   ", 1)
-                .replacen(" parts:", " parts under the planned μc range / tripods:", 1);
-        }
-        if let (Some(out), Some(_)) = (&args.out, plan) {
-            let draw = args
-                .draw
-                .clone()
-                .unwrap_or_else(|| out.with_extension("svg"));
-            t += &format!("wrote       {} and {}\n", out.display(), draw.display());
-        }
-        t
-    };
-    Ok(Executed {
-        output,
-        summary,
-        failure,
-    })
-}
-
-impl CheckReport {
-    pub(crate) fn of(summary: &crate::engine::Summary, started: std::time::Instant) -> Self {
-        CheckReport {
-            parts: summary.parts_in,
-            success_rate: summary.success_rate,
-            success_ci95: summary.success_ci95,
-            outcomes: summary.outcomes,
-            elapsed_s: started.elapsed().as_secs_f64(),
-        }
-    }
-}
-
-/// The plan run under the uncertainty it was planned against (`--mu-c-range`, `--tripod`): a
-/// Monte Carlo study of `--check-parts` samples, written beside `--out` as `STEM.uncertain.toml`
-/// (so `pinfeed mc` reruns it) or to a temporary folder.
-fn check_uncertain(
-    args: &PlanArgs,
-    problem: &Problem,
-    toml: &str,
-    pool: &rayon::ThreadPool,
-) -> Result<Option<CheckReport>> {
-    let (dir, file) = match &args.out {
-        Some(out) => (
-            out.parent().map_or(PathBuf::from("."), Path::to_path_buf),
-            out.file_name()
-                .map_or("plan.toml".into(), |f| f.to_string_lossy().to_string()),
-        ),
-        None => (
-            std::env::temp_dir().join(format!("pinfeed_plan_uncertain_{}", std::process::id())),
-            "plan.toml".to_string(),
-        ),
-    };
-    let stem = file.trim_end_matches(".toml");
-    let study_file = format!("{stem}.uncertain.toml");
-    let Some(study) =
-        crate::plan::check::uncertainty_study(problem, &file, &study_file, args.check_parts)
-    else {
-        return Ok(None);
-    };
+    let bar = progress_bar(args.quiet || args.json);
     let started = std::time::Instant::now();
-    let (outcomes, n) = pool
-        .install(|| crate::plan::check::check_uncertain(toml, &study, &dir, &file, &study_file))?;
-    if args.out.is_none() {
-        let _ = std::fs::remove_dir_all(&dir);
+    let tell = |p: &design::Progress| {
+        if let Some(b) = &bar {
+            b.set_message(format!(
+                "{}{} · {} · {} candidate(s), {} line run(s) · {:.0} s",
+                p.mode.map_or("", |m| m.name()),
+                if p.round > 0 {
+                    format!(" round {}", p.round + 1)
+                } else {
+                    String::new()
+                },
+                p.stage,
+                p.candidates,
+                p.line_runs,
+                started.elapsed().as_secs_f64()
+            ));
+        }
+    };
+    let d = pool.install(|| design::design(&o, &tell))?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
     }
-    Ok(Some(CheckReport {
-        parts: n,
-        success_rate: outcomes.success as f64 / n.max(1) as f64,
-        success_ci95: crate::statistics::wilson_interval(outcomes.success, n),
-        outcomes,
-        elapsed_s: started.elapsed().as_secs_f64(),
-    }))
+    let sensor = d
+        .chosen()
+        .is_some_and(|c| matches!(c.layout, Layout::Contingent(_)));
+    let (scenario, policy, draw) = paths(args, &o, sensor);
+    let mut files = Vec::new();
+    if let (Some(c), Some(toml), false) = (d.chosen(), &d.scenario_toml, args.no_write) {
+        write(&scenario, toml)?;
+        files.push(scenario.display().to_string());
+        if let (Some(p), Some((_, text))) = (&policy, &d.policy_toml) {
+            write(p, text)?;
+            files.push(p.display().to_string());
+        }
+        draw_design(&o, c, &d, &draw)?;
+        files.push(draw.display().to_string());
+        if let Some(u) = &c.uncertain_check {
+            let file = scenario
+                .file_name()
+                .map_or("plan.toml".into(), |f| f.to_string_lossy().to_string());
+            let study_path = scenario.with_file_name(format!("{}.uncertain.toml", o.name));
+            let study_file = study_path
+                .file_name()
+                .map_or(String::new(), |f| f.to_string_lossy().to_string());
+            if let Some(study) =
+                crate::plan::check::uncertainty_study(&c.problem, &file, &study_file, u.parts)
+            {
+                write(&study_path, &study)?;
+                files.push(study_path.display().to_string());
+            }
+        }
+    }
+    let out = if args.json {
+        let c = d.chosen();
+        let doc = PlanJson {
+            schema_version: 1,
+            pinfeed_version: env!("CARGO_PKG_VERSION"),
+            command: &o.command,
+            status: d.status,
+            message: &d.message,
+            name: &o.name,
+            mode: c.map(|c| c.mode),
+            predicted_success: c.map(|c| c.predicted_success),
+            line_check: c.and_then(|c| c.line_check.as_ref()),
+            uncertain_check: c.and_then(|c| c.uncertain_check.as_ref()),
+            obstacles: c.map(|c| c.obstacles.as_slice()),
+            belt_length_m: c.map(|c| c.belt_length_m),
+            belt_width_m: c.map(|c| c.belt_width_m),
+            headway_s: c.map(|c| c.headway_s),
+            oriented_per_min: c.map(|c| c.oriented_per_min),
+            files,
+            limit: d.limit.as_deref(),
+            elapsed_s: d.elapsed_s,
+            candidates: &d.candidates,
+            chosen: c,
+            problem: &o.problem,
+            objective: o.objective,
+            scenario: d.scenario_toml.as_deref(),
+        };
+        serde_json::to_string_pretty(&doc)? + "\n"
+    } else {
+        text(&o, &d, &files)
+    };
+    print_result(&out)?;
+    match (d.status, &d.limit) {
+        (Status::Confirmed, _) => Ok(()),
+        (_, Some(limit)) => Err(anyhow!("{limit}: no confirmed design")),
+        (Status::NoDesign, None) => Err(super::Exit(4).into()),
+        _ => Err(super::Exit(3).into()),
+    }
 }
 
-/// The line check's line of the table (`extra` follows the prediction).
-pub(crate) fn check_text(c: &CheckReport, predicted: f64, extra: &str) -> String {
+fn write(path: &Path, text: &str) -> Result<()> {
+    crate::plan::design::line::write_whole(path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// A spinner on standard error when it is a terminal (and not `quiet`).
+fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let b = indicatif::ProgressBar::new_spinner();
+    b.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} plan: {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    b.enable_steady_tick(std::time::Duration::from_millis(120));
+    Some(b)
+}
+
+/// The drawing's title: the verdict with the line's number beside the prediction.
+fn title(o: &DesignOptions, c: &Candidate, d: &Design) -> String {
+    let verdict = match c.verdict_check() {
+        Some(l) => format!(
+            "{}: line {:.3} [{:.3}, {:.3}] of {} parts, target {}",
+            d.status.word(),
+            l.success_rate,
+            l.ci95[0],
+            l.ci95[1],
+            l.parts,
+            o.problem.target
+        ),
+        None => "unchecked".into(),
+    };
     format!(
-        "line check  {} parts: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}{extra}; {} ({:.1} s)\n",
-        c.parts,
-        c.success_rate,
-        c.success_ci95[0],
-        c.success_ci95[1],
-        predicted,
-        outcome_mix(&c.outcomes),
-        c.elapsed_s
+        "{} — {}; {verdict}; predicted {:.3}",
+        o.name,
+        describe_obstacles(c),
+        c.predicted_success
     )
 }
 
-/// The fence planner's transition from the arguments (`--fences`).
-fn fence_transition(args: &PlanArgs, problem: &Problem) -> Result<FenceTransition> {
-    let mu_f = args.mu_f.unwrap_or(problem.mu_c);
-    if !(mu_f.is_finite() && mu_f >= 0.0) {
-        bail!("--mu-f {mu_f}: must be a finite number ≥ 0");
+fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) -> Result<()> {
+    let t = title(o, c, d);
+    let tmp = path.with_file_name(format!(
+        ".{}.tmp{}.svg",
+        path.file_stem()
+            .map_or("plan".into(), |s| s.to_string_lossy()),
+        std::process::id()
+    ));
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    if !(args.fence_overhang.is_finite() && args.fence_overhang >= 0.0) {
-        bail!(
-            "--fence-overhang {}: must be a finite number ≥ 0",
-            args.fence_overhang
-        );
+    let res = match &c.layout {
+        Layout::Sequence(plan) => crate::report::plot_plan::plot_plan(&c.problem, plan, &t, &tmp),
+        Layout::Contingent(plan) => {
+            let mut planner = crate::plan::search::Planner::new(&c.problem)?;
+            let stages = crate::plan::contingent::stage_states(&mut planner, plan)?;
+            crate::report::plot_plan::plot_contingent(&c.problem, plan, &stages, &t, &tmp)
+        }
     }
-    if !args.max_fence_angle.is_finite() {
-        bail!(
-            "--max-fence-angle {}: must be a finite angle in degrees",
-            args.max_fence_angle
-        );
+    .and_then(|_| std::fs::rename(&tmp, path).map_err(Into::into));
+    if res.is_err() {
+        let _ = std::fs::remove_file(&tmp);
     }
-    if !(args.fence_angle_step.is_finite() && (0.5..=45.0).contains(&args.fence_angle_step)) {
-        bail!(
-            "--fence-angle-step {}: must lie in [0.5, 45] degrees",
-            args.fence_angle_step
-        );
-    }
-    let mut opts =
-        crate::plan::FenceOptions::grid(mu_f, args.fence_angle_step, args.max_fence_angle);
-    opts.overhang_a = args.fence_overhang;
-    if opts.angles_deg.is_empty() {
-        bail!(
-            "--max-fence-angle {}: no candidate angle (from ±15°, below the jam limit {:.1}° for μf {mu_f}) is left",
-            args.max_fence_angle,
-            90.0 - mu_f.atan().to_degrees()
-        );
-    }
-    Ok(FenceTransition::new(opts))
+    res.with_context(|| format!("drawing {}", path.display()))
 }
 
-/// The result word, the message, the plan to emit (found or best effort) and the failure message
-/// (a limit) of a search.
-fn describe<'a>(
-    problem: &Problem,
-    outcome: &'a Outcome,
-    stats: &SearchStats,
-    what: &str,
-) -> (&'static str, String, Option<&'a Plan>, Option<String>) {
-    let best_text = |best: &Option<Plan>| {
-        best.as_ref().map_or(
-            format!("; no {what} sequence brings more of them into one window than the feed"),
-            |b| {
-                format!(
-                    "; the best effort, {} {what}(s), brings {:.4} of them into one window",
-                    b.steps.len(),
-                    b.predicted_success
-                )
-            },
-        )
-    };
-    match outcome {
-        Outcome::Found(p) => {
-            let m = if problem.fewest_sets {
-                format!(
-                    "found a plan of {} {what}(s) to {} orientation set(s), the fewest up to depth {}",
-                    p.steps.len(),
-                    p.sets,
-                    stats.depth_completed.max(p.steps.len())
-                )
-            } else {
-                format!("found a shortest plan: {} {what}(s)", p.steps.len())
-            };
-            ("found", m, Some(p), None)
-        }
-        Outcome::NoneUpTo { depth, best } => (
-            "none_up_to_depth",
-            format!(
-                "no sensorless plan up to depth {depth}: every plan of at most {depth} {what}s in this action set leaves less than {} of the parts in one ±{}° window{}",
-                problem.target,
-                problem.tolerance_deg,
-                best_text(best)
-            ),
-            best.as_ref(),
-            None,
-        ),
-        Outcome::Exhausted { depth, best } => (
-            "exhausted",
-            format!(
-                "no sensorless plan at any depth: after {depth} {what}(s) no new state that could still reach the goal is reachable in this action set{}{}",
-                if *depth == 0 {
-                    " (no position keeps every particle at least --min-margin from a band edge; try a smaller --min-margin)"
-                } else {
+/// The printed result.
+fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
+    let p = &o.problem;
+    let mut t = format!("{}\n", o.command);
+    t += &format!(
+        "design      {}: modes {}; objective {:?}; goal ≥ {} of the parts in one ±{}° window, on the line\n",
+        o.name,
+        o.modes.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "),
+        o.objective,
+        p.target,
+        p.tolerance_deg
+    );
+    t += "candidates  mode     round  particles  search                obstacles                        belt (m)  width (m)  predicted  line (parts, headway)\n";
+    for (i, c) in d.candidates.iter().enumerate() {
+        let line = match c.measured() {
+            Some(l) => format!(
+                "{:.4} [{:.4}, {:.4}] ({}, {} s){}",
+                l.success_rate,
+                l.ci95[0],
+                l.ci95[1],
+                l.parts,
+                design::line::fmt_headway(l.headway_s),
+                if c.line_check.is_some() {
                     ""
-                },
-                best_text(best)
+                } else {
+                    " screen"
+                }
             ),
-            best.as_ref(),
-            None,
-        ),
-        Outcome::LimitHit {
-            limit,
-            depth_completed,
-            best,
-        } => {
-            let msg = format!(
-                "search stopped by its {limit} after completing depth {depth_completed} ({} states kept): no plan of at most {depth_completed} {what}(s) reaches the goal; deeper levels were not finished{}",
-                stats.states_per_depth.iter().sum::<usize>(),
-                best_text(best)
+            None => "not run".into(),
+        };
+        t += &format!(
+            "  {}{:<2}      {:<8} {:<6} {:>9}  {:<21} {:<32} {:>8.3}  {:>9.3}  {:>9.4}  {line}\n",
+            if Some(i) == d.chosen { "*" } else { " " },
+            i + 1,
+            c.mode.name(),
+            c.round,
+            c.search.particles,
+            format!("{} {:.1} s", c.search.result, c.search.elapsed_s),
+            describe_obstacles(c),
+            c.belt_length_m,
+            c.belt_width_m,
+            c.predicted_success
+        );
+    }
+    t += &format!("result      {}\n", d.message);
+    if let Some(c) = d.chosen() {
+        if let Some(l) = &c.line_check {
+            t += &format!(
+                "line check  {} parts at headway {} s: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}{}; {} ({:.1} s)\n",
+                l.parts,
+                design::line::fmt_headway(l.headway_s),
+                l.success_rate,
+                l.ci95[0],
+                l.ci95[1],
+                c.predicted_success,
+                c.predicted_with_confusion.map_or(String::new(), |w| format!(
+                    " (perfect classifier), {w:.4} with the line's confusion (sensor accuracy {:.4})",
+                    c.sensor_accuracy.unwrap_or(0.0)
+                )),
+                outcome_mix(&l.outcomes),
+                l.elapsed_s
             );
-            ("limit", msg.clone(), best.as_ref(), Some(msg))
+            if let Some(u) = &c.uncertain_check {
+                t += &format!(
+                    "uncertain   {} samples under the planned μc range / tripods: success {:.4} (95% CI {:.4}–{:.4}); {} — the verdict\n",
+                    u.parts,
+                    u.success_rate,
+                    u.ci95[0],
+                    u.ci95[1],
+                    outcome_mix(&u.outcomes)
+                );
+            }
+            t += &format!(
+                "headway     {} s, the shortest with no collision and no loss of success over {} probe(s), with a 25% reserve: {:.2} oriented parts per minute\n",
+                design::line::fmt_headway(c.headway_s),
+                c.headway_probes.len(),
+                c.oriented_per_min
+            );
+        }
+        t += &format!(
+            "belt        length {:.3} m, width {:.3} m\n",
+            c.belt_length_m, c.belt_width_m
+        );
+        for ob in &c.obstacles {
+            t += &format!(
+                "  {:<10} {:<8} x {:.3} m  y {:+7.2} mm{}{}\n",
+                ob.kind,
+                ob.name,
+                ob.x_m,
+                ob.y_m * 1e3,
+                ob.angle_deg.map_or(String::new(), |a| format!(
+                    "  angle {a:+}°  length {:.4} m",
+                    ob.length_m.unwrap_or(0.0)
+                )),
+                if ob.targets_m.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "  targets (mm) [{}]",
+                        ob.targets_m
+                            .iter()
+                            .map(|y| format!("{:+.2}", y * 1e3))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                }
+            );
         }
     }
+    if let Some(l) = &d.limit {
+        t += &format!("limit       {l}\n");
+    }
+    t += &format!("time        {:.1} s\n", d.elapsed_s);
+    if !files.is_empty() {
+        t += &format!("wrote       {}\n", files.join(", "));
+    }
+    t
 }
 
+/// "success 9987, wrong_orientation 13".
 pub(crate) fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
     let parts = [
         ("success", o.success),
@@ -922,11 +758,4 @@ pub(crate) fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
         .map(|(k, n)| format!("{k} {n}"))
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-pub(crate) fn write_file(path: &Path, text: &str) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }

@@ -70,6 +70,9 @@ pub fn pin_actions(
         .map(|p| (p.sample, p.theta_q))
         .collect();
     tr.ensure_columns(&cols);
+    if tr.expired() {
+        return Vec::new();
+    }
     // Cuts: pin positions c where some particle's signature differs between c − 1 and c.
     let mut cuts: Vec<i32> = Vec::new();
     let columns: Vec<_> = cols.iter().map(|&(s, t)| tr.column_of(s, t)).collect();
@@ -122,6 +125,9 @@ pub fn pin_actions(
         }
     }
     tr.ensure(&keys);
+    if tr.expired() {
+        return Vec::new();
+    }
     let mut out = Vec::with_capacity(intervals.len());
     for (s, e, rep, margin) in intervals {
         let next = tr.apply(state, rep);

@@ -239,7 +239,11 @@ pub fn branch_states(planner: &Planner) -> Result<Vec<State>, PlanError> {
     let robust = p.tripod || p.mu_c_range.is_some();
     let per = p.jitter_samples * p.offset_samples;
     let mut out = vec![Vec::new(); c.stable_deg.len()];
-    for (i, (t, y)) in feed_samples(p, c).into_iter().enumerate() {
+    for (i, (t, y)) in feed_samples(p, c)
+        .into_iter()
+        .take(c.stable_deg.len() * per)
+        .enumerate()
+    {
         out[i / per].push(Particle {
             sample: if robust { i as u32 } else { 0 },
             theta_q: theta_quanta(t, p.theta_quantum_deg, c.theta_steps),
@@ -291,6 +295,16 @@ pub fn search(
         sensor_candidates: sensors.len(),
         ..ContingentStats::default()
     };
+    if planner.transition.expired() {
+        stats.elapsed_s = started.elapsed().as_secs_f64();
+        return Ok((
+            ContingentOutcome::LimitHit {
+                limit: format!("time limit {} s", p.time_limit_s),
+                depth_completed: 0,
+            },
+            stats,
+        ));
+    }
     if sensors.is_empty() {
         return Err(PlanError::input(
             "--min-margin",
@@ -317,7 +331,10 @@ pub fn search(
                 for bs in row.iter_mut() {
                     new += bs.level(planner, width_q, steps);
                     kept += bs.nodes.len();
-                    if started.elapsed().as_secs_f64() > p.time_limit_s || kept >= p.max_states {
+                    if started.elapsed().as_secs_f64() > p.time_limit_s
+                        || planner.transition.expired()
+                        || kept >= p.max_states
+                    {
                         let limit = if kept >= p.max_states {
                             format!("state limit {} (--max-states)", p.max_states)
                         } else {

@@ -23,106 +23,148 @@ fn num(x: f64, digits: usize) -> String {
     }
 }
 
-/// The scenario of a plan. `parts` is the feed's part count (the line check's), `command` the
-/// command line that wrote it, `symmetry` the order of the part's rotational symmetry, `file` the scenario's file name, `stable_count` the part's number of stable states.
-pub fn scenario_toml(
+/// How an emitted line is laid out and fed: its name (the scenario's `name`, which names its
+/// output folder), the seconds between parts, the belt width (m) and the feed's part count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LineSpec {
+    pub name: String,
+    pub headway_s: f64,
+    pub belt_width_m: f64,
+    pub parts: u64,
+}
+
+/// Where the obstacles of a sequence plan stand along the belt: each step's x (m; a fence's
+/// upstream end) and the belt length. The first obstacle stands one spacing in; after a pin the
+/// next one follows one spacing on, after a fence [`super::fences::fence_gap_m`] past its
+/// downstream end (so a part touches one obstacle at a time); the belt ends one spacing after
+/// the last pin, or a gap and a spacing after the last fence.
+pub fn layout(problem: &Problem, plan: &Plan, radius_m: f64) -> (Vec<f64>, f64) {
+    let gap = super::fences::fence_gap_m(radius_m);
+    let sp = problem.spacing_m;
+    let mut xs = Vec::with_capacity(plan.steps.len());
+    let mut cursor = sp;
+    let mut last_fence = false;
+    for step in &plan.steps {
+        xs.push(cursor);
+        match step.action {
+            Action::Pin(_) => {
+                cursor += sp;
+                last_fence = false;
+            }
+            Action::Fence(f) => {
+                cursor += f.x_extent_m() + gap;
+                last_fence = true;
+            }
+        }
+    }
+    let length = if last_fence { cursor + sp } else { cursor };
+    (xs, length)
+}
+
+/// The body of a sequence plan's scenario (pins, fences, or both in belt order), without the
+/// header ([`header`]): the line of `line`, the feed the plan was made for and the goal.
+pub fn sequence_toml(
     problem: &Problem,
     plan: &Plan,
     stable_count: usize,
     symmetry: u32,
-    parts: u64,
-    command: &str,
-    file: &str,
+    line: &LineSpec,
 ) -> String {
-    if plan
-        .steps
-        .iter()
-        .any(|s| matches!(s.action, Action::Fence(_)))
-    {
-        return fence_scenario_toml(problem, plan, stable_count, symmetry, parts, command, file);
-    }
-    let n = plan.steps.len();
-    let sp = problem.spacing_m;
-    let mut t = String::new();
-    let name = format!("plan_{}", crate::cli::part_folder(&problem.part));
-    t += &plan_header(
-        problem,
-        plan,
-        ("", "sensorless pin", "pin"),
-        &format!(
-            "pin intervals with margin ≥ {} mm",
-            problem.min_margin_m * 1e3
-        ),
-        command,
-        file,
-    );
-    let length = sp * (n as f64 + 1.0);
-    t += &line_sections(&name, problem, (length, "pin"), stable_count, parts, None);
-    for (k, step) in plan.steps.iter().enumerate() {
-        let Action::Pin(pin) = step.action else {
-            continue;
-        };
-        t += &format!(
-            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{}\"\nx = {}\ny = {}\nradius = {}\n",
-            pin.margin_m * 1e3,
-            step.sets,
-            step.window.share,
-            k + 1,
-            num(sp * (k as f64 + 1.0), 6),
-            num(pin.y_m, 6),
-            num(problem.pin_radius_m, 6),
-        );
+    let radius = problem.compile().map(|c| c.radius).unwrap_or(0.0);
+    let (xs, length) = layout(problem, plan, radius);
+    let mut t = line_sections(problem, line, length, stable_count);
+    let (mut pins, mut fences) = (0, 0);
+    for (step, x) in plan.steps.iter().zip(&xs) {
+        match step.action {
+            Action::Pin(pin) => {
+                pins += 1;
+                t += &format!(
+                    "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{pins}\"\nx = {}\ny = {}\nradius = {}\n",
+                    pin.margin_m * 1e3,
+                    step.sets,
+                    step.window.share,
+                    num(*x, 6),
+                    num(pin.y_m, 6),
+                    num(problem.pin_radius_m, 6),
+                );
+            }
+            Action::Fence(f) => {
+                fences += 1;
+                t += &format!(
+                    "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"fence\"\nname = \"fence{fences}\"\nx = {}             # m: the upstream end\ny = {}\nangle = {}          # degrees\nlength = {}\nmu_f = {}\n",
+                    f.margin_m * 1e3,
+                    step.sets,
+                    step.window.share,
+                    num(*x, 6),
+                    num(f.y0_m, 6),
+                    num(f.angle_deg, 6),
+                    num(f.length_m, 6),
+                    num(f.mu_f, 6),
+                );
+            }
+        }
     }
     t += &goal_and_model(problem, plan.window.centre_deg, symmetry);
     t
 }
 
-/// The header of an emitted sensorless plan: the command that wrote it, what the plan claims (a
-/// shortest plan or a best effort) over which abstraction (`rule`: how its actions are placed),
-/// its prediction, the uncertainty it was planned against, and how to run it. `words`: the
-/// command's flag, the planner's name and the action's name.
-fn plan_header(
-    problem: &Problem,
-    plan: &Plan,
-    (flag, planner, what): (&str, &str, &str),
-    rule: &str,
-    command: &str,
-    file: &str,
-) -> String {
-    let mut t = format!(
-        "# Written by `pinfeed plan{flag}` ({planner} planner, issue 14):\n#\n#   {command}\n#\n"
-    );
-    t += &best_effort_note(problem, plan, what);
-    t += &format!(
-        "# {} {what}(s), {} (BFS over {} particle(s), θ rounded to {}°,\n",
-        plan.steps.len(),
-        kind_of(problem, plan),
+/// A scenario file's header: `lines` as comments (each already a sentence), then how to run it.
+pub fn header(lines: &[String], file: &str) -> String {
+    let mut t = String::new();
+    for l in lines {
+        if l.is_empty() {
+            t += "#\n";
+        } else {
+            for w in l.lines() {
+                t += &format!("# {w}\n");
+            }
+        }
+    }
+    t += &format!("#\n#   pinfeed run {file}\n\n");
+    t
+}
+
+/// What a sequence plan claims over which abstraction: its kind (a shortest plan or a best
+/// effort), the particles, quanta and action rule, and its prediction (header lines).
+pub fn prediction_lines(problem: &Problem, plan: &Plan) -> Vec<String> {
+    let pins = plan
+        .steps
+        .iter()
+        .filter(|s| matches!(s.action, Action::Pin(_)))
+        .count();
+    let fences = plan.steps.len() - pins;
+    let what = match (pins, fences) {
+        (_, 0) => format!("{pins} pin(s)"),
+        (0, _) => format!("{fences} fence(s)"),
+        _ => format!("{pins} pin(s) and {fences} fence(s)"),
+    };
+    let kind = if reaches_goal(problem, plan) {
+        "a shortest plan for its action set"
+    } else {
+        "BEST EFFORT: no plan in the search reached the goal; the shortest of those bringing the most particles into one window"
+    };
+    let mut l = vec![format!(
+        "Prediction: {what}, {kind} (BFS over {} particle(s), θ rounded to {}°, y to {} mm, margins ≥ {} mm): {:.4} ({} of {} particles within {}° ± {}°).",
         plan.initial.total(),
-        problem.theta_quantum_deg
-    );
-    t += &format!(
-        "# y to {} mm; {rule}). Predicted success {:.4} ({} of {}\n",
+        problem.theta_quantum_deg,
         problem.y_quantum_m * 1e3,
+        problem.min_margin_m * 1e3,
         plan.predicted_success,
         plan.window.inside,
         plan.initial.total(),
-    );
-    t += &format!(
-        "# particles within {}° ± {}°).",
         num(plan.window.centre_deg, 2),
         problem.tolerance_deg
-    );
+    )];
     if let Some((lo, hi)) = problem.mu_c_range {
-        t += &format!(
-            " Planned against μc ∈ [{lo}, {hi}] per part (the line uses μc = {}).",
+        l.push(format!(
+            "Planned against μc ∈ [{lo}, {hi}] per part (the line uses μc = {}).",
             problem.mu_c
-        );
+        ));
     }
     if problem.tripod {
-        t += " Planned against random tripod supports.";
+        l.push("Planned against random tripod supports.".into());
     }
-    t += &format!("\n#\n#   pinfeed run {file}\n\n");
-    t
+    l
 }
 
 /// Does the plan reach the problem's goal (or is it the best effort of a search that found none)?
@@ -130,113 +172,27 @@ fn reaches_goal(problem: &Problem, plan: &Plan) -> bool {
     problem.fewest_sets || plan.predicted_success >= problem.target - 1e-12
 }
 
-fn kind_of(problem: &Problem, plan: &Plan) -> &'static str {
-    if reaches_goal(problem, plan) {
-        "a shortest plan for its action set"
+/// The part's label as a scenario names it (what a policy file's `part` must match): the shape
+/// name, or `vertices` for a vertex list.
+pub fn scenario_part_label(part: &str) -> String {
+    let p = part.trim();
+    if p.to_lowercase().starts_with("vertices:") {
+        "vertices".into()
     } else {
-        "the shortest of those bringing the most particles into one window"
+        p.to_string()
     }
 }
 
-/// The header line that marks a best-effort plan (none reaches the goal).
-fn best_effort_note(problem: &Problem, plan: &Plan, what: &str) -> String {
-    if reaches_goal(problem, plan) {
-        return String::new();
-    }
-    format!(
-        "# BEST EFFORT: no plan in the search reaches the goal ({} of the parts in one window); these\n# {what}s come closest.\n#\n",
-        problem.target
-    )
-}
-
-/// The scenario of a fence plan (the fence planner, [`super::fences`]): fences one after another
-/// along the belt (the first upstream end one spacing in, then the gap of
-/// [`super::fences::layout`]), each a `kind = "fence"` obstacle from its upstream end, parts every
-/// [`super::fences::headway_s`] apart (a part sliding along a fence lags the belt).
-#[allow(clippy::too_many_arguments)]
-pub fn fence_scenario_toml(
-    problem: &Problem,
-    plan: &Plan,
-    stable_count: usize,
-    symmetry: u32,
-    parts: u64,
-    command: &str,
-    file: &str,
-) -> String {
-    let fences: Vec<super::FenceAction> = plan
-        .steps
-        .iter()
-        .filter_map(|s| match s.action {
-            Action::Fence(f) => Some(f),
-            Action::Pin(_) => None,
-        })
-        .collect();
-    let radius = problem.compile().map(|c| c.radius).unwrap_or(0.0);
-    let (xs, end) = super::fences::layout(&fences, radius, problem.spacing_m);
-    let mut t = String::new();
-    let name = format!("plan_{}_fences", crate::cli::part_folder(&problem.part));
-    t += &plan_header(
-        problem,
-        plan,
-        (" --fences", "sensorless fence", "fence"),
-        "each fence's upstream end clear of every part's reach",
-        command,
-        file,
-    );
-    // Parts lag the belt along the fences: they are fed further apart.
-    let headway = super::fences::headway_s(&fences, radius, BELT_SPEED);
-    let length = end + problem.spacing_m;
-    t += &line_sections(
-        &name,
-        problem,
-        (length, "fence"),
-        stable_count,
-        parts,
-        Some(headway),
-    );
-    for (k, (f, x)) in fences.iter().zip(&xs).enumerate() {
-        let step = &plan.steps[k];
-        t += &format!(
-            "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"fence\"\nname = \"fence{}\"\nx = {}             # m: the upstream end\ny = {}\nangle = {}          # degrees\nlength = {}\nmu_f = {}\n",
-            f.margin_m * 1e3,
-            step.sets,
-            step.window.share,
-            k + 1,
-            num(*x, 6),
-            num(f.y0_m, 6),
-            num(f.angle_deg, 6),
-            num(f.length_m, 6),
-            num(f.mu_f, 6),
-        );
-    }
-    t += &goal_and_model(problem, plan.window.centre_deg, symmetry);
-    t
-}
-
-/// The `[part]`, `[feed]` and `[feed.lateral]` sections of a planned scenario.
 /// The belt speed of every planned line (m/s).
-const BELT_SPEED: f64 = 0.05;
-/// Seconds between parts on a planned pin line.
-const HEADWAY_S: f64 = 4.0;
+pub const BELT_SPEED: f64 = 0.05;
 
-/// The name, `[belt]` (`length` m: one spacing after the last `obstacle`), `[part]`, `[feed]` and
-/// `[feed.lateral]` sections of a planned scenario; `headway` (s) replaces the default spacing of
-/// parts where the obstacles make them lag.
-fn line_sections(
-    name: &str,
-    problem: &Problem,
-    (length, obstacle): (f64, &str),
-    stable_count: usize,
-    parts: u64,
-    headway: Option<f64>,
-) -> String {
-    let mut t = format!("name = \"{name}\"\nseed = {}\n\n", problem.seed);
+/// The name, `[belt]` (`length` m), `[part]`, `[feed]` and `[feed.lateral]` sections of a
+/// planned scenario.
+fn line_sections(problem: &Problem, line: &LineSpec, length: f64, stable_count: usize) -> String {
+    let mut t = format!("name = \"{}\"\nseed = {}\n\n", line.name, problem.seed);
     t += &format!("[belt]\nspeed = {BELT_SPEED}        # m/s\n");
-    t += &format!("width = {}\n", num(problem.belt_width_m, 6));
-    t += &format!(
-        "length = {}        # m: one spacing after the last {obstacle}\n\n",
-        num(length, 6)
-    );
+    t += &format!("width = {}\n", num(line.belt_width_m, 6));
+    t += &format!("length = {}        # m\n\n", num(length, 6));
     t += "[part]\n";
     if let Some(v) = problem.part.trim().strip_prefix("vertices:") {
         let pts = crate::geometry::named::parse_vertex_list(v).unwrap_or_default();
@@ -254,13 +210,11 @@ fn line_sections(
         "support = \"{}\"\n\n",
         if problem.tripod { "tripod" } else { "uniform" }
     );
-    t += &match headway {
-        None => format!("[feed]\nparts = {parts}\narrival = \"periodic\"\nheadway = {HEADWAY_S:.1}\n"),
-        Some(h) => format!(
-            "[feed]\nparts = {parts}\narrival = \"periodic\"\nheadway = {}        # s: parts lag the belt along the fences\n",
-            num(h, 3)
-        ),
-    };
+    t += &format!(
+        "[feed]\nparts = {}\narrival = \"periodic\"\nheadway = {}        # s: chosen on the line (see the header)\n",
+        line.parts,
+        num(line.headway_s, 3)
+    );
     match problem.feed {
         FeedKind::Stable => {
             let w = vec!["1"; stable_count].join(", ");
@@ -300,45 +254,22 @@ fn goal_and_model(problem: &Problem, centre_deg: f64, symmetry: u32) -> String {
     t
 }
 
-/// The scenario and policy file of a contingent plan: (scenario TOML, policy TOML). `policy_file`
-/// is the policy's file name as the scenario refers to it (relative to the scenario).
-#[allow(clippy::too_many_arguments)]
+/// The body (no header: [`header`]) and policy file of a contingent plan: (scenario TOML,
+/// policy TOML). `policy_file` is the policy's file name as the scenario refers to it (relative to
+/// the scenario).
 pub fn contingent_toml(
     problem: &Problem,
     plan: &super::contingent::ContingentPlan,
     stable_count: usize,
     symmetry: u32,
-    parts: u64,
-    command: &str,
-    file: &str,
+    line: &LineSpec,
     policy_file: &str,
 ) -> (String, String) {
     let sp = problem.spacing_m;
     let k = plan.k;
-    let half = problem.belt_width_m / 2.0;
-    let mut t = String::new();
-    let name = format!("plan_{}_sensing", crate::cli::part_folder(&problem.part));
-    t += &format!(
-        "# Written by `pinfeed plan --sensor` (contingent planner with sensing, issue 14):\n#\n#   {command}\n#\n"
-    );
-    t += &format!(
-        "# A force/torque sensor pin reads the stable state; {k} moving pin(s) then take, per part, the\n# lateral position the policy ({policy_file}) gives for the decision. The fewest moving pins for\n"
-    );
-    t += &format!(
-        "# its action set (BFS per branch over {} particle(s), θ rounded to {}°, y to {} mm, margins ≥ {} mm).\n",
-        plan.branches.iter().map(|b| b.total).sum::<u32>(),
-        problem.theta_quantum_deg,
-        problem.y_quantum_m * 1e3,
-        problem.min_margin_m * 1e3
-    );
-    t += &format!(
-        "# Predicted success {:.4} with a perfect classifier, within {}° ± {}°.\n#\n#   pinfeed run {file}\n\n",
-        plan.predicted_success,
-        num(plan.centre_deg, 2),
-        problem.tolerance_deg
-    );
+    let half = line.belt_width_m / 2.0;
     let length = sp * (k as f64 + 2.0);
-    t += &line_sections(&name, problem, (length, "pin"), stable_count, parts, None);
+    let mut t = line_sections(problem, line, length, stable_count);
     t += &format!(
         "\n[[obstacles]]   # the sensor (margin {:.2} mm)\nkind = \"sensor_pin\"\nname = \"probe\"\nx = {}\ny = {}\nradius = {}\n",
         plan.sensor.margin_m * 1e3,
@@ -349,8 +280,9 @@ pub fn contingent_toml(
     t += "\n[obstacles.sensor]\ntype = \"ft\"\nrate = 1000          # Hz\nheight = 0.02        # m\nclassifier = \"likelihood\"\ntemplates = 32       # per stable state\n";
     let mut rules = String::new();
     rules += &format!(
-        "# Policy of {file} (written by `pinfeed plan --sensor`): per decision of the sensor pin\n# `probe`, the lateral position of each moving pin.\n\npart = \"{}\"\n",
-        problem.part.trim()
+        "# Policy of {} (written by `pinfeed plan`): per decision of the sensor pin `probe`, the\n# lateral position of each moving pin.\n\npart = \"{}\"\n",
+        line.name,
+        scenario_part_label(&problem.part)
     );
     for j in 0..k {
         let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j]).collect();

@@ -235,8 +235,17 @@ impl FenceTransition {
         let this = &*self;
         let out: Vec<FenceOutcome> = missing
             .par_iter()
-            .map(|&k| this.pass(tr, problem, k))
+            .map(|&k| {
+                if tr.past_deadline() {
+                    None
+                } else {
+                    this.pass(tr, problem, k)
+                }
+            })
             .collect();
+        if tr.expired() {
+            return Vec::new();
+        }
         self.computed += out.len() as u64;
         self.memo.extend(missing.into_iter().zip(out));
         let mut res = Vec::new();

@@ -51,6 +51,7 @@ pub mod actions;
 pub mod bound;
 pub mod check;
 pub mod contingent;
+pub mod design;
 pub mod emit;
 pub mod fences;
 pub mod particles;

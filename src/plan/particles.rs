@@ -165,12 +165,13 @@ pub fn feed_samples(problem: &Problem, compiled: &Compiled) -> Vec<(f64, f64)> {
             }
         }
     }
-    let mut out = Vec::with_capacity(thetas.len() * no);
+    let mut out = Vec::with_capacity(thetas.len() * no + problem.extra_samples.len());
     for &t in &thetas {
         for &y in &offsets {
             out.push((t, y));
         }
     }
+    out.extend(problem.extra_samples.iter().copied());
     out
 }
 

@@ -69,6 +69,14 @@ pub struct Problem {
     /// Integration tolerance of the contact model while planning.
     pub contact_tol: f64,
     pub seed: u64,
+    /// Extra feed particles (θ degrees, y metres) after the stratified ones: parts the line
+    /// check found failing, added where the abstraction missed them (see [`super::design`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub extra_samples: Vec<(f64, f64)>,
+    /// No contact pass is computed past this instant (the whole command's time limit); the
+    /// search then ends with its time limit.
+    #[serde(skip)]
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Problem {
@@ -102,6 +110,8 @@ impl Problem {
             time_limit_s: 600.0,
             contact_tol: 1e-5,
             seed: 1,
+            extra_samples: Vec::new(),
+            deadline: None,
         }
     }
 
@@ -178,6 +188,13 @@ impl Problem {
             ));
         }
         finite_pos("--belt-width", self.belt_width_m)?;
+        if self.belt_width_m > 10.0 {
+            return Err(PlanError::input(
+                "--belt-width",
+                self.belt_width_m,
+                "must lie in (0, 10] m",
+            ));
+        }
         if self.belt_width_m < 2.0 * a {
             return Err(PlanError::input(
                 "--belt-width",
@@ -201,6 +218,13 @@ impl Problem {
             ));
         }
         finite_pos("--spacing", self.spacing_m)?;
+        if self.spacing_m > 10.0 {
+            return Err(PlanError::input(
+                "--spacing",
+                self.spacing_m,
+                "must lie in [2.5a, 10] m",
+            ));
+        }
         if self.spacing_m < 2.5 * a {
             return Err(PlanError::input(
                 "--spacing",

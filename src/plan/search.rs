@@ -122,8 +122,10 @@ pub struct Planner {
     pub compiled: Compiled,
     pub transition: Transition,
     pub initial: State,
-    /// With fences: the fence actions replace the pin actions.
+    /// With fences: the fence actions replace the pin actions (or, with `hybrid`, join them).
     pub fences: Option<super::fences::FenceTransition>,
+    /// With fences: pins and fences in one action set (a line may mix them).
+    pub hybrid: bool,
 }
 
 struct Node {
@@ -145,6 +147,7 @@ impl Planner {
             transition,
             initial,
             fences: None,
+            hybrid: false,
         })
     }
 
@@ -158,7 +161,17 @@ impl Planner {
     pub fn actions_worth(&mut self, state: &State, worth: Option<Worth>) -> Vec<(Action, State)> {
         if let Some(f) = self.fences.as_mut() {
             let steps = self.compiled.theta_steps;
-            return f.actions(state, &self.transition, &self.problem, steps);
+            let mut out = f.actions(state, &self.transition, &self.problem, steps);
+            if !self.hybrid {
+                return out;
+            }
+            out.extend(pin_actions(
+                state,
+                &mut self.transition,
+                self.problem.min_margin_m,
+                worth,
+            ));
+            return out;
         }
         pin_actions(
             state,
@@ -256,7 +269,8 @@ impl Planner {
             let mut next = Vec::new();
             let mut open = 0usize;
             for &id in &frontier {
-                if run.started.elapsed().as_secs_f64() > p.time_limit_s {
+                if run.started.elapsed().as_secs_f64() > p.time_limit_s || self.transition.expired()
+                {
                     let limit = format!("time limit {} s", p.time_limit_s);
                     return self.limit(run, limit, depth - 1);
                 }

@@ -26,7 +26,9 @@ use crate::mechanics::{push, ContactSettings, ContactStatus, Fidelity, PartModel
 use rand::RngExt;
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use std::time::Instant;
 
 /// Signature of a pass without contact.
 pub const NO_CONTACT: u32 = 0;
@@ -83,6 +85,10 @@ pub struct Transition {
     memo: HashMap<PassKey, PassOutcome>,
     columns: HashMap<(u32, i32), Arc<Vec<u32>>>,
     pub counters: PushCounters,
+    /// Past this instant no pass is computed: [`Transition::expired`] turns true and the batch
+    /// in progress is dropped (a search then stops with its time limit).
+    deadline: Option<Instant>,
+    expired: AtomicBool,
 }
 
 /// Stream of the physics samples (each particle's own μc and tripod).
@@ -96,12 +102,17 @@ impl Transition {
             part: problem.part.clone(),
             reason,
         };
-        // Every pass at the nominal μc shares this model: its exact slides come from tables.
-        let uniform = Arc::new(
-            PartModel::new(&compiled.polygon, &Support::Uniform)
-                .map_err(part_err)?
-                .with_slide_tables(&[problem.mu_c]),
-        );
+        // Every pass at the nominal μc shares this model: its exact slides come from tables,
+        // built per edge on first use. A table costs ~10³ limit-surface evaluations, each linear
+        // in the vertices; past 64 vertices the tables of a part with hundreds of edges cost
+        // more than the passes they serve (ngon:500: seconds per edge), so the solver serves
+        // the slides directly.
+        let model = PartModel::new(&compiled.polygon, &Support::Uniform).map_err(part_err)?;
+        let uniform = Arc::new(if compiled.polygon.vertices().len() <= 64 {
+            model.with_slide_tables(&[problem.mu_c])
+        } else {
+            model
+        });
         let robust = problem.tripod || problem.mu_c_range.is_some();
         let mut samples = Vec::new();
         if !robust {
@@ -151,6 +162,8 @@ impl Transition {
             memo: HashMap::new(),
             columns: HashMap::new(),
             counters: PushCounters::default(),
+            deadline: problem.deadline,
+            expired: AtomicBool::new(false),
         })
     }
 
@@ -176,9 +189,33 @@ impl Transition {
         self.memo.len()
     }
 
-    /// One pass, computed (pure).
+    /// Has the deadline passed during a computation? Then the batch that saw it was dropped.
+    pub fn expired(&self) -> bool {
+        self.expired.load(Ordering::Relaxed)
+    }
+
+    /// Is the deadline past? (Records it: see [`Transition::expired`].)
+    pub(crate) fn past_deadline(&self) -> bool {
+        if self.expired() {
+            return true;
+        }
+        let past = self.deadline.is_some_and(|d| Instant::now() >= d);
+        if past {
+            self.expired.store(true, Ordering::Relaxed);
+        }
+        past
+    }
+
+    /// One pass, computed (pure); past the deadline a placeholder that the caller drops.
     fn pass(&self, key: PassKey) -> PassOutcome {
         let (sample, theta_q, dy_q) = key;
+        if self.past_deadline() {
+            return PassOutcome {
+                signature: FAILED,
+                theta_deg: 0.0,
+                dy_m: 0.0,
+            };
+        }
         let phys = &self.samples[sample as usize];
         let theta_deg = theta_q as f64 * self.theta_quantum;
         let d = dy_q as f64 * self.y_quantum / self.radius;
@@ -258,6 +295,9 @@ impl Transition {
         missing.dedup();
         let this = &*self;
         let out: Vec<PassOutcome> = missing.par_iter().map(|&k| this.pass(k)).collect();
+        if self.expired() {
+            return;
+        }
         self.counters.computed += out.len() as u64;
         self.memo.extend(missing.into_iter().zip(out));
     }
@@ -349,6 +389,9 @@ impl Transition {
             .par_iter()
             .map(|&(s, t)| this.column(s, t))
             .collect();
+        if self.expired() {
+            return;
+        }
         for ((s, t), (sig, local, hits)) in missing.into_iter().zip(out) {
             self.counters.columns += 1;
             self.counters.memo_hits += hits;
@@ -364,7 +407,8 @@ impl Transition {
     }
 
     /// The state after a pin at `pin_q` (quanta); every touched particle's pass must be in the
-    /// memo (see [`Transition::ensure`]).
+    /// memo (see [`Transition::ensure`]); one that is not (the deadline dropped its batch) counts
+    /// as lost.
     pub fn apply(&self, state: &State, pin_q: i32) -> State {
         let mut lost = state.lost;
         let mut parts = Vec::with_capacity(state.particles.len());
@@ -374,7 +418,10 @@ impl Transition {
                 parts.push(*p);
                 continue;
             }
-            let o = self.memo[&(p.sample, p.theta_q, dy)];
+            let Some(&o) = self.memo.get(&(p.sample, p.theta_q, dy)) else {
+                lost += p.weight;
+                continue;
+            };
             match o.signature {
                 NO_CONTACT => parts.push(*p),
                 FAILED => lost += p.weight,

@@ -119,41 +119,19 @@ fn sets_view<'a, 'b>(
     Ok(ch)
 }
 
-/// Draw a plan to `path`.
-pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<()> {
+/// Draw a plan to `path` under `title` (the design's verdict: its line check beside the
+/// prediction).
+pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> anyhow::Result<()> {
     let compiled = problem.compile()?;
     let period = compiled.period_deg();
-    let n = plan.steps.len();
-    let stages = n + 1;
-    let fences: Vec<crate::plan::FenceAction> = plan
-        .steps
-        .iter()
-        .filter_map(|s| match s.action {
-            Action::Fence(f) => Some(f),
-            Action::Pin(_) => None,
-        })
-        .collect();
-    let (fence_x, fence_len) =
-        crate::plan::fences::layout(&fences, compiled.radius, problem.spacing_m);
-    let length = if fences.is_empty() {
-        problem.spacing_m * (n as f64 + 1.0)
-    } else {
-        fence_len + problem.spacing_m
-    };
+    let stages = plan.steps.len() + 1;
+    let (xs_layout, length) = crate::plan::emit::layout(problem, plan, compiled.radius);
     let half = problem.belt_width_m / 2.0 * 1e3;
     let height = 330 + 40 * stages as u32 + 80;
     let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(330);
-    let mut ch = belt_view(
-        &top,
-        format!(
-            "pinfeed plan: {} — {} pin(s), predicted success {:.3}",
-            problem.part, n, plan.predicted_success
-        ),
-        length,
-        half,
-    )?;
+    let mut ch = belt_view(&top, title.to_string(), length, half)?;
     // Pixels per metre along each axis, to draw true shapes on stretched axes.
     let (w_px, h_px) = ch.plotting_area().dim_in_pixel();
     let px_per_m_x = w_px as f64 / length;
@@ -163,7 +141,7 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
         let p = match s.action {
             Action::Pin(p) => p,
             Action::Fence(f) => {
-                let x0 = fence_x[k];
+                let x0 = xs_layout[k];
                 let x1 = x0 + f.x_extent_m();
                 ch.draw_series(std::iter::once(PathElement::new(
                     vec![(x0, f.y0_m * 1e3), (x1, f.y1_m * 1e3)],
@@ -182,7 +160,7 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
                 continue;
             }
         };
-        let x = problem.spacing_m * (k as f64 + 1.0);
+        let x = xs_layout[k];
         let label = format!(
             "pin{} y={:+.2} mm ±{:.2}",
             k + 1,
@@ -214,7 +192,7 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, path: &Path) -> anyhow::Result<
         period,
         compiled.symmetry,
         stages,
-        "after pin",
+        "after obstacle",
         &label,
         plan.window.centre_deg,
         problem.tolerance_deg,
@@ -256,6 +234,7 @@ pub fn plot_contingent(
     problem: &Problem,
     plan: &crate::plan::contingent::ContingentPlan,
     stages: &[Vec<State>],
+    title: &str,
     path: &Path,
 ) -> anyhow::Result<()> {
     let compiled = problem.compile()?;
@@ -268,15 +247,7 @@ pub fn plot_contingent(
     let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(330);
-    let mut ch = belt_view(
-        &top,
-        format!(
-            "pinfeed plan --sensor: {} — sensor pin + {k} moving pin(s), predicted success {:.3}",
-            problem.part, plan.predicted_success
-        ),
-        length,
-        half,
-    )?;
+    let mut ch = belt_view(&top, title.to_string(), length, half)?;
     let (_, h_px) = ch.plotting_area().dim_in_pixel();
     let pin_px = ((problem.pin_radius_m * h_px as f64 / (2.0 * half * 1e-3)).round() as i32).max(3);
     let s = plan.sensor;

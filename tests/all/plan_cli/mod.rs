@@ -35,3 +35,33 @@ pub fn run_300(file: &str) -> Value {
         runs.to_str().unwrap(),
     ])
 }
+
+/// `pinfeed plan ARGS` (ARGS include `--json`): its exit code and JSON document. Exit 0 is a
+/// confirmed design, 3 a written design the line does not confirm (or an unchecked one), 4 none.
+pub fn plan_json(args: &[&str]) -> (i32, Value) {
+    let out = pinfeed(args);
+    let code = out.status.code().unwrap_or(-1);
+    assert!(
+        [0, 3, 4].contains(&code),
+        "{args:?}: exit {code}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "{args:?}: stdout is not JSON ({e}): {}",
+            String::from_utf8_lossy(&out.stdout)
+        )
+    });
+    (code, v)
+}
+
+/// `pinfeed` with any arguments that are not `plan` (other commands' JSON), or `plan` with a
+/// confirmed design (exit 0): its JSON document.
+pub fn plan_ok(args: &[&str]) -> Value {
+    if args.first() == Some(&"plan") {
+        let (code, v) = plan_json(args);
+        assert_eq!(code, 0, "{args:?}: {}", v["message"]);
+        return v;
+    }
+    json_ok(args)
+}

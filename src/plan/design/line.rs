@@ -1,0 +1,187 @@
+//! A candidate design on the line: the emitted scenario parsed and run by the discrete-event
+//! engine ([`crate::engine::run`]) — once with the parts far apart (the physics alone: no part
+//! can meet another), then at shorter headways to find the line's own spacing of parts, then
+//! the full check whose result is the design's verdict.
+
+use super::LineCheck;
+use crate::engine::{run, OutcomeCounts, RunOptions, RunResult};
+use crate::statistics::wilson_interval;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// Why a candidate could not be run on the line.
+#[derive(Debug, thiserror::Error)]
+pub enum LineError {
+    #[error("the emitted scenario does not compile: {0}")]
+    Scenario(#[from] crate::scenario::ScenarioError),
+    #[error("the line could not run the design: {0}")]
+    Engine(#[from] crate::engine::EngineError),
+    #[error("writing the design's files to {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// A scratch folder for a design's files while it is checked (a policy file must exist beside
+/// the scenario that names it); removed when dropped.
+pub struct Scratch {
+    pub dir: PathBuf,
+}
+
+impl Scratch {
+    pub fn new() -> Result<Scratch, LineError> {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        let dir = std::env::temp_dir().join(format!(
+            "pinfeed-design-{}-{}",
+            std::process::id(),
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        ));
+        std::fs::create_dir_all(&dir).map_err(|source| LineError::Io {
+            path: dir.clone(),
+            source,
+        })?;
+        Ok(Scratch { dir })
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// A scenario with the feed's headway as a parameter: its text is `before` + headway + `after`
+/// (the `headway = …` line of `[feed]`), with an optional policy file written beside it.
+#[derive(Debug, Clone)]
+pub struct Runnable {
+    pub toml: String,
+    pub policy: Option<(String, String)>,
+}
+
+impl Runnable {
+    /// The scenario with headway `h` (s).
+    pub fn with_headway(&self, h: f64) -> String {
+        let mut out = String::with_capacity(self.toml.len());
+        for line in self.toml.lines() {
+            if line.starts_with("headway = ") {
+                out += &format!(
+                    "headway = {}        # s: chosen on the line (see the header)\n",
+                    fmt_headway(h)
+                );
+            } else {
+                out += line;
+                out.push('\n');
+            }
+        }
+        out
+    }
+
+    /// Run `parts` parts at headway `h` with `seed`, keeping per-part records if asked.
+    pub fn run(
+        &self,
+        scratch: &Scratch,
+        h: f64,
+        parts: u64,
+        seed: u64,
+        records: bool,
+    ) -> Result<(LineCheck, RunResult), LineError> {
+        let path = scratch.dir.join("design.toml");
+        if let Some((name, text)) = &self.policy {
+            let p = scratch.dir.join(name);
+            std::fs::write(&p, text).map_err(|source| LineError::Io { path: p, source })?;
+        }
+        let toml = self.with_headway(h);
+        let scene = crate::scenario::parse(&path, &toml)?;
+        let opts = RunOptions {
+            parts,
+            seed,
+            sample_paths: 0,
+            keep_records: records,
+        };
+        let started = Instant::now();
+        let res = run(&scene, &opts, &mut |_| {})?;
+        let check = LineCheck::of(&res.summary.outcomes, parts, h, started);
+        Ok((check, res))
+    }
+}
+
+/// A headway as written (s, 3 decimals at most).
+pub fn fmt_headway(h: f64) -> String {
+    let s = format!("{h:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    if s.contains('.') {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+impl LineCheck {
+    pub(crate) fn of(o: &OutcomeCounts, parts: u64, headway_s: f64, started: Instant) -> Self {
+        LineCheck {
+            parts,
+            success: o.success,
+            success_rate: o.success as f64 / parts.max(1) as f64,
+            ci95: wilson_interval(o.success, parts),
+            outcomes: *o,
+            headway_s,
+            elapsed_s: started.elapsed().as_secs_f64(),
+        }
+    }
+}
+
+/// One probe of the headway search: (headway s, parts, collisions, success rate).
+pub type HeadwayProbe = (f64, u64, u64, f64);
+
+/// The shortest headway in `[lo, hi]` (s) at which `probe_parts` parts show no collision and
+/// a success of at least `floor`, by bisection on the logarithm (`steps` probes at most; `hi` is
+/// taken to pass), then with a 25% reserve, rounded up to 0.1 s and at most `hi`. Returns it with
+/// the probes. (Short headways fail by collisions, and on lines with moving pins by pins that
+/// cannot reach the next part's position in time.)
+#[allow(clippy::too_many_arguments)]
+pub fn shortest_headway(
+    r: &Runnable,
+    scratch: &Scratch,
+    (lo, hi): (f64, f64),
+    floor: f64,
+    probe_parts: u64,
+    seed: u64,
+    steps: usize,
+    deadline: Instant,
+) -> Result<(f64, Vec<HeadwayProbe>), LineError> {
+    let mut probes = Vec::new();
+    let (mut bad, mut good) = (lo, hi);
+    for _ in 0..steps {
+        if Instant::now() >= deadline || good / bad < 1.08 {
+            break;
+        }
+        let mid = (bad * good).sqrt();
+        let (c, _) = r.run(scratch, mid, probe_parts, seed, false)?;
+        probes.push((mid, probe_parts, c.outcomes.collision, c.success_rate));
+        if c.outcomes.collision == 0 && c.success_rate >= floor {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    let chosen = ((good * 1.25) * 10.0).ceil() / 10.0;
+    Ok((chosen.min(hi), probes))
+}
+
+/// Write `text` to `path` whole or not at all (a temporary file beside it, then a rename).
+pub fn write_whole(path: &Path, text: &[u8]) -> std::io::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)?;
+    }
+    let name = path
+        .file_name()
+        .map_or("out".into(), |n| n.to_string_lossy().to_string());
+    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
+    let res = std::fs::write(&tmp, text).and_then(|_| std::fs::rename(&tmp, path));
+    if res.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    res
+}

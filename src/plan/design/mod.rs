@@ -1,0 +1,1290 @@
+//! **Designs the line confirms**: the workflow behind `pinfeed plan`. Given a part and a goal, it
+//! searches each kind of line it is allowed — fixed pins, fences, pins and fences mixed in one
+//! line (the hybrid), a sensor pin with moving pins — runs every candidate on the line, and
+//! returns the best design *the line confirmed*, with the number.
+//!
+//! For every mode ([`Mode`]):
+//! 1. the search over the particle abstraction ([`super::search`], [`super::contingent`]) gives a
+//!    plan (or its best effort) and a *prediction*: the share of particles in one window;
+//! 2. the plan is emitted as a scenario ([`super::emit`]) and run on the line with the parts far
+//!    apart (the *screen*: `screen_parts` parts, no part can meet another);
+//! 3. while the screen holds less than the target (and `refine` allows), the parts the line got
+//!    wrong join the particle set at their own feed orientation and lateral offset (the
+//!    abstraction grows where the line says it is wrong, not blindly) and the mode searches again;
+//!    every round's candidate is kept with its screen.
+//!
+//! Then the candidates the screen holds at the target are taken in the order of the objective
+//! ([`Objective`]); for each, the line's own spacing of parts is found by simulation
+//! ([`line::shortest_headway`]: the shortest headway without collisions, with a reserve) and the
+//! full line check (`check_parts` parts at that headway) decides: the first that holds the target
+//! is **confirmed** and chosen. If none is, the best the line measured is chosen and reported as
+//! **not confirmed**, with its number; with no plan at all the result is **no design**.
+//!
+//! The whole workflow — searches, screens, headway searches and checks — runs within
+//! `time_limit_s` (searches stop early enough to leave time for the checks; a check that would
+//! not fit runs fewer parts and says how many).
+
+pub mod line;
+pub mod survey;
+
+use super::contingent::{self, ContingentOutcome, ContingentPlan};
+use super::emit::{self, LineSpec, BELT_SPEED};
+use super::fences::{FenceOptions, FenceTransition};
+use super::search::{Outcome, Plan, Planner};
+use super::{Action, PlanError, Problem};
+use crate::engine::OutcomeCounts;
+use line::{HeadwayProbe, LineError, Runnable, Scratch};
+use serde::Serialize;
+use std::time::Instant;
+
+/// A kind of line the designer may build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Fixed pins only.
+    Pins,
+    /// Fences only.
+    Fences,
+    /// Pins and fences in one search: a line may mix them.
+    Hybrid,
+    /// A sensor pin that reads the stable state, then per-decision moving pins.
+    Sensor,
+}
+
+impl Mode {
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Pins => "pins",
+            Mode::Fences => "fences",
+            Mode::Hybrid => "hybrid",
+            Mode::Sensor => "sensor",
+        }
+    }
+}
+
+/// What "best" means among confirmed designs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Objective {
+    /// The shortest belt (then the fewest obstacles).
+    BeltLength,
+    /// The fewest obstacles (then the shortest belt).
+    Obstacles,
+    /// The fewest actuated obstacles: sensors and moving pins (then obstacles, then belt).
+    Actuators,
+    /// The most oriented parts per minute at the line's own headway.
+    Throughput,
+}
+
+impl std::str::FromStr for Objective {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "belt-length" | "belt_length" | "length" => Ok(Objective::BeltLength),
+            "obstacles" => Ok(Objective::Obstacles),
+            "actuators" => Ok(Objective::Actuators),
+            "throughput" => Ok(Objective::Throughput),
+            o => Err(format!(
+                "'{o}': expected belt-length, obstacles, actuators or throughput"
+            )),
+        }
+    }
+}
+
+/// Fence settings of the fence and hybrid modes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FenceSettings {
+    /// Fence friction μf (None: the part's μc).
+    pub mu_f: Option<f64>,
+    /// Downstream overhang past the parts' reach (units of a).
+    pub overhang_a: f64,
+    /// Largest |angle| tried (degrees).
+    pub max_angle_deg: f64,
+    /// Step between candidate angles (degrees, from ±15°).
+    pub angle_step_deg: f64,
+}
+
+impl Default for FenceSettings {
+    fn default() -> Self {
+        FenceSettings {
+            mu_f: None,
+            overhang_a: 0.0,
+            max_angle_deg: 55.0,
+            angle_step_deg: 5.0,
+        }
+    }
+}
+
+/// Everything a design needs. [`DesignOptions::new`] gives the defaults.
+#[derive(Debug, Clone)]
+pub struct DesignOptions {
+    pub problem: Problem,
+    /// The modes tried, in this order.
+    pub modes: Vec<Mode>,
+    pub objective: Objective,
+    /// Parts of the full line check (0: no check; the design is then unchecked).
+    pub check_parts: u64,
+    /// Parts of each candidate's screen and of each headway probe.
+    pub screen_parts: u64,
+    /// Search rounds after the first, each with the line's failures added to the particles.
+    pub refine: usize,
+    /// Wall-time limit of the whole design (s).
+    pub time_limit_s: f64,
+    pub fences: FenceSettings,
+    /// Sensor mode: most moving pins, sensor positions tried.
+    pub max_moving: usize,
+    pub sensor_candidates: usize,
+    /// Was the belt width given? If not, the fence and hybrid modes may use a wider belt.
+    pub belt_width_given: bool,
+    /// The design's name: its scenario's `name` and its files' stem.
+    pub name: String,
+    /// The command line that asked for it (written into the scenario's header).
+    pub command: String,
+}
+
+impl DesignOptions {
+    /// The defaults for a problem: every mode, the shortest belt, 10⁴ parts checked.
+    pub fn new(problem: Problem) -> DesignOptions {
+        let name = design_name(&problem.part);
+        let command = format!("pinfeed plan --part {}", problem.part);
+        DesignOptions {
+            problem,
+            modes: vec![Mode::Pins, Mode::Fences, Mode::Hybrid, Mode::Sensor],
+            objective: Objective::BeltLength,
+            check_parts: 10_000,
+            screen_parts: 2_000,
+            refine: 2,
+            time_limit_s: 110.0,
+            fences: FenceSettings::default(),
+            max_moving: 3,
+            sensor_candidates: 6,
+            belt_width_given: false,
+            command,
+            name,
+        }
+    }
+}
+
+/// A design's name from its part: a named part's own name (`rect:2:1` → `rect-2-1`), a vertex
+/// list `custom-` and a hash of its text, so that different parts never share files.
+pub fn design_name(part: &str) -> String {
+    let p = part.trim();
+    if p.to_lowercase().starts_with("vertices:") {
+        // FNV-1a over the normalised list: stable across runs and platforms.
+        let norm: String = p.split_whitespace().collect::<Vec<_>>().join(" ");
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in norm.bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        return format!("custom-{:08x}", (h >> 32) as u32 ^ h as u32);
+    }
+    p.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect()
+}
+
+/// The verdict of a design.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// The full line check holds the target.
+    Confirmed,
+    /// The best design the line measured holds less than the target.
+    NotConfirmed,
+    /// Designed but not run on the line (`check_parts` 0).
+    Unchecked,
+    /// No mode produced a design (no obstacle improves on the feed).
+    NoDesign,
+}
+
+impl Status {
+    pub fn word(self) -> &'static str {
+        match self {
+            Status::Confirmed => "confirmed",
+            Status::NotConfirmed => "not confirmed",
+            Status::Unchecked => "unchecked",
+            Status::NoDesign => "no design",
+        }
+    }
+}
+
+/// A run of the line.
+#[derive(Debug, Clone, Serialize)]
+pub struct LineCheck {
+    pub parts: u64,
+    pub success: u64,
+    pub success_rate: f64,
+    /// 95% Wilson interval of the success rate.
+    pub ci95: [f64; 2],
+    pub outcomes: OutcomeCounts,
+    /// Seconds between parts.
+    pub headway_s: f64,
+    pub elapsed_s: f64,
+}
+
+/// One obstacle of a design, as placed on the belt.
+#[derive(Debug, Clone, Serialize)]
+pub struct ObstacleInfo {
+    /// pin | fence | sensor_pin | moving_pin
+    pub kind: &'static str,
+    pub name: String,
+    /// Along the belt (m; a fence's upstream end).
+    pub x_m: f64,
+    /// Across the belt (m; a fence's upstream end, a moving pin's home).
+    pub y_m: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub length_m: Option<f64>,
+    /// A moving pin's lateral targets, one per decision (m).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub targets_m: Vec<f64>,
+}
+
+/// What a search ended with.
+#[derive(Debug, Clone, Serialize)]
+pub struct SearchSummary {
+    /// found | none_up_to_depth | exhausted | limit
+    pub result: &'static str,
+    pub message: String,
+    /// Particles searched over, and the levels completed.
+    pub particles: u32,
+    pub depth_completed: usize,
+    pub elapsed_s: f64,
+}
+
+/// The plan behind a candidate.
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Layout {
+    Sequence(Plan),
+    Contingent(ContingentPlan),
+}
+
+/// One design the workflow produced and ran on the line.
+#[derive(Debug, Clone, Serialize)]
+pub struct Candidate {
+    pub mode: Mode,
+    /// Refinement round (0: the first search).
+    pub round: usize,
+    pub search: SearchSummary,
+    /// The particle abstraction's prediction.
+    pub predicted_success: f64,
+    /// Sensor mode: the prediction with the classifier's confusion measured on the line, and its
+    /// accuracy there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted_with_confusion: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_accuracy: Option<f64>,
+    pub obstacles: Vec<ObstacleInfo>,
+    /// Sensors and moving pins.
+    pub actuators: usize,
+    pub belt_length_m: f64,
+    /// The belt width the design uses (m): what its obstacles and parts reach, with a margin.
+    pub belt_width_m: f64,
+    /// The line with the parts far apart.
+    pub screen: Option<LineCheck>,
+    /// The headway probes (s, parts, collisions, success) and the headway chosen.
+    pub headway_probes: Vec<HeadwayProbe>,
+    pub headway_s: f64,
+    /// The full check at `headway_s`.
+    pub line_check: Option<LineCheck>,
+    /// A problem planned against uncertainty (a μc range, tripods): the full check is also run
+    /// under it, as a Monte Carlo study of `check_parts` samples (one part through a freshly
+    /// perturbed line each); the verdict is then this run's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub uncertain_check: Option<LineCheck>,
+    /// Oriented parts per minute at `headway_s` (the full check's success, else the screen's).
+    pub oriented_per_min: f64,
+    pub layout: Layout,
+    /// The problem the candidate was searched with (its belt width and particles).
+    #[serde(skip)]
+    pub problem: Problem,
+    #[serde(skip)]
+    pub runnable: Runnable,
+}
+
+impl Candidate {
+    /// The line's best word on it: the check under uncertainty, else the full check, else the
+    /// screen.
+    pub fn measured(&self) -> Option<&LineCheck> {
+        self.verdict_check().or(self.screen.as_ref())
+    }
+
+    /// The check the verdict is read from: under the planned uncertainty if there is one, else
+    /// the full check.
+    pub fn verdict_check(&self) -> Option<&LineCheck> {
+        self.uncertain_check.as_ref().or(self.line_check.as_ref())
+    }
+
+    /// The ordering key of an objective (smaller is better).
+    fn key(&self, o: Objective) -> (f64, f64, f64) {
+        let n = self.obstacles.len() as f64;
+        match o {
+            Objective::BeltLength => (self.belt_length_m, n, 0.0),
+            Objective::Obstacles => (n, self.belt_length_m, 0.0),
+            Objective::Actuators => (self.actuators as f64, n, self.belt_length_m),
+            Objective::Throughput => (-self.oriented_per_min, self.belt_length_m, n),
+        }
+    }
+}
+
+/// A finished design.
+#[derive(Debug, Clone, Serialize)]
+pub struct Design {
+    pub status: Status,
+    /// One sentence: what was found and what the line says.
+    pub message: String,
+    pub target: f64,
+    pub tolerance_deg: f64,
+    /// Every candidate, in the order produced.
+    pub candidates: Vec<Candidate>,
+    /// The candidate chosen (written).
+    pub chosen: Option<usize>,
+    /// A limit that cut the work short (the time limit), if any.
+    pub limit: Option<String>,
+    pub elapsed_s: f64,
+    /// The chosen design's files' text: scenario (with its header) and policy.
+    #[serde(skip)]
+    pub scenario_toml: Option<String>,
+    #[serde(skip)]
+    pub policy_toml: Option<(String, String)>,
+}
+
+impl Design {
+    pub fn chosen(&self) -> Option<&Candidate> {
+        self.chosen.map(|i| &self.candidates[i])
+    }
+}
+
+/// Where a design stands, for a progress display.
+#[derive(Debug, Clone)]
+pub struct Progress {
+    pub mode: Option<Mode>,
+    pub round: usize,
+    /// What runs now ("searching 125 particles", "line check 3 (2000 parts)", …).
+    pub stage: String,
+    pub candidates: usize,
+    pub line_runs: usize,
+}
+
+/// Why a design could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum DesignError {
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+    #[error(transparent)]
+    Line(#[from] LineError),
+    #[error("{flag} {value}: {reason}")]
+    Input {
+        flag: &'static str,
+        value: String,
+        reason: String,
+    },
+}
+
+fn input(flag: &'static str, value: impl ToString, reason: impl ToString) -> DesignError {
+    DesignError::Input {
+        flag,
+        value: value.to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+/// Refuse goals no design can meet before any search: a window finer than the orientation
+/// quantum, a target above 1, a belt narrower than the part, an empty mode set, …
+pub fn check_goal(o: &DesignOptions) -> Result<(), DesignError> {
+    let p = &o.problem;
+    p.compile()?;
+    if p.tolerance_deg < p.theta_quantum_deg {
+        return Err(input(
+            "--tolerance",
+            p.tolerance_deg,
+            format!(
+                "the window ±{}° is finer than the planner's orientation quantum {}° (--theta-quantum): it cannot tell orientations that close apart; use a tolerance ≥ the quantum",
+                p.tolerance_deg, p.theta_quantum_deg
+            ),
+        ));
+    }
+    if o.modes.is_empty() {
+        return Err(input("--pins/--fences/--sensor", "", "no mode left to try"));
+    }
+    if !(o.time_limit_s.is_finite() && o.time_limit_s > 0.0 && o.time_limit_s <= 86_400.0) {
+        return Err(input(
+            "--time-limit",
+            o.time_limit_s,
+            "must lie in (0, 86400] seconds",
+        ));
+    }
+    if o.check_parts > 10_000_000 {
+        return Err(input("--check-parts", o.check_parts, "must lie in 0..=10⁷"));
+    }
+    if !(1..=1_000_000).contains(&o.screen_parts) {
+        return Err(input(
+            "--screen-parts",
+            o.screen_parts,
+            "must lie in 1..=10⁶",
+        ));
+    }
+    if o.refine > 10 {
+        return Err(input("--refine", o.refine, "must lie in 0..=10"));
+    }
+    if o.max_moving > 8 {
+        return Err(input("--max-moving", o.max_moving, "must lie in 0..=8"));
+    }
+    if !(1..=64).contains(&o.sensor_candidates) {
+        return Err(input(
+            "--sensor-candidates",
+            o.sensor_candidates,
+            "must lie in 1..=64",
+        ));
+    }
+    if o.name.is_empty()
+        || o.name.len() > 100
+        || !o
+            .name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+        || o.name.starts_with('.')
+    {
+        return Err(input(
+            "--name",
+            &o.name,
+            "must be 1–100 characters of letters, digits, '-', '_' or '.', not starting with '.'",
+        ));
+    }
+    fence_options(o, p.mu_c)?;
+    Ok(())
+}
+
+/// The fence actions of the fence and hybrid modes.
+fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignError> {
+    let f = &o.fences;
+    let mu_f = f.mu_f.unwrap_or(mu_c);
+    if !(mu_f.is_finite() && (0.0..=10.0).contains(&mu_f)) {
+        return Err(input("--mu-f", mu_f, "must lie in [0, 10]"));
+    }
+    if !(f.overhang_a.is_finite() && (0.0..=10.0).contains(&f.overhang_a)) {
+        return Err(input(
+            "--fence-overhang",
+            f.overhang_a,
+            "must lie in [0, 10] (units of a)",
+        ));
+    }
+    if !(f.max_angle_deg.is_finite() && (15.0..90.0).contains(&f.max_angle_deg)) {
+        return Err(input(
+            "--max-fence-angle",
+            f.max_angle_deg,
+            "must lie in [15, 90) degrees",
+        ));
+    }
+    if !(f.angle_step_deg.is_finite() && (0.5..=45.0).contains(&f.angle_step_deg)) {
+        return Err(input(
+            "--fence-angle-step",
+            f.angle_step_deg,
+            "must lie in [0.5, 45] degrees",
+        ));
+    }
+    let mut opts = FenceOptions::grid(mu_f, f.angle_step_deg, f.max_angle_deg);
+    opts.overhang_a = f.overhang_a;
+    if opts.angles_deg.is_empty() && o.modes.contains(&Mode::Fences) {
+        return Err(input(
+            "--max-fence-angle",
+            f.max_angle_deg,
+            format!(
+                "no candidate angle (from ±15°, below the jam limit {:.1}° for μf {mu_f}) is left",
+                90.0 - mu_f.atan().to_degrees()
+            ),
+        ));
+    }
+    Ok(opts)
+}
+
+/// The belt width a mode searches with: the given one; without one, fences (which sweep parts
+/// across the belt) get room for the parts' reach and a sweep either way.
+fn mode_width(o: &DesignOptions, mode: Mode, a: f64) -> f64 {
+    let p = &o.problem;
+    if o.belt_width_given || matches!(mode, Mode::Pins | Mode::Sensor) {
+        return p.belt_width_m;
+    }
+    let room = 2.0 * p.lateral_m + 6.0 * a;
+    p.belt_width_m.max((room * 100.0).ceil() / 100.0)
+}
+
+/// Run the design workflow. `progress` is told what runs (it must be cheap).
+pub fn design(
+    o: &DesignOptions,
+    progress: &(dyn Fn(&Progress) + Sync),
+) -> Result<Design, DesignError> {
+    check_goal(o)?;
+    let started = Instant::now();
+    let deadline = started + std::time::Duration::from_secs_f64(o.time_limit_s);
+    // Searches stop early enough to leave the line checks their time.
+    let search_end = started + std::time::Duration::from_secs_f64(o.time_limit_s * 0.6);
+    let mut w = Work {
+        o,
+        progress,
+        deadline,
+        candidates: Vec::new(),
+        line_runs: 0,
+        limit: None,
+    };
+    let modes = o.modes.clone();
+    for (i, &mode) in modes.iter().enumerate() {
+        let now = Instant::now();
+        if now >= search_end {
+            w.limit = Some(format!(
+                "time limit {} s: {} not tried",
+                o.time_limit_s,
+                modes[i..]
+                    .iter()
+                    .map(|m| m.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+            break;
+        }
+        // An equal share of the search time left for each mode left (a fast mode leaves its
+        // unused share to the next).
+        let share = (search_end - now) / (modes.len() - i) as u32;
+        w.run_mode(mode, now + share)?;
+    }
+    w.finish(started)
+}
+
+struct Work<'a> {
+    o: &'a DesignOptions,
+    progress: &'a (dyn Fn(&Progress) + Sync),
+    deadline: Instant,
+    candidates: Vec<Candidate>,
+    line_runs: usize,
+    limit: Option<String>,
+}
+
+impl Work<'_> {
+    /// A search's limit as the command states it: a time limit is the command's (`--time-limit`).
+    fn command_limit(&self, limit: &str) -> String {
+        if limit.starts_with("time limit") {
+            format!("time limit {} s (--time-limit)", self.o.time_limit_s)
+        } else {
+            limit.to_string()
+        }
+    }
+
+    fn tell(&self, mode: Option<Mode>, round: usize, stage: String) {
+        (self.progress)(&Progress {
+            mode,
+            round,
+            stage,
+            candidates: self.candidates.len(),
+            line_runs: self.line_runs,
+        });
+    }
+
+    /// One mode: search, screen, and refine with the line's failures.
+    fn run_mode(&mut self, mode: Mode, until: Instant) -> Result<(), DesignError> {
+        let o = self.o;
+        let mut problem = o.problem.clone();
+        let a = problem.compile()?.radius;
+        problem.belt_width_m = mode_width(o, mode, a);
+        for round in 0..=o.refine {
+            let now = Instant::now();
+            if now >= until {
+                if round == 0 {
+                    self.limit
+                        .get_or_insert(format!("time limit {} s", o.time_limit_s));
+                }
+                return Ok(());
+            }
+            problem.deadline = Some(until);
+            problem.time_limit_s = (until - now).as_secs_f64().max(1e-3);
+            let mut planner = Planner::new(&problem)?;
+            self.tell(
+                Some(mode),
+                round,
+                format!("searching ({} particles)", planner.initial.total()),
+            );
+            let Some(mut cand) = self.search(mode, round, &problem, &mut planner)? else {
+                return Ok(());
+            };
+            if o.check_parts == 0 {
+                self.candidates.push(cand);
+                return Ok(());
+            }
+            self.tell(
+                Some(mode),
+                round,
+                format!("line screen ({} parts)", o.screen_parts),
+            );
+            let scratch = Scratch::new()?;
+            let h = isolation_headway(cand.belt_length_m);
+            let (screen, res) =
+                cand.runnable
+                    .run(&scratch, h, o.screen_parts, problem.seed, true)?;
+            self.line_runs += 1;
+            cand.headway_s = h;
+            if let Layout::Contingent(plan) = &cand.layout {
+                let (acc, with) = confusion_prediction(plan, &res.summary);
+                cand.sensor_accuracy = acc;
+                cand.predicted_with_confusion = with;
+            }
+            cand.oriented_per_min = screen.success_rate * 60.0 / h;
+            let held = screen.success_rate >= problem.target;
+            cand.screen = Some(screen);
+            self.candidates.push(cand);
+            if held || round == o.refine {
+                return Ok(());
+            }
+            // Refine: the sensor mode with more particles everywhere; the others with the parts
+            // the line got wrong.
+            if mode == Mode::Sensor {
+                problem.jitter_samples += 2;
+                problem.offset_samples += 2;
+                continue;
+            }
+            let base = (problem.jitter_samples * problem.offset_samples).max(25);
+            let mut added = 0;
+            for r in res.records.iter().filter(|r| r.outcome != "success") {
+                if added >= base * 2 {
+                    break;
+                }
+                let s = (r.theta_in_deg, r.y_in_m);
+                if !problem.extra_samples.contains(&s) {
+                    problem.extra_samples.push(s);
+                    added += 1;
+                }
+            }
+            if added == 0 {
+                return Ok(());
+            }
+        }
+        Ok(())
+    }
+
+    /// Search one mode and emit its plan (found or best effort) as a candidate; None when no
+    /// plan improves on the feed.
+    fn search(
+        &mut self,
+        mode: Mode,
+        round: usize,
+        problem: &Problem,
+        planner: &mut Planner,
+    ) -> Result<Option<Candidate>, DesignError> {
+        let o = self.o;
+        let compiled = planner.compiled.clone();
+        let line = LineSpec {
+            name: o.name.clone(),
+            headway_s: 4.0,
+            belt_width_m: problem.belt_width_m,
+            parts: o.check_parts.max(1),
+        };
+        if mode == Mode::Sensor {
+            let res = contingent::search(planner, o.max_moving, o.sensor_candidates);
+            let (outcome, stats) = match res {
+                Ok(x) => x,
+                // A part the sensor cannot tell apart (one stable state, no position) is not an
+                // error of the design: the mode has no plan.
+                Err(e) => {
+                    if o.modes == [Mode::Sensor] {
+                        return Err(e.into());
+                    }
+                    self.tell(Some(mode), round, format!("no sensing plan: {e}"));
+                    return Ok(None);
+                }
+            };
+            let (result, message, plan) = match outcome {
+                ContingentOutcome::Found(p) => (
+                    "found",
+                    format!(
+                        "a contingent plan: a sensor pin and {} moving pin(s), the fewest for its action set",
+                        p.k
+                    ),
+                    p,
+                ),
+                ContingentOutcome::NoneUpTo { depth } => {
+                    self.tell(
+                        Some(mode),
+                        round,
+                        format!("no contingent plan up to {depth} moving pins"),
+                    );
+                    return Ok(None);
+                }
+                ContingentOutcome::LimitHit { limit, .. } => {
+                    self.limit.get_or_insert(self.command_limit(&limit));
+                    return Ok(None);
+                }
+            };
+            let policy_name = format!("{}.policy.toml", o.name);
+            let (body, policy) = emit::contingent_toml(
+                problem,
+                &plan,
+                compiled.stable_deg.len(),
+                compiled.symmetry,
+                &line,
+                &policy_name,
+            );
+            let mut obstacles = vec![ObstacleInfo {
+                kind: "sensor_pin",
+                name: "probe".into(),
+                x_m: problem.spacing_m,
+                y_m: plan.sensor.y_m,
+                angle_deg: None,
+                length_m: None,
+                targets_m: Vec::new(),
+            }];
+            for j in 0..plan.k {
+                let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j]).collect();
+                let fixed = ys.iter().all(|&y| (y - ys[0]).abs() < 1e-12);
+                obstacles.push(ObstacleInfo {
+                    kind: if fixed { "pin" } else { "moving_pin" },
+                    name: if fixed {
+                        format!("pin{}", j + 2)
+                    } else {
+                        format!("mover{}", j + 1)
+                    },
+                    x_m: problem.spacing_m * (j as f64 + 2.0),
+                    y_m: ys[0],
+                    angle_deg: None,
+                    length_m: None,
+                    targets_m: if fixed { Vec::new() } else { ys },
+                });
+            }
+            let actuators = obstacles.iter().filter(|x| x.kind != "pin").count();
+            let belt_length_m = problem.spacing_m * (plan.k as f64 + 2.0);
+            return Ok(Some(Candidate {
+                mode,
+                round,
+                search: SearchSummary {
+                    result,
+                    message,
+                    particles: planner.initial.total(),
+                    depth_completed: stats.depth_completed,
+                    elapsed_s: stats.elapsed_s,
+                },
+                predicted_success: plan.predicted_success,
+                predicted_with_confusion: None,
+                sensor_accuracy: None,
+                obstacles,
+                actuators,
+                belt_length_m,
+                belt_width_m: problem.belt_width_m,
+                screen: None,
+                headway_probes: Vec::new(),
+                headway_s: 0.0,
+                line_check: None,
+                uncertain_check: None,
+                oriented_per_min: 0.0,
+                layout: Layout::Contingent(plan),
+                problem: problem.clone(),
+                runnable: Runnable {
+                    toml: body,
+                    policy: Some((policy_name, policy)),
+                },
+            }));
+        }
+        if matches!(mode, Mode::Fences | Mode::Hybrid) {
+            planner.fences = Some(FenceTransition::new(fence_options(o, problem.mu_c)?));
+            planner.hybrid = mode == Mode::Hybrid;
+        }
+        let (outcome, stats) = planner.search();
+        let (result, message, plan) = match outcome {
+            Outcome::Found(p) => (
+                "found",
+                "a shortest plan for its action set".into(),
+                Some(p),
+            ),
+            Outcome::NoneUpTo { depth, best } => (
+                "none_up_to_depth",
+                format!("no plan up to depth {depth} reaches the goal; the best effort is kept"),
+                best,
+            ),
+            Outcome::Exhausted { depth, best } => (
+                "exhausted",
+                format!(
+                    "no plan at any depth (no new state after {depth}); the best effort is kept"
+                ),
+                best,
+            ),
+            Outcome::LimitHit {
+                limit,
+                depth_completed,
+                best,
+            } => {
+                let l = self.command_limit(&limit);
+                self.limit.get_or_insert(l);
+                (
+                    "limit",
+                    format!("stopped by its {limit} after depth {depth_completed}; the best so far is kept"),
+                    best,
+                )
+            }
+        };
+        let Some(plan) = plan else {
+            self.tell(Some(mode), round, "no obstacle improves on the feed".into());
+            return Ok(None);
+        };
+        // The width the design needs (within the searched one): its obstacles, and the parts'
+        // centroids with a margin of a/2, rounded up to 5 mm.
+        let a = compiled.radius;
+        let mut reach: f64 = problem.lateral_m + a / 2.0;
+        for s in std::iter::once(&plan.initial).chain(plan.steps.iter().map(|s| &s.state)) {
+            for q in &s.particles {
+                reach = reach.max((q.y_q as f64 * problem.y_quantum_m).abs() + a / 2.0);
+            }
+        }
+        for s in &plan.steps {
+            match s.action {
+                Action::Pin(p) => reach = reach.max(p.y_m.abs() + problem.pin_radius_m),
+                Action::Fence(f) => reach = reach.max(f.y0_m.abs()).max(f.y1_m.abs()),
+            }
+        }
+        let width = ((2.0 * reach / 0.005).ceil() * 0.005).min(problem.belt_width_m);
+        let line = LineSpec {
+            belt_width_m: width,
+            ..line
+        };
+        let body = emit::sequence_toml(
+            problem,
+            &plan,
+            compiled.stable_deg.len(),
+            compiled.symmetry,
+            &line,
+        );
+        let (xs, belt_length_m) = emit::layout(problem, &plan, a);
+        let (mut pins, mut fences) = (0, 0);
+        let obstacles = plan
+            .steps
+            .iter()
+            .zip(&xs)
+            .map(|(s, &x)| match s.action {
+                Action::Pin(p) => {
+                    pins += 1;
+                    ObstacleInfo {
+                        kind: "pin",
+                        name: format!("pin{pins}"),
+                        x_m: x,
+                        y_m: p.y_m,
+                        angle_deg: None,
+                        length_m: None,
+                        targets_m: Vec::new(),
+                    }
+                }
+                Action::Fence(f) => {
+                    fences += 1;
+                    ObstacleInfo {
+                        kind: "fence",
+                        name: format!("fence{fences}"),
+                        x_m: x,
+                        y_m: f.y0_m,
+                        angle_deg: Some(f.angle_deg),
+                        length_m: Some(f.length_m),
+                        targets_m: Vec::new(),
+                    }
+                }
+            })
+            .collect();
+        let mut problem = problem.clone();
+        problem.belt_width_m = width;
+        Ok(Some(Candidate {
+            mode,
+            round,
+            search: SearchSummary {
+                result,
+                message,
+                particles: planner.initial.total(),
+                depth_completed: stats.depth_completed,
+                elapsed_s: stats.elapsed_s,
+            },
+            predicted_success: plan.predicted_success,
+            predicted_with_confusion: None,
+            sensor_accuracy: None,
+            obstacles,
+            actuators: 0,
+            belt_length_m,
+            belt_width_m: width,
+            screen: None,
+            headway_probes: Vec::new(),
+            headway_s: 0.0,
+            line_check: None,
+            uncertain_check: None,
+            oriented_per_min: 0.0,
+            layout: Layout::Sequence(plan),
+            problem,
+            runnable: Runnable {
+                toml: body,
+                policy: None,
+            },
+        }))
+    }
+
+    /// Find candidate `i`'s headway and run its full check.
+    fn confirm(&mut self, i: usize) -> Result<(), DesignError> {
+        let o = self.o;
+        let seed = o.problem.seed;
+        let scratch = Scratch::new()?;
+        let c = &self.candidates[i];
+        let (mode, round) = (c.mode, c.round);
+        let poly = c.problem.compile()?.polygon;
+        let lo = crate::study::compare::part_length(&poly) / BELT_SPEED;
+        let hi = c.headway_s;
+        let per_part = c
+            .screen
+            .as_ref()
+            .map_or(1e-3, |s| s.elapsed_s / s.parts.max(1) as f64);
+        // Leave the full check its time.
+        let check_s = per_part * o.check_parts as f64;
+        let probe_end = self
+            .deadline
+            .checked_sub(std::time::Duration::from_secs_f64(check_s * 1.1))
+            .unwrap_or_else(Instant::now);
+        self.tell(Some(mode), round, "finding the line's headway".into());
+        let runnable = c.runnable.clone();
+        // The success a shorter headway must keep: half of the screen's margin over the target,
+        // or (a screen below the target) the screen's own success less 0.5%.
+        let target = o.problem.target;
+        let floor = c.screen.as_ref().map_or(0.0, |s| {
+            if s.success_rate >= target {
+                target + (s.success_rate - target) / 2.0
+            } else {
+                s.success_rate - 0.005
+            }
+        });
+        let (h, probes) = line::shortest_headway(
+            &runnable,
+            &scratch,
+            (lo, hi),
+            floor,
+            o.screen_parts.min(1000),
+            seed,
+            7,
+            probe_end,
+        )?;
+        self.line_runs += probes.len();
+        let left = (self.deadline - Instant::now().min(self.deadline)).as_secs_f64();
+        let mut parts = o.check_parts;
+        if per_part * parts as f64 > left {
+            parts = ((left / per_part) as u64).max(o.screen_parts.min(o.check_parts));
+            self.limit.get_or_insert(format!(
+                "time limit {} s: the line check ran {parts} of {} parts",
+                o.time_limit_s, o.check_parts
+            ));
+        }
+        self.tell(
+            Some(mode),
+            round,
+            format!("line check ({parts} parts at {h:.1} s)"),
+        );
+        let (check, res) = runnable.run(&scratch, h, parts, seed, false)?;
+        self.line_runs += 1;
+        let c = &mut self.candidates[i];
+        if let Layout::Contingent(plan) = &c.layout {
+            let (acc, with) = confusion_prediction(plan, &res.summary);
+            c.sensor_accuracy = acc;
+            c.predicted_with_confusion = with;
+        }
+        c.headway_probes = probes;
+        c.headway_s = h;
+        c.oriented_per_min = check.success_rate * 60.0 / h;
+        c.line_check = Some(check);
+        let study = super::check::uncertainty_study(
+            &c.problem,
+            "design.toml",
+            "design.uncertain.toml",
+            parts,
+        );
+        if let Some(study) = study {
+            self.tell(
+                Some(mode),
+                round,
+                format!("line check under the planned uncertainty ({parts} samples)"),
+            );
+            let toml = runnable.with_headway(h);
+            let started = Instant::now();
+            let (outcomes, n) = super::check::check_uncertain(
+                &toml,
+                &study,
+                &scratch.dir,
+                "design.toml",
+                "design.uncertain.toml",
+            )
+            .map_err(|e| input("--mu-c-range/--tripod", "", e))?;
+            self.line_runs += 1;
+            let c = &mut self.candidates[i];
+            c.uncertain_check = Some(LineCheck::of(&outcomes, n, h, started));
+            c.oriented_per_min = outcomes.success as f64 / n.max(1) as f64 * 60.0 / h;
+        }
+        Ok(())
+    }
+
+    fn finish(mut self, started: Instant) -> Result<Design, DesignError> {
+        let o = self.o;
+        let target = o.problem.target;
+        let mut chosen = None;
+        let mut status = Status::NoDesign;
+        if !self.candidates.is_empty() && o.check_parts == 0 {
+            chosen = self.best_by(|_| true);
+            status = Status::Unchecked;
+        } else if !self.candidates.is_empty() {
+            // Screen-held candidates in the objective's order; the first the full check holds.
+            let mut tried = Vec::new();
+            loop {
+                let next = self.best_by(|c| {
+                    c.line_check.is_none()
+                        && c.screen.as_ref().is_some_and(|s| s.success_rate >= target)
+                });
+                let Some(i) = next else { break };
+                if !tried.is_empty() && Instant::now() >= self.deadline {
+                    break;
+                }
+                self.confirm(i)?;
+                tried.push(i);
+                if self.candidates[i]
+                    .verdict_check()
+                    .is_some_and(|c| c.success_rate >= target)
+                {
+                    chosen = Some(i);
+                    status = Status::Confirmed;
+                    break;
+                }
+            }
+            if chosen.is_none() {
+                // The best the line measured: confirm it (if not yet) so its number is the full
+                // check's.
+                let best = (0..self.candidates.len()).max_by(|&a, &b| {
+                    let (x, y) = (&self.candidates[a], &self.candidates[b]);
+                    let r = |c: &Candidate| c.measured().map_or(-1.0, |m| m.success_rate);
+                    r(x).total_cmp(&r(y)).then(
+                        y.key(o.objective)
+                            .partial_cmp(&x.key(o.objective))
+                            .unwrap_or(std::cmp::Ordering::Equal),
+                    )
+                });
+                if let Some(i) = best {
+                    if self.candidates[i].line_check.is_none() {
+                        self.confirm(i)?;
+                    }
+                    let held = self.candidates[i]
+                        .verdict_check()
+                        .is_some_and(|c| c.success_rate >= target);
+                    status = if held {
+                        Status::Confirmed
+                    } else {
+                        Status::NotConfirmed
+                    };
+                    chosen = Some(i);
+                }
+            }
+        }
+        let message = self.message(status, chosen);
+        let (scenario_toml, policy_toml) = match chosen {
+            Some(i) => {
+                let c = &self.candidates[i];
+                let text =
+                    c.runnable
+                        .with_headway(if c.headway_s > 0.0 { c.headway_s } else { 4.0 });
+                let file = format!("{}.toml", o.name);
+                let head = emit::header(&header_lines(o, c, status), &file);
+                (Some(head + &text), c.runnable.policy.clone())
+            }
+            None => (None, None),
+        };
+        Ok(Design {
+            status,
+            message,
+            target,
+            tolerance_deg: o.problem.tolerance_deg,
+            candidates: self.candidates,
+            chosen,
+            limit: self.limit,
+            elapsed_s: started.elapsed().as_secs_f64(),
+            scenario_toml,
+            policy_toml,
+        })
+    }
+
+    /// The best candidate by the objective among those `keep` accepts.
+    fn best_by(&self, keep: impl Fn(&Candidate) -> bool) -> Option<usize> {
+        let obj = self.o.objective;
+        (0..self.candidates.len())
+            .filter(|&i| keep(&self.candidates[i]))
+            .min_by(|&a, &b| {
+                self.candidates[a]
+                    .key(obj)
+                    .partial_cmp(&self.candidates[b].key(obj))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+                    .then(a.cmp(&b))
+            })
+    }
+
+    fn message(&self, status: Status, chosen: Option<usize>) -> String {
+        let target = self.o.problem.target;
+        let tol = self.o.problem.tolerance_deg;
+        let Some(c) = chosen.map(|i| &self.candidates[i]) else {
+            return format!(
+                "no design: no mode ({}) produced a line that brings more parts into one window than the feed",
+                self.o.modes.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+            );
+        };
+        let what = describe_obstacles(c);
+        let under = if c.uncertain_check.is_some() {
+            " under the planned uncertainty"
+        } else {
+            ""
+        };
+        match (status, c.verdict_check()) {
+            (Status::Unchecked, _) | (_, None) => format!(
+                "{what} ({} mode), predicted {:.4}; not run on the line (--check-parts 0): unchecked",
+                c.mode.name(),
+                c.predicted_success
+            ),
+            (_, Some(l)) => format!(
+                "{} — {what} ({} mode): the line{under} holds {:.4} (95% CI {:.4}–{:.4}) of {} parts in one ±{tol}° window, target {target}; predicted {:.4}",
+                status.word(),
+                c.mode.name(),
+                l.success_rate,
+                l.ci95[0],
+                l.ci95[1],
+                l.parts,
+                c.predicted_success
+            ),
+        }
+    }
+}
+
+/// "3 pin(s)", "2 fence(s) and 1 pin(s)", "a sensor pin and 2 moving pin(s)".
+pub fn describe_obstacles(c: &Candidate) -> String {
+    let count = |k: &str| c.obstacles.iter().filter(|o| o.kind == k).count();
+    let (pins, fences, sensors, movers) = (
+        count("pin"),
+        count("fence"),
+        count("sensor_pin"),
+        count("moving_pin"),
+    );
+    let mut parts = Vec::new();
+    if sensors > 0 {
+        parts.push(format!("{sensors} sensor pin(s)"));
+    }
+    if movers > 0 {
+        parts.push(format!("{movers} moving pin(s)"));
+    }
+    if pins > 0 {
+        parts.push(format!("{pins} pin(s)"));
+    }
+    if fences > 0 {
+        parts.push(format!("{fences} fence(s)"));
+    }
+    if parts.is_empty() {
+        "no obstacle".into()
+    } else {
+        parts.join(", ")
+    }
+}
+
+/// The headway that keeps parts apart whatever the line does to them: twice the belt's transit
+/// time plus 10 s (s).
+fn isolation_headway(belt_length_m: f64) -> f64 {
+    (2.0 * belt_length_m / BELT_SPEED + 10.0).ceil()
+}
+
+/// The scenario header of a design: the command, the verdict with the line's number, the
+/// prediction beside it, the headway and what it gives.
+pub fn header_lines(o: &DesignOptions, c: &Candidate, status: Status) -> Vec<String> {
+    let mut l = vec![
+        format!("Written by `pinfeed plan` ({} mode):", c.mode.name()),
+        String::new(),
+        format!("  {}", o.command),
+        String::new(),
+    ];
+    let p = &o.problem;
+    if let (Some(u), Some(k)) = (&c.uncertain_check, &c.line_check) {
+        l.push(format!(
+            "Line check under the planned uncertainty ({} samples, `pinfeed mc` on a study of this file): {} — {} ({:.4}, 95% CI {:.4}–{:.4}); at nominal physics {} of {} ({:.4}).",
+            u.parts,
+            status.word().to_uppercase(),
+            u.success,
+            u.success_rate,
+            u.ci95[0],
+            u.ci95[1],
+            k.success,
+            k.parts,
+            k.success_rate
+        ));
+    }
+    match c.line_check.as_ref().filter(|_| c.uncertain_check.is_none()) {
+        Some(k) => l.push(format!(
+            "Line check: {} — {} of {} parts ({:.4}, 95% CI {:.4}–{:.4}) in one ±{}° window; target {}.",
+            status.word().to_uppercase(),
+            k.success,
+            k.parts,
+            k.success_rate,
+            k.ci95[0],
+            k.ci95[1],
+            p.tolerance_deg,
+            p.target
+        )),
+        None if c.line_check.is_none() => {
+            l.push("Line check: none (--check-parts 0): UNCHECKED.".into())
+        }
+        None => {}
+    }
+    if let Some(k) = &c.line_check {
+        l.push(format!(
+            "Headway {} s: the shortest with no collision and no loss of success in {} probes of the line, with a 25% reserve; {:.2} oriented parts per minute.",
+            line::fmt_headway(k.headway_s),
+            c.headway_probes.len(),
+            c.oriented_per_min
+        ));
+    }
+    match &c.layout {
+        Layout::Sequence(plan) => l.extend(emit::prediction_lines(&c.problem, plan)),
+        Layout::Contingent(plan) => {
+            l.push(format!(
+                "Prediction: a sensor pin and {} moving pin(s), the fewest for their action set: {:.4} with a perfect classifier within {:.2}° ± {}°{}.",
+                plan.k,
+                plan.predicted_success,
+                plan.centre_deg,
+                p.tolerance_deg,
+                c.predicted_with_confusion
+                    .map_or(String::new(), |w| format!(", {w:.4} with the classifier's confusion on the line"))
+            ));
+        }
+    }
+    l
+}
+
+/// The sensor's accuracy on the line and the contingent prediction with the confusion the line
+/// measured (rows and columns matched to the branches by label).
+fn confusion_prediction(
+    plan: &ContingentPlan,
+    summary: &crate::engine::Summary,
+) -> (Option<f64>, Option<f64>) {
+    let Some(s) = summary.sensors.first() else {
+        return (None, None);
+    };
+    let acc = Some(s.confusion.accuracy());
+    let idx: Option<Vec<usize>> = plan
+        .branches
+        .iter()
+        .map(|b| s.confusion.labels.iter().position(|l| *l == b.label))
+        .collect();
+    let Some(idx) = idx else {
+        return (acc, None);
+    };
+    let counts: Vec<Vec<u64>> = idx
+        .iter()
+        .map(|&i| {
+            let row = &s.confusion.counts[i];
+            let mut r: Vec<u64> = idx.iter().map(|&j| row[j]).collect();
+            r.push(row[row.len() - 1]);
+            r
+        })
+        .collect();
+    (acc, Some(plan.with_confusion(&counts)))
+}
