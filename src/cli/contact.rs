@@ -55,7 +55,7 @@ pub struct ContactArgs {
     /// The thesis's app. E set-up: the pin moves across the belt at `--pin-speed` for this much
     /// belt travel (units of a, from its start just clear of the part at offset d), then stands
     /// still at d + w·S — one push with the true relative velocity, the stop mid-contact included
-    /// (SPEC §5).
+    /// (docs/physics.md#moving-and-retractable-pins).
     #[arg(
         long = "pin-stop-after",
         value_name = "S",

@@ -1,4 +1,4 @@
-//! `pinfeed run SCENARIO.toml`: simulate a feeder line (SPEC §7) and report throughput and
+//! `pinfeed run SCENARIO.toml`: simulate a feeder line (docs/physics.md#the-line) and report throughput and
 //! orientation success. Writes `summary.json` (and, as the scenario's `[output]` asks, the
 //! per-part CSV, the orientation histogram SVG and the event log) under
 //! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`. `--draw` and

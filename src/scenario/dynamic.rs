@@ -1,4 +1,4 @@
-//! Dynamic pins and the controller that drives them (SPEC §5; README "Moving and retractable
+//! Dynamic pins and the controller that drives them (docs/physics.md#moving-and-retractable-pins; README "Moving and retractable
 //! pins", "Controller and rules"): the compiled forms. Validation is in
 //! [`super::dynamic_check`].
 

@@ -102,7 +102,7 @@ pub struct RawDistribution {
 pub enum SupportModel {
     /// Uniform pressure over the footprint.
     Uniform,
-    /// A random tripod per sample (SPEC §2).
+    /// A random tripod per sample (docs/physics.md#support).
     Tripod,
     /// A random smooth pressure density per sample (see [`super::smooth_support`]).
     Smooth,
