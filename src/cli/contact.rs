@@ -177,7 +177,7 @@ pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>)
     crate::maps::fence_pass_start(poly, c.d, angle_deg, length, c.mu_c)
 }
 
-/// Ranges of the numeric settings of a contact (README "One contact"). Lengths relative to the part
+/// Ranges of the numeric settings of a contact (docs/commands.md#one-contact-pinfeed-contact). Lengths relative to the part
 /// are in units of `a`, so the ranges mean the same at any magnitude of the part.
 pub mod limits {
     /// |θ0| in degrees: any angle within it is represented to better than 1e-11 rad.

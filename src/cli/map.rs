@@ -94,7 +94,7 @@ pub struct MapArgs {
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Ensemble map under uncertain physics (README "Validating against measurements"), e.g.
+    /// Ensemble map under uncertain physics (docs/commands.md#validating-against-measurements-pinfeed-validate-pinfeed-calibrate), e.g.
     /// `mu_c=normal:0.5:0.1,support=tripod:0.5,pin_radius=uniform:0:0.1,jitter=2`.
     #[arg(long, value_name = "KEY=VALUE,...", conflicts_with_all = ["fence", "json", "csv"])]
     pub uncertain: Option<String>,

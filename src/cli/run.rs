@@ -16,7 +16,7 @@ use std::time::Instant;
 /// Arguments of `pinfeed run`.
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// Scenario file (TOML; see README "Scenario format").
+    /// Scenario file (TOML; see docs/scenario-format.md).
     pub scenario: PathBuf,
     /// Number of parts (overrides [feed] parts).
     #[arg(long)]

@@ -1,5 +1,5 @@
 //! Scenario files: the TOML a user writes to describe a feeder line (belt, part, feed, obstacles,
-//! goal, model, effects, output; README "Scenario format"), parsed with `deny_unknown_fields`,
+//! goal, model, effects, output; docs/scenario-format.md), parsed with `deny_unknown_fields`,
 //! validated with errors that name file, line, column, key and the allowed values, and compiled
 //! into an immutable [`Scene`] (docs/physics.md#frames, #the-line).
 //!

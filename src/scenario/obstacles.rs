@@ -1,4 +1,4 @@
-//! Validation and compilation of `[[obstacles]]`: pins and fences (README "Scenario format";
+//! Validation and compilation of `[[obstacles]]`: pins and fences (docs/scenario-format.md;
 //! docs/physics.md#fences fences, §7 the line), and the neighbour lists the engine uses to look for a second
 //! obstacle during a push.
 //!

@@ -1,7 +1,7 @@
 //! Monte Carlo robustness studies (issue 6): how often a line orients its parts when the physics
 //! and the build are uncertain.
 //!
-//! A study file (TOML, README "Monte Carlo studies") points at a scenario and declares uncertain
+//! A study file (TOML, docs/study-format.md) points at a scenario and declares uncertain
 //! parameters — pin–part friction μc, the support model (uniform, a random tripod, a random smooth
 //! density), shape tolerance, pin position and radius errors, entry pose noise, belt speed, sensor
 //! pins' noise, bias, timing threshold and jitter — and

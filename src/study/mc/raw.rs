@@ -1,4 +1,4 @@
-//! The study file as written: serde structs mirroring the TOML (README "Study format"), each with
+//! The study file as written: serde structs mirroring the TOML (docs/study-format.md), each with
 //! `deny_unknown_fields` so a misspelt key is a located error. Values are checked in
 //! [`super::compile`]; this layer only fixes names and types.
 //!
