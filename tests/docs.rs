@@ -210,3 +210,78 @@ fn shell_words_and_commands_are_read_as_a_shell_would() {
     let text = "```\ncargo run --release -- map --part tripoly1 \\\n    --d=0.1\nls\n```\n";
     assert_eq!(commands(text), ["pinfeed map --part tripoly1 --d=0.1"]);
 }
+
+/// Ways a document may write the number `v`: plain (`0.0001`, `1000`), exponent (`1e-4`, `1e3`)
+/// or a power of ten with superscripts (`10⁴`).
+fn forms(v: f64) -> Vec<String> {
+    let mut f = vec![format!("{v}"), format!("{v:e}").replace("e0", "")];
+    let exp = v.abs().log10();
+    if v != 0.0 && exp.fract() == 0.0 {
+        let sup: String = format!("{}", exp as i64)
+            .chars()
+            .map(|c| match c {
+                '-' => '⁻',
+                d => "⁰¹²³⁴⁵⁶⁷⁸⁹"
+                    .chars()
+                    .nth(d.to_digit(10).unwrap() as usize)
+                    .unwrap(),
+            })
+            .collect();
+        f.push(format!("10{sup}"));
+    }
+    f
+}
+
+/// The ranges docs/scenario-format.md quotes are those of the code's range table
+/// (`pinfeed::scenario::limits`): each key's row names both ends of its range, in order.
+#[test]
+fn scenario_format_quotes_the_range_table() {
+    use pinfeed::scenario::limits::*;
+    let text = std::fs::read_to_string(root().join("docs/scenario-format.md")).unwrap();
+    let row = |key: &str| -> &str {
+        text.lines()
+            .find(|l| l.starts_with('|') && l.contains(key))
+            .unwrap_or_else(|| panic!("no row for {key}"))
+    };
+    let quotes = |line: &str, (lo, hi): (f64, f64)| {
+        forms(lo).iter().any(|a| {
+            forms(hi).iter().any(|b| {
+                line.contains(&format!("[{a}, {b}]")) || line.contains(&format!("({a}, {b}]"))
+            })
+        })
+    };
+    let cases: [(&str, (f64, f64)); 13] = [
+        ("`[belt]` `speed`", BELT_SPEED),
+        ("`[belt]` `speed`", BELT_WIDTH),
+        ("`[belt]` `speed`", BELT_LENGTH),
+        ("`[part]` `scale`", PART_SCALE),
+        ("`[part]` `scale`", PART_RADIUS),
+        ("`[part]` `mu_c`", FRICTION),
+        ("`[part]` `mass`", MASS_KG),
+        ("`[feed]` `headway`", HEADWAY),
+        ("`[feed]` `headway`", RATE),
+        ("`[feed]` `jitter`", JITTER_DEG),
+        ("`[feed]` `weights`", WEIGHT),
+        ("`[model]` `tol`", TOL),
+        ("`histogram_bin`", HISTOGRAM_BIN_DEG),
+    ];
+    for (key, range) in cases {
+        assert!(
+            quotes(row(key), range),
+            "{key}: {range:?} not quoted in\n{}",
+            row(key)
+        );
+    }
+    let fence = row("`angle`, `length`");
+    let (lo, hi) = FENCE_LENGTH_OF_A;
+    assert!(
+        fence.contains(&format!("{} a to {} a", forms(lo)[2], forms(hi)[2])),
+        "{fence}"
+    );
+    let moving = row("`travel`, `speed`");
+    assert!(
+        quotes(moving, ACTUATOR_SPEED)
+            && quotes(moving, ACTUATOR_ACCEL)
+            && quotes(moving, ACTUATOR_TIME)
+    );
+}
