@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end check of README.md's Slurm example on a one-node Slurm stood up on this machine.
+# End-to-end check of docs/cluster.md's Slurm example on a one-node Slurm stood up on this machine.
 # NOT run by CI: it needs root, installs Debian packages and starts daemons.
 #
 #   sudo scripts/slurm_e2e.sh            # SAMPLES=200 TIMEOUT=900 KEEP=0 by default
@@ -10,12 +10,12 @@
 #  3. writes a private slurm.conf (in $STATE, default /tmp/pinfeed-slurm-e2e; /etc/slurm is not
 #     touched) for this host with the cores and memory `slurmd -C` reports, and starts munged,
 #     slurmctld and slurmd;
-#  4. extracts the job script (mc.sh) and the submit commands from README.md — the fenced blocks
+#  4. extracts the job script (mc.sh) and the submit commands from docs/cluster.md — the fenced blocks
 #     after the markers `<!-- slurm_e2e: mc.sh -->` and `<!-- slurm_e2e: submit -->`, so what runs
-#     here is what README says — changing only the job's size: `--samples 100000` becomes
+#     here is what docs/cluster.md says — changing only the job's size: `--samples 100000` becomes
 #     `--samples $SAMPLES` and `--cpus-per-task=4` becomes 1 (this node may have fewer than 4 cores);
 #  5. in a scratch project root (a copy of studies/ and scenarios/, so results/ is not touched)
-#     submits them as README says, waits for the merge job with a bounded timeout, and compares the
+#     submits them as docs/cluster.md says, waits for the merge job with a bounded timeout, and compares the
 #     merged report (report.md, report.json, sensitivity.svg) byte for byte with an unsharded
 #     `pinfeed mc` run of the same study;
 #  6. failure path: submits the same blocks in a scratch root without studies/, so every array task
@@ -141,19 +141,19 @@ sinfo -h -n "$host" -o '%T' | grep -qE '^idle' || {
 }
 say "node $host up: $cpus CPUs"
 
-# 4. The README's blocks.
+# 4. The blocks of docs/cluster.md.
 block() { # the fenced block after the marker line `<!-- slurm_e2e: $1 -->`
     awk -v m="<!-- slurm_e2e: $1 -->" '
         $0 == m { armed = 1; next }
         armed == 1 && /^```/ { armed = 2; next }
         armed == 2 && /^```/ { exit }
-        armed == 2 { print }' "$root/README.md"
+        armed == 2 { print }' "$root/docs/cluster.md"
 }
 job=$(block mc.sh)
 submit=$(block submit)
-[ -n "$job" ] && [ -n "$submit" ] || die "README.md has no slurm_e2e blocks"
-grep -q -- '--samples 100000' <<<"$job" || die "README's job has no '--samples 100000' to shrink"
-grep -q -- '--cpus-per-task=4' <<<"$job" || die "README's job has no '--cpus-per-task=4' to shrink"
+[ -n "$job" ] && [ -n "$submit" ] || die "docs/cluster.md has no slurm_e2e blocks"
+grep -q -- '--samples 100000' <<<"$job" || die "the job in docs/cluster.md has no '--samples 100000' to shrink"
+grep -q -- '--cpus-per-task=4' <<<"$job" || die "the job in docs/cluster.md has no '--cpus-per-task=4' to shrink"
 job=$(sed -e "s/--samples 100000/--samples $SAMPLES/" -e 's/--cpus-per-task=4/--cpus-per-task=1/' <<<"$job")
 
 # Wait until job $1 has left the queue (or TIMEOUT); print its final state.
@@ -173,14 +173,14 @@ wait_job() {
     echo TIMEOUT
 }
 
-# Submit README's blocks from a scratch project root $1; print the merge job's final state.
+# Submit the blocks of docs/cluster.md from a scratch project root $1; print the merge job's final state.
 run_readme_job() {
     local dir=$1
     printf '%s\n' "$job" >"$dir/mc.sh"
     # The submit block prints "Submitted batch job ID" for the merge job; then the array job's id.
     local out merge_id array_id
     out=$(cd "$dir" && bash -c "set -euo pipefail"$'\n'"$submit"$'\necho "$jobid"') ||
-        die "README's submit commands failed in $dir"
+        die "the submit commands of docs/cluster.md failed in $dir"
     merge_id=$(head -n1 <<<"$out" | grep -oE '[0-9]+$') || die "no merge job id in: $out"
     array_id=$(tail -n1 <<<"$out")
     say "submitted array job $array_id and merge job $merge_id in $dir" >&2
@@ -198,7 +198,7 @@ show_logs() {
 # 5. Success path.
 work=$(mktemp -d /tmp/pinfeed-slurm-e2e-work.XXXXXX)
 cp -r "$root/studies" "$root/scenarios" "$work/"
-say "README's job, --samples $SAMPLES, in $work"
+say "docs/cluster.md job, --samples $SAMPLES, in $work"
 t0=$SECONDS
 state=$(run_readme_job "$work")
 [ "$state" = COMPLETED ] || {

@@ -5,7 +5,7 @@
 //! limit-surface data, obstacles, settings); a seeded stream of randomly posed parts runs through a
 //! discrete-event engine, which calls the contact model — a pure function from (part, pose, obstacle,
 //! settings) to a `ContactOutcome` — for each pin or fence encounter; metrics and reports come out
-//! the other end. Physics and conventions follow `SPEC.md` (quasi-static pushing with Coulomb
+//! the other end. Physics and conventions are described in `docs/physics.md` (quasi-static pushing with Coulomb
 //! friction; x along belt travel, y to the left, angles counter-clockwise, degrees at interfaces).
 //!
 //! Modules: [`geometry`] (polygons, stable states, first contact), [`mechanics`] (the contact

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 /// Arguments of `pinfeed calibrate`.
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
-    /// The measured-bands file (CSV; README "Validating against measurements").
+    /// The measured-bands file (CSV; docs/commands.md#validating-against-measurements-pinfeed-validate-pinfeed-calibrate).
     pub measured: PathBuf,
     /// First write the bundled synthetic data set (hidden parameters, seed 16) to MEASURED.
     #[arg(long)]

@@ -55,7 +55,7 @@ pub struct ContactArgs {
     /// The thesis's app. E set-up: the pin moves across the belt at `--pin-speed` for this much
     /// belt travel (units of a, from its start just clear of the part at offset d), then stands
     /// still at d + w·S — one push with the true relative velocity, the stop mid-contact included
-    /// (SPEC §5).
+    /// (docs/physics.md#moving-and-retractable-pins).
     #[arg(
         long = "pin-stop-after",
         value_name = "S",
@@ -177,7 +177,7 @@ pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>)
     crate::maps::fence_pass_start(poly, c.d, angle_deg, length, c.mu_c)
 }
 
-/// Ranges of the numeric settings of a contact (README "One contact"). Lengths relative to the part
+/// Ranges of the numeric settings of a contact (docs/commands.md#one-contact-pinfeed-contact). Lengths relative to the part
 /// are in units of `a`, so the ranges mean the same at any magnitude of the part.
 pub mod limits {
     /// |θ0| in degrees: any angle within it is represented to better than 1e-11 rad.

@@ -1,4 +1,4 @@
-//! `pinfeed fuzz TARGET`: the long-running fuzzing driver (README "Fuzzing and robustness";
+//! `pinfeed fuzz TARGET`: the long-running fuzzing driver (docs/commands.md#fuzzing-and-robustness-pinfeed-fuzz;
 //! [`crate::study::robustness`]). It generates and mutates scenario and study files, random
 //! contacts and random polygons, runs each case in-process under `catch_unwind` with a per-case
 //! time budget, and writes the counts to a Markdown report (default results/robustness.md) headed

@@ -1,9 +1,9 @@
-//! `pinfeed map`: configuration maps θ0 → θf for a list of contact parameters d (SPEC §3, thesis
+//! `pinfeed map`: configuration maps θ0 → θf for a list of contact parameters d (docs/physics.md#configuration-maps, thesis
 //! chapter 3), their bands, and the figures and report files under `results/maps/<part>/`.
 //!
 //! Each map samples θ0 over [0°, 360°) with the start convention of `pinfeed contact`
 //! ([`crate::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
-//! (SPEC §6), placed as `pinfeed contact --fence` places it ([`super::contact::case_fence`]);
+//! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`super::contact::case_fence`]);
 //! a fence map has no contact parameter, so `--d` is not taken, and its report goes to
 //! `results/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
 //! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
@@ -94,7 +94,7 @@ pub struct MapArgs {
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Ensemble map under uncertain physics (README "Validating against measurements"), e.g.
+    /// Ensemble map under uncertain physics (docs/commands.md#validating-against-measurements-pinfeed-validate-pinfeed-calibrate), e.g.
     /// `mu_c=normal:0.5:0.1,support=tripod:0.5,pin_radius=uniform:0:0.1,jitter=2`.
     #[arg(long, value_name = "KEY=VALUE,...", conflicts_with_all = ["fence", "json", "csv"])]
     pub uncertain: Option<String>,
@@ -538,7 +538,7 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
     md += &format!(
         "Part `{}`, model `{}`, {obstacle}, support `{}`, \
          θ0 every {}° ({samples} samples per map), band threshold T = {}°, integration tolerance {}. \
-         Conventions: SPEC §3 and the module docs of `src/maps/` (bands group neighbours in sorted \
+         Conventions: docs/physics.md#configuration-maps and the module docs of `src/maps/` (bands group neighbours in sorted \
          final angle, circularly; an interval [a, b] with b < a straddles 0°/360°; sd uses n − 1; \
          adjusted band = mean ± sd, thesis eq. 3-2). Contacts that did not end `ok`: {non_ok}.\n\n",
         report.part,

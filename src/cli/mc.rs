@@ -1,4 +1,4 @@
-//! `pinfeed mc STUDY.toml`: a Monte Carlo robustness study (README "Monte Carlo studies"). Without
+//! `pinfeed mc STUDY.toml`: a Monte Carlo robustness study (docs/study-format.md). Without
 //! `--shard` it runs every sample and writes `report.md`, `report.json` and `sensitivity.svg` to
 //! `<out>` (default `results/mc/<study name>/`), printing the table (or the JSON with `--json`).
 //! With `--shard K/N` it runs one contiguous share of the samples and writes only a shard file
@@ -20,7 +20,7 @@ use std::time::Instant;
 /// Arguments of `pinfeed mc`.
 #[derive(Debug, Args)]
 pub struct McArgs {
-    /// Study file (TOML; see README "Monte Carlo studies").
+    /// Study file (TOML; see docs/study-format.md), or the name of a bundled study.
     pub study: PathBuf,
     /// Samples per sweep point (overrides the study's `samples`).
     #[arg(long)]
@@ -71,7 +71,7 @@ pub fn run(args: &McArgs) -> Result<()> {
             bail!("--threads must lie in [1, 1024], got {t}");
         }
     }
-    let study = mc::load(&args.study, args.samples)?;
+    let study = crate::study::bundled::load_study(&args.study, args.samples)?;
     let header = StudyHeader::of(&study);
     let total = study.total_samples();
     let shard = match &args.shard {

@@ -8,8 +8,10 @@ pub mod bench_map_tier;
 pub mod bench_mc;
 pub mod calibrate;
 pub mod compare;
+pub mod completions;
 pub mod contact;
 pub mod contact_map;
+pub mod examples;
 pub mod fuzz;
 pub mod map;
 pub mod map_ensemble;
@@ -80,6 +82,10 @@ pub enum Command {
     Validate(validate::ValidateArgs),
     /// Fit μc centre and spread, tripod share and pin radius to measured bands, with intervals.
     Calibrate(calibrate::CalibrateArgs),
+    /// List the bundled scenarios and studies, or write them into a folder.
+    Examples(examples::ExamplesArgs),
+    /// Print the shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(completions::CompletionsArgs),
 }
 
 /// Run a parsed command line.
@@ -98,6 +104,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fuzz(a) => fuzz::run(&a),
         Command::Validate(a) => validate::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
+        Command::Examples(a) => examples::run(&a),
+        Command::Completions(a) => completions::run(&a),
     }
 }
 

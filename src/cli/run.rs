@@ -1,4 +1,4 @@
-//! `pinfeed run SCENARIO.toml`: simulate a feeder line (SPEC §7) and report throughput and
+//! `pinfeed run SCENARIO.toml`: simulate a feeder line (docs/physics.md#the-line) and report throughput and
 //! orientation success. Writes `summary.json` (and, as the scenario's `[output]` asks, the
 //! per-part CSV, the orientation histogram SVG and the event log) under
 //! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`. `--draw` and
@@ -16,7 +16,7 @@ use std::time::Instant;
 /// Arguments of `pinfeed run`.
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// Scenario file (TOML; see README "Scenario format").
+    /// Scenario file (TOML; see docs/scenario-format.md), or the name of a bundled scenario.
     pub scenario: PathBuf,
     /// Number of parts (overrides [feed] parts).
     #[arg(long)]
@@ -54,7 +54,7 @@ pub struct RunArgs {
 const SAMPLE_POOL: usize = 64;
 
 pub fn run(args: &RunArgs) -> Result<()> {
-    let scene = crate::scenario::load(&args.scenario)?;
+    let scene = crate::study::bundled::load_scenario(&args.scenario)?;
     let mut opts = RunOptions::from_scene(&scene);
     if let Some(n) = args.parts {
         if !(1..=1_000_000_000).contains(&n) {

@@ -1,4 +1,4 @@
-//! `pinfeed sense`: what a sensorised pin can tell about a part (SPEC §4, thesis ch. 5).
+//! `pinfeed sense`: what a sensorised pin can tell about a part (docs/physics.md#sensing, thesis ch. 5).
 //!
 //! For one push (part in metres via `--scale`, pin offset `--d`, radius, μc, μs) and a set of
 //! hypotheses (the part's stable states by default, listed orientations, or `vertex-edge`), every

@@ -129,7 +129,7 @@ impl ModelArgs {
 /// Arguments of `pinfeed validate`.
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
-    /// The measured-bands file (CSV; README "Validating against measurements").
+    /// The measured-bands file (CSV; docs/commands.md#validating-against-measurements-pinfeed-validate-pinfeed-calibrate).
     pub measured: PathBuf,
     /// Uncertain parameters, as for `pinfeed map --uncertain` (none: the nominal model).
     #[arg(long, value_name = "KEY=VALUE,...")]

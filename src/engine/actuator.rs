@@ -1,4 +1,4 @@
-//! The actuators of dynamic pins (SPEC §5): where a moving pin stands and whether a retractable
+//! The actuators of dynamic pins (docs/physics.md#moving-and-retractable-pins): where a moving pin stands and whether a retractable
 //! pin is raised, at any time, as a timeline of commanded moves with their real motion times.
 //!
 //! * A **moving pin** travels along y in trapezoidal moves: acceleration `accel` up to `speed`,

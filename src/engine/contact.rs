@@ -1,5 +1,5 @@
-//! Contact begin: a part touches an obstacle and the contact model gives the whole push (SPEC §6,
-//! §7).
+//! Contact begin: a part touches an obstacle and the contact model gives the whole push (docs/physics.md#fences,
+//! #the-line).
 //!
 //! In order: the obstacle becomes a [`Pusher`] with its contact settings ([`pusher_for`]); the push
 //! is run (recording its knots for a sensor pin); a grazing touch lets the part ride on, a pin

@@ -1,4 +1,4 @@
-//! The online controller in the event engine (SPEC §5, §7): a sensor pin's reading becomes a
+//! The online controller in the event engine (docs/physics.md#controller): a sensor pin's reading becomes a
 //! decision, the decision (after the controller's computation latency) becomes commands for the
 //! dynamic pins through the rules, and each command becomes an actuator motion with its real
 //! timing ([`super::actuator`]).

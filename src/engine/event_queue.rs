@@ -1,4 +1,4 @@
-//! The time-ordered event queue (SPEC §7): events pop in increasing time; events at the same time
+//! The time-ordered event queue (docs/physics.md#the-line): events pop in increasing time; events at the same time
 //! pop in the order they were scheduled (a sequence number), so a run is a pure function of
 //! (scene, seed) with no dependence on heap internals.
 //!

@@ -1,4 +1,4 @@
-//! The feeder line as a discrete-event simulation (SPEC §7; DESIGN.md "the shape of the program").
+//! The feeder line as a discrete-event simulation (docs/physics.md#the-line; the data flow in `src/lib.rs`).
 //!
 //! Parts arrive (periodic or Poisson, at x = 0 with a random orientation and lateral offset), ride
 //! the belt, are pushed by pins and fences and leave at x = belt length. Each part is, at any time,
@@ -32,7 +32,7 @@
 //!   ([`super::contact`]).
 //! * **jam**: an obstacle that holds the part for good: a pin still pushing it after the contact
 //!   model's travel limit (cause `travel_limit`), or a fence at α + atan μf ≥ 90° against which the
-//!   part stops in the world while the belt slips under it (cause `fence_angle`, SPEC §6). A real
+//!   part stops in the world while the belt slips under it (cause `fence_angle`, docs/physics.md#fences). A real
 //!   line would stop there; the simulator counts the part and takes it off at that instant, so the
 //!   parts behind it are still measured.
 //! * **solver**: any other failure of the contact model, with its cause.

@@ -1,6 +1,6 @@
 //! The feeder line: a discrete-event engine that streams randomly posed parts through a scene of
 //! pins and fences, calls the contact model at each encounter and measures throughput and
-//! orientation success (SPEC §6, §7; DESIGN.md "the shape of the program").
+//! orientation success (docs/physics.md#fences, #the-line; the data flow of the crate docs in `src/lib.rs`).
 //!
 //! * [`event_queue`]: events ordered by (time, sequence number);
 //! * [`part_stream`]: part i drawn from its own random stream (seed, i);

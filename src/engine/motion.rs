@@ -1,9 +1,9 @@
-//! How a part moves on the line between events (SPEC §7).
+//! How a part moves on the line between events (docs/physics.md#the-line).
 //!
 //! * Free: the part rides the belt: its world pose at time t is its pose at the anchor time t₀
 //!   translated by V·(t − t₀) along x.
 //! * Held: a pin or a fence is pushing it. The contact model works in the belt frame that coincides
-//!   with the world at the anchor time t_ref (SPEC §2, §6): the obstacle, fixed in the world, starts
+//!   with the world at the anchor time t_ref (docs/physics.md#frames, #fences): the obstacle, fixed in the world, starts
 //!   where it stands and travels along −x relative to the belt, its travel s = V·(t − t_ref). The
 //!   push outcome gives the belt-frame pose after the obstacle has passed; the world pose at time t
 //!   is the belt-frame pose translated by s along x. The part therefore lags the belt while it is

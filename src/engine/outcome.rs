@@ -1,4 +1,4 @@
-//! How a part leaves the line. Every part that enters ends in exactly one class (SPEC §7):
+//! How a part leaves the line. Every part that enters ends in exactly one class (docs/physics.md#the-line):
 //!
 //! | class | meaning |
 //! |---|---|
@@ -7,7 +7,7 @@
 //! | `collision` | overlapped another part (both parts are taken off the line at that instant) |
 //! | `multi_contact` | touched two obstacles at once (another obstacle during a push), or the pin met a concave notch (two contact points) |
 //! | `off_belt` | its centroid left the belt's width after a push, or while a fence carried it across (it falls off) |
-//! | `jam` | an obstacle holds it for good: it rides on a pin beyond `model.max_travel` (cause `travel_limit`), or it stops against a fence at α + atan μf ≥ 90° while the belt slips under it (cause `fence_angle`, SPEC §6). A real line would stop here; the part is counted and removed at that instant |
+//! | `jam` | an obstacle holds it for good: it rides on a pin beyond `model.max_travel` (cause `travel_limit`), or it stops against a fence at α + atan μf ≥ 90° while the belt slips under it (cause `fence_angle`, docs/physics.md#fences). A real line would stop here; the part is counted and removed at that instant |
 //! | `solver` | the contact model could not finish the push (evaluation/event limits, step too small, a sub-problem failed); the cause is counted |
 
 use serde::Serialize;

@@ -1,4 +1,4 @@
-//! Overlap tests for the line (SPEC §7: "simultaneous contact with two obstacles and part–part
+//! Overlap tests for the line (docs/physics.md#the-line: "simultaneous contact with two obstacles and part–part
 //! overlap are detected and reported, never silently mis-simulated").
 //!
 //! * [`polygon_clearance`]: the distance between two simple polygons (world vertices), 0 when they

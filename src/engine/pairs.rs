@@ -1,4 +1,4 @@
-//! Part–part overlap (SPEC §7): whenever a part's motion changes, its new motion is checked
+//! Part–part overlap (docs/physics.md#the-line): whenever a part's motion changes, its new motion is checked
 //! against every other part on the belt over the time both motions are known (until the earlier
 //! of their next events). A broad phase (`bounding_capsule`: capsules in the belt frame) skips
 //! distant pairs; close pairs are resolved in time with [`super::overlap::first_touch`] on the

@@ -1,5 +1,5 @@
-//! The stream of parts (SPEC §7): what part `i` looks like when it enters, drawn from its own
-//! random stream `random::stream(seed, i)` (DESIGN.md "determinism") so that a run does not depend
+//! The stream of parts (docs/physics.md#the-line): what part `i` looks like when it enters, drawn from its own
+//! random stream `random::stream(seed, i)` (docs/physics.md#determinism) so that a run does not depend
 //! on event order, sharding or how many parts are simulated.
 //!
 //! Draw order within a part's stream (fixed, so adding a draw at the end never changes earlier

@@ -44,7 +44,7 @@ pub enum EngineError {
     PartDraw { index: u64, reason: String },
     /// An event time came out non-finite (NaN or ±∞): the scene's numbers leave f64. Validated
     /// scenarios never get here; the engine refuses instead of panicking.
-    #[error("an event time is not finite ({kind:?} at {time} s; {refused} event(s) refused): the scene's numbers are out of range (see README \"Scenario format\")")]
+    #[error("an event time is not finite ({kind:?} at {time} s; {refused} event(s) refused): the scene's numbers are out of range (see docs/scenario-format.md)")]
     NonFiniteTime {
         time: f64,
         kind: EventKind,

@@ -1,4 +1,4 @@
-//! Sensor pins in the line (SPEC §4; issue "Sensor pins"): a push against a pin with a sensor is
+//! Sensor pins in the line (docs/physics.md#sensing; issue "Sensor pins"): a push against a pin with a sensor is
 //! computed once with a knot recorder, its clean signal read through the sensor's noise model on
 //! a stream of its own, and classified with the sensor's trained classifier; the decision joins the
 //! part's record and the sensor's statistics.

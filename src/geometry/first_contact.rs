@@ -5,7 +5,7 @@
 //! radius ρ ≥ 0 (ρ = 0 is the thesis's point pin) swept from `start` along the unit direction `dir`
 //! against the polygon. The answer is the travel until first touch, the touching feature (an edge with
 //! its fraction, or a vertex), the contact point and the unit normal pointing *into* the part
-//! (SPEC §2: an edge's inward normal, or for a disc touching a vertex the direction from the pin
+//! (docs/physics.md#pin-radius: an edge's inward normal, or for a disc touching a vertex the direction from the pin
 //! centre to the vertex).
 //!
 //! A touch is *grazing* when the pin's direction of travel does not enter the part there (the pin
@@ -179,7 +179,7 @@ pub fn first_contact(
     })
 }
 
-/// The belt-frame question of SPEC §1: a part at `pose` travels in +x toward a pin centred at world
+/// The belt-frame question (docs/physics.md#frames): a part at `pose` travels in +x toward a pin centred at world
 /// `pin` (radius `radius`). Returns how far the part travels before first touch (the same as the
 /// pin's travel in −x relative to the part). Points in the answer are for the part held at `pose`
 /// and the pin moved back by the travel (the belt-frame picture).

@@ -1,4 +1,4 @@
-//! Named parts (SPEC §1) and the textual part specifications the CLI and scenarios accept.
+//! Named parts (docs/physics.md#the-part) and the textual part specifications the CLI and scenarios accept.
 //!
 //! | spec | shape |
 //! |---|---|

@@ -1,7 +1,7 @@
 //! Simple polygons: validation, mass properties, convex hull, radius function and stable states.
 //!
 //! A part is a simple polygon (convex or concave) stored counter-clockwise in its own frame with the
-//! origin at its area centroid (SPEC §1). Construction validates the input and normalises it:
+//! origin at its area centroid (docs/physics.md#the-part). Construction validates the input and normalises it:
 //!
 //! * at least three vertices, all finite, no vertex repeating its predecessor (within 1e-12 of the
 //!   part's size — an edge of 1e-9 of the size is kept), non-zero area, no self-intersection;
@@ -18,7 +18,7 @@
 //! 1e±75) is refused with [`PolygonError::NotRepresentable`] rather than carrying inf or NaN.
 //!
 //! Mass properties use the shoelace formulas; `a` is the largest centroid-to-vertex distance.
-//! Stable states (SPEC §1) are the orientations θ at which an edge of the convex hull has its outward
+//! Stable states (docs/physics.md#stable-states) are the orientations θ at which an edge of the convex hull has its outward
 //! normal along −y and the foot of the perpendicular from the centroid lies strictly inside that edge:
 //! the local minima of the radius function ρ(φ) = max_v v·(cos φ, sin φ).
 
@@ -585,7 +585,7 @@ impl Polygon {
         self.radius_function(-std::f64::consts::FRAC_PI_2 - theta)
     }
 
-    /// Stable states (SPEC §1), sorted by θ ascending in [0, 2π).
+    /// Stable states (docs/physics.md#stable-states), sorted by θ ascending in [0, 2π).
     pub fn stable_states(&self) -> Vec<StableState> {
         let h = &self.hull;
         let m = h.len();

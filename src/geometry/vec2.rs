@@ -1,6 +1,6 @@
 //! A small 2-D vector type and rigid transforms of the plane.
 //!
-//! Everything pinfeed computes lives in the plane z = 0 (SPEC §1): x along belt travel, y to the left.
+//! Everything pinfeed computes lives in the plane z = 0 (docs/physics.md#frames): x along belt travel, y to the left.
 //! Angles are radians inside the library; the CLI and files speak degrees. The scalar cross product
 //! `a.cross(b) = a.x b.y − a.y b.x` is the z component of the 3-D cross product, so for a moment arm
 //! `r` and force `f`, `r.cross(f)` is the counter-clockwise moment.

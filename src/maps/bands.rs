@@ -1,4 +1,4 @@
-//! Bands of a configuration map (thesis §2.17, eqs. 2-15, 2-16, 2-18 and 3-2; SPEC §3).
+//! Bands of a configuration map (thesis §2.17, eqs. 2-15, 2-16, 2-18 and 3-2; docs/physics.md#configuration-maps).
 //!
 //! **Grouping.** The final angles θf of the *contacting* samples are sorted around the circle and
 //! neighbours in that order are compared (eq. 2-15: |θf,j+1 − θf,j| < T keeps them in one group).

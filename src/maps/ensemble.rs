@@ -6,7 +6,7 @@
 //! (d, input state) is the pool of all members' passes; its predicted bands are the smallest set of
 //! arcs holding 90% of it, gaps under 5° closed ([`super::arcs::highest_density_arcs`]).
 //!
-//! Random streams (DESIGN.md "determinism"): member i of an ensemble seeded with s draws five
+//! Random streams (docs/physics.md#determinism): member i of an ensemble seeded with s draws five
 //! sub-seeds from `random::stream(s, i)`, in the order μc, support share, support shape, pin radius,
 //! pose jitter; pass number p of member i draws its jitter z (and, for a θ0 arc, its uniform u) from
 //! `random::stream(jitter sub-seed, p)`. A value is always `mean + sd·z`, `min + (max − min)·u` or
@@ -182,7 +182,7 @@ fn parse_support(s: &str) -> Result<(SupportChoice, f64), String> {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum InputState {
-    /// Resting in stable state k (SPEC §1; the order of `pinfeed part`).
+    /// Resting in stable state k (docs/physics.md#stable-states; the order of `pinfeed part`).
     State { index: usize },
     /// θ0 uniform on an arc.
     Theta { arc: Arc },

@@ -1,5 +1,5 @@
-//! Configuration maps (thesis §2.17 and chapter 3; SPEC §3): initial orientation θ0 → final
-//! orientation θf of a part after one pass of a pin at contact parameter d — or of a fence (SPEC §6,
+//! Configuration maps (thesis §2.17 and chapter 3; docs/physics.md#configuration-maps): initial orientation θ0 → final
+//! orientation θf of a part after one pass of a pin at contact parameter d — or of a fence (docs/physics.md#fences,
 //! [`MapFence`]; placed by [`fence_pass_start`]) — and what the thesis reads off them.
 //!
 //! * [`sample`]: θ0 on a regular grid over [0°, 360°), one contact per sample (pure, parallel,
@@ -60,7 +60,7 @@ pub enum MapError {
     FenceLength(f64),
 }
 
-/// A fence to map instead of a pin (SPEC §6): its friction is the settings' `mu_c`.
+/// A fence to map instead of a pin (docs/physics.md#fences): its friction is the settings' `mu_c`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct MapFence {
     /// Angle from the belt direction (degrees, strictly between −90 and 90; positive fences deflect

@@ -1,5 +1,5 @@
 //! Sampling a configuration map: one pin pass per initial orientation θ0 on a regular grid over
-//! [0°, 360°), for each contact parameter d (SPEC §3, thesis eq. 2-14: θf = f(θi, d; μc, pressure)).
+//! [0°, 360°), for each contact parameter d (docs/physics.md#configuration-maps, thesis eq. 2-14: θf = f(θi, d; μc, pressure)).
 //!
 //! Every sample is an independent call of the pure contact model ([`push`], or [`push_fence`] for
 //! a fence map) from the standard start ([`super::pass_start`], [`super::fence_pass_start`]). The (d, θ0) pairs are flattened into one list, computed with rayon and

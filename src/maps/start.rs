@@ -1,11 +1,11 @@
 //! Where a pin or fence pass starts: the convention every map sample and `pinfeed contact` use.
 //!
 //! The part's centroid sits at the origin of the belt frame with orientation θ0; the pin centre
-//! starts just clear of the part's circumscribed circle, at x = 1.01·a + ρ, y = d·a (SPEC §1:
+//! starts just clear of the part's circumscribed circle, at x = 1.01·a + ρ, y = d·a (docs/physics.md#contact-parameter:
 //! d = (y_pin − y_com)/a, taken before contact), and travels in −x relative to the belt. Lengths
 //! are in the part's units.
 //!
-//! A fence (SPEC §6) at angle α is placed with its line 1.01·a from the centroid on the upstream
+//! A fence (docs/physics.md#fences) at angle α is placed with its line 1.01·a from the centroid on the upstream
 //! side (so it starts clear of the part) and its upstream end 1.5·a beyond the part's lateral band
 //! on the side parts come from (y = −1.5a for α > 0, +1.5a for α < 0): the part meets the fence
 //! with the whole fence length ahead of it, less the stretch needed to cross the band. The fence

@@ -1,4 +1,4 @@
-//! Fences (SPEC §6): a segment fixed over the belt at angle α to the belt direction, with friction μf.
+//! Fences (docs/physics.md#fences): a segment fixed over the belt at angle α to the belt direction, with friction μf.
 //!
 //! In the belt frame the fence translates at v = (−V, 0), like a fixed pin. Only the part's convex
 //! hull can touch a straight fence. A contact passes through these states, all integrated by
@@ -179,7 +179,7 @@ impl Ctx<'_, '_> {
         (lo, hi, meet)
     }
 
-    /// A flush edge translates (SPEC §6): sliding with the force on a friction-cone edge, or, in
+    /// A flush edge translates (docs/physics.md#fences): sliding with the force on a friction-cone edge, or, in
     /// `Stick` mode, jammed (moving with the fence). The force passes through the centroid; the
     /// margins say how far inside the supported interval it meets the fence.
     pub(super) fn flush_instant(&self, k: usize, y: [f64; 2], mode: Mode) -> Instant {

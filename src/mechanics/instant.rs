@@ -1,5 +1,5 @@
 //! One instant of one contact: which mode (stick, slide left, slide right, separate) is consistent,
-//! and the part's twist in it (SPEC §2, "Solving one instant robustly").
+//! and the part's twist in it (docs/physics.md#one-instant).
 //!
 //! Inputs are in the part frame, normalised units: contact point `p` (relative to the centroid), unit
 //! normal `n` pointing into the part, and the pin's velocity `v_pin` relative to the belt.
@@ -256,7 +256,7 @@ struct SideSlide {
 
 /// Sliding on one cone edge (`sign` +1 left, −1 right): the scaled twist, the force, and the
 /// margin — the signed sine between v_b and v_pin, forced negative when n·v_b ≤ ε (that side can
-/// never slide: SPEC's guard for large μc).
+/// never slide: the guard for large μc of docs/physics.md#one-instant).
 #[allow(clippy::too_many_arguments)]
 fn slide_side(
     model: &PartModel,

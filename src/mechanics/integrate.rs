@@ -1,5 +1,5 @@
 //! Integration of one contact: from the first touch until separation, in pin travel, with error
-//! control and precise event location (SPEC §2, "Integration over a contact").
+//! control and precise event location (docs/physics.md#integration-and-events).
 //!
 //! The contact is held in reduced coordinates on its feature (`mechanics::contact_state`). Each turn
 //! of the loop in `integrate_contact` is one of these named steps:

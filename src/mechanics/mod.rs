@@ -1,4 +1,4 @@
-//! The contact model: what happens to a part carried by the belt into one pin (SPEC §2).
+//! The contact model: what happens to a part carried by the belt into one pin (docs/physics.md#one-instant).
 //!
 //! * [`limit_surface`]: dissipation D(ξ), its gradient (the support load) and Hessian for uniform
 //!   pressure (closed form per edge, with a far-field quadrature) and for weighted support points.
@@ -14,8 +14,8 @@
 //! * `pass`: the pass loop — cast the obstacle's path, integrate each contact, cast again — and
 //!   the entry points [`push`], [`push_path`], [`push_fence`].
 //! * [`outcome`]: [`ContactOutcome`], segments, statuses and the optional trajectory recorder.
-//! * [`pin_path`]: a moving pin's lateral speed profile over a pass (SPEC §5).
-//! * [`fence`]: fences (SPEC §6): vertex on the fence line, flush edge translation or jam, ends.
+//! * [`pin_path`]: a moving pin's lateral speed profile over a pass (docs/physics.md#moving-and-retractable-pins).
+//! * [`fence`]: fences (docs/physics.md#fences): vertex on the fence line, flush edge translation or jam, ends.
 //! * [`slide_table`]: the exact model's sliding twists on each edge and vertex, tabulated per (μc, place,
 //!   side) for models many contacts share.
 //! * [`stick_table`]: the exact model's sticking twists on each edge, tabulated per edge over (ℓ,

@@ -132,7 +132,7 @@ impl ContactStatus {
     }
 }
 
-/// The result of pushing one part with one pin (SPEC §2): a pure function of its inputs.
+/// The result of pushing one part with one pin (docs/physics.md#one-instant): a pure function of its inputs.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ContactOutcome {
     /// Did the pin push the part at all?

@@ -1,6 +1,5 @@
 //! The part as the contact model sees it: geometry normalised to unit size plus its support
-//! (friction) model, and the two convex sub-problems every instant reduces to (SPEC §2, "Solving one
-//! instant robustly"):
+//! (friction) model, and the two convex sub-problems every instant reduces to (docs/physics.md#one-instant):
 //!
 //! * [`PartModel::twist_for_wrench`]: the twist ξ normal to the limit surface at a contact wrench w,
 //!   ξ = argmin D(ξ) subject to w·ξ = 1;
@@ -77,7 +76,7 @@ pub fn point_velocity(xi: Twist, p: Vec2) -> Vec2 {
     Vec2::new(xi[0], xi[1]) + p.perp() * xi[2]
 }
 
-/// Which model of the support friction to use (SPEC §2, "Fidelity levels").
+/// Which model of the support friction to use (docs/physics.md#fidelity-tiers).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum Fidelity {
@@ -127,7 +126,7 @@ pub enum Support {
 }
 
 impl Support {
-    /// A random tripod (SPEC §2): three points drawn uniformly inside the part whose triangle
+    /// A random tripod (docs/physics.md#support): three points drawn uniformly inside the part whose triangle
     /// contains the centroid; each carries the centroid's barycentric weight (static equilibrium).
     /// Points are in the polygon's part frame (centroid origin). Each weight is at least 2%, so the
     /// tripod is never degenerate.

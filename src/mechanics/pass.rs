@@ -170,7 +170,7 @@ pub fn push(
     )
 }
 
-/// Push a part with a pin of radius `radius` whose lateral speed follows `path` (SPEC §5: one push
+/// Push a part with a pin of radius `radius` whose lateral speed follows `path` (docs/physics.md#moving-and-retractable-pins: one push
 /// with the pin's true relative velocity (−V, w(s)), each change of w a step boundary). Pure.
 pub fn push_path(
     model: &PartModel,
@@ -238,7 +238,7 @@ pub fn pin_first_touch(
     }
 }
 
-/// Push a part resting at `pose` with a fence (SPEC §6; see [`super::fence`]): the fence travels at
+/// Push a part resting at `pose` with a fence (docs/physics.md#fences; see [`super::fence`]): the fence travels at
 /// (−V, 0) relative to the belt past the part; its friction μf replaces μc in `settings`.
 /// Fence-contact features index the part's convex hull.
 pub fn push_fence(

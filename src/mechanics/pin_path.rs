@@ -1,4 +1,4 @@
-//! A pin's path relative to the belt when its lateral speed changes during a pass (SPEC §5).
+//! A pin's path relative to the belt when its lateral speed changes during a pass (docs/physics.md#moving-and-retractable-pins).
 //!
 //! A moving pin's lateral velocity is piecewise constant in pin travel: it starts at `w0` and
 //! changes to `w` at each [`Turn`]. Relative to the belt the pin moves along (−1, w) (speeds as

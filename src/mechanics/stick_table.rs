@@ -3,7 +3,7 @@
 //!
 //! While a pin sticks on edge k at ℓ, the contact point p = a_k + ℓ e_k moves with the pin: its
 //! velocity in the part frame is the pin's, v. The part's twist is the one of least dissipation
-//! among those giving p that velocity (SPEC §2, stick):
+//! among those giving p that velocity (docs/physics.md#one-instant, stick):
 //!
 //!   ξ(ω) = (v + ω q, ω),  q = −ẑ×p,   ω* = argmin D(ξ(ω)),  i.e.  ∇D(ξ)·(q, 1) = 0,
 //!
@@ -689,7 +689,7 @@ mod tests {
     }
 
     /// Where the centre of rotation crosses the part's boundary the stick twist is not smooth
-    /// (SPEC §2): the refinement stops there and leaves those pieces to the solver, while the rest
+    /// (docs/physics.md#limit-surface): the refinement stops there and leaves those pieces to the solver, while the rest
     /// of the table is certified.
     #[test]
     fn pieces_across_a_kink_are_left_to_the_solver() {

@@ -1,6 +1,6 @@
 //! `pinfeed run --animate FILE.svg`: the line seen from above as an animated SVG (SMIL
 //! `<animate>`, `<animateTransform>`; browsers such as Chromium play it), to scale with equal
-//! metres on both axes (world frame of SPEC §1: x along travel, y to the left, drawn upwards).
+//! metres on both axes (world frame of docs/physics.md#frames: x along travel, y to the left, drawn upwards).
 //!
 //! The renderer works over plain data, [`Animation`]: the belt, the part's outline in its own
 //! frame, the obstacles (a pin's lateral position and raised/withdrawn state as knots in time, so

@@ -1,5 +1,5 @@
 //! Validation and compilation: [`RawScenario`] → [`Scene`]. Every check names the key and the
-//! allowed range (SPEC §1 units: m, s, degrees in the file; radians inside).
+//! allowed range (docs/physics.md#frames units: m, s, degrees in the file; radians inside).
 //!
 //! Geometry rules that keep a run well defined:
 //! * a part enters with its centroid at x = 0 and must fit on the belt: the lateral offsets lie

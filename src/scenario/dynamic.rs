@@ -1,5 +1,6 @@
-//! Dynamic pins and the controller that drives them (SPEC §5; README "Moving and retractable
-//! pins", "Controller and rules"): the compiled forms. Validation is in
+//! Dynamic pins and the controller that drives them (docs/physics.md#moving-and-retractable-pins;
+//! docs/scenario-format.md#moving-and-retractable-pins, #controller-and-rules): the compiled
+//! forms. Validation is in
 //! [`super::dynamic_check`].
 
 /// A moving pin's actuator: it translates along y within `travel`, in trapezoidal moves.

@@ -1,6 +1,6 @@
 //! Validation of dynamic pins (`kind = "moving_pin"`, `"retractable_pin"`), of `[controller]`
-//! and of `[[rules]]` or a policy file (README "Moving and retractable pins", "Controller and
-//! rules"). Every refusal names the file, the line and the key.
+//! and of `[[rules]]` or a policy file (docs/scenario-format.md#moving-and-retractable-pins,
+//! #controller-and-rules). Every refusal names the file, the line and the key.
 //!
 //! * a moving pin's `travel` = [min, max] lies over the belt (|y| ≤ width/2) and holds its home
 //!   `y`; `speed` and `accel` are positive and finite ([`super::limits::ACTUATOR_SPEED`],

@@ -1,5 +1,5 @@
-//! The physically meaningful range of every number in a scenario or study file (README "Scenario
-//! format", "Study format"). A value outside its range is refused with a located error naming the
+//! The physically meaningful range of every number in a scenario or study file (docs/scenario-format.md,
+//! docs/study-format.md). A value outside its range is refused with a located error naming the
 //! key, the range and the value, before any geometry or simulation sees it.
 //!
 //! Why ranges at all: the simulator is scale invariant in principle, but a number like

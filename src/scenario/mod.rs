@@ -1,7 +1,7 @@
 //! Scenario files: the TOML a user writes to describe a feeder line (belt, part, feed, obstacles,
-//! goal, model, effects, output; README "Scenario format"), parsed with `deny_unknown_fields`,
+//! goal, model, effects, output; docs/scenario-format.md), parsed with `deny_unknown_fields`,
 //! validated with errors that name file, line, column, key and the allowed values, and compiled
-//! into an immutable [`Scene`] (DESIGN.md "model vs state"; SPEC §1 units and frames, §7 the line).
+//! into an immutable [`Scene`] (docs/physics.md#frames, #the-line).
 //!
 //! * [`raw`]: serde structs mirroring the file;
 //! * [`compile`]: checks and conversion to [`Scene`], one function per section;

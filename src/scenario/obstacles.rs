@@ -1,5 +1,5 @@
-//! Validation and compilation of `[[obstacles]]`: pins and fences (README "Scenario format";
-//! SPEC §6 fences, §7 the line), and the neighbour lists the engine uses to look for a second
+//! Validation and compilation of `[[obstacles]]`: pins and fences (docs/scenario-format.md;
+//! docs/physics.md#fences fences, §7 the line), and the neighbour lists the engine uses to look for a second
 //! obstacle during a push.
 //!
 //! Rules that keep a run well defined:

@@ -1,7 +1,7 @@
 //! The scenario file as written: serde structs mirroring the TOML, one per section, each with
 //! `deny_unknown_fields` so a misspelt key is an error (no `flatten`, which would defeat it).
 //! Values are checked and converted in [`super::compile`]; this layer only fixes names and types.
-//! Units are SI (m, s) and degrees, as documented in README.md's "Scenario format".
+//! Units are SI (m, s) and degrees, as documented in docs/scenario-format.md.
 
 use crate::mechanics::Fidelity;
 use serde::Deserialize;
@@ -173,7 +173,7 @@ pub struct RawObstacle {
     pub lower_time: Option<f64>,
 }
 
-/// `[controller]`: how decisions become actuator commands (README "Controller and rules").
+/// `[controller]`: how decisions become actuator commands (docs/scenario-format.md#controller-and-rules).
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RawController {
@@ -208,7 +208,7 @@ pub struct RawPolicy {
     pub rules: Vec<RawRule>,
 }
 
-/// `[obstacles.sensor]` of a sensor pin (README "Sensor pins"; defaults in
+/// `[obstacles.sensor]` of a sensor pin (docs/scenario-format.md#sensor-pins; defaults in
 /// [`crate::sensing::settings`]). Units: N, N·mm, m, s, Hz.
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]

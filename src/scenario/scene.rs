@@ -1,5 +1,5 @@
 //! The compiled scene: everything a run needs, validated, in SI units and radians, never mutated
-//! (DESIGN.md "model vs state"). Run state lives in [`crate::engine`].
+//! (the model, apart from the state). Run state lives in [`crate::engine`].
 
 use super::dynamic::{Actuator, Controller};
 pub use super::raw::SupportKind;
@@ -157,7 +157,7 @@ impl PartialEq for SensorPin {
     }
 }
 
-/// A fixed fence over the belt (SPEC §6): the segment from `start` (its upstream end) along
+/// A fixed fence over the belt (docs/physics.md#fences): the segment from `start` (its upstream end) along
 /// `angle` for `length`.
 ///
 /// Side: parts meet the fence's upstream face. A positive angle runs downstream to the left (+y):
@@ -270,7 +270,7 @@ impl Goal {
     }
 }
 
-/// Optional work, switched per scene (DESIGN.md "effects are opt-in").
+/// Optional work, switched per scene (effects are opt-in: a scene pays only for what it asks for).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Effects {
     pub collisions: bool,

@@ -1,5 +1,5 @@
 //! `[obstacles.sensor]` of a `sensor_pin`: validation of the sensor's settings and hypotheses, and
-//! training of its classifier on simulated templates (README "Sensor pins"; SPEC §4).
+//! training of its classifier on simulated templates (docs/scenario-format.md#sensor-pins; docs/physics.md#sensing).
 //!
 //! The templates model what the sensor expects: the part reaching the pin as fed — orientation
 //! one of the hypotheses (with the feed's orientation jitter), lateral offset drawn from the

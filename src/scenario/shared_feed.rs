@@ -1,4 +1,4 @@
-//! One part stream for several scenes (`pinfeed compare`; SPEC §7 "a run is a pure function of
+//! One part stream for several scenes (`pinfeed compare`; docs/physics.md#the-line "a run is a pure function of
 //! (scenario, seed)").
 //!
 //! Part i of a run is drawn from its own random stream (seed, i) by the scene's feed and part

@@ -1,4 +1,4 @@
-//! Sensing (SPEC §4; thesis ch. 5, app. C, D, F): what a sensorised pin measures during a push and
+//! Sensing (docs/physics.md#sensing; thesis ch. 5, app. C, D, F): what a sensorised pin measures during a push and
 //! what can be told from it.
 //!
 //! * [`settings`]: the sensor (force/torque or contact timing) and its noise model, with defaults

@@ -1,9 +1,9 @@
-//! Sensor settings (SPEC §4; thesis ch. 5 and app. C, F) and their physical ranges.
+//! Sensor settings (docs/physics.md#sensing; thesis ch. 5 and app. C, F) and their physical ranges.
 //!
 //! Two kinds of sensor sit on a pin:
 //! * **force/torque** (`ft`): six channels (Fx, Fy, Fz in N; Tx, Ty, Tz in N·mm) of the force the part
 //!   puts on the pin, in world axes, about the sensor origin on the pin's axis at height `height`
-//!   above the contact (SPEC §4: T = r × F with r = (p − c_pin, −h)), sampled at `rate` Hz;
+//!   above the contact (docs/physics.md#sensing: T = r × F with r = (p − c_pin, −h)), sampled at `rate` Hz;
 //! * **timing** (`timing`): the instants at which |F| rises above and falls below `threshold`
 //!   (a contact or strain-gauge switch), each stamped with Gaussian jitter.
 //!
@@ -15,7 +15,7 @@
 //!
 //! Defaults (each documented where it comes from):
 //! * resolution 0.025 N (Fx, Fy), 0.05 N (Fz), 0.125 N·mm (torques): ATI Nano, 25/250 calibration
-//!   (thesis app. C, table C-1; SPEC §4) — the calibration the thesis's chapter 5 used;
+//!   (thesis app. C, table C-1; docs/physics.md#sensing) — the calibration the thesis's chapter 5 used;
 //! * noise σ = 0.0125 N and 0.0625 N·mm: half a count of that calibration (ATI quotes noise of the
 //!   order of the resolution; the thesis shows raw profiles with a few counts of jitter);
 //! * rate 1000 Hz: a common DAQ rate for a Nano (the thesis states none);

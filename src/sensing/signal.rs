@@ -1,4 +1,4 @@
-//! The force/torque signal of one pin pass, taken from the push itself (SPEC §4; thesis ch. 5).
+//! The force/torque signal of one pin pass, taken from the push itself (docs/physics.md#sensing; thesis ch. 5).
 //!
 //! The contact model's [`Recorder`] receives a knot at the start of every contact, at every
 //! accepted integration step, and on both sides of every event (mode switch, feature change), so the
@@ -14,7 +14,7 @@
 //! (x along belt travel, y left, z up). The force on the pin is F = −f, with f the force the pin
 //! applies to the part (the contact model's force, in units of μs m g, times μs m g in newtons).
 //! The torques about the sensor origin, on the pin's axis at height h above the contact plane, are
-//! T = r × F with r = (p − c_pin, −h) (SPEC §4; for a point pin p = c_pin), in N·mm:
+//! T = r × F with r = (p − c_pin, −h) (docs/physics.md#sensing; for a point pin p = c_pin), in N·mm:
 //! Tx = h Fy, Ty = −h Fx, Tz = r_x F_y − r_y F_x (the contact friction's moment on a disc pin).
 
 use super::settings::CHANNELS;

@@ -132,7 +132,7 @@ pub const MAX_HYPOTHESES: usize = 64;
 pub const VERTEX_EDGE_STEP_DEG: f64 = 5.0;
 
 impl Hypotheses {
-    /// The part's stable states (SPEC §1), labelled by their orientation; at least two are needed.
+    /// The part's stable states (docs/physics.md#stable-states), labelled by their orientation; at least two are needed.
     pub fn stable_states(poly: &Polygon) -> Result<Hypotheses, String> {
         let degrees: Vec<f64> = poly
             .stable_states()

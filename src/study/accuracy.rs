@@ -293,7 +293,7 @@ pub fn csv(st: &AccuracyStudy) -> String {
     s
 }
 
-/// Exact/ellipsoid rotation-rate ratio for a near-central frictionless push (SPEC §2's gap):
+/// Exact/ellipsoid rotation-rate ratio for a near-central frictionless push (docs/physics.md#limit-surface):
 /// (part, θ0, measured ratio, closed-form ratio c²/((1/A)∫x∥² dA)).
 pub fn central_push_gap() -> Vec<(String, f64, f64, f64)> {
     let mut out = Vec::new();
@@ -413,7 +413,7 @@ pub fn report_markdown(st: &AccuracyStudy, cmd: &str) -> String {
         ));
     }
     s.push_str(
-        "\n### The ellipsoid's near-central-push gap (SPEC §2)\n\n\
+        "\n### The ellipsoid's near-central-push gap\n\n\
          For a push through (almost) the centroid the exact uniform model has (COR distance)·(force-line \
          offset) → (1/A)∫x∥² dA with x∥ along the push; the ellipsoid has c² = (m_max/f_max)². The exact \
          model therefore turns c²/((1/A)∫x∥² dA) times faster. Measured rotation rates at d = 1e-4, μc = 0:\n\n\
@@ -426,8 +426,7 @@ pub fn report_markdown(st: &AccuracyStudy, cmd: &str) -> String {
     }
     s.push_str(
         "\nA 2×1 rectangle struck on a short side is pushed along its long axis (ratio ≈ 1.06); struck on \
-         a long side it is pushed along its short axis (ratio ≈ 4.22). SPEC quotes \"4.2× on a 2×1 \
-         rectangle pushed on its short side\"; by its own formula the 4.2 belongs to the long side.\n",
+         a long side it is pushed along its short axis (ratio ≈ 4.22).\n",
     );
     s
 }

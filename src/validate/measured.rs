@@ -1,4 +1,4 @@
-//! The measured-bands file (README "Validating against measurements"): CSV with a header,
+//! The measured-bands file (docs/commands.md#validating-against-measurements-pinfeed-validate-pinfeed-calibrate): CSV with a header,
 //! `#` comment lines and blank lines allowed, one measured band per row:
 //!
 //! ```text

@@ -1,4 +1,4 @@
-//! Physics invariants of the contact model (SPEC §2), for every fidelity level.
+//! Physics invariants of the contact model (docs/physics.md#one-instant), for every fidelity level.
 
 use crate::common::*;
 use pinfeed::geometry::{Polygon, Pose, Vec2};
@@ -259,11 +259,11 @@ fn tip_rotates_slowest_initially() {
     }
 }
 
-/// SPEC §2's known accuracy gap: for near-central pushes (μc = 0) the exact uniform model has
+/// The ellipsoid's accuracy gap (docs/physics.md#limit-surface): for near-central pushes (μc = 0) the exact uniform model has
 /// (COR distance)·(force-line offset) → (1/A)∫x∥² dA (x∥ along the push), the ellipsoid c², so the
 /// exact model turns c²/((1/A)∫x∥² dA) times faster: 1.757 on a square; on a 2×1 rectangle 1.056
 /// when the pin strikes a short side (push along the long axis) and 4.22 when it strikes a long
-/// side. (SPEC quotes 4.2 "pushed on its short side"; its formula gives 4.2 for the long side.)
+/// side.
 #[test]
 fn ellipsoid_under_rotates_near_central_pushes() {
     // (part, θ0, length of the part along the push)
@@ -290,7 +290,7 @@ fn ellipsoid_under_rotates_near_central_pushes() {
             "{name} θ0={theta}: exact/ellipsoid rotation rate {ratio:.4}, formula {expected:.4}"
         );
     }
-    // The numbers SPEC quotes.
+    // The numbers docs/physics.md#limit-surface quotes.
     let sq = model(&poly("square")).ellipsoid_c() * poly("square").radius();
     assert!((sq * sq * 12.0 - 1.757).abs() < 0.01);
     let r = model(&poly("rect:2:1")).ellipsoid_c() * poly("rect:2:1").radius();

@@ -1,4 +1,4 @@
-//! Fences (SPEC §6): flush stable orientations, the jam angle, the COR-tip bound, μs invariance,
+//! Fences (docs/physics.md#fences): flush stable orientations, the jam angle, the COR-tip bound, μs invariance,
 //! short fences, mirror symmetry — for the contact model's fence path.
 
 use crate::common::*;

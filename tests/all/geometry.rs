@@ -1,4 +1,4 @@
-//! Library-level tests of the part geometry (SPEC §1): mass properties, `a`, convexity, stable states
+//! Library-level tests of the part geometry (docs/physics.md#the-part): mass properties, `a`, convexity, stable states
 //! of the named parts, validation of bad vertex lists, and invariance of stable states and `a` under
 //! rotation, scaling and translation of the input (property tests).
 

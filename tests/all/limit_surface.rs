@@ -1,4 +1,4 @@
-//! Limit-surface numerics (SPEC §2): the uniform-pressure closed forms against brute-force
+//! Limit-surface numerics (docs/physics.md#limit-surface): the uniform-pressure closed forms against brute-force
 //! integration, derivatives against finite differences, the far-field switch and pure translation,
 //! scaling, and point supports.
 
@@ -301,7 +301,7 @@ fn closed_forms_match_a_plain_fine_mesh() {
 
 #[test]
 fn spec_worked_number_tripoly2_at_30_degrees() {
-    // SPEC §2 prints the rotated vertices to 4 decimals and I0 = 3.47666: that value belongs to the
+    // docs/physics.md#limit-surface prints the rotated vertices to 4 decimals and I0 = 3.47666: that value belongs to the
     // printed (rounded) vertices. Polygon::new re-centres them (their centroid is (−3.3e−5, 0)), so
     // evaluate at r expressed in the part frame.
     let printed = [(-0.4107, -0.6220), (1.3213, 0.3780), (-0.9107, 0.2440)];
@@ -319,7 +319,7 @@ fn spec_worked_number_tripoly2_at_30_degrees() {
         .map(|&(x, y)| Vec2::new(x, y).rotate(th))
         .collect();
     for (v, p) in exact.iter().zip(printed) {
-        // SPEC prints 1.3213 for 1.321367: agreement to 1e-4 only.
+        // The printed 1.3213 is 1.321367: agreement to 1e-4 only.
         assert!((v.x - p.0).abs() < 1e-4 && (v.y - p.1).abs() < 1e-4);
     }
     let poly = Polygon::new(&exact).unwrap();

@@ -24,6 +24,8 @@ mod cli_sense;
 mod compare;
 mod contact_invariants;
 mod contact_regressions;
+mod docs;
+mod examples;
 mod fences;
 mod first_contact;
 mod fuzz_cli;

@@ -1,4 +1,4 @@
-//! Configuration maps (SPEC §3, issue 4): bands partition the contacting samples, NC intervals are
+//! Configuration maps (docs/physics.md#configuration-maps): bands partition the contacting samples, NC intervals are
 //! exactly the no-contact samples, wrap-around bands are one band, adjusted bands are mean ± sd,
 //! results do not depend on the thread count, a known no-contact geometry, and the `pinfeed map`
 //! command (JSON keys, report files, refusals).

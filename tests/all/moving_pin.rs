@@ -1,4 +1,4 @@
-//! Moving pins in the contact model (SPEC §5): one push with the pin's true relative velocity,
+//! Moving pins in the contact model (docs/physics.md#moving-and-retractable-pins): one push with the pin's true relative velocity,
 //! its lateral speed piecewise constant in travel.
 
 use crate::common::*;
@@ -26,7 +26,7 @@ fn rot(p: Pose, beta: f64) -> Pose {
     Pose::new(c.x, c.y, p.theta + beta)
 }
 
-/// Galilean check (SPEC §5): a pin moving at constant lateral speed w relative to the belt pushes
+/// Galilean check (docs/physics.md#moving-and-retractable-pins): a pin moving at constant lateral speed w relative to the belt pushes
 /// exactly as a still pin met by a belt moving along (V, −w): the same push seen in a frame turned
 /// by atan w. Over parts, orientations, offsets, radii and all three fidelities.
 #[test]

@@ -1,4 +1,4 @@
-//! Physics of the sensor signal (SPEC §4): the force the part puts on a sensor pin, taken from the
+//! Physics of the sensor signal (docs/physics.md#sensing): the force the part puts on a sensor pin, taken from the
 //! push itself, and the torques about the sensor origin.
 
 use pinfeed::geometry::{named, Polygon, Vec2};

@@ -211,7 +211,7 @@ fn dissipation_matches_monte_carlo_and_closed_form() {
     }
 }
 
-/// A symmetric part pushed head-on at the middle of an edge translates (SPEC §2: the push through
+/// A symmetric part pushed head-on at the middle of an edge translates (docs/physics.md#limit-surface: the push through
 /// the centroid stays smooth, ω = 0, v = v_pin), for μc = 0 (the point at infinity of the COR
 /// search) and with friction (stick, by symmetry).
 #[test]
@@ -654,7 +654,7 @@ fn reference_agrees_with_production_over_random_pushes() {
     assert_agreement(&s);
 }
 
-/// The comparison can fail: the ellipsoidal approximation, which SPEC §2 says under-rotates, is
+/// The comparison can fail: the ellipsoidal approximation, which under-rotates (docs/physics.md#limit-surface), is
 /// told apart from the exact model by this reference on most pushes.
 #[test]
 fn comparison_tells_the_ellipsoid_from_the_exact_model() {

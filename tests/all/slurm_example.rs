@@ -1,6 +1,6 @@
-//! README's Slurm and Kubernetes examples are consistent, and scripts/slurm_e2e.sh (which runs the
-//! Slurm example on a real one-node Slurm, outside CI) runs exactly what README shows: the script
-//! takes the job script and the submit commands from README's marked blocks, so this cheap test
+//! The Slurm and Kubernetes examples of docs/cluster.md are consistent, and scripts/slurm_e2e.sh (which runs the
+//! Slurm example on a real one-node Slurm, outside CI) runs exactly what docs/cluster.md shows: the script
+//! takes the job script and the submit commands from its marked blocks, so this cheap test
 //! checks that those blocks exist, fit together (array size, `--shard /N`, merge glob, log folder,
 //! a merge that cannot hang) and contain the two size settings the script shrinks.
 
@@ -16,7 +16,11 @@ fn block(readme: &str, name: &str) -> String {
     let marker = format!("<!-- slurm_e2e: {name} -->");
     let lines: Vec<&str> = readme.lines().collect();
     let at: Vec<usize> = (0..lines.len()).filter(|&i| lines[i] == marker).collect();
-    assert_eq!(at.len(), 1, "README.md: marker {marker} must occur once");
+    assert_eq!(
+        at.len(),
+        1,
+        "docs/cluster.md: marker {marker} must occur once"
+    );
     let open = (at[0] + 1..lines.len())
         .find(|&i| lines[i].starts_with("```"))
         .expect("a fenced block after the marker");
@@ -70,7 +74,7 @@ fn shard_count(text: &str) -> u64 {
 /// cancelled rather than left pending when a task fails. Fails if any of these drifts apart.
 #[test]
 fn readme_slurm_job_fits_together() {
-    let readme = read("README.md");
+    let readme = read("docs/cluster.md");
     let job = block(&readme, "mc.sh");
     let submit = block(&readme, "submit");
 
@@ -134,19 +138,23 @@ fn readme_slurm_job_fits_together() {
     assert!(submit.contains("pinfeed merge") && submit.contains("--quiet"));
 }
 
-/// scripts/slurm_e2e.sh runs README's blocks (by their markers) and shrinks exactly the two size
-/// settings it names, which README's job must contain once each; the script compares the merged
-/// report with an unsharded run of the same study. Fails if README and the script drift apart.
+/// scripts/slurm_e2e.sh runs docs/cluster.md's blocks (by their markers) and shrinks exactly the two size
+/// settings it names, which docs/cluster.md's job must contain once each; the script compares the merged
+/// report with an unsharded run of the same study. Fails if docs/cluster.md and the script drift apart.
 #[test]
 fn e2e_script_runs_the_readme_job() {
-    let readme = read("README.md");
+    let readme = read("docs/cluster.md");
     let script = read("scripts/slurm_e2e.sh");
     let job = block(&readme, "mc.sh");
     assert!(script.contains("job=$(block mc.sh)"));
     assert!(script.contains("submit=$(block submit)"));
     assert!(script.contains(r#"awk -v m="<!-- slurm_e2e: $1 -->""#));
     for setting in ["--samples 100000", "--cpus-per-task=4"] {
-        assert_eq!(job.matches(setting).count(), 1, "README's job: {setting}");
+        assert_eq!(
+            job.matches(setting).count(),
+            1,
+            "docs/cluster.md's job: {setting}"
+        );
         assert!(
             script.contains(&format!("s/{setting}/")),
             "the script shrinks {setting}"
@@ -160,7 +168,7 @@ fn e2e_script_runs_the_readme_job() {
         script.contains(&format!("study={study}\n")),
         "the script's unsharded run must be of {study}"
     );
-    // The merge writes results/mc/<study name>/ (no --out in README's merge): the script compares
+    // The merge writes results/mc/<study name>/ (no --out in docs/cluster.md's merge): the script compares
     // that folder.
     let name = read(study)
         .lines()
@@ -173,7 +181,7 @@ fn e2e_script_runs_the_readme_job() {
 /// The Kubernetes Indexed Job runs one pod per shard and the merge reads that many shards.
 #[test]
 fn readme_kubernetes_job_fits_together() {
-    let readme = read("README.md");
+    let readme = read("docs/cluster.md");
     let at = readme
         .find("completionMode: Indexed")
         .expect("the Kubernetes example");

@@ -1,4 +1,4 @@
-//! Limit surfaces of planar sliding (SPEC §2): the support's frictional dissipation
+//! Limit surfaces of planar sliding (docs/physics.md#limit-surface): the support's frictional dissipation
 //! D(ξ) = ∫ p(x) |u(x)| dA, u(x) = v + ω ẑ×x, as a function of the part twist ξ = [vx, vy, ω]
 //! (part frame, centroid at the origin), with its gradient and Hessian.
 //!

@@ -1,5 +1,4 @@
-//! Limit surface of a support by N weighted points (SPEC §2: "a finite set of weighted support
-//! points"; a tripod is the case N = 3 with barycentric loads).
+//! Limit surface of a support by N weighted points (docs/physics.md#support; a tripod is the case N = 3 with barycentric loads).
 //!
 //! Part frame, centroid at the origin; weights are the normalised loads (sum 1, μs = 1). For a
 //! twist ξ = [vx, vy, ω] the point x_i slides at u_i = v + ω ẑ×x_i.

@@ -1,4 +1,4 @@
-//! Exact limit surface of a polygon under uniform pressure (SPEC §2, "Closed forms").
+//! Exact limit surface of a polygon under uniform pressure (docs/physics.md#limit-surface).
 //!
 //! Part frame, centroid at the origin, pressure p0 = 1/A (total load 1), μs = 1. For a twist
 //! ξ = [vx, vy, ω] the sliding velocity of the material point x is u(x) = v + ω ẑ×x and
@@ -18,11 +18,11 @@
 //! * H = (p0/|ω|) L K(r) Lᵀ with L = [[1, 0], [0, 1], [−r_y, r_x]] (because I − ûûᵀ = ê êᵀ and
 //!   x×ê = r×ê).
 //!
-//! These agree with SPEC §2 (whose F, M_c are the load on the part, i.e. −∇D).
+//! These agree with docs/physics.md#limit-surface (whose F, M_c are the load on the part, i.e. −∇D).
 //!
 //! The three integrals are sums over the directed edges a→b of the signed fan triangles (r, a, b).
-//! Per edge, with e the unit edge direction, n = ẑ×e, c = (a − r)·n (signed; h = |c|, SPEC's
-//! ν = sgn(c) n and σ = −sgn(c)), u = (x − r)·e, ρ = |x − r| and L(u) = asinh(u/h) = ln((ρ + u)/h),
+//! Per edge, with e the unit edge direction, n = ẑ×e, c = (a − r)·n (signed; h = |c|; the foot of the
+//! perpendicular from r is r + c n), u = (x − r)·e, ρ = |x − r| and L(u) = asinh(u/h) = ln((ρ + u)/h),
 //! each bracket [·] taken from a to b:
 //!
 //! * I0 += −c/6 [u ρ + c² L],

@@ -99,7 +99,7 @@ fn slot_mut<'a>(u: &'a mut RawUncertain, name: &str) -> &'a mut Option<RawDistri
 }
 
 /// Largest error (m) a study may add to a length (shape, pin position and radius, lateral pose):
-/// the longest belt (README "Study format").
+/// the longest belt (docs/study-format.md).
 pub const LENGTH_ERROR: (f64, f64) = (-1e3, 1e3);
 /// Largest error (degrees) a study may add to the entry orientation.
 pub const ANGLE_ERROR: (f64, f64) = (-360.0, 360.0);

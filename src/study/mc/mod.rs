@@ -1,7 +1,7 @@
 //! Monte Carlo robustness studies (issue 6): how often a line orients its parts when the physics
 //! and the build are uncertain.
 //!
-//! A study file (TOML, README "Monte Carlo studies") points at a scenario and declares uncertain
+//! A study file (TOML, docs/study-format.md) points at a scenario and declares uncertain
 //! parameters — pin–part friction μc, the support model (uniform, a random tripod, a random smooth
 //! density), shape tolerance, pin position and radius errors, entry pose noise, belt speed, sensor
 //! pins' noise, bias, timing threshold and jitter — and
@@ -97,6 +97,17 @@ pub fn load(path: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
 
 /// Validate study text; `file` locates errors and resolves the scenario path.
 pub fn parse(file: &Path, source: &str, samples: Option<u64>) -> Result<Study, StudyError> {
+    parse_with(file, source, samples, &|p| std::fs::read_to_string(p))
+}
+
+/// [`parse`], reading the scenario the study names through `read` (given the path resolved
+/// against `file`): the bundled studies read their scenarios from the binary this way.
+pub fn parse_with(
+    file: &Path,
+    source: &str,
+    samples: Option<u64>,
+    read: &dyn Fn(&Path) -> std::io::Result<String>,
+) -> Result<Study, StudyError> {
     let loc = Locator::new(file, source);
     let raw: raw::RawStudy = toml::from_str(source).map_err(|e| loc.from_toml(&e))?;
     let at = |k: &str, m: String| -> StudyError { loc.at_key(&KeyPath::parse(k), m).into() };
@@ -130,7 +141,7 @@ pub fn parse(file: &Path, source: &str, samples: Option<u64>) -> Result<Study, S
         ));
     }
     let scenario_file = normalise(&file.parent().unwrap_or(Path::new("")).join(&raw.scenario));
-    let scenario_text = std::fs::read_to_string(&scenario_file).map_err(|e| {
+    let scenario_text = read(&scenario_file).map_err(|e| {
         at(
             "scenario",
             format!(
@@ -178,7 +189,7 @@ pub fn parse(file: &Path, source: &str, samples: Option<u64>) -> Result<Study, S
 }
 
 /// `a/b/../c` → `a/c` (lexically; a leading `..` is kept).
-fn normalise(p: &Path) -> PathBuf {
+pub(crate) fn normalise(p: &Path) -> PathBuf {
     use std::path::Component;
     let mut out: Vec<Component> = Vec::new();
     for c in p.components() {

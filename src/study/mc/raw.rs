@@ -1,4 +1,4 @@
-//! The study file as written: serde structs mirroring the TOML (README "Study format"), each with
+//! The study file as written: serde structs mirroring the TOML (docs/study-format.md), each with
 //! `deny_unknown_fields` so a misspelt key is a located error. Values are checked in
 //! [`super::compile`]; this layer only fixes names and types.
 //!
@@ -102,7 +102,7 @@ pub struct RawDistribution {
 pub enum SupportModel {
     /// Uniform pressure over the footprint.
     Uniform,
-    /// A random tripod per sample (SPEC §2).
+    /// A random tripod per sample (docs/physics.md#support).
     Tripod,
     /// A random smooth pressure density per sample (see [`super::smooth_support`]).
     Smooth,

@@ -184,7 +184,7 @@ pub struct McReport {
     pub results: Vec<PointReport>,
 }
 
-/// What a sample is, in one sentence (README and `sample` module docs).
+/// What a sample is, in one sentence (docs/physics.md#monte-carlo and the `sample` module docs).
 pub const SAMPLE_MEANING: &str =
     "one part through a freshly perturbed copy of the line (independent samples; no part-part collisions)";
 

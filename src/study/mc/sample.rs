@@ -8,7 +8,7 @@
 //! is drawn afresh for every sample, so the success rate is the probability that a random part on
 //! a random realisation of the line ends in the goal.
 //!
-//! Random streams (DESIGN.md "determinism"): sample i of a study seeded with s draws fifteen
+//! Random streams (docs/physics.md#determinism): sample i of a study seeded with s draws fifteen
 //! sub-seeds from `random::stream(s, i)`, in the fixed order μc, belt speed, shape, pin x, pin y,
 //! pin radius, pose θ, pose y, support, feed, sensor noise, sensor bias, sensor threshold, sensor
 //! jitter, sensor readings, and each parameter draws from its own ChaCha8 stream seeded with its

@@ -1,4 +1,4 @@
-//! Sharding a study over machines (DESIGN.md "Scaling past one machine").
+//! Sharding a study over machines (docs/cluster.md).
 //!
 //! * `--shard k/n` (k 0-based) runs global samples [⌊k·T/n⌋, ⌊(k+1)·T/n⌋) of T. With `--shard /n`
 //!   (or `auto/n`) k comes from the batch scheduler: `SLURM_ARRAY_TASK_ID` (minus

@@ -1,5 +1,4 @@
-//! A random smooth pressure density under the part, as weighted support points (SPEC §2 allows
-//! "a finite set of weighted support points"; the contact model's point support treats each point
+//! A random smooth pressure density under the part, as weighted support points (docs/physics.md#support; the contact model's point support treats each point
 //! as a small patch).
 //!
 //! Construction, in the part frame (centroid at the origin, metres):

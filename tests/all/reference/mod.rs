@@ -1,4 +1,4 @@
-//! An independent, deliberately slow reference for the contact model (SPEC §2), used only by tests.
+//! An independent, deliberately slow reference for the contact model (docs/physics.md#one-instant), used only by tests.
 //!
 //! It computes the same physics as `pinfeed::mechanics::push` by a different algorithm, sharing no
 //! code with `src/mechanics` (only the caller's vertex list):
@@ -10,7 +10,7 @@
 //!   panels graded towards the foot of the perpendicular from r. Farther away (and for pure
 //!   translation) the integrand is smooth over the part and a collapsed-product Gauss rule on the fan
 //!   triangles from the centroid is used instead.
-//! * **One instant** follows SPEC §2's steps, but every minimisation is brute force (function values
+//! * **One instant** follows the steps of docs/physics.md#one-instant, but every minimisation is brute force (function values
 //!   only, no gradient, no Newton on the limit surface): the friction-cone edge twists
 //!   ξ_e = argmin D(ξ) subject to w(f_e)·ξ = 1 are found over the COR plane, where the problem is
 //!   J(r) = I0(r) / (A |(p − r)×f|) (ω = 1/((p − r)×f), v = −ω ẑ×r), by a log-polar grid
