@@ -1,4 +1,4 @@
-//! The drawing of `pinfeed bench plans`: each surveyed polygon to scale in its first stable state
+//! The drawing of a survey of planned parts: each surveyed polygon to scale in its first stable state
 //! (flat side down), its name, and three badges — **P** (sensorless pins orient it), **S** (pins
 //! orient it only with a sensor), **F** (fences orient it) — filled when true, hollow when not.
 

@@ -136,7 +136,8 @@ impl LineCheck {
 pub type HeadwayProbe = (f64, u64, u64, f64);
 
 /// The shortest headway in `[lo, hi]` (s) at which `probe_parts` parts show no collision and
-/// a success of at least `floor`, by bisection on the logarithm (`steps` probes at most; `hi` is
+/// keep their success with the parts far apart (at `hi`) within half its margin over `target`
+/// (at least 0.2%; below the target, within 0.5%), by bisection on the logarithm (`steps` probes at most; `hi` is
 /// taken to pass), then with a 25% reserve, rounded up to 0.1 s and at most `hi`. Returns it with
 /// the probes. (Short headways fail by collisions, and on lines with moving pins by pins that
 /// cannot reach the next part's position in time.)
@@ -145,13 +146,22 @@ pub fn shortest_headway(
     r: &Runnable,
     scratch: &Scratch,
     (lo, hi): (f64, f64),
-    floor: f64,
+    target: f64,
     probe_parts: u64,
     seed: u64,
     steps: usize,
     deadline: Instant,
 ) -> Result<(f64, Vec<HeadwayProbe>), LineError> {
     let mut probes = Vec::new();
+    // The same parts with the parts far apart: a probe is compared with them (paired), so the
+    // sampling noise of a short run does not pass for a loss.
+    let (iso, _) = r.run(scratch, hi, probe_parts, seed, false)?;
+    let i = iso.success_rate;
+    let floor = if i >= target {
+        target.max(i - ((i - target) / 2.0).max(0.002))
+    } else {
+        i - 0.005
+    };
     let (mut bad, mut good) = (lo, hi);
     for _ in 0..steps {
         if Instant::now() >= deadline || good / bad < 1.08 {

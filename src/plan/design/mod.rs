@@ -946,21 +946,12 @@ impl Work<'_> {
             .unwrap_or_else(Instant::now);
         self.tell(Some(mode), round, "finding the line's headway".into());
         let runnable = c.runnable.clone();
-        // The success a shorter headway must keep: half of the screen's margin over the target,
-        // or (a screen below the target) the screen's own success less 0.5%.
         let target = o.problem.target;
-        let floor = c.screen.as_ref().map_or(0.0, |s| {
-            if s.success_rate >= target {
-                target + (s.success_rate - target) / 2.0
-            } else {
-                s.success_rate - 0.005
-            }
-        });
         let (h, probes) = line::shortest_headway(
             &runnable,
             &scratch,
             (lo, hi),
-            floor,
+            target,
             o.screen_parts.min(1000),
             seed,
             7,
