@@ -463,11 +463,10 @@ pub fn run(args: &PlanArgs) -> Result<()> {
         .build()
         .context("starting the worker threads")?;
     let bar = progress_bar(args.quiet || args.json);
-    let started = std::time::Instant::now();
     let tell = |p: &design::Progress| {
         if let Some(b) = &bar {
             b.set_message(format!(
-                "{}{} · {} · {} candidate(s), {} line run(s) · {:.0} s",
+                "{}{} · {} · {} candidate(s), {} line run(s)",
                 p.mode.map_or("", |m| m.name()),
                 if p.round > 0 {
                     format!(" round {}", p.round + 1)
@@ -477,7 +476,6 @@ pub fn run(args: &PlanArgs) -> Result<()> {
                 p.stage,
                 p.candidates,
                 p.line_runs,
-                started.elapsed().as_secs_f64()
             ));
         }
     };
@@ -567,7 +565,7 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
     }
     let b = indicatif::ProgressBar::new_spinner();
     b.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} plan: {msg}")
+        indicatif::ProgressStyle::with_template("{spinner} plan {elapsed}: {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
     );
     b.enable_steady_tick(std::time::Duration::from_millis(120));

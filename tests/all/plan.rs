@@ -678,3 +678,49 @@ fn custom_parts_get_names_of_their_own() {
     assert_eq!(a, design_name("vertices:0,0  40,0 46,18 20,32 -4,14 "));
     assert_eq!(design_name("rect:2:1"), "rect-2-1");
 }
+
+#[test]
+fn plan_shows_progress_on_a_terminal_and_nothing_otherwise() {
+    let args = [
+        "plan",
+        "--part",
+        "square",
+        "--pins",
+        "--check-parts",
+        "200",
+        "--screen-parts",
+        "200",
+        "--no-write",
+    ];
+    let out = pinfeed(&args);
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("plan "),
+        "no progress when standard error is not a terminal"
+    );
+    // Through a pseudo-terminal (util-linux `script`, on every Debian machine).
+    let has_script = std::process::Command::new("script")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_script {
+        eprintln!("`script` is not installed: the pseudo-terminal half of this test did not run");
+        return;
+    }
+    let log = tmp("progress.tty");
+    let cmd = format!("{} {}", env!("CARGO_BIN_EXE_pinfeed"), args.join(" "));
+    let o = std::process::Command::new("script")
+        .args(["-qec", &cmd, log.to_str().unwrap()])
+        .stdin(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    assert!([0, 3].contains(&o.status.code().unwrap_or(-1)), "{o:?}");
+    let text = String::from_utf8_lossy(&std::fs::read(&log).unwrap()).to_string();
+    assert!(
+        text.contains("plan ") && text.contains("searching"),
+        "{text}"
+    );
+    assert!(
+        text.contains("line screen") || text.contains("line check"),
+        "{text}"
+    );
+}

@@ -594,6 +594,35 @@ impl Work<'_> {
         let mut problem = o.problem.clone();
         let a = problem.compile()?.radius;
         problem.belt_width_m = mode_width(o, mode, a);
+        // A mixed line that cannot beat the best one the screen already holds is not searched
+        // for: by obstacles, one with more of them; by belt length, one whose belt is at least
+        // as long — k obstacles take at least one spacing in and k times the smaller of the pin
+        // spacing and the gap after a fence (see `emit::layout`).
+        if mode == Mode::Hybrid && !problem.fewest_sets {
+            let target = problem.target;
+            let held: Vec<&Candidate> = self
+                .candidates
+                .iter()
+                .filter(|c| c.screen.as_ref().is_some_and(|s| s.success_rate >= target))
+                .collect();
+            let step = problem.spacing_m.min(super::fences::fence_gap_m(a));
+            let most = match o.objective {
+                Objective::Obstacles => held.iter().map(|c| c.obstacles.len()).min(),
+                Objective::BeltLength => held
+                    .iter()
+                    .map(|c| {
+                        (((c.belt_length_m - problem.spacing_m) / step).ceil() as usize)
+                            .saturating_sub(1)
+                    })
+                    .min(),
+                _ => None,
+            };
+            match most {
+                Some(0) => return Ok(()),
+                Some(n) => problem.max_pins = problem.max_pins.min(n),
+                None => {}
+            }
+        }
         for round in 0..=o.refine {
             let now = Instant::now();
             if now >= until {
