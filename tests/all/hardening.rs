@@ -709,17 +709,7 @@ fn pin_stop_at_says_where_the_pin_stops() {
         "{at}"
     );
     assert_eq!(at["rotation_deg"], after["rotation_deg"]);
-    let o = pinfeed(&[
-        "contact",
-        "--part",
-        "tripoly1",
-        "--theta0",
-        "30",
-        "--d=-0.1",
-        "--pin-speed",
-        "0.4",
-        "--pin-stop-at=-0.3",
-    ]);
+    let o = pinfeed(&[&["contact"][..], &base[..], &["--pin-stop-at=-0.3"]].concat());
     let e = refused(&o, "a stop behind the pin");
     assert!(
         e.contains("--pin-stop-at -0.3") && e.contains("[1e-9, 1000]"),
