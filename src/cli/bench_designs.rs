@@ -2,8 +2,8 @@
 //! Markdown report (rewritten after every part, so a long survey shows its progress).
 
 use super::shell_word;
-use crate::plan::design::line::write_whole;
 use crate::plan::design::survey::{markdown, survey_part, SurveyPart, SurveySettings};
+use crate::report::atomic::write_atomic;
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::PathBuf;
 
@@ -99,7 +99,7 @@ pub fn run(a: &DesignsArgs) -> Result<()> {
             ),
         };
         m += &markdown(&title, &rows);
-        write_whole(&a.out, m.as_bytes())
+        write_atomic(&a.out, m.as_bytes())
             .with_context(|| format!("writing {}", a.out.display()))?;
     }
     eprintln!("wrote {}", a.out.display());

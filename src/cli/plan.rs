@@ -554,7 +554,7 @@ pub fn run(args: &PlanArgs) -> Result<()> {
 }
 
 fn write(path: &Path, text: &str) -> Result<()> {
-    crate::plan::design::line::write_whole(path, text.as_bytes())
+    crate::report::atomic::write_atomic(path, text.as_bytes())
         .with_context(|| format!("writing {}", path.display()))
 }
 
@@ -596,28 +596,19 @@ fn title(o: &DesignOptions, c: &Candidate, d: &Design) -> String {
 
 fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) -> Result<()> {
     let t = title(o, c, d);
-    let tmp = path.with_file_name(format!(
-        ".{}.tmp{}.svg",
-        path.file_stem()
-            .map_or("plan".into(), |s| s.to_string_lossy()),
-        std::process::id()
-    ));
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    let res = match &c.layout {
-        Layout::Sequence(plan) => crate::report::plot_plan::plot_plan(&c.problem, plan, &t, &tmp),
+    // The plots write whole files or none (report::atomic).
+    match &c.layout {
+        Layout::Sequence(plan) => crate::report::plot_plan::plot_plan(&c.problem, plan, &t, path),
         Layout::Contingent(plan) => {
             let mut planner = crate::plan::search::Planner::new(&c.problem)?;
             let stages = crate::plan::contingent::stage_states(&mut planner, plan)?;
-            crate::report::plot_plan::plot_contingent(&c.problem, plan, &stages, &t, &tmp)
+            crate::report::plot_plan::plot_contingent(&c.problem, plan, &stages, &t, path)
         }
     }
-    .and_then(|_| std::fs::rename(&tmp, path).map_err(Into::into));
-    if res.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    res.with_context(|| format!("drawing {}", path.display()))
+    .with_context(|| format!("drawing {}", path.display()))
 }
 
 /// The printed result.

@@ -6,7 +6,7 @@
 use super::LineCheck;
 use crate::engine::{run, OutcomeCounts, RunOptions, RunResult};
 use crate::statistics::wilson_interval;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -90,7 +90,8 @@ impl Runnable {
         let path = scratch.dir.join("design.toml");
         if let Some((name, text)) = &self.policy {
             let p = scratch.dir.join(name);
-            std::fs::write(&p, text).map_err(|source| LineError::Io { path: p, source })?;
+            crate::report::atomic::write_atomic(&p, text)
+                .map_err(|source| LineError::Io { path: p, source })?;
         }
         let toml = self.with_headway(h);
         let scene = crate::scenario::parse(&path, &toml)?;
@@ -178,20 +179,4 @@ pub fn shortest_headway(
     }
     let chosen = ((good * 1.25) * 10.0).ceil() / 10.0;
     Ok((chosen.min(hi), probes))
-}
-
-/// Write `text` to `path` whole or not at all (a temporary file beside it, then a rename).
-pub fn write_whole(path: &Path, text: &[u8]) -> std::io::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
-    let name = path
-        .file_name()
-        .map_or("out".into(), |n| n.to_string_lossy().to_string());
-    let tmp = path.with_file_name(format!(".{name}.tmp{}", std::process::id()));
-    let res = std::fs::write(&tmp, text).and_then(|_| std::fs::rename(&tmp, path));
-    if res.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    res
 }
