@@ -4,7 +4,7 @@
 //!
 //! * a moving pin's `travel` = [min, max] lies over the belt (|y| ≤ width/2) and holds its home
 //!   `y`; `speed` and `accel` are positive and finite ([`super::limits::ACTUATOR_SPEED`],
-//!   [`super::limits::ACTUATOR_ACCEL`]); `settle` ≥ 0; `pieces` in 1..=64;
+//!   [`super::limits::ACTUATOR_ACCEL`]), the speed at most [`super::limits::max_pin_speed`]; `settle` ≥ 0; `pieces` in 1..=64;
 //! * a retractable pin's times are ≥ 0 and finite;
 //! * a rule names a sensor pin, one of that sensor's hypothesis labels (or `unknown`), a dynamic
 //!   pin, and a target that fits the pin (`y` within a moving pin's travel, `raised` for a
@@ -69,7 +69,17 @@ pub(super) fn actuator(
                 ));
             }
             let speed = need("speed", ro.speed)?;
-            let speed = c.range(&path("speed"), speed, limits::ACTUATOR_SPEED, "m/s")?;
+            let speed = c.within(
+                &path("speed"),
+                speed,
+                limits::ACTUATOR_SPEED.0,
+                limits::max_pin_speed(belt.speed),
+                &format!(
+                    "m/s; at most {} belt speeds, belt.speed = {} m/s",
+                    crate::mechanics::MAX_LATERAL_SPEED,
+                    limits::num(belt.speed)
+                ),
+            )?;
             let accel = need("accel", ro.accel)?;
             let accel = c.range(&path("accel"), accel, limits::ACTUATOR_ACCEL, "m/s²")?;
             let settle = match ro.settle {
