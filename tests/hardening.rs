@@ -122,3 +122,85 @@ fn moving_pin_at_the_speed_limit_runs() {
     assert!(stdout(&o).contains("\"parts\""), "{}", stdout(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `pinfeed contact ... --json` parsed.
+fn contact_json(args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["contact"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let o = pinfeed(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_slice(&o.stdout).expect("contact --json prints JSON")
+}
+
+const ITEM3_PART: &str = "vertices:0.834679,0.289496 0.004451,0.772773 -0.235451,0.208773 \
+     -0.158718,-0.044483 -0.174336,-0.150671 -0.077899,-0.507635 0.725425,-0.427230";
+
+/// Item 3: after the first contact separated, the pin's ray ran parallel to an edge to rounding
+/// (d·n = 1e-16 but the edge's cross product exactly 0): the ray cast divided by zero and the pass
+/// went on with NaN travels, reporting `com_final: [null, null]` with status ok.
+#[test]
+fn moving_pin_contact_parallel_to_an_edge_stays_finite() {
+    let args = [
+        "--part",
+        ITEM3_PART,
+        "--theta0=216.493855",
+        "--d=-0.706386",
+        "--mu-c",
+        "1.957260",
+        "--pin-radius",
+        "0.119391",
+        "--pin-speed=-1.0160397778846972",
+        "--pin-stop-after",
+        "1e-9",
+    ];
+    let j = contact_json(&args);
+    let com = j["com_final"].as_array().unwrap();
+    assert!(
+        com.iter().all(|v| v.as_f64().is_some_and(f64::is_finite)),
+        "com_final {com:?}"
+    );
+    assert!(j["contact_length"].as_f64().is_some_and(f64::is_finite));
+    assert_eq!(j["status"], "ok");
+    let tight = contact_json(&[&args[..], &["--tol", "1e-9"]].concat());
+    let (r, rt) = (
+        j["rotation_deg"].as_f64().unwrap(),
+        tight["rotation_deg"].as_f64().unwrap(),
+    );
+    assert!(
+        (r - rt).abs() < 1.0,
+        "rotation {r}° at the default tol, {rt}° at 1e-9"
+    );
+}
+
+/// Item 4a: the pin ran along the edge it had just left, overlapping it by 1e-10 a (rounding at
+/// the default tolerance), then stopped; the cast from the stop refused the touch 1.5e-10 behind
+/// it, so the part was never pushed again: −30.5° `ok` at the default tol, −115.0° at 1e-8..1e-10.
+#[test]
+fn moving_pin_that_stops_against_an_edge_pushes_at_every_tolerance() {
+    let part = "vertices:0.725303,0.058429 0.325696,0.900163 -0.019889,0.828967 \
+         -0.138246,0.314445 -0.626215,0.071178 -0.705679,-0.477172 -0.388298,-0.444634 \
+         0.059999,-0.831000 0.166186,-0.430234 0.206930,-0.061261";
+    let base = [
+        "--part",
+        part,
+        "--theta0=320.062671",
+        "--d=0.460694",
+        "--mu-c",
+        "1.925483",
+        "--pin-radius",
+        "0.150644",
+        "--pin-speed=-0.9977",
+        "--pin-stop-after",
+        "0.9842",
+    ];
+    let mut rotations = Vec::new();
+    for tol in ["1e-6", "1e-8", "1e-9", "1e-10"] {
+        let j = contact_json(&[&base[..], &["--tol", tol]].concat());
+        assert_eq!(j["status"], "ok", "tol {tol}");
+        rotations.push(j["rotation_deg"].as_f64().unwrap());
+    }
+    for r in &rotations {
+        assert!((r - (-115.03)).abs() < 0.1, "rotations {rotations:?}");
+    }
+}
