@@ -237,3 +237,81 @@ fn latency_percentiles_do_not_exceed_the_maximum_on_quickstart() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Files in `dir` whose names mark them as temporary.
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .filter(|n| n.contains(".tmp"))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Every file in `dir` with its bytes, by name.
+fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            let name = e.file_name().to_string_lossy().to_string();
+            (name, std::fs::read(e.path()).unwrap())
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// Item 5: a run whose last file cannot be written (on a full disk: a truncated SVG beside a new
+/// summary, or a 0-byte summary) leaves the previous run's files whole and no temporary file.
+#[test]
+fn a_run_that_fails_to_write_leaves_the_previous_results_whole() {
+    let dir = scratch("atomic-run");
+    let quick = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+    let quick = quick.to_str().unwrap();
+    let out = dir.join("out");
+    let ok = pinfeed(&[
+        "run",
+        quick,
+        "--parts",
+        "2",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let results = out.join("quickstart");
+    let before = contents(&results);
+    assert!(before.iter().any(|(n, _)| n == "summary.json"));
+    // The drawing cannot be written (its folder is a file): nothing of the new run may appear.
+    let blocker = dir.join("not-a-folder");
+    std::fs::write(&blocker, "x").unwrap();
+    let draw = blocker.join("line.svg");
+    let bad = pinfeed(&[
+        "run",
+        quick,
+        "--parts",
+        "3",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--draw",
+        draw.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.status.code(), Some(1), "{}", stderr(&bad));
+    let after = contents(&results);
+    assert_eq!(
+        before.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        after.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        "files changed"
+    );
+    assert!(before == after, "the previous run's files were changed");
+    assert!(
+        temporaries(&results).is_empty(),
+        "{:?}",
+        temporaries(&results)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

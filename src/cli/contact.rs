@@ -588,7 +588,7 @@ pub(crate) fn print_motion(r: &ContactReport) {
 }
 
 fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut f = Vec::new();
     writeln!(
         f,
         "s,x,y,theta_deg,pin_x,pin_y,contact_x,contact_y,force_x,force_y,mode,feature,index,normal_x,normal_y,rotation_rate"
@@ -616,6 +616,7 @@ fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
             t.rotation_rate
         )?;
     }
+    crate::report::atomic::write_atomic(path, f)?;
     Ok(())
 }
 

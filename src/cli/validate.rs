@@ -220,7 +220,7 @@ pub fn write_report_files<T: Serialize>(
 ) -> Result<()> {
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let json = out_dir.join(json_name);
-    std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
+    crate::report::atomic::write_atomic(&json, serde_json::to_string_pretty(report)? + "\n")
         .with_context(|| format!("writing {}", json.display()))?;
     let mut md = format!(
         "# {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{}\n\n",
@@ -232,7 +232,8 @@ pub fn write_report_files<T: Serialize>(
     md.push('\n');
     md.push_str(&body(out_dir)?);
     let readme = out_dir.join("README.md");
-    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
+    crate::report::atomic::write_atomic(&readme, md)
+        .with_context(|| format!("writing {}", readme.display()))?;
     Ok(())
 }
 

@@ -2,6 +2,7 @@
 
 pub mod aligned;
 pub mod animate;
+pub mod atomic;
 pub mod compare_table;
 pub mod line_table;
 pub mod map_table;

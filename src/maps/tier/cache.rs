@@ -143,9 +143,8 @@ pub fn write(path: &Path, map: &TierMap) -> Result<(), CacheError> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(io)?;
     }
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&tmp, encode(map)).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    // Whole or not at all; a failed write leaves no temporary file behind.
+    crate::report::atomic::write_atomic(path, encode(map)).map_err(io)
 }
 
 /// Read the map with key `key` from `path`, refusing anything that does not check out.

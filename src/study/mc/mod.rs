@@ -23,7 +23,7 @@
 //! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report;
 //! * [`atomic`]: files written by rename; [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
 
-pub mod atomic;
+pub use crate::report::atomic;
 pub mod compile;
 pub use crate::random::distribution;
 pub mod error;
