@@ -653,10 +653,11 @@ struct CaseOut<'a> {
 }
 
 fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
+    let text =
+        crate::input::read_text(path).with_context(|| format!("reading {}", path.display()))?;
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_path(path)
-        .with_context(|| format!("reading {}", path.display()))?;
+        .from_reader(text.as_bytes());
     let mut wtr = csv::Writer::from_writer(std::io::stdout().lock());
     let mut compiled: std::collections::HashMap<String, (Polygon, PartModel)> = Default::default();
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;

@@ -189,7 +189,7 @@ fn policy(
     part_label: &str,
     on_late: OnLate,
 ) -> R<Vec<(String, Rule)>> {
-    let source = std::fs::read_to_string(path).map_err(|e| {
+    let source = crate::input::read_text(path).map_err(|e| {
         c.err(
             "controller.policy",
             format!("cannot read the policy file {}: {e}", path.display()),

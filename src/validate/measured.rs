@@ -88,7 +88,7 @@ impl Measured {
 
 /// Read and check a measured-bands file; `max_pin_radius` (part units) sets the reach of d.
 pub fn load(path: &Path, max_pin_radius: f64) -> Result<Measured, MeasuredError> {
-    let text = std::fs::read_to_string(path).map_err(|e| MeasuredError {
+    let text = crate::input::read_text(path).map_err(|e| MeasuredError {
         file: path.to_path_buf(),
         line: 0,
         field: None,

@@ -88,16 +88,16 @@ impl Study {
 
 /// Read and validate a study file; `samples` overrides the file's samples per point.
 pub fn load(path: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
-    let source = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+    let source = crate::input::read_text(path).map_err(|error| StudyError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parse(path, &source, samples)
 }
 
 /// Validate study text; `file` locates errors and resolves the scenario path.
 pub fn parse(file: &Path, source: &str, samples: Option<u64>) -> Result<Study, StudyError> {
-    parse_with(file, source, samples, &|p| std::fs::read_to_string(p))
+    parse_with(file, source, samples, &|p| crate::input::read_text(p))
 }
 
 /// [`parse`], reading the scenario the study names through `read` (given the path resolved

@@ -257,7 +257,7 @@ impl ShardPoint {
 
 /// Read a shard file.
 pub fn read(path: &Path) -> Result<ShardFile, StudyError> {
-    let text = std::fs::read_to_string(path)
+    let text = crate::input::read_text(path)
         .map_err(|e| StudyError::Shard(format!("{}: cannot read: {e}", path.display())))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
         StudyError::Shard(format!(
