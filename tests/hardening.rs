@@ -402,3 +402,144 @@ fn a_map_cache_file_linked_to_a_device_is_rebuilt() {
     assert!(std::fs::symlink_metadata(&file).unwrap().is_file());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// tripoly1_sensing.toml with its rules moved to a policy file `p.toml` holding `policy`.
+fn with_policy(dir: &Path, policy: &str) -> PathBuf {
+    let src = bundled("tripoly1_sensing.toml");
+    let (i, j) = (src.find("[[rules]]").unwrap(), src.find("[goal]").unwrap());
+    let text = format!("{}{}", &src[..i], &src[j..])
+        .replace("[controller]\n", "[controller]\npolicy = \"p.toml\"\n");
+    let f = dir.join("s.toml");
+    std::fs::write(&f, text).unwrap();
+    std::fs::write(dir.join("p.toml"), policy).unwrap();
+    f
+}
+
+/// Item 7: a policy file's errors are located in the policy file: a rule contradicting an
+/// earlier one was blamed on `scenario.toml:1:1`, an empty policy was told it "needs a [part]
+/// section" like a scenario.
+#[test]
+fn policy_errors_are_located_in_the_policy_file() {
+    let dir = scratch("policy-errors");
+    let rule = |y: f64| {
+        format!("\n[[rules]]\nsensor = \"probe\"\ndecides = \"0°\"\npin = \"mover\"\ny = {y}\n")
+    };
+    let dup = format!("part = \"tripoly1\"\n{}{}", rule(0.021), rule(0.012));
+    let f = with_policy(&dir, &dup);
+    let e = refused(
+        &pinfeed(&["run", f.to_str().unwrap(), "--parts", "1"]),
+        "dup",
+    );
+    assert!(e.contains("p.toml:12:7: key `rules[1].pin`"), "{e}");
+    assert!(
+        e.contains("another rule already sends this pin elsewhere"),
+        "{e}"
+    );
+    let f = with_policy(&dir, "");
+    let e = refused(
+        &pinfeed(&["run", f.to_str().unwrap(), "--parts", "1"]),
+        "empty",
+    );
+    assert!(e.contains("p.toml:1:1: key `part`"), "{e}");
+    assert!(
+        e.contains("a policy file") && !e.contains("scenario needs"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Item 7: `PINFEED_CACHE=` (set, empty) failed with "a value is required for '--cache-dir'";
+/// empty means unset, as for the cache's own default.
+#[test]
+fn an_empty_pinfeed_cache_means_unset() {
+    let dir = scratch("empty-cache-env");
+    let o = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args([
+            "contact", "--part", "square", "--theta0", "10", "--d", "0.1",
+        ])
+        .env("PINFEED_CACHE", "")
+        .env("XDG_CACHE_HOME", &dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Item 7: `contact --cases c.csv --pin-stop-after 0` blamed `c.csv:2`; the flag is at fault.
+#[test]
+fn a_batch_flag_out_of_range_is_the_flags_error() {
+    let dir = scratch("cases-flag");
+    let csv = dir.join("c.csv");
+    std::fs::write(&csv, "part,theta0,d,mu_c\nsquare,10,0.1,0.5\n").unwrap();
+    let o = pinfeed(&[
+        "contact",
+        "--cases",
+        csv.to_str().unwrap(),
+        "--pin-speed",
+        "0.5",
+        "--pin-stop-after",
+        "0",
+    ]);
+    let e = refused(&o, "--pin-stop-after 0");
+    assert!(e.contains("--pin-stop-after") && e.contains("got 0"), "{e}");
+    assert!(!e.contains("c.csv:2"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Item 7: a UTF-8 byte-order mark before the header of a `validate` CSV gave "the header must
+/// be `part,d,…`, got `part,d,…`"; it is skipped.
+#[test]
+fn a_byte_order_mark_in_a_measured_csv_is_skipped() {
+    let dir = scratch("bom");
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/validate/synthetic.csv");
+    let text = std::fs::read_to_string(&src).unwrap();
+    let plain = pinfeed::validate::measured::load(&src, 0.5).expect("the fixture loads");
+    let f = dir.join("bom.csv");
+    std::fs::write(&f, format!("\u{feff}{text}")).unwrap();
+    let bom = pinfeed::validate::measured::load(&f, 0.5).expect("a BOM is skipped");
+    assert_eq!(format!("{:?}", plain.rows), format!("{:?}", bom.rows));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Item 7: `calibrate --score-members 0` was refused as "--members must lie in …".
+#[test]
+fn score_members_is_named_by_its_flag() {
+    let csv = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/validate/synthetic.csv");
+    let o = pinfeed(&["calibrate", csv.to_str().unwrap(), "--score-members", "0"]);
+    let e = refused(&o, "--score-members 0");
+    assert!(e.contains("--score-members must lie in [1,"), "{e}");
+}
+
+/// Item 7: a study whose sensor noise factor (1e5, inside the study's range) makes the sensor's
+/// jitter leave its range failed with "1001 draws in a row … outside the allowed range" and no
+/// range; the message names the sensor setting, its range and the value.
+#[test]
+fn a_sensor_value_out_of_the_sensors_range_says_which_range() {
+    let dir = scratch("sensor-range");
+    let scenario =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scenarios/sensor_pin.toml");
+    let study = dir.join("s.toml");
+    std::fs::write(
+        &study,
+        format!(
+            "scenario = \"{}\"\nsamples = 4\n\n[uncertain.sensor_noise]\ndistribution = \"fixed\"\nvalue = 1e5\n",
+            scenario.display()
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = pinfeed(&[
+        "mc",
+        study.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let e = refused(&o, "sensor_noise 1e5");
+    assert!(
+        e.contains("at sensor_noise = 100000 the sensor's jitter"),
+        "{e}"
+    );
+    assert!(e.contains("must lie in") && e.contains("got 100"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -85,8 +85,8 @@ fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
         "smooth" => SupportChoice::Smooth(SmoothParams::default()),
         s => bail!("--support must be tripod or smooth, got '{s}'"),
     };
-    check_members(args.members)?;
-    check_members(args.score_members)?;
+    check_members("--members", args.members)?;
+    check_members("--score-members", args.score_members)?;
     let c = &args.common;
     Ok(CalibrationSettings {
         members: args.members,

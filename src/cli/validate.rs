@@ -237,10 +237,10 @@ pub fn write_report_files<T: Serialize>(
     Ok(())
 }
 
-/// Check the member count.
-pub fn check_members(members: usize) -> Result<()> {
+/// Check a member count given by `flag` (`--members`, `--score-members`).
+pub fn check_members(flag: &str, members: usize) -> Result<()> {
     if !(1..=MAX_MEMBERS).contains(&members) {
-        bail!("--members must lie in [1, {MAX_MEMBERS}], got {members}");
+        bail!("{flag} must lie in [1, {MAX_MEMBERS}], got {members}");
     }
     Ok(())
 }
@@ -305,7 +305,7 @@ pub fn load_measured(path: &Path, spec: &EnsembleSpec) -> Result<Measured> {
 
 pub fn run(args: &ValidateArgs) -> Result<()> {
     let score = args.common.score()?;
-    check_members(args.members)?;
+    check_members("--members", args.members)?;
     let spec = ensemble_spec(
         args.mu_c,
         args.pin_radius,
