@@ -543,3 +543,17 @@ fn a_sensor_value_out_of_the_sensors_range_says_which_range() {
     assert!(e.contains("must lie in") && e.contains("got 100"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Item 4e: `validate --pin-radius 1e308` was accepted (`map` refuses it) and scored every row as
+/// "no rotation"; it is refused with the range `map` allows.
+#[test]
+fn validate_refuses_a_pin_radius_map_refuses() {
+    let csv = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/validate/synthetic.csv");
+    let o = pinfeed(&["validate", csv.to_str().unwrap(), "--pin-radius", "1e308"]);
+    let e = refused(&o, "--pin-radius 1e308");
+    assert!(
+        e.contains("--pin-radius") && e.contains("must lie in [0,"),
+        "{e}"
+    );
+    assert!(e.contains("got 1e308"), "{e}");
+}

@@ -299,8 +299,24 @@ pub fn summary_text(s: &Summary) -> String {
 }
 
 /// Load the measured file for an ensemble (its largest pin radius sets the reach of d).
+/// The pin radius may be at most the range `map` and `contact` allow for each part (10·a).
 pub fn load_measured(path: &Path, spec: &EnsembleSpec) -> Result<Measured> {
-    Ok(measured::load(path, spec.max_pin_radius())?)
+    let m = measured::load(path, spec.max_pin_radius())?;
+    let r = spec.max_pin_radius();
+    for (part, poly) in &m.parts {
+        let rmax = super::contact::limits::PIN_RADIUS_A * poly.radius();
+        if r > rmax {
+            bail!(
+                "--pin-radius (or the largest pin_radius of --uncertain) must lie in [0, {}] for part {part} of {} (part units: at most {}·a, a = {}), got {}",
+                crate::scenario::limits::num(rmax),
+                path.display(),
+                super::contact::limits::PIN_RADIUS_A,
+                crate::scenario::limits::num(poly.radius()),
+                crate::scenario::limits::num(r)
+            );
+        }
+    }
+    Ok(m)
 }
 
 pub fn run(args: &ValidateArgs) -> Result<()> {
