@@ -557,3 +557,127 @@ fn validate_refuses_a_pin_radius_map_refuses() {
     );
     assert!(e.contains("got 1e308"), "{e}");
 }
+
+/// A study of tripoly1_sensing with its rules in a policy file, in `dir` (files s.toml, p.toml,
+/// st.toml); returns the study path.
+fn policy_study(dir: &Path) -> PathBuf {
+    let src = bundled("tripoly1_sensing.toml");
+    let (i, j) = (src.find("[[rules]]").unwrap(), src.find("[goal]").unwrap());
+    with_policy(dir, &format!("part = \"tripoly1\"\n\n{}", &src[i..j]));
+    let st = dir.join("st.toml");
+    std::fs::write(
+        &st,
+        "scenario = \"s.toml\"\nsamples = 6\n\n[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = 0.4\nmax = 0.6\n",
+    )
+    .unwrap();
+    st
+}
+
+fn shard(study: &Path, k: u32, out: &Path) {
+    let o = pinfeed(&[
+        "mc",
+        study.to_str().unwrap(),
+        "--shard",
+        &format!("{k}/2"),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+fn merge(dir: &Path, shards: &[&str]) -> Output {
+    let mut args = vec!["merge".to_string()];
+    args.extend(
+        shards
+            .iter()
+            .map(|s| dir.join("sh").join(s).display().to_string()),
+    );
+    args.extend([
+        "--out".into(),
+        dir.join("rep").display().to_string(),
+        "--quiet".into(),
+    ]);
+    pinfeed(&args.iter().map(String::as_str).collect::<Vec<_>>())
+}
+
+const SHARD0: &str = "shard-0000-of-0002.json";
+const SHARD1: &str = "shard-0001-of-0002.json";
+
+/// Item 4b: a policy edited between two shards merged with exit 0 into a mixture; the study and
+/// scenario hashes cover the policy file, and merge names the field that differs.
+#[test]
+fn merge_refuses_shards_run_against_different_policies() {
+    let dir = scratch("merge-policy");
+    let st = policy_study(&dir);
+    let sh = dir.join("sh");
+    shard(&st, 0, &sh);
+    let p = dir.join("p.toml");
+    let policy = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, policy.replace("y = 0.021", "y = 0.018")).unwrap();
+    shard(&st, 1, &sh);
+    let e = refused(&merge(&dir, &[SHARD0, SHARD1]), "two policies");
+    assert!(
+        e.contains("field `scenario_hash`") && e.contains(SHARD1),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Item 4c: hand-edited shard contents (counts moved between classes, a changed hash or
+/// version on every shard) were merged; each shard's checksum of its content is checked.
+#[test]
+fn merge_refuses_edited_shards() {
+    let dir = scratch("merge-tamper");
+    let st = policy_study(&dir);
+    let sh = dir.join("sh");
+    shard(&st, 0, &sh);
+    shard(&st, 1, &sh);
+    assert!(merge(&dir, &[SHARD0, SHARD1]).status.success());
+    let f = sh.join(SHARD1);
+    let good = std::fs::read_to_string(&f).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&good).unwrap();
+    let version = v["header"]["pinfeed_version"].as_str().unwrap().to_string();
+    let edits: Vec<(&str, String)> = vec![
+        (
+            "a count moved",
+            good.replacen("\"success\": ", "\"success\": 1", 1),
+        ),
+        (
+            "the version",
+            good.replace(
+                &format!("\"pinfeed_version\": \"{version}\""),
+                "\"pinfeed_version\": \"9.9.9\"",
+            ),
+        ),
+        (
+            "contacts",
+            good.replacen("\"contacts\": ", "\"contacts\": 1000000000000", 1),
+        ),
+    ];
+    for (what, text) in edits {
+        assert_ne!(text, good, "{what}: the edit changed nothing");
+        std::fs::write(&f, &text).unwrap();
+        let e = refused(&merge(&dir, &[SHARD0, SHARD1]), what);
+        assert!(
+            e.contains(SHARD1) && e.contains("field `checksum`"),
+            "{what}: {e}"
+        );
+    }
+    std::fs::write(&f, good).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Item 4c: when shards are missing, merge prints the commands that rerun only those.
+#[test]
+fn merge_prints_the_commands_for_missing_shards() {
+    let dir = scratch("merge-missing");
+    let st = policy_study(&dir);
+    shard(&st, 0, &dir.join("sh"));
+    let e = refused(&merge(&dir, &[SHARD0]), "a missing shard");
+    assert!(e.contains("samples [3, 6) are missing"), "{e}");
+    assert!(e.contains("--samples 6 --shard 1/2 --out"), "{e}");
+    assert!(e.contains("sbatch --array=1 --wrap"), "{e}");
+    assert!(e.contains("--shard \\$SLURM_ARRAY_TASK_ID/2"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

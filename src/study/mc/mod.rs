@@ -165,13 +165,30 @@ pub fn parse_with(
         compile::compile_points(&loc, &raw.uncertain, &axes, scene.part.support)?
     };
     let samples_text = samples.to_string();
-    let study_hash = hash::fnv1a(&[
+    // The policy file the scenario names shapes every sample: its bytes are hashed too (a study
+    // without one hashes what it did before policies existed).
+    let policy_text = match scene.controller.as_ref().filter(|c| c.source != "scenario") {
+        Some(c) => crate::input::read_text(Path::new(&c.source)).map_err(|e| {
+            at(
+                "scenario",
+                format!("cannot read the policy file {} ({e})", c.source),
+            )
+        })?,
+        None => String::new(),
+    };
+    let mut parts: Vec<&[u8]> = vec![
         b"pinfeed-mc-study",
         source.as_bytes(),
         scenario_text.as_bytes(),
         samples_text.as_bytes(),
-    ]);
-    let scenario_hash = hash::fnv1a(&[scenario_text.as_bytes()]);
+    ];
+    let mut scenario_parts: Vec<&[u8]> = vec![scenario_text.as_bytes()];
+    if !policy_text.is_empty() {
+        parts.push(policy_text.as_bytes());
+        scenario_parts.push(policy_text.as_bytes());
+    }
+    let study_hash = hash::fnv1a(&parts);
+    let scenario_hash = hash::fnv1a(&scenario_parts);
     Ok(Study {
         name,
         file: file.to_path_buf(),
