@@ -681,3 +681,17 @@ fn merge_prints_the_commands_for_missing_shards() {
     assert!(e.contains("--shard \\$SLURM_ARRAY_TASK_ID/2"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Item 4d: a measured band [0, 360] (allowed by README) was read as the point 0° ("not
+/// overlapping, P −0.000"); it is the whole circle.
+#[test]
+fn a_measured_band_from_0_to_360_is_the_whole_circle() {
+    use pinfeed::maps::arcs::Arc;
+    let text = "part,d,input,min_deg,max_deg,trials\ntripoly1,0.1,all,0,360,20\n";
+    let m = pinfeed::validate::measured::parse(Path::new("full.csv"), text, 0.5).unwrap();
+    let band = &m.rows[0].band;
+    assert!(band.contains_angle(180.0), "{band:?}");
+    assert!(band.contains(&Arc::from_ends(350.0, 10.0)), "{band:?}");
+    // A narrower band is still the arc it says.
+    assert!(!Arc::from_measured_ends(0.0, 90.0).contains_angle(180.0));
+}

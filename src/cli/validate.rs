@@ -10,6 +10,7 @@ use super::map_ensemble::bands_text;
 use super::shell_word;
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::{EnsembleSpec, PredictedBands};
+use crate::report::fixed;
 use crate::report::plot_validate::plot_band_distributions;
 use crate::validate::measured::{self, Measured};
 use crate::validate::score::{RowScore, ScoreSettings, Summary};
@@ -264,7 +265,7 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:+} | {} | [{}, {}] | {} | {} | {} | {} | {:.3} | {:.2} | {} |",
+            "| {} | {} | {:+} | {} | [{}, {}] | {} | {} | {} | {} | {} | {} | {} |",
             r.line,
             r.part,
             r.d,
@@ -275,9 +276,9 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
             yes(r.contained),
             yes(r.overlapping),
             r.centre_offset_deg
-                .map_or("—".into(), |o| format!("{o:+.1}°")),
-            r.predicted_probability,
-            r.log_score,
+                .map_or("—".into(), |o| format!("{}°", fixed(o, 1, true))),
+            fixed(r.predicted_probability, 3, false),
+            fixed(r.log_score, 2, false),
             bands_text(&r.predicted)
         );
     }
@@ -288,13 +289,13 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
 /// The summary in one line.
 pub fn summary_text(s: &Summary) -> String {
     format!(
-        "{} rows: {} contained, {} overlapping; predicted bands cover {:.1}% of the circle on average; log score {:.2} ({:.3} per row)",
+        "{} rows: {} contained, {} overlapping; predicted bands cover {}% of the circle on average; log score {} ({} per row)",
         s.rows,
         s.contained,
         s.overlapping,
-        100.0 * s.coverage,
-        s.log_score,
-        s.mean_log_score
+        fixed(100.0 * s.coverage, 1, false),
+        fixed(s.log_score, 2, false),
+        fixed(s.mean_log_score, 3, false)
     )
 }
 

@@ -221,7 +221,7 @@ fn parse_row(
         part,
         d,
         input,
-        band: Arc::from_ends(min_deg, max_deg),
+        band: Arc::from_measured_ends(min_deg, max_deg),
         min_deg,
         max_deg,
         trials,
@@ -248,7 +248,7 @@ fn parse_input(s: &str, states: usize) -> FieldResult<InputState> {
         if let Some((a, b)) = rest.split_once(':') {
             let (a, b) = (angle("input", a)?, angle("input", b)?);
             return Ok(InputState::Theta {
-                arc: Arc::from_ends(a, b),
+                arc: Arc::from_measured_ends(a, b),
             });
         }
     }
