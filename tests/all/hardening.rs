@@ -1,15 +1,9 @@
 //! Issue 28 ("Hardening the new surface"): each reproducer of the report as a named regression
 //! test, run through the release binary as the report ran it.
 
+use crate::support::{pinfeed, pinfeed_json};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn pinfeed(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pinfeed"))
-        .args(args)
-        .output()
-        .expect("run pinfeed")
-}
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
@@ -123,14 +117,12 @@ fn moving_pin_at_the_speed_limit_runs() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// `pinfeed contact ... --json` parsed.
+/// `pinfeed contact ARGS --json` parsed.
 fn contact_json(args: &[&str]) -> serde_json::Value {
     let mut all = vec!["contact"];
     all.extend_from_slice(args);
     all.push("--json");
-    let o = pinfeed(&all);
-    assert!(o.status.success(), "{}", stderr(&o));
-    serde_json::from_slice(&o.stdout).expect("contact --json prints JSON")
+    pinfeed_json(&all)
 }
 
 const ITEM3_PART: &str = "vertices:0.834679,0.289496 0.004451,0.772773 -0.235451,0.208773 \
