@@ -16,6 +16,7 @@
 pub mod cli;
 pub mod engine;
 pub mod geometry;
+pub mod input;
 pub mod maps;
 pub mod mechanics;
 pub mod plan;

@@ -1,6 +1,15 @@
 //! Small statistics shared by the layers that report rates: the line's success rate, Monte Carlo
 //! studies, sensor accuracies.
 
+/// The 50th, 90th and 99th percentiles (s) of a latency histogram recorded in whole µs, each
+/// clamped into [`min`, `max`] (s), the smallest and largest latencies it summarises: an HDR
+/// histogram reports a quantile as the highest value equivalent to its bucket (3 significant
+/// digits), which can lie above the largest value recorded (or, for `min`, its bucket's top above
+/// the least). A percentile outside the range it summarises is never reported.
+pub fn latency_percentiles(h: &hdrhistogram::Histogram<u64>, min: f64, max: f64) -> [f64; 3] {
+    [0.5, 0.9, 0.99].map(|p| (h.value_at_quantile(p) as f64 * 1e-6).clamp(min, max.max(min)))
+}
+
 /// The 95% Wilson score interval for `k` successes in `n` trials.
 pub fn wilson_interval(k: u64, n: u64) -> [f64; 2] {
     if n == 0 {
@@ -19,6 +28,25 @@ pub fn wilson_interval(k: u64, n: u64) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 28 item 4f: one latency of 13.3613 s (the quickstart line with one part) has an HDR
+    /// bucket whose top is 13.3693 s; its percentiles are that latency, not the bucket's top.
+    #[test]
+    fn latency_percentiles_never_exceed_the_maximum() {
+        let mut h =
+            hdrhistogram::Histogram::<u64>::new_with_bounds(1, 1_000_000_000_000, 3).unwrap();
+        h.record(13_361_300).unwrap();
+        assert!(
+            h.value_at_quantile(0.99) as f64 * 1e-6 > 13.3613,
+            "the bucket rounds up"
+        );
+        assert_eq!(latency_percentiles(&h, 13.3613, 13.3613), [13.3613; 3]);
+        for us in [1_000_000, 2_000_000, 13_361_300] {
+            h.record(us).unwrap();
+        }
+        let [p50, p90, p99] = latency_percentiles(&h, 1.0, 13.3613);
+        assert!(1.0 <= p50 && p50 <= p90 && p90 <= p99 && p99 <= 13.3613);
+    }
 
     #[test]
     fn wilson_matches_reference_values() {

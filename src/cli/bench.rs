@@ -140,8 +140,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             }
             let p_csv = out.with_extension("csv");
             let p_svg = out.with_extension("svg");
-            std::fs::write(&p_md, md).with_context(|| format!("writing {}", p_md.display()))?;
-            std::fs::write(&p_csv, crate::study::accuracy::csv(&st))
+            crate::report::atomic::write_atomic(&p_md, md)
+                .with_context(|| format!("writing {}", p_md.display()))?;
+            crate::report::atomic::write_atomic(&p_csv, crate::study::accuracy::csv(&st))
                 .with_context(|| format!("writing {}", p_csv.display()))?;
             crate::report::plot_accuracy::plot_accuracy(&st, &p_svg)
                 .with_context(|| format!("writing {}", p_svg.display()))?;
@@ -216,7 +217,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             if let Some(dir) = out.parent() {
                 std::fs::create_dir_all(dir).ok();
             }
-            std::fs::write(out, &doc).with_context(|| format!("writing {}", out.display()))?;
+            crate::report::atomic::write_atomic(out, &doc)
+                .with_context(|| format!("writing {}", out.display()))?;
             print!("{table}");
             eprintln!("wrote {}", out.display());
             Ok(())
@@ -290,7 +292,8 @@ fn bench_maps(repeats: usize, out: &std::path::Path) -> Result<()> {
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    std::fs::write(out, &doc).with_context(|| format!("writing {}", out.display()))?;
+    crate::report::atomic::write_atomic(out, &doc)
+        .with_context(|| format!("writing {}", out.display()))?;
     print!("{table}");
     eprintln!("wrote {}", out.display());
     Ok(())

@@ -62,7 +62,7 @@ pub fn run(a: &LineArgs) -> Result<()> {
     );
     let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, &cmd), MARKERS.1);
     let old = std::fs::read_to_string(&a.out).unwrap_or_default();
-    std::fs::write(&a.out, splice_between(&old, &marked, MARKERS))
+    crate::report::atomic::write_atomic(&a.out, splice_between(&old, &marked, MARKERS))
         .with_context(|| format!("writing {}", a.out.display()))?;
     eprintln!("wrote {}", a.out.display());
     Ok(())

@@ -32,7 +32,7 @@ pub struct MapTierArgs {
 
 fn write_section(path: &Path, section: &str) -> Result<()> {
     let old = std::fs::read_to_string(path).unwrap_or_default();
-    std::fs::write(path, splice(&old, &marked(section)))
+    crate::report::atomic::write_atomic(path, splice(&old, &marked(section)))
         .with_context(|| format!("writing {}", path.display()))?;
     eprintln!("wrote {}", path.display());
     Ok(())

@@ -88,7 +88,7 @@ pub fn run(study_file: &Path, counts: &[u64], repeats: usize, out: &Path) -> Res
         },
     );
     let doc = std::fs::read_to_string(out).unwrap_or_default();
-    std::fs::write(out, precision::splice(&doc, &section))
+    crate::report::atomic::write_atomic(out, precision::splice(&doc, &section))
         .with_context(|| format!("writing {}", out.display()))?;
     print!("{section}");
     eprintln!(

@@ -85,8 +85,8 @@ fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
         "smooth" => SupportChoice::Smooth(SmoothParams::default()),
         s => bail!("--support must be tripod or smooth, got '{s}'"),
     };
-    check_members(args.members)?;
-    check_members(args.score_members)?;
+    check_members("--members", args.members)?;
+    check_members("--score-members", args.score_members)?;
     let c = &args.common;
     Ok(CalibrationSettings {
         members: args.members,
@@ -159,7 +159,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         if let Some(dir) = args.measured.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         }
-        std::fs::write(&args.measured, text)
+        crate::report::atomic::write_atomic(&args.measured, text)
             .with_context(|| format!("writing {}", args.measured.display()))?;
         eprintln!("synthetic data set written to {}", args.measured.display());
         Some(SyntheticDesign::TRUTH)

@@ -272,14 +272,25 @@ fn check_inputs_named(c: &Case, name: &dyn Fn(&str) -> String) -> Result<()> {
             num(c.pin_radius)
         );
     }
+    check_flag_settings(c.pin_speed, c.pin_stop, c.tol, name)
+}
+
+/// The settings a batch takes from flags only (the pin's path and the tolerance), named by `name`.
+fn check_flag_settings(
+    pin_speed: f64,
+    pin_stop: Option<f64>,
+    tol: f64,
+    name: &dyn Fn(&str) -> String,
+) -> Result<()> {
+    use limits::*;
     in_range(
         &name("pin_speed"),
-        c.pin_speed,
+        pin_speed,
         -PIN_SPEED,
         PIN_SPEED,
         "fraction of the belt speed",
     )?;
-    if let Some(s_stop) = c.pin_stop {
+    if let Some(s_stop) = pin_stop {
         in_range(
             "--pin-stop-after",
             s_stop,
@@ -290,7 +301,7 @@ fn check_inputs_named(c: &Case, name: &dyn Fn(&str) -> String) -> Result<()> {
     }
     in_range(
         &name("tol"),
-        c.tol,
+        tol,
         TOL.0,
         TOL.1,
         "integration tolerance per step",
@@ -588,7 +599,7 @@ pub(crate) fn print_motion(r: &ContactReport) {
 }
 
 fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
-    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut f = Vec::new();
     writeln!(
         f,
         "s,x,y,theta_deg,pin_x,pin_y,contact_x,contact_y,force_x,force_y,mode,feature,index,normal_x,normal_y,rotation_rate"
@@ -616,6 +627,7 @@ fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
             t.rotation_rate
         )?;
     }
+    crate::report::atomic::write_atomic(path, f)?;
     Ok(())
 }
 
@@ -652,13 +664,17 @@ struct CaseOut<'a> {
 }
 
 fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
+    let text =
+        crate::input::read_text(path).with_context(|| format!("reading {}", path.display()))?;
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_path(path)
-        .with_context(|| format!("reading {}", path.display()))?;
+        .from_reader(text.as_bytes());
     let mut wtr = csv::Writer::from_writer(std::io::stdout().lock());
     let mut compiled: std::collections::HashMap<String, (Polygon, PartModel)> = Default::default();
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;
+    // Flags that apply to every row are checked once, before any row (an error there is the
+    // flag's, not a row's).
+    check_flag_settings(args.pin_speed, args.pin_stop, args.tol, &flag)?;
     for (i, row) in rdr.deserialize::<CaseRow>().enumerate() {
         let row = row.map_err(|e| {
             let line = e.position().map(|p| p.line()).unwrap_or(i as u64 + 2);

@@ -452,12 +452,16 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
     }
     let json_path = out_dir.join("map.json");
     // Compact: the document holds every sample (README.md is the readable summary).
-    std::fs::write(&json_path, serde_json::to_string(report)? + "\n")
+    crate::report::atomic::write_atomic(&json_path, serde_json::to_string(report)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     let csv_path = out_dir.join("samples.csv");
-    let f = std::fs::File::create(&csv_path)
-        .with_context(|| format!("writing {}", csv_path.display()))?;
-    write_csv(std::io::BufWriter::new(f), report.maps)?;
+    crate::report::atomic::produce_atomic(&csv_path, |tmp| {
+        write_csv(
+            std::io::BufWriter::new(std::fs::File::create(tmp)?),
+            report.maps,
+        )
+    })
+    .with_context(|| format!("writing {}", csv_path.display()))?;
 
     let describe = match &report.fence {
         Some(f) => format!(
@@ -561,7 +565,8 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
         md += &format!("### {what}\n\n![{what}]({})\n\n", link(path));
     }
     let readme = out_dir.join("README.md");
-    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
+    crate::report::atomic::write_atomic(&readme, md)
+        .with_context(|| format!("writing {}", readme.display()))?;
     Ok(())
 }
 

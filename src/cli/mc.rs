@@ -5,8 +5,8 @@
 //! (`<out>/shard-K-of-N.json`, default `<out>` = `results/mc/<study name>/shards/`) for
 //! `pinfeed merge`.
 
+use crate::report::atomic::Batch;
 use crate::report::plot_sensitivity::plot_sensitivity;
-use crate::study::mc::atomic::{produce_atomic, write_atomic};
 use crate::study::mc::report::{self, McReport, StudyHeader};
 use crate::study::mc::shard::{self, ShardFile, ShardSpec};
 use crate::study::mc::{self, run};
@@ -102,8 +102,7 @@ pub fn run(args: &McArgs) -> Result<()> {
         let path = dir.join(spec.file_name());
         let file = ShardFile::new(&header, spec, range.clone(), &tallies);
         let text = serde_json::to_string_pretty(&file)? + "\n";
-        shard::write_atomic(&path, text.as_bytes(), &mut |_| {})
-            .with_context(|| format!("writing {}", path.display()))?;
+        shard::write_atomic(&path, text).with_context(|| format!("writing {}", path.display()))?;
         if !args.quiet {
             eprintln!(
                 "shard {}/{}: samples [{}, {}) of {total}; {speed}; wrote {}",
@@ -133,19 +132,24 @@ pub fn run(args: &McArgs) -> Result<()> {
 pub fn publish(r: &McReport, dir: &Path, json: bool, quiet: bool) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let figure = "sensitivity.svg";
-    // Each file appears whole or not at all (written beside it, then renamed).
+    // The three files appear whole, and together, or not at all.
     let md = dir.join("report.md");
-    write_atomic(&md, report::markdown(r, figure).as_bytes(), &mut |_| {})
-        .with_context(|| format!("writing {}", md.display()))?;
     let js = dir.join("report.json");
-    let json_text = report::json(r);
-    write_atomic(&js, json_text.as_bytes(), &mut |_| {})
-        .with_context(|| format!("writing {}", js.display()))?;
     let svg = dir.join(figure);
-    produce_atomic(&svg, |tmp| {
-        plot_sensitivity(r, tmp).map_err(|e| std::io::Error::other(e.to_string()))
-    })
-    .with_context(|| format!("writing {}", svg.display()))?;
+    let json_text = report::json(r);
+    let mut batch = Batch::new();
+    batch
+        .write(&md, report::markdown(r, figure))
+        .with_context(|| format!("writing {}", md.display()))?;
+    batch
+        .write(&js, &json_text)
+        .with_context(|| format!("writing {}", js.display()))?;
+    batch
+        .produce(&svg, |tmp| plot_sensitivity(r, tmp))
+        .with_context(|| format!("writing {}", svg.display()))?;
+    batch
+        .commit()
+        .with_context(|| format!("writing the report into {}", dir.display()))?;
     let text = if json {
         json_text
     } else if quiet {

@@ -6,6 +6,7 @@
 //! [`crate::report::animate`]).
 
 use crate::engine::{self, RunOptions};
+use crate::report::atomic::Batch;
 use crate::report::{animate, line_table, parts_csv, plot_line, plot_orientations};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -107,33 +108,44 @@ pub fn run(args: &RunArgs) -> Result<()> {
         .unwrap_or_else(|| PathBuf::from(&scene.output.dir))
         .join(&scene.name);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    // The run's files appear whole and together, or not at all (a full disk leaves the previous
+    // run's files as they were, never a new summary beside a truncated figure).
+    let mut batch = Batch::new();
     let json = serde_json::to_string_pretty(summary)? + "\n";
     let summary_path = dir.join("summary.json");
-    std::fs::write(&summary_path, &json)
+    batch
+        .write(&summary_path, &json)
         .with_context(|| format!("writing {}", summary_path.display()))?;
     if scene.output.parts_csv {
         let p = dir.join("parts.csv");
-        parts_csv::write_parts_csv(&p, &result.records)
+        batch
+            .produce(&p, |tmp| parts_csv::write_parts_csv(tmp, &result.records))
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if scene.output.histogram_svg {
         let p = dir.join("orientation_histogram.svg");
-        plot_orientations::plot_orientation_histogram(&scene, summary, &p)
+        batch
+            .produce(&p, |tmp| {
+                plot_orientations::plot_orientation_histogram(&scene, summary, tmp)
+            })
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if scene.effects.event_log {
         let p = dir.join("events.json");
-        std::fs::write(&p, serde_json::to_string(&result.events)? + "\n")
+        batch
+            .write(&p, serde_json::to_string(&result.events)? + "\n")
             .with_context(|| format!("writing {}", p.display()))?;
         if !result.control.is_empty() {
             let p = dir.join("control.json");
-            std::fs::write(&p, serde_json::to_string(&result.control)? + "\n")
+            batch
+                .write(&p, serde_json::to_string(&result.control)? + "\n")
                 .with_context(|| format!("writing {}", p.display()))?;
         }
     }
     if let Some(p) = &args.draw {
         let samples = plot_line::choose_samples(&result.paths, scene.output.draw_parts as usize);
-        plot_line::plot_line(&scene, &samples, p)
+        batch
+            .produce(p, |tmp| plot_line::plot_line(&scene, &samples, tmp))
             .with_context(|| format!("writing {}", p.display()))?;
     }
     if let Some(p) = &args.animate {
@@ -149,9 +161,13 @@ pub fn run(args: &RunArgs) -> Result<()> {
                 animate::MAX_DURATION_S
             );
         }
-        std::fs::write(p, animate::render(&anim, &aopts))
+        batch
+            .write(p, animate::render(&anim, &aopts))
             .with_context(|| format!("writing {}", p.display()))?;
     }
+    batch
+        .commit()
+        .with_context(|| format!("writing the results into {}", dir.display()))?;
 
     let mut text = String::new();
     if args.json {

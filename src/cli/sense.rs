@@ -889,7 +889,7 @@ fn write_report(
 ) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let json_path = out.join("sense.json");
-    std::fs::write(&json_path, serde_json::to_string_pretty(r)? + "\n")
+    crate::report::atomic::write_atomic(&json_path, serde_json::to_string_pretty(r)? + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     let what = format!(
         "{} at d = {}, μc {}, {} sensor",
@@ -940,7 +940,7 @@ fn write_report(
         )
         .with_context(|| format!("writing {}", f.display()))?;
     }
-    std::fs::write(out.join("report.md"), report_markdown(r))
+    crate::report::atomic::write_atomic(out.join("report.md"), report_markdown(r))
         .with_context(|| format!("writing {}", out.join("report.md").display()))?;
     Ok(())
 }

@@ -10,6 +10,7 @@ use super::map_ensemble::bands_text;
 use super::shell_word;
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::{EnsembleSpec, PredictedBands};
+use crate::report::fixed;
 use crate::report::plot_validate::plot_band_distributions;
 use crate::validate::measured::{self, Measured};
 use crate::validate::score::{RowScore, ScoreSettings, Summary};
@@ -220,7 +221,7 @@ pub fn write_report_files<T: Serialize>(
 ) -> Result<()> {
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let json = out_dir.join(json_name);
-    std::fs::write(&json, serde_json::to_string_pretty(report)? + "\n")
+    crate::report::atomic::write_atomic(&json, serde_json::to_string_pretty(report)? + "\n")
         .with_context(|| format!("writing {}", json.display()))?;
     let mut md = format!(
         "# {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{}\n\n",
@@ -232,14 +233,15 @@ pub fn write_report_files<T: Serialize>(
     md.push('\n');
     md.push_str(&body(out_dir)?);
     let readme = out_dir.join("README.md");
-    std::fs::write(&readme, md).with_context(|| format!("writing {}", readme.display()))?;
+    crate::report::atomic::write_atomic(&readme, md)
+        .with_context(|| format!("writing {}", readme.display()))?;
     Ok(())
 }
 
-/// Check the member count.
-pub fn check_members(members: usize) -> Result<()> {
+/// Check a member count given by `flag` (`--members`, `--score-members`).
+pub fn check_members(flag: &str, members: usize) -> Result<()> {
     if !(1..=MAX_MEMBERS).contains(&members) {
-        bail!("--members must lie in [1, {MAX_MEMBERS}], got {members}");
+        bail!("{flag} must lie in [1, {MAX_MEMBERS}], got {members}");
     }
     Ok(())
 }
@@ -263,7 +265,7 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:+} | {} | [{}, {}] | {} | {} | {} | {} | {:.3} | {:.2} | {} |",
+            "| {} | {} | {:+} | {} | [{}, {}] | {} | {} | {} | {} | {} | {} | {} |",
             r.line,
             r.part,
             r.d,
@@ -274,9 +276,9 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
             yes(r.contained),
             yes(r.overlapping),
             r.centre_offset_deg
-                .map_or("—".into(), |o| format!("{o:+.1}°")),
-            r.predicted_probability,
-            r.log_score,
+                .map_or("—".into(), |o| format!("{}°", fixed(o, 1, true))),
+            fixed(r.predicted_probability, 3, false),
+            fixed(r.log_score, 2, false),
             bands_text(&r.predicted)
         );
     }
@@ -287,24 +289,40 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
 /// The summary in one line.
 pub fn summary_text(s: &Summary) -> String {
     format!(
-        "{} rows: {} contained, {} overlapping; predicted bands cover {:.1}% of the circle on average; log score {:.2} ({:.3} per row)",
+        "{} rows: {} contained, {} overlapping; predicted bands cover {}% of the circle on average; log score {} ({} per row)",
         s.rows,
         s.contained,
         s.overlapping,
-        100.0 * s.coverage,
-        s.log_score,
-        s.mean_log_score
+        fixed(100.0 * s.coverage, 1, false),
+        fixed(s.log_score, 2, false),
+        fixed(s.mean_log_score, 3, false)
     )
 }
 
 /// Load the measured file for an ensemble (its largest pin radius sets the reach of d).
+/// The pin radius may be at most the range `map` and `contact` allow for each part (10·a).
 pub fn load_measured(path: &Path, spec: &EnsembleSpec) -> Result<Measured> {
-    Ok(measured::load(path, spec.max_pin_radius())?)
+    let m = measured::load(path, spec.max_pin_radius())?;
+    let r = spec.max_pin_radius();
+    for (part, poly) in &m.parts {
+        let rmax = super::contact::limits::PIN_RADIUS_A * poly.radius();
+        if r > rmax {
+            bail!(
+                "--pin-radius (or the largest pin_radius of --uncertain) must lie in [0, {}] for part {part} of {} (part units: at most {}·a, a = {}), got {}",
+                crate::scenario::limits::num(rmax),
+                path.display(),
+                super::contact::limits::PIN_RADIUS_A,
+                crate::scenario::limits::num(poly.radius()),
+                crate::scenario::limits::num(r)
+            );
+        }
+    }
+    Ok(m)
 }
 
 pub fn run(args: &ValidateArgs) -> Result<()> {
     let score = args.common.score()?;
-    check_members(args.members)?;
+    check_members("--members", args.members)?;
     let spec = ensemble_spec(
         args.mu_c,
         args.pin_radius,

@@ -15,7 +15,7 @@
 //! every part on the belt was last planned are forgotten ([`Track::forget_before`]), so memory is
 //! flat in the number of parts.
 
-use crate::mechanics::{PinPath, Turn};
+use crate::mechanics::{PinPath, Turn, MAX_LATERAL_SPEED};
 use crate::scenario::{MovingSpec, RetractSpec, Target};
 use std::collections::VecDeque;
 
@@ -254,7 +254,7 @@ impl Track {
     /// The pin's lateral speed profile from time `t0` on, as the contact model takes it: travel
     /// s = V·(t − t0), speed w = ẏ / V, each acceleration phase in `pieces` pieces.
     pub fn path_from(&self, t0: f64, belt_speed: f64, pieces: usize) -> PinPath {
-        let Track::Moving { moves, .. } = self else {
+        let Track::Moving { moves, spec, .. } = self else {
             return PinPath::constant(0.0);
         };
         let mut knots: Vec<f64> = Vec::new();
@@ -262,6 +262,10 @@ impl Track {
             knots.extend(m.knots(pieces));
         }
         // Pieces between successive knots (and from t0 to the first), at their mean speed.
+        // A piece's mean speed never exceeds the actuator's limit; rounding of the difference
+        // quotient over a short piece may, so it is clamped to the limit (which the scenario
+        // checker keeps within the path's invariant, `limits::max_pin_speed`).
+        let w_max = (spec.speed / belt_speed).min(MAX_LATERAL_SPEED);
         let mut w0 = 0.0;
         let mut turns = Vec::new();
         let mut prev = t0;
@@ -270,7 +274,8 @@ impl Track {
             if k - prev <= 1e-12 * (1.0 + k.abs()) {
                 continue;
             }
-            let w = (self.y_at(k, home) - self.y_at(prev, home)) / (k - prev) / belt_speed;
+            let w = ((self.y_at(k, home) - self.y_at(prev, home)) / (k - prev) / belt_speed)
+                .clamp(-w_max, w_max);
             if prev == t0 {
                 w0 = w;
             } else {

@@ -168,6 +168,8 @@ pub struct Metrics {
     pub latency_us: Histogram<u64>,
     /// Largest latency (s), exact.
     pub latency_max: f64,
+    /// Smallest latency (s), exact (+∞ before the first exit).
+    pub latency_min: f64,
     pub contacts: u64,
     pub obstacles: Vec<ObstacleStats>,
     /// Final orientations of exiting parts, counts per bin of `bin_deg`.
@@ -198,6 +200,7 @@ impl Metrics {
             latency_us: Histogram::new_with_bounds(1, 1_000_000_000_000, 3)
                 .expect("valid histogram bounds: 1 µs to 10⁶ s, 3 significant digits"),
             latency_max: 0.0,
+            latency_min: f64::INFINITY,
             contacts: 0,
             obstacles: obstacle_names
                 .into_iter()
@@ -244,6 +247,7 @@ impl Metrics {
         let us = (latency * 1e6).round().max(1.0) as u64;
         self.latency_us.saturating_record(us);
         self.latency_max = self.latency_max.max(latency);
+        self.latency_min = self.latency_min.min(latency);
         let n = self.orientation_bins.len();
         let bin = ((theta_deg / self.bin_deg).floor() as usize).min(n - 1);
         self.orientation_bins[bin] += 1;
@@ -352,11 +356,15 @@ impl Metrics {
             None => (None, None, None),
         };
         let latency = (!self.latency_us.is_empty()).then(|| {
-            let q = |p: f64| self.latency_us.value_at_quantile(p) as f64 * 1e-6;
+            let [p50, p90, p99] = crate::statistics::latency_percentiles(
+                &self.latency_us,
+                self.latency_min,
+                self.latency_max,
+            );
             LatencySummary {
-                p50: q(0.5),
-                p90: q(0.9),
-                p99: q(0.99),
+                p50,
+                p90,
+                p99,
                 max: self.latency_max,
             }
         });

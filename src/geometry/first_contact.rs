@@ -104,7 +104,9 @@ pub fn first_contact(
         let t = w.cross(e) / den;
         let s = w.cross(d) / den;
         let eps = 1e-12 * scale / len;
-        if s < -eps || s > 1.0 + eps {
+        // `!(..)` also skips NaN: an edge parallel to the ray to rounding (den = 0 while d·n
+        // rounds above 0) has no face touch; its ends are the neighbours' or the vertex loop's.
+        if !(t.is_finite() && s >= -eps && s <= 1.0 + eps) {
             continue;
         }
         // A touch within the tolerance of an edge end is that vertex, for point and disc pins alike

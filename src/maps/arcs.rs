@@ -29,6 +29,16 @@ impl Arc {
         }
     }
 
+    /// The arc a user writes as [min, max] degrees (each in [0, 360]): [0, 360] (max − min = 360)
+    /// is the whole circle, not the point at 0° that wrapping its ends would make.
+    pub fn from_measured_ends(min: f64, max: f64) -> Arc {
+        if max - min >= 360.0 {
+            Arc::full()
+        } else {
+            Arc::from_ends(min, max)
+        }
+    }
+
     /// The whole circle.
     pub fn full() -> Arc {
         Arc {

@@ -374,12 +374,18 @@ impl Ctx<'_, '_> {
         [e3, e4, e5, e6]
     }
 
+    /// How far (normalised units) a state may stray from its contact before the self-check fails:
+    /// the pin may overlap the part, or a contact point lie off its feature, by this much.
+    pub(super) fn check_limit(&self) -> f64 {
+        10.0 * self.tol
+    }
+
     /// The self-check at the end of a contact (a few event functions and one distance): the state
     /// must still lie on its feature, and the pin must not overlap the part. Both hold by
     /// construction in exact arithmetic and to the landing tolerance in a correct run; a failure
     /// means an accepted step or landing went wrong.
     pub(super) fn self_check(&self, s: f64, feat: Feat, y: [f64; 2]) -> Option<SelfCheck> {
-        let limit = 10.0 * self.tol;
+        let limit = self.check_limit();
         if self.feature_events(feat, y).iter().any(|&e| e < -limit) {
             return Some(SelfCheck::OffFeature);
         }

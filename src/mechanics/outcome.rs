@@ -99,6 +99,8 @@ pub enum SelfCheck {
     OffFeature,
     /// At the end of a contact the pin overlaps the part.
     Penetration,
+    /// A computed travel or pose is not a finite number (a degenerate geometric query).
+    NonFinite,
 }
 
 impl SelfCheck {
@@ -106,6 +108,7 @@ impl SelfCheck {
         match self {
             SelfCheck::OffFeature => "off_feature",
             SelfCheck::Penetration => "penetration",
+            SelfCheck::NonFinite => "non_finite",
         }
     }
 }

@@ -11,7 +11,7 @@ use super::contact_state::{initial_state, Ctx, Feat};
 use super::fence::{first_touch, next_fence_touch, FenceGeom, FenceSpec};
 use super::instant::{classify, ContactGeom, Instant};
 use super::integrate::{integrate_contact, End, Tally};
-use super::outcome::{ContactOutcome, ContactStatus, Recorder};
+use super::outcome::{ContactOutcome, ContactStatus, Recorder, SelfCheck};
 use super::part_model::PartModel;
 use super::pin_path::PinPath;
 use super::settings::{ContactSettings, Pin};
@@ -51,7 +51,10 @@ fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touc
         }
         s = s_turn;
         ctx.take_turn();
-        min_travel = 0.0;
+        // At a turn the pin may already overlap the part by the rounding of the integration (it
+        // can run along an edge it has just left, then turn into it): a touch up to the
+        // self-check's limit behind the turn is a touch at the turn, not a pin passing through.
+        min_travel = -ctx.check_limit();
     }
 }
 
@@ -93,6 +96,14 @@ fn cast_piece(ctx: &mut Ctx, cur: &Pose, s: f64, mut min_travel: f64) -> Touch {
     Touch::None
 }
 
+/// The status of a pass stopped by a non-finite travel or pose after travel `s` (normalised).
+fn non_finite(s: f64, k: f64) -> ContactStatus {
+    ContactStatus::SelfCheck {
+        check: SelfCheck::NonFinite,
+        s: s * k,
+    }
+}
+
 /// The outcome of a pass that never touched the part.
 pub(crate) fn untouched(pose: Pose, status: ContactStatus) -> ContactOutcome {
     ContactOutcome {
@@ -126,6 +137,10 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
                 out.status = st;
                 break;
             }
+            Touch::At(t, ..) if !t.is_finite() => {
+                out.status = non_finite(s, k);
+                break;
+            }
             Touch::At(t, f, y) => (t, f, y),
         };
         if out.contacts == 0 {
@@ -133,6 +148,14 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
         }
         out.contacts += 1;
         let (end, s_end, pose_end) = integrate_contact(ctx, settings, s_touch, feat, y, &mut segs);
+        if ![s_end, pose_end.x, pose_end.y, pose_end.theta]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            // Keep the last finite state as the result and say why it stopped.
+            out.status = non_finite(s_touch, k);
+            break;
+        }
         segs.close(s_end, pose_end.theta, k);
         out.contact_length += (s_end - s_touch) * k;
         s = s_end;

@@ -8,10 +8,12 @@ use std::path::Path;
 pub fn write_parts_csv(path: &Path, records: &[PartRecord]) -> anyhow::Result<()> {
     let mut sorted: Vec<&PartRecord> = records.iter().collect();
     sorted.sort_by_key(|r| r.part);
-    let mut w = csv::Writer::from_path(path)?;
-    for r in sorted {
-        w.serialize(r)?;
-    }
-    w.flush()?;
-    Ok(())
+    crate::report::atomic::produce_atomic(path, |tmp| {
+        let mut w = csv::Writer::from_path(tmp)?;
+        for r in sorted {
+            w.serialize(r)?;
+        }
+        w.flush()?;
+        Ok(())
+    })
 }

@@ -1,13 +1,16 @@
 //! SVG of the accuracy-vs-time study: error against time per contact, one point per tier
 //! (log–log), mean error and 95th percentile.
 
+use crate::report::atomic::Staged;
 use crate::study::accuracy::AccuracyStudy;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 pub fn plot_accuracy(st: &AccuracyStudy, path: &Path) -> anyhow::Result<()> {
-    let root = SVGBackend::new(path, (900, 600)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 600)).into_drawing_area();
     root.fill(&WHITE)?;
     let floor = 1e-9;
     let pts: Vec<(f64, f64, f64, &str)> = st
@@ -76,5 +79,6 @@ pub fn plot_accuracy(st: &AccuracyStudy, path: &Path) -> anyhow::Result<()> {
         .background_style(WHITE.mix(0.8))
         .draw()?;
     root.present()?;
+    staged.commit()?;
     Ok(())
 }

@@ -5,6 +5,7 @@
 
 use crate::geometry::{Polygon, Pose, Vec2};
 use crate::mechanics::{ContactOutcome, TraceSample};
+use crate::report::atomic::Staged;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -68,7 +69,9 @@ pub fn plot_contact(
     let span = w.max(h);
     let cx = 0.5 * (lo.x + hi.x);
     let cy = 0.5 * (lo.y + hi.y);
-    let root = SVGBackend::new(path, (800, 800)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (800, 800)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut ch = ChartBuilder::on(&root)
         .caption(
@@ -145,6 +148,7 @@ pub fn plot_contact(
         }
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@
 
 use crate::engine::{PartOutcome, SamplePath};
 use crate::geometry::{wrap_deg, Pose};
+use crate::report::atomic::Staged;
 use crate::scenario::{Obstacle, Scene};
 use plotters::prelude::*;
 use std::path::Path;
@@ -101,7 +102,9 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
     let panel_h = plot_h as u32 + bottom + top + 10;
     let n = samples.len().max(1);
     let width = plot_w as u32 + left + 20;
-    let root = SVGBackend::new(path, (width, panel_h * n as u32)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (width, panel_h * n as u32)).into_drawing_area();
     root.fill(&WHITE)?;
     let panels = root.split_evenly((n, 1));
     for (k, panel) in panels.iter().enumerate() {
@@ -186,5 +189,6 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
         ch.draw_series(LineSeries::new(track, colour.mix(0.35)))?;
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }

@@ -12,6 +12,7 @@
 
 use crate::geometry::wrap_deg;
 use crate::maps::{Band, ConfigurationMap};
+use crate::report::atomic::Staged;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::ComposedElement;
@@ -114,7 +115,9 @@ pub fn plot_map(
     step_deg: f64,
     path: &Path,
 ) -> anyhow::Result<()> {
-    let root = SVGBackend::new(path, (760, 680)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (760, 680)).into_drawing_area();
     let mut ch = degree_chart(&root, title, 0.0..360.0, 360.0)?;
     ch.configure_mesh()
         .x_labels(13)
@@ -204,6 +207,7 @@ pub fn plot_map(
     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
     draw_legend(&mut ch, SeriesLabelPosition::UpperLeft)?;
     root.present()?;
+    staged.commit()?;
     Ok(())
 }
 
@@ -232,7 +236,9 @@ pub fn plot_band_intervals(
         (dmin, dmax) = (-1.0, 1.0);
     }
     let pad = ((dmax - dmin) * 0.06).max(0.1);
-    let root = SVGBackend::new(path, (900, 620)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 620)).into_drawing_area();
     // Room above 360° for the legend, so it never hides an interval.
     let mut ch = degree_chart(&root, title, (dmin - pad)..(dmax + pad), 420.0)?;
     d_axis_mesh(
@@ -300,6 +306,7 @@ pub fn plot_band_intervals(
         .legend(|(x, y)| Circle::new((x + 8, y), 3, RED.filled()));
     draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
     root.present()?;
+    staged.commit()?;
     Ok(())
 }
 

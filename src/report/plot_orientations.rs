@@ -2,6 +2,7 @@
 //! part's stable states marked (dashed) and the goal's tolerance bands shaded.
 
 use crate::engine::Summary;
+use crate::report::atomic::Staged;
 use crate::scenario::{Goal, Scene};
 use plotters::prelude::*;
 use std::path::Path;
@@ -9,7 +10,9 @@ use std::path::Path;
 pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> anyhow::Result<()> {
     let h = &s.orientation_histogram;
     let ymax = h.counts.iter().copied().max().unwrap_or(0).max(1) as f64 * 1.1;
-    let root = SVGBackend::new(path, (900, 420)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 420)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut ch = ChartBuilder::on(&root)
         .caption(
@@ -70,5 +73,6 @@ pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> an
         ))?;
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }

@@ -2,12 +2,15 @@
 //! `a`) beside its radius function ρ(φ) with the stable states marked.
 
 use crate::geometry::{Polygon, Vec2};
+use crate::report::atomic::Staged;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Draw the part and its radius function into an SVG file.
 pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> anyhow::Result<()> {
-    let root = SVGBackend::new(path, (1000, 460)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (1000, 460)).into_drawing_area();
     root.fill(&WHITE)?;
     let (left, right) = root.split_horizontally(460);
     let a = poly.radius() * 1.15;
@@ -85,5 +88,6 @@ pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> anyhow::Result<()>
         )))?;
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }

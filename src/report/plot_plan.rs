@@ -6,6 +6,7 @@
 
 use crate::geometry::{Pose, Vec2};
 use crate::plan::{Action, Plan, Problem, State};
+use crate::report::atomic::Staged;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
@@ -128,7 +129,9 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> an
     let (xs_layout, length) = crate::plan::emit::layout(problem, plan, compiled.radius);
     let half = problem.belt_width_m / 2.0 * 1e3;
     let height = 330 + 40 * stages as u32 + 80;
-    let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (1000, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(330);
     let mut ch = belt_view(&top, title.to_string(), length, half)?;
@@ -209,6 +212,7 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> an
         }))?;
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }
 
@@ -244,7 +248,9 @@ pub fn plot_contingent(
     let length = problem.spacing_m * (k as f64 + 2.0);
     let half = problem.belt_width_m / 2.0 * 1e3;
     let height = 330 + 40 * rows as u32 + 80;
-    let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (1000, height)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(330);
     let mut ch = belt_view(&top, title.to_string(), length, half)?;
@@ -319,5 +325,6 @@ pub fn plot_contingent(
         }
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }

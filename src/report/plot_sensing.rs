@@ -6,6 +6,7 @@
 //!   chance;
 //! * [`plot_placement`]: mutual information against d per sensor kind, with the ceiling H(state).
 
+use crate::report::atomic::Staged;
 use crate::sensing::evaluate::Evaluation;
 use crate::sensing::placement::Placement;
 use crate::sensing::reading::Reading;
@@ -74,7 +75,9 @@ pub fn plot_templates(
             curves.push((h, m, [fx, fy]));
         }
     }
-    let root = SVGBackend::new(path, (1000, 760)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (1000, 760)).into_drawing_area();
     root.fill(&WHITE)?;
     let (head, body) = root.split_vertically(40);
     head.draw(&Text::new(
@@ -173,6 +176,7 @@ pub fn plot_templates(
             .draw()?;
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }
 
@@ -189,7 +193,9 @@ pub fn plot_accuracy_noise(ev: &Evaluation, title: &str, path: &Path) -> anyhow:
         }
     }
     let n = factors.len().max(1);
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut ch = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 17))
@@ -256,6 +262,7 @@ pub fn plot_accuracy_noise(ev: &Evaluation, title: &str, path: &Path) -> anyhow:
         .background_style(WHITE.mix(0.85))
         .draw()?;
     root.present()?;
+    staged.commit()?;
     Ok(())
 }
 
@@ -284,7 +291,9 @@ pub fn plot_placement(p: &Placement, title: &str, path: &Path) -> anyhow::Result
         .map(|r| r.state_entropy_bits)
         .fold(0.0, f64::max);
     let ymax = ceiling.max(0.1) * 1.08;
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let pad = 0.03 * (d1 - d0);
     let mut ch = ChartBuilder::on(&root)
@@ -333,5 +342,6 @@ pub fn plot_placement(p: &Placement, title: &str, path: &Path) -> anyhow::Result
         .background_style(WHITE.mix(0.85))
         .draw()?;
     root.present()?;
+    staged.commit()?;
     Ok(())
 }

@@ -3,13 +3,16 @@
 //! parameter; without a sweep: the share of every outcome class that occurred, with whiskers.
 
 use crate::engine::PartOutcome;
+use crate::report::atomic::Staged;
 use crate::study::mc::report::McReport;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Draw the figure for `r` into `path`.
 pub fn plot_sensitivity(r: &McReport, path: &Path) -> anyhow::Result<()> {
-    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let title = format!(
         "{}: {} samples per point",
@@ -21,6 +24,7 @@ pub fn plot_sensitivity(r: &McReport, path: &Path) -> anyhow::Result<()> {
         success_lines(r, &root, &title)?;
     }
     root.present()?;
+    staged.commit()?;
     Ok(())
 }
 

@@ -7,6 +7,7 @@
 use super::plot_map::{arc_pieces, d_axis_mesh, degree_chart, draw_legend, Chart, PALETTE};
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::PredictedBands;
+use crate::report::atomic::Staged;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -47,7 +48,9 @@ pub fn plot_band_distributions(
     let step = spacing(&ds);
     let lo = ds.iter().copied().fold(f64::INFINITY, f64::min) - step;
     let hi = ds.iter().copied().fold(f64::NEG_INFINITY, f64::max) + step;
-    let root = SVGBackend::new(path, (900, 640)).into_drawing_area();
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 640)).into_drawing_area();
     let mut ch = degree_chart(&root, title, lo..hi, 420.0)?;
     d_axis_mesh(&mut ch, "final orientation θf (deg)")?;
     ch.draw_series(LineSeries::new(
@@ -111,5 +114,6 @@ pub fn plot_band_distributions(
     }
     draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
     root.present()?;
+    staged.commit()?;
     Ok(())
 }

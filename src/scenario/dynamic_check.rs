@@ -4,7 +4,7 @@
 //!
 //! * a moving pin's `travel` = [min, max] lies over the belt (|y| ≤ width/2) and holds its home
 //!   `y`; `speed` and `accel` are positive and finite ([`super::limits::ACTUATOR_SPEED`],
-//!   [`super::limits::ACTUATOR_ACCEL`]); `settle` ≥ 0; `pieces` in 1..=64;
+//!   [`super::limits::ACTUATOR_ACCEL`]), the speed at most [`super::limits::max_pin_speed`]; `settle` ≥ 0; `pieces` in 1..=64;
 //! * a retractable pin's times are ≥ 0 and finite;
 //! * a rule names a sensor pin, one of that sensor's hypothesis labels (or `unknown`), a dynamic
 //!   pin, and a target that fits the pin (`y` within a moving pin's travel, `raised` for a
@@ -69,7 +69,17 @@ pub(super) fn actuator(
                 ));
             }
             let speed = need("speed", ro.speed)?;
-            let speed = c.range(&path("speed"), speed, limits::ACTUATOR_SPEED, "m/s")?;
+            let speed = c.within(
+                &path("speed"),
+                speed,
+                limits::ACTUATOR_SPEED.0,
+                limits::max_pin_speed(belt.speed),
+                &format!(
+                    "m/s; at most {} belt speeds, belt.speed = {} m/s",
+                    crate::mechanics::MAX_LATERAL_SPEED,
+                    limits::num(belt.speed)
+                ),
+            )?;
             let accel = need("accel", ro.accel)?;
             let accel = c.range(&path("accel"), accel, limits::ACTUATOR_ACCEL, "m/s²")?;
             let settle = match ro.settle {
@@ -155,13 +165,13 @@ pub(super) fn controller(
         }
     };
     let mut compiled = compile_rules(c, "rules", rules, obstacles, on_late)?;
+    check_conflicts(c, &compiled, 0)?;
     let mut source = "scenario".to_string();
     if let Some(file) = &rc.policy {
         let path = loc.file.parent().unwrap_or(Path::new(".")).join(file);
-        compiled.extend(policy(c, &path, obstacles, part_label, on_late)?);
+        compiled = policy(c, &path, compiled, obstacles, part_label, on_late)?;
         source = path.display().to_string();
     }
-    check_conflicts(c, &compiled)?;
     Ok(Some(Controller {
         latency,
         min_posterior,
@@ -171,21 +181,27 @@ pub(super) fn controller(
     }))
 }
 
-/// Rules read from a policy file, located in that file.
+/// The scenario's rules followed by those read from a policy file; a policy's errors (and a
+/// rule of it that contradicts an earlier one) are located in that file.
 fn policy(
     c: &Checker,
     path: &Path,
+    mut compiled: Vec<(String, Rule)>,
     obstacles: &[Obstacle],
     part_label: &str,
     on_late: OnLate,
 ) -> R<Vec<(String, Rule)>> {
-    let source = std::fs::read_to_string(path).map_err(|e| {
+    let source = crate::input::read_text(path).map_err(|e| {
         c.err(
             "controller.policy",
             format!("cannot read the policy file {}: {e}", path.display()),
         )
     })?;
-    let ploc = Locator::new(path, &source);
+    let ploc = Locator::of(
+        path,
+        &source,
+        "a policy file (the part it was planned for, then its [[rules]])",
+    );
     let pc = Checker::new(&ploc);
     let raw: RawPolicy = toml::from_str(&source).map_err(|e| ploc.from_toml(&e))?;
     if raw.part != part_label {
@@ -197,7 +213,10 @@ fn policy(
             ),
         ));
     }
-    compile_rules(&pc, "rules", &raw.rules, obstacles, on_late)
+    let from = compiled.len();
+    compiled.extend(compile_rules(&pc, "rules", &raw.rules, obstacles, on_late)?);
+    check_conflicts(&pc, &compiled, from)?;
+    Ok(compiled)
 }
 
 fn compile_rules(
@@ -316,9 +335,10 @@ fn compile_rules(
     Ok(out)
 }
 
-/// Two rules may not send one pin to two places on the same decision.
-fn check_conflicts(c: &Checker, rules: &[(String, Rule)]) -> R<()> {
-    for (i, (at, r)) in rules.iter().enumerate() {
+/// Two rules may not send one pin to two places on the same decision: each rule from index
+/// `from` on (the rules `c` locates) is checked against every earlier one.
+fn check_conflicts(c: &Checker, rules: &[(String, Rule)], from: usize) -> R<()> {
+    for (i, (at, r)) in rules.iter().enumerate().skip(from) {
         if let Some((_, q)) = rules[..i]
             .iter()
             .find(|(_, q)| q.sensor == r.sensor && q.decides == r.decides && q.pin == r.pin)

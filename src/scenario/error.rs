@@ -11,11 +11,11 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum ScenarioError {
     /// The file could not be read.
-    #[error("{}: cannot read the scenario: {source}", path.display())]
+    /// (The cause is in the message, not a `source`, so that it is printed once.)
+    #[error("{}: cannot read the scenario: {error}", path.display())]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file is not valid TOML, or a key or value is wrong.
     #[error("{0}")]
@@ -70,6 +70,8 @@ pub struct Locator<'a> {
     pub file: &'a Path,
     pub source: &'a str,
     pub doc: SpannedDoc<'a>,
+    /// What the file is, as a missing key's message names it ("the scenario", "a policy file").
+    pub what: &'static str,
 }
 
 impl<'a> Locator<'a> {
@@ -78,6 +80,15 @@ impl<'a> Locator<'a> {
             file,
             source,
             doc: SpannedDoc::parse(source),
+            what: "the scenario",
+        }
+    }
+
+    /// The same, for a file that is not a scenario (`what` names it in messages).
+    pub fn of(file: &'a Path, source: &'a str, what: &'static str) -> Locator<'a> {
+        Locator {
+            what,
+            ..Locator::new(file, source)
         }
     }
 
@@ -134,8 +145,10 @@ impl<'a> Locator<'a> {
         let mut key = self.doc.path_at(&span);
         if let Some(field) = backticked_after(&message, "missing field ") {
             key = key.key(&field);
-            let message = if key.0.len() == 1 {
+            let message = if key.0.len() == 1 && self.what == "the scenario" {
                 format!("{message}: the scenario needs a [{field}] section or `{field} = ...` key")
+            } else if key.0.len() == 1 {
+                format!("{message}: {} needs `{field} = ...`", self.what)
             } else {
                 message
             };

@@ -80,8 +80,19 @@ pub fn contains(r: (f64, f64), v: f64) -> bool {
     v.is_finite() && v >= r.0 && v <= r.1
 }
 
-/// A moving pin's actuator speed limit (m/s).
+/// A moving pin's actuator speed limit (m/s); also at most [`max_pin_speed`] for the belt.
 pub const ACTUATOR_SPEED: (f64, f64) = (1e-6, 1e3);
+
+/// The one rule for how fast a moving pin may move: the contact model follows a pin whose
+/// lateral speed is at most [`crate::mechanics::MAX_LATERAL_SPEED`] belt speeds, so a moving pin's
+/// speed limit (m/s) may be at most that many times `belt_speed` (m/s) as well as within
+/// [`ACTUATOR_SPEED`]. The scenario checker refuses a faster pin; the actuator's pin path never
+/// exceeds the speed limit (see `engine::actuator`), so a valid file keeps the engine's invariant.
+pub fn max_pin_speed(belt_speed: f64) -> f64 {
+    ACTUATOR_SPEED
+        .1
+        .min(crate::mechanics::MAX_LATERAL_SPEED * belt_speed)
+}
 /// A moving pin's actuator acceleration limit (m/s²).
 pub const ACTUATOR_ACCEL: (f64, f64) = (1e-6, 1e6);
 /// Actuator and controller times: settle, raise and lower times, decision latency (s).

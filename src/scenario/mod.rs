@@ -46,9 +46,9 @@ pub fn parse(file: &Path, source: &str) -> Result<Scene, ScenarioError> {
 
 /// Read, parse and compile a scenario file.
 pub fn load(path: &Path) -> Result<Scene, ScenarioError> {
-    let source = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+    let source = crate::input::read_text(path).map_err(|error| ScenarioError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parse(path, &source)
 }

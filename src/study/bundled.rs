@@ -159,8 +159,7 @@ pub fn write(
         if !force && target.exists() {
             return Err(WriteError::Exists(target.clone()));
         }
-        crate::study::mc::atomic::write_atomic(target, b.text.as_bytes(), &mut |_| {})
-            .map_err(io)?;
+        crate::report::atomic::write_atomic(target, b.text.as_bytes()).map_err(io)?;
     }
     Ok(targets)
 }

@@ -116,7 +116,10 @@ pub fn compare(
                 across_m: y_span.map(|[a, b]| b - a + length),
                 belt_width_m: scene.belt.width,
                 throughput_ok_per_min: s.throughput_ok_per_min,
-                latency_mean_s: (!hist.is_empty()).then(|| hist.mean() * 1e-6),
+                latency_mean_s: (!hist.is_empty()).then(|| {
+                    // The histogram's mean is of bucket midpoints: keep it within the range.
+                    (hist.mean() * 1e-6).clamp(r.metrics.latency_min, r.metrics.latency_max)
+                }),
                 latency_p99_s: s.latency_s.map(|l| l.p99),
                 contacts_per_part: s.contacts_per_part,
                 jams: s.outcomes.jam,

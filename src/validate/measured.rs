@@ -88,7 +88,7 @@ impl Measured {
 
 /// Read and check a measured-bands file; `max_pin_radius` (part units) sets the reach of d.
 pub fn load(path: &Path, max_pin_radius: f64) -> Result<Measured, MeasuredError> {
-    let text = std::fs::read_to_string(path).map_err(|e| MeasuredError {
+    let text = crate::input::read_text(path).map_err(|e| MeasuredError {
         file: path.to_path_buf(),
         line: 0,
         field: None,
@@ -221,7 +221,7 @@ fn parse_row(
         part,
         d,
         input,
-        band: Arc::from_ends(min_deg, max_deg),
+        band: Arc::from_measured_ends(min_deg, max_deg),
         min_deg,
         max_deg,
         trials,
@@ -248,7 +248,7 @@ fn parse_input(s: &str, states: usize) -> FieldResult<InputState> {
         if let Some((a, b)) = rest.split_once(':') {
             let (a, b) = (angle("input", a)?, angle("input", b)?);
             return Ok(InputState::Theta {
-                arc: Arc::from_ends(a, b),
+                arc: Arc::from_measured_ends(a, b),
             });
         }
     }

@@ -32,6 +32,7 @@ mod fuzz_cli;
 mod fuzz_files;
 mod geometry;
 mod hard_cases;
+mod hardening;
 mod input_regressions;
 mod invariant_properties;
 mod limit_surface;

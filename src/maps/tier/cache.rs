@@ -25,10 +25,11 @@ pub enum CacheError {
         "map cache file {path} is corrupted or stale ({reason}); it is refused and the map rebuilt"
     )]
     Refused { path: PathBuf, reason: String },
-    #[error("map cache file {path}: {source}")]
+    /// (The cause is in the message, not a `source`, so that it is printed once.)
+    #[error("map cache file {path}: {error}")]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
 }
 
@@ -136,23 +137,24 @@ pub fn shared(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
 
 /// Write `map` to `path` atomically.
 pub fn write(path: &Path, map: &TierMap) -> Result<(), CacheError> {
-    let io = |source| CacheError::Io {
+    let io = |error| CacheError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     };
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(io)?;
     }
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&tmp, encode(map)).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    // Whole or not at all; a failed write leaves no temporary file behind.
+    crate::report::atomic::write_atomic(path, encode(map)).map_err(io)
 }
 
 /// Read the map with key `key` from `path`, refusing anything that does not check out.
 pub fn read(path: &Path, key: &TierKey) -> Result<TierMap, CacheError> {
-    let bytes = std::fs::read(path).map_err(|source| CacheError::Io {
-        path: path.to_path_buf(),
-        source,
+    let bytes = crate::input::read_bounded(path, crate::input::MAP_CAP).map_err(|error| {
+        CacheError::Io {
+            path: path.to_path_buf(),
+            error,
+        }
     })?;
     decode(&bytes, key).map_err(|reason| CacheError::Refused {
         path: path.to_path_buf(),

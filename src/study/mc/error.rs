@@ -9,11 +9,11 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum StudyError {
     /// The study file could not be read.
-    #[error("{}: cannot read the study: {source}", path.display())]
+    /// (The cause is in the message, not a `source`, so that it is printed once.)
+    #[error("{}: cannot read the study: {error}", path.display())]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A located problem in the study file (file:line:column, key, what is allowed).
     #[error("{0}")]

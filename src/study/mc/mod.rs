@@ -23,7 +23,7 @@
 //! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report;
 //! * [`atomic`]: files written by rename; [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
 
-pub mod atomic;
+pub use crate::report::atomic;
 pub mod compile;
 pub use crate::random::distribution;
 pub mod error;
@@ -88,16 +88,16 @@ impl Study {
 
 /// Read and validate a study file; `samples` overrides the file's samples per point.
 pub fn load(path: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
-    let source = std::fs::read_to_string(path).map_err(|source| StudyError::Io {
+    let source = crate::input::read_text(path).map_err(|error| StudyError::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parse(path, &source, samples)
 }
 
 /// Validate study text; `file` locates errors and resolves the scenario path.
 pub fn parse(file: &Path, source: &str, samples: Option<u64>) -> Result<Study, StudyError> {
-    parse_with(file, source, samples, &|p| std::fs::read_to_string(p))
+    parse_with(file, source, samples, &|p| crate::input::read_text(p))
 }
 
 /// [`parse`], reading the scenario the study names through `read` (given the path resolved
@@ -165,13 +165,30 @@ pub fn parse_with(
         compile::compile_points(&loc, &raw.uncertain, &axes, scene.part.support)?
     };
     let samples_text = samples.to_string();
-    let study_hash = hash::fnv1a(&[
+    // The policy file the scenario names shapes every sample: its bytes are hashed too (a study
+    // without one hashes what it did before policies existed).
+    let policy_text = match scene.controller.as_ref().filter(|c| c.source != "scenario") {
+        Some(c) => crate::input::read_text(Path::new(&c.source)).map_err(|e| {
+            at(
+                "scenario",
+                format!("cannot read the policy file {} ({e})", c.source),
+            )
+        })?,
+        None => String::new(),
+    };
+    let mut parts: Vec<&[u8]> = vec![
         b"pinfeed-mc-study",
         source.as_bytes(),
         scenario_text.as_bytes(),
         samples_text.as_bytes(),
-    ]);
-    let scenario_hash = hash::fnv1a(&[scenario_text.as_bytes()]);
+    ];
+    let mut scenario_parts: Vec<&[u8]> = vec![scenario_text.as_bytes()];
+    if !policy_text.is_empty() {
+        parts.push(policy_text.as_bytes());
+        scenario_parts.push(policy_text.as_bytes());
+    }
+    let study_hash = hash::fnv1a(&parts);
+    let scenario_hash = hash::fnv1a(&scenario_parts);
     Ok(Study {
         name,
         file: file.to_path_buf(),

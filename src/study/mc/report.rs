@@ -204,13 +204,9 @@ fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
     }
     let h = &t.latency_us;
     let latency = (!h.is_empty()).then(|| {
-        let q = |p: f64| h.value_at_quantile(p) as f64 * 1e-6;
-        Latency {
-            p50: q(0.5),
-            p90: q(0.9),
-            p99: q(0.99),
-            max: h.max() as f64 * 1e-6,
-        }
+        let max = h.max() as f64 * 1e-6;
+        let [p50, p90, p99] = crate::statistics::latency_percentiles(h, h.min() as f64 * 1e-6, max);
+        Latency { p50, p90, p99, max }
     });
     let success = shares["success"];
     PointReport {

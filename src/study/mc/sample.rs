@@ -221,7 +221,29 @@ fn draw_sensor_values(
                     .iter()
                     .all(|s| set(v).apply(&s.settings).validate().is_ok())
         };
-        draw_value(d, rng, name, ok, redraws)
+        draw_value(d, rng, name, ok, redraws).map_err(|e| {
+            // Say which range the values left: the study's domain, or a sensor's own setting.
+            let (domain, unit) = super::compile::domain(name);
+            let why = d.as_ref().and_then(|d| {
+                let (lo, hi) = d.range();
+                [lo, hi].into_iter().find_map(|v| {
+                    if !super::compile::in_domain(name, v) {
+                        return Some(format!(
+                            "{name} must lie in {} ({unit}), it reaches {v}",
+                            crate::scenario::limits::show(domain)
+                        ));
+                    }
+                    sensors.iter().find_map(|s| {
+                        let err = set(v).apply(&s.settings).validate().err()?;
+                        Some(format!("at {name} = {v} the sensor's {err}"))
+                    })
+                })
+            });
+            match why {
+                Some(w) => format!("{e}: {w}"),
+                None => e,
+            }
+        })
     };
     Ok(SensorDraw {
         noise: pick(&p.sensor_noise, &mut st.sensor_noise, "sensor_noise", |v| {

@@ -152,6 +152,11 @@ pub struct ShardFile {
     /// Global sample range [start, end).
     pub samples: [u64; 2],
     pub points: Vec<ShardPoint>,
+    /// FNV-1a of the file's content with this field empty ([`ShardFile::content_checksum`]):
+    /// `merge` refuses a shard whose content was edited or damaged. Not cryptographic: it catches
+    /// hand edits and corruption, not a forger who recomputes it.
+    #[serde(default)]
+    pub checksum: String,
 }
 
 impl ShardFile {
@@ -195,7 +200,25 @@ impl ShardFile {
             },
             samples: [range.start, range.end],
             points,
+            checksum: String::new(),
         }
+        .sealed()
+    }
+
+    /// The checksum of the file's content: its JSON with `checksum` empty.
+    pub fn content_checksum(&self) -> String {
+        let bare = ShardFile {
+            checksum: String::new(),
+            ..self.clone()
+        };
+        let json = serde_json::to_string(&bare).expect("a shard serialises");
+        super::hash::hex(super::hash::fnv1a(&[b"pinfeed-mc-shard", json.as_bytes()]))
+    }
+
+    /// The same file with its checksum set.
+    fn sealed(mut self) -> ShardFile {
+        self.checksum = self.content_checksum();
+        self
     }
 }
 
@@ -257,7 +280,7 @@ impl ShardPoint {
 
 /// Read a shard file.
 pub fn read(path: &Path) -> Result<ShardFile, StudyError> {
-    let text = std::fs::read_to_string(path)
+    let text = crate::input::read_text(path)
         .map_err(|e| StudyError::Shard(format!("{}: cannot read: {e}", path.display())))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
         StudyError::Shard(format!(
@@ -279,8 +302,70 @@ pub fn read(path: &Path) -> Result<ShardFile, StudyError> {
             v.map_or("missing".to_string(), |v| v.to_string())
         )));
     }
-    serde_json::from_value(value)
-        .map_err(|e| StudyError::Shard(format!("{}: malformed shard file: {e}", path.display())))
+    let file: ShardFile = serde_json::from_value(value)
+        .map_err(|e| StudyError::Shard(format!("{}: malformed shard file: {e}", path.display())))?;
+    let expected = file.content_checksum();
+    if file.checksum != expected {
+        return Err(StudyError::Shard(format!(
+            "{}: field `checksum` is {:?} but the content gives {expected}: the shard was edited or damaged after it was written (rerun it: {})",
+            path.display(),
+            file.checksum,
+            rerun_command(&file.header, file.shard.index, file.shard.count, path)
+        )));
+    }
+    Ok(file)
+}
+
+/// The command that rewrites shard `k` of `n` of the study into the folder of `path`.
+fn rerun_command(h: &StudyHeader, k: u64, n: u64, path: &Path) -> String {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    format!(
+        "pinfeed mc {} --samples {} --shard {k}/{n} --out {} --quiet",
+        h.study_file,
+        h.samples_per_point,
+        dir.display()
+    )
+}
+
+/// What to run when shards are missing: each missing shard of `n` (by the indices the given
+/// files do not hold) as a `--shard K/N` command, and the Slurm `--array=` list of them.
+fn missing_shards_help(h: &StudyHeader, files: &[(PathBuf, ShardFile)], total: u64) -> String {
+    let (first_path, first) = &files[0];
+    let n = first.shard.count;
+    let have: std::collections::BTreeSet<u64> = files
+        .iter()
+        .filter(|(_, f)| f.shard.count == n)
+        .map(|(_, f)| f.shard.index)
+        .collect();
+    let missing: Vec<u64> = (0..n)
+        .filter(|k| !have.contains(k))
+        .filter(|&k| {
+            let r = ShardSpec { index: k, count: n }.range(total);
+            r.start < r.end
+        })
+        .collect();
+    if missing.is_empty() {
+        return String::new();
+    }
+    let mut s = format!("\nrerun only the missing shards of {n}:\n");
+    for &k in &missing {
+        s += &format!("  {}\n", rerun_command(h, k, n, first_path));
+    }
+    let list: Vec<String> = missing.iter().map(u64::to_string).collect();
+    // The array's task ids are the shard indices themselves (`--shard /N` would subtract
+    // SLURM_ARRAY_TASK_MIN and run shard 0).
+    let each = rerun_command(h, 0, n, first_path).replace(
+        &format!("--shard 0/{n}"),
+        &format!("--shard \\$SLURM_ARRAY_TASK_ID/{n}"),
+    );
+    s += &format!(
+        "or as one Slurm array job:\n  sbatch --array={} --wrap \"{each}\"",
+        list.join(",")
+    );
+    s
 }
 
 /// Check that the shards fit together and add them: the common header and each point's tally.
@@ -294,6 +379,21 @@ pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTa
     for (path, f) in &files[1..] {
         let h = &f.header;
         let p = path.display();
+        for (field, a, b, why) in [
+            (
+                "scenario_hash",
+                &h.scenario_hash,
+                &h0.scenario_hash,
+                ": they ran different scenarios or policy files",
+            ),
+            ("fidelity", &h.fidelity, &h0.fidelity, ""),
+        ] {
+            if a != b {
+                return bad(format!(
+                    "{p} and {p0} differ in field `{field}` ({a} vs {b}){why}"
+                ));
+            }
+        }
         if h.pinfeed_version != h0.pinfeed_version {
             return bad(format!(
                 "{p} was written by pinfeed {} but {p0} by pinfeed {}: shards must come from the same version",
@@ -338,7 +438,8 @@ pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTa
         }
         if a > covered {
             return bad(format!(
-                "samples [{covered}, {a}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?)"
+                "samples [{covered}, {a}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?){}",
+                missing_shards_help(h0, files, total)
             ));
         }
         covered = b;
@@ -346,7 +447,8 @@ pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTa
     }
     if covered < total {
         return bad(format!(
-            "samples [{covered}, {total}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?)"
+            "samples [{covered}, {total}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?){}",
+            missing_shards_help(h0, files, total)
         ));
     }
     let mut tallies: Vec<PointTally> = (0..h0.points.len())
