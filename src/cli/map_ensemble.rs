@@ -2,7 +2,7 @@
 //! member passes at every (d, θ0 on the grid); per d and input state (all θ0, and each stable
 //! state) the pooled θf give the predicted bands (smallest arcs holding 90%) and the share of the
 //! circle they cover. Standard output gets the band table; unless `--no-write`, the report directory
-//! (`results/maps/<part>/ensemble/` by default) receives `README.md` headed by the regenerating
+//! (`pinfeed-out/maps/<part>/ensemble/` by default) receives `README.md` headed by the regenerating
 //! command, `ensemble.json` and one figure per input state (`ensemble_all.svg`,
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 

@@ -18,6 +18,8 @@ pub mod plot_sensing;
 pub mod plot_sensitivity;
 pub mod plot_survey;
 pub mod plot_validate;
+pub mod stale;
+pub mod versioned;
 
 /// `x` with `decimals` decimals (`plus`: with its sign always), never as a negative zero: a value
 /// that rounds to zero is printed as 0 (`-0.000` from a −0.0 or a −1e-17 says nothing).
@@ -50,4 +52,13 @@ mod fixed_tests {
         assert_eq!(fixed(-0.25, 2, false), "-0.25");
         assert_eq!(fixed(1.5, 1, true), "+1.5");
     }
+}
+
+/// Create the folder `path` goes into (if it has one), naming it on failure.
+pub fn create_parent(path: &std::path::Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+    }
+    Ok(())
 }
