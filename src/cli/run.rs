@@ -28,7 +28,8 @@ pub struct RunArgs {
     /// Print the summary as JSON instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Folder for results (default: <the scenario's [output] dir>/<scenario name>, with dir "pinfeed-out/runs" unless the scenario sets it).
+    /// Folder under which <scenario name>/ is written (default: the scenario's [output] dir, else
+    /// pinfeed-out/runs).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// No table and no progress bar.
