@@ -63,6 +63,17 @@ pub struct ContactArgs {
         requires = "pin_speed"
     )]
     pub pin_stop: Option<f64>,
+    /// Where the moving pin stops, instead of when: it moves at `--pin-speed` from its start at
+    /// offset d until it stands at lateral offset Y (units of a, the frame of `--d`), i.e. after
+    /// `--pin-stop-after (Y − d)/w` of belt travel. Not with `--cases` (d differs per row).
+    #[arg(
+        long = "pin-stop-at",
+        value_name = "Y",
+        allow_hyphen_values = true,
+        requires = "pin_speed",
+        conflicts_with_all = ["pin_stop", "cases"]
+    )]
+    pub pin_stop_at: Option<f64>,
     /// Support: uniform or tripod:SEED.
     #[arg(long, default_value = "uniform")]
     pub support: String,
@@ -518,20 +529,41 @@ pub(crate) fn parse_model(s: &str) -> Result<Fidelity> {
 
 /// The single case the arguments describe, with fidelity `model`.
 pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
+    let d = args.d.unwrap_or(0.0);
+    let pin_stop = match args.pin_stop_at {
+        Some(y) => Some(stop_travel(y, d, args.pin_speed)?),
+        None => args.pin_stop,
+    };
     Ok(Case {
         part: args.part.clone().unwrap_or_default(),
         theta0_deg: args.theta0.unwrap_or(0.0),
-        d: args.d.unwrap_or(0.0),
+        d,
         mu_c: args.mu_c,
         mu_s: args.mu_s,
         model,
         pin_radius: args.pin_radius,
         pin_speed: args.pin_speed,
-        pin_stop: args.pin_stop,
+        pin_stop,
         support: args.support.clone(),
         tol: args.tol,
         fence: args.fence.as_deref().map(parse_fence).transpose()?,
     })
+}
+
+/// The belt travel (units of a) after which a pin starting at lateral offset `d` and moving at
+/// `w` (lateral per unit of travel) stands at offset `y`: (y − d)/w, in `--pin-stop-after`'s range.
+fn stop_travel(y: f64, d: f64, w: f64) -> Result<f64> {
+    let s = (y - d) / w;
+    if !(y.is_finite() && s.is_finite() && (1e-9..=1e3).contains(&s)) {
+        bail!(
+            "--pin-stop-at {}: a pin starting at d = {} and moving {} per unit of travel reaches it after {} units of a; that must lie in [1e-9, 1000] (Y on the side the pin moves to, within 1000·|w| of d)",
+            num(y),
+            num(d),
+            num(w),
+            num(s)
+        );
+    }
+    Ok(s)
 }
 
 pub fn run(args: &ContactArgs) -> Result<()> {

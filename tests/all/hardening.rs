@@ -687,3 +687,32 @@ fn a_measured_band_from_0_to_360_is_the_whole_circle() {
     // A narrower band is still the arc it says.
     assert!(!Arc::from_measured_ends(0.0, 90.0).contains_angle(180.0));
 }
+
+/// Item 8: `--pin-stop-after` counts travel from the pin's start 1.01·a before the part, so a
+/// user could not say where the pin stops; `--pin-stop-at Y` stops it at lateral offset Y, the
+/// same push as `--pin-stop-after (Y − d)/w`, and a Y the pin never reaches is refused.
+#[test]
+fn pin_stop_at_says_where_the_pin_stops() {
+    let base = [
+        "--part",
+        "tripoly1",
+        "--theta0",
+        "30",
+        "--d=-0.1",
+        "--pin-speed",
+        "0.4",
+    ];
+    let at = contact_json(&[&base[..], &["--pin-stop-at", "0"]].concat());
+    let after = contact_json(&[&base[..], &["--pin-stop-after", "0.25"]].concat());
+    assert!(
+        (at["pin_stop"].as_f64().unwrap() - 0.25).abs() < 1e-12,
+        "{at}"
+    );
+    assert_eq!(at["rotation_deg"], after["rotation_deg"]);
+    let o = pinfeed(&[&["contact"][..], &base[..], &["--pin-stop-at=-0.3"]].concat());
+    let e = refused(&o, "a stop behind the pin");
+    assert!(
+        e.contains("--pin-stop-at -0.3") && e.contains("[1e-9, 1000]"),
+        "{e}"
+    );
+}
