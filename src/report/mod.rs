@@ -41,6 +41,15 @@ pub fn fixed(x: f64, decimals: usize, plus: bool) -> String {
     }
 }
 
+/// Create the folder `path` goes into (if it has one), naming it on failure.
+pub fn create_parent(path: &std::path::Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod fixed_tests {
     #[test]
@@ -52,13 +61,4 @@ mod fixed_tests {
         assert_eq!(fixed(-0.25, 2, false), "-0.25");
         assert_eq!(fixed(1.5, 1, true), "+1.5");
     }
-}
-
-/// Create the folder `path` goes into (if it has one), naming it on failure.
-pub fn create_parent(path: &std::path::Path) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
-    }
-    Ok(())
 }
