@@ -31,7 +31,7 @@ TIMEOUT=${TIMEOUT:-900}
 STATE=${STATE:-/tmp/pinfeed-slurm-e2e}
 KEEP=${KEEP:-0}
 study=studies/quickstart_shape_tolerance.toml
-report_dir=results/mc/quickstart-shape-tolerance
+report_dir=pinfeed-out/mc/quickstart-shape-tolerance
 
 say() { printf '== %s\n' "$*"; }
 die() {
@@ -210,9 +210,11 @@ nshards=$(ls "$work"/shards/shard-*-of-0008.json | wc -l)
 [ "$nshards" = 8 ] || die "expected 8 shard files, found $nshards"
 
 say "unsharded run"
-(cd "$work" && pinfeed mc "$study" --samples "$SAMPLES" --out full --quiet)
+# Into the same default folder (a report's command names its folder), the merged one moved aside.
+mv "$work/$report_dir" "$work/merged"
+(cd "$work" && pinfeed mc "$study" --samples "$SAMPLES" --quiet)
 for f in report.md report.json sensitivity.svg; do
-    cmp "$work/full/$f" "$work/$report_dir/$f" ||
+    cmp "$work/merged/$f" "$work/$report_dir/$f" ||
         die "$f: the merged report differs from the unsharded run ($work)"
 done
 say "merged report == unsharded report, byte for byte (report.md, report.json, sensitivity.svg)"

@@ -27,3 +27,25 @@ pub mod sensing;
 pub mod statistics;
 pub mod study;
 pub mod validate;
+
+/// The version of the layout of every JSON document pinfeed prints (`--json`) or writes
+/// (`summary.json`, `report.json`, `map.json`, …), stored in each as `"schema_version"`; it grows
+/// when a field is removed, renamed or changes meaning (docs/outputs.md).
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// The version of pinfeed that produced a JSON document, stored in each as `"pinfeed_version"`.
+pub const PINFEED_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The folder under which every command writes by default (`pinfeed-out/runs/<scenario>/`,
+/// `pinfeed-out/mc/<study>/`, …): relative to the working folder, and ignored by git in the
+/// repository. An explicit `--out` (or a scenario's `[output] dir`) is used exactly as given.
+pub const DEFAULT_OUT_ROOT: &str = "pinfeed-out";
+
+/// `pinfeed-out/<parts…>`: a command's default output folder.
+pub fn default_out(parts: &[&str]) -> std::path::PathBuf {
+    let mut p = std::path::PathBuf::from(DEFAULT_OUT_ROOT);
+    for s in parts {
+        p.push(s);
+    }
+    p
+}

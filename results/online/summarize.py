@@ -220,6 +220,8 @@ def main():
     line = load("line")
     timing = load("timing")
     comp = json.load(open(os.path.join(HERE, "compare.json")))
+    if isinstance(comp, dict):  # `compare --json`: the version fields and the rows as "designs"
+        comp = comp["designs"]
     t_line = load("line_time")["line_wall_s"]
     t_total = load("total_time")["total_wall_s"]
     nd = load("noise_defaults")

@@ -15,7 +15,7 @@ pub struct BenchArgs {
 #[derive(Debug, Subcommand)]
 pub enum BenchWhat {
     /// What accuracy costs in time: every fidelity tier against a tight exact reference; writes
-    /// results/accuracy-vs-time.{md,csv,svg}.
+    /// OUT.{md,csv,svg} (the committed report: --out results/accuracy-vs-time).
     Accuracy {
         /// Random contacts (split evenly over tripoly1, tripoly2, square, lshape).
         #[arg(long, default_value_t = 1200)]
@@ -23,11 +23,11 @@ pub enum BenchWhat {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Output path without extension.
-        #[arg(long, default_value = "results/accuracy-vs-time")]
+        #[arg(long, default_value = "pinfeed-out/accuracy-vs-time")]
         out: PathBuf,
     },
     /// Monte Carlo precision against samples and wall time (and 1- vs 2-thread efficiency) for a
-    /// study; writes a marked section of results/accuracy-vs-time.md.
+    /// study; writes a marked section of --out (the committed report: results/accuracy-vs-time.md).
     McPrecision {
         /// A study without sweeps.
         #[arg(long, default_value = "studies/quickstart_mu_tripod.toml")]
@@ -43,11 +43,11 @@ pub enum BenchWhat {
         #[arg(long, default_value_t = 3)]
         repeats: usize,
         /// The Markdown file that receives the section.
-        #[arg(long, default_value = "results/accuracy-vs-time.md")]
+        #[arg(long, default_value = "pinfeed-out/accuracy-vs-time.md")]
         out: PathBuf,
     },
     /// Time, evaluations and self-accuracy per contact for each fidelity on the reference parts;
-    /// writes results/contact-model.md.
+    /// writes --out (the committed report: results/contact-model.md).
     Contact {
         /// Random contacts per (part, fidelity).
         #[arg(long, default_value_t = 400)]
@@ -58,7 +58,7 @@ pub enum BenchWhat {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Output Markdown file.
-        #[arg(long, default_value = "results/contact-model.md")]
+        #[arg(long, default_value = "pinfeed-out/contact-model.md")]
         out: PathBuf,
     },
     /// Designs for many parts: each mode alone and all modes together, every verdict from the
@@ -92,20 +92,20 @@ pub enum BenchWhat {
         out: PathBuf,
     },
     /// Wall time of the 18 thesis configuration maps (d = ±0.1 … ±0.9, 360 θ0 each) per part,
-    /// model and thread count; writes results/maps/timing.md.
+    /// model and thread count; writes --out (the committed report: results/maps/timing.md).
     Maps {
         /// Timed repeats per row (after one warm-up).
         #[arg(long, default_value_t = 5)]
         repeats: usize,
         /// Output Markdown file.
-        #[arg(long, default_value = "results/maps/timing.md")]
+        #[arg(long, default_value = "pinfeed-out/maps-timing.md")]
         out: PathBuf,
     },
     /// The certified map tier against the exact model: per contact (a section of
     /// results/accuracy-vs-time.md) and on the line (a section of results/line-speed.md).
     MapTier(super::bench_map_tier::MapTierArgs),
     /// What the line adds to its contacts: each scenario's run against the same pushes as a bare
-    /// batch; writes a section of results/line-speed.md.
+    /// batch; writes a section of --out (the committed report: results/line-speed.md).
     Line(super::bench_line::LineArgs),
 }
 

@@ -22,7 +22,7 @@ pub struct LineArgs {
     /// Alternating repeats of the line and the batches (the minimum of each is reported).
     #[arg(long, default_value_t = 3)]
     pub reps: usize,
-    #[arg(long, default_value = "results/line-speed.md")]
+    #[arg(long, default_value = "pinfeed-out/line-speed.md")]
     pub out: PathBuf,
 }
 
@@ -61,6 +61,7 @@ pub fn run(a: &LineArgs) -> Result<()> {
         a.out.display()
     );
     let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, &cmd), MARKERS.1);
+    crate::report::create_parent(&a.out)?;
     let old = std::fs::read_to_string(&a.out).unwrap_or_default();
     crate::report::atomic::write_atomic(&a.out, splice_between(&old, &marked, MARKERS))
         .with_context(|| format!("writing {}", a.out.display()))?;

@@ -24,13 +24,14 @@ pub struct MapTierArgs {
     /// Parts of the line runs.
     #[arg(long, default_value_t = 10_000)]
     pub line_parts: u64,
-    #[arg(long, default_value = "results/accuracy-vs-time.md")]
+    #[arg(long, default_value = "pinfeed-out/accuracy-vs-time.md")]
     pub accuracy_out: PathBuf,
-    #[arg(long, default_value = "results/line-speed.md")]
+    #[arg(long, default_value = "pinfeed-out/line-speed.md")]
     pub line_out: PathBuf,
 }
 
 fn write_section(path: &Path, section: &str) -> Result<()> {
+    crate::report::create_parent(path)?;
     let old = std::fs::read_to_string(path).unwrap_or_default();
     crate::report::atomic::write_atomic(path, splice(&old, &marked(section)))
         .with_context(|| format!("writing {}", path.display()))?;

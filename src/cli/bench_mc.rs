@@ -87,6 +87,7 @@ pub fn run(study_file: &Path, counts: &[u64], repeats: usize, out: &Path) -> Res
             load_after,
         },
     );
+    crate::report::create_parent(out)?;
     let doc = std::fs::read_to_string(out).unwrap_or_default();
     crate::report::atomic::write_atomic(out, precision::splice(&doc, &section))
         .with_context(|| format!("writing {}", out.display()))?;

@@ -4,7 +4,7 @@
 //! model and the fitted ensemble on the same rows with `validate`'s scorer (fresh ensembles, the
 //! same seed). With `--synthesize` the file is first written: the bundled synthetic data set drawn
 //! from hidden parameters ([`crate::validate::synthetic`]), and the report says whether each
-//! interval holds the hidden value. Unless `--no-write`, `results/calibrate/<file stem>/` receives
+//! interval holds the hidden value. Unless `--no-write`, `pinfeed-out/calibrate/<file stem>/` receives
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
 use super::shell_word;
@@ -28,7 +28,7 @@ pub struct CalibrateArgs {
     /// The measured-bands file (CSV; docs/commands.md#validating-against-measurements-pinfeed-validate-pinfeed-calibrate).
     pub measured: PathBuf,
     /// First write the bundled synthetic data set (hidden parameters, seed 16) to MEASURED.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "part")]
     pub synthesize: bool,
     /// Members of the proposal ensemble.
     #[arg(long, default_value_t = 2000)]
@@ -166,7 +166,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     } else {
         None
     };
-    let measured = load_measured(&args.measured, &s.proposal())?;
+    let measured = load_measured(&args.measured, &s.proposal(), args.common.part.as_deref())?;
     let pool = pool(c.threads)?;
     let started = std::time::Instant::now();
     let cal = pool

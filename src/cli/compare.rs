@@ -105,7 +105,12 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     let rows = compare(&scenes, &files, parts).context("running the comparison")?;
     let text = if args.json {
-        serde_json::to_string_pretty(&rows)? + "\n"
+        // One document: the version fields and the rows, one per design.
+        #[derive(serde::Serialize)]
+        struct Designs<'a, T: serde::Serialize> {
+            designs: &'a T,
+        }
+        crate::report::versioned::pretty(&Designs { designs: &rows })?
     } else {
         let feed = feed_line(&files[0], &source, parts);
         if args.markdown {

@@ -586,7 +586,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     }
     let r = report(&c, &out);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        print!("{}", crate::report::versioned::pretty(&r)?);
     } else {
         println!(
             "part {}  model {}  θ0 {}°  d {}  μc {}",

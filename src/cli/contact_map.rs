@@ -112,7 +112,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             "source": describe(&loaded),
             "query_s": query_s,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        print!("{}", crate::report::versioned::pretty(&v)?);
         return Ok(());
     }
     println!(

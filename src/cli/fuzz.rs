@@ -1,7 +1,7 @@
 //! `pinfeed fuzz TARGET`: the long-running fuzzing driver (docs/commands.md#fuzzing-and-robustness-pinfeed-fuzz;
 //! [`crate::study::robustness`]). It generates and mutates scenario and study files, random
 //! contacts and random polygons, runs each case in-process under `catch_unwind` with a per-case
-//! time budget, and writes the counts to a Markdown report (default results/robustness.md) headed
+//! time budget, and writes the counts to a Markdown report (default pinfeed-out/robustness.md; the committed report: --report results/robustness.md) headed
 //! by the command that regenerates it. `--case N` re-runs one case and prints its input.
 
 use crate::study::robustness::{self, Class, Corpus, Options, Target};
@@ -43,7 +43,7 @@ pub struct FuzzArgs {
     #[arg(long, default_value_t = 60.0)]
     pub budget: f64,
     /// The report file.
-    #[arg(long, default_value = "results/robustness.md")]
+    #[arg(long, default_value = "pinfeed-out/robustness.md")]
     pub report: PathBuf,
     /// The project root, where scenarios/, studies/ and tests/fixtures/ are read.
     #[arg(long, default_value = ".")]

@@ -1,11 +1,11 @@
 //! `pinfeed map`: configuration maps θ0 → θf for a list of contact parameters d (docs/physics.md#configuration-maps, thesis
-//! chapter 3), their bands, and the figures and report files under `results/maps/<part>/`.
+//! chapter 3), their bands, and the figures and report files under `pinfeed-out/maps/<part>/`.
 //!
 //! Each map samples θ0 over [0°, 360°) with the start convention of `pinfeed contact`
 //! ([`crate::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
 //! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`super::contact::case_fence`]);
 //! a fence map has no contact parameter, so `--d` is not taken, and its report goes to
-//! `results/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
+//! `pinfeed-out/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
 //! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
 //! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
@@ -82,7 +82,7 @@ pub struct MapArgs {
     /// Print the samples as CSV.
     #[arg(long)]
     pub csv: bool,
-    /// Report directory (README.md, map.json, samples.csv, figures) [default: results/maps/<part>].
+    /// Report directory (README.md, map.json, samples.csv, figures) [default: pinfeed-out/maps/<part>].
     #[arg(long, value_name = "DIR")]
     pub out_dir: Option<PathBuf>,
     /// Directory for the SVG figures [default: the report directory].
@@ -181,7 +181,7 @@ pub fn command_line(args: &MapArgs) -> String {
     words.join(" ")
 }
 
-/// The default report directory of a map command: `results/maps/<part>` (a vertex list is
+/// The default report directory of a map command: `pinfeed-out/maps/<part>` (a vertex list is
 /// `custom`), and below it `fence_<angle>[_<length>]` for a fence map.
 pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
     let dir = default_out_dir(&args.part);
@@ -199,11 +199,9 @@ pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
     }
 }
 
-/// The default report directory of a part: `results/maps/<part>` (a vertex list is `custom`).
+/// The default report directory of a part: `pinfeed-out/maps/<part>` (a vertex list is `custom`).
 pub fn default_out_dir(part: &str) -> PathBuf {
-    Path::new("results")
-        .join("maps")
-        .join(super::part_folder(part))
+    crate::default_out(&["maps", &super::part_folder(part)])
 }
 
 /// The angle of a fence map as the user gave it (degrees; 0 for pin maps).
@@ -393,7 +391,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         maps: &maps,
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        print!("{}", crate::report::versioned::pretty(&report)?);
     } else if args.csv {
         write_csv(std::io::stdout().lock(), &maps)?;
     } else {
@@ -452,7 +450,7 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
     }
     let json_path = out_dir.join("map.json");
     // Compact: the document holds every sample (README.md is the readable summary).
-    crate::report::atomic::write_atomic(&json_path, serde_json::to_string(report)? + "\n")
+    crate::report::atomic::write_atomic(&json_path, crate::report::versioned::compact(report)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     let csv_path = out_dir.join("samples.csv");
     crate::report::atomic::produce_atomic(&csv_path, |tmp| {
@@ -567,7 +565,23 @@ fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> 
     let readme = out_dir.join("README.md");
     crate::report::atomic::write_atomic(&readme, md)
         .with_context(|| format!("writing {}", readme.display()))?;
+    // The folder holds this run's figures only: a figure of an earlier run for a d not asked
+    // for now goes.
+    let written: Vec<String> = figures
+        .iter()
+        .filter_map(|(_, p)| p.file_name().map(|f| f.to_string_lossy().into_owned()))
+        .collect();
+    crate::report::stale::remove_stale(plot_dir, &written, is_map_figure)
+        .with_context(|| format!("removing earlier figures from {}", plot_dir.display()))?;
     Ok(())
+}
+
+/// The names of the figures `pinfeed map` writes.
+fn is_map_figure(name: &str) -> bool {
+    name.ends_with(".svg")
+        && (name.starts_with("map_d")
+            || name == "map_fence.svg"
+            || name.starts_with("band_intervals"))
 }
 
 #[cfg(test)]
@@ -628,15 +642,15 @@ mod tests {
     fn default_report_directory_is_per_part() {
         assert_eq!(
             default_out_dir("tripoly1"),
-            Path::new("results/maps/tripoly1")
+            Path::new("pinfeed-out/maps/tripoly1")
         );
         assert_eq!(
             default_out_dir("rect:2:1"),
-            Path::new("results/maps/rect_2_1")
+            Path::new("pinfeed-out/maps/rect_2_1")
         );
         assert_eq!(
             default_out_dir("vertices:0,0 1,0 0,1"),
-            Path::new("results/maps/custom")
+            Path::new("pinfeed-out/maps/custom")
         );
     }
 }

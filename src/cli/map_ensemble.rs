@@ -2,7 +2,7 @@
 //! member passes at every (d, θ0 on the grid); per d and input state (all θ0, and each stable
 //! state) the pooled θf give the predicted bands (smallest arcs holding 90%) and the share of the
 //! circle they cover. Standard output gets the band table; unless `--no-write`, the report directory
-//! (`results/maps/<part>/ensemble/` by default) receives `README.md` headed by the regenerating
+//! (`pinfeed-out/maps/<part>/ensemble/` by default) receives `README.md` headed by the regenerating
 //! command, `ensemble.json` and one figure per input state (`ensemble_all.svg`,
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
@@ -11,7 +11,7 @@ use super::shell_word;
 use super::validate::{write_report_files, ReportHead};
 use crate::geometry::Polygon;
 use crate::maps::ensemble::{
-    ensemble_maps, stable_states_deg, EnsembleSpec, InputState, MemberDraw, PredictedBands,
+    ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState, MemberDraw, PredictedBands,
 };
 use crate::maps::theta_grid;
 use crate::mechanics::Fidelity;
@@ -105,9 +105,34 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
     }
     let pool = super::validate::pool(args.threads)?;
     let started = std::time::Instant::now();
+    // Progress on a terminal (indicatif draws nothing when stderr is not one).
+    let bar = if args.json || args.csv {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let b = indicatif::ProgressBar::with_draw_target(
+            Some(passes as u64),
+            indicatif::ProgressDrawTarget::stderr(),
+        );
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} passes  eta {eta}")
+                .expect("valid progress template"),
+        );
+        b
+    };
     let maps = pool
-        .install(|| ensemble_maps(poly, &spec, &args.d, &grid, args.seed, args.members))
+        .install(|| {
+            ensemble_maps_observed(
+                poly,
+                &spec,
+                &args.d,
+                &grid,
+                args.seed,
+                args.members,
+                &|| bar.inc(1),
+            )
+        })
         .map_err(anyhow::Error::msg)?;
+    bar.finish_and_clear();
     eprintln!(
         "computed {} members × {} d × {} θ0 = {passes} passes ({}) in {:.3} s on {} threads",
         args.members,

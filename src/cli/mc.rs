@@ -1,8 +1,8 @@
 //! `pinfeed mc STUDY.toml`: a Monte Carlo robustness study (docs/study-format.md). Without
 //! `--shard` it runs every sample and writes `report.md`, `report.json` and `sensitivity.svg` to
-//! `<out>` (default `results/mc/<study name>/`), printing the table (or the JSON with `--json`).
+//! `<out>` (default `pinfeed-out/mc/<study name>/`), printing the table (or the JSON with `--json`).
 //! With `--shard K/N` it runs one contiguous share of the samples and writes only a shard file
-//! (`<out>/shard-K-of-N.json`, default `<out>` = `results/mc/<study name>/shards/`) for
+//! (`<out>/shard-K-of-N.json`, default `<out>` = `pinfeed-out/mc/<study name>/shards/`) for
 //! `pinfeed merge`.
 
 use crate::report::atomic::Batch;
@@ -45,7 +45,7 @@ pub struct McArgs {
 
 /// The default report folder of a study.
 pub fn default_dir(study_name: &str) -> PathBuf {
-    PathBuf::from("results").join("mc").join(study_name)
+    crate::default_out(&["mc", study_name])
 }
 
 fn progress(total: u64, quiet: bool) -> ProgressBar {
@@ -118,13 +118,24 @@ pub fn run(args: &McArgs) -> Result<()> {
     let tallies: Vec<_> = (0..study.points.len())
         .map(|j| tallies.get(&j).cloned().unwrap_or_default())
         .collect();
-    let r = report::build(&header, &tallies);
     let dir = args.out.clone().unwrap_or_else(|| default_dir(&study.name));
+    let r = report::build(&with_out(header, &dir), &tallies);
     publish(&r, &dir, args.json, args.quiet)?;
     if !args.quiet && !args.json {
         eprintln!("{speed}");
     }
     Ok(())
+}
+
+/// The header with `--out DIR` on its regenerating command: the report names the folder it was
+/// written to, so its command rewrites exactly that report (and never the default folder in
+/// place of a committed one).
+pub fn with_out(mut header: StudyHeader, dir: &Path) -> StudyHeader {
+    header.command.push_str(" --out ");
+    header
+        .command
+        .push_str(&super::shell_word(&dir.display().to_string()));
+    header
 }
 
 /// Write a report's files (`report.md`, `report.json`, `sensitivity.svg`) to `dir` and print the

@@ -17,7 +17,7 @@ pub struct MergeArgs {
     /// Print the report as JSON instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Folder for the report (default: results/mc/<study name>/).
+    /// Folder for the report (default: pinfeed-out/mc/<study name>/).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// No table.
@@ -31,10 +31,10 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         files.push((p.clone(), shard::read(p)?));
     }
     let (header, tallies) = shard::merge(&files)?;
-    let r = report::build(&header, &tallies);
     let dir = args
         .out
         .clone()
         .unwrap_or_else(|| default_dir(&header.study));
+    let r = report::build(&super::mc::with_out(header, &dir), &tallies);
     publish(&r, &dir, args.json, args.quiet)
 }

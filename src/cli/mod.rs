@@ -74,9 +74,9 @@ pub enum Command {
     /// Design a line for a part (pins, fences, both, or a sensor with moving pins), checked on the
     /// line: the best design the line confirms, written as a scenario and drawn.
     Plan(Box<plan::PlanArgs>),
-    /// Measurements that write the reports in results/ (e.g. `bench contact`).
+    /// Measurements behind the reports in results/ (each report names its command; default output pinfeed-out/).
     Bench(bench::BenchArgs),
-    /// Fuzz the inputs (scenario and study files, contacts, polygons) and write results/robustness.md.
+    /// Fuzz the inputs (scenario and study files, contacts, polygons) and write a robustness report.
     Fuzz(fuzz::FuzzArgs),
     /// Measured bands (CSV) against an ensemble's predicted bands: containment, overlap, log score.
     Validate(validate::ValidateArgs),

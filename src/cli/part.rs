@@ -9,12 +9,22 @@ use std::path::PathBuf;
 /// Arguments of `pinfeed part`.
 #[derive(Debug, Args)]
 pub struct PartArgs {
-    /// Named part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N].
+    /// The part, as every command takes it: tripoly1, tripoly2, square, rect:W:H, ngon:N,
+    /// lshape, random:SEED[:N], or vertices:"x1,y1 x2,y2 ..." (any orientation, any unit).
+    #[arg(
+        long,
+        value_name = "PART",
+        conflicts_with = "name",
+        allow_hyphen_values = true
+    )]
+    pub part: Option<String>,
+    /// The same as --part (positional).
+    #[arg(value_name = "PART")]
     pub name: Option<String>,
-    /// Vertex list instead of a name: "x1,y1 x2,y2 ..." (any orientation, any unit).
+    /// Deprecated: `--vertices "x1,y1 ..."` is `--part vertices:"x1,y1 ..."`.
     // allow_hyphen_values: a list that starts with a negative coordinate ("-1.5,-0.5 ...") is a
     // value, not an unknown flag.
-    #[arg(long, conflicts_with = "name", allow_hyphen_values = true)]
+    #[arg(long, hide = true, conflicts_with_all = ["name", "part"], allow_hyphen_values = true)]
     pub vertices: Option<String>,
     /// Print one JSON object instead of a table.
     #[arg(long)]
@@ -40,12 +50,17 @@ pub struct PartReport {
     pub part_frame_vertices: Vec<[f64; 2]>,
 }
 
-/// Resolve `NAME` or `--vertices` to a validated polygon and a display name.
+/// Resolve a part spec (`--part`, or the positional name) or `--vertices` to a validated polygon
+/// and a display name (`vertices` for a vertex list).
 pub fn resolve_part(name: Option<&str>, vertices: Option<&str>) -> Result<(Polygon, String)> {
     match (name, vertices) {
         (Some(n), None) => Ok((
-            named::part_from_spec(n).with_context(|| format!("part '{n}'"))?,
-            n.to_string(),
+            named::part_from_spec(n).with_context(|| format!("--part '{n}'"))?,
+            if n.to_lowercase().starts_with("vertices:") {
+                "vertices".to_string()
+            } else {
+                n.to_string()
+            },
         )),
         (None, Some(v)) => {
             let pts = named::parse_vertex_list(v)?;
@@ -54,12 +69,16 @@ pub fn resolve_part(name: Option<&str>, vertices: Option<&str>) -> Result<(Polyg
                 "vertices".to_string(),
             ))
         }
-        _ => bail!("give a part name (e.g. tripoly2) or --vertices \"x1,y1 x2,y2 ...\""),
+        _ => bail!("give a part: --part tripoly2, or --part vertices:\"x1,y1 x2,y2 ...\""),
     }
 }
 
 pub fn run(args: &PartArgs) -> Result<()> {
-    let (poly, name) = resolve_part(args.name.as_deref(), args.vertices.as_deref())?;
+    if args.vertices.is_some() {
+        eprintln!("warning: --vertices is deprecated; use --part vertices:\"x1,y1 x2,y2 ...\"");
+    }
+    let spec = args.part.as_deref().or(args.name.as_deref());
+    let (poly, name) = resolve_part(spec, args.vertices.as_deref())?;
     let report = PartReport {
         name: name.clone(),
         vertices: poly.len(),
@@ -80,7 +99,7 @@ pub fn run(args: &PartArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        print!("{}", crate::report::versioned::pretty(&report)?);
     } else {
         println!("part            {}", report.name);
         println!("vertices        {}", report.vertices);

@@ -516,7 +516,7 @@ pub fn run(args: &PlanArgs) -> Result<()> {
     let out = if args.json {
         let c = d.chosen();
         let doc = PlanJson {
-            schema_version: 1,
+            schema_version: crate::SCHEMA_VERSION,
             pinfeed_version: env!("CARGO_PKG_VERSION"),
             command: &o.command,
             status: d.status,

@@ -28,7 +28,8 @@ pub struct RunArgs {
     /// Print the summary as JSON instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Folder for results (default: the scenario's [output] dir, "results").
+    /// Folder under which <scenario name>/ is written (default: the scenario's [output] dir, else
+    /// pinfeed-out/runs).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// No table and no progress bar.
@@ -111,7 +112,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
     // The run's files appear whole and together, or not at all (a full disk leaves the previous
     // run's files as they were, never a new summary beside a truncated figure).
     let mut batch = Batch::new();
-    let json = serde_json::to_string_pretty(summary)? + "\n";
+    let json = crate::report::versioned::pretty(summary)?;
     let summary_path = dir.join("summary.json");
     batch
         .write(&summary_path, &json)
@@ -168,6 +169,24 @@ pub fn run(args: &RunArgs) -> Result<()> {
     batch
         .commit()
         .with_context(|| format!("writing the results into {}", dir.display()))?;
+    // The folder holds this run's files only (a parts.csv or events.json of an earlier run whose
+    // scenario asked for it does not outlive it).
+    let written: Vec<String> = [
+        Some("summary.json"),
+        scene.output.parts_csv.then_some("parts.csv"),
+        scene
+            .output
+            .histogram_svg
+            .then_some("orientation_histogram.svg"),
+        scene.effects.event_log.then_some("events.json"),
+        (scene.effects.event_log && !result.control.is_empty()).then_some("control.json"),
+    ]
+    .into_iter()
+    .flatten()
+    .map(String::from)
+    .collect();
+    crate::report::stale::remove_stale(&dir, &written, |n| RUN_FILES.contains(&n))
+        .with_context(|| format!("removing earlier files from {}", dir.display()))?;
 
     let mut text = String::new();
     if args.json {
@@ -190,6 +209,15 @@ pub fn run(args: &RunArgs) -> Result<()> {
 /// serve every later contact; the line's own work counters leave them out): nothing for a model
 /// without tables (tip or ellipsoid fidelity, a part with its own tripod). A scene's model has no
 /// stick tables (`PartModel::with_stick_tables`: a map tier's build makes them).
+/// The files `pinfeed run` writes into a run's folder.
+const RUN_FILES: [&str; 5] = [
+    "summary.json",
+    "parts.csv",
+    "orientation_histogram.svg",
+    "events.json",
+    "control.json",
+];
+
 fn tables_line(model: &crate::mechanics::PartModel) -> String {
     match model.slide_table_stats() {
         Some(slide) if slide.tables > 0 => format!(

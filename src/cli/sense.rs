@@ -8,7 +8,7 @@
 //! in bits. `--placement` adds the search over d × sensor kind ([`crate::sensing::placement`]).
 //!
 //! Standard output gets a table per classifier (default) or the JSON document (`--json`); unless
-//! `--no-write`, the report directory (default `results/sensing/<part>/`) receives `report.md`
+//! `--no-write`, the report directory (default `pinfeed-out/sensing/<part>/`) receives `report.md`
 //! headed by the command that regenerates it, `sense.json`, and the SVG figures. The time spent goes
 //! to standard error.
 
@@ -166,7 +166,7 @@ pub struct SenseArgs {
     /// Print one JSON document.
     #[arg(long)]
     pub json: bool,
-    /// Report directory [default: results/sensing/<part>].
+    /// Report directory [default: pinfeed-out/sensing/<part>].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Print only; write no files.
@@ -302,11 +302,9 @@ pub fn command_line(a: &SenseArgs) -> String {
     w.join(" ")
 }
 
-/// The default report directory: `results/sensing/<part>` (a vertex list is `custom`).
+/// The default report directory: `pinfeed-out/sensing/<part>` (a vertex list is `custom`).
 pub fn default_out_dir(part: &str) -> PathBuf {
-    Path::new("results")
-        .join("sensing")
-        .join(super::part_folder(part))
+    crate::default_out(&["sensing", &super::part_folder(part)])
 }
 
 /// `flag must be > lo …` for strictly positive quantities.
@@ -788,7 +786,7 @@ pub fn run(a: &SenseArgs) -> Result<()> {
         placement,
     };
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        print!("{}", crate::report::versioned::pretty(&report)?);
     } else {
         print!("{}", text_summary(&report));
     }
@@ -889,7 +887,7 @@ fn write_report(
 ) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let json_path = out.join("sense.json");
-    crate::report::atomic::write_atomic(&json_path, serde_json::to_string_pretty(r)? + "\n")
+    crate::report::atomic::write_atomic(&json_path, crate::report::versioned::pretty(r)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     let what = format!(
         "{} at d = {}, μc {}, {} sensor",
@@ -942,6 +940,14 @@ fn write_report(
     }
     crate::report::atomic::write_atomic(out.join("report.md"), report_markdown(r))
         .with_context(|| format!("writing {}", out.join("report.md").display()))?;
+    // A placement figure of an earlier run with --placement does not outlive this one.
+    let written: Vec<String> = ["templates.svg", "accuracy_noise.svg"]
+        .into_iter()
+        .chain(r.placement.as_ref().map(|_| "placement.svg"))
+        .map(String::from)
+        .collect();
+    crate::report::stale::remove_stale(out, &written, |n| n.ends_with(".svg"))
+        .with_context(|| format!("removing earlier figures from {}", out.display()))?;
     Ok(())
 }
 

@@ -2,7 +2,7 @@
 //! [`crate::validate`]). Standard output gets one line per measured row (contained, overlapping,
 //! centre offset, predicted probability of the measured band, log score, predicted bands) and the
 //! summary; `--json` prints the whole report instead. Unless `--no-write`, the report directory
-//! (`results/validate/<file stem>/`) receives `README.md` headed by the regenerating command,
+//! (`pinfeed-out/validate/<file stem>/`) receives `README.md` headed by the regenerating command,
 //! `validate.json` and one figure per (part, input): the measured bands over the predicted
 //! distributions and bands against d.
 
@@ -26,6 +26,10 @@ pub const MAX_MEMBERS: usize = 1_000_000;
 /// The model and scoring options `validate` and `calibrate` share.
 #[derive(Debug, Args, Clone)]
 pub struct ModelArgs {
+    /// The part of every row (e.g. vertices:"0,0 36,0 8,22" or tripoly1): the file's part column
+    /// may then be left out, and when present this part replaces it.
+    #[arg(long, value_name = "PART", allow_hyphen_values = true)]
+    pub part: Option<String>,
     /// Fidelity: exact, ellipsoid or tip.
     #[arg(long, default_value = "exact")]
     pub model: String,
@@ -50,7 +54,7 @@ pub struct ModelArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Report directory [default: results/<command>/<file stem>].
+    /// Report directory [default: pinfeed-out/<command>/<file stem>].
     #[arg(long, value_name = "DIR")]
     pub out_dir: Option<PathBuf>,
     /// Print only; write no files.
@@ -104,6 +108,9 @@ impl ModelArgs {
             self.floor,
             self.window
         );
+        if let Some(p) = &self.part {
+            s.push_str(&format!(" --part {}", shell_word(p)));
+        }
         if let Some(d) = &self.out_dir {
             s.push_str(&format!(
                 " --out-dir {}",
@@ -120,9 +127,7 @@ impl ModelArgs {
                 .file_stem()
                 .and_then(|s| s.to_str())
                 .unwrap_or("measured");
-            Path::new("results")
-                .join(command)
-                .join(super::part_folder(stem))
+            crate::default_out(&[command, &super::part_folder(stem)])
         })
     }
 }
@@ -180,7 +185,7 @@ pub fn ensemble_spec(
 }
 
 /// Print a report (`--json`: the document, else `text`) and, unless `--no-write`, have `write`
-/// write it into `results/<command>/<file stem>/` (or `--out-dir`).
+/// write it into `pinfeed-out/<command>/<file stem>/` (or `--out-dir`).
 pub fn emit<T: Serialize>(
     report: &T,
     text: &str,
@@ -190,7 +195,7 @@ pub fn emit<T: Serialize>(
     write: impl FnOnce(&Path) -> Result<()>,
 ) -> Result<()> {
     if c.json {
-        println!("{}", serde_json::to_string_pretty(report)?);
+        print!("{}", crate::report::versioned::pretty(report)?);
     } else {
         print!("{text}");
     }
@@ -221,7 +226,7 @@ pub fn write_report_files<T: Serialize>(
 ) -> Result<()> {
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let json = out_dir.join(json_name);
-    crate::report::atomic::write_atomic(&json, serde_json::to_string_pretty(report)? + "\n")
+    crate::report::atomic::write_atomic(&json, crate::report::versioned::pretty(report)?)
         .with_context(|| format!("writing {}", json.display()))?;
     let mut md = format!(
         "# {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{}\n\n",
@@ -301,8 +306,9 @@ pub fn summary_text(s: &Summary) -> String {
 
 /// Load the measured file for an ensemble (its largest pin radius sets the reach of d).
 /// The pin radius may be at most the range `map` and `contact` allow for each part (10·a).
-pub fn load_measured(path: &Path, spec: &EnsembleSpec) -> Result<Measured> {
-    let m = measured::load(path, spec.max_pin_radius())?;
+/// `part` (`--part`) replaces the file's part column.
+pub fn load_measured(path: &Path, spec: &EnsembleSpec, part: Option<&str>) -> Result<Measured> {
+    let m = measured::load_for(path, spec.max_pin_radius(), part)?;
     let r = spec.max_pin_radius();
     for (part, poly) in &m.parts {
         let rmax = super::contact::limits::PIN_RADIUS_A * poly.radius();
@@ -329,7 +335,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         args.uncertain.as_deref(),
         &args.common,
     )?;
-    let measured = load_measured(&args.measured, &spec)?;
+    let measured = load_measured(&args.measured, &spec, args.common.part.as_deref())?;
     let c = &args.common;
     let (rows, summary, _) = pool(c.threads)?
         .install(|| {

@@ -341,6 +341,19 @@ pub fn ensemble_maps(
     seed: u64,
     n: usize,
 ) -> Result<EnsembleMaps, String> {
+    ensemble_maps_observed(poly, spec, ds, grid, seed, n, &|| {})
+}
+
+/// [`ensemble_maps`], calling `on_pass` after every pass (a progress bar counts them).
+pub fn ensemble_maps_observed(
+    poly: &Polygon,
+    spec: &EnsembleSpec,
+    ds: &[f64],
+    grid: &[f64],
+    seed: u64,
+    n: usize,
+    on_pass: &(dyn Fn() + Sync),
+) -> Result<EnsembleMaps, String> {
     let members = members(poly, spec, seed, n)?;
     let (nd, nk) = (ds.len(), grid.len());
     let states = stable_states_deg(poly);
@@ -354,7 +367,9 @@ pub fn ensemble_maps(
                     width: 0.0,
                 },
             };
-            members[i].pass(poly, spec, &input, &states, ds[j], (j * nk + k) as u64)
+            let f = members[i].pass(poly, spec, &input, &states, ds[j], (j * nk + k) as u64);
+            on_pass();
+            f
         })
         .collect();
     Ok(EnsembleMaps {

@@ -18,6 +18,8 @@ pub mod plot_sensing;
 pub mod plot_sensitivity;
 pub mod plot_survey;
 pub mod plot_validate;
+pub mod stale;
+pub mod versioned;
 
 /// `x` with `decimals` decimals (`plus`: with its sign always), never as a negative zero: a value
 /// that rounds to zero is printed as 0 (`-0.000` from a −0.0 or a −1e-17 says nothing).
@@ -37,6 +39,15 @@ pub fn fixed(x: f64, decimals: usize, plus: bool) -> String {
     } else {
         s
     }
+}
+
+/// Create the folder `path` goes into (if it has one), naming it on failure.
+pub fn create_parent(path: &std::path::Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -612,7 +612,10 @@ fn compile_effects(re: &RawEffects) -> Effects {
 /// `--draw` shows.
 fn compile_output(c: &Checker, ro: &RawOutput) -> R<OutputOptions> {
     Ok(OutputOptions {
-        dir: ro.dir.clone().unwrap_or_else(|| "results".into()),
+        dir: ro
+            .dir
+            .clone()
+            .unwrap_or_else(|| format!("{}/runs", crate::DEFAULT_OUT_ROOT)),
         parts_csv: ro.parts_csv.unwrap_or(false),
         histogram_svg: ro.histogram_svg.unwrap_or(true),
         histogram_bin_deg: histogram_bin(c, ro.histogram_bin.unwrap_or(5.0))?,

@@ -320,7 +320,7 @@ pub struct RawEffects {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawOutput {
-    /// Folder under which `<scenario name>/` is written (default "results").
+    /// Folder under which `<scenario name>/` is written (default "pinfeed-out/runs").
     pub dir: Option<String>,
     /// Write one CSV row per part (default false).
     pub parts_csv: Option<bool>,

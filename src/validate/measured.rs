@@ -8,7 +8,9 @@
 //! tripoly1,0.1,all,200,230,
 //! ```
 //!
-//! * `part`: a named part (`tripoly1`, `rect:2:1`, …; not a vertex list, whose commas clash);
+//! * `part`: the part (`tripoly1`, `rect:2:1`, …, or a vertex list quoted as CSV quotes a field
+//!   with commas: `"vertices:0,0 36,0 8,22"`); with `--part P` the column may be left out, and
+//!   when present P replaces it in every row;
 //! * `d`: contact parameter, |d| ≤ 1 + (largest pin radius)/a;
 //! * `input`: `state:K` (resting in stable state K, numbered as `pinfeed part` lists them),
 //!   `theta:MIN:MAX` (θ0 spread over the arc from MIN to MAX degrees, counter-clockwise) or `all`;
@@ -88,17 +90,87 @@ impl Measured {
 
 /// Read and check a measured-bands file; `max_pin_radius` (part units) sets the reach of d.
 pub fn load(path: &Path, max_pin_radius: f64) -> Result<Measured, MeasuredError> {
+    load_for(path, max_pin_radius, None)
+}
+
+/// [`load`], with `part` (`--part`) in place of the file's part column, which may then be absent.
+pub fn load_for(
+    path: &Path,
+    max_pin_radius: f64,
+    part: Option<&str>,
+) -> Result<Measured, MeasuredError> {
     let text = crate::input::read_text(path).map_err(|e| MeasuredError {
         file: path.to_path_buf(),
         line: 0,
         field: None,
         message: format!("cannot read the file: {e}"),
     })?;
-    parse(path, &text, max_pin_radius)
+    parse_for(path, &text, max_pin_radius, part)
 }
 
 /// Check the text of a measured-bands file (`file` names it in errors).
 pub fn parse(file: &Path, text: &str, max_pin_radius: f64) -> Result<Measured, MeasuredError> {
+    parse_for(file, text, max_pin_radius, None)
+}
+
+/// The fields of one CSV line, trimmed: a field in double quotes may hold commas, and `""` in it
+/// is one quote (RFC 4180).
+pub fn split_fields(line: &str) -> Result<Vec<String>, String> {
+    let mut fields = Vec::new();
+    let mut chars = line.chars().peekable();
+    loop {
+        let mut field = String::new();
+        // Spaces before an opening quote are not part of the field.
+        while chars.peek() == Some(&' ') || chars.peek() == Some(&'\t') {
+            chars.next();
+        }
+        if chars.peek() == Some(&'"') {
+            chars.next();
+            loop {
+                match chars.next() {
+                    Some('"') if chars.peek() == Some(&'"') => {
+                        chars.next();
+                        field.push('"');
+                    }
+                    Some('"') => break,
+                    Some(c) => field.push(c),
+                    None => return Err("a quoted field is not closed (a `\"` is missing)".into()),
+                }
+            }
+            while chars.peek().is_some_and(|c| *c == ' ' || *c == '\t') {
+                chars.next();
+            }
+            match chars.next() {
+                None => {
+                    fields.push(field);
+                    return Ok(fields);
+                }
+                Some(',') => fields.push(field),
+                Some(c) => return Err(format!("'{c}' after a closing quote (expected ',')")),
+            }
+        } else {
+            loop {
+                match chars.next() {
+                    None => {
+                        fields.push(field.trim().to_string());
+                        return Ok(fields);
+                    }
+                    Some(',') => break,
+                    Some(c) => field.push(c),
+                }
+            }
+            fields.push(field.trim().to_string());
+        }
+    }
+}
+
+/// [`parse`], with `part` (`--part`) in place of the file's part column, which may then be absent.
+pub fn parse_for(
+    file: &Path,
+    text: &str,
+    max_pin_radius: f64,
+    part: Option<&str>,
+) -> Result<Measured, MeasuredError> {
     let err = |line: usize, field: Option<&str>, message: String| MeasuredError {
         file: file.to_path_buf(),
         line,
@@ -113,15 +185,27 @@ pub fn parse(file: &Path, text: &str, max_pin_radius: f64) -> Result<Measured, M
     let (hline, header) = lines
         .next()
         .ok_or_else(|| err(1, None, "empty file: expected the header `part,d,input,min_deg,max_deg,trials` and at least one row".into()))?;
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    if names != COLUMNS[..5] && names != COLUMNS {
+    let names: Vec<String> = split_fields(header).map_err(|m| err(hline, None, m))?;
+    let has_part = names.first().is_some_and(|n| n == "part");
+    let without_part: Vec<&str> = names[usize::from(has_part)..]
+        .iter()
+        .map(String::as_str)
+        .collect();
+    if without_part != COLUMNS[1..5] && without_part != COLUMNS[1..] {
         return Err(err(
             hline,
             None,
             format!(
-                "the header must be `{}` (trials optional), got `{header}`",
+                "the header must be `{}` (trials optional; part optional with --part), got `{header}`",
                 COLUMNS.join(",")
             ),
+        ));
+    }
+    if !has_part && part.is_none() {
+        return Err(err(
+            hline,
+            None,
+            "the header has no `part` column: give the part of every row with --part".into(),
         ));
     }
     let mut out = Measured {
@@ -130,8 +214,9 @@ pub fn parse(file: &Path, text: &str, max_pin_radius: f64) -> Result<Measured, M
         parts: Vec::new(),
     };
     for (line, text) in lines {
-        let fields: Vec<&str> = text.split(',').map(str::trim).collect();
-        if fields.len() != names.len() && !(names.len() == 6 && fields.len() == 5) {
+        let mut fields: Vec<String> = split_fields(text).map_err(|m| err(line, None, m))?;
+        let full = names.len() + usize::from(!has_part);
+        if fields.len() != names.len() && !(full == 6 && fields.len() + 1 == names.len()) {
             return Err(err(
                 line,
                 None,
@@ -143,6 +228,12 @@ pub fn parse(file: &Path, text: &str, max_pin_radius: f64) -> Result<Measured, M
                 ),
             ));
         }
+        match (part, has_part) {
+            (Some(p), true) => fields[0] = p.to_string(),
+            (Some(p), false) => fields.insert(0, p.to_string()),
+            (None, _) => {}
+        }
+        let fields: Vec<&str> = fields.iter().map(String::as_str).collect();
         let row = parse_row(line, &fields, &mut out.parts, max_pin_radius)
             .map_err(|(field, m)| err(line, Some(field), m))?;
         out.rows.push(row);

@@ -106,12 +106,22 @@ fn parametrised_parts_json() {
 #[test]
 fn vertex_list_json() {
     // tripoly1 typed shifted by (10, 20) and clockwise: same answers, centroid (10, 20).
-    let v = pinfeed_json(&["part", "--vertices", "10,21 11.5,19.5 8.5,19.5", "--json"]);
+    let v = pinfeed_json(&[
+        "part",
+        "--part",
+        "vertices:10,21 11.5,19.5 8.5,19.5",
+        "--json",
+    ]);
     let (cx, cy) = centroid(&v);
     assert!((cx - 10.0).abs() < 1e-12 && (cy - 20.0).abs() < 1e-12);
     assert_states(&v, &[0.0, 135.0, 225.0]);
     // A list starting with a negative number must not be taken for a command-line flag.
-    let v = pinfeed_json(&["part", "--vertices", "-1.5,-0.5 1.5,-0.5 0,1", "--json"]);
+    let v = pinfeed_json(&[
+        "part",
+        "--part",
+        "vertices:-1.5,-0.5 1.5,-0.5 0,1",
+        "--json",
+    ]);
     assert!((f(&v, "area") - 2.25).abs() < 1e-12);
     assert_states(&v, &[0.0, 135.0, 225.0]);
     // Semicolons separate vertices too, and the `vertices:` spec works as a NAME.
@@ -124,8 +134,8 @@ fn vertex_list_json() {
 #[test]
 fn vertex_list_scale_free_through_cli() {
     // Scaling the typed vertices by 1000 multiplies a by 1000, area by 10⁶, keeps stable states.
-    let small = pinfeed_json(&["part", "--vertices", "0,0 2,0 0,1", "--json"]);
-    let big = pinfeed_json(&["part", "--vertices", "0,0 2000,0 0,1000", "--json"]);
+    let small = pinfeed_json(&["part", "--part", "vertices:0,0 2,0 0,1", "--json"]);
+    let big = pinfeed_json(&["part", "--part", "vertices:0,0 2000,0 0,1000", "--json"]);
     assert!((f(&big, "a") - 1000.0 * f(&small, "a")).abs() < 1e-9);
     assert!((f(&big, "area") - 1e6 * f(&small, "area")).abs() < 1e-6);
     let (s, b) = (states(&small), states(&big));
@@ -149,36 +159,42 @@ fn text_output_lists_stable_states() {
 
 #[test]
 fn refuses_too_few_vertices() {
-    assert_refused_with(&["part", "--vertices", "0,0 1,0"], &["at least 3"]);
-    assert_refused_with(&["part", "--vertices", "0,0"], &["at least 3"]);
-    assert_refused_with(&["part", "--vertices", ""], &["at least 3"]);
+    assert_refused_with(&["part", "--part", "vertices:0,0 1,0"], &["at least 3"]);
+    assert_refused_with(&["part", "--part", "vertices:0,0"], &["at least 3"]);
+    assert_refused_with(&["part", "--part", "vertices:"], &["at least 3"]);
 }
 
 #[test]
 fn refuses_collinear_vertices() {
-    assert_refused_with(&["part", "--vertices", "0,0 1,1 2,2"], &["collinear"]);
-    assert_refused_with(&["part", "--vertices", "0,0 1,0 3,0 2,0"], &["collinear"]);
+    assert_refused_with(&["part", "--part", "vertices:0,0 1,1 2,2"], &["collinear"]);
+    assert_refused_with(
+        &["part", "--part", "vertices:0,0 1,0 3,0 2,0"],
+        &["collinear"],
+    );
 }
 
 #[test]
 fn refuses_degenerate_sliver() {
     // Not all collinear, but with an area below the relative tolerance: zero area.
-    assert_refused_with(&["part", "--vertices", "0,0 1,0 2,1e-14"], &["zero area"]);
+    assert_refused_with(
+        &["part", "--part", "vertices:0,0 1,0 2,1e-14"],
+        &["zero area"],
+    );
 }
 
 #[test]
 fn refuses_self_intersecting() {
     assert_refused_with(
-        &["part", "--vertices", "0,0 1,1 1,0 0,1"],
+        &["part", "--part", "vertices:0,0 1,1 1,0 0,1"],
         &["not simple", "intersect"],
     );
     // A vertex touching a non-adjacent edge, and a spike folding back on itself.
     assert_refused_with(
-        &["part", "--vertices", "0,0 4,0 4,2 2,0 0,2"],
+        &["part", "--part", "vertices:0,0 4,0 4,2 2,0 0,2"],
         &["not simple", "intersect"],
     );
     assert_refused_with(
-        &["part", "--vertices", "0,0 2,0 1,0 1,1"],
+        &["part", "--part", "vertices:0,0 2,0 1,0 1,1"],
         &["not simple", "intersect"],
     );
 }
@@ -199,18 +215,21 @@ fn refuses_non_finite() {
 
 #[test]
 fn refuses_repeated_vertex() {
-    assert_refused_with(&["part", "--vertices", "0,0 1,0 1,0 0,1"], &["repeat"]);
+    assert_refused_with(&["part", "--part", "vertices:0,0 1,0 1,0 0,1"], &["repeat"]);
     // Closing the ring by hand is refused too, with the hint.
-    let err = refused(&["part", "--vertices", "0,0 1,0 0,1 0,0"]);
+    let err = refused(&["part", "--part", "vertices:0,0 1,0 0,1 0,0"]);
     assert!(err.contains("repeat"), "{err}");
     assert!(err.contains("do not repeat the first vertex"), "{err}");
 }
 
 #[test]
 fn refuses_malformed_vertex_lists() {
-    assert_refused_with(&["part", "--vertices", "0,0 1,x 0,1"], &["not a number"]);
-    assert_refused_with(&["part", "--vertices", "0,0 1 0,1"], &["x,y"]);
-    assert_refused_with(&["part", "--vertices", "0,0 1,0,2 0,1"], &["x,y"]);
+    assert_refused_with(
+        &["part", "--part", "vertices:0,0 1,x 0,1"],
+        &["not a number"],
+    );
+    assert_refused_with(&["part", "--part", "vertices:0,0 1 0,1"], &["x,y"]);
+    assert_refused_with(&["part", "--part", "vertices:0,0 1,0,2 0,1"], &["x,y"]);
 }
 
 #[test]
@@ -245,7 +264,7 @@ fn refuses_bad_rect_and_ngon_parameters() {
 
 #[test]
 fn refuses_missing_or_conflicting_part() {
-    assert_refused_with(&["part"], &["give a part name"]);
+    assert_refused_with(&["part"], &["give a part: --part"]);
     // NAME and --vertices together: clap refuses (usage error).
     let err = refused(&["part", "square", "--vertices", "0,0 1,0 0,1"]);
     assert!(err.contains("cannot be used with"), "{err}");
@@ -300,5 +319,34 @@ fn plot_to_unwritable_path_fails_cleanly() {
     assert_refused_with(
         &["part", "square", "--plot", path.to_str().unwrap()],
         &["writing"],
+    );
+}
+
+/// `--part` is the flag every command takes; `--vertices` still works, hidden, with a warning
+/// naming its replacement, and the two cannot be mixed.
+#[test]
+fn part_takes_the_part_flag_and_warns_on_vertices() {
+    let by_flag = pinfeed_json(&["part", "--part", "tripoly2", "--json"]);
+    let by_name = pinfeed_json(&["part", "tripoly2", "--json"]);
+    assert_eq!(by_flag, by_name);
+    assert_eq!(by_flag["name"], "tripoly2");
+    assert_eq!(by_flag["schema_version"], pinfeed::SCHEMA_VERSION);
+    assert_eq!(by_flag["pinfeed_version"], pinfeed::PINFEED_VERSION);
+    let custom = pinfeed_json(&["part", "--part", "vertices:0,0 3,0 0,3", "--json"]);
+    assert_eq!(custom["name"], "vertices");
+    let old = pinfeed(&["part", "--vertices", "0,0 3,0 0,3", "--json"]);
+    assert!(old.status.success());
+    let stderr = String::from_utf8_lossy(&old.stderr);
+    assert!(
+        stderr.contains("--vertices is deprecated") && stderr.contains("--part vertices:"),
+        "{stderr}"
+    );
+    let old: Value = serde_json::from_slice(&old.stdout).unwrap();
+    assert_eq!(old["area"], custom["area"]);
+    let help = pinfeed(&["part", "--help"]);
+    assert!(!String::from_utf8_lossy(&help.stdout).contains("--vertices"));
+    assert_refused_with(
+        &["part", "--part", "tripoly1", "--vertices", "0,0 1,0 0,1"],
+        &["cannot be used with"],
     );
 }

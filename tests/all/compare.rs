@@ -19,8 +19,10 @@ fn pins_and_fences_on_one_part_stream() {
     assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
     let b = pinfeed(&args);
     assert_eq!(a.stdout, b.stdout, "compare --json differs between runs");
-    let rows: Value = serde_json::from_slice(&a.stdout).unwrap();
-    let rows = rows.as_array().unwrap();
+    let doc: Value = serde_json::from_slice(&a.stdout).unwrap();
+    assert_eq!(doc["schema_version"], pinfeed::SCHEMA_VERSION);
+    assert_eq!(doc["pinfeed_version"], pinfeed::PINFEED_VERSION);
+    let rows = doc["designs"].as_array().unwrap();
     assert_eq!(rows.len(), 2);
     assert_eq!(rows[0]["scenario"], "quickstart");
     assert_eq!(rows[1]["scenario"], "tripoly2_fences");
@@ -102,8 +104,7 @@ fn the_first_file_s_feed_is_imposed_and_can_be_made_uniform() {
             "{}",
             String::from_utf8_lossy(&out.stderr)
         );
-        serde_json::from_slice::<Value>(&out.stdout)
-            .unwrap()
+        serde_json::from_slice::<Value>(&out.stdout).unwrap()["designs"]
             .as_array()
             .unwrap()
             .clone()

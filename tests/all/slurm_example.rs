@@ -168,14 +168,14 @@ fn e2e_script_runs_the_readme_job() {
         script.contains(&format!("study={study}\n")),
         "the script's unsharded run must be of {study}"
     );
-    // The merge writes results/mc/<study name>/ (no --out in docs/cluster.md's merge): the script compares
-    // that folder.
+    // The merge writes pinfeed-out/mc/<study name>/ (no --out in docs/cluster.md's merge): the script
+    // compares that folder.
     let name = read(study)
         .lines()
         .find_map(|l| l.strip_prefix("name = "))
         .map(|v| v.trim().trim_matches('"').to_string())
         .unwrap();
-    assert!(script.contains(&format!("report_dir=results/mc/{name}\n")));
+    assert!(script.contains(&format!("report_dir=pinfeed-out/mc/{name}\n")));
 }
 
 /// The Kubernetes Indexed Job runs one pod per shard and the merge reads that many shards.

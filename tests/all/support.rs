@@ -46,3 +46,17 @@ pub fn pinfeed_json(args: &[&str]) -> Value {
         )
     })
 }
+
+/// `text` with the folder `dir` written as `OUT`: a report names the folder it was written to in
+/// its regenerating command (`--out DIR`), so two reports of the same study written to two
+/// folders compare equal after this.
+pub fn without_dir(text: &str, dir: &std::path::Path) -> String {
+    text.replace(dir.to_str().expect("a UTF-8 path"), "OUT")
+}
+
+/// The file `name` of the report folder `dir`, with `dir` written as `OUT` ([`without_dir`]).
+pub fn report_text(dir: &std::path::Path, name: &str) -> String {
+    let text = std::fs::read_to_string(dir.join(name))
+        .unwrap_or_else(|e| panic!("reading {}: {e}", dir.join(name).display()));
+    without_dir(&text, dir)
+}

@@ -314,3 +314,89 @@ fn map_uncertain_prints_predicted_bands_and_refuses_bad_settings() {
         );
     }
 }
+
+/// `--part` gives the part of every row, so a measured file for a `vertices:` part needs no part
+/// column; a part column with the vertex list quoted as CSV quotes it reads the same; and the
+/// report names `--part` in its command.
+#[test]
+fn validate_takes_part_for_a_vertex_list() {
+    let dir = std::env::temp_dir().join(format!("pinfeed-validate-part-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let part = "vertices:0,0 36,0 8,22";
+    let bare = dir.join("bare.csv");
+    std::fs::write(
+        &bare,
+        "d,input,min_deg,max_deg,trials\n0.2,state:0,0,40,10\n-0.3,all,100,200,\n",
+    )
+    .unwrap();
+    let quoted = dir.join("quoted.csv");
+    std::fs::write(
+        &quoted,
+        format!("part,d,input,min_deg,max_deg,trials\n\"{part}\",0.2,state:0,0,40,10\n\"{part}\",-0.3,all,100,200,\n"),
+    )
+    .unwrap();
+    let run = |file: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "validate",
+            file.to_str().unwrap(),
+            "--members",
+            "8",
+            "--json",
+            "--no-write",
+        ];
+        args.extend_from_slice(extra);
+        crate::support::pinfeed(&args)
+    };
+    let a = run(&bare, &["--part", part]);
+    assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    let b = run(&quoted, &[]);
+    assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
+    let ja: serde_json::Value = serde_json::from_slice(&a.stdout).unwrap();
+    let jb: serde_json::Value = serde_json::from_slice(&b.stdout).unwrap();
+    assert_eq!(ja["schema_version"], pinfeed::SCHEMA_VERSION);
+    assert_eq!(ja["rows"].as_array().unwrap().len(), 2);
+    assert_eq!(ja["rows"][0]["part"], part);
+    assert_eq!(ja["rows"], jb["rows"]);
+    assert!(
+        ja["command"]
+            .as_str()
+            .unwrap()
+            .contains("--part 'vertices:0,0 36,0 8,22'"),
+        "{}",
+        ja["command"]
+    );
+    // --part replaces a named part column.
+    let named = dir.join("named.csv");
+    std::fs::write(
+        &named,
+        "part,d,input,min_deg,max_deg\ntripoly1,0.2,state:0,0,40\n",
+    )
+    .unwrap();
+    let c = run(&named, &["--part", part]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let jc: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
+    assert_eq!(jc["rows"][0]["part"], part);
+    // Without --part, a file with no part column is refused, naming the flag; an unclosed quote
+    // is refused naming the line.
+    let d = run(&bare, &[]);
+    assert!(!d.status.success());
+    let e = String::from_utf8_lossy(&d.stderr);
+    assert!(
+        e.contains("no `part` column") && e.contains("--part"),
+        "{e}"
+    );
+    std::fs::write(
+        &quoted,
+        format!("part,d,input,min_deg,max_deg\n\"{part},0.2,state:0,0,40\n"),
+    )
+    .unwrap();
+    let f = run(&quoted, &[]);
+    assert!(!f.status.success());
+    let e = String::from_utf8_lossy(&f.stderr);
+    assert!(
+        e.contains("quoted.csv:2") && e.contains("not closed"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

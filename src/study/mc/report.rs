@@ -176,6 +176,8 @@ pub struct PointReport {
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct McReport {
+    /// [`crate::SCHEMA_VERSION`] (the header carries `pinfeed_version`).
+    pub schema_version: u32,
     #[serde(flatten)]
     pub header: StudyHeader,
     /// What one sample is.
@@ -245,6 +247,7 @@ fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
 /// Build the report from the header and the tally of every point (index order).
 pub fn build(header: &StudyHeader, tallies: &[PointTally]) -> McReport {
     McReport {
+        schema_version: crate::SCHEMA_VERSION,
         header: header.clone(),
         sample: SAMPLE_MEANING.to_string(),
         total_samples: tallies.iter().map(|t| t.samples).sum(),
