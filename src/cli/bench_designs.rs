@@ -99,6 +99,9 @@ pub fn run(a: &DesignsArgs) -> Result<()> {
             ),
         };
         m += &markdown(&title, &rows);
+        if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        }
         write_atomic(&a.out, m.as_bytes())
             .with_context(|| format!("writing {}", a.out.display()))?;
     }

@@ -110,9 +110,10 @@ impl EnsembleSpec {
         ]
     }
 
-    /// Largest pin radius any member can have.
+    /// Largest pin radius a member takes in practice (a normal no more than 8 sd above its mean:
+    /// a draw beyond has probability below 1e-15).
     pub fn max_pin_radius(&self) -> f64 {
-        self.pin_radius.range().1.max(0.0)
+        self.pin_radius.practical_max().max(0.0)
     }
 }
 

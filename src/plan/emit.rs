@@ -250,7 +250,7 @@ fn goal_and_model(problem: &Problem, centre_deg: f64, symmetry: u32) -> String {
         goals.join(", "),
         num(problem.tolerance_deg, 6)
     );
-    t += "\n[model]\nfidelity = \"exact\"\ntol = 1e-6\n\n[output]\ndir = \"results\"\nhistogram_svg = false\nhistogram_bin = 1\n";
+    t += "\n[model]\nfidelity = \"exact\"\ntol = 1e-6\n\n[output]\nhistogram_svg = false\nhistogram_bin = 1\n";
     t
 }
 

@@ -97,6 +97,15 @@ impl Distribution {
         }
     }
 
+    /// The largest value a draw takes in practice: the range's top, but for a normal no more
+    /// than 8 standard deviations above its mean (its truncation bound may be unset, 1e6).
+    pub fn practical_max(&self) -> f64 {
+        match *self {
+            Distribution::Normal { mean, sd, hi, .. } => hi.min(mean + 8.0 * sd),
+            _ => self.range().1,
+        }
+    }
+
     /// Is the distribution a single value?
     pub fn is_fixed(&self) -> bool {
         matches!(self, Distribution::Fixed(_))

@@ -724,3 +724,33 @@ fn plan_shows_progress_on_a_terminal_and_nothing_otherwise() {
         "{text}"
     );
 }
+
+#[test]
+fn without_out_a_design_is_written_under_pinfeed_out_by_its_name() {
+    let dir = tmp("default_out");
+    std::fs::create_dir_all(&dir).unwrap();
+    let part = "vertices:0,0 36,0 8,22";
+    let out = crate::support::pinfeed_in(
+        &dir,
+        &[
+            "plan",
+            "--part",
+            part,
+            "--scale",
+            "0.001",
+            "--pins",
+            "--check-parts",
+            "300",
+            "--quiet",
+        ],
+    );
+    assert!([0, 3].contains(&out.status.code().unwrap()), "{out:?}");
+    let name = pinfeed::plan::design::design_name(part);
+    let f = dir.join("pinfeed-out/plans").join(format!("{name}.toml"));
+    let text = std::fs::read_to_string(&f).unwrap();
+    assert!(text.contains(&format!("name = \"{name}\"")), "{text}");
+    assert!(
+        !text.contains("dir = \"results\""),
+        "a planned line writes outside results/"
+    );
+}
