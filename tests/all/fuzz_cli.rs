@@ -385,7 +385,11 @@ fn check_binary(args: &[String], csv: bool) -> Result<(), TestCaseError> {
             }
         }
         Some(1) => {
-            let first = err.lines().next().unwrap_or("");
+            // After any warnings (`--vertices` is deprecated), the first line is the cause.
+            let first = err
+                .lines()
+                .find(|l| !l.starts_with("warning: "))
+                .unwrap_or("");
             prop_assert!(
                 first.starts_with("error: ") && first.len() > "error: ".len() + 5,
                 "{args:?}: the first stderr line should be the cause: {err}"
