@@ -424,7 +424,7 @@ pub fn targets(rows: &[ContactCostRow], scaling: &[ScalingRow]) -> String {
         _ => "not measured".into(),
     };
     format!(
-        "## Targets (issue 15 item 1) and where they land\n\n\
+        "## Targets and where they land\n\n\
          | target | measured here | met |\n|---|---|---|\n\
          | exact ≤ 20 µs median per contact (slides solved) | {} µs | {} |\n\
          {}\

@@ -110,7 +110,7 @@ pub fn measure(scene: &Scene, parts: u64, reps: usize) -> Result<LineCost> {
 /// The Markdown section for `rows`, headed by the command `cmd` that regenerates it.
 pub fn section(rows: &[LineCost], cmd: &str) -> String {
     let mut s = format!(
-        "## What the line adds to its contacts (issue 15 item 2)\n\n\
+        "## What the line adds to its contacts\n\n\
          Regenerate this section with:\n\n```\n{cmd}\n```\n\n\
          Each scenario is run once to capture every push it asks of the contact model, then, \
          alternating on one thread, the line itself and the same pushes as a bare batch (without \

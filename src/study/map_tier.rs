@@ -183,7 +183,7 @@ pub fn contact_section(rows: &[ContactRow], cmd: &str) -> String {
         .fold(f64::INFINITY, f64::min);
     let mismatches: usize = rows.iter().map(|r| r.class_mismatch).sum();
     s.push_str(&format!(
-        "\nTargets (issue 15 item 3): every served answer within 0.05° of exact — largest error here \
+        "\nTargets: every served answer within 0.05° of exact — largest error here \
          {max_err:.3}°; ≥ 100× faster per contact — here {min_speedup:.0}× or more (served pushes); \
          build time reported (above; a map is built once and then read from its cache file in \
          milliseconds); contact/no-contact never differs from exact ({mismatches} mismatches).\n"
@@ -270,7 +270,7 @@ pub fn line_section(r: &LineRow, scenario: &Path, cmd: &str) -> String {
          | **parts ending in the same outcome class** | — | **{same} / {parts} ({agree:.3}%)** |\n\
          | largest final-orientation difference (same class) | — | {dt:.4}° |\n\
          | success rate | {esr:.4} | {msr:.4} |\n\n\
-         Target (issue 15 item 3): the outcome class equal to exact for ≥ 99.99% of parts — here \
+         Target: the outcome class equal to exact for ≥ 99.99% of parts — here \
          {agree:.3}%. The map serves {sp:.1}% of the pushes; the rest fall in cells it could not \
          certify (pushes near the centroid, grazing touches, jumps of θf) and are computed \
          exactly, which bounds the line's speed-up at about 1/(share computed exactly).\n",
