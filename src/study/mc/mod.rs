@@ -157,6 +157,7 @@ pub fn parse_with(
         crate::scenario::Obstacle::Fence(_) => false,
     });
     compile::check_sensor_parameters(&loc, &raw.uncertain, &raw.sweep, has_sensor)?;
+    compile::check_reach(&loc, &raw.uncertain, &raw.sweep, &scene)?;
     let declared = compile::compile_uncertain(&loc, &raw.uncertain, scene.part.support)?;
     let axes = compile::compile_sweeps(&loc, &raw.sweep)?;
     let points = if axes.is_empty() {
