@@ -4,7 +4,8 @@
 //! A study file (TOML, docs/study-format.md) points at a scenario and declares uncertain
 //! parameters — pin–part friction μc, the support model (uniform, a random tripod, a random smooth
 //! density), shape tolerance, pin position and radius errors, entry pose noise, belt speed, sensor
-//! pins' noise, bias, timing threshold and jitter — and
+//! pins' noise, bias, timing threshold and jitter, fences' friction μf, angle, position and length,
+//! dynamic pins' speed, acceleration and settle time, the controller's latency — and
 //! optionally sweeps one or two of them over a grid. For each sweep point, N samples are drawn; a
 //! sample is one part through a freshly perturbed line ([`sample`]). Computed per point: the count
 //! of each outcome class, the success rate with its 95% Wilson score interval (and the same interval
@@ -157,8 +158,8 @@ pub fn parse_with(
         crate::scenario::Obstacle::Fence(_) => false,
     });
     compile::check_sensor_parameters(&loc, &raw.uncertain, &raw.sweep, has_sensor)?;
-    compile::check_reach(&loc, &raw.uncertain, &raw.sweep, &scene)?;
     let declared = compile::compile_uncertain(&loc, &raw.uncertain, scene.part.support)?;
+    compile::check_reach(&loc, &raw.uncertain, &raw.sweep, &scene)?;
     let axes = compile::compile_sweeps(&loc, &raw.sweep)?;
     let points = if axes.is_empty() {
         vec![declared.clone()]

@@ -15,7 +15,10 @@
 //! sub-seed. (The sensor sub-seeds come last, so a study written before they existed draws the same
 //! numbers as it always did.) A parameter's draws therefore never depend on how many draws another one needed
 //! (redraws), on the thread count or on sharding, and sample i sees the same underlying numbers at
-//! every sweep point (common random numbers).
+//! every sweep point (common random numbers). The fence, actuator and controller parameters' nine
+//! sub-seeds (fence μf, angle, x, y, length, actuator speed, acceleration, settle, controller
+//! latency) come after the readings' seed, and are drawn only at a sweep point that declares one
+//! of them: a study without them does no work for them and draws what it always drew.
 //!
 //! What is drawn, per sample:
 //! * μc: one value, used at every pin (replacing each pin's own μc);
@@ -41,9 +44,18 @@
 //! * readings: the sensor's noise in sample i is drawn from the sample's own readings sub-seed,
 //!   so readings are independent across samples.
 //!
-//! Obstacles are matched exhaustively: a pin (sensor or not) gets the pin errors; a fence is not a
-//! pin and no study parameter perturbs it yet, so it passes unchanged — explicitly, so that a new
-//! kind of obstacle cannot slip through this step unnoticed.
+//! * fences: one μf per sample, used at every fence `fence_mu_f` reaches (μc never reaches a
+//!   fence); errors added to each fence's angle, upstream end and length, drawn per fence and
+//!   redrawn together (counted) until the fence is one the scenario would accept;
+//! * actuators: per dynamic pin, factors on the speed (a retractable pin's raise and lower times
+//!   are divided by it) and on a moving pin's acceleration, an error added to a moving pin's
+//!   settle time, redrawn together (counted) until the actuator is valid; the controller's
+//!   latency plus one error per sample.
+//!
+//! Obstacles are matched exhaustively: a pin (sensor or not) gets the pin errors and, if it is
+//! dynamic, the actuator parameters; a fence gets the fence parameters — explicitly, so that a new
+//! kind of obstacle cannot slip through this step unnoticed. Fence and actuator parameters reach
+//! only the obstacles their `fences`/`pins` selector names, if it names any.
 
 use super::distribution::Distribution;
 use super::perturbations::{Perturbations, SupportChoice};
@@ -430,8 +442,9 @@ pub(crate) fn draw_support(
 
 /// One obstacle of the perturbed line: a pin (with or without a sensor) with its position and
 /// radius errors (redrawn until it lies over the belt, clear of the entry, with a radius ≥ 0), the
-/// sample's μc and its sensor under the sample's sensor values; a fence unchanged (no parameter
-/// perturbs fences). No catch-all: a new obstacle kind must be handled here.
+/// sample's μc, its sensor under the sample's sensor values and its actuator under the actuator
+/// parameters; a fence under the fence parameters ([`draw_fence`]). No catch-all: a new obstacle
+/// kind must be handled here.
 #[allow(clippy::too_many_arguments)]
 fn draw_obstacle(
     ob: &Obstacle,
