@@ -648,3 +648,35 @@ fn a_study_without_the_new_parameters_does_no_extra_work() {
     assert!(a[0]["outcomes"]["success"].as_u64().unwrap() < 40, "{a}");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+#[test]
+fn a_plans_uncertainty_study_perturbs_the_fences_friction_with_the_pins() {
+    use pinfeed::plan::check::uncertainty_study;
+    let mut problem = pinfeed::plan::Problem::new("tripoly1");
+    problem.mu_c_range = Some((0.3, 0.7));
+    let study = |kinds: &[&str], mu_f_given: bool| {
+        uncertainty_study(&problem, kinds, mu_f_given, "plan.toml", "u.toml", 100).unwrap()
+    };
+    // Fences whose μf is the nominal μc vary with it; μc itself only where there are pins.
+    let fences = study(&["fence", "fence"], false);
+    assert!(
+        fences.contains("[uncertain.fence_mu_f]\ndistribution = \"uniform\"\nmin = 0.3\nmax = 0.7")
+    );
+    assert!(!fences.contains("[uncertain.mu_c]"), "{fences}");
+    let both = study(&["pin", "fence"], false);
+    assert!(both.contains("[uncertain.mu_c]") && both.contains("[uncertain.fence_mu_f]"));
+    // Given their own μf (--mu-f), the fences keep it.
+    let own = study(&["fence", "moving_pin"], true);
+    assert!(
+        own.contains("[uncertain.mu_c]") && !own.contains("fence_mu_f"),
+        "{own}"
+    );
+    // Every study it writes loads: nothing declared reaches nothing.
+    let d = tmp("plan");
+    std::fs::write(d.join("line.toml"), LINE).unwrap();
+    for text in [&fences, &both, &own] {
+        std::fs::write(d.join("u.toml"), text.replace("plan.toml", "line.toml")).unwrap();
+        mc::load(&d.join("u.toml"), None).unwrap();
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
