@@ -739,7 +739,14 @@ pub fn draw_scene(
                         )
                     },
                     &mut other,
-                )?
+                )
+                .map_err(|e| {
+                    format!(
+                        "{e}: the controller's latency ({} s) plus the error must lie in {} s",
+                        c.latency,
+                        crate::scenario::limits::show(crate::scenario::limits::ACTUATOR_TIME)
+                    )
+                })?
                 .map(|e| c.latency + e),
                 None => None,
             },
