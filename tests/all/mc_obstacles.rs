@@ -680,3 +680,41 @@ fn a_plans_uncertainty_study_perturbs_the_fences_friction_with_the_pins() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+#[test]
+fn mu_c_on_a_line_with_fences_warns_that_it_does_not_reach_them() {
+    let d = tmp("warn");
+    let mu_c = "[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = 0.3\nmax = 0.7\n";
+    let st = mc::load(&mixed_study(&d, "mu_c.toml", mu_c), None).unwrap();
+    let w = st.warnings().join("\n");
+    assert!(
+        w.contains("`f1` (μf 0.5), `f2` (μf 0.5) keep their own μf"),
+        "{w}"
+    );
+    // On the command line, on stderr (the report is what it was).
+    let out = pinfeed_ok(&[
+        "mc",
+        s(&d.join("mu_c.toml")),
+        "--samples",
+        "2",
+        "--quiet",
+        "--out",
+        s(&d.join("o")),
+    ]);
+    assert!(String::from_utf8_lossy(&out.stderr)
+        .contains("warning: mu_c varies the pins' friction only"));
+    // fence_mu_f reaching one fence leaves the other in the warning; reaching both, none.
+    let one = format!(
+        "{mu_c}[uncertain.fence_mu_f]\ndistribution = \"fixed\"\nvalue = 0.6\nfences = [\"f2\"]\n"
+    );
+    let st = mc::load(&mixed_study(&d, "one.toml", &one), None).unwrap();
+    let w = st.warnings().join("\n");
+    assert!(w.contains("`f1`") && !w.contains("`f2`"), "{w}");
+    let both = format!("{mu_c}{}", tables(&["fence_mu_f"]));
+    let st = mc::load(&mixed_study(&d, "both.toml", &both), None).unwrap();
+    assert!(st.warnings().is_empty());
+    // No μc, no warning.
+    let st = mc::load(&mixed_study(&d, "none.toml", ""), None).unwrap();
+    assert!(st.warnings().is_empty());
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -85,6 +85,38 @@ impl Study {
     pub fn total_samples(&self) -> u64 {
         self.points.len() as u64 * self.samples
     }
+
+    /// What the study may be taken to perturb but does not (printed as warnings; the report is
+    /// unchanged): μc varied on a line whose fences no `fence_mu_f` reaches, since μc does not
+    /// reach a fence.
+    pub fn warnings(&self) -> Vec<String> {
+        if !self.points.iter().any(|p| p.mu_c.is_some()) {
+            return Vec::new();
+        }
+        let kept: Vec<String> = self
+            .scene
+            .obstacles
+            .iter()
+            .filter_map(|o| match o {
+                crate::scenario::Obstacle::Fence(f) => Some(f),
+                crate::scenario::Obstacle::Pin(_) => None,
+            })
+            .filter(|f| {
+                !self
+                    .points
+                    .iter()
+                    .any(|p| p.fence_mu_f.is_some() && p.reaches("fence_mu_f", &f.name))
+            })
+            .map(|f| format!("`{}` (μf {})", f.name, f.mu_f))
+            .collect();
+        if kept.is_empty() {
+            return Vec::new();
+        }
+        vec![format!(
+            "mu_c varies the pins' friction only; the fence(s) {} keep their own μf: declare [uncertain.fence_mu_f] to vary it",
+            kept.join(", ")
+        )]
+    }
 }
 
 /// Read and validate a study file; `samples` overrides the file's samples per point.
