@@ -287,7 +287,7 @@ impl CsvCase {
         };
         if calibrate {
             flag(rng, "--members", &["10"], 1.0);
-            flag(rng, "--score-members", &["3", "0"], 1.0);
+            flag(rng, "--score-members", &["3", "5", "0"], 1.0);
             flag(rng, "--jitter", &["0", "3", "90", "91", "nan"], 0.5);
             flag(rng, "--support", &["tripod", "smooth", "uniform"], 0.3);
             flag(
@@ -305,7 +305,7 @@ impl CsvCase {
             flag(rng, "--pin-radius-sd", &["0.03", "1e-9", "0", "nan"], 0.3);
             flag(rng, "--mu-c", &["0.5", "0", "10", "11"], 0.2);
         } else {
-            flag(rng, "--members", &["1", "2", "5", "0", "1000001"], 1.0);
+            flag(rng, "--members", &["1", "2", "3", "5", "0", "1000001"], 1.0);
             flag(rng, "--mu-c", &["0.5", "0", "10", "11", "-1", "nan"], 0.3);
             flag(
                 rng,

@@ -524,7 +524,21 @@ Re-run one case with `pinfeed fuzz TARGET --seed {} --case N` (prints its input 
     for (t, _) in tallies {
         s.push_str(&format!("* **{}**: {}\n", t.name(), t.describe()));
     }
+    s.push_str(&totals(tallies));
     s.push_str("\n## Counts\n\n");
+    s.push_str(
+        "Each case ends in one class: a *located error* points at the input (file, line and \
+column, or a CSV file and line); an *error naming the cause* names a key, flag, field, shard or \
+sample and why; an *unlocated error* says neither (a problem); a *success* ran and every output \
+is finite (a contact: `ok` at both tolerances and agreeing within 1°); *other statuses* are \
+contacts that ended with a named status other than `ok` at the default tolerance; *panics*, \
+*hangs* (slower than the budget) and *non-finite outputs* are problems; a *self-check \
+disagreement* is a contact `ok` at both tolerances whose rotations differ by more than 1°, or a \
+plan whose written scenario the parser refuses; *ok, then failed* is a contact `ok` at the \
+default tolerance that ends in another status at the 1000× tighter one (listed, not a wrong \
+answer); an *edited shard accepted* is a merge that succeeded though a shard's content was \
+changed.\n\n",
+    );
     s.push_str(&counts_table(
         "target",
         tallies.iter().map(|(t, y)| {
@@ -580,6 +594,56 @@ Re-run one case with `pinfeed fuzz TARGET --seed {} --case N` (prints its input 
     }
     if !any {
         s.push_str("\nNo problems: no panic, hang, non-finite output, unlocated error, self-check disagreement or accepted edited shard.\n");
+    }
+    s
+}
+
+/// The totals the acceptance targets are stated in: the new surface's cases and their problems,
+/// and the contacts (with moving pins apart) and their disagreements.
+fn totals(tallies: &[(Target, Tally)]) -> String {
+    let surface = [Target::Pairs, Target::Plans, Target::Csvs, Target::Merges];
+    let of = |ts: &[Target], c: Option<Class>| -> u64 {
+        tallies
+            .iter()
+            .filter(|(t, _)| ts.contains(t))
+            .map(|(_, y)| c.map_or(y.generated, |c| y.count(c)))
+            .sum()
+    };
+    let mut s = String::from("\n## Totals\n\n");
+    if tallies.iter().any(|(t, _)| surface.contains(t)) {
+        s.push_str(&format!(
+            "* sensing/actuator/controller/policy key pairs, plan argument sets, validate/calibrate CSV files and edited merge shards: **{}** generated; {} panics, {} hangs, {} non-finite outputs, {} unlocated errors, {} self-check disagreements, {} edited shards accepted\n",
+            of(&surface, None),
+            of(&surface, Some(Class::Panic)),
+            of(&surface, Some(Class::Hang)),
+            of(&surface, Some(Class::NonFinite)),
+            of(&surface, Some(Class::Unlocated)),
+            of(&surface, Some(Class::Disagreement)),
+            of(&surface, Some(Class::Accepted)),
+        ));
+    }
+    if let Some((_, y)) = tallies.iter().find(|(t, _)| *t == Target::Contacts) {
+        let moving = |c: Option<Class>| -> u64 {
+            y.kinds
+                .iter()
+                .filter(|(k, _)| k.starts_with("moving pin"))
+                .map(|(_, m)| match c {
+                    Some(c) => m.get(&c).copied().unwrap_or(0),
+                    None => m.values().sum(),
+                })
+                .sum()
+        };
+        s.push_str(&format!(
+            "* contacts: **{}** generated, **{}** of them with moving pins; {} `ok` at both the default and the 1000× tighter tolerance with rotations more than 1° apart ({} with moving pins); {} panics, {} hangs, {} non-finite outputs; {} `ok` at the default tolerance only\n",
+            y.generated,
+            moving(None),
+            y.count(Class::Disagreement),
+            moving(Some(Class::Disagreement)),
+            y.count(Class::Panic),
+            y.count(Class::Hang),
+            y.count(Class::NonFinite),
+            y.count(Class::OkThenFailed),
+        ));
     }
     s
 }

@@ -13,7 +13,7 @@ use clap::Parser;
 use rand::RngExt;
 use std::path::Path;
 
-pub const DESCRIPTION: &str = "`pinfeed plan` argument sets: one of 12 parts (named parts, ngon:500, random and degenerate vertex lists, an unknown name), a time limit of 0.05–1 s, line checks of at most 200 parts, one thread, no files, and 0–4 more of 36 flags with values inside, at the ends of and beyond their ranges; parsed and checked as the command does, designed, and the design's numbers and the scenario and policy it would write checked (parsed and run for 3 parts)";
+pub const DESCRIPTION: &str = "`pinfeed plan` argument sets: one of 12 parts (named parts, ngon:500, random and degenerate vertex lists, an unknown name), a time limit of 0.05–1 s, line checks of at most 200 parts, one thread, no files, and 0–4 more of 36 flags with values inside, at the ends of and beyond their ranges; parsed and checked as the command does, designed, and the design's numbers and the scenario and policy it would write checked (parsed and run for 3 parts); the searches stop at a wall-time limit, so these counts can depend on the machine";
 
 /// The parts a case plans for.
 const PARTS: [&str; 12] = [
