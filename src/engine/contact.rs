@@ -68,6 +68,7 @@ impl Line<'_> {
         };
         if let Some(list) = self.captured.as_mut() {
             list.push(CapturedPush {
+                obstacle: j,
                 model: part.model.clone(),
                 pusher: pusher.clone(),
                 pose,
@@ -139,6 +140,18 @@ impl Line<'_> {
         let Some(c) = self.control.as_ref() else {
             return;
         };
+        if c.online_model().is_some() {
+            // Online: the decided label is kept for the sensor's statistics only; the belief
+            // takes the reading itself.
+            let decision = match sensed.classification.decision {
+                Decision::Hypothesis(h) => Some(h),
+                Decision::Unknown => None,
+            };
+            part.decided.push((j, decision, sensed.truth));
+            let t_ready = t_end + c.latency();
+            self.online_reading(part, index, j, sensed.reading.as_ref(), t_ready);
+            return;
+        }
         let c12 = &sensed.classification;
         let h = match c12.decision {
             Decision::Hypothesis(h) => Some(h),

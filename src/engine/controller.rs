@@ -20,14 +20,19 @@
 
 use super::actuator::Track;
 use super::event_queue::EventKind;
-use super::line::Line;
+use super::line::{ActivePart, Line};
 use super::motion::Motion;
+use super::online::OnlineModel;
 use super::outcome::PartOutcome;
 use crate::geometry::Vec2;
 use crate::mechanics::PinPath;
-use crate::scenario::{Actuator, Controller, Obstacle, OnLate, PinObstacle, Scene, Target};
+use crate::scenario::{
+    Actuator, ControlMode, Controller, Obstacle, OnLate, PinObstacle, Scene, Target,
+};
+use crate::sensing::belief::Update;
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// What the controller did, for the event log and the animation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -80,6 +85,48 @@ pub struct DecisionStats {
     pub wrong_failed: u64,
 }
 
+/// One bin of the online controller's calibration: parts whose predicted success fell in
+/// [lo, hi), their mean prediction and the share that ended in the goal.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct CalibrationBin {
+    pub lo: f64,
+    pub hi: f64,
+    pub parts: u64,
+    pub predicted_mean: f64,
+    pub observed: f64,
+}
+
+/// What the online controller did (docs/physics.md#belief-and-online-replanning).
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct OnlineSummary {
+    /// The model: hypotheses, joint actions, line runs its build took.
+    pub hypotheses: usize,
+    pub actions: usize,
+    pub model_runs: u64,
+    /// Decisions taken (one per part once every sensor has spoken).
+    pub decisions: u64,
+    /// Mean entropy of the belief before any observation and at the decision (bits).
+    pub entropy_prior_bits: f64,
+    pub entropy_posterior_bits: f64,
+    /// Observations no hypothesis explained (the belief was left as it was).
+    pub inconsistent: u64,
+    /// Passes of a sensor without contact used as evidence.
+    pub no_contact_passes: u64,
+    /// Mean predicted success of the decisions, and the observed success of those parts.
+    pub predicted_mean: f64,
+    pub observed: f64,
+    /// Predicted against observed, in ten bins of the prediction (empty bins left out).
+    pub calibration: Vec<CalibrationBin>,
+    /// How often each joint command was chosen (`pin=target, …`).
+    pub chosen: BTreeMap<String, u64>,
+    /// Per sensor: the power its likelihood is raised to (calibrated on held-out members).
+    pub temper: BTreeMap<String, f64>,
+    /// Decisions whose most probable stable state (the belief's marginal) is the part's true
+    /// state, over the decisions whose part has a known true state.
+    pub state_correct: u64,
+    pub state_known: u64,
+}
+
 /// The controller's part of the summary.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct ControllerSummary {
@@ -93,6 +140,19 @@ pub struct ControllerSummary {
     pub misclassified_failed: u64,
     pub late_actuations: u64,
     pub actuators: Vec<ActuatorStats>,
+    /// `policy` or `online`.
+    pub mode: &'static str,
+    /// The online controller's record (online mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub online: Option<OnlineSummary>,
+}
+
+/// Running sums behind [`OnlineSummary`].
+struct OnlineRun {
+    model: Arc<OnlineModel>,
+    summary: OnlineSummary,
+    /// Per calibration bin: parts, Σ predicted, successes.
+    bins: [(u64, f64, u64); 10],
 }
 
 /// The controller's run state.
@@ -106,6 +166,8 @@ pub(super) struct Control {
     /// Per obstacle: index into `summary.actuators`.
     stats_of: Vec<Option<usize>>,
     pub(super) log: Option<Vec<ControlRecord>>,
+    /// The online controller's model and record (online mode only).
+    online: Option<OnlineRun>,
 }
 
 impl Control {
@@ -145,11 +207,31 @@ impl Control {
             on_late: OnLate::Skip,
             rules: Vec::new(),
             source: "none".into(),
+            mode: ControlMode::Policy,
+            online: None,
         });
         summary.rules_from = spec.source.clone();
         summary.latency_s = spec.latency;
         summary.on_late = spec.on_late.name();
+        let online = spec.online.as_ref().map(|h| OnlineRun {
+            model: h.0.clone(),
+            summary: OnlineSummary {
+                hypotheses: h.0.hypotheses.len(),
+                actions: h.0.actions.len(),
+                model_runs: h.0.runs,
+                temper: h
+                    .0
+                    .sensors
+                    .iter()
+                    .map(|sm| (scene.obstacles[sm.obstacle].name().to_string(), sm.temper))
+                    .collect(),
+                ..OnlineSummary::default()
+            },
+            bins: [(0, 0.0, 0); 10],
+        });
+        summary.mode = if online.is_some() { "online" } else { "policy" };
         Some(Control {
+            online,
             queues: vec![BTreeMap::new(); tracks.len()],
             spec,
             tracks,
@@ -161,6 +243,29 @@ impl Control {
 
     pub(super) fn latency(&self) -> f64 {
         self.spec.latency
+    }
+
+    /// The online controller's model (online mode only).
+    pub(super) fn online_model(&self) -> Option<&Arc<OnlineModel>> {
+        self.online.as_ref().map(|o| &o.model)
+    }
+
+    /// An observation the belief could not take (no hypothesis explains it).
+    pub(super) fn count_update(&mut self, u: Update, no_contact: bool) {
+        if let Some(o) = self.online.as_mut() {
+            o.summary.inconsistent += u64::from(u == Update::Inconsistent);
+            o.summary.no_contact_passes += u64::from(no_contact);
+        }
+    }
+
+    /// A part decided online has finished: its prediction against its outcome.
+    pub(super) fn calibrate(&mut self, predicted: f64, success: bool) {
+        if let Some(o) = self.online.as_mut() {
+            let k = ((predicted * 10.0) as usize).min(9);
+            o.bins[k].0 += 1;
+            o.bins[k].1 += predicted;
+            o.bins[k].2 += u64::from(success);
+        }
     }
 
     /// The decision a reading stands for once the posterior threshold is applied.
@@ -210,6 +315,31 @@ impl Control {
             a.utilisation = if span > 0.0 { a.busy_s / span } else { 0.0 };
         }
         self.summary.late_actuations = self.summary.actuators.iter().map(|a| a.late).sum();
+        if let Some(o) = self.online.as_mut() {
+            let s = &mut o.summary;
+            let n = s.decisions.max(1) as f64;
+            s.entropy_prior_bits /= n;
+            s.entropy_posterior_bits /= n;
+            let parts: u64 = o.bins.iter().map(|b| b.0).sum();
+            let pred: f64 = o.bins.iter().map(|b| b.1).sum();
+            let ok: u64 = o.bins.iter().map(|b| b.2).sum();
+            s.predicted_mean = pred / parts.max(1) as f64;
+            s.observed = ok as f64 / parts.max(1) as f64;
+            s.calibration = o
+                .bins
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| b.0 > 0)
+                .map(|(k, b)| CalibrationBin {
+                    lo: k as f64 / 10.0,
+                    hi: (k + 1) as f64 / 10.0,
+                    parts: b.0,
+                    predicted_mean: b.1 / b.0 as f64,
+                    observed: b.2 as f64 / b.0 as f64,
+                })
+                .collect();
+            self.summary.online = Some(s.clone());
+        }
         self.summary.clone()
     }
 }
@@ -282,6 +412,10 @@ impl Line<'_> {
     /// A sensor's decision on part `index` reaches the controller: the rules turn it into
     /// commands.
     pub(super) fn decide(&mut self, t: f64, index: u64, sensor: usize, decision: Option<usize>) {
+        if self.control.as_ref().is_some_and(|c| c.online.is_some()) {
+            self.decide_online(t, index);
+            return;
+        }
         let Some(c) = self.control.as_mut() else {
             return;
         };
@@ -304,6 +438,192 @@ impl Line<'_> {
             .map(|r| (r.pin, r.target))
             .collect();
         for (pin, target) in commands {
+            self.metrics.work.actuator_commands += 1;
+            c.queues[pin].insert(index, target);
+            if let Some(k) = c.stats_of[pin] {
+                c.summary.actuators[k].commands += 1;
+            }
+        }
+        self.serve(t);
+    }
+
+    /// Online mode: a part enters with the prior belief; for each sensor pin a check is scheduled
+    /// for when it could first be past the pin riding the belt (a pass without contact is
+    /// evidence too).
+    pub(super) fn online_arrival(&mut self, t: f64, index: u64, part: &mut ActivePart) {
+        let Some(model) = self
+            .control
+            .as_ref()
+            .and_then(|c| c.online_model())
+            .cloned()
+        else {
+            return;
+        };
+        part.belief = Some(model.prior.clone());
+        part.sensors_left = model.sensors.len() as u32;
+        for s in &model.sensors {
+            let clear = self.sensor_clear_x(s.obstacle);
+            self.queue.schedule(
+                t + (clear - part.motion.world_pose(t, self.speed()).x).max(0.0) / self.speed(),
+                EventKind::Unread {
+                    part: index,
+                    obstacle: s.obstacle as u32,
+                },
+            );
+        }
+    }
+
+    /// The centroid x beyond which a part can no longer touch sensor pin `j`.
+    fn sensor_clear_x(&self, j: usize) -> f64 {
+        let a = self.scene.part.radius;
+        match &self.scene.obstacles[j] {
+            Obstacle::Pin(p) => p.centre.x + p.radius + a,
+            Obstacle::Fence(_) => self.scene.obstacles[j].x_range()[1] + a,
+        }
+    }
+
+    /// A sensor pin's reading of part `index` (online mode): the belief takes it; once every
+    /// sensor has spoken the decision is scheduled at `t_ready`.
+    pub(super) fn online_reading(
+        &mut self,
+        part: &mut ActivePart,
+        index: u64,
+        j: usize,
+        reading: Option<&crate::sensing::reading::Reading>,
+        t_ready: f64,
+    ) {
+        let Some(c) = self.control.as_mut() else {
+            return;
+        };
+        let Some(model) = c.online_model().cloned() else {
+            return;
+        };
+        let Some(sm) = model.sensor(j) else {
+            return;
+        };
+        if let Some(b) = part.belief.as_mut() {
+            let ll = reading.and_then(|r| sm.log_likelihood(r));
+            let u = b.observe_reading(&sm.p_touch, ll.as_deref());
+            c.count_update(u, false);
+        }
+        self.sensor_spoke(part, index, j, t_ready);
+    }
+
+    fn sensor_spoke(&mut self, part: &mut ActivePart, index: u64, j: usize, t_ready: f64) {
+        part.sensors_left = part.sensors_left.saturating_sub(1);
+        if part.sensors_left == 0 {
+            self.queue.schedule(
+                t_ready,
+                EventKind::Decision {
+                    part: index,
+                    obstacle: j as u32,
+                    hypothesis: u32::MAX,
+                },
+            );
+        }
+    }
+
+    /// Has part `index` gone past sensor pin `j` without touching it? Then that is evidence;
+    /// a part still short of the pin (held upstream) is checked again later.
+    pub(super) fn unread(&mut self, t: f64, index: u64, j: usize) {
+        let v = self.speed();
+        let clear = self.sensor_clear_x(j);
+        let Some(mut part) = self.active.remove(&index) else {
+            return;
+        };
+        if part.sensed.iter().any(|(o, _)| *o == j) {
+            self.active.insert(index, part);
+            return;
+        }
+        let x = part.motion.world_pose(t, v).x;
+        if x < clear {
+            // Held upstream (or pushed back): look again when it could be clear riding the belt.
+            let dt = ((clear - x) / v).max(1e-6);
+            self.queue.schedule(
+                t + dt,
+                EventKind::Unread {
+                    part: index,
+                    obstacle: j as u32,
+                },
+            );
+            self.active.insert(index, part);
+            return;
+        }
+        let model = self
+            .control
+            .as_ref()
+            .and_then(|c| c.online_model())
+            .cloned();
+        if let (Some(model), Some(c)) = (model, self.control.as_mut()) {
+            if let (Some(sm), Some(b)) = (model.sensor(j), part.belief.as_mut()) {
+                let u = b.observe_no_contact(&sm.p_touch);
+                c.count_update(u, true);
+            }
+            let latency = c.latency();
+            self.sensor_spoke(&mut part, index, j, t + latency);
+        }
+        self.active.insert(index, part);
+    }
+
+    /// The online decision for part `index`: the joint command of the dynamic pins that
+    /// maximises P(goal) under its belief, queued like a rule's commands.
+    fn decide_online(&mut self, t: f64, index: u64) {
+        let Some(c) = self.control.as_mut() else {
+            return;
+        };
+        let Some(model) = c.online_model().cloned() else {
+            return;
+        };
+        self.metrics.work.decisions += 1;
+        let Some(part) = self.active.get_mut(&index) else {
+            return;
+        };
+        let Some(belief) = part.belief.as_ref() else {
+            return;
+        };
+        let choice = model.choose(belief);
+        part.predicted = Some(choice.predicted);
+        let (h0, h1) = (model.prior.entropy_bits(), belief.entropy_bits());
+        let action = &model.actions[choice.action];
+        let described: Vec<String> = model
+            .pins
+            .iter()
+            .zip(action)
+            .map(|(&j, t)| format!("{}={}", self.scene.obstacles[j].name(), describe_target(*t)))
+            .collect();
+        let described = described.join(", ");
+        let truth = part.decided.iter().find_map(|d| d.2);
+        let states = model
+            .hypotheses
+            .iter()
+            .map(|h| h.state)
+            .max()
+            .map_or(0, |m| m + 1);
+        let group: Vec<usize> = model.hypotheses.iter().map(|h| h.state).collect();
+        let marginal = belief.marginal(&group, states);
+        let map_state = (0..states).max_by(|&a, &b| marginal[a].total_cmp(&marginal[b]));
+        if let Some(o) = c.online.as_mut() {
+            if let Some(t) = truth {
+                o.summary.state_known += 1;
+                o.summary.state_correct += u64::from(map_state == Some(t));
+            }
+            o.summary.decisions += 1;
+            o.summary.entropy_prior_bits += h0;
+            o.summary.entropy_posterior_bits += h1;
+            *o.summary.chosen.entry(described.clone()).or_default() += 1;
+        }
+        c.log(ControlRecord {
+            t,
+            part: index,
+            obstacle: "online".into(),
+            kind: "decision",
+            what: format!(
+                "{described} (P = {:.3}; entropy {h0:.2} → {h1:.2} bits)",
+                choice.predicted
+            ),
+            motion: None,
+        });
+        for (&pin, &target) in model.pins.iter().zip(action) {
             self.metrics.work.actuator_commands += 1;
             c.queues[pin].insert(index, target);
             if let Some(k) = c.stats_of[pin] {

@@ -31,6 +31,9 @@ pub enum EventKind {
         obstacle: u32,
         hypothesis: u32,
     },
+    /// The online controller asks whether part `part` has gone past sensor pin `obstacle`
+    /// without touching it (evidence for the part's belief).
+    Unread { part: u64, obstacle: u32 },
 }
 
 /// A scheduled event.

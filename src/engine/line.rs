@@ -81,6 +81,11 @@ pub(super) struct ActivePart {
     /// The part's events are valid from this sequence number on: a part planned again after an
     /// actuator moved leaves its older contact, exit and collision events stale.
     pub(super) valid_from: u64,
+    /// Online controller: the part's belief, the sensors still to speak, the prediction its
+    /// decision was taken with.
+    pub(super) belief: Option<crate::sensing::belief::Belief>,
+    pub(super) sensors_left: u32,
+    pub(super) predicted: Option<f64>,
 }
 
 /// The run state: the scene it runs, the event queue, the parts on the belt and what they have
@@ -104,6 +109,44 @@ pub(super) struct Line<'a> {
     pub(super) maps: Option<LineMaps>,
     /// Every push as asked for, when the run captures them ([`run_capturing`]).
     pub(super) captured: Option<Vec<CapturedPush>>,
+    /// A forced first part ([`run_entry`]): its pose and support instead of the feed's draw.
+    entry: Option<Entry>,
+}
+
+/// One part with a given entry pose and support, for [`run_entry`].
+#[derive(Debug, Clone)]
+pub struct Entry {
+    /// Orientation at entry (radians).
+    pub theta: f64,
+    /// Lateral offset of the centroid at entry (m).
+    pub y: f64,
+    /// The part's own contact model (a tripod), else the scene's.
+    pub model: Option<PartModel>,
+}
+
+/// Run the line with one part entering as `entry` says (instead of a draw from the feed), keeping
+/// its record and, with `capture`, every push it met: what the online controller's model
+/// predicts a hypothesis does on the line ([`super::online`]). Same engine, same detection.
+pub fn run_entry(
+    scene: &Scene,
+    entry: Entry,
+    capture: bool,
+) -> Result<(PartRecord, Vec<CapturedPush>), EngineError> {
+    let opts = RunOptions {
+        parts: 1,
+        seed: scene.seed,
+        sample_paths: 0,
+        keep_records: true,
+    };
+    let (mut r, captured) = run_inner(
+        scene,
+        &opts,
+        &mut |_| {},
+        capture.then(Vec::new),
+        Some(entry),
+    )?;
+    let record = r.records.pop().expect("one part, one record");
+    Ok((record, captured))
 }
 
 /// Run the line: a pure function of (scene, options). `progress` is called with the number of
@@ -130,6 +173,16 @@ fn run_with(
     opts: &RunOptions,
     progress: &mut dyn FnMut(u64),
     captured: Option<Vec<CapturedPush>>,
+) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
+    run_inner(scene, opts, progress, captured, None)
+}
+
+fn run_inner(
+    scene: &Scene,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(u64),
+    captured: Option<Vec<CapturedPush>>,
+    entry: Option<Entry>,
 ) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
     let names = scene
         .obstacles
@@ -163,6 +216,7 @@ fn run_with(
         control: Control::new(scene, scene.effects.event_log || opts.sample_paths > 0),
         maps: LineMaps::for_scene(scene),
         captured,
+        entry,
     };
     if opts.parts > 0 {
         line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
@@ -252,6 +306,7 @@ impl Line<'_> {
                 let h = (hypothesis != u32::MAX).then_some(hypothesis as usize);
                 self.decide(t, part, obstacle as usize, h);
             }
+            EventKind::Unread { part, obstacle } => self.unread(t, part, obstacle as usize),
         }
         // A part that moved on may have freed a dynamic pin for the next command.
         if self.control.is_some() {
@@ -261,8 +316,16 @@ impl Line<'_> {
     }
 
     fn arrival(&mut self, t: f64, index: u64) -> Result<(), EngineError> {
-        let d = draw_part(self.scene, self.opts.seed, index)
-            .map_err(|reason| EngineError::PartDraw { index, reason })?;
+        let d = match self.entry.take() {
+            Some(e) => super::part_stream::PartDraw {
+                gap: 0.0,
+                theta: e.theta,
+                y: e.y,
+                model: e.model,
+            },
+            None => draw_part(self.scene, self.opts.seed, index)
+                .map_err(|reason| EngineError::PartDraw { index, reason })?,
+        };
         if d.model.is_some() {
             self.metrics.work.tripods_drawn += 1;
         }
@@ -293,7 +356,11 @@ impl Line<'_> {
             sensed: Vec::new(),
             decided: Vec::new(),
             valid_from: 0,
+            belief: None,
+            sensors_left: 0,
+            predicted: None,
         };
+        self.online_arrival(t, index, &mut part);
         self.plan_next(index, &mut part, t);
         self.active.insert(index, part);
         self.check_pairs(index, t);
@@ -433,6 +500,9 @@ impl Line<'_> {
         self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
         if let Some(c) = self.control.as_mut() {
             c.count_decisions(self.scene, &part.decided, outcome);
+            if let Some(p) = part.predicted {
+                c.calibrate(p, outcome == PartOutcome::Success);
+            }
         }
         self.count_untouched(&part, pose.x);
         self.metrics.cause(outcome, cause);

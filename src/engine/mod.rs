@@ -22,6 +22,7 @@ pub mod event_queue;
 pub mod line;
 pub mod metrics;
 pub mod motion;
+pub mod online;
 pub mod outcome;
 pub mod overlap;
 pub mod pairs;
@@ -29,7 +30,7 @@ pub mod part_stream;
 pub mod results;
 pub mod sensing;
 
-pub use line::{run, run_capturing};
+pub use line::{run, run_capturing, run_entry, Entry};
 pub use metrics::Summary;
 pub use outcome::{OutcomeCounts, PartOutcome};
 pub use results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};

@@ -83,6 +83,8 @@ pub struct SamplePath {
 /// and whether the line recorded its path.
 #[derive(Clone)]
 pub struct CapturedPush {
+    /// The obstacle's index in the scene.
+    pub obstacle: usize,
     pub model: Option<PartModel>,
     pub pusher: Pusher,
     pub pose: Pose,

@@ -41,6 +41,8 @@ pub struct SensedPass {
     pub classification: Classification,
     /// Knots the signal was built from.
     pub knots: usize,
+    /// The reading itself (None: nothing detectable), for the online controller's belief.
+    pub reading: Option<crate::sensing::reading::Reading>,
 }
 
 /// Reads and classifies one pass of part `part` (pose θ `theta` rad just before contact) against
@@ -58,8 +60,9 @@ pub fn sense_pass(
 ) -> SensedPass {
     let signal = ContactSignal::new(outcome, knots, scale);
     let mut rng = stream(seed, reading_stream(part, obstacle));
-    let classification = match read(&signal, &sensor.settings, &mut rng) {
-        Some(r) => sensor.classifier.classify(&r),
+    let reading = read(&signal, &sensor.settings, &mut rng);
+    let classification = match &reading {
+        Some(r) => sensor.classifier.classify(r),
         None => Classification::unknown(),
     };
     let truth = match &sensor.hypotheses {
@@ -70,6 +73,7 @@ pub fn sense_pass(
         truth,
         classification,
         knots: knots.len(),
+        reading,
     }
 }
 

@@ -144,11 +144,16 @@ fn map_tier_line(o: &mut String, m: &crate::engine::metrics::MapTierCounters) {
 /// The controller's block: decisions and how their parts ended, misclassifications and the
 /// failures they caused, and per dynamic pin its commands, moves, late ones, travel and use.
 fn controller_table(o: &mut String, c: &crate::engine::controller::ControllerSummary) {
-    let _ = writeln!(
-        o,
-        "controller                rules from {}, latency {} s, late commands: {}",
-        c.rules_from, c.latency_s, c.on_late
-    );
+    match &c.online {
+        None => {
+            let _ = writeln!(
+                o,
+                "controller                rules from {}, latency {} s, late commands: {}",
+                c.rules_from, c.latency_s, c.on_late
+            );
+        }
+        Some(on) => online_block(o, c, on),
+    }
     for (decision, d) in &c.decisions {
         let _ = writeln!(
             o,
@@ -177,6 +182,49 @@ fn controller_table(o: &mut String, c: &crate::engine::controller::ControllerSum
             a.travel_m,
             a.busy_s,
             100.0 * a.utilisation
+        );
+    }
+}
+
+/// The online controller: its model, the belief's entropy, the prediction beside what the line
+/// did with the same parts, and the calibration bins.
+fn online_block(
+    o: &mut String,
+    c: &crate::engine::controller::ControllerSummary,
+    on: &crate::engine::controller::OnlineSummary,
+) {
+    let _ = writeln!(
+        o,
+        "controller                online: {} hypotheses, {} joint commands ({} line runs to build), latency {} s, late commands: {}",
+        on.hypotheses, on.actions, on.model_runs, c.latency_s, c.on_late
+    );
+    let temper: Vec<String> = on
+        .temper
+        .iter()
+        .map(|(k, v)| format!("{k} {v:.0e}"))
+        .collect();
+    let _ = writeln!(
+        o,
+        "  belief                  {} decisions; entropy {:.2} → {:.2} bits; true state most probable in {} of {}; likelihood power {}; {} passes without contact; {} observations unexplained",
+        on.decisions,
+        on.entropy_prior_bits,
+        on.entropy_posterior_bits,
+        on.state_correct,
+        on.state_known,
+        temper.join(", "),
+        on.no_contact_passes,
+        on.inconsistent
+    );
+    let _ = writeln!(
+        o,
+        "  predicted vs line       predicted {:.3}, the line {:.3} on the same parts",
+        on.predicted_mean, on.observed
+    );
+    for b in &on.calibration {
+        let _ = writeln!(
+            o,
+            "    P in [{:.1}, {:.1})      {:>6} parts: predicted {:.3}, observed {:.3}",
+            b.lo, b.hi, b.parts, b.predicted_mean, b.observed
         );
     }
 }

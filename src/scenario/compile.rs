@@ -62,7 +62,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         &obstacles,
         &part.label,
     )?;
-    Ok(Scene {
+    let mut scene = Scene {
         name,
         seed,
         belt,
@@ -76,7 +76,35 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         output,
         controller,
         map_tier,
-    })
+    };
+    attach_online_model(&c, raw, &mut scene)?;
+    Ok(scene)
+}
+
+/// `[controller] mode = "online"`: build the controller's model from the scene's nominal physics
+/// (docs/physics.md#belief-and-online-replanning). Its errors are located at the belief (or the
+/// mode when the belief is not written).
+fn attach_online_model(c: &Checker, raw: &RawScenario, scene: &mut Scene) -> R<()> {
+    let Some(ctl) = scene.controller.as_ref() else {
+        return Ok(());
+    };
+    let super::dynamic::ControlMode::Online(spec) = &ctl.mode else {
+        return Ok(());
+    };
+    let model = crate::engine::online::OnlineModel::build(scene, spec).map_err(|e| {
+        let at = match raw.controller.as_ref().and_then(|r| r.belief.as_ref()) {
+            Some(_) => "controller.belief",
+            None => "controller.mode",
+        };
+        c.err(
+            at,
+            format!("the online controller's model cannot be built: {e}"),
+        )
+    })?;
+    if let Some(ctl) = scene.controller.as_mut() {
+        ctl.online = Some(super::dynamic::OnlineHandle(std::sync::Arc::new(model)));
+    }
+    Ok(())
 }
 
 /// The μc values the scene's pins push with: the shared part model tabulates its exact slides

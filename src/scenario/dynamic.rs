@@ -74,6 +74,34 @@ pub struct Rule {
     pub target: Target,
 }
 
+/// How the controller turns what the sensors said into commands.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ControlMode {
+    /// Look the decision up in the rules (`[[rules]]` and the policy file).
+    Policy,
+    /// Keep a belief per part and choose, when the sensors have spoken, the commands of the
+    /// dynamic pins that maximise the predicted probability of the goal
+    /// (docs/physics.md#belief-and-online-replanning).
+    Online(BeliefSpec),
+}
+
+/// What the online controller considers possible about a part (`[controller.belief]`): its
+/// hypotheses are stable state × lateral-offset bin × pin–part friction × support class.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeliefSpec {
+    /// Pin–part friction values (each a hypothesis; the scene's μc when not declared).
+    pub mu_c: Vec<f64>,
+    /// Support classes (`uniform`, `tripod`: a random tripod, averaged over `samples` draws).
+    pub support: Vec<super::raw::SupportKind>,
+    /// Lateral-offset bins over the feed's lateral range.
+    pub offsets: usize,
+    /// Simulated members per hypothesis (orientation jitter, offset within its bin, tripods).
+    pub samples: usize,
+    /// Positions per moving pin on the action grid (its travel, evenly; plus home and the
+    /// targets of any rules).
+    pub targets: usize,
+}
+
 /// The controller: computation latency, rules, and what to do when late.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Controller {
@@ -85,4 +113,26 @@ pub struct Controller {
     pub rules: Vec<Rule>,
     /// Where the rules came from: "scenario" or the policy file's path.
     pub source: String,
+    /// Rules or online replanning.
+    pub mode: ControlMode,
+    /// The online controller's model (built with the scene from its nominal physics; shared by
+    /// the scenes a study draws from it, so that the controller never sees a sample's physics).
+    pub online: Option<OnlineHandle>,
+}
+
+/// The online model behind an `Arc`; two handles are equal when they share the model (a model
+/// is a function of the scene and the belief spec, which the controller's equality covers).
+#[derive(Clone)]
+pub struct OnlineHandle(pub std::sync::Arc<crate::engine::online::OnlineModel>);
+
+impl PartialEq for OnlineHandle {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for OnlineHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "OnlineModel({} hypotheses)", self.0.hypotheses.len())
+    }
 }

@@ -12,7 +12,9 @@
 //! * a policy file must be written for the scenario's part.
 
 use super::checker::Checker;
-use super::dynamic::{Actuator, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target};
+use super::dynamic::{
+    Actuator, BeliefSpec, ControlMode, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target,
+};
 use super::error::Locator;
 use super::limits;
 use super::raw::{ObstacleKind, RawController, RawObstacle, RawPolicy, RawRule};
@@ -164,6 +166,7 @@ pub(super) fn controller(
             ))
         }
     };
+    let mode = control_mode(c, &rc, obstacles)?;
     let mut compiled = compile_rules(c, "rules", rules, obstacles, on_late)?;
     check_conflicts(c, &compiled, 0)?;
     let mut source = "scenario".to_string();
@@ -178,7 +181,96 @@ pub(super) fn controller(
         on_late,
         rules: compiled.into_iter().map(|(_, r)| r).collect(),
         source,
+        mode,
+        online: None,
     }))
+}
+
+/// `[controller] mode` and `[controller.belief]`.
+fn control_mode(c: &Checker, rc: &RawController, obstacles: &[Obstacle]) -> R<ControlMode> {
+    match rc.mode.as_deref() {
+        None | Some("policy") => {
+            if rc.belief.is_some() {
+                return Err(c.err(
+                    "controller.belief",
+                    "a belief is used by the online controller only: set [controller] mode = \"online\" or remove [controller.belief]",
+                ));
+            }
+            Ok(ControlMode::Policy)
+        }
+        Some("online") => {
+            let rb = rc.belief.clone().unwrap_or_default();
+            let count = |key: &str, v: Option<usize>, dflt: usize, r: (f64, f64)| -> R<usize> {
+                match v {
+                    None => Ok(dflt),
+                    Some(n) => c
+                        .within(&format!("controller.belief.{key}"), n as f64, r.0, r.1, "a count")
+                        .map(|_| n),
+                }
+            };
+            let mu_c = match rb.mu_c {
+                None => Vec::new(),
+                Some(v) => {
+                    if v.is_empty() || v.len() > limits::BELIEF_MU_VALUES {
+                        return Err(c.err(
+                            "controller.belief.mu_c",
+                            format!(
+                                "must list 1 to {} friction values, got {}",
+                                limits::BELIEF_MU_VALUES,
+                                v.len()
+                            ),
+                        ));
+                    }
+                    for (i, &m) in v.iter().enumerate() {
+                        c.range(&format!("controller.belief.mu_c[{i}]"), m, limits::FRICTION, "friction")?;
+                    }
+                    v
+                }
+            };
+            let support = rb.support.unwrap_or_default();
+            if support.len() > 2 {
+                return Err(c.err(
+                    "controller.belief.support",
+                    "lists support classes, \"uniform\" and/or \"tripod\", each once",
+                ));
+            }
+            let first_dynamic = obstacles
+                .iter()
+                .filter(|o| matches!(o, Obstacle::Pin(p) if p.actuator.is_some()))
+                .map(|o| o.x_range()[0])
+                .fold(f64::INFINITY, f64::min);
+            let sensors: Vec<&Obstacle> = obstacles
+                .iter()
+                .filter(|o| matches!(o, Obstacle::Pin(p) if p.sensor.is_some()))
+                .collect();
+            if sensors.is_empty() {
+                return Err(c.err(
+                    "controller.mode",
+                    "the online controller needs a sensor pin to update its belief from: add an obstacle of kind \"sensor_pin\"",
+                ));
+            }
+            if let Some(s) = sensors.iter().find(|o| o.x_range()[1] >= first_dynamic) {
+                return Err(c.err(
+                    "controller.mode",
+                    format!(
+                        "the online controller decides once every sensor has read the part, so every sensor pin must stand upstream of every dynamic pin; sensor \"{}\" is not",
+                        s.name()
+                    ),
+                ));
+            }
+            Ok(ControlMode::Online(BeliefSpec {
+                mu_c,
+                support,
+                offsets: count("offsets", rb.offsets, 5, limits::BELIEF_OFFSETS)?,
+                samples: count("samples", rb.samples, 4, limits::BELIEF_SAMPLES)?,
+                targets: count("targets", rb.targets, 25, limits::BELIEF_TARGETS)?,
+            }))
+        }
+        Some(other) => Err(c.err(
+            "controller.mode",
+            format!("must be \"policy\" (look decisions up in the rules) or \"online\" (replan from a belief per part), got \"{other}\""),
+        )),
+    }
 }
 
 /// The scenario's rules followed by those read from a policy file; a policy's errors (and a

@@ -98,6 +98,13 @@ pub const ACTUATOR_ACCEL: (f64, f64) = (1e-6, 1e6);
 /// Actuator and controller times: settle, raise and lower times, decision latency (s).
 pub const ACTUATOR_TIME: (f64, f64) = (0.0, 1e4);
 
+/// `[controller.belief]`: lateral-offset bins, members per hypothesis, positions per moving pin
+/// on the online controller's action grid, friction values (bounded build time and memory).
+pub const BELIEF_OFFSETS: (f64, f64) = (1.0, 41.0);
+pub const BELIEF_SAMPLES: (f64, f64) = (1.0, 64.0);
+pub const BELIEF_TARGETS: (f64, f64) = (2.0, 101.0);
+pub const BELIEF_MU_VALUES: usize = 16;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -25,7 +25,10 @@ pub mod scene;
 pub mod sensors;
 pub mod shared_feed;
 
-pub use dynamic::{Actuator, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target};
+pub use dynamic::{
+    Actuator, BeliefSpec, ControlMode, Controller, MovingSpec, OnLate, OnlineHandle, RetractSpec,
+    Rule, Target,
+};
 pub use error::{InvalidScenario, ScenarioError};
 pub use scene::*;
 pub use shared_feed::{FeedMismatch, FeedSource};

@@ -185,6 +185,21 @@ pub struct RawController {
     pub on_late: Option<String>,
     /// A policy file (rules written by `pinfeed plan`), relative to the scenario file.
     pub policy: Option<String>,
+    /// `policy` (default: the rules) or `online` (replanning from a belief per part).
+    pub mode: Option<String>,
+    /// What the online controller considers possible about a part.
+    pub belief: Option<RawBelief>,
+}
+
+/// `[controller.belief]` (docs/scenario-format.md#online-controller).
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RawBelief {
+    pub mu_c: Option<Vec<f64>>,
+    pub support: Option<Vec<SupportKind>>,
+    pub offsets: Option<usize>,
+    pub samples: Option<usize>,
+    pub targets: Option<usize>,
 }
 
 /// `[[rules]]`: when `sensor` decides `decides`, bring `pin` to `y` (a moving pin) or `raised`

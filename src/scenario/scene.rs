@@ -22,7 +22,7 @@ pub struct Belt {
 }
 
 /// The part: its polygon in metres (centroid at the origin) and its contact model.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct PartSpec {
     /// How the part was named in the file (`tripoly2`, or `vertices`).
     pub label: String,
@@ -290,7 +290,7 @@ pub struct OutputOptions {
 }
 
 /// A compiled, validated scenario.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Scene {
     pub name: String,
     pub seed: u64,

@@ -11,6 +11,7 @@
 //! * [`evaluate`]: classifiers scored on simulated trials (confusion, accuracy, mutual information);
 //! * [`placement`]: which pin offset and sensor kind tell the hypotheses apart best.
 
+pub mod belief;
 pub mod classify;
 pub mod confusion;
 pub mod evaluate;

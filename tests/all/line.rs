@@ -153,6 +153,7 @@ fn events_are_processed_in_time_order_with_ties_in_sequence_order() {
             | engine::event_queue::EventKind::ContactEnd { part, .. }
             | engine::event_queue::EventKind::Exit { part }
             | engine::event_queue::EventKind::Decision { part, .. }
+            | engine::event_queue::EventKind::Unread { part, .. }
             | engine::event_queue::EventKind::Arrival { part } => part == 7,
             engine::event_queue::EventKind::Collision { first, second } => {
                 first == 7 || second == 7

@@ -18,6 +18,7 @@ mod support;
 
 mod accuracy_study;
 mod animate;
+mod belief;
 mod cli_contact;
 mod cli_part;
 mod cli_sense;

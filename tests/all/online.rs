@@ -12,12 +12,12 @@ fn source() -> String {
     std::fs::read_to_string(SENSING).unwrap()
 }
 
-fn parse(text: &str) -> Scene {
+pub(crate) fn parse(text: &str) -> Scene {
     scenario::parse(Path::new("test.toml"), text).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The error a scenario text is refused with.
-fn refused(text: &str) -> String {
+pub(crate) fn refused(text: &str) -> String {
     match scenario::parse(Path::new("bad.toml"), text) {
         Ok(_) => panic!("accepted:\n{text}"),
         Err(e) => e.to_string(),

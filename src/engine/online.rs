@@ -1,0 +1,628 @@
+//! The online controller's model (docs/physics.md#belief-and-online-replanning): hypotheses
+//! about a part, what each makes the sensors read, and what each does on the line under every
+//! joint command of the dynamic pins.
+//!
+//! Built once per scene from its **nominal** physics and the declared `[controller.belief]`:
+//! * **Hypotheses** h = stable state × lateral-offset bin × pin–part friction μ × support class,
+//!   each with a prior (the feed's state weight × the bin's share of the lateral distribution,
+//!   uniform over μ and support classes).
+//! * **Members**: `samples` simulated parts per hypothesis, drawn from the controller's own
+//!   streams (seed, 3·2⁶¹ | h·2¹⁶ | m): the feed's orientation jitter about the state, an offset
+//!   uniform within the bin, and a random tripod for the tripod class. The member is the unit of
+//!   prediction; the hypothesis averages its members (what the controller cannot resolve).
+//! * **Sensors**: each member is run through the line (the same engine, [`super::run_entry`]);
+//!   its push at each sensor pin, replayed with a knot recorder, is that member's template. Per
+//!   sensor, p_touch(h) is the share of h's members that touch it, and a likelihood classifier
+//!   ([`crate::sensing::classify::likelihood`]) over the hypotheses' templates gives
+//!   log p(reading | h, touch).
+//! * **Actions**: the joint commands of the dynamic pins: each moving pin on a grid of `targets`
+//!   positions over its travel plus its home and the targets its rules name, each retractable
+//!   pin raised or withdrawn. For every action and member the line is run with the pins standing
+//!   at the action's targets; success[a][h] is the share of h's members that end in the goal.
+//!
+//! A decision is then a dot product per action: P(goal | a) = Σ_h p(h | readings) · success[a][h],
+//! maximised over the actions (ties: the least travel from where the pins stand).
+
+use super::line::{run_entry, Entry};
+use crate::mechanics::{PartModel, Support};
+use crate::random::stream;
+use crate::scenario::raw::SupportKind;
+use crate::scenario::{
+    Actuator, BeliefSpec, Lateral, Obstacle, Orientation, PinObstacle, Scene, Target,
+};
+use crate::sensing::belief::Belief;
+use crate::sensing::classify::likelihood::Likelihood;
+use crate::sensing::classify::ClassifierOptions;
+use crate::sensing::reading::{read, Reading};
+use crate::sensing::signal::{ContactSignal, KnotRecorder, SignalScale};
+use crate::sensing::templates::TemplateSet;
+use rand::RngExt;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+
+/// First stream index of the online model's members.
+const MEMBER_STREAMS: u64 = 3 << 61;
+/// First stream index of the held-out members' readings.
+const HELD_OUT_READINGS: u64 = 5 << 60;
+/// Largest joint action set and largest number of line runs a model may take to build.
+pub const MAX_ACTIONS: usize = 4096;
+pub const MAX_RUNS: usize = 4_000_000;
+/// Predictions closer than this are a tie: they are shares of a few simulated members, and a
+/// belief that is all but certain leaves differences far below it.
+pub const TIE: f64 = 1e-3;
+/// Orientation sectors standing for the states of a uniform feed.
+const UNIFORM_SECTORS: usize = 12;
+
+/// One hypothesis about a part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hypothesis {
+    /// State index and its orientation (degrees).
+    pub state: usize,
+    pub state_deg: f64,
+    /// The lateral-offset bin [lo, hi] (m).
+    pub offset: [f64; 2],
+    pub mu_c: f64,
+    pub support: SupportKind,
+}
+
+/// What one sensor tells about the hypotheses.
+pub struct SensorModel {
+    /// The sensor pin's obstacle index.
+    pub obstacle: usize,
+    /// Per hypothesis: the share of its members that touch the pin.
+    pub p_touch: Vec<f64>,
+    /// The likelihood over the hypotheses that touch (None: no member touches).
+    likelihood: Option<Likelihood>,
+    /// Hypothesis of each of the likelihood's labels.
+    rows: Vec<usize>,
+    /// The power the likelihood is raised to (1: trusted as it is; see [`temper`]).
+    pub temper: f64,
+}
+
+/// The online controller's model; see the module notes.
+pub struct OnlineModel {
+    pub hypotheses: Vec<Hypothesis>,
+    pub prior: Belief,
+    pub sensors: Vec<SensorModel>,
+    /// The dynamic pins (obstacle indices) and the joint actions over them.
+    pub pins: Vec<usize>,
+    pub actions: Vec<Vec<Target>>,
+    /// Number of options per pin (the actions are their product, the last pin fastest).
+    options: Vec<usize>,
+    /// Each dynamic pin's state before any command.
+    homes: Vec<Target>,
+    /// success[a · H + h].
+    success: Vec<f64>,
+    /// Members per hypothesis and line runs the build took.
+    pub samples: usize,
+    pub runs: u64,
+}
+
+/// The controller's choice for one part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Choice {
+    /// Index into [`OnlineModel::actions`].
+    pub action: usize,
+    /// P(goal | action, belief).
+    pub predicted: f64,
+}
+
+impl OnlineModel {
+    /// Build the model of `scene` (its nominal physics) for `spec`. Errors name the size that is
+    /// too large or the hypothesis set that is empty.
+    pub fn build(scene: &Scene, spec: &BeliefSpec) -> Result<OnlineModel, String> {
+        let (hypotheses, prior) = hypotheses(scene, spec);
+        let prior = Belief::new(&prior).ok_or("the belief's prior has no positive weight")?;
+        let pins = indices(scene, |p| p.actuator.is_some());
+        let (actions, options) = joint_actions(scene, &pins, spec.targets)?;
+        let s = spec.samples;
+        let n_members = hypotheses.len() * s;
+        let runs = n_members * (actions.len() + 1);
+        if runs > MAX_RUNS {
+            return Err(format!(
+                "the online model would run the line {runs} times ({} hypotheses × {s} samples × {} actions; at most {MAX_RUNS}): lower controller.belief.offsets, samples or targets, or the friction values",
+                hypotheses.len(),
+                actions.len()
+            ));
+        }
+        let members: Vec<(usize, Entry)> = (0..n_members)
+            .map(|k| member(scene, &hypotheses[k / s], k / s, k % s).map(|e| (k / s, e)))
+            .collect::<Result<_, String>>()?;
+        let mus = distinct(hypotheses.iter().map(|h| h.mu_c));
+        let variant_of = |a: Option<&[Target]>, mu: f64| variant(scene, &pins, a, mu);
+        let sensing: Vec<Scene> = mus.iter().map(|&m| variant_of(None, m)).collect();
+        let scenes: Vec<Vec<Scene>> = actions
+            .iter()
+            .map(|a| mus.iter().map(|&m| variant_of(Some(a), m)).collect())
+            .collect();
+        let mu_index = |mu: f64| mus.iter().position(|&m| m == mu).expect("listed μ");
+        let sensor_obstacles = indices(scene, |p| p.sensor.is_some());
+        let signals_of = |h: usize, e: &Entry| -> Result<Vec<Option<ContactSignal>>, String> {
+            let base = &sensing[mu_index(hypotheses[h].mu_c)];
+            sensor_signals(scene, base, &sensor_obstacles, e)
+        };
+        // Per member: its signal at each sensor (None: no touch) and its success per action.
+        type MemberOut = (Vec<Option<ContactSignal>>, Vec<bool>);
+        let outs: Vec<MemberOut> = members
+            .par_iter()
+            .map(|(h, e)| -> Result<MemberOut, String> {
+                let mi = mu_index(hypotheses[*h].mu_c);
+                let signals = signals_of(*h, e)?;
+                let ok = scenes
+                    .iter()
+                    .map(|per_mu| {
+                        run_entry(&per_mu[mi], e.clone(), false)
+                            .map(|(r, _)| r.outcome == "success")
+                            .map_err(|e| e.to_string())
+                    })
+                    .collect::<Result<Vec<bool>, String>>()?;
+                Ok((signals, ok))
+            })
+            .collect::<Result<_, String>>()?;
+        // Held-out members (other streams) calibrate how far each sensor's likelihood can be
+        // trusted (see `temper`).
+        let v = (s / 2).max(2);
+        let held_out: Vec<(usize, Vec<Option<ContactSignal>>)> = (0..hypotheses.len() * v)
+            .into_par_iter()
+            .map(|k| {
+                let (h, m) = (k / v, s + k % v);
+                let e = member(scene, &hypotheses[h], h, m)?;
+                Ok((h, signals_of(h, &e)?))
+            })
+            .collect::<Result<_, String>>()?;
+        let n_h = hypotheses.len();
+        let mut success = vec![0.0; actions.len() * n_h];
+        for (k, (_, ok)) in outs.iter().enumerate() {
+            for (a, &yes) in ok.iter().enumerate() {
+                success[a * n_h + k / s] += f64::from(u8::from(yes)) / s as f64;
+            }
+        }
+        let mut sensors = Vec::new();
+        for (i, &j) in sensor_obstacles.iter().enumerate() {
+            let Obstacle::Pin(pin) = &scene.obstacles[j] else {
+                continue;
+            };
+            let sensor = pin.sensor.as_ref().expect("a sensor pin");
+            let mut p_touch = vec![0.0; n_h];
+            let mut set = TemplateSet {
+                labels: Vec::new(),
+                members: Vec::new(),
+            };
+            let mut rows = Vec::new();
+            for h in 0..n_h {
+                let sigs: Vec<ContactSignal> = (0..s)
+                    .filter_map(|m| outs[h * s + m].0[i].clone())
+                    .collect();
+                p_touch[h] = sigs.len() as f64 / s as f64;
+                if !sigs.is_empty() {
+                    rows.push(h);
+                    set.labels.push(format!("h{h}"));
+                    set.members.push(sigs);
+                }
+            }
+            let likelihood = if rows.is_empty() {
+                None
+            } else {
+                Some(
+                    Likelihood::new(&set, &sensor.settings, &ClassifierOptions::default())
+                        .map_err(|e| format!("sensor \"{}\": {e}", pin.name))?,
+                )
+            };
+            let mut sm = SensorModel {
+                obstacle: j,
+                p_touch,
+                likelihood,
+                rows,
+                temper: 1.0,
+            };
+            let trials: Vec<(usize, Vec<f64>)> = held_out
+                .iter()
+                .enumerate()
+                .filter_map(|(k, (h, sigs))| {
+                    let sig = sigs[i].as_ref()?;
+                    let mut rng =
+                        stream(scene.seed, HELD_OUT_READINGS | ((k as u64) << 8) | i as u64);
+                    let r = read(sig, &sensor.settings, &mut rng)?;
+                    Some((*h, sm.log_likelihood(&r)?))
+                })
+                .collect();
+            sm.temper = temper(&prior, &sm.p_touch, &trials);
+            sensors.push(sm);
+        }
+        let homes = pins.iter().map(|&j| home_of(&scene.obstacles[j])).collect();
+        Ok(OnlineModel {
+            hypotheses,
+            prior,
+            sensors,
+            pins,
+            actions,
+            options,
+            homes,
+            success,
+            samples: s,
+            runs: runs as u64,
+        })
+    }
+
+    /// The model of sensor pin `obstacle`, if it is one.
+    pub fn sensor(&self, obstacle: usize) -> Option<&SensorModel> {
+        self.sensors.iter().find(|s| s.obstacle == obstacle)
+    }
+
+    /// The action that maximises P(goal) under `belief`. Ties (within [`TIE`]) go to the action whose grid
+    /// neighbours (one step of one pin) do best on average — the middle of a range of good
+    /// positions, the most robust to what the model does not know — then to the least travel
+    /// from the pins' homes. The choice is a function of the belief alone (not of where the pins
+    /// happen to stand), so a rule table can reproduce it.
+    pub fn choose(&self, belief: &Belief) -> Choice {
+        let current = &self.homes;
+        let n_h = self.hypotheses.len();
+        let w = belief.probabilities();
+        let p: Vec<f64> = (0..self.actions.len())
+            .map(|a| {
+                let row = &self.success[a * n_h..(a + 1) * n_h];
+                w.iter().zip(row).map(|(w, s)| w * s).sum()
+            })
+            .collect();
+        let key = |a: usize| {
+            let nb = self.neighbours(a);
+            let around = nb.iter().map(|&b| p[b]).sum::<f64>() / nb.len().max(1) as f64;
+            (p[a], around, -travel(&self.actions[a], current))
+        };
+        let mut best = 0;
+        let mut best_key = key(0);
+        for a in 1..self.actions.len() {
+            let k = key(a);
+            let better = if (k.0 - best_key.0).abs() > TIE {
+                k.0 > best_key.0
+            } else if (k.1 - best_key.1).abs() > TIE {
+                k.1 > best_key.1
+            } else {
+                k.2 > best_key.2 + 1e-12
+            };
+            if better {
+                best = a;
+                best_key = k;
+            }
+        }
+        Choice {
+            action: best,
+            predicted: p[best].clamp(0.0, 1.0),
+        }
+    }
+
+    /// The actions one grid step of one pin away from action `a`.
+    fn neighbours(&self, a: usize) -> Vec<usize> {
+        let mut out = Vec::new();
+        let mut stride = 1;
+        for size in self.options.iter().rev() {
+            let digit = (a / stride) % size;
+            if digit > 0 {
+                out.push(a - stride);
+            }
+            if digit + 1 < *size {
+                out.push(a + stride);
+            }
+            stride *= size;
+        }
+        out
+    }
+
+    /// success[a][h] for every hypothesis.
+    pub fn success_of(&self, action: usize) -> &[f64] {
+        let n_h = self.hypotheses.len();
+        &self.success[action * n_h..(action + 1) * n_h]
+    }
+}
+
+impl SensorModel {
+    /// log p(reading | h, touch) per hypothesis (−∞ for one that never touches); None when the
+    /// reading carries no usable signal (no contact detected in it).
+    pub fn log_likelihood(&self, reading: &Reading) -> Option<Vec<f64>> {
+        let ll = self.likelihood.as_ref()?.log_likelihoods(reading)?;
+        let mut out = vec![f64::NEG_INFINITY; self.p_touch.len()];
+        for (k, &h) in self.rows.iter().enumerate() {
+            out[h] = self.temper * ll[k];
+        }
+        Some(out)
+    }
+}
+
+/// The power τ the sensor's likelihood is raised to: the matched filter's noise model knows the
+/// sensor's noise only, not how far a real push strays from every simulated member (another
+/// tripod, another jitter), so its raw likelihood is far too sharp and one reading would make the
+/// belief certain of a wrong hypothesis. τ is chosen on held-out members (readings the
+/// likelihood was not built from) to maximise the mean log posterior of their true hypothesis —
+/// a fractional (tempered) likelihood, calibrated by cross-validation — from 1 down to 10⁻⁶ in
+/// half-decades.
+fn temper(prior: &Belief, p_touch: &[f64], trials: &[(usize, Vec<f64>)]) -> f64 {
+    if trials.is_empty() {
+        return 1.0;
+    }
+    let taus: Vec<f64> = (0..=12).map(|k| 10f64.powf(-(k as f64) / 2.0)).collect();
+    let score = |tau: f64| -> f64 {
+        trials
+            .iter()
+            .map(|(h, ll)| {
+                let mut b = prior.clone();
+                let scaled: Vec<f64> = ll.iter().map(|l| tau * l).collect();
+                b.observe_reading(p_touch, Some(&scaled));
+                b.probability(*h).max(1e-300).ln()
+            })
+            .sum()
+    };
+    taus.iter()
+        .map(|&t| (t, score(t)))
+        .fold((1.0, f64::NEG_INFINITY), |best, (t, sc)| {
+            if sc > best.1 {
+                (t, sc)
+            } else {
+                best
+            }
+        })
+        .0
+}
+
+/// Each sensor's clean signal when a part entering as `e` meets it on the line `base` (None:
+/// the part passes without touching).
+fn sensor_signals(
+    scene: &Scene,
+    base: &Scene,
+    sensors: &[usize],
+    e: &Entry,
+) -> Result<Vec<Option<ContactSignal>>, String> {
+    let (_, pushes) = run_entry(base, e.clone(), true).map_err(|e| e.to_string())?;
+    Ok(sensors
+        .iter()
+        .map(|&j| {
+            let p = pushes.iter().find(|p| p.obstacle == j)?;
+            let Obstacle::Pin(pin) = &scene.obstacles[j] else {
+                return None;
+            };
+            let sensor = pin.sensor.as_ref()?;
+            let model = p.model.as_ref().unwrap_or(&base.part.model);
+            let mut knots = KnotRecorder::default();
+            let out = p.pusher.push(model, p.pose, &p.settings, Some(&mut knots));
+            out.contact.then(|| {
+                let scale = SignalScale {
+                    mass: scene.part.mass,
+                    belt_speed: scene.belt.speed,
+                    height: sensor.settings.height,
+                    metres_per_unit: 1.0,
+                };
+                ContactSignal::new(&out, &knots.samples, &scale)
+            })
+        })
+        .collect())
+}
+
+/// The hypotheses and their prior weights.
+fn hypotheses(scene: &Scene, spec: &BeliefSpec) -> (Vec<Hypothesis>, Vec<f64>) {
+    let states: Vec<(f64, f64)> = match &scene.feed.orientation {
+        Orientation::Stable {
+            thetas, weights, ..
+        } => thetas
+            .iter()
+            .zip(weights)
+            .map(|(t, w)| (t.to_degrees(), *w))
+            .collect(),
+        Orientation::Uniform => (0..UNIFORM_SECTORS)
+            .map(|k| ((k as f64 + 0.5) * 360.0 / UNIFORM_SECTORS as f64, 1.0))
+            .collect(),
+    };
+    let bins = offset_bins(&scene.feed.lateral, spec.offsets);
+    let mus = if spec.mu_c.is_empty() {
+        vec![scene.contact.mu_c]
+    } else {
+        spec.mu_c.clone()
+    };
+    let supports = if spec.support.is_empty() {
+        vec![scene.part.support]
+    } else {
+        spec.support.clone()
+    };
+    let mut hs = Vec::new();
+    let mut prior = Vec::new();
+    for (state, &(deg, w)) in states.iter().enumerate() {
+        for &(lo, hi, mass) in &bins {
+            for &mu in &mus {
+                for &support in &supports {
+                    hs.push(Hypothesis {
+                        state,
+                        state_deg: deg,
+                        offset: [lo, hi],
+                        mu_c: mu,
+                        support,
+                    });
+                    prior.push(w * mass);
+                }
+            }
+        }
+    }
+    (hs, prior)
+}
+
+/// Lateral-offset bins (lo, hi, probability mass) over the feed's lateral range.
+fn offset_bins(lateral: &Lateral, n: usize) -> Vec<(f64, f64, f64)> {
+    let (lo, hi, pdf): (f64, f64, Box<dyn Fn(f64) -> f64>) = match *lateral {
+        Lateral::Fixed(y) => return vec![(y, y, 1.0)],
+        Lateral::Uniform { min, max } => (min, max, Box::new(|_| 1.0)),
+        Lateral::Normal { mean, sd, lo, hi } => (
+            lo.max(mean - 3.0 * sd),
+            hi.min(mean + 3.0 * sd),
+            Box::new(move |y: f64| (-0.5 * ((y - mean) / sd).powi(2)).exp()),
+        ),
+    };
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        return vec![(lo, lo, 1.0)];
+    }
+    let w = (hi - lo) / n as f64;
+    (0..n)
+        .map(|k| {
+            let (a, b) = (lo + k as f64 * w, lo + (k + 1) as f64 * w);
+            // Midpoint rule over 32 sub-intervals: the bin's share of the density.
+            let mass: f64 = (0..32).map(|i| pdf(a + (i as f64 + 0.5) * w / 32.0)).sum();
+            (a, b, mass)
+        })
+        .collect()
+}
+
+/// Member `m` of hypothesis `h`: its entry pose and support.
+fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, String> {
+    let mut rng = stream(scene.seed, MEMBER_STREAMS | ((h as u64) << 16) | m as u64);
+    let theta_deg = match &scene.feed.orientation {
+        Orientation::Stable { jitter, .. } => {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            hyp.state_deg + jitter.to_degrees() * z
+        }
+        Orientation::Uniform => {
+            let u: f64 = rng.random();
+            hyp.state_deg + (u - 0.5) * 360.0 / UNIFORM_SECTORS as f64
+        }
+    };
+    let u: f64 = rng.random();
+    let y = hyp.offset[0] + u * (hyp.offset[1] - hyp.offset[0]);
+    let model = match hyp.support {
+        SupportKind::Uniform => None,
+        SupportKind::Tripod => {
+            let support = Support::random_tripod(&scene.part.polygon, &mut rng)?;
+            Some(PartModel::new(&scene.part.polygon, &support)?)
+        }
+    };
+    Ok(Entry {
+        theta: theta_deg.to_radians().rem_euclid(std::f64::consts::TAU),
+        y,
+        model,
+    })
+}
+
+/// The scene as a static line: every dynamic pin standing at `action` (or at home), every pin
+/// pushing with friction `mu`, sensor pins plain pins, no controller.
+fn variant(scene: &Scene, pins: &[usize], action: Option<&[Target]>, mu: f64) -> Scene {
+    let mut v = scene.clone();
+    v.controller = None;
+    v.contact.mu_c = mu;
+    v.effects.event_log = false;
+    for (k, &j) in pins.iter().enumerate() {
+        let target = action.map(|a| a[k]);
+        if let Obstacle::Pin(p) = &mut v.obstacles[j] {
+            match (&mut p.actuator, target) {
+                (Some(Actuator::Moving(m)), Some(Target::Y(y))) => {
+                    m.home = y;
+                    p.centre.y = y;
+                }
+                (Some(Actuator::Retractable(r)), Some(Target::Raised(up))) => r.raised = up,
+                _ => {}
+            }
+        }
+    }
+    for o in &mut v.obstacles {
+        if let Obstacle::Pin(p) = o {
+            p.mu_c = mu;
+            p.sensor = None;
+        }
+    }
+    v
+}
+
+/// The joint actions over `pins`.
+fn joint_actions(
+    scene: &Scene,
+    pins: &[usize],
+    targets: usize,
+) -> Result<(Vec<Vec<Target>>, Vec<usize>), String> {
+    let mut per_pin: Vec<Vec<Target>> = Vec::new();
+    for &j in pins {
+        let Obstacle::Pin(p) = &scene.obstacles[j] else {
+            continue;
+        };
+        let named = scene
+            .controller
+            .iter()
+            .flat_map(|c| c.rules.iter())
+            .filter(|r| r.pin == j)
+            .map(|r| r.target);
+        let options = match p.actuator {
+            Some(Actuator::Moving(m)) => {
+                let [lo, hi] = m.travel;
+                let mut ys: Vec<f64> = (0..targets)
+                    .map(|k| lo + (hi - lo) * k as f64 / (targets - 1) as f64)
+                    .chain([m.home])
+                    .chain(named.filter_map(|t| match t {
+                        Target::Y(y) => Some(y),
+                        Target::Raised(_) => None,
+                    }))
+                    .collect();
+                ys.sort_by(f64::total_cmp);
+                ys.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+                ys.into_iter().map(Target::Y).collect()
+            }
+            _ => vec![Target::Raised(true), Target::Raised(false)],
+        };
+        per_pin.push(options);
+    }
+    let n: usize = per_pin.iter().map(Vec::len).product();
+    if n > MAX_ACTIONS {
+        return Err(format!(
+            "the dynamic pins have {n} joint commands on the action grid (at most {MAX_ACTIONS}): lower controller.belief.targets"
+        ));
+    }
+    let sizes = per_pin.iter().map(Vec::len).collect();
+    let mut out: Vec<Vec<Target>> = vec![Vec::new()];
+    for options in &per_pin {
+        out = out
+            .into_iter()
+            .flat_map(|prefix| {
+                options.iter().map(move |t| {
+                    let mut a = prefix.clone();
+                    a.push(*t);
+                    a
+                })
+            })
+            .collect();
+    }
+    Ok((out, sizes))
+}
+
+/// A dynamic pin's state before any command.
+fn home_of(o: &Obstacle) -> Target {
+    match o {
+        Obstacle::Pin(p) => match p.actuator {
+            Some(Actuator::Moving(m)) => Target::Y(m.home),
+            Some(Actuator::Retractable(r)) => Target::Raised(r.raised),
+            None => Target::Y(p.centre.y),
+        },
+        Obstacle::Fence(_) => Target::Raised(true),
+    }
+}
+
+/// Total travel from `current` to `action` (a retractable switch counts 1 mm).
+fn travel(action: &[Target], current: &[Target]) -> f64 {
+    action
+        .iter()
+        .zip(current)
+        .map(|(a, c)| match (a, c) {
+            (Target::Y(a), Target::Y(c)) => (a - c).abs(),
+            (Target::Raised(a), Target::Raised(c)) => f64::from(u8::from(a != c)) * 1e-3,
+            _ => 0.0,
+        })
+        .sum()
+}
+
+/// The obstacle indices of the pins for which `pick` holds.
+fn indices(scene: &Scene, pick: impl Fn(&PinObstacle) -> bool) -> Vec<usize> {
+    scene
+        .obstacles
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| matches!(o, Obstacle::Pin(p) if pick(p)))
+        .map(|(j, _)| j)
+        .collect()
+}
+
+fn distinct(values: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut v: Vec<f64> = values.collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
