@@ -32,7 +32,7 @@ pub enum Place {
 }
 
 /// The keys moved in pairs and the values each takes.
-pub const PAIR_KEYS: [(Place, &str, &[&str]); 30] = [
+pub const PAIR_KEYS: [(Place, &str, &[&str]); 31] = [
     (
         Place::Obstacle("moving_pin"),
         "speed",
@@ -166,6 +166,11 @@ pub const PAIR_KEYS: [(Place, &str, &[&str]); 30] = [
         Place::Section("controller"),
         "on_late",
         &["\"skip\"", "\"move\"", "\"wait\""],
+    ),
+    (
+        Place::Section("controller"),
+        "mode",
+        &["\"policy\"", "\"online\"", "\"bogus\""],
     ),
     (
         Place::Rule,
