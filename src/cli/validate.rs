@@ -266,6 +266,8 @@ pub struct ValidateReport<'a> {
     pub uncertain: Vec<String>,
     pub members: usize,
     pub score_settings: ScoreSettings,
+    /// What `contained` and the verdicts mean ([`containment_text`]).
+    pub containment: String,
     pub summary: &'a Summary,
     pub rows: &'a [RowScore],
 }
@@ -389,6 +391,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         uncertain: spec.describe(),
         members: args.members,
         score_settings: score,
+        containment: containment_text(score.contained_share),
         summary: &summary,
         rows: &rows,
     };

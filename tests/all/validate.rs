@@ -176,7 +176,20 @@ fn the_same_inputs_and_seed_give_the_same_report_on_any_number_of_threads() {
         );
         out.stdout
     };
-    assert_eq!(run("1"), run("3"));
+    let one = run("1");
+    assert_eq!(one, run("3"));
+    // The report says what "contained" means, with the threshold, and each row its interval.
+    let j: serde_json::Value = serde_json::from_slice(&one).unwrap();
+    let means = j["containment"].as_str().unwrap();
+    assert!(
+        means.contains("at least 80% of the predicted mass"),
+        "{means}"
+    );
+    let row = &j["rows"][0];
+    let [lo, hi] = [0, 1].map(|k| row["contained_share_ci95"][k].as_f64().unwrap());
+    let share = row["contained_share"].as_f64().unwrap();
+    assert!(lo <= share && share <= hi, "{row}");
+    assert!(row["containment"].is_string(), "{row}");
     let poly = pinfeed::geometry::part_from_spec("tripoly2").unwrap();
     let spec = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
         .with_settings("mu_c=uniform:0.3:0.7,support=smooth:0.5,jitter=2")
