@@ -72,6 +72,9 @@ pub fn run(args: &McArgs) -> Result<()> {
         }
     }
     let study = crate::study::bundled::load_study(&args.study, args.samples)?;
+    for w in study.warnings() {
+        eprintln!("warning: {w}");
+    }
     let header = StudyHeader::of(&study);
     let total = study.total_samples();
     let shard = match &args.shard {

@@ -505,9 +505,15 @@ pub fn run(args: &PlanArgs) -> Result<()> {
             let study_file = study_path
                 .file_name()
                 .map_or(String::new(), |f| f.to_string_lossy().to_string());
-            if let Some(study) =
-                crate::plan::check::uncertainty_study(&c.problem, &file, &study_file, u.parts)
-            {
+            let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind).collect();
+            if let Some(study) = crate::plan::check::uncertainty_study(
+                &c.problem,
+                &kinds,
+                o.fences.mu_f.is_some(),
+                &file,
+                &study_file,
+                u.parts,
+            ) {
                 write(&study_path, &study)?;
                 files.push(study_path.display().to_string());
             }

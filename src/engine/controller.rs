@@ -125,6 +125,17 @@ pub struct OnlineSummary {
     /// state, over the decisions whose part has a known true state.
     pub state_correct: u64,
     pub state_known: u64,
+    /// What the model says this line can do, per support class the belief declares: the best
+    /// single command with no information, and with a belief certain of the hypothesis.
+    pub bounds: Vec<ModelBound>,
+}
+
+/// The model's bounds for one support class (see [`crate::engine::online::OnlineModel::bounds`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct ModelBound {
+    pub support: String,
+    pub no_information: f64,
+    pub certain_hypothesis: f64,
 }
 
 /// The controller's part of the summary.
@@ -225,6 +236,25 @@ impl Control {
                     .iter()
                     .map(|sm| (scene.obstacles[sm.obstacle].name().to_string(), sm.temper))
                     .collect(),
+                bounds: {
+                    let mut classes = Vec::new();
+                    for x in &h.0.hypotheses {
+                        if !classes.contains(&x.support) {
+                            classes.push(x.support);
+                        }
+                    }
+                    classes
+                        .into_iter()
+                        .map(|c| {
+                            let (blind, informed) = h.0.bounds(Some(c));
+                            ModelBound {
+                                support: format!("{c:?}").to_lowercase(),
+                                no_information: blind,
+                                certain_hypothesis: informed,
+                            }
+                        })
+                        .collect()
+                },
                 ..OnlineSummary::default()
             },
             bins: [(0, 0.0, 0); 10],

@@ -178,6 +178,7 @@ impl OnlineModel {
             }
         }
         let mut sensors = Vec::new();
+        let mut held_trials = Vec::new();
         for (i, &j) in sensor_obstacles.iter().enumerate() {
             let Obstacle::Pin(pin) = &scene.obstacles[j] else {
                 continue;
@@ -208,7 +209,7 @@ impl OnlineModel {
                         .map_err(|e| format!("sensor \"{}\": {e}", pin.name))?,
                 )
             };
-            let mut sm = SensorModel {
+            let sm = SensorModel {
                 obstacle: j,
                 p_touch,
                 likelihood,
@@ -226,11 +227,11 @@ impl OnlineModel {
                     Some((*h, sm.log_likelihood(&r)?))
                 })
                 .collect();
-            sm.temper = temper(&prior, &sm.p_touch, &trials);
+            held_trials.push(trials);
             sensors.push(sm);
         }
         let homes = pins.iter().map(|&j| home_of(&scene.obstacles[j])).collect();
-        Ok(OnlineModel {
+        let mut model = OnlineModel {
             hypotheses,
             prior,
             sensors,
@@ -241,7 +242,49 @@ impl OnlineModel {
             success,
             samples: s,
             runs: runs as u64,
-        })
+        };
+        for (i, trials) in held_trials.iter().enumerate() {
+            model.sensors[i].temper = temper(&model, i, trials);
+        }
+        Ok(model)
+    }
+
+    /// What the model says the line can do for the hypotheses of support class `support` (all
+    /// with None), weighted by the prior: (the best single command with no information, the mean
+    /// of each hypothesis's best command — a belief certain of the hypothesis, which still cannot
+    /// know the member: the tripod, the jitter, the offset within its bin).
+    pub fn bounds(&self, support: Option<SupportKind>) -> (f64, f64) {
+        let w: Vec<f64> = self
+            .hypotheses
+            .iter()
+            .enumerate()
+            .map(|(h, hy)| {
+                if support.is_none_or(|s| s == hy.support) {
+                    self.prior.probability(h)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let total: f64 = w.iter().sum();
+        if total <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let blind = (0..self.actions.len())
+            .map(|a| {
+                let row = self.success_of(a);
+                w.iter().zip(row).map(|(w, s)| w * s).sum::<f64>()
+            })
+            .fold(0.0, f64::max);
+        let informed: f64 = (0..self.hypotheses.len())
+            .map(|h| {
+                let best = (0..self.actions.len())
+                    .map(|a| self.success_of(a)[h])
+                    .fold(0.0, f64::max);
+                w[h] * best
+            })
+            .sum();
+        (blind / total, informed / total)
     }
 
     /// The model of sensor pin `obstacle`, if it is one.
@@ -328,39 +371,47 @@ impl SensorModel {
     }
 }
 
-/// The power τ the sensor's likelihood is raised to: the matched filter's noise model knows the
+/// The power τ sensor `i`'s likelihood is raised to: the matched filter's noise model knows the
 /// sensor's noise only, not how far a real push strays from every simulated member (another
 /// tripod, another jitter), so its raw likelihood is far too sharp and one reading would make the
 /// belief certain of a wrong hypothesis. τ is chosen on held-out members (readings the
-/// likelihood was not built from) to maximise the mean log posterior of their true hypothesis —
-/// a fractional (tempered) likelihood, calibrated by cross-validation — from 1 down to 10⁻⁶ in
-/// half-decades.
-fn temper(prior: &Belief, p_touch: &[f64], trials: &[(usize, Vec<f64>)]) -> f64 {
+/// likelihood was not built from; `trials` holds their true hypothesis and raw log-likelihood),
+/// from 1 down to 10⁻⁶ in half-decades: the τ whose decisions do best on them (the mean
+/// success(a*, h_true) of the command the belief after their reading chooses), ties broken by the
+/// mean log posterior of their true hypothesis — a tempered likelihood, calibrated by
+/// cross-validation on what the controller does with it.
+fn temper(model: &OnlineModel, i: usize, trials: &[(usize, Vec<f64>)]) -> f64 {
     if trials.is_empty() {
         return 1.0;
     }
-    let taus: Vec<f64> = (0..=12).map(|k| 10f64.powf(-(k as f64) / 2.0)).collect();
-    let score = |tau: f64| -> f64 {
-        trials
-            .iter()
-            .map(|(h, ll)| {
-                let mut b = prior.clone();
-                let scaled: Vec<f64> = ll.iter().map(|l| tau * l).collect();
-                b.observe_reading(p_touch, Some(&scaled));
-                b.probability(*h).max(1e-300).ln()
-            })
-            .sum()
+    let p_touch = &model.sensors[i].p_touch;
+    let score = |tau: f64| -> (f64, f64) {
+        let mut won = 0.0;
+        let mut log = 0.0;
+        for (h, ll) in trials {
+            let mut b = model.prior.clone();
+            let scaled: Vec<f64> = ll.iter().map(|l| tau * l).collect();
+            b.observe_reading(p_touch, Some(&scaled));
+            won += model.success_of(model.choose(&b).action)[*h];
+            log += b.probability(*h).max(1e-300).ln();
+        }
+        let n = trials.len() as f64;
+        (won / n, log / n)
     };
-    taus.iter()
-        .map(|&t| (t, score(t)))
-        .fold((1.0, f64::NEG_INFINITY), |best, (t, sc)| {
-            if sc > best.1 {
-                (t, sc)
-            } else {
-                best
-            }
-        })
-        .0
+    let mut best = (1.0, score(1.0));
+    for k in 1..=12 {
+        let tau = 10f64.powf(-(k as f64) / 2.0);
+        let sc = score(tau);
+        let better = if (sc.0 - best.1 .0).abs() > TIE {
+            sc.0 > best.1 .0
+        } else {
+            sc.1 > best.1 .1
+        };
+        if better {
+            best = (tau, sc);
+        }
+    }
+    best.0
 }
 
 /// Each sensor's clean signal when a part entering as `e` meets it on the line `base` (None:

@@ -38,11 +38,16 @@ pub fn footprint_m(toml: &str, path: &Path) -> Option<f64> {
 }
 
 /// The Monte Carlo study that runs a plan under the uncertainty it was planned against
-/// (`--mu-c-range` → `[uncertain.mu_c]` uniform, `--tripod` → `[uncertain.support]` tripod):
-/// each sample sends one part through a freshly perturbed copy of the line, as `pinfeed mc`
-/// does. None for a plan without declared uncertainty.
+/// (`--mu-c-range` → `[uncertain.mu_c]` uniform for the line's pins, and `[uncertain.fence_mu_f]`
+/// over the same range for its fences when their μf is the nominal μc (`fence_mu_f_given`
+/// false, no `--mu-f`); `--tripod` → `[uncertain.support]` tripod): each sample sends one part
+/// through a freshly perturbed copy of the line, as `pinfeed mc` does. `obstacles` are the
+/// kinds of the line's obstacles (`pin`, `fence`, …). None for a plan without declared
+/// uncertainty.
 pub fn uncertainty_study(
     problem: &super::Problem,
+    obstacles: &[&str],
+    fence_mu_f_given: bool,
     scenario_file: &str,
     study_file: &str,
     samples: u64,
@@ -55,7 +60,17 @@ pub fn uncertainty_study(
         problem.seed
     );
     if let Some((lo, hi)) = problem.mu_c_range {
-        t += &format!("\n[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = {lo}\nmax = {hi}\n");
+        // A study parameter that reaches nothing is refused: μc only where the line has pins.
+        if obstacles.iter().any(|&k| k != "fence") {
+            t += &format!(
+                "\n[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = {lo}\nmax = {hi}\n"
+            );
+        }
+        if !fence_mu_f_given && obstacles.contains(&"fence") {
+            t += &format!(
+                "\n# The fences' μf is the nominal μc: it is as uncertain.\n[uncertain.fence_mu_f]\ndistribution = \"uniform\"\nmin = {lo}\nmax = {hi}\n"
+            );
+        }
     }
     if problem.tripod {
         t += "\n[uncertain.support]\nmodel = \"tripod\"\n";

@@ -220,6 +220,15 @@ fn online_block(
         "  predicted vs line       predicted {:.3}, the line {:.3} on the same parts",
         on.predicted_mean, on.observed
     );
+    for b in &on.bounds {
+        let _ = writeln!(
+            o,
+            "  model, {:<17}P(goal) {:.3} with no information, {:.3} with a belief certain of the hypothesis",
+            format!("{} support", b.support),
+            b.no_information,
+            b.certain_hypothesis
+        );
+    }
     for b in &on.calibration {
         let _ = writeln!(
             o,

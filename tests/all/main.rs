@@ -44,6 +44,7 @@ mod map_fence;
 mod map_tier;
 mod maps;
 mod mc;
+mod mc_obstacles;
 mod mc_sensing;
 mod moving_pin;
 mod online;

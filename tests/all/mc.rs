@@ -86,7 +86,7 @@ fn write_study(dir: &Path, body: &str) -> PathBuf {
 }
 
 /// The command must fail with exit code 1, print nothing on stdout, and not panic; returns stderr.
-fn refused(args: &[&str]) -> String {
+pub(crate) fn refused(args: &[&str]) -> String {
     let out = pinfeed(args);
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");

@@ -1013,8 +1013,11 @@ impl Work<'_> {
         c.headway_s = h;
         c.oriented_per_min = check.success_rate * 60.0 / h;
         c.line_check = Some(check);
+        let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind).collect();
         let study = super::check::uncertainty_study(
             &c.problem,
+            &kinds,
+            o.fences.mu_f.is_some(),
             "design.toml",
             "design.uncertain.toml",
             parts,

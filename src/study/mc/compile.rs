@@ -20,8 +20,9 @@ type R<T> = Result<T, ScenarioError>;
 pub const MAX_POINTS: usize = 10_000;
 
 /// Names of the distribution parameters, in the order they are drawn (the sensor parameters
-/// last: their streams come after every earlier one, so studies without them draw as before).
-pub const DISTRIBUTION_PARAMETERS: [&str; 12] = [
+/// after the others, then the fence and actuator parameters: each group's streams come after
+/// every earlier one, so studies without them draw as before).
+pub const DISTRIBUTION_PARAMETERS: [&str; 21] = [
     "mu_c",
     "belt_speed",
     "shape",
@@ -34,7 +35,32 @@ pub const DISTRIBUTION_PARAMETERS: [&str; 12] = [
     "sensor_bias",
     "sensor_threshold",
     "sensor_jitter",
+    "fence_mu_f",
+    "fence_angle",
+    "fence_x",
+    "fence_y",
+    "fence_length",
+    "actuator_speed",
+    "actuator_accel",
+    "actuator_settle",
+    "controller_latency",
 ];
+
+/// The parameters that act on pins (every kind: fixed, sensor, moving, retractable).
+pub const PIN_PARAMETERS: [&str; 4] = ["mu_c", "pin_x", "pin_y", "pin_radius"];
+
+/// The parameters that act on fences; each takes an optional `fences = [NAME, ...]`.
+pub const FENCE_PARAMETERS: [&str; 5] = [
+    "fence_mu_f",
+    "fence_angle",
+    "fence_x",
+    "fence_y",
+    "fence_length",
+];
+
+/// The parameters that act on dynamic pins' actuators; each takes an optional
+/// `pins = [NAME, ...]`.
+pub const ACTUATOR_PARAMETERS: [&str; 3] = ["actuator_speed", "actuator_accel", "actuator_settle"];
 
 /// The parameters that act on sensor pins' settings: a study may give them only for a scenario
 /// with at least one sensor pin.
@@ -77,6 +103,15 @@ fn slot<'a>(u: &'a RawUncertain, name: &str) -> &'a Option<RawDistribution> {
         "sensor_bias" => &u.sensor_bias,
         "sensor_threshold" => &u.sensor_threshold,
         "sensor_jitter" => &u.sensor_jitter,
+        "fence_mu_f" => &u.fence_mu_f,
+        "fence_angle" => &u.fence_angle,
+        "fence_x" => &u.fence_x,
+        "fence_y" => &u.fence_y,
+        "fence_length" => &u.fence_length,
+        "actuator_speed" => &u.actuator_speed,
+        "actuator_accel" => &u.actuator_accel,
+        "actuator_settle" => &u.actuator_settle,
+        "controller_latency" => &u.controller_latency,
         _ => &u.pose_y,
     }
 }
@@ -94,6 +129,15 @@ fn slot_mut<'a>(u: &'a mut RawUncertain, name: &str) -> &'a mut Option<RawDistri
         "sensor_bias" => &mut u.sensor_bias,
         "sensor_threshold" => &mut u.sensor_threshold,
         "sensor_jitter" => &mut u.sensor_jitter,
+        "fence_mu_f" => &mut u.fence_mu_f,
+        "fence_angle" => &mut u.fence_angle,
+        "fence_x" => &mut u.fence_x,
+        "fence_y" => &mut u.fence_y,
+        "fence_length" => &mut u.fence_length,
+        "actuator_speed" => &mut u.actuator_speed,
+        "actuator_accel" => &mut u.actuator_accel,
+        "actuator_settle" => &mut u.actuator_settle,
+        "controller_latency" => &mut u.controller_latency,
         _ => &mut u.pose_y,
     }
 }
@@ -113,6 +157,14 @@ pub const SENSOR_BIAS: (f64, f64) = (-1e6, 1e6);
 pub const SENSOR_THRESHOLD: (f64, f64) = (1e-9, 1e6);
 /// Range of the error added to a sensor's timing jitter (s): ± the largest jitter a sensor takes.
 pub const SENSOR_JITTER: (f64, f64) = (-10.0, 10.0);
+/// Largest error (degrees) a study may add to a fence's angle (a drawn angle must still lie
+/// strictly between −90° and 90°).
+pub const FENCE_ANGLE_ERROR: (f64, f64) = (-180.0, 180.0);
+/// Range of the factors on an actuator's speed and acceleration.
+pub const ACTUATOR_FACTOR: (f64, f64) = (1e-6, 1e6);
+/// Largest error (s) a study may add to a settle time or the controller's latency: ± the longest
+/// actuator time ([`crate::scenario::limits::ACTUATOR_TIME`]).
+pub const TIME_ERROR: (f64, f64) = (-1e4, 1e4);
 
 /// The physical range of parameter `name` and its unit (crate::scenario::limits): every value a
 /// study gives (value, min, max, mean, mode) must lie in it, a standard deviation must not exceed
@@ -133,6 +185,24 @@ pub fn domain(name: &str) -> ((f64, f64), &'static str) {
         "sensor_bias" => (SENSOR_BIAS, "N, added to every sensor's force bias"),
         "sensor_threshold" => (SENSOR_THRESHOLD, "N, every sensor's timing threshold, > 0"),
         "sensor_jitter" => (SENSOR_JITTER, "s, added to every sensor's timing jitter"),
+        "fence_mu_f" => (limits::FRICTION, "a fence-part friction coefficient"),
+        "fence_angle" => (
+            FENCE_ANGLE_ERROR,
+            "degrees, an error added to a fence's angle",
+        ),
+        "actuator_speed" => (
+            ACTUATOR_FACTOR,
+            "a factor multiplying a dynamic pin's speed",
+        ),
+        "actuator_accel" => (
+            ACTUATOR_FACTOR,
+            "a factor multiplying a moving pin's acceleration",
+        ),
+        "actuator_settle" => (
+            TIME_ERROR,
+            "s, an error added to a moving pin's settle time",
+        ),
+        "controller_latency" => (TIME_ERROR, "s, an error added to the controller's latency"),
         _ => (LENGTH_ERROR, "m, an error added to a length or position"),
     }
 }
@@ -376,9 +446,15 @@ pub fn compile_uncertain(
     scenario_support: SupportKind,
 ) -> R<Perturbations> {
     let mut d: Vec<Option<Distribution>> = Vec::new();
+    let mut only = std::collections::BTreeMap::new();
     for name in DISTRIBUTION_PARAMETERS {
         d.push(match slot(u, name) {
-            Some(raw) => Some(compile_distribution(loc, name, raw)?),
+            Some(raw) => {
+                if let Some(names) = selection(loc, name, raw)? {
+                    only.insert(name.to_string(), names);
+                }
+                Some(compile_distribution(loc, name, raw)?)
+            }
             None => None,
         });
     }
@@ -402,8 +478,76 @@ pub fn compile_uncertain(
         sensor_bias: d[9],
         sensor_threshold: d[10],
         sensor_jitter: d[11],
+        fence_mu_f: d[12],
+        fence_angle: d[13],
+        fence_x: d[14],
+        fence_y: d[15],
+        fence_length: d[16],
+        actuator_speed: d[17],
+        actuator_accel: d[18],
+        actuator_settle: d[19],
+        controller_latency: d[20],
+        only,
         support,
     })
+}
+
+/// The `fences = [...]` or `pins = [...]` of parameter `name`'s table, if given: only on the
+/// parameters it applies to, non-empty, without repeats. (Whether the names exist in the scenario
+/// is checked by [`check_reach`].)
+fn selection(loc: &Locator, name: &str, d: &RawDistribution) -> R<Option<Vec<String>>> {
+    let base = format!("uncertain.{name}");
+    let (key, given, applies, what) = match (&d.fences, &d.pins) {
+        (Some(f), _) => ("fences", f, FENCE_PARAMETERS.contains(&name), "fence"),
+        (None, Some(p)) => ("pins", p, ACTUATOR_PARAMETERS.contains(&name), "actuator"),
+        (None, None) => return Ok(None),
+    };
+    if !applies {
+        return Err(err(
+            loc,
+            &format!("{base}.{key}"),
+            format!(
+                "applies only to the {what} parameters ({}); {name} reaches {}",
+                if what == "fence" {
+                    FENCE_PARAMETERS.join(", ")
+                } else {
+                    ACTUATOR_PARAMETERS.join(", ")
+                },
+                reach_text(name)
+            ),
+        ));
+    }
+    if given.is_empty() {
+        return Err(err(
+            loc,
+            &format!("{base}.{key}"),
+            format!("names no {what}; name at least one, or leave `{key}` out to reach every one"),
+        ));
+    }
+    for (i, n) in given.iter().enumerate() {
+        if given[..i].contains(n) {
+            return Err(err(
+                loc,
+                &format!("{base}.{key}[{i}]"),
+                format!("`{n}` is named twice"),
+            ));
+        }
+    }
+    Ok(Some(given.clone()))
+}
+
+/// What parameter `name` reaches, in words (docs/study-format.md, the table of what reaches what).
+pub fn reach_text(name: &str) -> &'static str {
+    match name {
+        "mu_c" => "every pin's friction (not the fences': their μf is fence_mu_f)",
+        "pin_x" | "pin_y" | "pin_radius" => "every pin (of any kind)",
+        "fence_mu_f" | "fence_angle" | "fence_x" | "fence_y" | "fence_length" => "fences",
+        "actuator_speed" => "moving and retractable pins",
+        "actuator_accel" | "actuator_settle" => "moving pins",
+        "controller_latency" => "the controller",
+        n if n.starts_with("sensor_") => "sensor pins",
+        _ => "the part, the belt or the feed",
+    }
 }
 
 /// Set the field a sweep names to `value` (see the module docs).
@@ -439,9 +583,13 @@ fn apply_sweep(u: &mut RawUncertain, parameter: &str, value: f64) -> Result<(), 
     let d = slot_mut(u, name);
     match field {
         None => {
+            // The parameter fixed at the value, still restricted to the obstacles it named.
+            let named = d.take().unwrap_or_default();
             *d = Some(RawDistribution {
                 distribution: Some(DistributionKind::Fixed),
                 value: Some(value),
+                fences: named.fences,
+                pins: named.pins,
                 ..RawDistribution::default()
             });
         }
@@ -625,6 +773,128 @@ pub fn check_sensor_parameters(
         let name = s.parameter.split('.').next().unwrap_or("");
         if SENSOR_PARAMETERS.contains(&name) {
             return Err(err(loc, &format!("sweep[{k}].parameter"), msg(name)));
+        }
+    }
+    Ok(())
+}
+
+/// Every fence, pin and actuator parameter the study gives (an `[uncertain.NAME]` table or a
+/// sweep of NAME) must reach something in the scenario, and every name in its `fences = [...]` or
+/// `pins = [...]` must be an obstacle it applies to; otherwise a located error says why (at the
+/// table, the sweep or the name). Sensor parameters are checked by [`check_sensor_parameters`];
+/// the other parameters act on the part, the belt or the feed, which every scenario has.
+pub fn check_reach(
+    loc: &Locator,
+    u: &RawUncertain,
+    sweeps: &[RawSweep],
+    scene: &crate::scenario::Scene,
+) -> R<()> {
+    use crate::scenario::{Actuator, Obstacle};
+    let names = |keep: &dyn Fn(&Obstacle) -> bool| -> Vec<&str> {
+        scene
+            .obstacles
+            .iter()
+            .filter(|o| keep(o))
+            .map(|o| o.name())
+            .collect()
+    };
+    let pins = names(&|o| matches!(o, Obstacle::Pin(_)));
+    let fences = names(&|o| matches!(o, Obstacle::Fence(_)));
+    let dynamic = names(&|o| matches!(o, Obstacle::Pin(p) if p.actuator.is_some()));
+    let moving = names(
+        &|o| matches!(o, Obstacle::Pin(p) if matches!(p.actuator, Some(Actuator::Moving(_)))),
+    );
+    let controller: Vec<&str> = scene.controller.iter().map(|_| "controller").collect();
+    for name in DISTRIBUTION_PARAMETERS {
+        let (reached, kind, hint) = match name {
+            "mu_c" => (
+                &pins,
+                "pins",
+                if fences.is_empty() {
+                    ""
+                } else {
+                    "; the scenario's fences keep their own μf: perturb it with [uncertain.fence_mu_f]"
+                },
+            ),
+            "pin_x" | "pin_y" | "pin_radius" => (
+                &pins,
+                "pins",
+                if fences.is_empty() {
+                    ""
+                } else {
+                    "; the fences' geometry is fence_x, fence_y, fence_angle and fence_length"
+                },
+            ),
+            "fence_mu_f" | "fence_angle" | "fence_x" | "fence_y" | "fence_length" => (
+                &fences,
+                "fences (kind = \"fence\")",
+                if name == "fence_mu_f" && !pins.is_empty() {
+                    "; the pins' friction is mu_c"
+                } else {
+                    ""
+                },
+            ),
+            "actuator_speed" => (
+                &dynamic,
+                "moving or retractable pins (kind = \"moving_pin\", \"retractable_pin\")",
+                "",
+            ),
+            "actuator_accel" | "actuator_settle" => {
+                (&moving, "moving pins (kind = \"moving_pin\")", "")
+            }
+            "controller_latency" => (&controller, "a [controller]", ""),
+            _ => continue,
+        };
+        let at = if slot(u, name).is_some() {
+            format!("uncertain.{name}")
+        } else if let Some(k) = sweeps
+            .iter()
+            .position(|s| s.parameter.split('.').next() == Some(name))
+        {
+            format!("sweep[{k}].parameter")
+        } else {
+            continue;
+        };
+        if reached.is_empty() {
+            return Err(err(
+                loc,
+                &at,
+                format!(
+                    "{name} perturbs {kind}, but the scenario has none, so it would change nothing{hint}; remove it or point the study at a scenario with one"
+                ),
+            ));
+        }
+        let Some(raw) = slot(u, name) else { continue };
+        let (key, given) = match (&raw.fences, &raw.pins) {
+            (Some(f), _) => ("fences", f),
+            (None, Some(p)) => ("pins", p),
+            (None, None) => continue,
+        };
+        for (i, n) in given.iter().enumerate() {
+            if reached.contains(&n.as_str()) {
+                continue;
+            }
+            let what = match scene.obstacles.iter().find(|o| o.name() == n) {
+                Some(Obstacle::Fence(_)) => "is a fence".to_string(),
+                Some(Obstacle::Pin(p)) => match p.actuator {
+                    Some(Actuator::Moving(_)) => "is a moving pin".to_string(),
+                    Some(Actuator::Retractable(_)) => "is a retractable pin".to_string(),
+                    None => "is a fixed pin".to_string(),
+                },
+                None => "names no obstacle of the scenario".to_string(),
+            };
+            return Err(err(
+                loc,
+                &format!("uncertain.{name}.{key}[{i}]"),
+                format!(
+                    "`{n}` {what}; {name} reaches {kind}: {}",
+                    reached
+                        .iter()
+                        .map(|r| format!("`{r}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
         }
     }
     Ok(())

@@ -4,7 +4,8 @@
 //! A study file (TOML, docs/study-format.md) points at a scenario and declares uncertain
 //! parameters — pin–part friction μc, the support model (uniform, a random tripod, a random smooth
 //! density), shape tolerance, pin position and radius errors, entry pose noise, belt speed, sensor
-//! pins' noise, bias, timing threshold and jitter — and
+//! pins' noise, bias, timing threshold and jitter, fences' friction μf, angle, position and length,
+//! dynamic pins' speed, acceleration and settle time, the controller's latency — and
 //! optionally sweeps one or two of them over a grid. For each sweep point, N samples are drawn; a
 //! sample is one part through a freshly perturbed line ([`sample`]). Computed per point: the count
 //! of each outcome class, the success rate with its 95% Wilson score interval (and the same interval
@@ -84,6 +85,38 @@ impl Study {
     pub fn total_samples(&self) -> u64 {
         self.points.len() as u64 * self.samples
     }
+
+    /// What the study may be taken to perturb but does not (printed as warnings; the report is
+    /// unchanged): μc varied on a line whose fences no `fence_mu_f` reaches, since μc does not
+    /// reach a fence.
+    pub fn warnings(&self) -> Vec<String> {
+        if !self.points.iter().any(|p| p.mu_c.is_some()) {
+            return Vec::new();
+        }
+        let kept: Vec<String> = self
+            .scene
+            .obstacles
+            .iter()
+            .filter_map(|o| match o {
+                crate::scenario::Obstacle::Fence(f) => Some(f),
+                crate::scenario::Obstacle::Pin(_) => None,
+            })
+            .filter(|f| {
+                !self
+                    .points
+                    .iter()
+                    .any(|p| p.fence_mu_f.is_some() && p.reaches("fence_mu_f", &f.name))
+            })
+            .map(|f| format!("`{}` (μf {})", f.name, f.mu_f))
+            .collect();
+        if kept.is_empty() {
+            return Vec::new();
+        }
+        vec![format!(
+            "mu_c varies the pins' friction only; the fence(s) {} keep their own μf: declare [uncertain.fence_mu_f] to vary it",
+            kept.join(", ")
+        )]
+    }
 }
 
 /// Read and validate a study file; `samples` overrides the file's samples per point.
@@ -158,6 +191,7 @@ pub fn parse_with(
     });
     compile::check_sensor_parameters(&loc, &raw.uncertain, &raw.sweep, has_sensor)?;
     let declared = compile::compile_uncertain(&loc, &raw.uncertain, scene.part.support)?;
+    compile::check_reach(&loc, &raw.uncertain, &raw.sweep, &scene)?;
     let axes = compile::compile_sweeps(&loc, &raw.sweep)?;
     let points = if axes.is_empty() {
         vec![declared.clone()]

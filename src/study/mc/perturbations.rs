@@ -3,6 +3,7 @@
 //! degrees as written and converted when drawn.
 
 use super::distribution::Distribution;
+use std::collections::BTreeMap;
 
 /// Parameters of the random smooth pressure density (see [`super::smooth_support`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,6 +75,24 @@ pub struct Perturbations {
     pub sensor_bias: Option<Distribution>,
     pub sensor_threshold: Option<Distribution>,
     pub sensor_jitter: Option<Distribution>,
+    /// Fences: μf (one draw per sample, at every fence it reaches), errors of each fence's angle
+    /// (degrees), upstream end x and y and length (m), drawn per fence.
+    pub fence_mu_f: Option<Distribution>,
+    pub fence_angle: Option<Distribution>,
+    pub fence_x: Option<Distribution>,
+    pub fence_y: Option<Distribution>,
+    pub fence_length: Option<Distribution>,
+    /// Dynamic pins, drawn per pin: factors on the speed (a moving pin's limit, a retractable
+    /// pin's raise and lower rates) and on a moving pin's acceleration limit, error added to a
+    /// moving pin's settle time (s). The controller: error added to its latency (s), one draw.
+    pub actuator_speed: Option<Distribution>,
+    pub actuator_accel: Option<Distribution>,
+    pub actuator_settle: Option<Distribution>,
+    pub controller_latency: Option<Distribution>,
+    /// The obstacles a fence or actuator parameter is restricted to (`fences = [...]`,
+    /// `pins = [...]`), by parameter name; a parameter absent here reaches every obstacle it
+    /// applies to.
+    pub only: BTreeMap<String, Vec<String>>,
     pub support: SupportChoice,
 }
 
@@ -84,6 +103,31 @@ impl Perturbations {
             || self.sensor_bias.is_some()
             || self.sensor_threshold.is_some()
             || self.sensor_jitter.is_some()
+    }
+
+    /// Does any parameter act on fences, actuators or the controller? (Without one, a sample
+    /// seeds no stream for them and draws nothing for them.)
+    pub fn perturbs_obstacles(&self) -> bool {
+        [
+            &self.fence_mu_f,
+            &self.fence_angle,
+            &self.fence_x,
+            &self.fence_y,
+            &self.fence_length,
+            &self.actuator_speed,
+            &self.actuator_accel,
+            &self.actuator_settle,
+            &self.controller_latency,
+        ]
+        .iter()
+        .any(|d| d.is_some())
+    }
+
+    /// Does parameter `name` reach the obstacle named `obstacle` (of a kind it applies to)?
+    pub fn reaches(&self, name: &str, obstacle: &str) -> bool {
+        self.only
+            .get(name)
+            .is_none_or(|names| names.iter().any(|n| n == obstacle))
     }
 
     /// The first parameter that gives samples different map-tier inputs (a map is per part,
@@ -128,10 +172,27 @@ impl Perturbations {
             ),
             ("sensor_threshold", &self.sensor_threshold, " N"),
             ("sensor_jitter", &self.sensor_jitter, " s added"),
+            ("fence_mu_f", &self.fence_mu_f, ""),
+            ("fence_angle", &self.fence_angle, "° added"),
+            ("fence_x", &self.fence_x, " m added"),
+            ("fence_y", &self.fence_y, " m added"),
+            ("fence_length", &self.fence_length, " m added"),
+            ("actuator_speed", &self.actuator_speed, " × the speed"),
+            (
+                "actuator_accel",
+                &self.actuator_accel,
+                " × the acceleration",
+            ),
+            ("actuator_settle", &self.actuator_settle, " s added"),
+            ("controller_latency", &self.controller_latency, " s added"),
         ];
         for (name, d, unit) in named {
             if let Some(d) = d {
-                out.push(format!("{name}: {}{unit}", d.describe()));
+                let only = match self.only.get(name) {
+                    Some(names) => format!(" (only {})", names.join(", ")),
+                    None => String::new(),
+                };
+                out.push(format!("{name}: {}{unit}{only}", d.describe()));
             }
         }
         out.push(format!("support: {}", self.support.describe()));

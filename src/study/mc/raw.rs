@@ -70,6 +70,24 @@ pub struct RawUncertain {
     pub sensor_threshold: Option<RawDistribution>,
     /// Added to every sensor's timing jitter (s).
     pub sensor_jitter: Option<RawDistribution>,
+    /// Fence–part friction μf (its value; one draw per sample, used at every fence).
+    pub fence_mu_f: Option<RawDistribution>,
+    /// Error added to each fence's angle (degrees), drawn per fence.
+    pub fence_angle: Option<RawDistribution>,
+    /// Errors added to each fence's upstream end, x and y (m), drawn per fence.
+    pub fence_x: Option<RawDistribution>,
+    pub fence_y: Option<RawDistribution>,
+    /// Error added to each fence's length (m), drawn per fence.
+    pub fence_length: Option<RawDistribution>,
+    /// Factor on each dynamic pin's speed (a moving pin's speed limit; a retractable pin's
+    /// raise and lower rates), drawn per pin.
+    pub actuator_speed: Option<RawDistribution>,
+    /// Factor on each moving pin's acceleration limit, drawn per pin.
+    pub actuator_accel: Option<RawDistribution>,
+    /// Error added to each moving pin's settle time (s), drawn per pin.
+    pub actuator_settle: Option<RawDistribution>,
+    /// Error added to the controller's latency (s), one draw per sample.
+    pub controller_latency: Option<RawDistribution>,
 }
 
 /// Kinds of distribution.
@@ -94,6 +112,11 @@ pub struct RawDistribution {
     pub mean: Option<f64>,
     pub sd: Option<f64>,
     pub mode: Option<f64>,
+    /// Fence parameters only: the fences (by name) it perturbs (default: every fence).
+    pub fences: Option<Vec<String>>,
+    /// Actuator parameters only: the dynamic pins (by name) it perturbs (default: every one the
+    /// parameter applies to).
+    pub pins: Option<Vec<String>>,
 }
 
 /// Support models.

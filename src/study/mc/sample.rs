@@ -15,7 +15,10 @@
 //! sub-seed. (The sensor sub-seeds come last, so a study written before they existed draws the same
 //! numbers as it always did.) A parameter's draws therefore never depend on how many draws another one needed
 //! (redraws), on the thread count or on sharding, and sample i sees the same underlying numbers at
-//! every sweep point (common random numbers).
+//! every sweep point (common random numbers). The fence, actuator and controller parameters' nine
+//! sub-seeds (fence μf, angle, x, y, length, actuator speed, acceleration, settle, controller
+//! latency) come after the readings' seed, and are drawn only at a sweep point that declares one
+//! of them: a study without them does no work for them and draws what it always drew.
 //!
 //! What is drawn, per sample:
 //! * μc: one value, used at every pin (replacing each pin's own μc);
@@ -41,9 +44,18 @@
 //! * readings: the sensor's noise in sample i is drawn from the sample's own readings sub-seed,
 //!   so readings are independent across samples.
 //!
-//! Obstacles are matched exhaustively: a pin (sensor or not) gets the pin errors; a fence is not a
-//! pin and no study parameter perturbs it yet, so it passes unchanged — explicitly, so that a new
-//! kind of obstacle cannot slip through this step unnoticed.
+//! * fences: one μf per sample, used at every fence `fence_mu_f` reaches (μc never reaches a
+//!   fence); errors added to each fence's angle, upstream end and length, drawn per fence and
+//!   redrawn together (counted) until the fence is one the scenario would accept;
+//! * actuators: per dynamic pin, factors on the speed (a retractable pin's raise and lower times
+//!   are divided by it) and on a moving pin's acceleration, an error added to a moving pin's
+//!   settle time, redrawn together (counted) until the actuator is valid; the controller's
+//!   latency plus one error per sample.
+//!
+//! Obstacles are matched exhaustively: a pin (sensor or not) gets the pin errors and, if it is
+//! dynamic, the actuator parameters; a fence gets the fence parameters — explicitly, so that a new
+//! kind of obstacle cannot slip through this step unnoticed. Fence and actuator parameters reach
+//! only the obstacles their `fences`/`pins` selector names, if it names any.
 
 use super::distribution::Distribution;
 use super::perturbations::{Perturbations, SupportChoice};
@@ -54,8 +66,8 @@ use crate::geometry::{Polygon, Vec2};
 use crate::mechanics::{PartModel, Support};
 use crate::random::{stream, ChaCha8Rng};
 use crate::scenario::{
-    Arrival, Feed, Lateral, Obstacle, Orientation, PartSpec, PinObstacle, Scene, SensorPin,
-    SupportKind,
+    Actuator, Arrival, Controller, Feed, FenceObstacle, Lateral, MovingSpec, Obstacle, Orientation,
+    PartSpec, PinObstacle, RetractSpec, Scene, SensorPin, SupportKind,
 };
 use crate::sensing::SensorSettings;
 use rand::{RngExt, SeedableRng};
@@ -99,10 +111,32 @@ struct Streams {
     sensor_jitter: ChaCha8Rng,
     /// Seed of the sample's line run: its sensor readings' noise.
     readings_seed: u64,
+    /// The fence and actuator parameters' streams, seeded only when the point declares one.
+    obstacles: Option<ObstacleStreams>,
 }
 
+/// The streams of the fence, actuator and controller parameters (sub-seeds drawn after every
+/// earlier one, in this order).
+struct ObstacleStreams {
+    fence_mu_f: ChaCha8Rng,
+    fence_angle: ChaCha8Rng,
+    fence_x: ChaCha8Rng,
+    fence_y: ChaCha8Rng,
+    fence_length: ChaCha8Rng,
+    actuator_speed: ChaCha8Rng,
+    actuator_accel: ChaCha8Rng,
+    actuator_settle: ChaCha8Rng,
+    controller_latency: ChaCha8Rng,
+}
+
+/// Sub-streams a sample seeds without fence and actuator parameters (the 14 parameter streams
+/// and the feed's and readings' seeds count as one each), and with them.
+pub const BASE_STREAMS: u32 = 15;
+pub const OBSTACLE_STREAMS: u32 = 9;
+
 impl Streams {
-    fn new(seed: u64, sample: u64) -> Streams {
+    /// The sample's streams; `obstacles`: also seed the fence and actuator parameters' streams.
+    fn new(seed: u64, sample: u64, obstacles: bool) -> Streams {
         let mut master = stream(seed, sample);
         let mut next = || ChaCha8Rng::seed_from_u64(master.random::<u64>());
         let (mu_c, belt_speed, shape, pin_x, pin_y, pin_radius, pose_theta, pose_y, support) = (
@@ -122,6 +156,22 @@ impl Streams {
         let (sensor_noise, sensor_bias, sensor_threshold, sensor_jitter) =
             (next(), next(), next(), next());
         let readings_seed = master.random::<u64>();
+        // Appended after the readings' seed: every earlier sub-seed is what it was before them,
+        // and a study without them seeds none.
+        let obstacles = obstacles.then(|| {
+            let mut next = || ChaCha8Rng::seed_from_u64(master.random::<u64>());
+            ObstacleStreams {
+                fence_mu_f: next(),
+                fence_angle: next(),
+                fence_x: next(),
+                fence_y: next(),
+                fence_length: next(),
+                actuator_speed: next(),
+                actuator_accel: next(),
+                actuator_settle: next(),
+                controller_latency: next(),
+            }
+        });
         Streams {
             mu_c,
             belt_speed,
@@ -138,7 +188,13 @@ impl Streams {
             sensor_threshold,
             sensor_jitter,
             readings_seed,
+            obstacles,
         }
+    }
+
+    /// Sub-streams seeded (see [`BASE_STREAMS`]).
+    fn seeded(&self) -> u32 {
+        BASE_STREAMS + self.obstacles.as_ref().map_or(0, |_| OBSTACLE_STREAMS)
     }
 }
 
@@ -151,6 +207,10 @@ pub struct DrawnScene {
     /// The seed to run the scene with: it draws the sensor readings' noise (0 when the line has
     /// no sensor pin, as before sensors existed).
     pub run_seed: u64,
+    /// Random sub-streams the sample seeded: [`BASE_STREAMS`], plus [`OBSTACLE_STREAMS`] when
+    /// the point declares a fence, actuator or controller parameter (the work a study without
+    /// them does not do).
+    pub streams: u32,
 }
 
 /// One sample's values of the sensor parameters (`None`: the scenario's own setting).
@@ -382,8 +442,9 @@ pub(crate) fn draw_support(
 
 /// One obstacle of the perturbed line: a pin (with or without a sensor) with its position and
 /// radius errors (redrawn until it lies over the belt, clear of the entry, with a radius ≥ 0), the
-/// sample's μc and its sensor under the sample's sensor values; a fence unchanged (no parameter
-/// perturbs fences). No catch-all: a new obstacle kind must be handled here.
+/// sample's μc, its sensor under the sample's sensor values and its actuator under the actuator
+/// parameters; a fence under the fence parameters ([`draw_fence`]). No catch-all: a new obstacle
+/// kind must be handled here.
 #[allow(clippy::too_many_arguments)]
 fn draw_obstacle(
     ob: &Obstacle,
@@ -392,12 +453,23 @@ fn draw_obstacle(
     belt: &crate::scenario::Belt,
     radius: f64,
     mu_c: Option<f64>,
+    mu_f: Option<f64>,
     sensor_values: &SensorDraw,
     other: &mut u32,
 ) -> Result<Obstacle, String> {
     let pin = match ob {
         Obstacle::Pin(pin) => pin,
-        Obstacle::Fence(fence) => return Ok(Obstacle::Fence(fence.clone())),
+        Obstacle::Fence(fence) => {
+            let drawn = match st.obstacles.as_mut() {
+                Some(ost) => draw_fence(fence, p, ost, belt, radius, mu_f, other)?,
+                None => fence.clone(),
+            };
+            return Ok(Obstacle::Fence(drawn));
+        }
+    };
+    let actuator = match (pin.actuator, st.obstacles.as_mut()) {
+        (Some(a), Some(ost)) => Some(draw_actuator(&pin.name, a, p, ost, belt, other)?),
+        (a, _) => a,
     };
     let any = |_: f64| true;
     for _ in 0..=super::distribution::MAX_REDRAWS {
@@ -424,7 +496,7 @@ fn draw_obstacle(
                 radius: r,
                 mu_c: mu_c.unwrap_or(pin.mu_c),
                 sensor: perturb_sensor(pin, sensor_values)?,
-                actuator: pin.actuator,
+                actuator,
             }));
         }
         *other += 1;
@@ -436,6 +508,171 @@ fn draw_obstacle(
     ))
 }
 
+/// A fence of the perturbed line: the sample's μf if `fence_mu_f` reaches it, and its angle,
+/// upstream end and length errors (each only if its parameter reaches the fence), redrawn together
+/// until the fence is one the scenario would accept: angle strictly between −90° and 90°,
+/// upstream end over the belt beyond a from the entry, length in [10⁻⁶ a, 10⁶ a], downstream end
+/// on the belt.
+fn draw_fence(
+    fence: &FenceObstacle,
+    p: &Perturbations,
+    st: &mut ObstacleStreams,
+    belt: &crate::scenario::Belt,
+    radius: f64,
+    mu_f: Option<f64>,
+    other: &mut u32,
+) -> Result<FenceObstacle, String> {
+    let mu_f = match mu_f.filter(|_| p.reaches("fence_mu_f", &fence.name)) {
+        Some(m) => m,
+        None => fence.mu_f,
+    };
+    let reached = |d: &Option<Distribution>, name: &str| -> Option<Distribution> {
+        d.filter(|_| p.reaches(name, &fence.name))
+    };
+    let (d_angle, d_x, d_y, d_length) = (
+        reached(&p.fence_angle, "fence_angle"),
+        reached(&p.fence_x, "fence_x"),
+        reached(&p.fence_y, "fence_y"),
+        reached(&p.fence_length, "fence_length"),
+    );
+    if d_angle.is_none() && d_x.is_none() && d_y.is_none() && d_length.is_none() {
+        return Ok(FenceObstacle {
+            mu_f,
+            ..fence.clone()
+        });
+    }
+    let any = |_: f64| true;
+    let (lo, hi) = crate::scenario::limits::FENCE_LENGTH_OF_A;
+    let slack = 1e-9 * (belt.width + belt.length);
+    let half = belt.width / 2.0;
+    for _ in 0..=super::distribution::MAX_REDRAWS {
+        let mut none = 0;
+        let ea = draw_value(&d_angle, &mut st.fence_angle, "fence_angle", any, &mut none)?;
+        let ex = draw_value(&d_x, &mut st.fence_x, "fence_x", any, &mut none)?;
+        let ey = draw_value(&d_y, &mut st.fence_y, "fence_y", any, &mut none)?;
+        let el = draw_value(
+            &d_length,
+            &mut st.fence_length,
+            "fence_length",
+            any,
+            &mut none,
+        )?;
+        let drawn = FenceObstacle {
+            name: fence.name.clone(),
+            start: fence.start + Vec2::new(ex.unwrap_or(0.0), ey.unwrap_or(0.0)),
+            angle: fence.angle + ea.unwrap_or(0.0).to_radians(),
+            length: fence.length + el.unwrap_or(0.0),
+            mu_f,
+        };
+        let end = drawn.end();
+        let valid = drawn.angle.abs() < std::f64::consts::FRAC_PI_2
+            && drawn.start.x > radius
+            && drawn.start.x < belt.length
+            && drawn.start.y.abs() <= half
+            && (lo * radius..=hi * radius).contains(&drawn.length)
+            && end.x <= belt.length + slack
+            && end.y.abs() <= half + slack;
+        if valid {
+            return Ok(drawn);
+        }
+        *other += 1;
+    }
+    Err(format!(
+        "fence `{}`: {} perturbed fences in a row were invalid (an angle not strictly between -90° and 90°, an end off the belt or within a of the entry, or a length out of [1e-6 a, 1e6 a])",
+        fence.name,
+        super::distribution::MAX_REDRAWS + 1
+    ))
+}
+
+/// A dynamic pin's actuator under the sample's actuator parameters (drawn per pin, each only if
+/// it reaches the pin): a moving pin's speed and acceleration limits multiplied by their factors
+/// and its settle time plus its error; a retractable pin's raise and lower times divided by the
+/// speed factor. Redrawn together until the actuator is one the scenario would accept.
+fn draw_actuator(
+    name: &str,
+    a: Actuator,
+    p: &Perturbations,
+    st: &mut ObstacleStreams,
+    belt: &crate::scenario::Belt,
+    other: &mut u32,
+) -> Result<Actuator, String> {
+    use crate::scenario::limits::{contains, max_pin_speed, ACTUATOR_ACCEL, ACTUATOR_TIME};
+    let reached = |d: &Option<Distribution>, key: &str| -> Option<Distribution> {
+        d.filter(|_| p.reaches(key, name))
+    };
+    let d_speed = reached(&p.actuator_speed, "actuator_speed");
+    let (d_accel, d_settle) = match a {
+        Actuator::Moving(_) => (
+            reached(&p.actuator_accel, "actuator_accel"),
+            reached(&p.actuator_settle, "actuator_settle"),
+        ),
+        Actuator::Retractable(_) => (None, None),
+    };
+    if d_speed.is_none() && d_accel.is_none() && d_settle.is_none() {
+        return Ok(a);
+    }
+    let factor = |v: f64| super::compile::in_domain("actuator_speed", v);
+    for _ in 0..=super::distribution::MAX_REDRAWS {
+        let mut none = 0;
+        let fs = draw_value(
+            &d_speed,
+            &mut st.actuator_speed,
+            "actuator_speed",
+            factor,
+            other,
+        )?;
+        let fa = draw_value(
+            &d_accel,
+            &mut st.actuator_accel,
+            "actuator_accel",
+            factor,
+            other,
+        )?;
+        let es = draw_value(
+            &d_settle,
+            &mut st.actuator_settle,
+            "actuator_settle",
+            |_| true,
+            &mut none,
+        )?;
+        let (drawn, valid) = match a {
+            Actuator::Moving(m) => {
+                let m = MovingSpec {
+                    speed: m.speed * fs.unwrap_or(1.0),
+                    accel: m.accel * fa.unwrap_or(1.0),
+                    settle: m.settle + es.unwrap_or(0.0),
+                    ..m
+                };
+                let valid = (crate::scenario::limits::ACTUATOR_SPEED.0..=max_pin_speed(belt.speed))
+                    .contains(&m.speed)
+                    && contains(ACTUATOR_ACCEL, m.accel)
+                    && contains(ACTUATOR_TIME, m.settle);
+                (Actuator::Moving(m), valid)
+            }
+            Actuator::Retractable(r) => {
+                let f = fs.unwrap_or(1.0);
+                let r = RetractSpec {
+                    raise_time: r.raise_time / f,
+                    lower_time: r.lower_time / f,
+                    ..r
+                };
+                let valid =
+                    contains(ACTUATOR_TIME, r.raise_time) && contains(ACTUATOR_TIME, r.lower_time);
+                (Actuator::Retractable(r), valid)
+            }
+        };
+        if valid {
+            return Ok(drawn);
+        }
+        *other += 1;
+    }
+    Err(format!(
+        "pin `{name}`: {} perturbed actuators in a row were invalid (a speed above the belt's limit of {} m/s, or a time or acceleration out of range)",
+        super::distribution::MAX_REDRAWS + 1,
+        crate::scenario::limits::max_pin_speed(belt.speed)
+    ))
+}
+
 /// Draw sample `sample` of a study seeded with `seed` at the sweep point `p`: the perturbed scene.
 /// A pure function of its arguments.
 pub fn draw_scene(
@@ -444,7 +681,7 @@ pub fn draw_scene(
     seed: u64,
     sample: u64,
 ) -> Result<DrawnScene, String> {
-    let mut st = Streams::new(seed, sample);
+    let mut st = Streams::new(seed, sample, p.perturbs_obstacles());
     let mut other = 0u32;
     let mut shape_redraws = 0u32;
     let mu_c = draw_value(
@@ -481,6 +718,41 @@ pub fn draw_scene(
     };
     let radius = polygon.radius();
     let sensor_values = draw_sensor_values(base, p, &mut st, &mut other)?;
+    let (mu_f, latency) = match st.obstacles.as_mut() {
+        Some(ost) => (
+            draw_value(
+                &p.fence_mu_f,
+                &mut ost.fence_mu_f,
+                "fence_mu_f",
+                |v| super::compile::in_domain("fence_mu_f", v),
+                &mut other,
+            )?,
+            match &base.controller {
+                Some(c) => draw_value(
+                    &p.controller_latency,
+                    &mut ost.controller_latency,
+                    "controller_latency",
+                    |e| {
+                        crate::scenario::limits::contains(
+                            crate::scenario::limits::ACTUATOR_TIME,
+                            c.latency + e,
+                        )
+                    },
+                    &mut other,
+                )
+                .map_err(|e| {
+                    format!(
+                        "{e}: the controller's latency ({} s) plus the error must lie in {} s",
+                        c.latency,
+                        crate::scenario::limits::show(crate::scenario::limits::ACTUATOR_TIME)
+                    )
+                })?
+                .map(|e| c.latency + e),
+                None => None,
+            },
+        ),
+        None => (None, None),
+    };
 
     let mut obstacles = Vec::with_capacity(base.obstacles.len());
     for ob in &base.obstacles {
@@ -491,6 +763,7 @@ pub fn draw_scene(
             &belt,
             radius,
             mu_c,
+            mu_f,
             &sensor_values,
             &mut other,
         )?);
@@ -516,7 +789,10 @@ pub fn draw_scene(
         obstacles,
         neighbours,
         goal: base.goal.clone(),
-        controller: base.controller.clone(),
+        controller: base.controller.clone().map(|c| Controller {
+            latency: latency.unwrap_or(c.latency),
+            ..c
+        }),
         contact: crate::mechanics::ContactSettings {
             mu_c: mu_c.unwrap_or(base.contact.mu_c),
             ..base.contact
@@ -565,6 +841,7 @@ pub fn draw_scene(
         shape_redraws,
         other_redraws: other,
         run_seed,
+        streams: st.seeded(),
     })
 }
 
