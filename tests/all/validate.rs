@@ -533,3 +533,26 @@ fn rows_at_the_same_d_share_one_prediction() {
         }
     }
 }
+
+/// A calibration whose best grid point gives the members of one support group weights of order
+/// 1e-200 (10 members, μc range 0:10): their squares underflowed and the effective member count
+/// was 0/0, printed as `null`. It is finite now, between 1 and the member count.
+#[test]
+fn calibration_effective_members_stay_finite_when_weights_underflow() {
+    let text = "part,d,input,min_deg,max_deg,trials\ntripoly1,-0.7,state:0,355.1,5.9,20\ntripoly1,-0.7,state:1,129.2,142.5,20\ntripoly1,-0.7,state:2,219.4,229.7,20\n";
+    let m = measured::parse(Path::new("m.csv"), text, 0.5).unwrap();
+    let s = CalibrationSettings {
+        members: 10,
+        mu_c_range: (0.0, 10.0),
+        ..CalibrationSettings::default()
+    };
+    let cal = calibrate(&m, &s).unwrap();
+    assert!(
+        cal.effective_members.is_finite()
+            && cal.effective_members >= 1.0 - 1e-9
+            && cal.effective_members <= 10.0 + 1e-9,
+        "{}",
+        cal.effective_members
+    );
+    assert!(cal.log_likelihood.is_finite());
+}

@@ -173,6 +173,10 @@ fn fields(line: &str) -> Vec<String> {
 
 /// Apply one mutation to the lines (header first).
 fn apply(lines: &mut Vec<String>, m: CsvMutation) {
+    // A file reduced to nothing (its header dropped) takes no more edits.
+    if lines.is_empty() {
+        return;
+    }
     let data = lines.len().saturating_sub(1).max(1);
     let at = |row: usize| 1 + row % data;
     match m {
