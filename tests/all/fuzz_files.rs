@@ -282,3 +282,33 @@ fn plan_argument_sets_design_and_their_written_scenario_runs() {
     assert_eq!(r.class, Class::Named, "{}", r.detail);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `plan --fewest-sets --check-parts 0` for a square wrote a belt 0.02 m wide for a part with
+/// 2a = 0.028 m fed within ±2 mm, which the scenario parser refuses: the written width is now at
+/// least 2(a + lateral).
+#[test]
+fn a_planned_scenario_has_a_belt_at_least_as_wide_as_the_part() {
+    use pinfeed::study::robustness::plans;
+    let dir = std::env::temp_dir().join(format!("pinfeed-plan-width-{}", std::process::id()));
+    let args: Vec<String> = [
+        "--part",
+        "square",
+        "--time-limit",
+        "0.2",
+        "--check-parts",
+        "0",
+        "--screen-parts",
+        "50",
+        "--threads",
+        "1",
+        "--no-write",
+        "--quiet",
+        "--fewest-sets",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let r = plans::run(&args, &dir);
+    assert_eq!(r.class, Class::Success, "{}", r.detail);
+    let _ = std::fs::remove_dir_all(&dir);
+}
