@@ -250,32 +250,20 @@ fn merge_tampering_is_refused_and_an_untouched_set_merges() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `pinfeed plan` arguments for a test: part, time limit, check parts, then `extra`.
+fn plan_args(part: &str, time: &str, check: &str, extra: &[&str]) -> Vec<String> {
+    let mut a = pinfeed::study::robustness::plans::base_arguments(part, time, check, "50");
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a
+}
+
 /// A plan argument set runs through the command's checks and the design, and the scenario the
 /// design would write is accepted and runs; a refused argument names its flag.
 #[test]
 fn plan_argument_sets_design_and_their_written_scenario_runs() {
     use pinfeed::study::robustness::plans;
     let dir = std::env::temp_dir().join(format!("pinfeed-plan-fuzz-{}", std::process::id()));
-    let args = |extra: &[&str]| -> Vec<String> {
-        [
-            "--part",
-            "tripoly1",
-            "--time-limit",
-            "1",
-            "--check-parts",
-            "50",
-            "--screen-parts",
-            "50",
-            "--threads",
-            "1",
-            "--no-write",
-            "--quiet",
-        ]
-        .iter()
-        .chain(extra)
-        .map(|s| s.to_string())
-        .collect()
-    };
+    let args = |extra: &[&str]| plan_args("tripoly1", "1", "50", extra);
     let r = plans::run(&args(&[]), &dir.join("a"));
     assert_eq!(r.class, Class::Success, "{}", r.detail);
     let r = plans::run(&args(&["--jitter-samples=2001"]), &dir.join("b"));
@@ -290,24 +278,7 @@ fn plan_argument_sets_design_and_their_written_scenario_runs() {
 fn a_planned_scenario_has_a_belt_at_least_as_wide_as_the_part() {
     use pinfeed::study::robustness::plans;
     let dir = std::env::temp_dir().join(format!("pinfeed-plan-width-{}", std::process::id()));
-    let args: Vec<String> = [
-        "--part",
-        "square",
-        "--time-limit",
-        "0.2",
-        "--check-parts",
-        "0",
-        "--screen-parts",
-        "50",
-        "--threads",
-        "1",
-        "--no-write",
-        "--quiet",
-        "--fewest-sets",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
+    let args = plan_args("square", "0.2", "0", &["--fewest-sets"]);
     let r = plans::run(&args, &dir);
     assert_eq!(r.class, Class::Success, "{}", r.detail);
     let _ = std::fs::remove_dir_all(&dir);

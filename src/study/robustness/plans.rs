@@ -92,13 +92,10 @@ pub const PLAN_FLAGS: [(&str, &[&str]); 36] = [
     ("--refine", &["0", "2", "100"]),
 ];
 
-/// The argument list of a case (after `pinfeed plan`).
-pub fn arguments(rng: &mut ChaCha8Rng) -> Vec<String> {
-    let part = PARTS[rng.random_range(0..PARTS.len())];
-    let time = ["0.05", "0.2", "1"][rng.random_range(0..3usize)];
-    let check = ["0", "1", "50", "200"][rng.random_range(0..4usize)];
-    let screen = ["1", "50", "200"][rng.random_range(0..3usize)];
-    let mut a: Vec<String> = [
+/// The arguments every case has: the part, the time limit, the line checks' parts, one thread,
+/// no files, no progress display.
+pub fn base_arguments(part: &str, time: &str, check: &str, screen: &str) -> Vec<String> {
+    [
         "--part",
         part,
         "--time-limit",
@@ -114,7 +111,16 @@ pub fn arguments(rng: &mut ChaCha8Rng) -> Vec<String> {
     ]
     .iter()
     .map(|s| s.to_string())
-    .collect();
+    .collect()
+}
+
+/// The argument list of a case (after `pinfeed plan`).
+pub fn arguments(rng: &mut ChaCha8Rng) -> Vec<String> {
+    let part = PARTS[rng.random_range(0..PARTS.len())];
+    let time = ["0.05", "0.2", "1"][rng.random_range(0..3usize)];
+    let check = ["0", "1", "50", "200"][rng.random_range(0..4usize)];
+    let screen = ["1", "50", "200"][rng.random_range(0..3usize)];
+    let mut a = base_arguments(part, time, check, screen);
     for _ in 0..rng.random_range(0..=4usize) {
         let (flag, values) = PLAN_FLAGS[rng.random_range(0..PLAN_FLAGS.len())];
         if values.is_empty() {
