@@ -1,8 +1,8 @@
 #!/bin/sh
-# Regenerates results/online/** and results/online.md (run from the repository root):
+# Regenerates results/online/** and results/online-line.md (run from the repository root):
 #   sh results/online/regenerate.sh
 # Needs python3 with matplotlib for the figures (not in the standard library: install it with
-# `pip install matplotlib` if missing). Every number in results/online.md comes from the JSON
+# `pip install matplotlib` if missing). Every number in results/online-line.md comes from the JSON
 # files these commands write into results/online/ (the sweep variants are temporary copies of
 # scenarios/tripoly1_sensing.toml with one value changed, written to a temporary folder, never
 # into the repository). Runs one after another (lean on a shared machine); about 2.5 minutes.
@@ -87,4 +87,4 @@ run timing_exact 2000
 
 T1=$(date +%s.%N)
 echo "{\"total_wall_s\": $(awk "BEGIN{print $T1 - $T0}")}" > $OUT/runs/total_time.json
-python3 $OUT/summarize.py > results/online.md
+python3 $OUT/summarize.py > results/online-line.md

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes results/online.md (to stdout) and the SVG figures in results/online/ from the JSON files
+"""Writes results/online-line.md (to stdout) and the SVG figures in results/online/ from the JSON files
 that results/online/regenerate.sh writes (results/online/runs/*.json, compare.json).
 
 Every number in the Markdown comes from those files or, for the line's settings (positions, rules,
@@ -235,7 +235,7 @@ def main():
     w("    sh results/online/regenerate.sh\n")
     w(f"which builds the release binary, runs `pinfeed run` / `pinfeed compare` one after another "
       f"({t_total:.0f} s of runs on the shared 2-core machine) and ends with "
-      "`python3 results/online/summarize.py > results/online.md`. Every number here comes from the "
+      "`python3 results/online/summarize.py > results/online-line.md`. Every number here comes from the "
       "JSON files the script writes (`results/online/runs/*.json` are `pinfeed run --json` "
       "summaries, `results/online/compare.json` the `compare --json` rows) or, for the line's "
       "settings, from the scenario files. Sweep points are temporary copies of "

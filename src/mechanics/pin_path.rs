@@ -7,7 +7,7 @@
 //! switch: the state is continuous there and the mode is settled again with the new velocity.
 //!
 //! A continuous acceleration (a trapezoidal actuator move) is approximated by constant-velocity
-//! pieces whose positions agree with the true move at the piece ends; `results/online.md` measures
+//! pieces whose positions agree with the true move at the piece ends; `results/online-line.md` measures
 //! what that costs against a finely resolved acceleration phase.
 
 use serde::Serialize;

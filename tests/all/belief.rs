@@ -226,15 +226,7 @@ fn a_sensor_that_some_states_miss_gives_evidence_by_its_silence() {
         .replace("weights = [1, 1, 1]  # 0°, 135°, 225°", "")
         .replace("y = -0.007           # d = −0.22", "y = -0.0096");
     let scene = parse(&text);
-    let model = scene
-        .controller
-        .as_ref()
-        .unwrap()
-        .online
-        .as_ref()
-        .unwrap()
-        .0
-        .clone();
+    let model = scene.online_model().expect("an online model").clone();
     let never: Vec<usize> = (0..model.hypotheses.len())
         .filter(|&h| model.sensors[0].p_touch[h] == 0.0)
         .collect();

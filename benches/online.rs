@@ -1,0 +1,74 @@
+//! What the online controller costs (docs/physics.md#belief-and-online-replanning):
+//! * `decision/*`: one decision on `scenarios/tripoly1_online.toml` (54 hypotheses, 28 joint
+//!   commands): the reading's likelihood over every hypothesis's templates, the belief's update,
+//!   and the choice of the joint command — what the controller computes when a reading arrives;
+//!   and the choice alone;
+//! * `line_150_parts/*`: the same line driven by its rules and by the online controller (the
+//!   model is built once, outside the timing).
+//!
+//! `cargo bench --bench online`; figures in `results/online.md`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use pinfeed::engine::{self, RunOptions};
+use pinfeed::random::stream;
+use pinfeed::scenario::{self, Obstacle, Scene};
+use pinfeed::sensing::reading::read;
+use pinfeed::sensing::templates::{simulate, PushSetup};
+use std::path::Path;
+
+fn load(path: &str) -> Scene {
+    let text = std::fs::read_to_string(path).expect("bundled scenario");
+    scenario::parse(Path::new(path), &text).expect("bundled scenario parses")
+}
+
+fn decision(c: &mut Criterion) {
+    let scene = load("scenarios/tripoly1_online.toml");
+    let model = scene.online_model().expect("an online model").clone();
+    let sm = &model.sensors[0];
+    let Obstacle::Pin(pin) = &scene.obstacles[sm.obstacle] else {
+        panic!("the sensor is a pin")
+    };
+    let settings = pin.sensor.as_ref().unwrap().settings;
+    // A reading of state 135° at the sensor's d, read through the sensor's noise.
+    let mut setup = PushSetup::nominal(scene.part.polygon.clone(), -0.22);
+    setup.pin_radius = pin.radius;
+    setup.mass = scene.part.mass;
+    let pass = simulate(&setup, &scene.part.model, 135.0, -0.22, 0.5);
+    let reading = read(&pass.signal, &settings, &mut stream(1, 7)).expect("a reading");
+    let mut g = c.benchmark_group("decision");
+    g.bench_function("reading_update_choose", |b| {
+        b.iter(|| {
+            let mut belief = model.prior.clone();
+            let ll = sm.log_likelihood(&reading);
+            belief.observe_reading(&sm.p_touch, ll.as_deref());
+            model.choose(&belief).action
+        })
+    });
+    let mut belief = model.prior.clone();
+    let ll = sm.log_likelihood(&reading);
+    belief.observe_reading(&sm.p_touch, ll.as_deref());
+    g.bench_function("choose", |b| b.iter(|| model.choose(&belief).action));
+    g.finish();
+}
+
+fn line(c: &mut Criterion) {
+    let online = load("scenarios/tripoly1_online.toml");
+    let text = std::fs::read_to_string("scenarios/tripoly1_online.toml").unwrap();
+    let head = text.split("mode = \"online\"").next().unwrap();
+    let rules_part = &text[text.find("# The bundled rules").unwrap()..];
+    let rules = scenario::parse(Path::new("rules.toml"), &format!("{head}\n{rules_part}"))
+        .expect("the rules variant parses");
+    let mut g = c.benchmark_group("line_150_parts");
+    g.sample_size(10);
+    for (name, s) in [("rules", &rules), ("online", &online)] {
+        let mut opts = RunOptions::from_scene(s);
+        opts.parts = 150;
+        g.bench_function(name, |b| {
+            b.iter(|| engine::run(s, &opts, &mut |_| {}).unwrap().summary.outcomes)
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, decision, line);
+criterion_main!(benches);
