@@ -59,7 +59,7 @@ pub struct CalibrateArgs {
 }
 
 /// The calibration settings of the arguments, checked.
-fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
+pub(crate) fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
     let (lo, hi) = args
         .mu_c_range
         .split_once(':')

@@ -74,6 +74,18 @@ pub struct ContactArgs {
         conflicts_with_all = ["pin_stop", "cases"]
     )]
     pub pin_stop_at: Option<f64>,
+    /// When the moving pin stops, counted from its first touch: it moves at `--pin-speed` from its
+    /// start, touches the part, and stops after T more units of a of belt travel (0: at the
+    /// touch). A pin that never touches keeps moving. With `--cases`, T counts from each row's
+    /// own first touch.
+    #[arg(
+        long = "pin-stop-after-touch",
+        value_name = "T",
+        allow_hyphen_values = true,
+        requires = "pin_speed",
+        conflicts_with_all = ["pin_stop", "pin_stop_at", "fence"]
+    )]
+    pub pin_stop_after_touch: Option<f64>,
     /// Support: uniform or tripod:SEED.
     #[arg(long, default_value = "uniform")]
     pub support: String,
@@ -112,8 +124,18 @@ pub struct ContactReport {
     pub mu_s: f64,
     pub pin_radius: f64,
     pub pin_speed: f64,
+    /// Belt travel (units of a) from the pin's start to where it stops.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pin_stop: Option<f64>,
+    /// `--pin-stop-after-touch`: belt travel (units of a) from the first touch to the stop.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pin_stop_after_touch: Option<f64>,
+    /// A moving pin's lateral offset (units of a, the frame of `d`) at its first touch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pin_touch_d: Option<f64>,
+    /// A moving pin's lateral offset (units of a) where it stops.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pin_stop_d: Option<f64>,
     pub contact: bool,
     pub theta_final_deg: f64,
     pub rotation_deg: f64,
@@ -141,6 +163,8 @@ pub struct Case {
     pub pin_speed: f64,
     /// A moving pin stops after this much belt travel (units of a).
     pub pin_stop: Option<f64>,
+    /// A moving pin stops after this much belt travel (units of a) past its first touch.
+    pub pin_stop_after_touch: Option<f64>,
     pub support: String,
     pub tol: f64,
     /// A fence (angle in degrees, length in part units; None = default length) instead of a pin.
@@ -283,7 +307,22 @@ fn check_inputs_named(c: &Case, name: &dyn Fn(&str) -> String) -> Result<()> {
             num(c.pin_radius)
         );
     }
-    check_flag_settings(c.pin_speed, c.pin_stop, c.tol, name)
+    check_flag_settings(c.pin_speed, c.pin_stop, c.tol, name)?;
+    check_stop_after_touch(c.pin_stop_after_touch)
+}
+
+/// `--pin-stop-after-touch T`: T in [0, 1000] units of a.
+fn check_stop_after_touch(t: Option<f64>) -> Result<()> {
+    if let Some(t) = t {
+        in_range(
+            "--pin-stop-after-touch",
+            t,
+            0.0,
+            1e3,
+            "units of a of belt travel after the first touch",
+        )?;
+    }
+    Ok(())
 }
 
 /// The settings a batch takes from flags only (the pin's path and the tolerance), named by `name`.
@@ -437,6 +476,19 @@ fn run_compiled(
             push_fence(model, pose, &fence, &settings, recorder)
         }
         None => match c.pin_stop {
+            _ if c.pin_stop_after_touch.is_some() => {
+                let t = c.pin_stop_after_touch.unwrap_or(0.0) * poly.radius();
+                let path = crate::mechanics::stop_after_touch(
+                    model,
+                    pose,
+                    start,
+                    pin.radius,
+                    c.pin_speed,
+                    t,
+                )
+                .expect("checked by check_inputs");
+                push_path(model, pose, start, pin.radius, &path, &settings, recorder)
+            }
             Some(s_stop) => {
                 let turn = Turn {
                     s: s_stop * poly.radius(),
@@ -506,6 +558,9 @@ pub(crate) fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
         pin_radius: c.pin_radius,
         pin_speed: c.pin_speed,
         pin_stop: c.pin_stop,
+        pin_stop_after_touch: c.pin_stop_after_touch,
+        pin_touch_d: None,
+        pin_stop_d: None,
         contact: out.contact,
         theta_final_deg: wrap_deg(out.pose_final.theta.to_degrees()),
         rotation_deg: out.rotation.to_degrees(),
@@ -518,6 +573,27 @@ pub(crate) fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
         steps: out.steps,
         status: out.status.name().into(),
         status_detail: out.status,
+    }
+}
+
+impl ContactReport {
+    /// A moving pin's travel to its stop and its lateral offsets at the first touch and at the
+    /// stop (units of a; `a` is the part's size), from the case and its outcome.
+    pub(crate) fn with_pin_positions(mut self, c: &Case, a: f64, out: &ContactOutcome) -> Self {
+        if c.fence.is_some() || c.pin_speed == 0.0 {
+            return self;
+        }
+        let touch = out.contact.then(|| out.travel_to_contact / a);
+        let stop = match (c.pin_stop, c.pin_stop_after_touch) {
+            (Some(s), _) => Some(s),
+            (None, Some(t)) => touch.map(|s| s + t),
+            (None, None) => None,
+        };
+        let at = |s: f64| c.d + c.pin_speed * stop.map_or(s, |e| s.min(e));
+        self.pin_stop = stop;
+        self.pin_touch_d = touch.map(at);
+        self.pin_stop_d = stop.map(at);
+        self
     }
 }
 
@@ -544,6 +620,7 @@ pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
         pin_radius: args.pin_radius,
         pin_speed: args.pin_speed,
         pin_stop,
+        pin_stop_after_touch: args.pin_stop_after_touch,
         support: args.support.clone(),
         tol: args.tol,
         fence: args.fence.as_deref().map(parse_fence).transpose()?,
@@ -584,7 +661,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         plot_contact(&poly, pose, &obstacle, &out, &trace, &plot_title(&c), path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    let r = report(&c, &out);
+    let r = report(&c, &out).with_pin_positions(&c, poly.radius(), &out);
     if args.json {
         print!("{}", crate::report::versioned::pretty(&r)?);
     } else {
@@ -628,6 +705,12 @@ pub(crate) fn print_motion(r: &ContactReport) {
         r.com_final[0], r.com_final[1]
     );
     println!("contact length      {:.5}", r.contact_length);
+    if let Some(y) = r.pin_touch_d {
+        println!("pin at first touch  d = {y:.5}");
+    }
+    if let Some(y) = r.pin_stop_d {
+        println!("pin stops at        d = {y:.5}");
+    }
 }
 
 fn write_trace(path: &std::path::Path, trace: &[TraceSample]) -> Result<()> {
@@ -707,6 +790,7 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
     // Flags that apply to every row are checked once, before any row (an error there is the
     // flag's, not a row's).
     check_flag_settings(args.pin_speed, args.pin_stop, args.tol, &flag)?;
+    check_stop_after_touch(args.pin_stop_after_touch)?;
     for (i, row) in rdr.deserialize::<CaseRow>().enumerate() {
         let row = row.map_err(|e| {
             let line = e.position().map(|p| p.line()).unwrap_or(i as u64 + 2);
@@ -728,6 +812,7 @@ fn run_batch(args: &ContactArgs, path: &std::path::Path) -> Result<()> {
             pin_radius: row.pin_radius.unwrap_or(args.pin_radius),
             pin_speed: args.pin_speed,
             pin_stop: args.pin_stop,
+            pin_stop_after_touch: args.pin_stop_after_touch,
             support: args.support.clone(),
             tol: args.tol,
             fence,

@@ -18,13 +18,21 @@ pub enum FuzzTarget {
     Studies,
     Contacts,
     Polygons,
+    /// Sensing, actuator, controller and policy scenarios with pairs of keys set together.
+    Pairs,
+    /// `pinfeed plan` argument sets.
+    Plans,
+    /// Measured-band CSV files with `validate` and `calibrate` arguments.
+    Csvs,
+    /// Shard files edited before `merge`.
+    Merges,
     All,
 }
 
 /// Arguments of `pinfeed fuzz`.
 #[derive(Debug, Args)]
 pub struct FuzzArgs {
-    /// scenarios, studies, contacts, polygons or all.
+    /// scenarios, studies, contacts, polygons, pairs, plans, csvs, merges or all.
     #[arg(value_enum)]
     pub target: FuzzTarget,
     /// Cases per target.
@@ -33,6 +41,9 @@ pub struct FuzzArgs {
     /// Cases of the contacts target (default: --count).
     #[arg(long)]
     pub contacts: Option<u64>,
+    /// Cases of other targets, overriding --count: TARGET=N,... (e.g. plans=500,pairs=20000).
+    #[arg(long, value_name = "TARGET=N,...")]
+    pub counts: Option<String>,
     /// Seed; case i of a target draws from its own stream (seed, i).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -59,8 +70,46 @@ fn targets(t: FuzzTarget) -> Vec<Target> {
         FuzzTarget::Studies => vec![Target::Studies],
         FuzzTarget::Contacts => vec![Target::Contacts],
         FuzzTarget::Polygons => vec![Target::Polygons],
+        FuzzTarget::Pairs => vec![Target::Pairs],
+        FuzzTarget::Plans => vec![Target::Plans],
+        FuzzTarget::Csvs => vec![Target::Csvs],
+        FuzzTarget::Merges => vec![Target::Merges],
         FuzzTarget::All => Target::ALL.to_vec(),
     }
+}
+
+/// `--counts TARGET=N,...`: the targets' own case counts.
+fn parse_counts(text: &str) -> Result<Vec<(Target, u64)>> {
+    text.split(',')
+        .filter(|w| !w.trim().is_empty())
+        .map(|w| {
+            let (name, n) = w
+                .split_once('=')
+                .with_context(|| format!("--counts: `{w}` is not TARGET=N"))?;
+            let t = Target::ALL
+                .into_iter()
+                .find(|t| t.name() == name.trim())
+                .with_context(|| {
+                    format!(
+                        "--counts: unknown target `{}` (expected one of {})",
+                        name.trim(),
+                        Target::ALL.map(|t| t.name()).join(", ")
+                    )
+                })?;
+            let n: u64 = n
+                .trim()
+                .parse()
+                .ok()
+                .filter(|&n| n <= 100_000_000)
+                .with_context(|| {
+                    format!(
+                        "--counts: {} must be a count in [0, 100000000], got `{n}`",
+                        t.name()
+                    )
+                })?;
+            Ok((t, n))
+        })
+        .collect()
 }
 
 /// The command line that regenerates the report.
@@ -72,6 +121,12 @@ fn command_line(args: &FuzzArgs) -> String {
     );
     if let Some(n) = args.contacts {
         c.push_str(&format!(" --contacts {n}"));
+    }
+    if let Some(n) = &args.counts {
+        c.push_str(&format!(" --counts {n}"));
+    }
+    if let Some(n) = args.threads {
+        c.push_str(&format!(" --threads {n}"));
     }
     c.push_str(&format!(" --report {}", args.report.display()));
     c
@@ -87,6 +142,12 @@ pub fn run(args: &FuzzArgs) -> Result<()> {
     if args.count > 100_000_000 || args.contacts.is_some_and(|n| n > 100_000_000) {
         bail!("--count and --contacts must be at most 100000000");
     }
+    let overrides = args
+        .counts
+        .as_deref()
+        .map(parse_counts)
+        .transpose()?
+        .unwrap_or_default();
     let corpus = Arc::new(Corpus::load(&args.root).map_err(anyhow::Error::msg)?);
     let threads = match args.threads {
         Some(0) => bail!("--threads must be at least 1"),
@@ -95,6 +156,10 @@ pub fn run(args: &FuzzArgs) -> Result<()> {
             .map(|n| n.get())
             .unwrap_or(1),
     };
+    // Work a case hands to rayon (plan searches, ensembles) runs on at most as many threads.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global();
     let opts = Options {
         seed: args.seed,
         threads,
@@ -124,9 +189,12 @@ pub fn run(args: &FuzzArgs) -> Result<()> {
     }
     let mut tallies = Vec::new();
     for t in targets(args.target) {
-        let count = match t {
-            Target::Contacts => args.contacts.unwrap_or(args.count),
-            _ => args.count,
+        let count = match overrides.iter().find(|(o, _)| *o == t) {
+            Some(&(_, n)) => n,
+            None => match t {
+                Target::Contacts => args.contacts.unwrap_or(args.count),
+                _ => args.count,
+            },
         };
         eprintln!("fuzz {}: {count} cases on {threads} threads", t.name());
         let name = t.name();

@@ -287,6 +287,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         pin_radius: args.pin_radius,
         pin_speed: 0.0,
         pin_stop: None,
+        pin_stop_after_touch: None,
         support: args.support.clone(),
         tol: args.tol,
         fence,

@@ -51,6 +51,10 @@ pub struct ModelArgs {
     /// Log score: window (degrees each side) for rows with input `all`.
     #[arg(long, default_value_t = 20.0, allow_hyphen_values = true)]
     pub window: f64,
+    /// Containment: the least share of the predicted mass inside a measured band (for input
+    /// `all`, of the mass within --window of it) for the band to count as contained.
+    #[arg(long, default_value_t = crate::validate::score::CONTAINED_SHARE, allow_hyphen_values = true)]
+    pub contained_share: f64,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -73,6 +77,7 @@ impl ModelArgs {
             ("--floor", self.floor, 1e-9, 1.0),
             ("--window", self.window, 0.0, 180.0),
             ("--tol", self.tol, 1e-12, 1e-2),
+            ("--contained-share", self.contained_share, 0.01, 1.0),
         ];
         for (flag, v, lo, hi) in checks {
             if !(v.is_finite() && v >= lo && v <= hi) {
@@ -93,20 +98,22 @@ impl ModelArgs {
             kernel_deg: self.kernel,
             floor: self.floor,
             window_deg: self.window,
+            contained_share: self.contained_share,
         })
     }
 
     /// The flags as they regenerate a report.
     pub fn words(&self) -> String {
         let mut s = format!(
-            "--model {} --tol {} --passes {} --seed {} --kernel {} --floor {} --window {}",
+            "--model {} --tol {} --passes {} --seed {} --kernel {} --floor {} --window {} --contained-share {}",
             shell_word(&self.model),
             self.tol,
             self.passes,
             self.seed,
             self.kernel,
             self.floor,
-            self.window
+            self.window,
+            self.contained_share
         );
         if let Some(p) = &self.part {
             s.push_str(&format!(" --part {}", shell_word(p)));
@@ -259,18 +266,30 @@ pub struct ValidateReport<'a> {
     pub uncertain: Vec<String>,
     pub members: usize,
     pub score_settings: ScoreSettings,
+    /// What `contained` and the verdicts mean ([`containment_text`]).
+    pub containment: String,
     pub summary: &'a Summary,
     pub rows: &'a [RowScore],
 }
 
+/// What "contained" means, in one sentence.
+pub fn containment_text(threshold: f64) -> String {
+    format!(
+        "Contained: at least {}% of the predicted mass lies inside the measured band (for input `all`, of the mass within the window of it); the share is given with its 95% bootstrap interval over the members ({} resamples), and the verdict is yes when the whole interval is at or above {}%, no when it is below, undecided when it straddles it.",
+        fixed(100.0 * threshold, 0, false),
+        crate::validate::score::RESAMPLES,
+        fixed(100.0 * threshold, 0, false)
+    )
+}
+
 /// One line per row, then the summary.
 pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
-    let mut s = String::from("| line | part | d | input | measured | trials | contained | overlapping | centre offset | P(measured) | log score | predicted bands (90%) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let mut s = String::from("| line | part | d | input | measured | trials | contained | share in band [95%] | overlapping | centre offset | P(measured) | log score | predicted bands (90%) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     let yes = |b: bool| if b { "yes" } else { "no" };
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:+} | {} | [{}, {}] | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {:+} | {} | [{}, {}] | {} | {} | {} [{}, {}] | {} | {} | {} | {} | {} |",
             r.line,
             r.part,
             r.d,
@@ -278,7 +297,10 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
             r.min_deg,
             r.max_deg,
             r.trials.map_or("—".into(), |n| n.to_string()),
-            yes(r.contained),
+            r.containment.label(),
+            fixed(r.contained_share, 3, false),
+            fixed(r.contained_share_ci95[0], 3, false),
+            fixed(r.contained_share_ci95[1], 3, false),
             yes(r.overlapping),
             r.centre_offset_deg
                 .map_or("—".into(), |o| format!("{}°", fixed(o, 1, true))),
@@ -287,16 +309,26 @@ pub fn rows_text(rows: &[RowScore], summary: &Summary) -> String {
             bands_text(&r.predicted)
         );
     }
-    let _ = writeln!(s, "\n{}", summary_text(summary));
+    let _ = writeln!(
+        s,
+        "\n{}\n\n{}",
+        containment_text(summary.contained_share),
+        summary_text(summary)
+    );
     s
 }
 
 /// The summary in one line.
 pub fn summary_text(s: &Summary) -> String {
     format!(
-        "{} rows: {} contained, {} overlapping; predicted bands cover {}% of the circle on average; log score {} ({} per row)",
+        "{} rows: {} contained (95% interval {}–{}; verdicts {} yes, {} no, {} undecided), {} overlapping; predicted bands cover {}% of the circle on average; log score {} ({} per row)",
         s.rows,
         s.contained,
+        s.contained_ci95[0],
+        s.contained_ci95[1],
+        s.verdict_contained,
+        s.verdict_not_contained,
+        s.verdict_undecided,
         s.overlapping,
         fixed(100.0 * s.coverage, 1, false),
         fixed(s.log_score, 2, false),
@@ -359,6 +391,7 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         uncertain: spec.describe(),
         members: args.members,
         score_settings: score,
+        containment: containment_text(score.contained_share),
         summary: &summary,
         rows: &rows,
     };

@@ -50,7 +50,10 @@ pub use outcome::{
 };
 pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
 pub(crate) use pass::untouched;
-pub use pass::{fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path};
+pub use pass::{
+    fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path,
+    stop_after_touch,
+};
 pub use pin_path::{PinPath, Turn, MAX_LATERAL_SPEED};
 pub use settings::{ContactSettings, Pin};
 pub use vote::mason_vote;

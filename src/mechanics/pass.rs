@@ -261,6 +261,36 @@ pub fn pin_first_touch(
     }
 }
 
+/// The path of a pin moving at lateral speed `w` from `pin_start` that stops `after` (belt travel,
+/// caller's units) after it first touches the part resting at `pose` ([`pin_first_touch`] on the
+/// constant path, which the stopping path follows up to the stop), then stands still. A pin that
+/// never touches the part keeps moving (the stop never comes). `after` must be finite and ≥ 0.
+pub fn stop_after_touch(
+    model: &PartModel,
+    pose: Pose,
+    pin_start: Vec2,
+    radius: f64,
+    w: f64,
+    after: f64,
+) -> Result<PinPath, String> {
+    if !(after.is_finite() && after >= 0.0) {
+        return Err(format!(
+            "the travel after first touch must be a finite number >= 0, got {after}"
+        ));
+    }
+    let moving = PinPath::new(w, Vec::new())?;
+    match pin_first_touch(model, pose, pin_start, radius, &moving) {
+        Some(s) if s.is_finite() => PinPath::new(
+            w,
+            vec![super::pin_path::Turn {
+                s: s.max(0.0) + after.max(f64::MIN_POSITIVE),
+                w: 0.0,
+            }],
+        ),
+        _ => Ok(moving),
+    }
+}
+
 /// Push a part resting at `pose` with a fence (docs/physics.md#fences; see [`super::fence`]): the fence travels at
 /// (−V, 0) relative to the belt past the part; its friction μf replaces μc in `settings`.
 /// Fence-contact features index the part's convex hull.

@@ -200,6 +200,8 @@ fn shares_log_likelihood(
     score: &ScoreSettings,
 ) -> Vec<(f64, f64)> {
     let top = lw.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    // No member possible at this grid point: every weight 0 (not NaN).
+    let top = if top.is_finite() { top } else { 0.0 };
     // Member weights split by support group (tripod: g = 1).
     let split = |g: bool| -> Vec<f64> {
         pred.members
@@ -217,10 +219,29 @@ fn shares_log_likelihood(
     let (wu, wt) = (split(false), split(true));
     let (pu, pt) = (pred.pass_weights(&wu), pred.pass_weights(&wt));
     let (tot_u, tot_t): (f64, f64) = (pu.iter().sum(), pt.iter().sum());
-    let (sq_u, sq_t): (f64, f64) = (
-        wu.iter().map(|w| w * w).sum(),
-        wt.iter().map(|w| w * w).sum(),
-    );
+    // The effective member count (Σw)²/Σw² of a mixture, from weights scaled by their largest
+    // (the weights of one group can be 1e-200, whose squares underflow to 0).
+    let largest = |w: &[f64]| w.iter().copied().fold(0.0, f64::max);
+    let (mu, mt) = (largest(&wu), largest(&wt));
+    let scaled_sq = |w: &[f64], m: f64| -> f64 {
+        if m > 0.0 {
+            w.iter().map(|x| (x / m) * (x / m)).sum()
+        } else {
+            0.0
+        }
+    };
+    let (sq_u, sq_t) = (scaled_sq(&wu, mu), scaled_sq(&wt, mt));
+    let ess_of = |a: f64, b: f64| -> f64 {
+        let (ca, cb) = (a * mu, b * mt);
+        let m = ca.max(cb);
+        if m.is_nan() || m <= 0.0 {
+            return 0.0;
+        }
+        let (ra, rb) = (ca / m, cb / m);
+        let part = |r: f64, tot: f64, top: f64| if top > 0.0 { r * tot / top } else { 0.0 };
+        let n = (part(ra, tot_u, mu) + part(rb, tot_t, mt)) / pred.passes as f64;
+        n * n / (ra * ra * sq_u + rb * rb * sq_t)
+    };
     let sums: Vec<([f64; 4], [f64; 4])> =
         kernels.iter().map(|k| (k.sums(&pu), k.sums(&pt))).collect();
     shares
@@ -239,9 +260,7 @@ fn shares_log_likelihood(
                     k.log_likelihood(s, total, score)
                 })
                 .sum();
-            let mw = a * tot_u + b * tot_t;
-            let ess = (mw / pred.passes as f64).powi(2) / (a * a * sq_u + b * b * sq_t);
-            (ll, ess)
+            (ll, ess_of(a, b))
         })
         .collect()
 }

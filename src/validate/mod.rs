@@ -32,7 +32,7 @@ pub fn validate(
 ) -> Result<(Vec<RowScore>, Summary, Predictions), String> {
     let pred = predict::predict(measured, spec, seed, members, passes)?;
     let weights = vec![1.0; pred.members.len() * passes];
-    let rows = score::score_rows(measured, &pred.rows, &weights, score);
-    let summary = score::summarise(&rows);
+    let (rows, count) = score::score_rows(measured, &pred.rows, &weights, passes, score);
+    let summary = score::summarise(&rows, count, score.contained_share);
     Ok((rows, summary, pred))
 }

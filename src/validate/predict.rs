@@ -1,8 +1,10 @@
 //! What an ensemble predicts for each measured row: `passes` passes of every member from the
-//! row's input state at the row's d ([`crate::maps::ensemble::Member::pass`]). Row r's pass q of
-//! member i is pass number r · passes + q of that member, so its jitter and θ0 draw are fixed by
-//! (seed, i, r, q) whatever the thread count. Members are compiled once per part; a member's draw
-//! (μc, support choice, pin radius) is the same for every part.
+//! row's input state at the row's d ([`crate::maps::ensemble::Member::pass`]). Rows with the same
+//! part, d and input (a thesis-style table's bands at one d) share one prediction: number the
+//! distinct (part, d, input) in order of first appearance g = 0, 1, …; pass q of member i for
+//! prediction g is pass number g · passes + q of that member, so its jitter and θ0 draw are fixed
+//! by (seed, i, g, q) whatever the thread count. Members are compiled once per part; a member's
+//! draw (μc, support choice, pin radius) is the same for every part.
 
 use super::measured::Measured;
 use crate::maps::ensemble::{members, stable_states_deg, EnsembleSpec, Member, MemberDraw};
@@ -43,25 +45,46 @@ pub fn predict(
             Ok((name.clone(), m, stable_states_deg(poly)))
         })
         .collect::<Result<_, String>>()?;
-    let rows = measured
+    // The distinct (part, d, input) in order of first appearance, and each row's among them.
+    let mut groups: Vec<(&str, u64, String)> = Vec::new();
+    let group_of: Vec<usize> = measured
         .rows
         .iter()
-        .enumerate()
-        .map(|(r, row)| {
-            let (_, ms, states) = compiled
-                .iter()
-                .find(|(p, _, _)| *p == row.part)
-                .expect("every row's part is compiled");
-            let poly = measured.polygon(&row.part);
+        .map(|row| {
+            let key = (row.part.as_str(), row.d.to_bits(), row.input.label());
+            match groups.iter().position(|g| *g == key) {
+                Some(g) => g,
+                None => {
+                    groups.push(key);
+                    groups.len() - 1
+                }
+            }
+        })
+        .collect();
+    let mut predicted: Vec<Option<Vec<f64>>> = vec![None; groups.len()];
+    for (row, &g) in measured.rows.iter().zip(&group_of) {
+        if predicted[g].is_some() {
+            continue;
+        }
+        let (_, ms, states) = compiled
+            .iter()
+            .find(|(p, _, _)| *p == row.part)
+            .expect("every row's part is compiled");
+        let poly = measured.polygon(&row.part);
+        predicted[g] = Some(
             (0..n * passes)
                 .into_par_iter()
                 .map(|x| {
                     let (i, q) = (x / passes, x % passes);
-                    let pass = (r * passes + q) as u64;
+                    let pass = (g * passes + q) as u64;
                     ms[i].pass(poly, spec, &row.input, states, row.d, pass)
                 })
-                .collect()
-        })
+                .collect(),
+        );
+    }
+    let rows = group_of
+        .iter()
+        .map(|&g| predicted[g].clone().expect("every group is predicted"))
         .collect();
     let draws = compiled
         .first()

@@ -2,10 +2,24 @@
 //!
 //! **Per row.** The prediction is the row's pooled passes ([`super::predict`]), each weighted by its
 //! member's weight (1 for a plain ensemble). Its *predicted bands* are the smallest arcs holding 90%
-//! of it. The row is *contained* if one predicted band holds the whole measured band, *overlapping*
-//! if one shares an angle with it; the *centre offset* is the signed rotation from the centre of the
-//! nearest predicted band (overlapping ones first) to the measured band's centre; the *predicted
-//! probability* is the share of passes that end inside the measured band.
+//! of it. The row is *overlapping* if a predicted band shares an angle with the measured band; the
+//! *centre offset* is the signed rotation from the centre of the nearest predicted band
+//! (overlapping ones first) to the measured band's centre; the *predicted probability* is the share
+//! of passes that end inside the measured band.
+//!
+//! **Containment.** The *contained share* is the predicted mass inside the measured band, as a
+//! share of the predicted mass the band competes for: the whole circle for inputs `state:K` and
+//! `theta:…`, and for input `all` (one band of several, no θ0) the band widened by the window at
+//! each end. The row is *contained* when that share is at least [`ScoreSettings::contained_share`]
+//! (default 80%: the range of 20 trials drawn from the predicted distribution itself holds at
+//! least 80% of it 93% of the time, 90% only 61% of the time). The share is an estimate from a
+//! finite ensemble, so it comes with a 95% interval: the 2.5% and 97.5% quantiles over
+//! [`RESAMPLES`] bootstrap resamples of the ensemble's members (each member with all its passes and
+//! its weight; the resamples are the same for every row, so the interval of the *count* of
+//! contained rows, taken over the same resamples, accounts for rows that share members). The
+//! verdict is *contained* when the whole interval is at or above the threshold, *not contained*
+//! when it is below, and *undecided* when it straddles it: a verdict that is decided does not flip
+//! with the ensemble's seed except by chance outside the interval.
 //!
 //! **Log score.** The predicted density of θf is the passes smoothed by a wrapped normal kernel of
 //! sd h (default 2°: it stands for the measurement error of a band end), mixed with a uniform floor
@@ -35,7 +49,16 @@ pub struct ScoreSettings {
     pub floor: f64,
     /// Window for input `all` (degrees each side).
     pub window_deg: f64,
+    /// Least contained share (predicted mass inside the measured band) of a contained row.
+    pub contained_share: f64,
 }
+
+/// Bootstrap resamples of the members behind the intervals of the containment verdicts.
+pub const RESAMPLES: usize = 1000;
+/// Default [`ScoreSettings::contained_share`].
+pub const CONTAINED_SHARE: f64 = 0.8;
+/// Seed of the bootstrap resamples (fixed: the interval is a function of the ensemble).
+const RESAMPLE_SEED: u64 = 0xB007_57A9;
 
 impl Default for ScoreSettings {
     fn default() -> Self {
@@ -43,6 +66,7 @@ impl Default for ScoreSettings {
             kernel_deg: 2.0,
             floor: 0.01,
             window_deg: 20.0,
+            contained_share: CONTAINED_SHARE,
         }
     }
 }
@@ -173,7 +197,14 @@ pub struct RowScore {
     pub min_deg: f64,
     pub max_deg: f64,
     pub trials: Option<u32>,
+    /// The contained share is at least the threshold (the point estimate).
     pub contained: bool,
+    /// Predicted mass inside the measured band, as a share of the mass it competes for.
+    pub contained_share: f64,
+    /// 95% bootstrap interval of `contained_share` over the members.
+    pub contained_share_ci95: [f64; 2],
+    /// The verdict with its uncertainty: contained, not_contained or undecided.
+    pub containment: Verdict,
     pub overlapping: bool,
     /// Measured centre minus the nearest predicted band's centre (degrees, signed).
     pub centre_offset_deg: Option<f64>,
@@ -183,11 +214,51 @@ pub struct RowScore {
     pub predicted: PredictedBands,
 }
 
+/// A containment verdict that knows its sampling uncertainty.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// The whole 95% interval of the contained share is at or above the threshold.
+    Contained,
+    /// The whole interval is below it.
+    NotContained,
+    /// The interval straddles the threshold: more members would decide it.
+    Undecided,
+}
+
+impl Verdict {
+    pub fn of(ci95: [f64; 2], threshold: f64) -> Verdict {
+        if ci95[0] >= threshold {
+            Verdict::Contained
+        } else if ci95[1] < threshold {
+            Verdict::NotContained
+        } else {
+            Verdict::Undecided
+        }
+    }
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Contained => "yes",
+            Verdict::NotContained => "no",
+            Verdict::Undecided => "undecided",
+        }
+    }
+}
+
 /// Counts and totals over all rows.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
     pub rows: usize,
+    /// Rows whose contained share is at least the threshold (point estimates).
     pub contained: usize,
+    /// 95% bootstrap interval of that count.
+    pub contained_ci95: [usize; 2],
+    /// Rows with verdict contained, not contained and undecided.
+    pub verdict_contained: usize,
+    pub verdict_not_contained: usize,
+    pub verdict_undecided: usize,
+    /// The threshold of the contained share.
+    pub contained_share: f64,
     pub overlapping: usize,
     /// Mean over rows of the share of the circle the predicted bands cover.
     pub coverage: f64,
@@ -195,29 +266,150 @@ pub struct Summary {
     pub mean_log_score: f64,
 }
 
-/// Score every row: `predicted[r]` are row r's passes (θf, degrees), `weights` one weight per pass
-/// (all 1 for a plain ensemble).
+/// Score every row: `predicted[r]` are row r's passes (θf, degrees; index member · `passes` + q),
+/// `weights` one weight per pass (all 1 for a plain ensemble). Returns the rows and the bootstrap
+/// interval of the count of contained rows.
 pub fn score_rows(
     measured: &Measured,
     predicted: &[Vec<f64>],
     weights: &[f64],
+    passes: usize,
     s: &ScoreSettings,
-) -> Vec<RowScore> {
+) -> (Vec<RowScore>, [usize; 2]) {
     let total: f64 = weights.iter().sum();
-    measured
+    let masses: Vec<MemberMasses> = measured
         .rows
         .iter()
         .zip(predicted)
-        .map(|(row, values)| {
+        .map(|(row, values)| MemberMasses::new(row, values, weights, passes, s))
+        .collect();
+    let (intervals, count) = bootstrap(&masses, s.contained_share);
+    let rows = measured
+        .rows
+        .iter()
+        .zip(predicted)
+        .zip(masses.iter().zip(intervals))
+        .map(|((row, values), (m, ci95))| {
             let kernel = RowKernel::new(row, values, s);
             let log_score = kernel.log_likelihood(kernel.sums(weights), total, s);
-            judge(row, values, weights, log_score)
+            let share = m.share(None);
+            let containment = Containment {
+                share,
+                ci95,
+                threshold: s.contained_share,
+            };
+            judge(row, values, weights, log_score, containment)
         })
-        .collect()
+        .collect();
+    (rows, count)
+}
+
+/// Per member, the weight of its passes inside a row's measured band and in the arc the band
+/// competes for (the circle, or for input `all` the band ± the window).
+#[derive(Debug, Clone)]
+struct MemberMasses {
+    inside: Vec<f64>,
+    reference: Vec<f64>,
+}
+
+impl MemberMasses {
+    fn new(
+        row: &MeasuredRow,
+        values: &[f64],
+        w: &[f64],
+        passes: usize,
+        s: &ScoreSettings,
+    ) -> MemberMasses {
+        let reference_arc = match row.input {
+            InputState::All => row.band.widened(s.window_deg),
+            _ => Arc::full(),
+        };
+        let members = values.len() / passes.max(1);
+        let mut m = MemberMasses {
+            inside: vec![0.0; members],
+            reference: vec![0.0; members],
+        };
+        for (k, (&v, &wk)) in values.iter().zip(w).enumerate() {
+            let i = (k / passes.max(1)).min(members.saturating_sub(1));
+            if reference_arc.width >= 360.0 || reference_arc.contains_angle(v) {
+                m.reference[i] += wk;
+                if row.band.contains_angle(v) {
+                    m.inside[i] += wk;
+                }
+            }
+        }
+        m
+    }
+
+    /// The contained share with every member once (`None`) or `counts[i]` times.
+    fn share(&self, counts: Option<&[u32]>) -> f64 {
+        let (mut inside, mut reference) = (0.0, 0.0);
+        for i in 0..self.inside.len() {
+            let c = counts.map_or(1.0, |c| c[i] as f64);
+            inside += c * self.inside[i];
+            reference += c * self.reference[i];
+        }
+        if reference > 0.0 {
+            (inside / reference).min(1.0)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The 2.5% and 97.5% quantiles of sorted `x`.
+fn interval<T: Copy>(sorted: &[T]) -> [T; 2] {
+    let n = sorted.len();
+    let at = |q: f64| sorted[((q * (n - 1) as f64).round() as usize).min(n - 1)];
+    [at(0.025), at(0.975)]
+}
+
+/// Bootstrap over members: per row the 95% interval of the contained share, and the interval of
+/// the count of rows at or above `threshold`, over the same [`RESAMPLES`] resamples.
+fn bootstrap(masses: &[MemberMasses], threshold: f64) -> (Vec<[f64; 2]>, [usize; 2]) {
+    use rand::RngExt;
+    use rayon::prelude::*;
+    let members = masses.first().map_or(0, |m| m.inside.len());
+    if members == 0 {
+        let point: Vec<f64> = masses.iter().map(|m| m.share(None)).collect();
+        let count = point.iter().filter(|&&p| p >= threshold).count();
+        return (point.iter().map(|&p| [p, p]).collect(), [count, count]);
+    }
+    let shares: Vec<Vec<f64>> = (0..RESAMPLES as u64)
+        .into_par_iter()
+        .map(|b| {
+            let mut rng = crate::random::stream(RESAMPLE_SEED, b);
+            let mut counts = vec![0u32; members];
+            for _ in 0..members {
+                counts[rng.random_range(0..members)] += 1;
+            }
+            masses.iter().map(|m| m.share(Some(&counts))).collect()
+        })
+        .collect();
+    let per_row = (0..masses.len())
+        .map(|r| {
+            let mut x: Vec<f64> = shares.iter().map(|b| b[r]).collect();
+            x.sort_by(f64::total_cmp);
+            interval(&x)
+        })
+        .collect();
+    let mut counts: Vec<usize> = shares
+        .iter()
+        .map(|b| b.iter().filter(|&&p| p >= threshold).count())
+        .collect();
+    counts.sort_unstable();
+    (per_row, interval(&counts))
+}
+
+/// A row's contained share, its interval and the threshold.
+struct Containment {
+    share: f64,
+    ci95: [f64; 2],
+    threshold: f64,
 }
 
 /// Containment, overlap, offset and probability of one row.
-fn judge(row: &MeasuredRow, values: &[f64], w: &[f64], log_score: f64) -> RowScore {
+fn judge(row: &MeasuredRow, values: &[f64], w: &[f64], log_score: f64, c: Containment) -> RowScore {
     let predicted = PredictedBands::of(row.d, row.input.label(), values, w);
     let bands = &predicted.bands;
     let m = &row.band;
@@ -246,7 +438,10 @@ fn judge(row: &MeasuredRow, values: &[f64], w: &[f64], log_score: f64) -> RowSco
         min_deg: row.min_deg,
         max_deg: row.max_deg,
         trials: row.trials,
-        contained: bands.iter().any(|b| b.arc.contains(m)),
+        contained: c.share >= c.threshold,
+        contained_share: c.share,
+        contained_share_ci95: c.ci95,
+        containment: Verdict::of(c.ci95, c.threshold),
         overlapping: bands.iter().any(|b| b.arc.overlaps(m)),
         centre_offset_deg: nearest.map(|b| signed_difference(b.arc.centre(), m.centre())),
         predicted_probability: if total > 0.0 { inside / total } else { 0.0 },
@@ -255,13 +450,20 @@ fn judge(row: &MeasuredRow, values: &[f64], w: &[f64], log_score: f64) -> RowSco
     }
 }
 
-/// The summary of scored rows.
-pub fn summarise(rows: &[RowScore]) -> Summary {
+/// The summary of scored rows; `contained_ci95` is the count's interval from [`score_rows`] and
+/// `threshold` the contained share of a contained row.
+pub fn summarise(rows: &[RowScore], contained_ci95: [usize; 2], threshold: f64) -> Summary {
     let n = rows.len();
     let log_score: f64 = rows.iter().map(|r| r.log_score).sum();
+    let verdicts = |v: Verdict| rows.iter().filter(|r| r.containment == v).count();
     Summary {
         rows: n,
         contained: rows.iter().filter(|r| r.contained).count(),
+        contained_ci95,
+        verdict_contained: verdicts(Verdict::Contained),
+        verdict_not_contained: verdicts(Verdict::NotContained),
+        verdict_undecided: verdicts(Verdict::Undecided),
+        contained_share: threshold,
         overlapping: rows.iter().filter(|r| r.overlapping).count(),
         coverage: rows.iter().map(|r| r.predicted.coverage).sum::<f64>() / n.max(1) as f64,
         log_score,

@@ -562,6 +562,7 @@ proptest! {
             pin_radius: rho * scale,
             pin_speed: 0.0,
             pin_stop: None,
+            pin_stop_after_touch: None,
             support: "uniform".into(),
             tol: 1e-6,
             fence: None,

@@ -716,3 +716,86 @@ fn pin_stop_at_says_where_the_pin_stops() {
         "{e}"
     );
 }
+
+/// Item 8: `--pin-stop-after-touch T` stops the moving pin T units of a of belt travel after its
+/// first touch. The thesis's moving-pin set-up (tripoly1, θ0 = 15°, d = −0.1, the pin moving at
+/// the belt speed): the trace's pin moves w·T·a sideways from the first touch and then stands
+/// still, and the report's stop and offsets say the same.
+#[test]
+fn pin_stop_after_touch_stops_the_pin_that_far_past_the_first_touch() {
+    use pinfeed::cli::contact::{run_case, Case};
+    use pinfeed::mechanics::Fidelity;
+    let (w, t) = (1.0, 0.25);
+    let case = Case {
+        part: "tripoly1".into(),
+        theta0_deg: 15.0,
+        d: -0.1,
+        mu_c: 0.5,
+        mu_s: 0.3,
+        model: Fidelity::Exact,
+        pin_radius: 0.0,
+        pin_speed: w,
+        pin_stop: None,
+        pin_stop_after_touch: Some(t),
+        support: "uniform".into(),
+        tol: 1e-6,
+        fence: None,
+    };
+    let (poly, out, trace) = run_case(&case, true).unwrap();
+    let a = poly.radius();
+    assert!(out.status.is_ok() && out.contact, "{:?}", out.status);
+    let first = trace.first().unwrap();
+    let last = trace.last().unwrap();
+    // The contact lasts well past the stop, so the trace sees the pin both moving and still.
+    assert!(last.s - first.s > 2.0 * t * a, "{} {}", first.s, last.s);
+    assert!((first.s - out.travel_to_contact).abs() < 1e-9 * a);
+    let moved = last.pin_centre.y - first.pin_centre.y;
+    assert!(
+        (moved - w * t * a).abs() < 1e-9 * a,
+        "the pin moved {moved} after the touch, not {}",
+        w * t * a
+    );
+    for p in trace.iter().filter(|p| p.s > first.s + t * a + 1e-9 * a) {
+        assert!(
+            (p.pin_centre.y - last.pin_centre.y).abs() < 1e-12 * a,
+            "still moving at s = {}",
+            p.s
+        );
+    }
+    // The report: the stop counted from the pin's start, and the offsets at touch and stop.
+    let thesis = [
+        "--part",
+        "tripoly1",
+        "--theta0",
+        "15",
+        "--d=-0.1",
+        "--pin-speed",
+        "1",
+    ];
+    let j = contact_json(&[&thesis[..], &["--pin-stop-after-touch", "0.25"]].concat());
+    let touch = j["travel_to_contact"].as_f64().unwrap() / a;
+    let stop = j["pin_stop"].as_f64().unwrap();
+    assert!((stop - touch - t).abs() < 1e-12, "{j}");
+    let (yt, ys) = (
+        j["pin_touch_d"].as_f64().unwrap(),
+        j["pin_stop_d"].as_f64().unwrap(),
+    );
+    assert!((ys - yt - w * t).abs() < 1e-12, "{j}");
+    // On the way in the pin moved too: it touches above d = −0.1.
+    assert!(yt > -0.1 + 0.01, "{j}");
+    assert_eq!(j["rotation_deg"].as_f64(), Some(out.rotation.to_degrees()));
+    // Out of range: refused, naming the flag.
+    let o = pinfeed(
+        &[
+            &["contact"][..],
+            &thesis[..],
+            &["--pin-stop-after-touch=-1"],
+        ]
+        .concat(),
+    );
+    let e = refused(&o, "a negative travel");
+    assert!(
+        e.contains("--pin-stop-after-touch") && e.contains("got -1"),
+        "{e}"
+    );
+}

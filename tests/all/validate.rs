@@ -6,7 +6,7 @@ use pinfeed::maps::ensemble::{ensemble_maps, EnsembleSpec};
 use pinfeed::mechanics::Fidelity;
 use pinfeed::validate::calibrate::{calibrate, CalibrationSettings};
 use pinfeed::validate::measured::{self, Measured};
-use pinfeed::validate::score::{score_rows, summarise, ScoreSettings};
+use pinfeed::validate::score::{score_rows, summarise, ScoreSettings, Verdict};
 use pinfeed::validate::synthetic::{synthesize, SyntheticDesign};
 use std::path::Path;
 
@@ -99,7 +99,7 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
     let cluster: Vec<f64> = (0..200).map(|k| (350.0 + k as f64 * 0.1) % 360.0).collect();
     let preds = vec![cluster; 4];
     let s = ScoreSettings::default();
-    let rows = score_rows(&m, &preds, &vec![1.0; 200], &s);
+    let (rows, count) = score_rows(&m, &preds, &vec![1.0; 200], 1, &s);
     let band = &rows[0].predicted.bands;
     assert_eq!(band.len(), 1, "{band:?}");
     // 90% takes 18 of the 20 bins; the 2° gap left at 358° is closed again.
@@ -107,7 +107,11 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
         band[0].arc.lo == 350.0 && (band[0].arc.width - 19.9).abs() < 1e-9,
         "{band:?}"
     );
+    // 161 of the 200 passes lie in [352°, 8°]: a share of 0.805, just over the 80% threshold,
+    // and 200 members cannot tell it from one just under.
     assert!(rows[0].contained && rows[0].overlapping);
+    assert!((rows[0].contained_share - 0.805).abs() < 1e-9);
+    assert_eq!(rows[0].containment, Verdict::Undecided);
     assert!(rows[0].centre_offset_deg.unwrap().abs() < 0.2);
     assert!((rows[0].predicted_probability - 0.8).abs() < 0.01);
     assert!(!rows[1].contained && rows[1].overlapping);
@@ -115,9 +119,21 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
     assert!(!rows[2].contained && !rows[2].overlapping);
     assert!((rows[2].centre_offset_deg.unwrap() - 110.0).abs() < 0.5);
     assert!(rows[2].predicted_probability == 0.0);
-    assert!(rows[3].contained);
-    let summary = summarise(&rows);
-    assert_eq!((summary.contained, summary.overlapping), (2, 3));
+    assert_eq!(rows[1].containment, Verdict::NotContained);
+    // Input `all`: the share of the passes within 20° of [355°, 2°] (all of them) inside it.
+    assert!((rows[3].contained_share - 0.355).abs() < 1e-9);
+    assert!(!rows[3].contained && rows[3].overlapping);
+    let summary = summarise(&rows, count, s.contained_share);
+    assert_eq!((summary.contained, summary.overlapping), (1, 3));
+    assert_eq!(
+        (
+            summary.verdict_contained,
+            summary.verdict_not_contained,
+            summary.verdict_undecided
+        ),
+        (0, 3, 1)
+    );
+    assert!(count[0] <= 1 && count[1] >= 1, "{count:?}");
     assert!(
         (summary.coverage - 20.0 / 360.0).abs() < 0.001,
         "{}",
@@ -128,13 +144,13 @@ fn containment_overlap_and_coverage_on_hand_made_cases_across_zero() {
     let row = hand_made("tripoly1,0.1,state:0,352,8,10\n");
     let shifted: Vec<f64> = (0..200).map(|k| 20.0 + k as f64 * 0.1).collect();
     let everywhere: Vec<f64> = (0..200).map(|k| k as f64 * 1.8).collect();
-    let ls = |v: Vec<f64>| score_rows(&row, &[v], &vec![1.0; 200], &s)[0].log_score;
+    let ls = |v: Vec<f64>| score_rows(&row, &[v], &vec![1.0; 200], 1, &s).0[0].log_score;
     let (right, beside, flat) = (ls(preds[0].clone()), ls(shifted), ls(everywhere.clone()));
     assert!(
         right > beside + 10.0 && right > flat + 10.0,
         "{right} {beside} {flat}"
     );
-    let spread = score_rows(&row, &[everywhere], &vec![1.0; 200], &s);
+    let spread = score_rows(&row, &[everywhere], &vec![1.0; 200], 1, &s).0;
     assert!(spread[0].predicted.coverage > 0.85);
 }
 
@@ -160,7 +176,20 @@ fn the_same_inputs_and_seed_give_the_same_report_on_any_number_of_threads() {
         );
         out.stdout
     };
-    assert_eq!(run("1"), run("3"));
+    let one = run("1");
+    assert_eq!(one, run("3"));
+    // The report says what "contained" means, with the threshold, and each row its interval.
+    let j: serde_json::Value = serde_json::from_slice(&one).unwrap();
+    let means = j["containment"].as_str().unwrap();
+    assert!(
+        means.contains("at least 80% of the predicted mass"),
+        "{means}"
+    );
+    let row = &j["rows"][0];
+    let [lo, hi] = [0, 1].map(|k| row["contained_share_ci95"][k].as_f64().unwrap());
+    let share = row["contained_share"].as_f64().unwrap();
+    assert!(lo <= share && share <= hi, "{row}");
+    assert!(row["containment"].is_string(), "{row}");
     let poly = pinfeed::geometry::part_from_spec("tripoly2").unwrap();
     let spec = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
         .with_settings("mu_c=uniform:0.3:0.7,support=smooth:0.5,jitter=2")
@@ -399,4 +428,131 @@ fn validate_takes_part_for_a_vertex_list() {
         "{e}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A prediction with 95% of its mass inside the measured band is contained, one with 60% is not,
+/// whatever the seed of the members drawn; the verdicts carry their bootstrap intervals.
+#[test]
+fn a_prediction_with_95_percent_of_its_mass_inside_is_contained_at_every_seed() {
+    use pinfeed::random::ChaCha8Rng;
+    use rand::RngExt;
+    let m = hand_made("tripoly1,0.1,state:0,350,10,20\n");
+    let s = ScoreSettings::default();
+    for seed in 1..=3u64 {
+        let mut rng = pinfeed::random::stream(seed, 0);
+        // 500 members: each lands inside (±9°) with probability p, else near 180°.
+        let draw = |rng: &mut ChaCha8Rng, p: f64| -> Vec<f64> {
+            (0..500)
+                .map(|_| {
+                    let u: f64 = rng.random();
+                    let x: f64 = rng.random::<f64>() * 18.0 - 9.0;
+                    if u < p {
+                        (360.0 + x) % 360.0
+                    } else {
+                        180.0 + x
+                    }
+                })
+                .collect()
+        };
+        let inside = draw(&mut rng, 0.95);
+        let (rows, count) = score_rows(&m, &[inside], &vec![1.0; 500], 1, &s);
+        let r = &rows[0];
+        assert!(r.contained, "seed {seed}: {}", r.contained_share);
+        assert_eq!(r.containment, Verdict::Contained, "seed {seed}: {r:?}");
+        let [lo, hi] = r.contained_share_ci95;
+        assert!(
+            lo <= r.contained_share && r.contained_share <= hi && lo > 0.9,
+            "{lo} {hi}"
+        );
+        assert_eq!(count, [1, 1]);
+        let partly = draw(&mut rng, 0.6);
+        let (rows, count) = score_rows(&m, &[partly], &vec![1.0; 500], 1, &s);
+        assert_eq!(rows[0].containment, Verdict::NotContained, "seed {seed}");
+        assert_eq!(count, [0, 0]);
+    }
+}
+
+/// The same ensemble at two seeds: no row is decided contained at one and not contained at the
+/// other, and the counts' intervals overlap (the truth of the bundled data set, and a wrong μc).
+#[test]
+fn containment_verdicts_do_not_contradict_each_other_across_seeds() {
+    let m = fixture();
+    let s = ScoreSettings::default();
+    for spec in [
+        SyntheticDesign::default().truth,
+        truth_with("mu_c=normal:0.8:0.08"),
+    ] {
+        let run = |seed: u64| pinfeed::validate::validate(&m, &spec, seed, 300, 1, &s).unwrap();
+        let (a, sa, _) = run(1);
+        let (b, sb, _) = run(2);
+        for (x, y) in a.iter().zip(&b) {
+            assert!(
+                !matches!(
+                    (x.containment, y.containment),
+                    (Verdict::Contained, Verdict::NotContained)
+                        | (Verdict::NotContained, Verdict::Contained)
+                ),
+                "line {}: {:?} {:?} at seed 1, {:?} {:?} at seed 2",
+                x.line,
+                x.containment,
+                x.contained_share_ci95,
+                y.containment,
+                y.contained_share_ci95
+            );
+        }
+        assert!(
+            sa.contained_ci95[0] <= sb.contained_ci95[1]
+                && sb.contained_ci95[0] <= sa.contained_ci95[1],
+            "{sa:?} {sb:?}"
+        );
+        assert!(sa.verdict_undecided < sa.rows / 2, "{sa:?}");
+    }
+}
+
+/// Rows at the same d and input (a thesis-style table) use one prediction.
+#[test]
+fn rows_at_the_same_d_share_one_prediction() {
+    let m = measured::load(Path::new("tests/fixtures/validate/table_example.csv"), 0.0).unwrap();
+    let spec = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
+        .with_settings("mu_c=normal:0.5:0.1,jitter=2")
+        .unwrap();
+    let (rows, _, pred) =
+        pinfeed::validate::validate(&m, &spec, 1, 40, 1, &ScoreSettings::default()).unwrap();
+    for (i, a) in rows.iter().enumerate() {
+        for (j, b) in rows.iter().enumerate() {
+            if a.d == b.d {
+                assert_eq!(
+                    pred.rows[i], pred.rows[j],
+                    "lines {} and {}",
+                    a.line, b.line
+                );
+                assert_eq!(a.predicted, b.predicted);
+            } else {
+                assert_ne!(pred.rows[i], pred.rows[j]);
+            }
+        }
+    }
+}
+
+/// A calibration whose best grid point gives the members of one support group weights of order
+/// 1e-200 (10 members, μc range 0:10): their squares underflowed and the effective member count
+/// was 0/0, printed as `null`. It is finite now, between 1 and the member count.
+#[test]
+fn calibration_effective_members_stay_finite_when_weights_underflow() {
+    let text = "part,d,input,min_deg,max_deg,trials\ntripoly1,-0.7,state:0,355.1,5.9,20\ntripoly1,-0.7,state:1,129.2,142.5,20\ntripoly1,-0.7,state:2,219.4,229.7,20\n";
+    let m = measured::parse(Path::new("m.csv"), text, 0.5).unwrap();
+    let s = CalibrationSettings {
+        members: 10,
+        mu_c_range: (0.0, 10.0),
+        ..CalibrationSettings::default()
+    };
+    let cal = calibrate(&m, &s).unwrap();
+    assert!(
+        cal.effective_members.is_finite()
+            && cal.effective_members >= 1.0 - 1e-9
+            && cal.effective_members <= 10.0 + 1e-9,
+        "{}",
+        cal.effective_members
+    );
+    assert!(cal.log_likelihood.is_finite());
 }

@@ -874,7 +874,10 @@ impl Work<'_> {
                 Action::Fence(f) => reach = reach.max(f.y0_m.abs()).max(f.y1_m.abs()),
             }
         }
-        let width = ((2.0 * reach / 0.005).ceil() * 0.005).min(problem.belt_width_m);
+        // At least 2(a + lateral): the scenario parser refuses a belt on which the fed part
+        // does not fit.
+        let fits = a + problem.lateral_m;
+        let width = ((2.0 * reach.max(fits) / 0.005).ceil() * 0.005).min(problem.belt_width_m);
         let line = LineSpec {
             belt_width_m: width,
             ..line

@@ -1,7 +1,11 @@
 //! Random contacts for fuzzing: a random star polygon (3–12 vertices) pushed by a point pin or a
 //! disc pin (radius up to 0.3·a) at a random offset d ∈ [−1.2, 1.2] and orientation θ0, with
-//! μc ∈ [0, 2], through [`crate::mechanics::push`] at the default tolerance and at a 1000× tighter
-//! one (the same convention as `pinfeed contact`: [`crate::maps::pass_start`]).
+//! μc ∈ [0, 2], through [`crate::mechanics::push_path`] at the default tolerance and at a 1000×
+//! tighter one (the same convention as `pinfeed contact`: [`crate::maps::pass_start`]). Half the
+//! pins move across the belt ([`Motion`]): lateral speed |w| log-uniform in [0.01, 10] belt speeds
+//! of either sign, moving throughout, stopping S ∈ (0, 3] units of a after the start
+//! (`--pin-stop-after`) or T ∈ [0, 2] units of a after the first touch
+//! (`--pin-stop-after-touch`), a third each.
 //!
 //! The status at the default tolerance is counted by the name its serialisation gives (so new
 //! status variants show up without changes here). A contact `ok` at both tolerances whose
@@ -11,12 +15,14 @@
 
 use super::{all_finite, CaseReport, Class};
 use crate::geometry::{Polygon, Vec2};
-use crate::mechanics::{push, ContactOutcome, ContactSettings, PartModel, Pin, Support};
+use crate::mechanics::{
+    push_path, stop_after_touch, ContactOutcome, ContactSettings, PartModel, PinPath, Support, Turn,
+};
 use crate::random::ChaCha8Rng;
 use rand::RngExt;
 use std::f64::consts::TAU;
 
-pub const DESCRIPTION: &str = "random star polygons (3–12 vertices at sorted random angles, radii in [0.1, 1]), μc ∈ [0, 2], d ∈ [−1.2, 1.2], θ0 ∈ [0°, 360°), half point pins and half disc pins of radius up to 0.3·a, each pushed at the default tolerance and at a 1000× tighter one";
+pub const DESCRIPTION: &str = "random star polygons (3–12 vertices at sorted random angles, radii in [0.1, 1]), μc ∈ [0, 2], d ∈ [−1.2, 1.2], θ0 ∈ [0°, 360°), half point pins and half disc pins of radius up to 0.3·a; half the pins still, half moving across the belt at |w| log-uniform in [0.01, 10] belt speeds (either sign), a third of those moving throughout, a third stopping S ∈ (0, 3]·a after the start, a third T ∈ [0, 2]·a after the first touch; each pushed at the default tolerance and at a 1000× tighter one";
 
 /// The tighter tolerance: the default 1e-6 divided by 1000, written exactly as the reproducer's
 /// `--tol 1e-9` parses (1e-6 / 1000 in floating point is 9.999999999999999e-10, and near a
@@ -25,6 +31,96 @@ pub const TIGHT_TOL: f64 = 1e-9;
 
 /// Largest rotation difference (degrees) between the two tolerances for an `ok` contact.
 pub const SELF_CHECK_DEG: f64 = 1.0;
+
+/// How a generated pin moves across the belt.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Motion {
+    Still,
+    /// Lateral speed w (belt speeds), moving throughout.
+    Moving {
+        w: f64,
+    },
+    /// Moving at w, stopping after S units of a of belt travel from the start.
+    StopAfter {
+        w: f64,
+        s: f64,
+    },
+    /// Moving at w, stopping T units of a of belt travel after the first touch.
+    StopAfterTouch {
+        w: f64,
+        t: f64,
+    },
+}
+
+impl Motion {
+    /// Draw a motion: still half the time.
+    fn random(rng: &mut ChaCha8Rng) -> Motion {
+        if rng.random::<bool>() {
+            return Motion::Still;
+        }
+        let sign = if rng.random::<bool>() { 1.0 } else { -1.0 };
+        let w = round6(sign * 10f64.powf(-2.0 + 3.0 * rng.random::<f64>()));
+        match rng.random_range(0..3u32) {
+            0 => Motion::Moving { w },
+            1 => Motion::StopAfter {
+                w,
+                s: round6(1e-6 + 3.0 * rng.random::<f64>()),
+            },
+            _ => Motion::StopAfterTouch {
+                w,
+                t: round6(2.0 * rng.random::<f64>()),
+            },
+        }
+    }
+
+    pub fn is_moving(&self) -> bool {
+        !matches!(self, Motion::Still)
+    }
+
+    /// The kind of case in the report.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Motion::Still => "still pin",
+            Motion::Moving { .. } => "moving pin, moving throughout",
+            Motion::StopAfter { .. } => "moving pin, stopping S after its start",
+            Motion::StopAfterTouch { .. } => "moving pin, stopping T after its first touch",
+        }
+    }
+
+    /// The pin's path (travels in the part's units, `a` its size).
+    fn path(
+        &self,
+        model: &PartModel,
+        pose: crate::geometry::Pose,
+        start: Vec2,
+        rho: f64,
+        a: f64,
+    ) -> PinPath {
+        let still = PinPath::constant(0.0);
+        match *self {
+            Motion::Still => still,
+            Motion::Moving { w } => PinPath::new(w, Vec::new()).unwrap_or(still),
+            Motion::StopAfter { w, s } => {
+                PinPath::new(w, vec![Turn { s: s * a, w: 0.0 }]).unwrap_or(still)
+            }
+            Motion::StopAfterTouch { w, t } => {
+                stop_after_touch(model, pose, start, rho, w, t * a).unwrap_or(still)
+            }
+        }
+    }
+
+    /// The flags of `pinfeed contact` that give this motion.
+    fn flags(&self) -> String {
+        match *self {
+            Motion::Still => String::new(),
+            Motion::Moving { w } => format!(" --pin-speed={w}"),
+            Motion::StopAfter { w, s } => format!(" --pin-speed={w} --pin-stop-after {s}"),
+            Motion::StopAfterTouch { w, t } => {
+                format!(" --pin-speed={w} --pin-stop-after-touch {t}")
+            }
+        }
+    }
+}
 
 /// One generated contact.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,6 +131,7 @@ pub struct ContactCase {
     pub mu_c: f64,
     /// Pin radius in part units (0: a point pin).
     pub pin_radius: f64,
+    pub motion: Motion,
 }
 
 impl ContactCase {
@@ -65,12 +162,15 @@ impl ContactCase {
         let mu_c = round6(2.0 * rng.random::<f64>());
         let disc = rng.random::<bool>();
         let u = rng.random::<f64>();
+        // Drawn last: the still-pin cases keep the draws they had before pins moved.
+        let motion = Motion::random(rng);
         ContactCase {
             vertices,
             theta0_deg,
             d,
             mu_c,
             pin_radius: if disc { u } else { 0.0 },
+            motion,
         }
     }
 
@@ -86,6 +186,7 @@ impl ContactCase {
             "pinfeed contact --part 'vertices:{vs}' --theta0={} --d={} --mu-c {} --pin-radius {}",
             self.theta0_deg, self.d, self.mu_c, pin_radius
         );
+        c.push_str(&self.motion.flags());
         if let Some(t) = tol {
             c.push_str(&format!(" --tol {t:e}"));
         }
@@ -118,6 +219,12 @@ pub fn status_name(o: &ContactOutcome) -> String {
 
 /// Run a generated case.
 pub fn run(c: &ContactCase) -> CaseReport {
+    let mut r = run_unlabelled(c);
+    r.kind = Some(c.motion.kind().to_string());
+    r
+}
+
+fn run_unlabelled(c: &ContactCase) -> CaseReport {
     let poly = match Polygon::new(&c.vertices) {
         Ok(p) => p,
         Err(e) => {
@@ -137,10 +244,7 @@ pub fn run(c: &ContactCase) -> CaseReport {
     // Disc pins up to 0.3·a; the fraction is kept in `pin_radius` until the part's a is known.
     let rho = round6(c.pin_radius * 0.3 * poly.radius());
     let (pose, start) = crate::maps::pass_start(&poly, c.theta0_deg, c.d, rho);
-    let pin = Pin {
-        radius: rho,
-        lateral_speed: 0.0,
-    };
+    let path = c.motion.path(&model, pose, start, rho, poly.radius());
     let base = ContactSettings {
         mu_c: c.mu_c,
         ..ContactSettings::default()
@@ -149,7 +253,7 @@ pub fn run(c: &ContactCase) -> CaseReport {
         tol: TIGHT_TOL,
         ..base
     };
-    let a = push(&model, pose, start, &pin, &base, None);
+    let a = push_path(&model, pose, start, rho, &path, &base, None);
     let status = status_name(&a);
     let report = |class: Class, detail: String| {
         let mut r = CaseReport::with(class, detail);
@@ -165,7 +269,7 @@ pub fn run(c: &ContactCase) -> CaseReport {
             format!("status ok with a non-finite pose: {}", c.command(rho, None)),
         );
     }
-    let b = push(&model, pose, start, &pin, &tight, None);
+    let b = push_path(&model, pose, start, rho, &path, &tight, None);
     if !b.status.is_ok() {
         return report(
             Class::OkThenFailed,

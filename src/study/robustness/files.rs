@@ -322,7 +322,7 @@ fn numbers(lines: &[String]) -> Vec<(usize, usize, usize)> {
 }
 
 /// Header text without brackets.
-fn header_name(line: &str) -> Option<&str> {
+pub(crate) fn header_name(line: &str) -> Option<&str> {
     let t = line.split('#').next()?.trim();
     let t = t
         .strip_prefix("[[")

@@ -18,7 +18,11 @@
 //! stops, so runaway threads cannot pile up).
 
 pub mod contacts;
+pub mod csvs;
 pub mod files;
+pub mod merges;
+pub mod pairs;
+pub mod plans;
 pub mod polygons;
 
 use std::cell::RefCell;
@@ -40,14 +44,22 @@ pub enum Target {
     Studies,
     Contacts,
     Polygons,
+    Pairs,
+    Plans,
+    Csvs,
+    Merges,
 }
 
 impl Target {
-    pub const ALL: [Target; 4] = [
+    pub const ALL: [Target; 8] = [
         Target::Scenarios,
         Target::Studies,
         Target::Contacts,
         Target::Polygons,
+        Target::Pairs,
+        Target::Plans,
+        Target::Csvs,
+        Target::Merges,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -55,6 +67,10 @@ impl Target {
             Target::Studies => "studies",
             Target::Contacts => "contacts",
             Target::Polygons => "polygons",
+            Target::Pairs => "pairs",
+            Target::Plans => "plans",
+            Target::Csvs => "csvs",
+            Target::Merges => "merges",
         }
     }
     /// Mixed into the seed so that the targets draw different streams.
@@ -64,6 +80,10 @@ impl Target {
             Target::Studies => 0x1000_0002,
             Target::Contacts => 0x1000_0003,
             Target::Polygons => 0x1000_0004,
+            Target::Pairs => 0x1000_0005,
+            Target::Plans => 0x1000_0006,
+            Target::Csvs => 0x1000_0007,
+            Target::Merges => 0x1000_0008,
         }
     }
     /// What a case of this target is.
@@ -73,6 +93,10 @@ impl Target {
             Target::Studies => files::STUDY_DESCRIPTION,
             Target::Contacts => contacts::DESCRIPTION,
             Target::Polygons => polygons::DESCRIPTION,
+            Target::Pairs => pairs::DESCRIPTION,
+            Target::Plans => plans::DESCRIPTION,
+            Target::Csvs => csvs::DESCRIPTION,
+            Target::Merges => merges::DESCRIPTION,
         }
     }
 }
@@ -96,8 +120,42 @@ pub enum Class {
     Disagreement,
     /// A contact `ok` at the default tolerance but not at the tighter one.
     OkThenFailed,
+    /// `merge` accepted shards whose content was edited.
+    Accepted,
     Panic,
     Hang,
+}
+
+impl Class {
+    pub const ALL: [Class; 11] = [
+        Class::Located,
+        Class::Named,
+        Class::Unlocated,
+        Class::Success,
+        Class::Status,
+        Class::Panic,
+        Class::Hang,
+        Class::NonFinite,
+        Class::Disagreement,
+        Class::OkThenFailed,
+        Class::Accepted,
+    ];
+    /// The column heading of the class in the report.
+    pub fn label(self) -> &'static str {
+        match self {
+            Class::Located => "located errors",
+            Class::Named => "errors naming the cause",
+            Class::Unlocated => "unlocated errors",
+            Class::Success => "successes",
+            Class::Status => "other statuses",
+            Class::NonFinite => "non-finite outputs",
+            Class::Disagreement => "self-check disagreements",
+            Class::OkThenFailed => "ok, then failed at 1000× tighter tol",
+            Class::Accepted => "edited shards accepted",
+            Class::Panic => "panics",
+            Class::Hang => "hangs",
+        }
+    }
 }
 
 impl Class {
@@ -109,6 +167,7 @@ impl Class {
                 | Class::NonFinite
                 | Class::Disagreement
                 | Class::OkThenFailed
+                | Class::Accepted
                 | Class::Panic
                 | Class::Hang
         )
@@ -123,6 +182,9 @@ pub struct CaseReport {
     pub status: Option<String>,
     /// For problems: what happened and how to reproduce it.
     pub detail: String,
+    /// The kind of case within its target (a contact's pin motion, a file's seed, …), counted
+    /// apart in the report.
+    pub kind: Option<String>,
 }
 
 impl CaseReport {
@@ -131,6 +193,7 @@ impl CaseReport {
             class,
             status: None,
             detail: String::new(),
+            kind: None,
         }
     }
     pub fn with(class: Class, detail: impl Into<String>) -> CaseReport {
@@ -138,6 +201,7 @@ impl CaseReport {
             class,
             status: None,
             detail: detail.into(),
+            kind: None,
         }
     }
 }
@@ -149,6 +213,8 @@ pub struct Tally {
     pub counts: BTreeMap<Class, u64>,
     /// Contacts: statuses at the default tolerance, by name.
     pub statuses: BTreeMap<String, u64>,
+    /// Counts by the kind of case ([`CaseReport::kind`]), then by class.
+    pub kinds: BTreeMap<String, BTreeMap<Class, u64>>,
     /// The first few problems of each class, in case order: (case index, detail).
     pub problems: BTreeMap<Class, Vec<(u64, String)>>,
     /// The run stopped early after too many hangs.
@@ -165,6 +231,14 @@ impl Tally {
         *self.counts.entry(r.class).or_insert(0) += 1;
         if let Some(s) = &r.status {
             *self.statuses.entry(s.clone()).or_insert(0) += 1;
+        }
+        if let Some(k) = &r.kind {
+            *self
+                .kinds
+                .entry(k.clone())
+                .or_default()
+                .entry(r.class)
+                .or_insert(0) += 1;
         }
         if r.class.is_problem() {
             let list = self.problems.entry(r.class).or_default();
@@ -189,24 +263,77 @@ pub struct Options {
 /// Everything the generators need, shared by the case threads.
 pub struct Corpus {
     pub files: files::Seeds,
+    /// The seed scenarios of the pairs target.
+    pub pair_seeds: Vec<(PathBuf, String)>,
+    root: PathBuf,
+    /// The merges target's shards, made on first use.
+    shards: std::sync::OnceLock<Result<Vec<(String, String)>, String>>,
 }
 
 impl Corpus {
     pub fn load(root: &Path) -> Result<Corpus, String> {
+        let files = files::Seeds::load(root)?;
         Ok(Corpus {
-            files: files::Seeds::load(root)?,
+            pair_seeds: pairs::seeds(&files),
+            files,
+            root: root.to_path_buf(),
+            shards: std::sync::OnceLock::new(),
         })
+    }
+
+    /// The shards of the merges target (run once).
+    pub fn shards(&self) -> Result<&[(String, String)], String> {
+        self.shards
+            .get_or_init(|| merges::make_shards(&self.root))
+            .as_ref()
+            .map(|v| v.as_slice())
+            .map_err(|e| e.clone())
+    }
+}
+
+/// A fresh folder for case `index` of `target` (removed when the case ends).
+pub struct Scratch(PathBuf);
+
+impl Scratch {
+    pub fn new(target: Target, seed: u64, index: u64) -> Scratch {
+        let d = std::env::temp_dir().join(format!(
+            "pinfeed-fuzz-{}-{}-{seed}-{index}",
+            std::process::id(),
+            target.name()
+        ));
+        let _ = std::fs::remove_dir_all(&d);
+        Scratch(d)
+    }
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
     }
 }
 
 /// Run case `index` of `target` (no guard): a pure function of (corpus, seed, index).
 pub fn run_case(target: Target, corpus: &Corpus, seed: u64, index: u64) -> CaseReport {
     let mut rng = crate::random::stream(seed ^ target.tag(), index);
+    let scratch = || Scratch::new(target, seed, index);
     match target {
         Target::Scenarios => files::scenario_case(&corpus.files, &mut rng).1,
         Target::Studies => files::study_case(&corpus.files, &mut rng).1,
         Target::Contacts => contacts::case(&mut rng),
         Target::Polygons => polygons::case(&mut rng),
+        Target::Pairs => {
+            let c = pairs::PairCase::random(&corpus.pair_seeds, &mut rng);
+            pairs::run(&c, &corpus.pair_seeds, scratch().path())
+        }
+        Target::Plans => plans::run(&plans::arguments(&mut rng), scratch().path()),
+        Target::Csvs => csvs::run(&csvs::CsvCase::random(&mut rng), scratch().path()),
+        Target::Merges => match corpus.shards() {
+            Ok(shards) => merges::run(shards, &merges::edits(&mut rng), scratch().path()),
+            Err(e) => CaseReport::with(Class::Unlocated, format!("cannot make the shards: {e}")),
+        },
     }
 }
 
@@ -218,6 +345,34 @@ pub fn case_input(target: Target, corpus: &Corpus, seed: u64, index: u64) -> Str
         Target::Studies => files::study_input(&corpus.files, &mut rng),
         Target::Contacts => contacts::input(&mut rng),
         Target::Polygons => polygons::input(&mut rng),
+        Target::Pairs => {
+            let c = pairs::PairCase::random(&corpus.pair_seeds, &mut rng);
+            match corpus.pair_seeds.get(c.seed) {
+                Some((path, text)) => {
+                    let (scenario, policy) = pairs::texts(&c, text);
+                    let mut s = format!("# {}\n{scenario}", c.describe(path));
+                    if let Some(p) = policy {
+                        s.push_str(&format!("\n# {}:\n{p}", pairs::POLICY_NAME));
+                    }
+                    s
+                }
+                None => "no seed scenario".into(),
+            }
+        }
+        Target::Plans => plans::command(&plans::arguments(&mut rng)),
+        Target::Csvs => {
+            let c = csvs::CsvCase::random(&mut rng);
+            format!(
+                "{}\n# measured.csv:\n{}",
+                c.command(Path::new("measured.csv")),
+                c.text
+            )
+        }
+        Target::Merges => format!(
+            "shards of {} with edits {:?}",
+            "studies/quickstart_mu_tripod.toml (3 samples)",
+            merges::edits(&mut rng)
+        ),
     }
 }
 
@@ -369,30 +524,42 @@ Re-run one case with `pinfeed fuzz TARGET --seed {} --case N` (prints its input 
     for (t, _) in tallies {
         s.push_str(&format!("* **{}**: {}\n", t.name(), t.describe()));
     }
+    s.push_str(&totals(tallies));
     s.push_str("\n## Counts\n\n");
-    s.push_str("| target | generated | located errors | errors naming the cause | unlocated errors | successes | other statuses | panics | hangs | non-finite outputs | self-check disagreements | ok, then failed at 1000× tighter tol | seconds |\n");
-    s.push_str("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (t, y) in tallies {
-        s.push_str(&format!(
-            "| {} | {}{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} |\n",
-            t.name(),
-            y.generated,
-            if y.stopped_early {
-                " (stopped early)"
+    s.push_str(
+        "Each case ends in one class: a *located error* points at the input (file, line and \
+column, or a CSV file and line); an *error naming the cause* names a key, flag, field, shard or \
+sample and why; an *unlocated error* says neither (a problem); a *success* ran and every output \
+is finite (a contact: `ok` at both tolerances and agreeing within 1°); *other statuses* are \
+contacts that ended with a named status other than `ok` at the default tolerance; *panics*, \
+*hangs* (slower than the budget) and *non-finite outputs* are problems; a *self-check \
+disagreement* is a contact `ok` at both tolerances whose rotations differ by more than 1°, or a \
+plan whose written scenario the parser refuses; *ok, then failed* is a contact `ok` at the \
+default tolerance that ends in another status at the 1000× tighter one (listed, not a wrong \
+answer); an *edited shard accepted* is a merge that succeeded though a shard's content was \
+changed.\n\n",
+    );
+    s.push_str(&counts_table(
+        "target",
+        tallies.iter().map(|(t, y)| {
+            let name = if y.stopped_early {
+                format!("{} (stopped early)", t.name())
             } else {
-                ""
-            },
-            y.count(Class::Located),
-            y.count(Class::Named),
-            y.count(Class::Unlocated),
-            y.count(Class::Success),
-            y.count(Class::Status),
-            y.count(Class::Panic),
-            y.count(Class::Hang),
-            y.count(Class::NonFinite),
-            y.count(Class::Disagreement),
-            y.count(Class::OkThenFailed),
-            y.seconds
+                t.name().to_string()
+            };
+            (name, y.generated, &y.counts, Some(y.seconds))
+        }),
+    ));
+    for (t, y) in tallies {
+        if y.kinds.is_empty() {
+            continue;
+        }
+        s.push_str(&format!("\n## {} by kind\n\n", t.name()));
+        s.push_str(&counts_table(
+            "kind",
+            y.kinds
+                .iter()
+                .map(|(k, c)| (k.clone(), c.values().sum(), c, None)),
         ));
     }
     for (t, y) in tallies {
@@ -426,9 +593,120 @@ Re-run one case with `pinfeed fuzz TARGET --seed {} --case N` (prints its input 
         }
     }
     if !any {
-        s.push_str("\nNo problems: no panic, hang, non-finite output, unlocated error or self-check disagreement.\n");
+        s.push_str("\nNo problems: no panic, hang, non-finite output, unlocated error, self-check disagreement or accepted edited shard.\n");
     }
     s
+}
+
+/// The totals the acceptance targets are stated in: the new surface's cases and their problems,
+/// and the contacts (with moving pins apart) and their disagreements.
+fn totals(tallies: &[(Target, Tally)]) -> String {
+    let surface = [Target::Pairs, Target::Plans, Target::Csvs, Target::Merges];
+    let of = |ts: &[Target], c: Option<Class>| -> u64 {
+        tallies
+            .iter()
+            .filter(|(t, _)| ts.contains(t))
+            .map(|(_, y)| c.map_or(y.generated, |c| y.count(c)))
+            .sum()
+    };
+    let mut s = String::from("\n## Totals\n\n");
+    if tallies.iter().any(|(t, _)| surface.contains(t)) {
+        s.push_str(&format!(
+            "* sensing/actuator/controller/policy key pairs, plan argument sets, validate/calibrate CSV files and edited merge shards: **{}** generated; {} panics, {} hangs, {} non-finite outputs, {} unlocated errors, {} self-check disagreements, {} edited shards accepted\n",
+            of(&surface, None),
+            of(&surface, Some(Class::Panic)),
+            of(&surface, Some(Class::Hang)),
+            of(&surface, Some(Class::NonFinite)),
+            of(&surface, Some(Class::Unlocated)),
+            of(&surface, Some(Class::Disagreement)),
+            of(&surface, Some(Class::Accepted)),
+        ));
+    }
+    if let Some((_, y)) = tallies.iter().find(|(t, _)| *t == Target::Contacts) {
+        let moving = |c: Option<Class>| -> u64 {
+            y.kinds
+                .iter()
+                .filter(|(k, _)| k.starts_with("moving pin"))
+                .map(|(_, m)| match c {
+                    Some(c) => m.get(&c).copied().unwrap_or(0),
+                    None => m.values().sum(),
+                })
+                .sum()
+        };
+        s.push_str(&format!(
+            "* contacts: **{}** generated, **{}** of them with moving pins; {} `ok` at both the default and the 1000× tighter tolerance with rotations more than 1° apart ({} with moving pins); {} panics, {} hangs, {} non-finite outputs; {} `ok` at the default tolerance only\n",
+            y.generated,
+            moving(None),
+            y.count(Class::Disagreement),
+            moving(Some(Class::Disagreement)),
+            y.count(Class::Panic),
+            y.count(Class::Hang),
+            y.count(Class::NonFinite),
+            y.count(Class::OkThenFailed),
+        ));
+    }
+    s
+}
+
+/// A Markdown table of counts by class, one row per (name, generated, counts, seconds); the
+/// columns are every class, and the seconds when given.
+fn counts_table<'a>(
+    first: &str,
+    rows: impl Iterator<Item = (String, u64, &'a BTreeMap<Class, u64>, Option<f64>)>,
+) -> String {
+    let rows: Vec<_> = rows.collect();
+    let timed = rows.iter().any(|r| r.3.is_some());
+    let mut s = format!("| {first} | generated |");
+    let mut rule = String::from("|---|---:|");
+    for c in Class::ALL {
+        s.push_str(&format!(" {} |", c.label()));
+        rule.push_str("---:|");
+    }
+    if timed {
+        s.push_str(" seconds |");
+        rule.push_str("---:|");
+    }
+    s.push_str(&format!("\n{rule}\n"));
+    for (name, generated, counts, seconds) in rows {
+        s.push_str(&format!("| {name} | {generated} |"));
+        for c in Class::ALL {
+            s.push_str(&format!(" {} |", counts.get(&c).copied().unwrap_or(0)));
+        }
+        if let Some(t) = seconds {
+            s.push_str(&format!(" {t:.0} |"));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Does a Debug rendering show a NaN or an infinity (Rust prints them `NaN`, `inf`)?
+pub fn shows_non_finite(debug: &str) -> bool {
+    debug
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .any(|w| w == "NaN" || w == "inf")
+}
+
+/// A refusal given as a message: located when it points at a file and line (`….csv:LINE`),
+/// naming its cause when it names a flag, a field, a column, a file, a part or a range, else
+/// unlocated (listed in the report).
+pub fn refused(message: &str) -> CaseReport {
+    let located = message
+        .split(".csv:")
+        .nth(1)
+        .is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit()));
+    if located {
+        return CaseReport::new(Class::Located);
+    }
+    let names = [
+        "--", "field", "column", ".csv", ".json", "part", "must", "range", "expected", "shard",
+        "member",
+    ];
+    if names.iter().any(|n| message.contains(n)) {
+        CaseReport::new(Class::Named)
+    } else {
+        CaseReport::with(Class::Unlocated, message.to_string())
+    }
 }
 
 /// Does every number in `values` lie in f64's finite range?
