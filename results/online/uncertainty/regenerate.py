@@ -150,6 +150,38 @@ def main():
     write_report(rows, details, bench)
 
 
+def success_svg(rows):
+    """Success with its 95% interval per design, nominal and uncertain, as an SVG bar chart."""
+    rows = [r for r in rows if "nominal" in r]
+    left, width, bar, gap, top = 250, 420, 9, 10, 40
+    height = top + len(rows) * (2 * bar + gap) + 50
+    x = lambda v: left + v * width
+    o = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{left + width + 30}" height="{height}" font-family="sans-serif" font-size="12">',
+         '<rect width="100%" height="100%" fill="white"/>',
+         f'<text x="{left}" y="16" font-size="13">Success on 10 000 samples, 95% intervals</text>',
+         f'<rect x="{left}" y="24" width="10" height="8" fill="#4477aa"/><text x="{left + 14}" y="32">nominal physics</text>',
+         f'<rect x="{left + 130}" y="24" width="10" height="8" fill="#cc6677"/><text x="{left + 144}" y="32">μc 0.3–0.7 and random tripods</text>']
+    for k in range(0, 11, 2):
+        v = k / 10
+        o.append(f'<line x1="{x(v):.1f}" y1="{top}" x2="{x(v):.1f}" y2="{height - 40}" stroke="#ddd"/>')
+        o.append(f'<text x="{x(v):.1f}" y="{height - 25}" text-anchor="middle">{k * 10}%</text>')
+    y = top + 2
+    for r in rows:
+        o.append(f'<text x="{left - 8}" y="{y + bar + 4}" text-anchor="end">{r["part"]} · {r["kind"]}</text>')
+        for key, colour in [("nominal", "#4477aa"), ("uncertain", "#cc6677")]:
+            res = r[key]
+            o.append(f'<rect x="{left}" y="{y}" width="{res["success"] * width:.1f}" height="{bar}" fill="{colour}"/>')
+            lo, hi = res["ci"]
+            o.append(f'<line x1="{x(lo):.1f}" y1="{y + bar / 2}" x2="{x(hi):.1f}" y2="{y + bar / 2}" stroke="black"/>')
+            y += bar
+        y += gap
+    o.append(f'<line x1="{left}" y1="{top}" x2="{left}" y2="{height - 40}" stroke="black"/>')
+    o.append(f'<line x1="{x(0.95):.1f}" y1="{top}" x2="{x(0.95):.1f}" y2="{height - 40}" stroke="black" stroke-dasharray="4 3"/>')
+    o.append(f'<text x="{x(0.95):.1f}" y="{height - 8}" text-anchor="middle">target 95%</text>')
+    o.append("</svg>")
+    open(os.path.join(HERE, "success.svg"), "w").write("\n".join(o) + "\n")
+
+
 def pct(x):
     return f"{100 * x:.1f}%"
 
@@ -165,7 +197,9 @@ def write_report(rows, details, bench):
     w("Regenerate (builds the release binary, runs every study and line below; about 10 minutes on this 2-core machine):\n")
     w("    python3 results/online/uncertainty/regenerate.py\n")
     w(f"Three parts, each with up to three designs: (a) the best **robust sensorless** line `pinfeed plan --pins` finds when told the uncertainty, (b) a **sensor line with rules** (one force/torque sensor pin, moving pins, one command per decided state), (c) the **same sensor line with the online controller** (a belief per part over stable state × lateral-offset bin × friction × support, the joint command of the moving pins chosen per part to maximise the predicted probability of the goal; docs/physics.md#belief-and-online-replanning). Every success rate is a `pinfeed mc` study of {SAMPLES} samples (one part per sample through a copy of the line) with its 95% Wilson interval, under **nominal physics** (μc 0.5, uniform pressure) and under the **uncertainty**: μc uniform in [0.3, 0.7] and a random tripod support per part. All feeds have a ±3 mm lateral offset. The designs are in `results/online/uncertainty/designs/` and `scenarios/`; the studies are `studies/tripoly1_online_uncertain.toml` and `studies/tripoly2_online_uncertain.toml` with `samples = {SAMPLES}`.\n")
+    success_svg(rows)
     w("## Success\n")
+    w("![success per design, nominal and under the uncertainty](online/uncertainty/success.svg)\n")
     w("| part | design | nominal [95% CI] | uncertain [95% CI] | sensor accuracy, uncertain | what |")
     w("|---|---|---|---|---|---|")
     for r in rows:
@@ -176,6 +210,7 @@ def write_report(rows, details, bench):
         acc = pct(s["accuracy"]) if s else "—"
         w(f"| {r['part']} | {r['kind']} | {ci(r['nominal'])} | {ci(r['uncertain'])} | {acc} | {r['what']} |")
     w("")
+    w("The designs, drawn by `pinfeed plan`: [tripoly2, robust sensorless](online/uncertainty/designs/tripoly2_robust_pins.svg), [tripoly2, sensor line](online/uncertainty/designs/tripoly2_rules.svg) (the online line `scenarios/tripoly2_online.toml` is the same layout), [random:3, sensor line](online/uncertainty/designs/random3_rules.svg); tripoly1's sensing line is drawn by `pinfeed run scenarios/tripoly1_online.toml --animate tripoly1_online.svg`.\n")
     w("## Why no sensor line here reaches 95% under the uncertainty\n")
     bullets = []
     for d in details:
