@@ -95,7 +95,7 @@ fn attach_online_model(c: &Checker, raw: &RawScenario, scene: &mut Scene) -> R<(
     // file, and that policy's rules): a process that reads the same file again (a study's
     // shards, a fuzzer's unchanged scenario) shares the model built the first time.
     let key = (
-        c.file().to_path_buf(),
+        std::fs::canonicalize(c.file()).unwrap_or_else(|_| c.file().to_path_buf()),
         c.source().to_string(),
         format!("{:?}", ctl.rules),
     );
