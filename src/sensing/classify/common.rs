@@ -191,22 +191,17 @@ pub fn unique_argmax(v: &[f64], tie: f64) -> Option<usize> {
     (rivals == 0).then_some(i)
 }
 
-/// Normalises log-likelihoods into a posterior (equal priors); `None` when none is finite.
+/// Normalises log-likelihoods into a posterior (equal priors); `None` when none is finite. The
+/// posterior is the one belief type's ([`crate::sensing::belief::Belief`]): a uniform prior
+/// updated by the likelihoods (a NaN counts as excluded).
 pub fn posterior(ll: &[f64]) -> Option<Vec<f64>> {
-    let m = ll
+    use crate::sensing::belief::{Belief, Update};
+    let finite: Vec<f64> = ll
         .iter()
-        .copied()
-        .filter(|x| x.is_finite())
-        .fold(f64::NEG_INFINITY, f64::max);
-    if !m.is_finite() {
-        return None;
-    }
-    let w: Vec<f64> = ll
-        .iter()
-        .map(|&x| if x.is_finite() { (x - m).exp() } else { 0.0 })
+        .map(|&x| if x.is_finite() { x } else { f64::NEG_INFINITY })
         .collect();
-    let s: f64 = w.iter().sum();
-    Some(w.iter().map(|x| x / s).collect())
+    let mut b = Belief::new(&vec![1.0; ll.len()])?;
+    (b.observe_log_likelihood(&finite) == Update::Updated).then(|| b.probabilities())
 }
 
 /// log Σ exp(v), −∞ for an empty or all −∞ slice.
