@@ -230,7 +230,7 @@ def main():
     rules = sc["rules"]
     v_belt = sc["belt"]["speed"]
 
-    w("# Online sensing and a moving pin: tripoly1 in one orientation set (issue 13)\n")
+    w("# Online sensing and a moving pin: tripoly1 in one orientation set\n")
     w("Regenerate everything below (runs, figures and this file) from the repository root with\n")
     w("    sh results/online/regenerate.sh\n")
     w(f"which builds the release binary, runs `pinfeed run` / `pinfeed compare` one after another "
