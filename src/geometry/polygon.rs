@@ -125,6 +125,25 @@ pub fn segments_intersect(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> bool {
 }
 
 /// Signed area (positive for counter-clockwise) computed relative to the first vertex.
+/// Whether the ring turns the same way, by a clearly non-zero angle, at every vertex, and winds
+/// exactly once: then no two of its edges can cross or touch.
+fn strictly_convex_ring(points: &[Vec2]) -> bool {
+    let n = points.len();
+    let mut sign = 0.0_f64;
+    let mut turning = 0.0;
+    for i in 0..n {
+        let e1 = points[(i + 1) % n] - points[i];
+        let e2 = points[(i + 2) % n] - points[(i + 1) % n];
+        let cross = e1.cross(e2);
+        if cross.abs() <= 1e-9 * e1.norm() * e2.norm() || (sign != 0.0 && cross.signum() != sign) {
+            return false;
+        }
+        sign = cross.signum();
+        turning += cross.atan2(e1.dot(e2));
+    }
+    (turning.abs() - std::f64::consts::TAU).abs() < 1e-6
+}
+
 fn signed_area(v: &[Vec2]) -> f64 {
     let o = v[0];
     let mut s = 0.0;
@@ -178,8 +197,10 @@ fn validated_unit(points: &[Vec2]) -> Result<Unit, PolygonError> {
     if convex_hull(points).len() < 3 {
         return Err(PolygonError::ZeroArea);
     }
-    // Simplicity: non-adjacent edges must not touch; adjacent edges must not fold back.
-    for i in 0..n {
+    // Simplicity: non-adjacent edges must not touch; adjacent edges must not fold back. A
+    // strictly convex ring is simple, and is recognised in O(n) (a 500-gon's hull is checked
+    // for every random tripod a planner draws); any other ring gets the O(n²) pairwise test.
+    for i in 0..if strictly_convex_ring(points) { 0 } else { n } {
         let (a0, a1) = (points[i], points[(i + 1) % n]);
         for j in i + 1..n {
             let (b0, b1) = (points[j], points[(j + 1) % n]);
@@ -722,6 +743,42 @@ mod tests {
         for (got, want) in s.iter().zip([0.0, 135.0, 225.0]) {
             assert!((got - want).abs() < 1e-9, "{got} vs {want}");
         }
+    }
+
+    #[test]
+    fn convex_fast_path_accepts_convex_rings_and_leaves_stars_to_the_pairwise_test() {
+        let ring = |n: usize, step: usize| -> Vec<Vec2> {
+            (0..n)
+                .map(|k| {
+                    let t = std::f64::consts::TAU * (k * step) as f64 / n as f64;
+                    Vec2::new(t.cos(), t.sin())
+                })
+                .collect()
+        };
+        // A regular 500-gon, either way round: convex, simple, accepted.
+        assert!(strictly_convex_ring(&ring(500, 1)));
+        let mut cw = ring(500, 1);
+        cw.reverse();
+        assert!(strictly_convex_ring(&cw));
+        assert_eq!(Polygon::new(&cw).unwrap().len(), 500);
+        // A pentagram turns the same way at every vertex but winds twice: not taken as convex,
+        // and the pairwise test finds its crossing edges.
+        let star = ring(5, 2);
+        assert!(!strictly_convex_ring(&star));
+        assert!(matches!(
+            Polygon::new(&star),
+            Err(PolygonError::SelfIntersecting { .. })
+        ));
+        // A collinear vertex is left to the general path (which drops it).
+        let sq = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(2.0, 0.0),
+            Vec2::new(2.0, 2.0),
+            Vec2::new(0.0, 2.0),
+        ];
+        assert!(!strictly_convex_ring(&sq));
+        assert_eq!(Polygon::new(&sq).unwrap().len(), 4);
     }
 
     #[test]
