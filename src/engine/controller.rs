@@ -121,8 +121,11 @@ pub struct OnlineSummary {
     pub calibration: Vec<CalibrationBin>,
     /// How often each joint command was chosen (`pin=target, …`).
     pub chosen: BTreeMap<String, u64>,
-    /// Per sensor: the power its likelihood is raised to (calibrated on held-out members).
+    /// Per sensor: the powers its two likelihoods are raised to, calibrated on held-out members
+    /// (0: not used): the matched filter over the hypotheses' templates, and the sensor
+    /// classifier's posterior over the states.
     pub temper: BTreeMap<String, f64>,
+    pub classifier_power: BTreeMap<String, f64>,
     /// Decisions whose most probable stable state (the belief's marginal) is the part's true
     /// state, over the decisions whose part has a known true state.
     pub state_correct: u64,
@@ -238,6 +241,15 @@ impl Control {
                     .sensors
                     .iter()
                     .map(|sm| (scene.obstacles[sm.obstacle].name().to_string(), sm.temper))
+                    .collect(),
+                classifier_power: h
+                    .0
+                    .sensors
+                    .iter()
+                    .map(|sm| {
+                        let name = scene.obstacles[sm.obstacle].name().to_string();
+                        (name, sm.classifier_power)
+                    })
                     .collect(),
                 bounds: {
                     let mut classes = Vec::new();
@@ -523,6 +535,7 @@ impl Line<'_> {
         index: u64,
         j: usize,
         reading: Option<&crate::sensing::reading::Reading>,
+        posterior: Option<&[f64]>,
         t_ready: f64,
     ) {
         let Some(c) = self.control.as_mut() else {
@@ -535,7 +548,7 @@ impl Line<'_> {
             return;
         };
         if let Some(b) = part.belief.as_mut() {
-            let ll = reading.and_then(|r| sm.log_likelihood(r));
+            let ll = sm.log_likelihood(reading, posterior);
             let u = b.observe_reading(&sm.p_touch, ll.as_deref());
             c.count_update(u, false);
         }

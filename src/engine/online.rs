@@ -25,6 +25,7 @@
 
 use super::line::{run_entry, run_single, Entry};
 use super::outcome::PartOutcome;
+use super::sensing::nearest;
 use crate::mechanics::{PartModel, Support};
 use crate::random::stream;
 use crate::scenario::raw::SupportKind;
@@ -36,7 +37,7 @@ use crate::sensing::classify::likelihood::Likelihood;
 use crate::sensing::classify::ClassifierOptions;
 use crate::sensing::reading::{read, Reading};
 use crate::sensing::signal::{ContactSignal, KnotRecorder, SignalScale};
-use crate::sensing::templates::TemplateSet;
+use crate::sensing::templates::{Hypotheses, TemplateSet};
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
@@ -76,8 +77,14 @@ pub struct SensorModel {
     likelihood: Option<Likelihood>,
     /// Hypothesis of each of the likelihood's labels.
     rows: Vec<usize>,
-    /// The power the likelihood is raised to (1: trusted as it is; see [`temper`]).
+    /// The power the likelihood is raised to (1: trusted as it is, 0: not used; see [`temper`]).
     pub temper: f64,
+    /// Per hypothesis, the sensor's own classifier's label for its stable state (None when the
+    /// classifier's labels are not orientations).
+    state_label: Option<Vec<usize>>,
+    /// The power the classifier's posterior over the states is raised to as a second likelihood
+    /// (0: not used; see [`temper`]).
+    pub classifier_power: f64,
 }
 
 /// The online controller's model; see the module notes.
@@ -234,14 +241,23 @@ impl OnlineModel {
                         .map_err(|e| format!("sensor \"{}\": {e}", pin.name))?,
                 )
             };
+            let state_label = match &sensor.hypotheses {
+                Hypotheses::Orientations { degrees, .. } => hypotheses
+                    .iter()
+                    .map(|x| nearest(degrees, x.state_deg))
+                    .collect::<Option<Vec<usize>>>(),
+                Hypotheses::VertexEdge { .. } => None,
+            };
             let sm = SensorModel {
                 obstacle: j,
                 p_touch,
                 likelihood,
                 rows,
                 temper: 1.0,
+                state_label,
+                classifier_power: 1.0,
             };
-            let trials: Vec<(usize, Vec<f64>)> = held_out
+            let trials: Vec<(usize, Evidence)> = held_out
                 .iter()
                 .enumerate()
                 .filter_map(|(k, (h, sigs))| {
@@ -249,7 +265,8 @@ impl OnlineModel {
                     let mut rng =
                         stream(scene.seed, HELD_OUT_READINGS | ((k as u64) << 8) | i as u64);
                     let r = read(sig, &sensor.settings, &mut rng)?;
-                    Some((*h, sm.log_likelihood(&r)?))
+                    let post = sensor.classifier.classify(&r).posterior;
+                    Some((*h, Evidence::of(&sm, Some(&r), post.as_deref(), true)))
                 })
                 .collect();
             held_trials.push(trials);
@@ -269,7 +286,9 @@ impl OnlineModel {
             evaluations,
         };
         for (i, trials) in held_trials.iter().enumerate() {
-            model.sensors[i].temper = temper(&model, i, trials);
+            let (tau, sigma) = temper(&model, i, trials);
+            model.sensors[i].temper = tau;
+            model.sensors[i].classifier_power = sigma;
         }
         Ok(model)
     }
@@ -384,59 +403,136 @@ impl OnlineModel {
 }
 
 impl SensorModel {
-    /// log p(reading | h, touch) per hypothesis (−∞ for one that never touches); None when the
-    /// reading carries no usable signal (no contact detected in it).
-    pub fn log_likelihood(&self, reading: &Reading) -> Option<Vec<f64>> {
-        let ll = self.likelihood.as_ref()?.log_likelihoods(reading)?;
-        let mut out = vec![f64::NEG_INFINITY; self.p_touch.len()];
-        for (k, &h) in self.rows.iter().enumerate() {
-            out[h] = self.temper * ll[k];
-        }
-        Some(out)
+    /// log p(reading | h, touch) per hypothesis, as the belief takes it: the matched filter over
+    /// the hypotheses' templates raised to [`SensorModel::temper`] (−∞ for a hypothesis that
+    /// never touches), plus the sensor classifier's log posterior of h's state (`posterior`,
+    /// over its labels under a uniform prior, so proportional to the likelihood of each state)
+    /// raised to [`SensorModel::classifier_power`]. A channel with power 0 is not computed. None
+    /// when neither channel has anything to say (no contact detected in the reading).
+    pub fn log_likelihood(
+        &self,
+        reading: Option<&Reading>,
+        posterior: Option<&[f64]>,
+    ) -> Option<Vec<f64>> {
+        let raw = Evidence::of(self, reading, posterior, self.temper > 0.0);
+        raw.combine(self.temper, self.classifier_power)
     }
 }
 
-/// The power τ sensor `i`'s likelihood is raised to: the matched filter's noise model knows the
-/// sensor's noise only, not how far a real push strays from every simulated member (another
-/// tripod, another jitter), so its raw likelihood is far too sharp and one reading would make the
-/// belief certain of a wrong hypothesis. τ is chosen on held-out members (readings the
-/// likelihood was not built from; `trials` holds their true hypothesis and raw log-likelihood),
-/// from 1 down to 10⁻⁶ in half-decades: the τ whose decisions do best on them (the mean
-/// success(a*, h_true) of the command the belief after their reading chooses), ties broken by the
-/// mean log posterior of their true hypothesis — a tempered likelihood, calibrated by
-/// cross-validation on what the controller does with it.
-fn temper(model: &OnlineModel, i: usize, trials: &[(usize, Vec<f64>)]) -> f64 {
+/// The raw evidence of one reading per hypothesis, before the powers: the matched filter's log
+/// likelihood and the classifier's log posterior of the hypothesis's state.
+#[derive(Debug, Clone)]
+struct Evidence {
+    filter: Option<Vec<f64>>,
+    classifier: Option<Vec<f64>>,
+}
+
+impl Evidence {
+    fn of(
+        sm: &SensorModel,
+        reading: Option<&Reading>,
+        posterior: Option<&[f64]>,
+        with_filter: bool,
+    ) -> Evidence {
+        let filter = with_filter
+            .then(|| reading.and_then(|r| sm.likelihood.as_ref()?.log_likelihoods(r)))
+            .flatten()
+            .map(|ll| {
+                let mut out = vec![f64::NEG_INFINITY; sm.p_touch.len()];
+                for (k, &h) in sm.rows.iter().enumerate() {
+                    out[h] = ll[k];
+                }
+                out
+            });
+        let classifier = match (&sm.state_label, posterior) {
+            (Some(labels), Some(p)) => Some(
+                labels
+                    .iter()
+                    .map(|&l| p.get(l).copied().unwrap_or(0.0).max(1e-300).ln())
+                    .collect(),
+            ),
+            _ => None,
+        };
+        Evidence { filter, classifier }
+    }
+
+    fn combine(&self, tau: f64, sigma: f64) -> Option<Vec<f64>> {
+        let filter = self.filter.as_ref().filter(|_| tau > 0.0);
+        let classifier = self.classifier.as_ref().filter(|_| sigma > 0.0);
+        if filter.is_none() && classifier.is_none() {
+            return None;
+        }
+        let n = filter.or(classifier).map_or(0, Vec::len);
+        Some(
+            (0..n)
+                .map(|h| {
+                    filter.map_or(0.0, |f| tau * f[h]) + classifier.map_or(0.0, |c| sigma * c[h])
+                })
+                .collect(),
+        )
+    }
+}
+
+/// The powers sensor `i`'s two channels are raised to: τ for the matched filter over the
+/// hypotheses' templates, σ for the sensor classifier's posterior over the states. The filter's
+/// noise model knows the sensor's noise only, not how far a real push strays from every simulated
+/// member (another tripod, another jitter), so its raw likelihood is far too sharp and one reading
+/// would make the belief certain of a wrong hypothesis; the classifier, trained on many templates
+/// per state, names the state more robustly but says nothing of the offset, friction or support.
+/// Both powers are chosen together on held-out members (readings neither channel was built from;
+/// `trials` holds their true hypothesis and raw evidence), each from 1 down to 10⁻⁶ in
+/// half-decades or 0 (the channel unused): the pair whose decisions do best on them (the mean
+/// success(a*, h_true) of the command the belief after their reading chooses); among pairs whose
+/// decisions do as well (within [`TIE`]), one without the matched filter (which costs far more per
+/// reading than the classifier; a channel with power 0 is not computed), then the best mean log
+/// posterior of their true hypothesis — a tempered likelihood, calibrated by cross-validation on
+/// what the controller does with it.
+fn temper(model: &OnlineModel, i: usize, trials: &[(usize, Evidence)]) -> (f64, f64) {
     if trials.is_empty() {
-        return 1.0;
+        return (1.0, 1.0);
     }
     let p_touch = &model.sensors[i].p_touch;
-    let score = |tau: f64| -> (f64, f64) {
+    let score = |tau: f64, sigma: f64| -> (f64, f64) {
         let mut won = 0.0;
         let mut log = 0.0;
-        for (h, ll) in trials {
+        for (h, ev) in trials {
             let mut b = model.prior.clone();
-            let scaled: Vec<f64> = ll.iter().map(|l| tau * l).collect();
-            b.observe_reading(p_touch, Some(&scaled));
+            b.observe_reading(p_touch, ev.combine(tau, sigma).as_deref());
             won += model.success_of(model.choose(&b).action)[*h];
             log += b.probability(*h).max(1e-300).ln();
         }
         let n = trials.len() as f64;
         (won / n, log / n)
     };
-    let mut best = (1.0, score(1.0));
-    for k in 1..=12 {
-        let tau = 10f64.powf(-(k as f64) / 2.0);
-        let sc = score(tau);
-        let better = if (sc.0 - best.1 .0).abs() > TIE {
-            sc.0 > best.1 .0
-        } else {
-            sc.1 > best.1 .1
-        };
-        if better {
-            best = (tau, sc);
+    // From both channels off up.
+    let powers: Vec<f64> = std::iter::once(0.0)
+        .chain((0..=12).rev().map(|k| 10f64.powf(-(k as f64) / 2.0)))
+        .collect();
+    let mut pairs: Vec<(f64, f64)> = Vec::new();
+    for &tau in &powers {
+        for &sigma in &powers {
+            pairs.push((tau, sigma));
         }
     }
-    best.0
+    // The filter costs far more per reading than the classifier: every pair without it first.
+    pairs.sort_by_key(|&(tau, _)| tau > 0.0);
+    let scores: Vec<(f64, f64)> = pairs.par_iter().map(|&(t, s)| score(t, s)).collect();
+    let mut best = 0;
+    let costly = |k: usize| pairs[k].0 > 0.0;
+    for (k, sc) in scores.iter().enumerate() {
+        let b = scores[best];
+        let better = if (sc.0 - b.0).abs() > TIE {
+            sc.0 > b.0
+        } else if costly(k) != costly(best) {
+            !costly(k)
+        } else {
+            sc.1 > b.1 + 1e-9
+        };
+        if better {
+            best = k;
+        }
+    }
+    pairs[best]
 }
 
 /// Each sensor's clean signal when a part entering as `e` meets it on the line `base` (None:

@@ -201,7 +201,10 @@ fn online_block(
     let temper: Vec<String> = on
         .temper
         .iter()
-        .map(|(k, v)| format!("{k} {v:.0e}"))
+        .map(|(k, v)| {
+            let sigma = on.classifier_power.get(k).copied().unwrap_or(0.0);
+            format!("{k} filter {v:.0e}, classifier {sigma:.0e}")
+        })
         .collect();
     let _ = writeln!(
         o,
