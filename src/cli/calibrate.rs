@@ -12,7 +12,7 @@ use super::validate::{
     check_members, emit, ensemble_spec, load_measured, pool, summary_text, write_report_files,
     ModelArgs, ReportHead,
 };
-use crate::study::mc::perturbations::{SmoothParams, SupportChoice};
+use crate::mechanics::support::{SmoothParams, SupportChoice};
 use crate::validate::calibrate::{calibrate, Calibration, CalibrationSettings};
 use crate::validate::score::Summary;
 use crate::validate::synthetic::{synthesize, SyntheticDesign};

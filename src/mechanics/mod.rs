@@ -20,6 +20,7 @@
 //!   side) for models many contacts share.
 //! * [`stick_table`]: the exact model's sticking twists on each edge, tabulated per edge over (ℓ,
 //!   direction of the pin's velocity), for a map tier's build.
+//! * [`support`]: random support models — a tripod or a smooth density per sample — and their draw.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!
 //! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
@@ -41,6 +42,7 @@ pub mod pin_path;
 mod settings;
 pub mod slide_table;
 pub mod stick_table;
+pub mod support;
 pub mod vote;
 
 pub use fence::FenceSpec;
