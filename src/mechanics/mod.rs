@@ -2,6 +2,7 @@
 //!
 //! * [`limit_surface`]: dissipation D(ξ), its gradient (the support load) and Hessian for uniform
 //!   pressure (closed form per edge, with a far-field quadrature) and for weighted support points.
+//! * [`limits`]: the ranges in which a contact's numeric settings are accepted.
 //! * [`part_model`]: the compiled part (normalised geometry + support) and the two convex
 //!   sub-problems, at three fidelity levels (`tip`, `ellipsoid`, `exact`).
 //! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
@@ -34,6 +35,7 @@ pub mod fence;
 pub mod instant;
 pub mod integrate;
 pub mod limit_surface;
+pub mod limits;
 mod ode;
 pub mod outcome;
 pub mod part_model;
