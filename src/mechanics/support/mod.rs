@@ -61,7 +61,7 @@ impl SupportChoice {
 
 /// The support of one sample on its (perturbed) polygon; smooth densities redrawn because their
 /// tilt made the pressure negative are counted in `redraws`.
-pub(crate) fn draw_support(
+pub fn draw_support(
     polygon: &Polygon,
     choice: &SupportChoice,
     rng: &mut ChaCha8Rng,
