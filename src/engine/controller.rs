@@ -99,10 +99,12 @@ pub struct CalibrationBin {
 /// What the online controller did (docs/physics.md#belief-and-online-replanning).
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct OnlineSummary {
-    /// The model: hypotheses, joint actions, line runs its build took.
+    /// The model: hypotheses, joint actions, line runs its build took (a run through one
+    /// stretch of the line counts one) and the contact-model evaluations of its success runs.
     pub hypotheses: usize,
     pub actions: usize,
     pub model_runs: u64,
+    pub model_evaluations: u64,
     /// Decisions taken (one per part once every sensor has spoken).
     pub decisions: u64,
     /// Mean entropy of the belief before any observation and at the decision (bits).
@@ -230,6 +232,7 @@ impl Control {
                 hypotheses: h.0.hypotheses.len(),
                 actions: h.0.actions.len(),
                 model_runs: h.0.runs,
+                model_evaluations: h.0.evaluations,
                 temper: h
                     .0
                     .sensors

@@ -30,7 +30,7 @@ pub mod part_stream;
 pub mod results;
 pub mod sensing;
 
-pub use line::{run, run_capturing, run_entry, Entry};
+pub use line::{run, run_capturing, run_entry, run_single, Entry, SingleRun};
 pub use metrics::Summary;
 pub use outcome::{OutcomeCounts, PartOutcome};
 pub use results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};

@@ -23,7 +23,8 @@
 //! A decision is then a dot product per action: P(goal | a) = Σ_h p(h | readings) · `success[a][h]`,
 //! maximised over the actions (ties: the least travel from where the pins stand).
 
-use super::line::{run_entry, Entry};
+use super::line::{run_entry, run_single, Entry};
+use super::outcome::PartOutcome;
 use crate::mechanics::{PartModel, Support};
 use crate::random::stream;
 use crate::scenario::raw::SupportKind;
@@ -93,9 +94,12 @@ pub struct OnlineModel {
     homes: Vec<Target>,
     /// success[a · H + h].
     success: Vec<f64>,
-    /// Members per hypothesis and line runs the build took.
+    /// Members per hypothesis.
     pub samples: usize,
+    /// Line runs the build took (a run through one stretch of the line counts one), and the
+    /// contact-model evaluations of the runs that predict success.
     pub runs: u64,
+    pub evaluations: u64,
 }
 
 /// The controller's choice for one part.
@@ -111,10 +115,17 @@ impl OnlineModel {
     /// Build the model of `scene` (its nominal physics) for `spec`. Errors name the size that is
     /// too large or the hypothesis set that is empty.
     pub fn build(scene: &Scene, spec: &BeliefSpec) -> Result<OnlineModel, String> {
+        Self::build_with(scene, spec, true)
+    }
+
+    /// As [`OnlineModel::build`]; with `staged`, each member crosses the line stretch by stretch
+    /// ([`stages`]), else once per joint action from the line's start.
+    fn build_with(scene: &Scene, spec: &BeliefSpec, staged: bool) -> Result<OnlineModel, String> {
         let (hypotheses, prior) = hypotheses(scene, spec);
         let prior = Belief::new(&prior).ok_or("the belief's prior has no positive weight")?;
         let pins = indices(scene, |p| p.actuator.is_some());
-        let (actions, options) = joint_actions(scene, &pins, spec.targets)?;
+        let (actions, per_pin) = joint_actions(scene, &pins, spec.targets)?;
+        let options: Vec<usize> = per_pin.iter().map(Vec::len).collect();
         let s = spec.samples;
         let n_members = hypotheses.len() * s;
         let runs = n_members * (actions.len() + 1);
@@ -131,10 +142,28 @@ impl OnlineModel {
         let mus = distinct(hypotheses.iter().map(|h| h.mu_c));
         let variant_of = |a: Option<&[Target]>, mu: f64| variant(scene, &pins, a, mu);
         let sensing: Vec<Scene> = mus.iter().map(|&m| variant_of(None, m)).collect();
-        let scenes: Vec<Vec<Scene>> = actions
-            .iter()
-            .map(|a| mus.iter().map(|&m| variant_of(Some(a), m)).collect())
-            .collect();
+        let homes: Vec<Target> = pins.iter().map(|&j| home_of(&scene.obstacles[j])).collect();
+        let stretches = if staged {
+            stages(scene, &pins)
+        } else {
+            vec![Stage {
+                pins: (0..pins.len()).collect(),
+                end: None,
+            }]
+        };
+        let staging = Staging::new(
+            &stretches,
+            &per_pin,
+            &homes,
+            |targets, end, mu| {
+                let mut v = variant_of(Some(targets), mu);
+                if let Some(x) = end {
+                    v.belt.length = x;
+                }
+                v
+            },
+            &mus,
+        );
         let mu_index = |mu: f64| mus.iter().position(|&m| m == mu).expect("listed μ");
         let sensor_obstacles = indices(scene, |p| p.sensor.is_some());
         let signals_of = |h: usize, e: &Entry| -> Result<Vec<Option<ContactSignal>>, String> {
@@ -142,23 +171,18 @@ impl OnlineModel {
             sensor_signals(scene, base, &sensor_obstacles, e)
         };
         // Per member: its signal at each sensor (None: no touch) and its success per action.
-        type MemberOut = (Vec<Option<ContactSignal>>, Vec<bool>);
+        type MemberOut = (Vec<Option<ContactSignal>>, Vec<bool>, [u64; 2]);
         let outs: Vec<MemberOut> = members
             .par_iter()
             .map(|(h, e)| -> Result<MemberOut, String> {
                 let mi = mu_index(hypotheses[*h].mu_c);
                 let signals = signals_of(*h, e)?;
-                let ok = scenes
-                    .iter()
-                    .map(|per_mu| {
-                        run_entry(&per_mu[mi], e.clone(), false)
-                            .map(|(r, _)| r.outcome == "success")
-                            .map_err(|e| e.to_string())
-                    })
-                    .collect::<Result<Vec<bool>, String>>()?;
-                Ok((signals, ok))
+                let (ok, member_runs) = staging.success(mi, e)?;
+                Ok((signals, ok, member_runs))
             })
             .collect::<Result<_, String>>()?;
+        let runs_taken: u64 = outs.iter().map(|o| o.2[0] + 1).sum();
+        let evaluations: u64 = outs.iter().map(|o| o.2[1]).sum();
         // Held-out members (other streams) calibrate how far each sensor's likelihood can be
         // trusted (see `temper`).
         let v = (s / 2).max(2);
@@ -172,9 +196,10 @@ impl OnlineModel {
             .collect::<Result<_, String>>()?;
         let n_h = hypotheses.len();
         let mut success = vec![0.0; actions.len() * n_h];
-        for (k, (_, ok)) in outs.iter().enumerate() {
-            for (a, &yes) in ok.iter().enumerate() {
-                success[a * n_h + k / s] += f64::from(u8::from(yes)) / s as f64;
+        let order = staging.prefix_of_actions(&options);
+        for (k, (_, ok, _)) in outs.iter().enumerate() {
+            for (a, &p) in order.iter().enumerate() {
+                success[a * n_h + k / s] += f64::from(u8::from(ok[p])) / s as f64;
             }
         }
         let mut sensors = Vec::new();
@@ -230,7 +255,6 @@ impl OnlineModel {
             held_trials.push(trials);
             sensors.push(sm);
         }
-        let homes = pins.iter().map(|&j| home_of(&scene.obstacles[j])).collect();
         let mut model = OnlineModel {
             hypotheses,
             prior,
@@ -241,7 +265,8 @@ impl OnlineModel {
             homes,
             success,
             samples: s,
-            runs: runs as u64,
+            runs: runs_taken + held_out.len() as u64,
+            evaluations,
         };
         for (i, trials) in held_trials.iter().enumerate() {
             model.sensors[i].temper = temper(&model, i, trials);
@@ -541,10 +566,209 @@ fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, 
         }
     };
     Ok(Entry {
+        x: 0.0,
         theta: theta_deg.to_radians().rem_euclid(std::f64::consts::TAU),
         y,
         model,
     })
+}
+
+/// A stretch of the line that a part crosses after the previous one: the dynamic pins acting in
+/// it and where it ends.
+#[derive(Debug, Clone, PartialEq)]
+struct Stage {
+    /// Positions (into the model's `pins`) of the dynamic pins that stand in this stretch.
+    pins: Vec<usize>,
+    /// Where the stretch ends along the belt (m; None: at the line's end).
+    end: Option<f64>,
+}
+
+/// Cut the line into stretches a part crosses one after another, so that a member's path up to
+/// a dynamic pin is simulated once rather than once per command of the pins downstream, and
+/// members that leave a stretch in the same pose (a pin command that never touched them) go on
+/// as one. A cut lies where no obstacle is within 1.25·a of it on either side, so a part whose
+/// centroid crosses it touches nothing: in a line whose pins stand still the part is then free,
+/// and its pose (x, y, θ) is all there is to carry to the next stretch. Stretches end at every
+/// such gap before the last dynamic pin; the last runs to the line's end.
+fn stages(scene: &Scene, pins: &[usize]) -> Vec<Stage> {
+    let reach = 1.25 * scene.part.radius;
+    let mut spans: Vec<(f64, f64, Option<usize>)> = scene
+        .obstacles
+        .iter()
+        .enumerate()
+        .map(|(j, o)| {
+            let [lo, hi] = o.x_range();
+            (lo - reach, hi + reach, pins.iter().position(|&p| p == j))
+        })
+        .collect();
+    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Blocks of overlapping spans: (lo, hi, dynamic pins in it).
+    let mut blocks: Vec<(f64, f64, Vec<usize>)> = Vec::new();
+    for (lo, hi, pin) in spans {
+        match blocks.last_mut() {
+            Some(b) if lo <= b.1 => {
+                b.1 = b.1.max(hi);
+                b.2.extend(pin);
+            }
+            _ => blocks.push((lo, hi, pin.into_iter().collect())),
+        }
+    }
+    let Some(last) = blocks.iter().rposition(|b| !b.2.is_empty()) else {
+        return vec![Stage {
+            pins: Vec::new(),
+            end: None,
+        }];
+    };
+    let mut out: Vec<Stage> = Vec::new();
+    for (i, b) in blocks.iter().enumerate().take(last) {
+        let cut = 0.5 * (b.1 + blocks[i + 1].0);
+        if cut > 0.0 {
+            out.push(Stage {
+                pins: b.2.clone(),
+                end: Some(cut),
+            });
+        }
+    }
+    // Pins upstream of the first positive cut (a line starting inside a block) join the next
+    // stretch; the last stretch takes the rest.
+    let placed: Vec<usize> = out.iter().flat_map(|st| st.pins.clone()).collect();
+    out.push(Stage {
+        pins: (0..pins.len()).filter(|k| !placed.contains(k)).collect(),
+        end: None,
+    });
+    out
+}
+
+/// The stretches' line variants and how a member's results across them map to joint actions.
+struct Staging {
+    stages: Vec<Stage>,
+    /// Per stretch, per command of its pins (mixed radix, first pin slowest), per μ: the line.
+    scenes: Vec<Vec<Vec<Scene>>>,
+}
+
+/// Where a member stands after a stretch: gone from the line (and whether in the goal), or free
+/// at a pose for the next stretch.
+#[derive(Debug, Clone, Copy)]
+enum Cont {
+    Done(bool),
+    Going(crate::geometry::Pose),
+}
+
+impl Staging {
+    fn new(
+        stages: &[Stage],
+        per_pin: &[Vec<Target>],
+        homes: &[Target],
+        line: impl Fn(&[Target], Option<f64>, f64) -> Scene,
+        mus: &[f64],
+    ) -> Staging {
+        let scenes = stages
+            .iter()
+            .map(|st| {
+                let n: usize = st.pins.iter().map(|&k| per_pin[k].len()).product();
+                (0..n)
+                    .map(|c| {
+                        let mut targets = homes.to_vec();
+                        let mut rest = c;
+                        for &k in st.pins.iter().rev() {
+                            targets[k] = per_pin[k][rest % per_pin[k].len()];
+                            rest /= per_pin[k].len();
+                        }
+                        mus.iter().map(|&mu| line(&targets, st.end, mu)).collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        Staging {
+            stages: stages.to_vec(),
+            scenes,
+        }
+    }
+
+    /// A member's success for every command sequence (indexed stretch by stretch, as
+    /// [`Staging::prefix_of_actions`] maps them), and the line runs it took.
+    fn success(&self, mu: usize, e: &Entry) -> Result<(Vec<bool>, [u64; 2]), String> {
+        use std::collections::HashMap;
+        let mut states = vec![Cont::Going(crate::geometry::Pose::new(e.x, e.y, e.theta))];
+        let mut prefix: Vec<usize> = vec![0];
+        let mut runs = [0, 0];
+        for (s, stage) in self.scenes.iter().enumerate() {
+            let last = s + 1 == self.scenes.len();
+            let mut next: Vec<Cont> = Vec::new();
+            let mut seen: HashMap<(u64, u64, u64), usize> = HashMap::new();
+            let mut done = [None, None];
+            let mut id_of = |c: Cont, next: &mut Vec<Cont>| -> usize {
+                let push = || {
+                    next.push(c);
+                    next.len() - 1
+                };
+                match c {
+                    Cont::Done(b) => *done[usize::from(b)].get_or_insert_with(push),
+                    Cont::Going(p) => *seen
+                        .entry((p.x.to_bits(), p.y.to_bits(), p.theta.to_bits()))
+                        .or_insert_with(push),
+                }
+            };
+            let mut table: Vec<Vec<usize>> = Vec::with_capacity(states.len());
+            for c in &states {
+                let row = match *c {
+                    Cont::Done(b) => vec![id_of(Cont::Done(b), &mut next); stage.len()],
+                    Cont::Going(pose) => {
+                        let mut row = Vec::with_capacity(stage.len());
+                        for per_mu in stage {
+                            runs[0] += 1;
+                            let entry = Entry {
+                                theta: pose.theta,
+                                y: pose.y,
+                                x: pose.x,
+                                model: e.model.clone(),
+                            };
+                            let r = run_single(&per_mu[mu], entry).map_err(|e| e.to_string())?;
+                            runs[1] += r.model_evaluations;
+                            let c = if !last && r.outcome.exited() {
+                                Cont::Going(r.pose)
+                            } else {
+                                Cont::Done(r.outcome == PartOutcome::Success)
+                            };
+                            row.push(id_of(c, &mut next));
+                        }
+                        row
+                    }
+                };
+                table.push(row);
+            }
+            prefix = prefix
+                .iter()
+                .flat_map(|&p| table[p].iter().copied())
+                .collect();
+            states = next;
+        }
+        let ok = prefix
+            .iter()
+            .map(|&i| matches!(states[i], Cont::Done(true)))
+            .collect();
+        Ok((ok, runs))
+    }
+
+    /// For each joint action (its pins' options in `pins` order, the last fastest), its index
+    /// among the stretch-by-stretch command sequences of [`Staging::success`].
+    fn prefix_of_actions(&self, options: &[usize]) -> Vec<usize> {
+        let n: usize = options.iter().product();
+        (0..n)
+            .map(|a| {
+                let mut digit = vec![0; options.len()];
+                let mut rest = a;
+                for k in (0..options.len()).rev() {
+                    digit[k] = rest % options[k];
+                    rest /= options[k];
+                }
+                self.stages
+                    .iter()
+                    .flat_map(|st| st.pins.iter())
+                    .fold(0, |p, &k| p * options[k] + digit[k])
+            })
+            .collect()
+    }
 }
 
 /// The scene as a static line: every dynamic pin standing at `action` (or at home), every pin
@@ -576,12 +800,15 @@ fn variant(scene: &Scene, pins: &[usize], action: Option<&[Target]>, mu: f64) ->
     v
 }
 
-/// The joint actions over `pins`.
+/// Each dynamic pin's options, in the order of the model's `pins`.
+type PinOptions = Vec<Vec<Target>>;
+
+/// The joint actions over `pins`, and each pin's options.
 fn joint_actions(
     scene: &Scene,
     pins: &[usize],
     targets: usize,
-) -> Result<(Vec<Vec<Target>>, Vec<usize>), String> {
+) -> Result<(Vec<Vec<Target>>, PinOptions), String> {
     let mut per_pin: Vec<Vec<Target>> = Vec::new();
     for &j in pins {
         let Obstacle::Pin(p) = &scene.obstacles[j] else {
@@ -618,7 +845,6 @@ fn joint_actions(
             "the dynamic pins have {n} joint commands on the action grid (at most {MAX_ACTIONS}): lower controller.belief.targets"
         ));
     }
-    let sizes = per_pin.iter().map(Vec::len).collect();
     let mut out: Vec<Vec<Target>> = vec![Vec::new()];
     for options in &per_pin {
         out = out
@@ -632,7 +858,7 @@ fn joint_actions(
             })
             .collect();
     }
-    Ok((out, sizes))
+    Ok((out, per_pin))
 }
 
 /// A dynamic pin's state before any command.
@@ -676,4 +902,90 @@ fn distinct(values: impl Iterator<Item = f64>) -> Vec<f64> {
     v.sort_by(f64::total_cmp);
     v.dedup();
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::raw::SupportKind;
+    use std::path::Path;
+
+    /// tripoly2's online line with its controller in policy mode (no model built at parse).
+    fn tripoly2_line() -> Scene {
+        let path = Path::new("scenarios/tripoly2_online.toml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let cut = text.find("[controller.belief]").unwrap();
+        let end = text[cut..].find("[goal]").unwrap() + cut;
+        let text = format!("{}{}", &text[..cut], &text[end..])
+            .replace("mode = \"online\"", "mode = \"policy\"");
+        crate::scenario::parse(path, &text).unwrap()
+    }
+
+    fn small_spec() -> BeliefSpec {
+        BeliefSpec {
+            mu_c: vec![0.3, 0.7],
+            support: vec![SupportKind::Uniform, SupportKind::Tripod],
+            offsets: 2,
+            samples: 2,
+            targets: 5,
+        }
+    }
+
+    #[test]
+    fn the_line_is_cut_between_its_pins_and_never_within_reach_of_one() {
+        let scene = tripoly2_line();
+        let pins = indices(&scene, |p| p.actuator.is_some());
+        assert_eq!(pins.len(), 2);
+        let st = stages(&scene, &pins);
+        // The sensor's stretch, mover1's, then mover2's to the line's end.
+        assert_eq!(
+            st.iter().map(|s| s.pins.clone()).collect::<Vec<_>>(),
+            [vec![], vec![0], vec![1]]
+        );
+        let reach = 1.25 * scene.part.radius;
+        for s in &st {
+            let Some(cut) = s.end else { continue };
+            for o in &scene.obstacles {
+                let [lo, hi] = o.x_range();
+                assert!(
+                    hi + reach < cut || lo - reach > cut,
+                    "{} at the cut {cut}",
+                    o.name()
+                );
+            }
+        }
+        // Move mover2 within reach of mover1: one stretch holds both.
+        let mut near = scene.clone();
+        let x1 = near.obstacles[pins[0]].x_range()[1];
+        if let Obstacle::Pin(p) = &mut near.obstacles[pins[1]] {
+            p.centre.x = x1 + 0.5 * scene.part.radius + p.radius;
+        }
+        let st = stages(&near, &pins);
+        assert_eq!(st.last().unwrap().pins, [0, 1]);
+        assert!(st.iter().rev().skip(1).all(|s| s.pins.is_empty()));
+    }
+
+    #[test]
+    fn crossing_the_line_stretch_by_stretch_predicts_what_whole_runs_do() {
+        let scene = tripoly2_line();
+        let spec = small_spec();
+        let staged = OnlineModel::build_with(&scene, &spec, true).unwrap();
+        let whole = OnlineModel::build_with(&scene, &spec, false).unwrap();
+        assert_eq!(staged.actions, whole.actions);
+        let differ = staged
+            .success
+            .iter()
+            .zip(&whole.success)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "of {} success entries", whole.success.len());
+        assert!(staged.success.iter().any(|&p| p > 0.0) && staged.success.iter().any(|&p| p < 1.0));
+        // More runs (one per stretch), each through a part of the line: less contact work.
+        assert!(
+            staged.evaluations < whole.evaluations,
+            "{} vs {}",
+            staged.evaluations,
+            whole.evaluations
+        );
+    }
 }

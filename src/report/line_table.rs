@@ -195,8 +195,8 @@ fn online_block(
 ) {
     let _ = writeln!(
         o,
-        "controller                online: {} hypotheses, {} joint commands ({} line runs to build), latency {} s, late commands: {}",
-        on.hypotheses, on.actions, on.model_runs, c.latency_s, c.on_late
+        "controller                online: {} hypotheses, {} joint commands ({} line runs, {} contact-model evaluations to build), latency {} s, late commands: {}",
+        on.hypotheses, on.actions, on.model_runs, on.model_evaluations, c.latency_s, c.on_late
     );
     let temper: Vec<String> = on
         .temper
