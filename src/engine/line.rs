@@ -186,6 +186,19 @@ pub fn run_single(scene: &Scene, entry: Entry) -> Result<SingleRun, EngineError>
 
 /// Run the line: a pure function of (scene, options). `progress` is called with the number of
 /// finished parts from time to time.
+///
+/// ```
+/// use pinfeed::engine::{run, PartOutcome, RunOptions};
+/// use std::path::Path;
+///
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+/// let scene = pinfeed::scenario::load(&path).unwrap();
+/// let opts = RunOptions { parts: 100, ..RunOptions::from_scene(&scene) };
+/// let result = run(&scene, &opts, &mut |_| {}).unwrap();
+/// assert_eq!(result.summary.parts_in, 100);
+/// // The quickstart line orients every part.
+/// assert_eq!(result.summary.outcomes.get(PartOutcome::Success), 100);
+/// ```
 pub fn run(
     scene: &Scene,
     opts: &RunOptions,

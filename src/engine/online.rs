@@ -18,9 +18,9 @@
 //! * **Actions**: the joint commands of the dynamic pins: each moving pin on a grid of `targets`
 //!   positions over its travel plus its home and the targets its rules name, each retractable
 //!   pin raised or withdrawn. For every action and member the line is run with the pins standing
-//!   at the action's targets; success[a][h] is the share of h's members that end in the goal.
+//!   at the action's targets; `success[a][h]` is the share of h's members that end in the goal.
 //!
-//! A decision is then a dot product per action: P(goal | a) = Σ_h p(h | readings) · success[a][h],
+//! A decision is then a dot product per action: P(goal | a) = Σ_h p(h | readings) · `success[a][h]`,
 //! maximised over the actions (ties: the least travel from where the pins stand).
 
 use super::line::{run_entry, run_single, Entry};
@@ -77,13 +77,13 @@ pub struct SensorModel {
     likelihood: Option<Likelihood>,
     /// Hypothesis of each of the likelihood's labels.
     rows: Vec<usize>,
-    /// The power the likelihood is raised to (1: trusted as it is, 0: not used; see [`temper`]).
+    /// The power the likelihood is raised to (1: trusted as it is, 0: not used; see `temper`).
     pub temper: f64,
     /// Per hypothesis, the sensor's own classifier's label for its stable state (None when the
     /// classifier's labels are not orientations).
     state_label: Option<Vec<usize>>,
     /// The power the classifier's posterior over the states is raised to as a second likelihood
-    /// (0: not used; see [`temper`]).
+    /// (0: not used; see `temper`).
     pub classifier_power: f64,
 }
 
@@ -395,7 +395,7 @@ impl OnlineModel {
         out
     }
 
-    /// success[a][h] for every hypothesis.
+    /// `success[a][h]` for every hypothesis.
     pub fn success_of(&self, action: usize) -> &[f64] {
         let n_h = self.hypotheses.len();
         &self.success[action * n_h..(action + 1) * n_h]
