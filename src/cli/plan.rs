@@ -16,7 +16,6 @@ use crate::plan::{FeedKind, Problem};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `pinfeed plan`.
@@ -569,16 +568,7 @@ fn write(path: &Path, text: &str) -> Result<()> {
 
 /// A spinner on standard error when it is a terminal (and not `quiet`).
 fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let b = indicatif::ProgressBar::new_spinner();
-    b.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} plan {elapsed}: {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
-    );
-    b.enable_steady_tick(std::time::Duration::from_millis(120));
-    Some(b)
+    super::progress::shown(quiet).then(|| super::progress::spinner("plan", quiet))
 }
 
 /// The drawing's title: the verdict with the line's number beside the prediction.

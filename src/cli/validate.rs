@@ -67,6 +67,9 @@ pub struct ModelArgs {
     /// Worker threads (0: one per core); the result does not depend on it.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 impl ModelArgs {
@@ -369,11 +372,15 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
     )?;
     let measured = load_measured(&args.measured, &spec, args.common.part.as_deref())?;
     let c = &args.common;
+    let bar = super::progress::bar(0, "passes", c.quiet || c.json);
+    let tell = super::progress::counter(&bar);
     let (rows, summary, _) = pool(c.threads)?
         .install(|| {
-            crate::validate::validate(&measured, &spec, c.seed, args.members, c.passes, &score)
+            let draw = (c.seed, args.members, c.passes);
+            crate::validate::validate_observed(&measured, &spec, draw, &score, &tell)
         })
         .map_err(anyhow::Error::msg)?;
+    bar.finish_and_clear();
     let mut command = format!(
         "pinfeed validate {} --mu-c {} --pin-radius {} --members {} {}",
         shell_word(&args.measured.display().to_string()),

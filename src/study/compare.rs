@@ -85,6 +85,17 @@ pub fn compare(
     files: &[String],
     parts: u64,
 ) -> Result<Vec<ComparisonRow>, EngineError> {
+    compare_observed(scenes, files, parts, &crate::progress::silent)
+}
+
+/// [`compare`], telling `progress` the parts finished over all scenes of all.
+pub fn compare_observed(
+    scenes: &[Scene],
+    files: &[String],
+    parts: u64,
+    progress: crate::progress::Report,
+) -> Result<Vec<ComparisonRow>, EngineError> {
+    let tally = crate::progress::Tally::new(parts * scenes.len() as u64, progress);
     scenes
         .par_iter()
         .zip(files.par_iter())
@@ -93,7 +104,11 @@ pub fn compare(
                 parts,
                 ..RunOptions::from_scene(scene)
             };
-            let r = engine::run(scene, &opts, &mut |_| {})?;
+            let mut reported = 0;
+            let r = engine::run(scene, &opts, &mut |finished| {
+                tally.add(finished - reported);
+                reported = finished;
+            })?;
             let s = &r.summary;
             let span = obstacle_span(scene);
             let y_span = self::span(scene, Obstacle::y_range);

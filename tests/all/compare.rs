@@ -145,3 +145,33 @@ fn a_scenario_with_another_part_is_refused() {
     );
     assert!(err.contains("same shape, scale and support"), "{err}");
 }
+
+#[test]
+fn compare_shows_progress_on_a_terminal_and_nothing_otherwise() {
+    let (pins, fences) = (
+        scenario("quickstart.toml"),
+        scenario("tripoly2_fences.toml"),
+    );
+    let args = ["compare", &pins, &fences, "--parts", "600"];
+    let out = pinfeed(&args);
+    assert!(out.status.success());
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("/1200 parts"),
+        "no progress when standard error is not a terminal"
+    );
+    let log = std::env::temp_dir().join(format!("pinfeed-compare-{}.tty", std::process::id()));
+    let Some(text) = crate::support::pinfeed_on_terminal(&args, &log) else {
+        return;
+    };
+    assert!(text.contains("/1200 parts"), "{text}");
+    assert!(
+        text.contains("success (95% CI)"),
+        "the table follows: {text}"
+    );
+    let quiet = [&args[..], &["--quiet"]].concat();
+    let text = crate::support::pinfeed_on_terminal(&quiet, &log).unwrap();
+    assert!(
+        !text.contains("/1200 parts"),
+        "--quiet draws nothing: {text}"
+    );
+}
