@@ -545,7 +545,7 @@ pub fn run(args: &PlanArgs) -> Result<()> {
             objective: o.objective,
             scenario: d.scenario_toml.as_deref(),
         };
-        serde_json::to_string_pretty(&doc)? + "\n"
+        crate::report::versioned::pretty(&doc)?
     } else {
         text(&o, &d, &files)
     };

@@ -124,12 +124,12 @@ pub fn run(args: &RunArgs) -> Result<()> {
     if scene.effects.event_log {
         let p = dir.join("events.json");
         batch
-            .write(&p, serde_json::to_string(&result.events)? + "\n")
+            .write(&p, event_log("events", &result.events)?)
             .with_context(|| format!("writing {}", p.display()))?;
         if !result.control.is_empty() {
             let p = dir.join("control.json");
             batch
-                .write(&p, serde_json::to_string(&result.control)? + "\n")
+                .write(&p, event_log("control", &result.control)?)
                 .with_context(|| format!("writing {}", p.display()))?;
         }
     }
@@ -216,4 +216,10 @@ fn tables_line(model: &crate::mechanics::PartModel) -> String {
         ),
         _ => String::new(),
     }
+}
+
+/// An event log's file: one compact JSON object, the version fields and the log under `key`.
+fn event_log<T: serde::Serialize>(key: &str, log: &[T]) -> serde_json::Result<String> {
+    let body: std::collections::BTreeMap<&str, &[T]> = [(key, log)].into();
+    crate::report::versioned::compact(&body)
 }

@@ -36,6 +36,7 @@ mod hard_cases;
 mod hardening;
 mod input_regressions;
 mod invariant_properties;
+mod json_versions;
 mod limit_surface;
 mod line;
 mod line_cost;

@@ -89,3 +89,12 @@ pub fn pinfeed_on_terminal(args: &[&str], log: &Path) -> Option<String> {
     assert!([0, 3].contains(&o.status.code().unwrap_or(-1)), "{o:?}");
     Some(String::from_utf8_lossy(&std::fs::read(log).expect("the terminal's log")).to_string())
 }
+
+/// A fresh, empty folder `pinfeed-<tag>-<process id>` in the system's temporary folder (a test
+/// names it after its module and itself, so no other test uses it).
+pub fn fresh_dir(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("pinfeed-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("creating a temporary folder");
+    d
+}
