@@ -49,7 +49,7 @@ pub struct PlanArgs {
     /// Orientation jitter of a stable feed: standard deviation (degrees).
     #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
     pub jitter: f64,
-    /// Lateral offset at entry: uniform in ±LATERAL (m).
+    /// Lateral offset at entry: uniform in ±LATERAL metres.
     #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
     pub lateral: f64,
     /// Particles per stable state: this many jitter quantiles …
@@ -70,13 +70,13 @@ pub struct PlanArgs {
     /// Be robust against the support: each particle gets its own random tripod.
     #[arg(long)]
     pub tripod: bool,
-    /// Pin radius (m; 0 = point pin).
+    /// Pin radius in metres (0 = point pin); `contact`, `map` and `validate` take part units.
     #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
     pub pin_radius: f64,
-    /// Belt width (m) [default: 0.1; without it fence designs may use a wider belt, reported].
+    /// Belt width in metres [default: 0.1; without it fence designs may use a wider belt, reported].
     #[arg(long, allow_hyphen_values = true)]
     pub belt_width: Option<f64>,
-    /// Distance between pins along the belt (m).
+    /// Distance between pins along the belt, in metres.
     #[arg(long, default_value_t = 0.15, allow_hyphen_values = true)]
     pub spacing: f64,
     /// Most obstacles in a line (the search depth).

@@ -51,10 +51,11 @@ pub struct SenseArgs {
     /// Belt speed (m/s): turns travel into time.
     #[arg(long, default_value_t = 0.05, allow_hyphen_values = true)]
     pub belt_speed: f64,
-    /// Contact parameter d = (y_pin − y_com)/a of the sensorised pin.
+    /// Contact parameter of the sensorised pin: d = (y_pin − y_com)/a: the pin's lateral offset from the part's centroid in units of a (its
+    /// largest centroid–vertex distance), a ratio without a length unit.
     #[arg(long, allow_hyphen_values = true)]
     pub d: f64,
-    /// Pin radius (m; 0: point pin).
+    /// Pin radius in metres (0: point pin); `contact`, `map` and `validate` take part units.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Pin–part friction μc (nominal).

@@ -153,7 +153,8 @@ pub struct ValidateArgs {
     /// Nominal pin–part friction μc (replaced by `mu_c=` in --uncertain).
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
-    /// Nominal pin radius in part units (replaced by `pin_radius=` in --uncertain).
+    /// Nominal pin radius in part units, not metres, as `contact --pin-radius` (replaced by
+    /// `pin_radius=` in --uncertain).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Members of the ensemble.
