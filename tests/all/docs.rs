@@ -80,7 +80,7 @@ fn relative_links_resolve() {
 
 /// Split a shell command line into words: single and double quotes, backslash escapes; a `#`
 /// starting a word begins a comment.
-fn shell_words(line: &str) -> Vec<String> {
+pub(crate) fn shell_words(line: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut word = String::new();
     let mut in_word = false;

@@ -52,6 +52,7 @@ mod online;
 mod plan;
 mod plan_fences;
 mod plan_sensing;
+mod readme_tutorial;
 mod scenario_errors;
 mod sensing_classify;
 mod sensing_evaluate;
