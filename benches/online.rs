@@ -1,8 +1,8 @@
 //! What the online controller costs (docs/physics.md#belief-and-online-replanning):
 //! * `decision/*`: one decision on `scenarios/tripoly1_online.toml` (54 hypotheses, 28 joint
-//!   commands): the reading's likelihood over every hypothesis's templates, the belief's update,
-//!   and the choice of the joint command — what the controller computes when a reading arrives;
-//!   and the choice alone;
+//!   commands): the sensor's classification, the reading's likelihood over the hypotheses (the
+//!   channels its model calibrated in), the belief's update, and the choice of the joint command
+//!   — what the controller computes when a reading arrives; and the choice alone;
 //! * `line_150_parts/*`: the same line driven by its rules and by the online controller (the
 //!   model is built once, outside the timing).
 //!
@@ -29,6 +29,7 @@ fn decision(c: &mut Criterion) {
         panic!("the sensor is a pin")
     };
     let settings = pin.sensor.as_ref().unwrap().settings;
+    let classifier = pin.sensor.as_ref().unwrap().classifier.clone();
     // A reading of state 135° at the sensor's d, read through the sensor's noise.
     let mut setup = PushSetup::nominal(scene.part.polygon.clone(), -0.22);
     setup.pin_radius = pin.radius;
@@ -39,13 +40,15 @@ fn decision(c: &mut Criterion) {
     g.bench_function("reading_update_choose", |b| {
         b.iter(|| {
             let mut belief = model.prior.clone();
-            let ll = sm.log_likelihood(&reading);
+            let post = classifier.classify(&reading).posterior;
+            let ll = sm.log_likelihood(Some(&reading), post.as_deref());
             belief.observe_reading(&sm.p_touch, ll.as_deref());
             model.choose(&belief).action
         })
     });
     let mut belief = model.prior.clone();
-    let ll = sm.log_likelihood(&reading);
+    let post = classifier.classify(&reading).posterior;
+    let ll = sm.log_likelihood(Some(&reading), post.as_deref());
     belief.observe_reading(&sm.p_touch, ll.as_deref());
     g.bench_function("choose", |b| b.iter(|| model.choose(&belief).action));
     g.finish();

@@ -1,9 +1,9 @@
 //! `pinfeed bench designs`: maps its arguments to [`crate::plan::design::survey`] and writes the
 //! Markdown report (rewritten after every part, so a long survey shows its progress).
 
-use super::shell_word;
 use crate::plan::design::survey::{markdown, survey_part, SurveyPart, SurveySettings};
 use crate::report::atomic::write_atomic;
+use crate::report::shell_word;
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::PathBuf;
 

@@ -7,13 +7,13 @@
 //! interval holds the hidden value. Unless `--no-write`, `pinfeed-out/calibrate/<file stem>/` receives
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
-use super::shell_word;
 use super::validate::{
-    check_members, emit, ensemble_spec, load_measured, pool, summary_text, write_report_files,
-    ModelArgs, ReportHead,
+    emit, ensemble_spec, pool, summary_text, write_report_files, ModelArgs, ReportHead,
 };
-use crate::study::mc::perturbations::{SmoothParams, SupportChoice};
+use crate::mechanics::support::{SmoothParams, SupportChoice};
+use crate::report::shell_word;
 use crate::validate::calibrate::{calibrate_observed, Calibration, CalibrationSettings};
+use crate::validate::input::{check_members, load_measured};
 use crate::validate::score::Summary;
 use crate::validate::synthetic::{synthesize, SyntheticDesign};
 use anyhow::{anyhow, bail, Context, Result};

@@ -14,8 +14,8 @@ use super::contact::{
     case_fence, check_geometry, check_inputs, compile_part, num, parse_fence, parse_model,
     settings_and_pin, Case,
 };
-use super::shell_word;
 use crate::maps::{compute_maps_with, ConfigurationMap, MapFence, MapSettings};
+use crate::report::shell_word;
 use crate::report::{map_table, plot_map};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;

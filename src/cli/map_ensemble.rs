@@ -7,7 +7,6 @@
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
 use super::map::{command_line, default_out_dir_for, MapArgs};
-use super::shell_word;
 use super::validate::{write_report_files, ReportHead};
 use crate::geometry::Polygon;
 use crate::maps::ensemble::{
@@ -16,6 +15,7 @@ use crate::maps::ensemble::{
 use crate::maps::theta_grid;
 use crate::mechanics::Fidelity;
 use crate::report::plot_validate::plot_band_distributions;
+use crate::report::shell_word;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;

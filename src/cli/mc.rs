@@ -124,7 +124,7 @@ pub fn with_out(mut header: StudyHeader, dir: &Path) -> StudyHeader {
     header.command.push_str(" --out ");
     header
         .command
-        .push_str(&super::shell_word(&dir.display().to_string()));
+        .push_str(&crate::report::shell_word(&dir.display().to_string()));
     header
 }
 

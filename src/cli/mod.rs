@@ -1,5 +1,10 @@
 //! The command-line interface: argument definitions and one module per sub-command. `main.rs` only
 //! parses and dispatches; everything a command does lives here so it can be tested.
+//!
+//! The doc comments of the argument structs are the commands' `--help` text (clap prints them as
+//! written), so they are plain text rather than rustdoc Markdown: `[feed]`, `<part>` and
+//! `random:SEED[:N]` are what the user types, not links or HTML.
+#![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
 
 pub mod bench;
 pub mod bench_designs;
@@ -122,13 +127,3 @@ impl std::fmt::Display for Exit {
 }
 
 impl std::error::Error for Exit {}
-
-/// Quote a shell word if it needs it (for the command lines written at the top of reports).
-pub(crate) fn shell_word(s: &str) -> String {
-    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
-    if !s.is_empty() && s.chars().all(plain) {
-        s.to_string()
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
-}

@@ -6,13 +6,13 @@
 //! obstacle improves on the feed; nothing written); 1 an error, or a time limit that left no
 //! confirmed design.
 
-use super::shell_word;
 use super::stdout::print_result;
 use crate::plan::design::{
     self, describe_obstacles, Candidate, Design, DesignOptions, FenceSettings, Layout, Mode,
     Objective, Status,
 };
 use crate::plan::{FeedKind, Problem};
+use crate::report::shell_word;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;

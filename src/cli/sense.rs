@@ -13,11 +13,11 @@
 //! to standard error.
 
 use super::contact::{in_range, num, parse_model};
-use super::shell_word;
 use crate::geometry::named;
 use crate::mechanics::{PartModel, Support};
 use crate::random::distribution::Distribution;
 use crate::report::plot_sensing;
+use crate::report::shell_word;
 use crate::sensing::classify::{self, Classifier, ClassifierOptions};
 use crate::sensing::evaluate::{
     applicable, evaluate_observed, noise_sweep, trial_pass, Cell, Config, Evaluation, Factory,
@@ -414,7 +414,7 @@ struct Plan {
 }
 
 fn plan(a: &SenseArgs) -> Result<Plan> {
-    use super::contact::limits;
+    use crate::mechanics::limits;
     positive("--scale", a.scale, 100.0, "metres per part unit")?;
     positive("--mass", a.mass, 1e3, "kg")?;
     positive("--belt-speed", a.belt_speed, 100.0, "m/s")?;

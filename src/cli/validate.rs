@@ -7,21 +7,19 @@
 //! distributions and bands against d.
 
 use super::map_ensemble::bands_text;
-use super::shell_word;
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::{EnsembleSpec, PredictedBands};
 use crate::report::fixed;
 use crate::report::plot_validate::plot_band_distributions;
-use crate::validate::measured::{self, Measured};
+use crate::report::shell_word;
+use crate::validate::input::{self, check_members, load_measured};
+use crate::validate::measured::Measured;
 use crate::validate::score::{RowScore, ScoreSettings, Summary};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// Most members of a validation or calibration ensemble.
-pub const MAX_MEMBERS: usize = 1_000_000;
 
 /// The model and scoring options `validate` and `calibrate` share.
 #[derive(Debug, Args, Clone)]
@@ -172,7 +170,8 @@ pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
         .context("starting the worker threads")
 }
 
-/// The ensemble of the nominal values with `uncertain` applied.
+/// The ensemble of the nominal values with `uncertain` applied, the fidelity and tolerance from
+/// `common` ([`input::ensemble_spec`]).
 pub fn ensemble_spec(
     mu_c: f64,
     pin_radius: f64,
@@ -180,19 +179,9 @@ pub fn ensemble_spec(
     common: &ModelArgs,
 ) -> Result<EnsembleSpec> {
     let model = super::contact::parse_model(&common.model)?;
-    if !(mu_c.is_finite() && (0.0..=10.0).contains(&mu_c)) {
-        bail!("--mu-c must lie in [0, 10], got {mu_c}");
-    }
-    if !(pin_radius.is_finite() && pin_radius >= 0.0) {
-        bail!("--pin-radius must be a finite number ≥ 0, got {pin_radius}");
-    }
-    let spec = EnsembleSpec::nominal(mu_c, pin_radius, model, common.tol);
-    match uncertain {
-        None => Ok(spec),
-        Some(u) => spec
-            .with_settings(u)
-            .map_err(|e| anyhow::anyhow!("--uncertain: {e}")),
-    }
+    Ok(input::ensemble_spec(
+        mu_c, pin_radius, model, common.tol, uncertain,
+    )?)
 }
 
 /// Print a report (`--json`: the document, else `text`) and, unless `--no-write`, have `write`
@@ -251,14 +240,6 @@ pub fn write_report_files<T: Serialize>(
     let readme = out_dir.join("README.md");
     crate::report::atomic::write_atomic(&readme, md)
         .with_context(|| format!("writing {}", readme.display()))?;
-    Ok(())
-}
-
-/// Check a member count given by `flag` (`--members`, `--score-members`).
-pub fn check_members(flag: &str, members: usize) -> Result<()> {
-    if !(1..=MAX_MEMBERS).contains(&members) {
-        bail!("{flag} must lie in [1, {MAX_MEMBERS}], got {members}");
-    }
     Ok(())
 }
 
@@ -340,38 +321,24 @@ pub fn summary_text(s: &Summary) -> String {
     )
 }
 
-/// Load the measured file for an ensemble (its largest pin radius sets the reach of d).
-/// The pin radius may be at most the range `map` and `contact` allow for each part (10·a).
-/// `part` (`--part`) replaces the file's part column.
-pub fn load_measured(path: &Path, spec: &EnsembleSpec, part: Option<&str>) -> Result<Measured> {
-    let m = measured::load_for(path, spec.max_pin_radius(), part)?;
-    let r = spec.max_pin_radius();
-    for (part, poly) in &m.parts {
-        let rmax = super::contact::limits::PIN_RADIUS_A * poly.radius();
-        if r > rmax {
-            bail!(
-                "--pin-radius (or the largest pin_radius of --uncertain) must lie in [0, {}] for part {part} of {} (part units: at most {}·a, a = {}), got {}",
-                crate::scenario::limits::num(rmax),
-                path.display(),
-                super::contact::limits::PIN_RADIUS_A,
-                crate::scenario::limits::num(poly.radius()),
-                crate::scenario::limits::num(r)
-            );
-        }
+impl ValidateArgs {
+    /// The checked inputs of a validation: the score settings, the ensemble and the measured file.
+    pub fn inputs(&self) -> Result<(ScoreSettings, EnsembleSpec, Measured)> {
+        let score = self.common.score()?;
+        check_members("--members", self.members)?;
+        let spec = ensemble_spec(
+            self.mu_c,
+            self.pin_radius,
+            self.uncertain.as_deref(),
+            &self.common,
+        )?;
+        let measured = load_measured(&self.measured, &spec, self.common.part.as_deref())?;
+        Ok((score, spec, measured))
     }
-    Ok(m)
 }
 
 pub fn run(args: &ValidateArgs) -> Result<()> {
-    let score = args.common.score()?;
-    check_members("--members", args.members)?;
-    let spec = ensemble_spec(
-        args.mu_c,
-        args.pin_radius,
-        args.uncertain.as_deref(),
-        &args.common,
-    )?;
-    let measured = load_measured(&args.measured, &spec, args.common.part.as_deref())?;
+    let (score, spec, measured) = args.inputs()?;
     let c = &args.common;
     let bar = super::progress::bar(0, "passes", c.quiet || c.json);
     let tell = super::progress::counter(&bar);

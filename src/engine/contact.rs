@@ -142,14 +142,15 @@ impl Line<'_> {
         };
         if c.online_model().is_some() {
             // Online: the decided label is kept for the sensor's statistics only; the belief
-            // takes the reading itself.
+            // takes the reading itself and the classifier's posterior over the states.
             let decision = match sensed.classification.decision {
                 Decision::Hypothesis(h) => Some(h),
                 Decision::Unknown => None,
             };
             part.decided.push((j, decision, sensed.truth));
             let t_ready = t_end + c.latency();
-            self.online_reading(part, index, j, sensed.reading.as_ref(), t_ready);
+            let posterior = sensed.classification.posterior.as_deref();
+            self.online_reading(part, index, j, sensed.reading.as_ref(), posterior, t_ready);
             return;
         }
         let c12 = &sensed.classification;

@@ -99,10 +99,12 @@ pub struct CalibrationBin {
 /// What the online controller did (docs/physics.md#belief-and-online-replanning).
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct OnlineSummary {
-    /// The model: hypotheses, joint actions, line runs its build took.
+    /// The model: hypotheses, joint actions, line runs its build took (a run through one
+    /// stretch of the line counts one) and the contact-model evaluations of its success runs.
     pub hypotheses: usize,
     pub actions: usize,
     pub model_runs: u64,
+    pub model_evaluations: u64,
     /// Decisions taken (one per part once every sensor has spoken).
     pub decisions: u64,
     /// Mean entropy of the belief before any observation and at the decision (bits).
@@ -119,8 +121,11 @@ pub struct OnlineSummary {
     pub calibration: Vec<CalibrationBin>,
     /// How often each joint command was chosen (`pin=target, …`).
     pub chosen: BTreeMap<String, u64>,
-    /// Per sensor: the power its likelihood is raised to (calibrated on held-out members).
+    /// Per sensor: the powers its two likelihoods are raised to, calibrated on held-out members
+    /// (0: not used): the matched filter over the hypotheses' templates, and the sensor
+    /// classifier's posterior over the states.
     pub temper: BTreeMap<String, f64>,
+    pub classifier_power: BTreeMap<String, f64>,
     /// Decisions whose most probable stable state (the belief's marginal) is the part's true
     /// state, over the decisions whose part has a known true state.
     pub state_correct: u64,
@@ -230,11 +235,21 @@ impl Control {
                 hypotheses: h.0.hypotheses.len(),
                 actions: h.0.actions.len(),
                 model_runs: h.0.runs,
+                model_evaluations: h.0.evaluations,
                 temper: h
                     .0
                     .sensors
                     .iter()
                     .map(|sm| (scene.obstacles[sm.obstacle].name().to_string(), sm.temper))
+                    .collect(),
+                classifier_power: h
+                    .0
+                    .sensors
+                    .iter()
+                    .map(|sm| {
+                        let name = scene.obstacles[sm.obstacle].name().to_string();
+                        (name, sm.classifier_power)
+                    })
                     .collect(),
                 bounds: {
                     let mut classes = Vec::new();
@@ -520,6 +535,7 @@ impl Line<'_> {
         index: u64,
         j: usize,
         reading: Option<&crate::sensing::reading::Reading>,
+        posterior: Option<&[f64]>,
         t_ready: f64,
     ) {
         let Some(c) = self.control.as_mut() else {
@@ -532,7 +548,7 @@ impl Line<'_> {
             return;
         };
         if let Some(b) = part.belief.as_mut() {
-            let ll = reading.and_then(|r| sm.log_likelihood(r));
+            let ll = sm.log_likelihood(reading, posterior);
             let u = b.observe_reading(&sm.p_touch, ll.as_deref());
             c.count_update(u, false);
         }

@@ -111,6 +111,8 @@ pub(super) struct Line<'a> {
     pub(super) captured: Option<Vec<CapturedPush>>,
     /// A forced first part ([`run_entry`]): its pose and support instead of the feed's draw.
     entry: Option<Entry>,
+    /// How and where the last part to finish left the line ([`run_single`]).
+    last_end: Option<(PartOutcome, Pose)>,
 }
 
 /// One part with a given entry pose and support, for [`run_entry`].
@@ -120,6 +122,10 @@ pub struct Entry {
     pub theta: f64,
     /// Lateral offset of the centroid at entry (m).
     pub y: f64,
+    /// Position of the centroid along the belt at entry (m; 0 is the line's start). The part
+    /// arrives at time 0 wherever it enters, so a start past 0 suits a line whose pins stand
+    /// still (the online model's stages), not one whose pins keep time.
+    pub x: f64,
     /// The part's own contact model (a tripod), else the scene's.
     pub model: Option<PartModel>,
 }
@@ -149,8 +155,50 @@ pub fn run_entry(
     Ok((record, captured))
 }
 
+/// How a part entering as [`Entry`] says left a line, with no summary or record assembled: the
+/// online model runs the line this way hundreds of thousands of times.
+#[derive(Debug, Clone)]
+pub struct SingleRun {
+    pub outcome: PartOutcome,
+    /// The part's world pose when it left (at the belt's end when it exited).
+    pub pose: Pose,
+    /// Contact-model evaluations the run took (the work counter of the same name).
+    pub model_evaluations: u64,
+}
+
+/// Run one part entering as `entry` says through `scene`, and return only how and where it
+/// left (see [`SingleRun`]).
+pub fn run_single(scene: &Scene, entry: Entry) -> Result<SingleRun, EngineError> {
+    let opts = RunOptions {
+        parts: 1,
+        seed: scene.seed,
+        sample_paths: 0,
+        keep_records: false,
+    };
+    let line = simulate(scene, &opts, &mut |_| {}, None, Some(entry))?;
+    let (outcome, pose) = line.last_end.expect("one part, one end");
+    Ok(SingleRun {
+        outcome,
+        pose,
+        model_evaluations: line.metrics.work.model_evaluations,
+    })
+}
+
 /// Run the line: a pure function of (scene, options). `progress` is called with the number of
 /// finished parts from time to time.
+///
+/// ```
+/// use pinfeed::engine::{run, PartOutcome, RunOptions};
+/// use std::path::Path;
+///
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+/// let scene = pinfeed::scenario::load(&path).unwrap();
+/// let opts = RunOptions { parts: 100, ..RunOptions::from_scene(&scene) };
+/// let result = run(&scene, &opts, &mut |_| {}).unwrap();
+/// assert_eq!(result.summary.parts_in, 100);
+/// // The quickstart line orients every part.
+/// assert_eq!(result.summary.outcomes.get(PartOutcome::Success), 100);
+/// ```
 pub fn run(
     scene: &Scene,
     opts: &RunOptions,
@@ -184,6 +232,36 @@ fn run_inner(
     captured: Option<Vec<CapturedPush>>,
     entry: Option<Entry>,
 ) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
+    let mut line = simulate(scene, opts, progress, captured, entry)?;
+    let fidelity = match scene.map_tier {
+        Some(_) => "map",
+        None => scene.contact.fidelity.name(),
+    };
+    let mut summary = line.metrics.summary(&scene.name, opts.seed, fidelity);
+    let mut control_log = Vec::new();
+    if let Some(c) = line.control.as_mut() {
+        summary.controller = Some(c.finish(summary.simulated_time_s));
+        control_log = c.log.take().unwrap_or_default();
+    }
+    let result = RunResult {
+        summary,
+        metrics: line.metrics,
+        records: line.records,
+        events: line.events,
+        paths: line.paths,
+        control: control_log,
+    };
+    Ok((result, line.captured.unwrap_or_default()))
+}
+
+/// Process every event of the run and return the line as it ends.
+fn simulate<'a>(
+    scene: &'a Scene,
+    opts: &'a RunOptions,
+    progress: &mut dyn FnMut(u64),
+    captured: Option<Vec<CapturedPush>>,
+    entry: Option<Entry>,
+) -> Result<Line<'a>, EngineError> {
     let names = scene
         .obstacles
         .iter()
@@ -217,6 +295,7 @@ fn run_inner(
         maps: LineMaps::for_scene(scene),
         captured,
         entry,
+        last_end: None,
     };
     if opts.parts > 0 {
         line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
@@ -246,25 +325,7 @@ fn run_inner(
         "conservation: every part that enters ends in exactly one class"
     );
     assert_eq!(line.metrics.parts_in, opts.parts);
-    let fidelity = match scene.map_tier {
-        Some(_) => "map",
-        None => scene.contact.fidelity.name(),
-    };
-    let mut summary = line.metrics.summary(&scene.name, opts.seed, fidelity);
-    let mut control_log = Vec::new();
-    if let Some(c) = line.control.as_mut() {
-        summary.controller = Some(c.finish(summary.simulated_time_s));
-        control_log = c.log.take().unwrap_or_default();
-    }
-    let result = RunResult {
-        summary,
-        metrics: line.metrics,
-        records: line.records,
-        events: line.events,
-        paths: line.paths,
-        control: control_log,
-    };
-    Ok((result, line.captured.unwrap_or_default()))
+    Ok(line)
 }
 
 impl Line<'_> {
@@ -316,13 +377,17 @@ impl Line<'_> {
     }
 
     fn arrival(&mut self, t: f64, index: u64) -> Result<(), EngineError> {
+        let mut x0 = 0.0;
         let d = match self.entry.take() {
-            Some(e) => super::part_stream::PartDraw {
-                gap: 0.0,
-                theta: e.theta,
-                y: e.y,
-                model: e.model,
-            },
+            Some(e) => {
+                x0 = e.x;
+                super::part_stream::PartDraw {
+                    gap: 0.0,
+                    theta: e.theta,
+                    y: e.y,
+                    model: e.model,
+                }
+            }
             None => draw_part(self.scene, self.opts.seed, index)
                 .map_err(|reason| EngineError::PartDraw { index, reason })?,
         };
@@ -338,7 +403,7 @@ impl Line<'_> {
             self.queue
                 .schedule(next, EventKind::Arrival { part: index + 1 });
         }
-        let pose = Pose::new(0.0, d.y, d.theta);
+        let pose = Pose::new(x0, d.y, d.theta);
         let mut part = ActivePart {
             arrival: t,
             theta_in: d.theta,
@@ -497,6 +562,7 @@ impl Line<'_> {
         };
         let pose = part.motion.world_pose(t, self.speed());
         let theta_deg = wrap_deg(pose.theta.to_degrees());
+        self.last_end = Some((outcome, pose));
         self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
         if let Some(c) = self.control.as_mut() {
             c.count_decisions(self.scene, &part.decided, outcome);

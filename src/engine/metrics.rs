@@ -286,7 +286,7 @@ pub struct ObstacleSummary {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OrientationHistogram {
     pub bin_deg: f64,
-    /// counts[k] = parts with final θ in [k·bin, (k+1)·bin) degrees.
+    /// `counts[k]` = parts with final θ in [k·bin, (k+1)·bin) degrees.
     pub counts: Vec<u64>,
 }
 

@@ -6,7 +6,7 @@
 //! * [`part_stream`]: part i drawn from its own random stream (seed, i);
 //! * [`motion`]: a part riding the belt or held by a pin or fence, and its pose at any time;
 //! * [`overlap`]: clearance between parts and obstacles, and the first touch over a time window;
-//! * [`line`]: the event loop: arrivals, the next event of a free part, contact end, exit;
+//! * [`mod@line`]: the event loop: arrivals, the next event of a free part, contact end, exit;
 //! * [`contact`]: contact begin: the push, its stop, neighbouring obstacles and the belt's edges;
 //! * [`pairs`]: part–part overlap checks (broad and narrow phase);
 //! * [`results`]: what a run takes ([`RunOptions`]) and gives ([`RunResult`]);
@@ -30,7 +30,7 @@ pub mod part_stream;
 pub mod results;
 pub mod sensing;
 
-pub use line::{run, run_capturing, run_entry, Entry};
+pub use line::{run, run_capturing, run_entry, run_single, Entry, SingleRun};
 pub use metrics::Summary;
 pub use outcome::{OutcomeCounts, PartOutcome};
 pub use results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};

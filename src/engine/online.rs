@@ -18,12 +18,14 @@
 //! * **Actions**: the joint commands of the dynamic pins: each moving pin on a grid of `targets`
 //!   positions over its travel plus its home and the targets its rules name, each retractable
 //!   pin raised or withdrawn. For every action and member the line is run with the pins standing
-//!   at the action's targets; success[a][h] is the share of h's members that end in the goal.
+//!   at the action's targets; `success[a][h]` is the share of h's members that end in the goal.
 //!
-//! A decision is then a dot product per action: P(goal | a) = Σ_h p(h | readings) · success[a][h],
+//! A decision is then a dot product per action: P(goal | a) = Σ_h p(h | readings) · `success[a][h]`,
 //! maximised over the actions (ties: the least travel from where the pins stand).
 
-use super::line::{run_entry, Entry};
+use super::line::{run_entry, run_single, Entry};
+use super::outcome::PartOutcome;
+use super::sensing::nearest;
 use crate::mechanics::{PartModel, Support};
 use crate::random::stream;
 use crate::scenario::raw::SupportKind;
@@ -35,7 +37,7 @@ use crate::sensing::classify::likelihood::Likelihood;
 use crate::sensing::classify::ClassifierOptions;
 use crate::sensing::reading::{read, Reading};
 use crate::sensing::signal::{ContactSignal, KnotRecorder, SignalScale};
-use crate::sensing::templates::TemplateSet;
+use crate::sensing::templates::{Hypotheses, TemplateSet};
 use rand::RngExt;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
@@ -75,8 +77,14 @@ pub struct SensorModel {
     likelihood: Option<Likelihood>,
     /// Hypothesis of each of the likelihood's labels.
     rows: Vec<usize>,
-    /// The power the likelihood is raised to (1: trusted as it is; see [`temper`]).
+    /// The power the likelihood is raised to (1: trusted as it is, 0: not used; see `temper`).
     pub temper: f64,
+    /// Per hypothesis, the sensor's own classifier's label for its stable state (None when the
+    /// classifier's labels are not orientations).
+    state_label: Option<Vec<usize>>,
+    /// The power the classifier's posterior over the states is raised to as a second likelihood
+    /// (0: not used; see `temper`).
+    pub classifier_power: f64,
 }
 
 /// The online controller's model; see the module notes.
@@ -93,9 +101,12 @@ pub struct OnlineModel {
     homes: Vec<Target>,
     /// success[a · H + h].
     success: Vec<f64>,
-    /// Members per hypothesis and line runs the build took.
+    /// Members per hypothesis.
     pub samples: usize,
+    /// Line runs the build took (a run through one stretch of the line counts one), and the
+    /// contact-model evaluations of the runs that predict success.
     pub runs: u64,
+    pub evaluations: u64,
 }
 
 /// The controller's choice for one part.
@@ -111,10 +122,17 @@ impl OnlineModel {
     /// Build the model of `scene` (its nominal physics) for `spec`. Errors name the size that is
     /// too large or the hypothesis set that is empty.
     pub fn build(scene: &Scene, spec: &BeliefSpec) -> Result<OnlineModel, String> {
+        Self::build_with(scene, spec, true)
+    }
+
+    /// As [`OnlineModel::build`]; with `staged`, each member crosses the line stretch by stretch
+    /// ([`stages`]), else once per joint action from the line's start.
+    fn build_with(scene: &Scene, spec: &BeliefSpec, staged: bool) -> Result<OnlineModel, String> {
         let (hypotheses, prior) = hypotheses(scene, spec);
         let prior = Belief::new(&prior).ok_or("the belief's prior has no positive weight")?;
         let pins = indices(scene, |p| p.actuator.is_some());
-        let (actions, options) = joint_actions(scene, &pins, spec.targets)?;
+        let (actions, per_pin) = joint_actions(scene, &pins, spec.targets)?;
+        let options: Vec<usize> = per_pin.iter().map(Vec::len).collect();
         let s = spec.samples;
         let n_members = hypotheses.len() * s;
         let runs = n_members * (actions.len() + 1);
@@ -131,10 +149,28 @@ impl OnlineModel {
         let mus = distinct(hypotheses.iter().map(|h| h.mu_c));
         let variant_of = |a: Option<&[Target]>, mu: f64| variant(scene, &pins, a, mu);
         let sensing: Vec<Scene> = mus.iter().map(|&m| variant_of(None, m)).collect();
-        let scenes: Vec<Vec<Scene>> = actions
-            .iter()
-            .map(|a| mus.iter().map(|&m| variant_of(Some(a), m)).collect())
-            .collect();
+        let homes: Vec<Target> = pins.iter().map(|&j| home_of(&scene.obstacles[j])).collect();
+        let stretches = if staged {
+            stages(scene, &pins)
+        } else {
+            vec![Stage {
+                pins: (0..pins.len()).collect(),
+                end: None,
+            }]
+        };
+        let staging = Staging::new(
+            &stretches,
+            &per_pin,
+            &homes,
+            |targets, end, mu| {
+                let mut v = variant_of(Some(targets), mu);
+                if let Some(x) = end {
+                    v.belt.length = x;
+                }
+                v
+            },
+            &mus,
+        );
         let mu_index = |mu: f64| mus.iter().position(|&m| m == mu).expect("listed μ");
         let sensor_obstacles = indices(scene, |p| p.sensor.is_some());
         let signals_of = |h: usize, e: &Entry| -> Result<Vec<Option<ContactSignal>>, String> {
@@ -142,23 +178,18 @@ impl OnlineModel {
             sensor_signals(scene, base, &sensor_obstacles, e)
         };
         // Per member: its signal at each sensor (None: no touch) and its success per action.
-        type MemberOut = (Vec<Option<ContactSignal>>, Vec<bool>);
+        type MemberOut = (Vec<Option<ContactSignal>>, Vec<bool>, [u64; 2]);
         let outs: Vec<MemberOut> = members
             .par_iter()
             .map(|(h, e)| -> Result<MemberOut, String> {
                 let mi = mu_index(hypotheses[*h].mu_c);
                 let signals = signals_of(*h, e)?;
-                let ok = scenes
-                    .iter()
-                    .map(|per_mu| {
-                        run_entry(&per_mu[mi], e.clone(), false)
-                            .map(|(r, _)| r.outcome == "success")
-                            .map_err(|e| e.to_string())
-                    })
-                    .collect::<Result<Vec<bool>, String>>()?;
-                Ok((signals, ok))
+                let (ok, member_runs) = staging.success(mi, e)?;
+                Ok((signals, ok, member_runs))
             })
             .collect::<Result<_, String>>()?;
+        let runs_taken: u64 = outs.iter().map(|o| o.2[0] + 1).sum();
+        let evaluations: u64 = outs.iter().map(|o| o.2[1]).sum();
         // Held-out members (other streams) calibrate how far each sensor's likelihood can be
         // trusted (see `temper`).
         let v = (s / 2).max(2);
@@ -172,9 +203,10 @@ impl OnlineModel {
             .collect::<Result<_, String>>()?;
         let n_h = hypotheses.len();
         let mut success = vec![0.0; actions.len() * n_h];
-        for (k, (_, ok)) in outs.iter().enumerate() {
-            for (a, &yes) in ok.iter().enumerate() {
-                success[a * n_h + k / s] += f64::from(u8::from(yes)) / s as f64;
+        let order = staging.prefix_of_actions(&options);
+        for (k, (_, ok, _)) in outs.iter().enumerate() {
+            for (a, &p) in order.iter().enumerate() {
+                success[a * n_h + k / s] += f64::from(u8::from(ok[p])) / s as f64;
             }
         }
         let mut sensors = Vec::new();
@@ -209,14 +241,23 @@ impl OnlineModel {
                         .map_err(|e| format!("sensor \"{}\": {e}", pin.name))?,
                 )
             };
+            let state_label = match &sensor.hypotheses {
+                Hypotheses::Orientations { degrees, .. } => hypotheses
+                    .iter()
+                    .map(|x| nearest(degrees, x.state_deg))
+                    .collect::<Option<Vec<usize>>>(),
+                Hypotheses::VertexEdge { .. } => None,
+            };
             let sm = SensorModel {
                 obstacle: j,
                 p_touch,
                 likelihood,
                 rows,
                 temper: 1.0,
+                state_label,
+                classifier_power: 1.0,
             };
-            let trials: Vec<(usize, Vec<f64>)> = held_out
+            let trials: Vec<(usize, Evidence)> = held_out
                 .iter()
                 .enumerate()
                 .filter_map(|(k, (h, sigs))| {
@@ -224,13 +265,13 @@ impl OnlineModel {
                     let mut rng =
                         stream(scene.seed, HELD_OUT_READINGS | ((k as u64) << 8) | i as u64);
                     let r = read(sig, &sensor.settings, &mut rng)?;
-                    Some((*h, sm.log_likelihood(&r)?))
+                    let post = sensor.classifier.classify(&r).posterior;
+                    Some((*h, Evidence::of(&sm, Some(&r), post.as_deref(), true)))
                 })
                 .collect();
             held_trials.push(trials);
             sensors.push(sm);
         }
-        let homes = pins.iter().map(|&j| home_of(&scene.obstacles[j])).collect();
         let mut model = OnlineModel {
             hypotheses,
             prior,
@@ -241,10 +282,13 @@ impl OnlineModel {
             homes,
             success,
             samples: s,
-            runs: runs as u64,
+            runs: runs_taken + held_out.len() as u64,
+            evaluations,
         };
         for (i, trials) in held_trials.iter().enumerate() {
-            model.sensors[i].temper = temper(&model, i, trials);
+            let (tau, sigma) = temper(&model, i, trials);
+            model.sensors[i].temper = tau;
+            model.sensors[i].classifier_power = sigma;
         }
         Ok(model)
     }
@@ -351,7 +395,7 @@ impl OnlineModel {
         out
     }
 
-    /// success[a][h] for every hypothesis.
+    /// `success[a][h]` for every hypothesis.
     pub fn success_of(&self, action: usize) -> &[f64] {
         let n_h = self.hypotheses.len();
         &self.success[action * n_h..(action + 1) * n_h]
@@ -359,59 +403,136 @@ impl OnlineModel {
 }
 
 impl SensorModel {
-    /// log p(reading | h, touch) per hypothesis (−∞ for one that never touches); None when the
-    /// reading carries no usable signal (no contact detected in it).
-    pub fn log_likelihood(&self, reading: &Reading) -> Option<Vec<f64>> {
-        let ll = self.likelihood.as_ref()?.log_likelihoods(reading)?;
-        let mut out = vec![f64::NEG_INFINITY; self.p_touch.len()];
-        for (k, &h) in self.rows.iter().enumerate() {
-            out[h] = self.temper * ll[k];
-        }
-        Some(out)
+    /// log p(reading | h, touch) per hypothesis, as the belief takes it: the matched filter over
+    /// the hypotheses' templates raised to [`SensorModel::temper`] (−∞ for a hypothesis that
+    /// never touches), plus the sensor classifier's log posterior of h's state (`posterior`,
+    /// over its labels under a uniform prior, so proportional to the likelihood of each state)
+    /// raised to [`SensorModel::classifier_power`]. A channel with power 0 is not computed. None
+    /// when neither channel has anything to say (no contact detected in the reading).
+    pub fn log_likelihood(
+        &self,
+        reading: Option<&Reading>,
+        posterior: Option<&[f64]>,
+    ) -> Option<Vec<f64>> {
+        let raw = Evidence::of(self, reading, posterior, self.temper > 0.0);
+        raw.combine(self.temper, self.classifier_power)
     }
 }
 
-/// The power τ sensor `i`'s likelihood is raised to: the matched filter's noise model knows the
-/// sensor's noise only, not how far a real push strays from every simulated member (another
-/// tripod, another jitter), so its raw likelihood is far too sharp and one reading would make the
-/// belief certain of a wrong hypothesis. τ is chosen on held-out members (readings the
-/// likelihood was not built from; `trials` holds their true hypothesis and raw log-likelihood),
-/// from 1 down to 10⁻⁶ in half-decades: the τ whose decisions do best on them (the mean
-/// success(a*, h_true) of the command the belief after their reading chooses), ties broken by the
-/// mean log posterior of their true hypothesis — a tempered likelihood, calibrated by
-/// cross-validation on what the controller does with it.
-fn temper(model: &OnlineModel, i: usize, trials: &[(usize, Vec<f64>)]) -> f64 {
+/// The raw evidence of one reading per hypothesis, before the powers: the matched filter's log
+/// likelihood and the classifier's log posterior of the hypothesis's state.
+#[derive(Debug, Clone)]
+struct Evidence {
+    filter: Option<Vec<f64>>,
+    classifier: Option<Vec<f64>>,
+}
+
+impl Evidence {
+    fn of(
+        sm: &SensorModel,
+        reading: Option<&Reading>,
+        posterior: Option<&[f64]>,
+        with_filter: bool,
+    ) -> Evidence {
+        let filter = with_filter
+            .then(|| reading.and_then(|r| sm.likelihood.as_ref()?.log_likelihoods(r)))
+            .flatten()
+            .map(|ll| {
+                let mut out = vec![f64::NEG_INFINITY; sm.p_touch.len()];
+                for (k, &h) in sm.rows.iter().enumerate() {
+                    out[h] = ll[k];
+                }
+                out
+            });
+        let classifier = match (&sm.state_label, posterior) {
+            (Some(labels), Some(p)) => Some(
+                labels
+                    .iter()
+                    .map(|&l| p.get(l).copied().unwrap_or(0.0).max(1e-300).ln())
+                    .collect(),
+            ),
+            _ => None,
+        };
+        Evidence { filter, classifier }
+    }
+
+    fn combine(&self, tau: f64, sigma: f64) -> Option<Vec<f64>> {
+        let filter = self.filter.as_ref().filter(|_| tau > 0.0);
+        let classifier = self.classifier.as_ref().filter(|_| sigma > 0.0);
+        if filter.is_none() && classifier.is_none() {
+            return None;
+        }
+        let n = filter.or(classifier).map_or(0, Vec::len);
+        Some(
+            (0..n)
+                .map(|h| {
+                    filter.map_or(0.0, |f| tau * f[h]) + classifier.map_or(0.0, |c| sigma * c[h])
+                })
+                .collect(),
+        )
+    }
+}
+
+/// The powers sensor `i`'s two channels are raised to: τ for the matched filter over the
+/// hypotheses' templates, σ for the sensor classifier's posterior over the states. The filter's
+/// noise model knows the sensor's noise only, not how far a real push strays from every simulated
+/// member (another tripod, another jitter), so its raw likelihood is far too sharp and one reading
+/// would make the belief certain of a wrong hypothesis; the classifier, trained on many templates
+/// per state, names the state more robustly but says nothing of the offset, friction or support.
+/// Both powers are chosen together on held-out members (readings neither channel was built from;
+/// `trials` holds their true hypothesis and raw evidence), each from 1 down to 10⁻⁶ in
+/// half-decades or 0 (the channel unused): the pair whose decisions do best on them (the mean
+/// success(a*, h_true) of the command the belief after their reading chooses); among pairs whose
+/// decisions do as well (within [`TIE`]), one without the matched filter (which costs far more per
+/// reading than the classifier; a channel with power 0 is not computed), then the best mean log
+/// posterior of their true hypothesis — a tempered likelihood, calibrated by cross-validation on
+/// what the controller does with it.
+fn temper(model: &OnlineModel, i: usize, trials: &[(usize, Evidence)]) -> (f64, f64) {
     if trials.is_empty() {
-        return 1.0;
+        return (1.0, 1.0);
     }
     let p_touch = &model.sensors[i].p_touch;
-    let score = |tau: f64| -> (f64, f64) {
+    let score = |tau: f64, sigma: f64| -> (f64, f64) {
         let mut won = 0.0;
         let mut log = 0.0;
-        for (h, ll) in trials {
+        for (h, ev) in trials {
             let mut b = model.prior.clone();
-            let scaled: Vec<f64> = ll.iter().map(|l| tau * l).collect();
-            b.observe_reading(p_touch, Some(&scaled));
+            b.observe_reading(p_touch, ev.combine(tau, sigma).as_deref());
             won += model.success_of(model.choose(&b).action)[*h];
             log += b.probability(*h).max(1e-300).ln();
         }
         let n = trials.len() as f64;
         (won / n, log / n)
     };
-    let mut best = (1.0, score(1.0));
-    for k in 1..=12 {
-        let tau = 10f64.powf(-(k as f64) / 2.0);
-        let sc = score(tau);
-        let better = if (sc.0 - best.1 .0).abs() > TIE {
-            sc.0 > best.1 .0
-        } else {
-            sc.1 > best.1 .1
-        };
-        if better {
-            best = (tau, sc);
+    // From both channels off up.
+    let powers: Vec<f64> = std::iter::once(0.0)
+        .chain((0..=12).rev().map(|k| 10f64.powf(-(k as f64) / 2.0)))
+        .collect();
+    let mut pairs: Vec<(f64, f64)> = Vec::new();
+    for &tau in &powers {
+        for &sigma in &powers {
+            pairs.push((tau, sigma));
         }
     }
-    best.0
+    // The filter costs far more per reading than the classifier: every pair without it first.
+    pairs.sort_by_key(|&(tau, _)| tau > 0.0);
+    let scores: Vec<(f64, f64)> = pairs.par_iter().map(|&(t, s)| score(t, s)).collect();
+    let mut best = 0;
+    let costly = |k: usize| pairs[k].0 > 0.0;
+    for (k, sc) in scores.iter().enumerate() {
+        let b = scores[best];
+        let better = if (sc.0 - b.0).abs() > TIE {
+            sc.0 > b.0
+        } else if costly(k) != costly(best) {
+            !costly(k)
+        } else {
+            sc.1 > b.1 + 1e-9
+        };
+        if better {
+            best = k;
+        }
+    }
+    pairs[best]
 }
 
 /// Each sensor's clean signal when a part entering as `e` meets it on the line `base` (None:
@@ -541,10 +662,209 @@ fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, 
         }
     };
     Ok(Entry {
+        x: 0.0,
         theta: theta_deg.to_radians().rem_euclid(std::f64::consts::TAU),
         y,
         model,
     })
+}
+
+/// A stretch of the line that a part crosses after the previous one: the dynamic pins acting in
+/// it and where it ends.
+#[derive(Debug, Clone, PartialEq)]
+struct Stage {
+    /// Positions (into the model's `pins`) of the dynamic pins that stand in this stretch.
+    pins: Vec<usize>,
+    /// Where the stretch ends along the belt (m; None: at the line's end).
+    end: Option<f64>,
+}
+
+/// Cut the line into stretches a part crosses one after another, so that a member's path up to
+/// a dynamic pin is simulated once rather than once per command of the pins downstream, and
+/// members that leave a stretch in the same pose (a pin command that never touched them) go on
+/// as one. A cut lies where no obstacle is within 1.25·a of it on either side, so a part whose
+/// centroid crosses it touches nothing: in a line whose pins stand still the part is then free,
+/// and its pose (x, y, θ) is all there is to carry to the next stretch. Stretches end at every
+/// such gap before the last dynamic pin; the last runs to the line's end.
+fn stages(scene: &Scene, pins: &[usize]) -> Vec<Stage> {
+    let reach = 1.25 * scene.part.radius;
+    let mut spans: Vec<(f64, f64, Option<usize>)> = scene
+        .obstacles
+        .iter()
+        .enumerate()
+        .map(|(j, o)| {
+            let [lo, hi] = o.x_range();
+            (lo - reach, hi + reach, pins.iter().position(|&p| p == j))
+        })
+        .collect();
+    spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Blocks of overlapping spans: (lo, hi, dynamic pins in it).
+    let mut blocks: Vec<(f64, f64, Vec<usize>)> = Vec::new();
+    for (lo, hi, pin) in spans {
+        match blocks.last_mut() {
+            Some(b) if lo <= b.1 => {
+                b.1 = b.1.max(hi);
+                b.2.extend(pin);
+            }
+            _ => blocks.push((lo, hi, pin.into_iter().collect())),
+        }
+    }
+    let Some(last) = blocks.iter().rposition(|b| !b.2.is_empty()) else {
+        return vec![Stage {
+            pins: Vec::new(),
+            end: None,
+        }];
+    };
+    let mut out: Vec<Stage> = Vec::new();
+    for (i, b) in blocks.iter().enumerate().take(last) {
+        let cut = 0.5 * (b.1 + blocks[i + 1].0);
+        if cut > 0.0 {
+            out.push(Stage {
+                pins: b.2.clone(),
+                end: Some(cut),
+            });
+        }
+    }
+    // Pins upstream of the first positive cut (a line starting inside a block) join the next
+    // stretch; the last stretch takes the rest.
+    let placed: Vec<usize> = out.iter().flat_map(|st| st.pins.clone()).collect();
+    out.push(Stage {
+        pins: (0..pins.len()).filter(|k| !placed.contains(k)).collect(),
+        end: None,
+    });
+    out
+}
+
+/// The stretches' line variants and how a member's results across them map to joint actions.
+struct Staging {
+    stages: Vec<Stage>,
+    /// Per stretch, per command of its pins (mixed radix, first pin slowest), per μ: the line.
+    scenes: Vec<Vec<Vec<Scene>>>,
+}
+
+/// Where a member stands after a stretch: gone from the line (and whether in the goal), or free
+/// at a pose for the next stretch.
+#[derive(Debug, Clone, Copy)]
+enum Cont {
+    Done(bool),
+    Going(crate::geometry::Pose),
+}
+
+impl Staging {
+    fn new(
+        stages: &[Stage],
+        per_pin: &[Vec<Target>],
+        homes: &[Target],
+        line: impl Fn(&[Target], Option<f64>, f64) -> Scene,
+        mus: &[f64],
+    ) -> Staging {
+        let scenes = stages
+            .iter()
+            .map(|st| {
+                let n: usize = st.pins.iter().map(|&k| per_pin[k].len()).product();
+                (0..n)
+                    .map(|c| {
+                        let mut targets = homes.to_vec();
+                        let mut rest = c;
+                        for &k in st.pins.iter().rev() {
+                            targets[k] = per_pin[k][rest % per_pin[k].len()];
+                            rest /= per_pin[k].len();
+                        }
+                        mus.iter().map(|&mu| line(&targets, st.end, mu)).collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        Staging {
+            stages: stages.to_vec(),
+            scenes,
+        }
+    }
+
+    /// A member's success for every command sequence (indexed stretch by stretch, as
+    /// [`Staging::prefix_of_actions`] maps them), and the line runs it took.
+    fn success(&self, mu: usize, e: &Entry) -> Result<(Vec<bool>, [u64; 2]), String> {
+        use std::collections::HashMap;
+        let mut states = vec![Cont::Going(crate::geometry::Pose::new(e.x, e.y, e.theta))];
+        let mut prefix: Vec<usize> = vec![0];
+        let mut runs = [0, 0];
+        for (s, stage) in self.scenes.iter().enumerate() {
+            let last = s + 1 == self.scenes.len();
+            let mut next: Vec<Cont> = Vec::new();
+            let mut seen: HashMap<(u64, u64, u64), usize> = HashMap::new();
+            let mut done = [None, None];
+            let mut id_of = |c: Cont, next: &mut Vec<Cont>| -> usize {
+                let push = || {
+                    next.push(c);
+                    next.len() - 1
+                };
+                match c {
+                    Cont::Done(b) => *done[usize::from(b)].get_or_insert_with(push),
+                    Cont::Going(p) => *seen
+                        .entry((p.x.to_bits(), p.y.to_bits(), p.theta.to_bits()))
+                        .or_insert_with(push),
+                }
+            };
+            let mut table: Vec<Vec<usize>> = Vec::with_capacity(states.len());
+            for c in &states {
+                let row = match *c {
+                    Cont::Done(b) => vec![id_of(Cont::Done(b), &mut next); stage.len()],
+                    Cont::Going(pose) => {
+                        let mut row = Vec::with_capacity(stage.len());
+                        for per_mu in stage {
+                            runs[0] += 1;
+                            let entry = Entry {
+                                theta: pose.theta,
+                                y: pose.y,
+                                x: pose.x,
+                                model: e.model.clone(),
+                            };
+                            let r = run_single(&per_mu[mu], entry).map_err(|e| e.to_string())?;
+                            runs[1] += r.model_evaluations;
+                            let c = if !last && r.outcome.exited() {
+                                Cont::Going(r.pose)
+                            } else {
+                                Cont::Done(r.outcome == PartOutcome::Success)
+                            };
+                            row.push(id_of(c, &mut next));
+                        }
+                        row
+                    }
+                };
+                table.push(row);
+            }
+            prefix = prefix
+                .iter()
+                .flat_map(|&p| table[p].iter().copied())
+                .collect();
+            states = next;
+        }
+        let ok = prefix
+            .iter()
+            .map(|&i| matches!(states[i], Cont::Done(true)))
+            .collect();
+        Ok((ok, runs))
+    }
+
+    /// For each joint action (its pins' options in `pins` order, the last fastest), its index
+    /// among the stretch-by-stretch command sequences of [`Staging::success`].
+    fn prefix_of_actions(&self, options: &[usize]) -> Vec<usize> {
+        let n: usize = options.iter().product();
+        (0..n)
+            .map(|a| {
+                let mut digit = vec![0; options.len()];
+                let mut rest = a;
+                for k in (0..options.len()).rev() {
+                    digit[k] = rest % options[k];
+                    rest /= options[k];
+                }
+                self.stages
+                    .iter()
+                    .flat_map(|st| st.pins.iter())
+                    .fold(0, |p, &k| p * options[k] + digit[k])
+            })
+            .collect()
+    }
 }
 
 /// The scene as a static line: every dynamic pin standing at `action` (or at home), every pin
@@ -576,12 +896,15 @@ fn variant(scene: &Scene, pins: &[usize], action: Option<&[Target]>, mu: f64) ->
     v
 }
 
-/// The joint actions over `pins`.
+/// Each dynamic pin's options, in the order of the model's `pins`.
+type PinOptions = Vec<Vec<Target>>;
+
+/// The joint actions over `pins`, and each pin's options.
 fn joint_actions(
     scene: &Scene,
     pins: &[usize],
     targets: usize,
-) -> Result<(Vec<Vec<Target>>, Vec<usize>), String> {
+) -> Result<(Vec<Vec<Target>>, PinOptions), String> {
     let mut per_pin: Vec<Vec<Target>> = Vec::new();
     for &j in pins {
         let Obstacle::Pin(p) = &scene.obstacles[j] else {
@@ -618,7 +941,6 @@ fn joint_actions(
             "the dynamic pins have {n} joint commands on the action grid (at most {MAX_ACTIONS}): lower controller.belief.targets"
         ));
     }
-    let sizes = per_pin.iter().map(Vec::len).collect();
     let mut out: Vec<Vec<Target>> = vec![Vec::new()];
     for options in &per_pin {
         out = out
@@ -632,7 +954,7 @@ fn joint_actions(
             })
             .collect();
     }
-    Ok((out, sizes))
+    Ok((out, per_pin))
 }
 
 /// A dynamic pin's state before any command.
@@ -676,4 +998,90 @@ fn distinct(values: impl Iterator<Item = f64>) -> Vec<f64> {
     v.sort_by(f64::total_cmp);
     v.dedup();
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::raw::SupportKind;
+    use std::path::Path;
+
+    /// tripoly2's online line with its controller in policy mode (no model built at parse).
+    fn tripoly2_line() -> Scene {
+        let path = Path::new("scenarios/tripoly2_online.toml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let cut = text.find("[controller.belief]").unwrap();
+        let end = text[cut..].find("[goal]").unwrap() + cut;
+        let text = format!("{}{}", &text[..cut], &text[end..])
+            .replace("mode = \"online\"", "mode = \"policy\"");
+        crate::scenario::parse(path, &text).unwrap()
+    }
+
+    fn small_spec() -> BeliefSpec {
+        BeliefSpec {
+            mu_c: vec![0.3, 0.7],
+            support: vec![SupportKind::Uniform, SupportKind::Tripod],
+            offsets: 2,
+            samples: 2,
+            targets: 5,
+        }
+    }
+
+    #[test]
+    fn the_line_is_cut_between_its_pins_and_never_within_reach_of_one() {
+        let scene = tripoly2_line();
+        let pins = indices(&scene, |p| p.actuator.is_some());
+        assert_eq!(pins.len(), 2);
+        let st = stages(&scene, &pins);
+        // The sensor's stretch, mover1's, then mover2's to the line's end.
+        assert_eq!(
+            st.iter().map(|s| s.pins.clone()).collect::<Vec<_>>(),
+            [vec![], vec![0], vec![1]]
+        );
+        let reach = 1.25 * scene.part.radius;
+        for s in &st {
+            let Some(cut) = s.end else { continue };
+            for o in &scene.obstacles {
+                let [lo, hi] = o.x_range();
+                assert!(
+                    hi + reach < cut || lo - reach > cut,
+                    "{} at the cut {cut}",
+                    o.name()
+                );
+            }
+        }
+        // Move mover2 within reach of mover1: one stretch holds both.
+        let mut near = scene.clone();
+        let x1 = near.obstacles[pins[0]].x_range()[1];
+        if let Obstacle::Pin(p) = &mut near.obstacles[pins[1]] {
+            p.centre.x = x1 + 0.5 * scene.part.radius + p.radius;
+        }
+        let st = stages(&near, &pins);
+        assert_eq!(st.last().unwrap().pins, [0, 1]);
+        assert!(st.iter().rev().skip(1).all(|s| s.pins.is_empty()));
+    }
+
+    #[test]
+    fn crossing_the_line_stretch_by_stretch_predicts_what_whole_runs_do() {
+        let scene = tripoly2_line();
+        let spec = small_spec();
+        let staged = OnlineModel::build_with(&scene, &spec, true).unwrap();
+        let whole = OnlineModel::build_with(&scene, &spec, false).unwrap();
+        assert_eq!(staged.actions, whole.actions);
+        let differ = staged
+            .success
+            .iter()
+            .zip(&whole.success)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(differ, 0, "of {} success entries", whole.success.len());
+        assert!(staged.success.iter().any(|&p| p > 0.0) && staged.success.iter().any(|&p| p < 1.0));
+        // More runs (one per stretch), each through a part of the line: less contact work.
+        assert!(
+            staged.evaluations < whole.evaluations,
+            "{} vs {}",
+            staged.evaluations,
+            whole.evaluations
+        );
+    }
 }

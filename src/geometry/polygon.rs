@@ -107,7 +107,7 @@ fn on_segment(a: Vec2, b: Vec2, p: Vec2) -> bool {
     p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
 }
 
-/// Do the closed segments [p1,p2] and [q1,q2] share a point?
+/// Do the closed segments \[p1,p2\] and \[q1,q2\] share a point?
 pub fn segments_intersect(p1: Vec2, p2: Vec2, q1: Vec2, q2: Vec2) -> bool {
     let d1 = orient(q1, q2, p1);
     let d2 = orient(q1, q2, p2);

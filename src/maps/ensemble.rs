@@ -1,7 +1,7 @@
 //! Ensemble maps (issue 16): configuration maps under uncertain physics. Each ensemble *member*
 //! is one draw of the uncertain parameters — pin–part friction μc, the support (uniform pressure,
 //! or with probability `support_share` a random tripod or random smooth density, drawn as the
-//! Monte Carlo studies draw them: [`crate::study::mc::sample::draw_support`]), the pin radius — and
+//! Monte Carlo studies draw them: [`crate::mechanics::support::draw_support`]), the pin radius — and
 //! every pass it makes adds a pose error (normal, `jitter_deg`) to θ0. The distribution of θf at
 //! (d, input state) is the pool of all members' passes; its predicted bands are the smallest set of
 //! arcs holding 90% of it, gaps under 5° closed ([`super::arcs::highest_density_arcs`]).
@@ -18,11 +18,10 @@ use super::arcs::{Arc, MassArc};
 use super::sample::sample_one;
 use super::MapSettings;
 use crate::geometry::{wrap_deg, Polygon};
+use crate::mechanics::support::{draw_support, SmoothParams, SupportChoice};
 use crate::mechanics::{ContactSettings, Fidelity, PartModel, Pin};
 use crate::random::distribution::Distribution;
 use crate::random::{stream, ChaCha8Rng};
-use crate::study::mc::perturbations::{SmoothParams, SupportChoice};
-use crate::study::mc::sample::draw_support;
 use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution as _, StandardNormal};
 use rayon::prelude::*;

@@ -38,7 +38,7 @@ pub fn circular_runs(mask: &[bool]) -> Vec<(usize, usize)> {
     runs
 }
 
-/// The runs of `mask` as angle ranges [grid[start], grid[end]] (degrees).
+/// The runs of `mask` as angle ranges `[grid[start], grid[end]]` (degrees).
 pub fn circular_ranges(mask: &[bool], grid_deg: &[f64]) -> Vec<[f64; 2]> {
     circular_runs(mask)
         .into_iter()

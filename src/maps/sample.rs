@@ -95,7 +95,7 @@ pub fn sample_one_with(
     }
 }
 
-/// Sample the maps of all `ds` on the θ0 grid `grid` (degrees): `result[i][k]` is (ds[i], grid[k]).
+/// Sample the maps of all `ds` on the θ0 grid `grid` (degrees): `result[i][k]` is `(ds[i], grid[k])`.
 /// Runs on the current rayon pool; the output does not depend on its size.
 pub fn sample_maps(
     poly: &Polygon,

@@ -2,6 +2,7 @@
 //!
 //! * [`limit_surface`]: dissipation D(ξ), its gradient (the support load) and Hessian for uniform
 //!   pressure (closed form per edge, with a far-field quadrature) and for weighted support points.
+//! * [`limits`]: the ranges in which a contact's numeric settings are accepted.
 //! * [`part_model`]: the compiled part (normalised geometry + support) and the two convex
 //!   sub-problems, at three fidelity levels (`tip`, `ellipsoid`, `exact`).
 //! * [`instant`]: one instant — separation, stick, slide-left/right — in twist form.
@@ -20,6 +21,7 @@
 //!   side) for models many contacts share.
 //! * [`stick_table`]: the exact model's sticking twists on each edge, tabulated per edge over (ℓ,
 //!   direction of the pin's velocity), for a map tier's build.
+//! * [`support`]: random support models — a tripod or a smooth density per sample — and their draw.
 //! * [`vote`]: Mason's voting theorem, the geometric check on the sense of rotation.
 //!
 //! The entry point is [`push`], a pure function: (part model, pose, pin, settings, optional recorder)
@@ -33,6 +35,7 @@ pub mod fence;
 pub mod instant;
 pub mod integrate;
 pub mod limit_surface;
+pub mod limits;
 mod ode;
 pub mod outcome;
 pub mod part_model;
@@ -41,6 +44,7 @@ pub mod pin_path;
 mod settings;
 pub mod slide_table;
 pub mod stick_table;
+pub mod support;
 pub mod vote;
 
 pub use fence::FenceSpec;

@@ -320,7 +320,7 @@ const NEWTON_MAX: u32 = 60;
 
 /// The `final_gap` of the exact solves for integration tolerance `tol`: below this relative
 /// optimality gap a solve takes its last Newton step without evaluating D at its end (see
-/// [`linearised`]), since the gap after that step is O(gap²). Measured over 10⁶ solves on the
+/// `linearised`), since the gap after that step is O(gap²). Measured over 10⁶ solves on the
 /// reference parts, a step from a gap g left at most ≈ 100 g², so √(1e-6 tol) leaves a gap below
 /// 1e-4 tol: far below what the integration needs (`pinfeed bench contact`: the self-error at
 /// tol 1e-6 is the same to three digits as with every step evaluated). A larger gap would save a

@@ -179,6 +179,21 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
 
 /// Push a part with one pin: the pin starts at `pin_start` (world, caller's units) and travels along
 /// (−1, w) relative to the belt past the part resting at `pose`. Pure function of its inputs.
+///
+/// ```
+/// use pinfeed::geometry::part_from_spec;
+/// use pinfeed::maps::pass_start;
+/// use pinfeed::mechanics::{push, ContactSettings, ContactStatus, PartModel, Pin, Support};
+///
+/// // tripoly2 in metres at θ0 = 30°, a point pin at d = −0.2 (units of the part's radius a).
+/// let part = part_from_spec("tripoly2").unwrap().scaled(0.02);
+/// let model = PartModel::new(&part, &Support::Uniform).unwrap();
+/// let (pose, pin_start) = pass_start(&part, 30.0, -0.2, 0.0);
+/// let out = push(&model, pose, pin_start, &Pin::point(), &ContactSettings::default(), None);
+/// assert_eq!(out.status, ContactStatus::Ok);
+/// assert!(out.contact);
+/// assert!((out.rotation.to_degrees() - -19.05).abs() < 0.01);
+/// ```
 pub fn push(
     model: &PartModel,
     pose: Pose,

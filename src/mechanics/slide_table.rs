@@ -131,7 +131,7 @@ pub struct TableTwist {
 }
 
 /// The table of one (μc, place, side): nodes in increasing path coordinate and, per interval,
-/// whether it was certified; plus a uniform index (the first interval of each of [`INDEX_BUCKETS`]
+/// whether it was certified; plus a uniform index (the first interval of each of `INDEX_BUCKETS`
 /// equal pieces of the range) so that a lookup scans a few intervals instead of bisecting a
 /// thousand.
 #[derive(Debug)]

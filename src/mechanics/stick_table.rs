@@ -60,7 +60,7 @@ use std::sync::OnceLock;
 
 /// Relative agreement (twist and force) a piece must show.
 pub const STICK_TOL: f64 = 1e-10;
-/// |Ω|·max(1, |q|) below which a query is left to the solver (see [`EdgeTable::at`]): ten times
+/// |Ω|·max(1, |q|) below which a query is left to the solver (see `EdgeTable::at`): ten times
 /// the table's accuracy.
 pub const TRANSLATION_BAND: f64 = 10.0 * STICK_TOL;
 /// Cells of the grid along ℓ (over the edge and its reach).

@@ -19,7 +19,7 @@
 //! * [`fences`]: the fence planner's actions (`pinfeed plan --fences`): fences at candidate angles
 //!   below the jam limit, placed clear of every particle's reach, passes through
 //!   [`crate::mechanics::push_fence`]; the same search runs over them;
-//! * [`search`]: breadth-first search with deduplication, limits and statistics;
+//! * [`mod@search`]: breadth-first search with deduplication, limits and statistics;
 //! * [`bound`]: its branch and bound — what r more pins can at most bring into one window, from
 //!   the pins' lateral reach alone;
 //! * [`contingent`]: the contingent planner with sensing (a sensor pin, then per-decision moving

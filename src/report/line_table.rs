@@ -195,13 +195,16 @@ fn online_block(
 ) {
     let _ = writeln!(
         o,
-        "controller                online: {} hypotheses, {} joint commands ({} line runs to build), latency {} s, late commands: {}",
-        on.hypotheses, on.actions, on.model_runs, c.latency_s, c.on_late
+        "controller                online: {} hypotheses, {} joint commands ({} line runs, {} contact-model evaluations to build), latency {} s, late commands: {}",
+        on.hypotheses, on.actions, on.model_runs, on.model_evaluations, c.latency_s, c.on_late
     );
     let temper: Vec<String> = on
         .temper
         .iter()
-        .map(|(k, v)| format!("{k} {v:.0e}"))
+        .map(|(k, v)| {
+            let sigma = on.classifier_power.get(k).copied().unwrap_or(0.0);
+            format!("{k} filter {v:.0e}, classifier {sigma:.0e}")
+        })
         .collect();
     let _ = writeln!(
         o,

@@ -21,6 +21,18 @@ pub mod plot_validate;
 pub mod stale;
 pub mod versioned;
 
+/// A word of a command line, quoted for a POSIX shell if it needs it (for the command lines that
+/// regenerate a report, written at its top): plain when it holds only letters, digits and
+/// `-_.,:/+=`, else in single quotes.
+pub fn shell_word(s: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
+    if !s.is_empty() && s.chars().all(plain) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
 /// `x` with `decimals` decimals (`plus`: with its sign always), never as a negative zero: a value
 /// that rounds to zero is printed as 0 (`-0.000` from a −0.0 or a −1e-17 says nothing).
 pub fn fixed(x: f64, decimals: usize, plus: bool) -> String {

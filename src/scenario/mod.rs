@@ -48,6 +48,16 @@ pub fn parse(file: &Path, source: &str) -> Result<Scene, ScenarioError> {
 }
 
 /// Read, parse and compile a scenario file.
+///
+/// ```
+/// use std::path::Path;
+///
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+/// let scene = pinfeed::scenario::load(&path).unwrap();
+/// assert_eq!(scene.name, "quickstart");
+/// assert_eq!(scene.obstacles.len(), 3);
+/// assert_eq!(scene.part.stable_states.len(), 3);
+/// ```
 pub fn load(path: &Path) -> Result<Scene, ScenarioError> {
     let source = crate::input::read_text(path).map_err(|error| ScenarioError::Io {
         path: path.to_path_buf(),

@@ -5,7 +5,7 @@
 //! A bundled file keeps its place relative to the project root (`scenarios/NAME.toml`,
 //! `studies/NAME.toml`), both when it is written out and when it is run by name, so the relative
 //! paths inside it resolve as they do in the project: a study's `scenario = "../scenarios/…"`
-//! names another bundled file, which [`write`] writes too and [`load_study`] reads from the
+//! names another bundled file, which [`fn@write`] writes too and [`load_study`] reads from the
 //! binary. Run by name, a bundled file gives the same results as the file in the project.
 
 use crate::scenario::{ScenarioError, Scene};

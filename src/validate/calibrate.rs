@@ -24,9 +24,9 @@ use super::measured::Measured;
 use super::predict::{predict_observed, Predictions};
 use super::score::{RowKernel, ScoreSettings};
 use crate::maps::ensemble::EnsembleSpec;
+use crate::mechanics::support::SupportChoice;
 use crate::mechanics::Fidelity;
 use crate::random::distribution::Distribution;
-use crate::study::mc::perturbations::SupportChoice;
 use rayon::prelude::*;
 use serde::Serialize;
 

@@ -1,6 +1,7 @@
 //! Measured bands against the model (issue 16): `pinfeed validate` and `pinfeed calibrate`.
 //!
 //! * [`measured`]: the measured-bands CSV and its located errors;
+//! * [`input`]: the member count, the ensemble and the measured file, checked;
 //! * [`predict`]: an ensemble's passes for every measured row ([`crate::maps::ensemble`]);
 //! * [`score`]: containment, overlap, centre offset, predicted probability, coverage, log score;
 //! * [`calibrate`]: maximum-likelihood fit of μc centre and spread, tripod share and pin radius
@@ -8,6 +9,7 @@
 //! * [`synthetic`]: a measured-bands file drawn from hidden parameters, to check the two against.
 
 pub mod calibrate;
+pub mod input;
 pub mod measured;
 pub mod predict;
 pub mod score;

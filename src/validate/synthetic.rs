@@ -9,9 +9,9 @@
 use crate::geometry::part_from_spec;
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::{members, stable_states_deg, EnsembleSpec, InputState};
+use crate::mechanics::support::SupportChoice;
 use crate::mechanics::Fidelity;
 use crate::random::distribution::Distribution;
-use crate::study::mc::perturbations::SupportChoice;
 use rayon::prelude::*;
 
 /// The seed of the bundled synthetic data set.

@@ -171,7 +171,7 @@ fn fuzz_driver_is_deterministic_across_threads() {
 /// calibrate arguments, edited merge shards, and contacts with moving pins.
 #[test]
 fn new_surface_targets_run_clean_on_any_number_of_threads() {
-    let corpus = Arc::new(Corpus::load(root()).unwrap());
+    let corpus = Arc::new(pinfeed::cli::fuzz::corpus(root()).unwrap());
     let opts = |threads| options(11, threads);
     for (target, n) in [
         (Target::Pairs, 24),
@@ -252,7 +252,7 @@ fn merge_tampering_is_refused_and_an_untouched_set_merges() {
 
 /// `pinfeed plan` arguments for a test: part, time limit, check parts, then `extra`.
 fn plan_args(part: &str, time: &str, check: &str, extra: &[&str]) -> Vec<String> {
-    let mut a = pinfeed::study::robustness::plans::base_arguments(part, time, check, "50");
+    let mut a = pinfeed::cli::fuzz::plans::base_arguments(part, time, check, "50");
     a.extend(extra.iter().map(|s| s.to_string()));
     a
 }
@@ -261,7 +261,7 @@ fn plan_args(part: &str, time: &str, check: &str, extra: &[&str]) -> Vec<String>
 /// design would write is accepted and runs; a refused argument names its flag.
 #[test]
 fn plan_argument_sets_design_and_their_written_scenario_runs() {
-    use pinfeed::study::robustness::plans;
+    use pinfeed::cli::fuzz::plans;
     let dir = std::env::temp_dir().join(format!("pinfeed-plan-fuzz-{}", std::process::id()));
     let args = |extra: &[&str]| plan_args("tripoly1", "1", "50", extra);
     let r = plans::run(&args(&[]), &dir.join("a"));
@@ -276,7 +276,7 @@ fn plan_argument_sets_design_and_their_written_scenario_runs() {
 /// least 2(a + lateral).
 #[test]
 fn a_planned_scenario_has_a_belt_at_least_as_wide_as_the_part() {
-    use pinfeed::study::robustness::plans;
+    use pinfeed::cli::fuzz::plans;
     let dir = std::env::temp_dir().join(format!("pinfeed-plan-width-{}", std::process::id()));
     let args = plan_args("square", "0.2", "0", &["--fewest-sets"]);
     let r = plans::run(&args, &dir);

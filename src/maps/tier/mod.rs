@@ -12,7 +12,7 @@
 //! cheap and kinked where the touching vertex changes. A query whose ray cast misses is answered
 //! exactly (no contact) without the table.
 //!
-//! Grid and refinement ([`build`]): θ0 ∈ [0, 2π) in `theta_cells` base cells, d ∈ [−r, r] with
+//! Grid and refinement ([`mod@build`]): θ0 ∈ [0, 2π) in `theta_cells` base cells, d ∈ [−r, r] with
 //! r = (largest vertex radius + ρ)/a in `d_cells` base cells. A cell is **certified** when its 3 × 3
 //! nodes (corners, edge midpoints, centre) and twelve check points (the quarter points inside and
 //! on its edges) are all single, ok contacts ending on the same feature, and biquadratic

@@ -4,7 +4,7 @@
 //! returns the best design *the line confirmed*, with the number.
 //!
 //! For every mode ([`Mode`]):
-//! 1. the search over the particle abstraction ([`super::search`], [`super::contingent`]) gives a
+//! 1. the search over the particle abstraction ([`mod@super::search`], [`super::contingent`]) gives a
 //!    plan (or its best effort) and a *prediction*: the share of particles in one window;
 //! 2. the plan is emitted as a scenario ([`super::emit`]) and run on the line with the parts far
 //!    apart (the *screen*: `screen_parts` parts, no part can meet another);

@@ -5,7 +5,7 @@
 //! D1: each value replaced by the mean of itself and the n − 1 before it); Fx and Fy are the
 //! profiles compared (Fz and Tz discarded; the matrix holds Fx and Fy only); a cubic is fitted to
 //! each profile by least squares (app. D2) and its 1st, 2nd and 3rd derivatives are taken; five
-//! regions of points along each profile are selected and averaged; the sign matrix [S] (eq. 5-2)
+//! regions of points along each profile are selected and averaged; the sign matrix \[S\] (eq. 5-2)
 //! is 4 × 10: columns are the five regions of Fx then the five of Fy, row 1 the signs of the
 //! averaged profile values, rows 2 and 3 the signs of the averaged 1st and 2nd derivatives, row 4
 //! the sign of the (constant) 3rd derivative in each profile's first column and 0 in the other

@@ -7,8 +7,9 @@
 //! One or two sweeps make a grid; the first sweep varies slowest (point = i₀·n₁ + i₁).
 
 use super::distribution::Distribution;
-use super::perturbations::{Perturbations, SmoothParams, SupportChoice};
+use super::perturbations::Perturbations;
 use super::raw::*;
+use crate::mechanics::support::{SmoothParams, SupportChoice};
 use crate::scenario::error::Locator;
 use crate::scenario::limits::num;
 use crate::scenario::location::KeyPath;

@@ -19,7 +19,8 @@
 //! report one unsharded run writes ([`report`]).
 //!
 //! * [`raw`], [`compile`]: the study file and its validation (located errors);
-//! * [`distribution`], [`perturbations`], [`smooth_support`]: what is uncertain and how it is drawn;
+//! * [`distribution`], [`perturbations`]: what is uncertain and how it is drawn (the support
+//!   models in [`crate::mechanics::support`]);
 //! * [`sample`]: one perturbed line and its one part; [`run`]: many samples in parallel;
 //! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report;
 //! * [`atomic`]: files written by rename; [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
@@ -36,7 +37,6 @@ pub mod report;
 pub mod run;
 pub mod sample;
 pub mod shard;
-pub mod smooth_support;
 pub mod tally;
 
 pub use compile::SweepAxis;

@@ -3,54 +3,8 @@
 //! degrees as written and converted when drawn.
 
 use super::distribution::Distribution;
+use crate::mechanics::support::SupportChoice;
 use std::collections::BTreeMap;
-
-/// Parameters of the random smooth pressure density (see [`super::smooth_support`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SmoothParams {
-    /// Number of Gaussian bumps added to the uniform base pressure.
-    pub bumps: usize,
-    /// Bump standard deviation in units of the part's a.
-    pub width: f64,
-    /// Largest bump height relative to the base pressure.
-    pub contrast: f64,
-    /// Approximate number of support points.
-    pub points: usize,
-}
-
-impl Default for SmoothParams {
-    fn default() -> Self {
-        SmoothParams {
-            bumps: 3,
-            width: 0.3,
-            contrast: 2.0,
-            points: 48,
-        }
-    }
-}
-
-/// How the part's weight rests on the belt in a sample.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SupportChoice {
-    Uniform,
-    /// A random tripod per sample.
-    Tripod,
-    /// A random smooth density per sample.
-    Smooth(SmoothParams),
-}
-
-impl SupportChoice {
-    pub fn describe(&self) -> String {
-        match self {
-            SupportChoice::Uniform => "uniform pressure".into(),
-            SupportChoice::Tripod => "a random tripod per sample".into(),
-            SupportChoice::Smooth(p) => format!(
-                "a random smooth density per sample ({} bumps of width {} a, contrast {}, {} points)",
-                p.bumps, p.width, p.contrast, p.points
-            ),
-        }
-    }
-}
 
 /// The uncertain parameters at one sweep point; `None` keeps the scenario's nominal value.
 #[derive(Debug, Clone, PartialEq)]

@@ -127,7 +127,7 @@ pub enum SupportModel {
     Uniform,
     /// A random tripod per sample (docs/physics.md#support).
     Tripod,
-    /// A random smooth pressure density per sample (see [`super::smooth_support`]).
+    /// A random smooth pressure density per sample (see [`crate::mechanics::support::smooth`]).
     Smooth,
 }
 

@@ -27,7 +27,7 @@
 //!   re-validated and re-centred on its new centroid; an invalid polygon (self-intersecting, too
 //!   wide for the belt, or a sliver that cannot carry the support model) is redrawn and counted,
 //!   and after 1000 failures in a row the study stops with an error naming the sample;
-//! * support: uniform, a random tripod, or a random smooth density ([`super::smooth_support`]),
+//! * support: uniform, a random tripod, or a random smooth density ([`crate::mechanics::support::smooth`]),
 //!   on the perturbed polygon;
 //! * pins: errors added to each pin's x, y and radius; a pin that would leave the belt, sit within
 //!   a + radius of the entry, or get a negative radius is redrawn (counted);
@@ -58,12 +58,12 @@
 //! only the obstacles their `fences`/`pins` selector names, if it names any.
 
 use super::distribution::Distribution;
-use super::perturbations::{Perturbations, SupportChoice};
-use super::smooth_support::random_smooth_support;
+use super::perturbations::Perturbations;
 use crate::engine::part_stream::draw_part;
 use crate::engine::{self, PartOutcome, RunOptions};
 use crate::geometry::{Polygon, Vec2};
-use crate::mechanics::{PartModel, Support};
+use crate::mechanics::support::draw_support;
+use crate::mechanics::PartModel;
 use crate::random::{stream, ChaCha8Rng};
 use crate::scenario::{
     Actuator, Arrival, Controller, Feed, FenceObstacle, Lateral, MovingSpec, Obstacle, Orientation,
@@ -420,24 +420,6 @@ fn draw_polygon(
     Err(format!(
         "shape: {MAX_SHAPE_REDRAWS} perturbed polygons in a row were invalid (last: {last}); the shape tolerance is too large for this part"
     ))
-}
-
-/// The support of one sample on its (perturbed) polygon.
-pub(crate) fn draw_support(
-    polygon: &Polygon,
-    choice: &SupportChoice,
-    rng: &mut ChaCha8Rng,
-    redraws: &mut u32,
-) -> Result<Support, String> {
-    Ok(match choice {
-        SupportChoice::Uniform => Support::Uniform,
-        SupportChoice::Tripod => Support::random_tripod(polygon, rng)?,
-        SupportChoice::Smooth(params) => {
-            let (s, n) = random_smooth_support(polygon, params, rng)?;
-            *redraws += n;
-            s
-        }
-    })
 }
 
 /// One obstacle of the perturbed line: a pin (with or without a sensor) with its position and

@@ -5,7 +5,11 @@
 //!
 //! * [`files`]: scenario and study files mutated from the bundled ones and the test fixtures;
 //! * [`contacts`]: random star polygons pushed by point and disc pins at two tolerances;
-//! * [`polygons`]: vertex lists at extreme magnitudes, near-degenerate and self-intersecting.
+//! * [`polygons`]: vertex lists at extreme magnitudes, near-degenerate and self-intersecting;
+//! * [`pairs`], [`merges`]: scenarios with pairs of keys set together, edited shard files.
+//!
+//! The plans and csvs targets fuzz `pinfeed` command lines through the command's own argument
+//! parser: their cases come from the command line, given to the driver as [`CommandCases`].
 //!
 //! Determinism: case i of a target draws only from `random::stream(seed ^ tag, i)` and the results
 //! are tallied in index order, so the counts and the listed reproducers do not depend on the
@@ -18,19 +22,23 @@
 //! stops, so runaway threads cannot pile up).
 
 pub mod contacts;
-pub mod csvs;
 pub mod files;
 pub mod merges;
 pub mod pairs;
-pub mod plans;
 pub mod polygons;
 
+use crate::random::ChaCha8Rng;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
+
+/// What a case of the plans target is (its cases are [`CommandCases`]).
+pub const PLANS_DESCRIPTION: &str = "`pinfeed plan` argument sets: one of 12 parts (named parts, ngon:500, random and degenerate vertex lists, an unknown name), a time limit of 0.05–1 s, line checks of at most 200 parts, one thread, no files, and 0–4 more of 36 flags with values inside, at the ends of and beyond their ranges; parsed and checked as the command does, designed, and the design's numbers and the scenario and policy it would write checked (parsed and run for 3 parts); the searches stop at a wall-time limit, so these counts can depend on the machine";
+/// What a case of the csvs target is (its cases are [`CommandCases`]).
+pub const CSVS_DESCRIPTION: &str = "measured-band CSV files (1–6 rows of the bundled data sets, with and without the part column, with 0–3 mutations: fields set to extreme numbers, input states, parts or trial counts, fields dropped or added, rows duplicated, the header dropped or swapped, a byte-order mark, CRLF, an open quote, truncation) with random `validate` (three in four, at most 5 members) or `calibrate` (10 members) flags (μc, pin radius, --uncertain, --part, the score's settings, members); read from disk, checked and run as the commands do, every number of an accepted report finite";
 
 /// Hung cases after which a target stops generating new ones.
 pub const MAX_HANGS: u64 = 8;
@@ -94,8 +102,8 @@ impl Target {
             Target::Contacts => contacts::DESCRIPTION,
             Target::Polygons => polygons::DESCRIPTION,
             Target::Pairs => pairs::DESCRIPTION,
-            Target::Plans => plans::DESCRIPTION,
-            Target::Csvs => csvs::DESCRIPTION,
+            Target::Plans => PLANS_DESCRIPTION,
+            Target::Csvs => CSVS_DESCRIPTION,
             Target::Merges => merges::DESCRIPTION,
         }
     }
@@ -260,6 +268,18 @@ pub struct Options {
     pub root: PathBuf,
 }
 
+/// The cases of a target whose inputs are `pinfeed` command lines (plans, csvs): they go
+/// through the command's own argument parser, so the command line supplies them (`pinfeed fuzz`
+/// loads them into its corpus with [`Corpus::with_commands`]).
+#[derive(Debug, Clone, Copy)]
+pub struct CommandCases {
+    /// Run the case drawn from the case's stream, with a fresh folder for the files it writes.
+    pub run: fn(&mut ChaCha8Rng, &Path) -> CaseReport,
+    /// The input of the case drawn from the case's stream, as text (its command line, and the
+    /// file it reads).
+    pub input: fn(&mut ChaCha8Rng) -> String,
+}
+
 /// Everything the generators need, shared by the case threads.
 pub struct Corpus {
     pub files: files::Seeds,
@@ -268,6 +288,8 @@ pub struct Corpus {
     root: PathBuf,
     /// The merges target's shards, made on first use.
     shards: std::sync::OnceLock<Result<Vec<(String, String)>, String>>,
+    /// The command-line targets' cases ([`Corpus::with_commands`]).
+    commands: Vec<(Target, CommandCases)>,
 }
 
 impl Corpus {
@@ -278,7 +300,24 @@ impl Corpus {
             files,
             root: root.to_path_buf(),
             shards: std::sync::OnceLock::new(),
+            commands: Vec::new(),
         })
+    }
+
+    /// The corpus with `cases` as the cases of the command-line target `target`; without them a
+    /// case of that target is an unlocated error saying so.
+    pub fn with_commands(mut self, target: Target, cases: CommandCases) -> Corpus {
+        self.commands.retain(|(t, _)| *t != target);
+        self.commands.push((target, cases));
+        self
+    }
+
+    /// The cases of the command-line target `target`, if given.
+    fn command(&self, target: Target) -> Option<&CommandCases> {
+        self.commands
+            .iter()
+            .find(|(t, _)| *t == target)
+            .map(|(_, c)| c)
     }
 
     /// The shards of the merges target (run once).
@@ -328,8 +367,10 @@ pub fn run_case(target: Target, corpus: &Corpus, seed: u64, index: u64) -> CaseR
             let c = pairs::PairCase::random(&corpus.pair_seeds, &mut rng);
             pairs::run(&c, &corpus.pair_seeds, scratch().path())
         }
-        Target::Plans => plans::run(&plans::arguments(&mut rng), scratch().path()),
-        Target::Csvs => csvs::run(&csvs::CsvCase::random(&mut rng), scratch().path()),
+        Target::Plans | Target::Csvs => match corpus.command(target) {
+            Some(c) => (c.run)(&mut rng, scratch().path()),
+            None => no_commands(target),
+        },
         Target::Merges => match corpus.shards() {
             Ok(shards) => merges::run(shards, &merges::edits(&mut rng), scratch().path()),
             Err(e) => CaseReport::with(Class::Unlocated, format!("cannot make the shards: {e}")),
@@ -359,21 +400,27 @@ pub fn case_input(target: Target, corpus: &Corpus, seed: u64, index: u64) -> Str
                 None => "no seed scenario".into(),
             }
         }
-        Target::Plans => plans::command(&plans::arguments(&mut rng)),
-        Target::Csvs => {
-            let c = csvs::CsvCase::random(&mut rng);
-            format!(
-                "{}\n# measured.csv:\n{}",
-                c.command(Path::new("measured.csv")),
-                c.text
-            )
-        }
+        Target::Plans | Target::Csvs => match corpus.command(target) {
+            Some(c) => (c.input)(&mut rng),
+            None => no_commands(target).detail,
+        },
         Target::Merges => format!(
             "shards of {} with edits {:?}",
             "studies/quickstart_mu_tripod.toml (3 samples)",
             merges::edits(&mut rng)
         ),
     }
+}
+
+/// A case of a command-line target whose cases the corpus was not given.
+fn no_commands(target: Target) -> CaseReport {
+    CaseReport::with(
+        Class::Unlocated,
+        format!(
+            "{}: the corpus has no cases for this command-line target (Corpus::with_commands)",
+            target.name()
+        ),
+    )
 }
 
 thread_local! {

@@ -3,17 +3,15 @@
 //! and beyond their ranges. The arguments go through the command's own parser and checks
 //! ([`crate::cli::plan::options_of`]) and the design workflow ([`crate::plan::design::design`]);
 //! an accepted design's numbers must be finite and the scenario it would write (with its policy
-//! file) must be accepted by the scenario parser and run ([`super::files::check_scenario`]) — a
+//! file) must be accepted by the scenario parser and run ([`files::check_scenario`]) — a
 //! written plan the parser refuses counts as a self-check disagreement.
 
-use super::{refused, shows_non_finite, CaseReport, Class};
 use crate::cli::plan::PlanArgs;
 use crate::random::ChaCha8Rng;
+use crate::study::robustness::{files, refused, shows_non_finite, CaseReport, Class, CommandCases};
 use clap::Parser;
 use rand::RngExt;
 use std::path::Path;
-
-pub const DESCRIPTION: &str = "`pinfeed plan` argument sets: one of 12 parts (named parts, ngon:500, random and degenerate vertex lists, an unknown name), a time limit of 0.05–1 s, line checks of at most 200 parts, one thread, no files, and 0–4 more of 36 flags with values inside, at the ends of and beyond their ranges; parsed and checked as the command does, designed, and the design's numbers and the scenario and policy it would write checked (parsed and run for 3 parts); the searches stop at a wall-time limit, so these counts can depend on the machine";
 
 /// The parts a case plans for.
 const PARTS: [&str; 12] = [
@@ -135,9 +133,15 @@ pub fn arguments(rng: &mut ChaCha8Rng) -> Vec<String> {
     a
 }
 
+/// The cases of the plans target, for the fuzzing driver.
+pub const CASES: CommandCases = CommandCases {
+    run: |rng, scratch| run(&arguments(rng), scratch),
+    input: |rng| command(&arguments(rng)),
+};
+
 /// The command line of a case.
 pub fn command(args: &[String]) -> String {
-    let words: Vec<String> = args.iter().map(|a| crate::cli::shell_word(a)).collect();
+    let words: Vec<String> = args.iter().map(|a| crate::report::shell_word(a)).collect();
     format!("pinfeed plan {}", words.join(" "))
 }
 
@@ -184,7 +188,7 @@ fn run_unlabelled(args: &[String], scratch: &Path) -> CaseReport {
             return CaseReport::with(Class::Named, format!("cannot write the policy: {e}"));
         }
     }
-    let written = super::files::check_scenario(&scratch.join("plan.toml"), toml);
+    let written = files::check_scenario(&scratch.join("plan.toml"), toml);
     match written.class {
         Class::Success => CaseReport::new(Class::Success),
         Class::Located | Class::Named | Class::Unlocated => CaseReport::with(

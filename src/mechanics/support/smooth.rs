@@ -17,7 +17,7 @@ use crate::geometry::{Polygon, Vec2};
 use crate::mechanics::Support;
 use rand::RngExt;
 
-use super::perturbations::SmoothParams;
+use super::SmoothParams;
 
 /// Lower-left and upper-right corners of the polygon's bounding box.
 fn bounding_box(poly: &Polygon) -> (Vec2, Vec2) {

@@ -8,15 +8,14 @@
 //! at most 5 members, one in four calibrates with 10 members over the full grid. The file is read
 //! from disk as the commands read it; every number of an accepted report must be finite.
 
-use super::{refused, shows_non_finite, CaseReport, Class};
 use crate::cli::calibrate::CalibrateArgs;
 use crate::cli::validate::ValidateArgs;
 use crate::random::ChaCha8Rng;
+use crate::study::robustness::{refused, shows_non_finite, CaseReport, Class, CommandCases};
+use crate::validate::input::load_measured;
 use clap::Parser;
 use rand::RngExt;
 use std::path::Path;
-
-pub const DESCRIPTION: &str = "measured-band CSV files (1–6 rows of the bundled data sets, with and without the part column, with 0–3 mutations: fields set to extreme numbers, input states, parts or trial counts, fields dropped or added, rows duplicated, the header dropped or swapped, a byte-order mark, CRLF, an open quote, truncation) with random `validate` (three in four, at most 5 members) or `calibrate` (10 members) flags (μc, pin radius, --uncertain, --part, the score's settings, members); read from disk, checked and run as the commands do, every number of an accepted report finite";
 
 /// The seed files: header and data rows.
 const SEEDS: [(&str, &[&str]); 3] = [
@@ -366,7 +365,7 @@ impl CsvCase {
         let words: Vec<String> = self
             .args
             .iter()
-            .map(|a| crate::cli::shell_word(a))
+            .map(|a| crate::report::shell_word(a))
             .collect();
         format!(
             "pinfeed {} {} {}",
@@ -380,6 +379,20 @@ impl CsvCase {
         )
     }
 }
+
+/// The cases of the csvs target, for the fuzzing driver: a case runs with its file written into
+/// its folder; its input is the command line with the file's text.
+pub const CASES: CommandCases = CommandCases {
+    run: |rng, scratch| run(&CsvCase::random(rng), scratch),
+    input: |rng| {
+        let c = CsvCase::random(rng);
+        format!(
+            "{}\n# measured.csv:\n{}",
+            c.command(Path::new("measured.csv")),
+            c.text
+        )
+    },
+};
 
 #[derive(Parser)]
 struct ValidateCommand {
@@ -423,19 +436,7 @@ fn run_validate(c: &CsvCase, path: &Path) -> CaseReport {
         Ok(a) => a.args,
         Err(e) => return refused(&e.to_string()),
     };
-    let checked = (|| {
-        let score = a.common.score()?;
-        crate::cli::validate::check_members("--members", a.members)?;
-        let spec = crate::cli::validate::ensemble_spec(
-            a.mu_c,
-            a.pin_radius,
-            a.uncertain.as_deref(),
-            &a.common,
-        )?;
-        let m = crate::cli::validate::load_measured(&a.measured, &spec, a.common.part.as_deref())?;
-        anyhow::Ok((score, spec, m))
-    })();
-    let (score, spec, m) = match checked {
+    let (score, spec, m) = match a.inputs() {
         Ok(x) => x,
         Err(e) => return refused(&format!("{e:#}")),
     };
@@ -458,11 +459,7 @@ fn run_calibrate(c: &CsvCase, path: &Path) -> CaseReport {
     };
     let checked = (|| {
         let s = crate::cli::calibrate::settings(&a)?;
-        let m = crate::cli::validate::load_measured(
-            &a.measured,
-            &s.proposal(),
-            a.common.part.as_deref(),
-        )?;
+        let m = load_measured(&a.measured, &s.proposal(), a.common.part.as_deref())?;
         anyhow::Ok((s, m))
     })();
     let (s, m) = match checked {

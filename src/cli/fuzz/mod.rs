@@ -3,6 +3,14 @@
 //! contacts and random polygons, runs each case in-process under `catch_unwind` with a per-case
 //! time budget, and writes the counts to a Markdown report (default pinfeed-out/robustness.md; the committed report: --report results/robustness.md) headed
 //! by the command that regenerates it. `--case N` re-runs one case and prints its input.
+//!
+//! The targets whose inputs are `pinfeed` command lines run them through the commands' own
+//! argument parsers, so they live here: [`plans`] (`pinfeed plan` argument sets) and [`csvs`]
+//! (measured-band files with `validate` and `calibrate` arguments), given to the driver in the
+//! corpus ([`corpus`]).
+
+pub mod csvs;
+pub mod plans;
 
 use crate::study::robustness::{self, Class, Corpus, Options, Target};
 use anyhow::{bail, Context, Result};
@@ -62,6 +70,13 @@ pub struct FuzzArgs {
     /// Re-run only case N of the target: print its input and how it ended (no report).
     #[arg(long, value_name = "N")]
     pub case: Option<u64>,
+}
+
+/// The fuzzing corpus of the project at `root`, with the command-line targets' cases.
+pub fn corpus(root: &std::path::Path) -> Result<Corpus, String> {
+    Ok(Corpus::load(root)?
+        .with_commands(Target::Plans, plans::CASES)
+        .with_commands(Target::Csvs, csvs::CASES))
 }
 
 fn targets(t: FuzzTarget) -> Vec<Target> {
@@ -148,7 +163,7 @@ pub fn run(args: &FuzzArgs) -> Result<()> {
         .map(parse_counts)
         .transpose()?
         .unwrap_or_default();
-    let corpus = Arc::new(Corpus::load(&args.root).map_err(anyhow::Error::msg)?);
+    let corpus = Arc::new(corpus(&args.root).map_err(anyhow::Error::msg)?);
     let threads = match args.threads {
         Some(0) => bail!("--threads must be at least 1"),
         Some(n) => n,

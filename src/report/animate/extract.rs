@@ -1,0 +1,207 @@
+//! An [`Animation`] filled from a line run: the sample parts' paths, the obstacles, and the sensor
+//! readings, decisions and controller actions of the parts shown.
+
+use super::model::*;
+use crate::engine::controller::ControlRecord;
+use crate::engine::RunResult;
+use crate::geometry::{Pose, Vec2};
+use crate::scenario::{Actuator, Obstacle, PinObstacle, Scene};
+
+/// How many parts `pinfeed run --animate` shows by default: enough that several share the belt.
+pub const DEFAULT_PARTS: usize = 10;
+
+/// Fill an [`Animation`] from a run: the first `n_parts` sample paths (by part index; record at
+/// least that many with `RunOptions::sample_paths`), every obstacle (pins still and raised: one
+/// knot), and, when the run kept per-part records, each sensor pin's reading (at contact begin)
+/// and decision (at contact end) of the parts shown. The shown span runs from the first arrival
+/// to the last end plus a tenth, so the last part's outcome colour shows.
+pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation {
+    let mut paths: Vec<_> = result.paths.iter().collect();
+    paths.sort_by_key(|p| p.part);
+    paths.truncate(n_parts.min(MAX_PARTS));
+    let parts: Vec<AnimPart> = paths
+        .iter()
+        .map(|p| AnimPart {
+            part: p.part,
+            outcome: p.outcome,
+            poses: p.poses.clone(),
+        })
+        .collect();
+    let times = parts.iter().flat_map(|p| p.poses.iter().map(|q| q.0));
+    let t_first = times.clone().fold(f64::INFINITY, f64::min);
+    let t_last = times.fold(f64::NEG_INFINITY, f64::max);
+    let (t_start, t_end) = if t_first.is_finite() && t_last.is_finite() {
+        let span = (t_last - t_first).max(1e-3);
+        (t_first, t_last + 0.1 * span)
+    } else {
+        (0.0, scene.belt.length / scene.belt.speed)
+    };
+    let obstacles = scene
+        .obstacles
+        .iter()
+        .map(|o| match o {
+            Obstacle::Pin(p) => AnimObstacle {
+                name: p.name.clone(),
+                shape: AnimShape::Pin {
+                    x: p.centre.x,
+                    radius: p.radius,
+                },
+                sensor: p.sensor.is_some(),
+                track: pin_track(p, &result.control, t_start),
+            },
+            Obstacle::Fence(f) => AnimObstacle {
+                name: f.name.clone(),
+                shape: AnimShape::Fence {
+                    p0: f.start,
+                    p1: f.end(),
+                },
+                sensor: false,
+                track: Vec::new(),
+            },
+        })
+        .collect();
+    let mut marks = Vec::new();
+    for rec in &result.records {
+        let Some(part) = parts.iter().find(|p| p.part == rec.part) else {
+            continue;
+        };
+        for (name, decision) in parse_sensed(&rec.sensed) {
+            let Some(Obstacle::Pin(pin)) = scene.obstacles.iter().find(|o| o.name() == name) else {
+                continue;
+            };
+            let reach = scene.part.radius + pin.radius;
+            if let Some((tb, te)) = contact_interval(&part.poses, pin.centre, reach) {
+                marks.push(AnimMark {
+                    t: tb,
+                    at: pin.centre,
+                    kind: MarkKind::Reading,
+                    text: format!("{name}: reading"),
+                });
+                // With a controller its own decision records say when decisions were taken.
+                if result.control.is_empty() {
+                    marks.push(AnimMark {
+                        t: te,
+                        at: pin.centre,
+                        kind: MarkKind::Decision,
+                        text: format!("part {} → {decision}", part.part),
+                    });
+                }
+            }
+        }
+    }
+    marks.extend(control_marks(scene, &result.control, &parts));
+    Animation {
+        title: format!("{} — {} on the line", scene.name, scene.part.label),
+        belt_length: scene.belt.length,
+        belt_width: scene.belt.width,
+        belt_speed: scene.belt.speed,
+        outline: scene.part.polygon.vertices().to_vec(),
+        obstacles,
+        parts,
+        marks,
+        t_start,
+        t_end,
+    }
+}
+
+/// A pin's knots (time, centre y, raised?): where it starts and, for a dynamic pin, each motion the
+/// controller carried out (a retractable pin is withdrawn while in transit).
+fn pin_track(pin: &PinObstacle, control: &[ControlRecord], t_start: f64) -> Vec<(f64, f64, bool)> {
+    let home = pin.centre.y;
+    let mut track = vec![(
+        t_start,
+        home,
+        !matches!(pin.actuator, Some(Actuator::Retractable(r)) if !r.raised),
+    )];
+    for rec in control.iter().filter(|r| r.obstacle == pin.name) {
+        let Some(m) = rec.motion else { continue };
+        match pin.actuator {
+            Some(Actuator::Moving(_)) => {
+                track.push((m.t_start, m.from, true));
+                track.push((m.t_ready, m.to, true));
+            }
+            Some(Actuator::Retractable(_)) => {
+                track.push((m.t_start, home, false));
+                track.push((m.t_ready, home, m.to > 0.5));
+            }
+            None => {}
+        }
+    }
+    track.sort_by(|a, b| a.0.total_cmp(&b.0));
+    track
+}
+
+/// The controller's decisions, actuations and late commands for the animated parts, as marks at
+/// the sensor or the pin concerned.
+fn control_marks(scene: &Scene, control: &[ControlRecord], parts: &[AnimPart]) -> Vec<AnimMark> {
+    control
+        .iter()
+        .filter(|r| parts.iter().any(|p| p.part == r.part))
+        .filter_map(|r| {
+            let Some(Obstacle::Pin(pin)) = scene.obstacles.iter().find(|o| o.name() == r.obstacle)
+            else {
+                return None;
+            };
+            let (kind, text) = match r.kind {
+                "decision" => (MarkKind::Decision, format!("part {} → {}", r.part, r.what)),
+                "actuation" => (
+                    MarkKind::Actuation,
+                    format!("{} {} for part {}", r.obstacle, r.what, r.part),
+                ),
+                "late" => (
+                    MarkKind::Late,
+                    format!("late: {} {} for part {}", r.obstacle, r.what, r.part),
+                ),
+                _ => return None,
+            };
+            let at = match r.motion {
+                Some(m) if matches!(pin.actuator, Some(Actuator::Moving(_))) => {
+                    Vec2::new(pin.centre.x, m.from)
+                }
+                _ => pin.centre,
+            };
+            Some(AnimMark {
+                t: r.t,
+                at,
+                kind,
+                text,
+            })
+        })
+        .collect()
+}
+
+/// `pin=decision; pin2=decision` (a part record's `sensed`) as (pin, decision) pairs.
+fn parse_sensed(sensed: &str) -> Vec<(&str, &str)> {
+    sensed
+        .split("; ")
+        .filter_map(|item| item.split_once('='))
+        .map(|(a, b)| (a.trim(), b.trim()))
+        .collect()
+}
+
+/// The first run of recorded poses whose centroid lies within `reach` (part radius + pin
+/// radius) of a pin: its first and last times — contact begin and end, since a path records the
+/// pose at both and the pins stand beyond reach of the entry.
+fn contact_interval(poses: &[(f64, Pose)], pin: Vec2, reach: f64) -> Option<(f64, f64)> {
+    let near = |p: &Pose| (p.position() - pin).norm() <= reach * (1.0 + 1e-9) + 1e-12;
+    let i = poses.iter().position(|(_, p)| near(p))?;
+    let mut j = i;
+    while j + 1 < poses.len() && near(&poses[j + 1].1) {
+        j += 1;
+    }
+    Some((poses[i].0, poses[j].0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sensed_text_parses() {
+        assert_eq!(
+            parse_sensed("probe=0° (0.998); b=unknown"),
+            vec![("probe", "0° (0.998)"), ("b", "unknown")]
+        );
+        assert!(parse_sensed("").is_empty());
+    }
+}
