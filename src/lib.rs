@@ -20,6 +20,7 @@ pub mod input;
 pub mod maps;
 pub mod mechanics;
 pub mod plan;
+pub mod progress;
 pub mod random;
 pub mod report;
 pub mod scenario;

@@ -110,7 +110,15 @@ pub enum BenchWhat {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
-    match &args.what {
+    // The measurements run for seconds to hours: a spinner with the elapsed time and the stage.
+    let spin = super::progress::spinner("bench", false);
+    let result = measure(&args.what, &spin);
+    spin.finish_and_clear();
+    result
+}
+
+fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
+    match what {
         BenchWhat::Accuracy {
             contacts,
             seed,
@@ -120,6 +128,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 anyhow::bail!("--contacts must be between 4 and 1000000, got {contacts}");
             }
             let parts = ["tripoly1", "tripoly2", "square", "lshape"];
+            spin.set_message(format!(
+                "accuracy: {contacts} contacts against the reference"
+            ));
             let st = crate::study::accuracy::run(&parts, *contacts, *seed)?;
             let cmd = format!(
                 "cargo run --release -- bench accuracy --contacts {contacts} --seed {seed} --out {}",
@@ -169,7 +180,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             }
             let parts = ["tripoly1", "tripoly2", "square", "lshape"];
             let fids = [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact];
+            spin.set_message(format!("contact: {contacts} contacts per part and model"));
             let rows = contact_cost::measure(&parts, &fids, *contacts, *tol, *seed, true)?;
+            spin.set_message("contact: cost against the vertex count");
             let table = contact_cost::markdown(&rows);
             let scaling = contact_cost::vertex_scaling(
                 &[3, 6, 12, 24, 48],
@@ -223,7 +236,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             eprintln!("wrote {}", out.display());
             Ok(())
         }
-        BenchWhat::Maps { repeats, out } => bench_maps(*repeats, out),
+        BenchWhat::Maps { repeats, out } => {
+            spin.set_message(format!("maps: {repeats} timed runs per row"));
+            bench_maps(*repeats, out)
+        }
         BenchWhat::Designs {
             random,
             first,
@@ -234,25 +250,28 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             tripod,
             threads,
             out,
-        } => super::bench_designs::run(&super::bench_designs::DesignsArgs {
-            random: *random,
-            first: *first,
-            parts: parts.clone(),
-            time_limit: *time_limit,
-            check_parts: *check_parts,
-            mu_c_range: mu_c_range.clone(),
-            tripod: *tripod,
-            threads: *threads,
-            out: out.clone(),
-        }),
+        } => super::bench_designs::run(
+            &super::bench_designs::DesignsArgs {
+                random: *random,
+                first: *first,
+                parts: parts.clone(),
+                time_limit: *time_limit,
+                check_parts: *check_parts,
+                mu_c_range: mu_c_range.clone(),
+                tripod: *tripod,
+                threads: *threads,
+                out: out.clone(),
+            },
+            spin,
+        ),
         BenchWhat::McPrecision {
             study,
             samples,
             repeats,
             out,
-        } => super::bench_mc::run(study, samples, *repeats, out),
-        BenchWhat::MapTier(a) => super::bench_map_tier::run(a),
-        BenchWhat::Line(a) => super::bench_line::run(a),
+        } => super::bench_mc::run(study, samples, *repeats, out, spin),
+        BenchWhat::MapTier(a) => super::bench_map_tier::run(a, spin),
+        BenchWhat::Line(a) => super::bench_line::run(a, spin),
     }
 }
 

@@ -22,7 +22,7 @@ pub struct DesignsArgs {
 }
 
 /// Run the survey.
-pub fn run(a: &DesignsArgs) -> Result<()> {
+pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar) -> Result<()> {
     if a.random > 10_000 {
         bail!("--random {}: must lie in 0..=10000", a.random);
     }
@@ -81,8 +81,14 @@ pub fn run(a: &DesignsArgs) -> Result<()> {
         .build()
         .context("starting the worker threads")?;
     let mut rows = Vec::new();
-    for p in &parts {
-        eprintln!("bench designs: {} …", p.label);
+    for (i, p) in parts.iter().enumerate() {
+        super::progress::note(spin, &format!("bench designs: {} …", p.label));
+        spin.set_message(format!(
+            "designs: part {} of {}, {}",
+            i + 1,
+            parts.len(),
+            p.label
+        ));
         rows.push(pool.install(|| survey_part(&s, p)));
         let mut m = format!(
             "# Designs the line confirms (`pinfeed bench designs`)\n\nRegenerate:\n\n    {command}\n\n"

@@ -26,7 +26,7 @@ pub struct LineArgs {
     pub out: PathBuf,
 }
 
-pub fn run(a: &LineArgs) -> Result<()> {
+pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar) -> Result<()> {
     if a.parts == 0 || a.parts > 10_000_000 {
         bail!("--parts must be between 1 and 10000000, got {}", a.parts);
     }
@@ -36,9 +36,10 @@ pub fn run(a: &LineArgs) -> Result<()> {
     let mut rows = Vec::new();
     for path in &a.scenarios {
         let scene = crate::scenario::load(path)?;
+        spin.set_message(format!("line: {}", path.display()));
         let row = measure(&scene, a.parts, a.reps)
             .with_context(|| format!("measuring {}", path.display()))?;
-        eprintln!(
+        let line = format!(
             "{}: line {:.2} s, batch {:.2} s (recording {:.2} s), ratio {:.3}",
             path.display(),
             row.line_s,
@@ -46,6 +47,7 @@ pub fn run(a: &LineArgs) -> Result<()> {
             row.bare_recorded_s,
             row.ratio()
         );
+        super::progress::note(spin, &line);
         rows.push(row);
     }
     let list: Vec<String> = a

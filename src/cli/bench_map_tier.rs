@@ -39,7 +39,7 @@ fn write_section(path: &Path, section: &str) -> Result<()> {
     Ok(())
 }
 
-pub fn run(a: &MapTierArgs) -> Result<()> {
+pub fn run(a: &MapTierArgs, spin: &indicatif::ProgressBar) -> Result<()> {
     if a.contacts == 0 || a.contacts > 1_000_000 {
         bail!(
             "--contacts must be between 1 and 1000000, got {}",
@@ -64,13 +64,17 @@ pub fn run(a: &MapTierArgs) -> Result<()> {
     );
     let mut rows = Vec::new();
     for part in &a.parts {
-        eprintln!("map tier: building and measuring {part}");
+        let stage = format!("map tier: building and measuring {part}");
+        super::progress::note(spin, &stage);
+        spin.set_message(stage);
         rows.push(contact_row(part, a.contacts, a.seed)?);
     }
     let section = contact_section(&rows, &cmd);
     print!("{section}");
     write_section(&a.accuracy_out, &section)?;
-    eprintln!("map tier: line runs of {}", a.scenario.display());
+    let stage = format!("map tier: line runs of {}", a.scenario.display());
+    super::progress::note(spin, &stage);
+    spin.set_message(stage);
     let line = line_row(&a.scenario, a.line_parts)?;
     let section = line_section(&line, &a.scenario, &cmd);
     print!("{section}");

@@ -18,7 +18,13 @@ fn load_average() -> String {
 }
 
 /// Measure and write the section.
-pub fn run(study_file: &Path, counts: &[u64], repeats: usize, out: &Path) -> Result<()> {
+pub fn run(
+    study_file: &Path,
+    counts: &[u64],
+    repeats: usize,
+    out: &Path,
+    spin: &indicatif::ProgressBar,
+) -> Result<()> {
     if !(1..=100).contains(&repeats) {
         bail!("--repeats must lie in [1, 100], got {repeats}");
     }
@@ -34,9 +40,12 @@ pub fn run(study_file: &Path, counts: &[u64], repeats: usize, out: &Path) -> Res
         );
     }
     // Warm-up (page in the code, start the pools).
+    spin.set_message("mc-precision: warm-up");
     precision::measure(&study, &[largest.min(100)], 2, 1)?;
     let load_before = load_average();
+    spin.set_message(format!("mc-precision: {counts:?} samples, 2 threads"));
     let rows = precision::measure(&study, counts, 2, repeats)?;
+    spin.set_message("mc-precision: 1 against 2 threads");
     // 1 against 2 threads, alternating so that other work on the machine disturbs both alike;
     // the fastest of each is kept.
     let (mut one, mut two) = (f64::INFINITY, f64::INFINITY);
@@ -58,6 +67,7 @@ pub fn run(study_file: &Path, counts: &[u64], repeats: usize, out: &Path) -> Res
         if fid == study.scene.contact.fidelity {
             continue;
         }
+        spin.set_message(format!("mc-precision: {} model", fid.name()));
         let mut cheaper = mc::load(study_file, Some(largest))?;
         cheaper.scene.contact.fidelity = fid;
         let row = precision::measure(&cheaper, &[largest], 2, repeats)?;

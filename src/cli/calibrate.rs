@@ -12,7 +12,7 @@ use super::validate::{
 };
 use crate::mechanics::support::{SmoothParams, SupportChoice};
 use crate::report::shell_word;
-use crate::validate::calibrate::{calibrate, Calibration, CalibrationSettings};
+use crate::validate::calibrate::{calibrate_observed, Calibration, CalibrationSettings};
 use crate::validate::input::{check_members, load_measured};
 use crate::validate::score::Summary;
 use crate::validate::synthetic::{synthesize, SyntheticDesign};
@@ -42,7 +42,7 @@ pub struct CalibrateArgs {
     /// Range of the μc mean searched (and of the proposal): MIN:MAX.
     #[arg(long, default_value = "0.05:1", allow_hyphen_values = true)]
     pub mu_c_range: String,
-    /// Largest pin radius searched (part units).
+    /// Largest pin radius searched (part units, not metres, as `validate --pin-radius`).
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub pin_radius_max: f64,
     /// σρ: spread of the pin radius under every fitted ensemble (part units).
@@ -169,28 +169,28 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     let measured = load_measured(&args.measured, &s.proposal(), args.common.part.as_deref())?;
     let pool = pool(c.threads)?;
     let started = std::time::Instant::now();
+    let bar = super::progress::bar(0, "steps", c.quiet || c.json);
+    let tell = super::progress::counter(&bar);
+    bar.set_message("fitting ");
     let cal = pool
-        .install(|| calibrate(&measured, &s))
+        .install(|| calibrate_observed(&measured, &s, &tell))
         .map_err(anyhow::Error::msg)?;
-    eprintln!("calibrated in {:.1} s", started.elapsed().as_secs_f64());
+    bar.suspend(|| eprintln!("calibrated in {:.1} s", started.elapsed().as_secs_f64()));
     let nominal = ensemble_spec(args.mu_c, 0.0, None, c)?;
     let fitted = s.spec_at(cal.estimate());
     let score = s.score;
-    let run_score = |spec| {
+    let run_score = |spec, stage: &str| {
+        bar.set_message(format!("scoring {stage} "));
         pool.install(|| {
-            crate::validate::validate(
-                &measured,
-                spec,
-                c.seed,
-                args.score_members,
-                c.passes,
-                &score,
-            )
+            let draw = (c.seed, args.score_members, c.passes);
+            crate::validate::validate_observed(&measured, spec, draw, &score, &tell)
         })
         .map(|(_, summary, _)| summary)
         .map_err(anyhow::Error::msg)
     };
-    let (nominal_score, fitted_score) = (run_score(&nominal)?, run_score(&fitted)?);
+    let nominal_score = run_score(&nominal, "the nominal model")?;
+    let fitted_score = run_score(&fitted, "the fit")?;
+    bar.finish_and_clear();
     let mut text = parameter_table(&cal, hidden);
     let _ = writeln!(
         text,

@@ -12,7 +12,7 @@
 
 use crate::report::compare_table;
 use crate::scenario::{FeedSource, Lateral, Orientation};
-use crate::study::compare::compare;
+use crate::study::compare::compare_observed;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -38,6 +38,9 @@ pub struct CompareArgs {
     /// Print the table as Markdown.
     #[arg(long)]
     pub markdown: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// One line saying which part stream every design ran on.
@@ -103,7 +106,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             .apply(scene)
             .with_context(|| format!("{file} cannot run on the part stream of {}", files[0]))?;
     }
-    let rows = compare(&scenes, &files, parts).context("running the comparison")?;
+    let bar = super::progress::bar(0, "parts", args.quiet || args.json);
+    let tell = super::progress::counter(&bar);
+    let rows = compare_observed(&scenes, &files, parts, &tell).context("running the comparison")?;
+    bar.finish_and_clear();
     let text = if args.json {
         // One document: the version fields and the rows, one per design.
         #[derive(serde::Serialize)]

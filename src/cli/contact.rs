@@ -27,7 +27,8 @@ pub struct ContactArgs {
     /// Initial orientation θ0 (degrees).
     #[arg(long, allow_hyphen_values = true, required_unless_present = "cases")]
     pub theta0: Option<f64>,
-    /// Contact parameter d = (y_pin − y_com)/a.
+    /// Contact parameter d = (y_pin − y_com)/a: the pin's lateral offset from the part's centroid in units of a (its
+    /// largest centroid–vertex distance), a ratio without a length unit.
     #[arg(long, allow_hyphen_values = true, required_unless_present = "cases")]
     pub d: Option<f64>,
     /// Pin–part friction coefficient μc (≥ 0).
@@ -47,7 +48,8 @@ pub struct ContactArgs {
     /// (default 36,12,4).
     #[arg(long, value_name = "T,D,DEPTH")]
     pub map_grid: Option<String>,
-    /// Pin radius in part units (0: point pin).
+    /// Pin radius in part units: the coordinates the part is given in,
+    /// not metres (`plan` and `sense`, which take `--scale`, use metres); 0: point pin.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Lateral pin speed as a fraction of the belt speed (moving pin).

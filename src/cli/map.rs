@@ -28,7 +28,8 @@ pub struct MapArgs {
     /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], or vertices:"x,y x,y ...".
     #[arg(long)]
     pub part: String,
-    /// Contact parameters d = (y_pin − y_com)/a, comma-separated (e.g. -0.9,-0.5,0.3).
+    /// Contact parameters, comma-separated (e.g. -0.9,-0.5,0.3): d = (y_pin − y_com)/a: the pin's lateral offset from the part's centroid in units of a (its
+    /// largest centroid–vertex distance), a ratio without a length unit.
     #[arg(
         long,
         required_unless_present = "fence",
@@ -59,7 +60,8 @@ pub struct MapArgs {
     /// Pin–part friction coefficient μc (≥ 0).
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
-    /// Pin radius in part units (0: point pin).
+    /// Pin radius in part units: the coordinates the part is given in,
+    /// not metres (`plan` and `sense`, which take `--scale`, use metres); 0: point pin.
     #[arg(
         long,
         default_value_t = 0.0,

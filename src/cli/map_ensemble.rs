@@ -105,20 +105,7 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
     }
     let pool = super::validate::pool(args.threads)?;
     let started = std::time::Instant::now();
-    // Progress on a terminal (indicatif draws nothing when stderr is not one).
-    let bar = if args.json || args.csv {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let b = indicatif::ProgressBar::with_draw_target(
-            Some(passes as u64),
-            indicatif::ProgressDrawTarget::stderr(),
-        );
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} passes  eta {eta}")
-                .expect("valid progress template"),
-        );
-        b
-    };
+    let bar = super::progress::bar(passes as u64, "passes", args.json || args.csv);
     let maps = pool
         .install(|| {
             ensemble_maps_observed(

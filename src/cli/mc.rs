@@ -12,7 +12,6 @@ use crate::study::mc::shard::{self, ShardFile, ShardSpec};
 use crate::study::mc::{self, run};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -48,18 +47,6 @@ pub fn default_dir(study_name: &str) -> PathBuf {
     crate::default_out(&["mc", study_name])
 }
 
-fn progress(total: u64, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    b.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} samples  {per_sec}  eta {eta}")
-            .expect("valid progress template"),
-    );
-    b
-}
-
 pub fn run(args: &McArgs) -> Result<()> {
     if let Some(n) = args.samples {
         if !(1..=mc::MAX_SAMPLES).contains(&n) {
@@ -84,7 +71,7 @@ pub fn run(args: &McArgs) -> Result<()> {
         None => None,
     };
     let range = shard.map_or(0..total, |s| s.range(total));
-    let bar = progress(range.end - range.start, args.quiet);
+    let bar = super::progress::bar(range.end - range.start, "samples", args.quiet);
     let started = Instant::now();
     let tallies = run::run_range_with_threads(&study, range.clone(), args.threads, &|| bar.inc(1))
         .with_context(|| format!("running {}", args.study.display()))?;

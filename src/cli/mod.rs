@@ -24,6 +24,7 @@ pub mod mc;
 pub mod merge;
 pub mod part;
 pub mod plan;
+pub mod progress;
 pub mod run;
 pub mod sense;
 pub mod stdout;

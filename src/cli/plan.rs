@@ -16,7 +16,6 @@ use crate::report::shell_word;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `pinfeed plan`.
@@ -50,7 +49,7 @@ pub struct PlanArgs {
     /// Orientation jitter of a stable feed: standard deviation (degrees).
     #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
     pub jitter: f64,
-    /// Lateral offset at entry: uniform in ±LATERAL (m).
+    /// Lateral offset at entry: uniform in ±LATERAL metres.
     #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
     pub lateral: f64,
     /// Particles per stable state: this many jitter quantiles …
@@ -71,13 +70,13 @@ pub struct PlanArgs {
     /// Be robust against the support: each particle gets its own random tripod.
     #[arg(long)]
     pub tripod: bool,
-    /// Pin radius (m; 0 = point pin).
+    /// Pin radius in metres (0 = point pin); `contact`, `map` and `validate` take part units.
     #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
     pub pin_radius: f64,
-    /// Belt width (m) [default: 0.1; without it fence designs may use a wider belt, reported].
+    /// Belt width in metres [default: 0.1; without it fence designs may use a wider belt, reported].
     #[arg(long, allow_hyphen_values = true)]
     pub belt_width: Option<f64>,
-    /// Distance between pins along the belt (m).
+    /// Distance between pins along the belt, in metres.
     #[arg(long, default_value_t = 0.15, allow_hyphen_values = true)]
     pub spacing: f64,
     /// Most obstacles in a line (the search depth).
@@ -546,7 +545,7 @@ pub fn run(args: &PlanArgs) -> Result<()> {
             objective: o.objective,
             scenario: d.scenario_toml.as_deref(),
         };
-        serde_json::to_string_pretty(&doc)? + "\n"
+        crate::report::versioned::pretty(&doc)?
     } else {
         text(&o, &d, &files)
     };
@@ -569,16 +568,7 @@ fn write(path: &Path, text: &str) -> Result<()> {
 
 /// A spinner on standard error when it is a terminal (and not `quiet`).
 fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let b = indicatif::ProgressBar::new_spinner();
-    b.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} plan {elapsed}: {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
-    );
-    b.enable_steady_tick(std::time::Duration::from_millis(120));
-    Some(b)
+    super::progress::shown(quiet).then(|| super::progress::spinner("plan", quiet))
 }
 
 /// The drawing's title: the verdict with the line's number beside the prediction.

@@ -10,7 +10,6 @@ use crate::report::atomic::Batch;
 use crate::report::{animate, line_table, parts_csv, plot_line, plot_orientations};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -85,16 +84,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
             .any(|o| matches!(o, crate::scenario::Obstacle::Pin(p) if p.sensor.is_some()));
         opts.keep_records |= sensors;
     }
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::with_draw_target(Some(opts.parts), ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} parts  {per_sec}  eta {eta}")
-                .expect("valid progress template"),
-        );
-        b
-    };
+    let bar = super::progress::bar(opts.parts, "parts", args.quiet);
     let maps = super::contact_map::prepare_maps(&scene, args.cache_dir.as_deref(), args.quiet);
     let started = Instant::now();
     let result = engine::run(&scene, &opts, &mut |done| bar.set_position(done))
@@ -134,12 +124,12 @@ pub fn run(args: &RunArgs) -> Result<()> {
     if scene.effects.event_log {
         let p = dir.join("events.json");
         batch
-            .write(&p, serde_json::to_string(&result.events)? + "\n")
+            .write(&p, event_log("events", &result.events)?)
             .with_context(|| format!("writing {}", p.display()))?;
         if !result.control.is_empty() {
             let p = dir.join("control.json");
             batch
-                .write(&p, serde_json::to_string(&result.control)? + "\n")
+                .write(&p, event_log("control", &result.control)?)
                 .with_context(|| format!("writing {}", p.display()))?;
         }
     }
@@ -226,4 +216,10 @@ fn tables_line(model: &crate::mechanics::PartModel) -> String {
         ),
         _ => String::new(),
     }
+}
+
+/// An event log's file: one compact JSON object, the version fields and the log under `key`.
+fn event_log<T: serde::Serialize>(key: &str, log: &[T]) -> serde_json::Result<String> {
+    let body: std::collections::BTreeMap<&str, &[T]> = [(key, log)].into();
+    crate::report::versioned::compact(&body)
 }

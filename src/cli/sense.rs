@@ -20,8 +20,8 @@ use crate::report::plot_sensing;
 use crate::report::shell_word;
 use crate::sensing::classify::{self, Classifier, ClassifierOptions};
 use crate::sensing::evaluate::{
-    applicable, evaluate_with, noise_sweep, trial_pass, Cell, Config, Evaluation, Factory, Problem,
-    SensorPoint, TruthDraw, MAX_TEMPLATES, MAX_TRIALS, READING_STREAMS,
+    applicable, evaluate_observed, noise_sweep, trial_pass, Cell, Config, Evaluation, Factory,
+    Problem, SensorPoint, TruthDraw, MAX_TEMPLATES, MAX_TRIALS, READING_STREAMS,
 };
 use crate::sensing::placement::{self, Placement};
 use crate::sensing::templates::{Hypotheses, PushSetup, TemplateSet, Uncertainty};
@@ -51,10 +51,11 @@ pub struct SenseArgs {
     /// Belt speed (m/s): turns travel into time.
     #[arg(long, default_value_t = 0.05, allow_hyphen_values = true)]
     pub belt_speed: f64,
-    /// Contact parameter d = (y_pin − y_com)/a of the sensorised pin.
+    /// Contact parameter of the sensorised pin: d = (y_pin − y_com)/a: the pin's lateral offset from the part's centroid in units of a (its
+    /// largest centroid–vertex distance), a ratio without a length unit.
     #[arg(long, allow_hyphen_values = true)]
     pub d: f64,
-    /// Pin radius (m; 0: point pin).
+    /// Pin radius in metres (0: point pin); `contact`, `map` and `validate` take part units.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Pin–part friction μc (nominal).
@@ -172,6 +173,9 @@ pub struct SenseArgs {
     /// Print only; write no files.
     #[arg(long, conflicts_with = "out")]
     pub no_write: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// Most noise factors, placement offsets, threads (hypotheses: [`Hypotheses::orientations`]).
@@ -633,9 +637,12 @@ pub fn run(a: &SenseArgs) -> Result<()> {
         .build()
         .context("starting the worker threads")?;
     let started = std::time::Instant::now();
+    let bar = super::progress::bar(a.trials as u64, "trials", a.quiet || a.json);
+    let tell = super::progress::counter(&bar);
     let (templates, mut evaluation) = pool
-        .install(|| evaluate_with(&problem, &points, &config, &factory))
+        .install(|| evaluate_observed(&problem, &points, &config, &factory, &tell))
         .map_err(|e| anyhow!(e))?;
+    bar.finish_and_clear();
     let elapsed = started.elapsed().as_secs_f64();
     eprintln!(
         "sense: {} trials × {} noise levels × {} classifiers in {elapsed:.2} s on {} threads ({:.0} trials/s)",
@@ -721,15 +728,20 @@ pub fn run(a: &SenseArgs) -> Result<()> {
                 .or_else(|_| Ok(Box::new(Placeholder) as Box<dyn Classifier>))
         };
         let lenient: &Factory = &lenient;
+        let bar = super::progress::bar(a.placement_d.len() as u64, "offsets", a.quiet || a.json);
+        bar.set_message("placement ");
         let mut progress = |d: f64, rows: &[placement::Row]| {
-            for r in rows {
-                eprintln!(
-                    "placement d = {d:+.2} {:>6}: {:.3} bits ({})",
-                    r.sensor,
-                    r.mutual_information_bits,
-                    r.classifier.as_deref().unwrap_or("-")
-                );
-            }
+            bar.suspend(|| {
+                for r in rows {
+                    eprintln!(
+                        "placement d = {d:+.2} {:>6}: {:.3} bits ({})",
+                        r.sensor,
+                        r.mutual_information_bits,
+                        r.classifier.as_deref().unwrap_or("-")
+                    );
+                }
+            });
+            bar.inc(1);
         };
         let pl = pool
             .install(|| {
@@ -743,6 +755,7 @@ pub fn run(a: &SenseArgs) -> Result<()> {
                 )
             })
             .map_err(|e| anyhow!(e))?;
+        bar.finish_and_clear();
         eprintln!(
             "placement: {} offsets × {} sensor kinds in {:.2} s",
             a.placement_d.len(),

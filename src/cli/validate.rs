@@ -65,6 +65,9 @@ pub struct ModelArgs {
     /// Worker threads (0: one per core); the result does not depend on it.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 impl ModelArgs {
@@ -148,7 +151,8 @@ pub struct ValidateArgs {
     /// Nominal pin–part friction μc (replaced by `mu_c=` in --uncertain).
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
-    /// Nominal pin radius in part units (replaced by `pin_radius=` in --uncertain).
+    /// Nominal pin radius in part units, not metres, as `contact --pin-radius` (replaced by
+    /// `pin_radius=` in --uncertain).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Members of the ensemble.
@@ -336,11 +340,15 @@ impl ValidateArgs {
 pub fn run(args: &ValidateArgs) -> Result<()> {
     let (score, spec, measured) = args.inputs()?;
     let c = &args.common;
+    let bar = super::progress::bar(0, "passes", c.quiet || c.json);
+    let tell = super::progress::counter(&bar);
     let (rows, summary, _) = pool(c.threads)?
         .install(|| {
-            crate::validate::validate(&measured, &spec, c.seed, args.members, c.passes, &score)
+            let draw = (c.seed, args.members, c.passes);
+            crate::validate::validate_observed(&measured, &spec, draw, &score, &tell)
         })
         .map_err(anyhow::Error::msg)?;
+    bar.finish_and_clear();
     let mut command = format!(
         "pinfeed validate {} --mu-c {} --pin-radius {} --members {} {}",
         shell_word(&args.measured.display().to_string()),

@@ -1,12 +1,13 @@
 //! The table of `pinfeed compare`: one row per line design run on the same part stream (definitions
 //! in [`crate::study::compare`]), as aligned plain text for the terminal or as Markdown.
 
-use crate::study::compare::ComparisonRow;
+use crate::study::compare::{ComparisonRow, GoalWindow};
 
-const HEADER: [&str; 10] = [
+const HEADER: [&str; 11] = [
     "scenario",
     "obstacles",
     "parts",
+    "goal",
     "success (95% CI)",
     "footprint m",
     "across / belt m",
@@ -20,7 +21,23 @@ fn opt(v: Option<f64>, digits: usize) -> String {
     v.map_or_else(|| "n/a".into(), |x| format!("{x:.digits$}"))
 }
 
-fn cells(r: &ComparisonRow) -> [String; 10] {
+/// A goal as the table shows it: `name 6.6° ± 3°` per set (orientations joined by `/`), `any exit`
+/// without sets.
+pub fn goal_text(goal: &[GoalWindow]) -> String {
+    if goal.is_empty() {
+        return "any exit".into();
+    }
+    let sets: Vec<String> = goal
+        .iter()
+        .map(|g| {
+            let o: Vec<String> = g.orientations_deg.iter().map(|d| format!("{d}°")).collect();
+            format!("{} {} ± {}°", g.name, o.join("/"), g.tolerance_deg)
+        })
+        .collect();
+    sets.join("; ")
+}
+
+fn cells(r: &ComparisonRow) -> [String; 11] {
     let obstacles = match (r.pins, r.fences) {
         (0, 0) => "none".to_string(),
         (p, 0) => format!("{p} pin{}", if p == 1 { "" } else { "s" }),
@@ -31,6 +48,7 @@ fn cells(r: &ComparisonRow) -> [String; 10] {
         r.scenario.clone(),
         obstacles,
         r.parts_in.to_string(),
+        goal_text(&r.goal),
         format!(
             "{:.4} ({:.4}–{:.4})",
             r.success_rate, r.success_ci95[0], r.success_ci95[1]
@@ -46,7 +64,7 @@ fn cells(r: &ComparisonRow) -> [String; 10] {
 
 /// Aligned plain text.
 pub fn text(rows: &[ComparisonRow]) -> String {
-    let body: Vec<[String; 10]> = rows.iter().map(cells).collect();
+    let body: Vec<[String; 11]> = rows.iter().map(cells).collect();
     super::aligned::aligned_lines(&HEADER, &body).concat()
 }
 

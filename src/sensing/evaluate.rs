@@ -230,6 +230,18 @@ pub fn evaluate_with(
     config: &Config,
     factory: &Factory,
 ) -> Result<(TemplateSet, Evaluation), String> {
+    evaluate_observed(problem, points, config, factory, &crate::progress::silent)
+}
+
+/// [`evaluate_with`], telling `progress` the trials run of all (none while the templates are
+/// built).
+pub fn evaluate_observed(
+    problem: &Problem,
+    points: &[SensorPoint],
+    config: &Config,
+    factory: &Factory,
+    progress: crate::progress::Report,
+) -> Result<(TemplateSet, Evaluation), String> {
     if config.trials == 0 || config.trials > MAX_TRIALS {
         return Err(format!(
             "trials must lie in [1, {MAX_TRIALS}], got {}",
@@ -242,6 +254,7 @@ pub fn evaluate_with(
             config.templates_per_hypothesis
         ));
     }
+    let tally = crate::progress::Tally::new(config.trials as u64, progress);
     let templates = build_templates(
         problem.setup,
         problem.model,
@@ -285,6 +298,7 @@ pub fn evaluate_with(
         .map(|i| -> Result<Acc, String> {
             let mut acc = empty();
             let (truth, pass) = trial_pass(problem, config, i)?;
+            tally.add(1);
             let Some(truth) = truth else {
                 acc.1 = 1;
                 return Ok(acc);

@@ -4,6 +4,8 @@
 //! not depend on the thread count.
 //!
 //! Per scene:
+//! * **goal**: what counts as a success, each goal set's orientations and tolerance (designs with
+//!   different goal windows are not measured against the same target);
 //! * **success rate** with its 95% Wilson interval (as `pinfeed run`);
 //! * **footprint**: the belt length the design occupies — from the most upstream point of any
 //!   obstacle (a pin's disc, a fence's segment) to the most downstream one, plus the part's length
@@ -18,7 +20,7 @@
 
 use crate::engine::{self, EngineError, OutcomeCounts, RunOptions};
 use crate::geometry::Polygon;
-use crate::scenario::{Obstacle, Scene};
+use crate::scenario::{Goal, Obstacle, Scene};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -32,6 +34,8 @@ pub struct ComparisonRow {
     pub fences: usize,
     pub seed: u64,
     pub parts_in: u64,
+    /// What counts as a success: the goal sets; empty when every exiting part does (`any`).
+    pub goal: Vec<GoalWindow>,
     pub success_rate: f64,
     pub success_ci95: [f64; 2],
     /// [first, last] x of the obstacles (m).
@@ -51,6 +55,32 @@ pub struct ComparisonRow {
     pub contacts_per_part: f64,
     pub jams: u64,
     pub outcomes: OutcomeCounts,
+}
+
+/// One goal set of a scene: a part succeeds when its final orientation is within
+/// `tolerance_deg` of one of `orientations_deg`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GoalWindow {
+    pub name: String,
+    pub orientations_deg: Vec<f64>,
+    pub tolerance_deg: f64,
+}
+
+/// A scene's goal sets in degrees (none for `any`), rounded to 10⁻⁹° so that the degrees of the
+/// scenario file come back as written (not 3.0000000000000004 after radians and back).
+pub fn goal_windows(goal: &Goal) -> Vec<GoalWindow> {
+    let deg = |rad: f64| (rad.to_degrees() * 1e9).round() / 1e9;
+    match goal {
+        Goal::Any => Vec::new(),
+        Goal::Sets(sets) => sets
+            .iter()
+            .map(|s| GoalWindow {
+                name: s.name.clone(),
+                orientations_deg: s.orientations.iter().map(|&o| deg(o)).collect(),
+                tolerance_deg: deg(s.tolerance),
+            })
+            .collect(),
+    }
 }
 
 /// The greatest distance between two vertices of a polygon (its units).
@@ -85,6 +115,17 @@ pub fn compare(
     files: &[String],
     parts: u64,
 ) -> Result<Vec<ComparisonRow>, EngineError> {
+    compare_observed(scenes, files, parts, &crate::progress::silent)
+}
+
+/// [`compare`], telling `progress` the parts finished over all scenes of all.
+pub fn compare_observed(
+    scenes: &[Scene],
+    files: &[String],
+    parts: u64,
+    progress: crate::progress::Report,
+) -> Result<Vec<ComparisonRow>, EngineError> {
+    let tally = crate::progress::Tally::new(parts * scenes.len() as u64, progress);
     scenes
         .par_iter()
         .zip(files.par_iter())
@@ -93,7 +134,11 @@ pub fn compare(
                 parts,
                 ..RunOptions::from_scene(scene)
             };
-            let r = engine::run(scene, &opts, &mut |_| {})?;
+            let mut reported = 0;
+            let r = engine::run(scene, &opts, &mut |finished| {
+                tally.add(finished - reported);
+                reported = finished;
+            })?;
             let s = &r.summary;
             let span = obstacle_span(scene);
             let y_span = self::span(scene, Obstacle::y_range);
@@ -107,6 +152,7 @@ pub fn compare(
                 fences: count(|o| matches!(o, Obstacle::Fence(_))),
                 seed: s.seed,
                 parts_in: s.parts_in,
+                goal: goal_windows(&scene.goal),
                 success_rate: s.success_rate,
                 success_ci95: s.success_ci95,
                 obstacle_span_m: span,

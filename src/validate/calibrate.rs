@@ -21,7 +21,7 @@
 //! the grid is flagged: the data do not bound the parameter there.
 
 use super::measured::Measured;
-use super::predict::{predict, Predictions};
+use super::predict::{predict_observed, Predictions};
 use super::score::{RowKernel, ScoreSettings};
 use crate::maps::ensemble::EnsembleSpec;
 use crate::mechanics::support::SupportChoice;
@@ -289,7 +289,24 @@ fn profile_interval(x: &[f64], p: &[f64], best: f64) -> (f64, f64, bool, bool) {
 
 /// Calibrate the parameters to `measured`.
 pub fn calibrate(measured: &Measured, s: &CalibrationSettings) -> Result<Calibration, String> {
-    let pred = predict(measured, &s.proposal(), s.seed, s.members, s.passes)?;
+    calibrate_observed(measured, s, &crate::progress::silent)
+}
+
+/// [`calibrate`], telling `progress` first the proposal's passes run of all those needed, then the
+/// likelihood grid's cells done of all.
+pub fn calibrate_observed(
+    measured: &Measured,
+    s: &CalibrationSettings,
+    progress: crate::progress::Report,
+) -> Result<Calibration, String> {
+    let pred = predict_observed(
+        measured,
+        &s.proposal(),
+        s.seed,
+        s.members,
+        s.passes,
+        progress,
+    )?;
     let kernels: Vec<RowKernel> = measured
         .rows
         .iter()
@@ -299,12 +316,15 @@ pub fn calibrate(measured: &Measured, s: &CalibrationSettings) -> Result<Calibra
     let axes = s.axes();
     let (nm, ns, nt, nr) = (axes[0].len(), axes[1].len(), axes[2].len(), axes[3].len());
     // ll[((a · ns + b) · nr + c) · nt + t]
+    let tally = crate::progress::Tally::new((nm * ns * nr) as u64, progress);
     let cells: Vec<Vec<(f64, f64)>> = (0..nm * ns * nr)
         .into_par_iter()
         .map(|x| {
             let (a, b, c) = (x / (ns * nr), (x / nr) % ns, x % nr);
             let lw = log_weights(&pred, axes[0][a], axes[1][b], axes[3][c], s.pin_radius_sd);
-            shares_log_likelihood(&pred, &kernels, &lw, &axes[2], &s.score)
+            let cell = shares_log_likelihood(&pred, &kernels, &lw, &axes[2], &s.score);
+            tally.add(1);
+            cell
         })
         .collect();
     let at = |a: usize, b: usize, t: usize, c: usize| cells[(a * ns + b) * nr + c][t];

@@ -32,7 +32,20 @@ pub fn validate(
     passes: usize,
     score: &ScoreSettings,
 ) -> Result<(Vec<RowScore>, Summary, Predictions), String> {
-    let pred = predict::predict(measured, spec, seed, members, passes)?;
+    let draw = (seed, members, passes);
+    validate_observed(measured, spec, draw, score, &crate::progress::silent)
+}
+
+/// [`validate`] with `draw` = (seed, members, passes), telling `progress` the passes run of all
+/// those needed.
+pub fn validate_observed(
+    measured: &Measured,
+    spec: &EnsembleSpec,
+    (seed, members, passes): (u64, usize, usize),
+    score: &ScoreSettings,
+    progress: crate::progress::Report,
+) -> Result<(Vec<RowScore>, Summary, Predictions), String> {
+    let pred = predict::predict_observed(measured, spec, seed, members, passes, progress)?;
     let weights = vec![1.0; pred.members.len() * passes];
     let (rows, count) = score::score_rows(measured, &pred.rows, &weights, passes, score);
     let summary = score::summarise(&rows, count, score.contained_share);

@@ -37,6 +37,18 @@ pub fn predict(
     n: usize,
     passes: usize,
 ) -> Result<Predictions, String> {
+    predict_observed(measured, spec, seed, n, passes, &crate::progress::silent)
+}
+
+/// [`predict`], telling `progress` the passes run of all those needed.
+pub fn predict_observed(
+    measured: &Measured,
+    spec: &EnsembleSpec,
+    seed: u64,
+    n: usize,
+    passes: usize,
+    progress: crate::progress::Report,
+) -> Result<Predictions, String> {
     let compiled: Vec<(String, Vec<Member>, Vec<f64>)> = measured
         .parts
         .iter()
@@ -61,6 +73,7 @@ pub fn predict(
             }
         })
         .collect();
+    let tally = crate::progress::Tally::new((groups.len() * n * passes) as u64, progress);
     let mut predicted: Vec<Option<Vec<f64>>> = vec![None; groups.len()];
     for (row, &g) in measured.rows.iter().zip(&group_of) {
         if predicted[g].is_some() {
@@ -77,7 +90,9 @@ pub fn predict(
                 .map(|x| {
                     let (i, q) = (x / passes, x % passes);
                     let pass = (g * passes + q) as u64;
-                    ms[i].pass(poly, spec, &row.input, states, row.d, pass)
+                    let theta = ms[i].pass(poly, spec, &row.input, states, row.d, pass);
+                    tally.add(1);
+                    theta
                 })
                 .collect(),
         );

@@ -145,3 +145,92 @@ fn a_scenario_with_another_part_is_refused() {
     );
     assert!(err.contains("same shape, scale and support"), "{err}");
 }
+
+#[test]
+fn compare_shows_progress_on_a_terminal_and_nothing_otherwise() {
+    let (pins, fences) = (
+        scenario("quickstart.toml"),
+        scenario("tripoly2_fences.toml"),
+    );
+    let args = ["compare", &pins, &fences, "--parts", "600"];
+    let out = pinfeed(&args);
+    assert!(out.status.success());
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("/1200 parts"),
+        "no progress when standard error is not a terminal"
+    );
+    let log = std::env::temp_dir().join(format!("pinfeed-compare-{}.tty", std::process::id()));
+    let Some(text) = crate::support::pinfeed_on_terminal(&args, &log) else {
+        return;
+    };
+    assert!(text.contains("/1200 parts"), "{text}");
+    assert!(
+        text.contains("success (95% CI)"),
+        "the table follows: {text}"
+    );
+    let quiet = [&args[..], &["--quiet"]].concat();
+    let text = crate::support::pinfeed_on_terminal(&quiet, &log).unwrap();
+    assert!(
+        !text.contains("/1200 parts"),
+        "--quiet draws nothing: {text}"
+    );
+}
+
+/// Each design's goal stands beside its success: designs measured against different windows (or
+/// none) say so, in the table, in Markdown and in the JSON.
+#[test]
+fn each_design_shows_its_goal() {
+    let pins = scenario("tripoly1_pins_compact.toml");
+    let fences = scenario("tripoly1_fences.toml");
+    // The compact pins' scenario with every exiting part counted.
+    let text = std::fs::read_to_string(&pins).unwrap();
+    let goal = text.find("[goal]").unwrap();
+    let end = goal + text[goal..].find("\n\n").unwrap();
+    let any = format!("{}[goal]\nany = true{}", &text[..goal], &text[end..])
+        .replace("name = \"tripoly1_pins_compact\"", "name = \"every_exit\"");
+    let any_file =
+        std::env::temp_dir().join(format!("pinfeed-compare-any-{}.toml", std::process::id()));
+    std::fs::write(&any_file, any).unwrap();
+    let any_path = any_file.to_str().unwrap();
+
+    let doc: Value = crate::support::pinfeed_json(&[
+        "compare", &pins, &fences, any_path, "--parts", "20", "--json",
+    ]);
+    let rows = doc["designs"].as_array().unwrap();
+    assert_eq!(
+        rows[0]["goal"],
+        serde_json::json!([{"name": "apex-forward-left", "orientations_deg": [305.0], "tolerance_deg": 3.0}])
+    );
+    assert_eq!(
+        rows[1]["goal"],
+        serde_json::json!([{"name": "hypotenuse-down", "orientations_deg": [6.6], "tolerance_deg": 3.0}])
+    );
+    assert_eq!(rows[2]["goal"], serde_json::json!([]));
+
+    for format in [None, Some("--markdown")] {
+        let mut args = vec!["compare", &pins, &fences, any_path, "--parts", "20"];
+        args.extend(format);
+        let out = crate::support::pinfeed_ok(&args);
+        let text = String::from_utf8_lossy(&out.stdout);
+        let header = text
+            .lines()
+            .nth(if format.is_some() { 2 } else { 1 })
+            .unwrap();
+        assert!(header.contains("goal"), "{text}");
+        let row = |name: &str| {
+            text.lines()
+                .find(|l| l.trim_start_matches("| ").starts_with(name))
+                .unwrap_or_else(|| panic!("no row {name}: {text}"))
+                .to_string()
+        };
+        assert!(
+            row("tripoly1_pins_compact").contains("apex-forward-left 305° ± 3°"),
+            "{text}"
+        );
+        assert!(
+            row("tripoly1_fences").contains("hypotenuse-down 6.6° ± 3°"),
+            "{text}"
+        );
+        assert!(row("every_exit").contains("any exit"), "{text}");
+    }
+}

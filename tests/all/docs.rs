@@ -80,7 +80,7 @@ fn relative_links_resolve() {
 
 /// Split a shell command line into words: single and double quotes, backslash escapes; a `#`
 /// starting a word begins a comment.
-fn shell_words(line: &str) -> Vec<String> {
+pub(crate) fn shell_words(line: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut word = String::new();
     let mut in_word = false;
@@ -283,5 +283,85 @@ fn scenario_format_quotes_the_range_table() {
         quotes(moving, ACTUATOR_SPEED)
             && quotes(moving, ACTUATOR_ACCEL)
             && quotes(moving, ACTUATOR_TIME)
+    );
+}
+
+/// The flags that take a length (or a ratio of lengths): each is in docs/commands.md's table of
+/// units with the unit its `--help` names, and no command has one the table leaves out.
+#[test]
+fn every_length_flag_names_its_unit_as_the_units_table_does() {
+    use clap::CommandFactory;
+    const LENGTH_FLAGS: [&str; 13] = [
+        "pin-radius",
+        "pin-radius-max",
+        "pin-radius-sd",
+        "lateral",
+        "belt-width",
+        "spacing",
+        "scale",
+        "d",
+        "pin-stop-after",
+        "pin-stop-at",
+        "pin-stop-after-touch",
+        "d-jitter",
+        "fence-overhang",
+    ];
+    const UNITS: [&str; 3] = ["part units", "metres", "units of a"];
+    let text = std::fs::read_to_string(root().join("docs/commands.md")).unwrap();
+    let section = text
+        .split("## Units of length")
+        .nth(1)
+        .expect("docs/commands.md has a section on units")
+        .split("\n## ")
+        .next()
+        .unwrap();
+    // (command, flag) → unit, from the table's rows of plain flags.
+    let mut table = std::collections::BTreeMap::new();
+    for row in section.lines().filter(|l| l.starts_with("| `")) {
+        let cells: Vec<&str> = row.trim_matches('|').split(" | ").map(str::trim).collect();
+        let unit = UNITS
+            .iter()
+            .find(|u| cells[2].to_lowercase().starts_with(*u))
+            .unwrap_or_else(|| panic!("no unit in {row}"));
+        let ticked = |cell: &str| -> Vec<String> {
+            cell.split('`')
+                .skip(1)
+                .step_by(2)
+                .map(str::to_string)
+                .collect()
+        };
+        for flag in ticked(cells[0]).iter().filter(|f| !f.contains(' ')) {
+            for cmd in ticked(cells[1]) {
+                table.insert((cmd, flag.trim_start_matches("--").to_string()), *unit);
+            }
+        }
+    }
+    let mut seen = 0;
+    let cli = pinfeed::cli::Cli::command();
+    for sub in cli.get_subcommands() {
+        for arg in sub.get_arguments() {
+            let Some(long) = arg.get_long() else { continue };
+            if !LENGTH_FLAGS.contains(&long) {
+                continue;
+            }
+            seen += 1;
+            let key = (sub.get_name().to_string(), long.to_string());
+            let unit = table
+                .get(&key)
+                .unwrap_or_else(|| panic!("{key:?} is not in docs/commands.md's table of units"));
+            let help = arg
+                .get_help()
+                .map(|h| h.to_string().to_lowercase())
+                .unwrap_or_default();
+            assert!(
+                help.contains(unit),
+                "{key:?}: the table says {unit}, --help says: {help}"
+            );
+        }
+    }
+    assert_eq!(
+        seen,
+        table.len(),
+        "rows of the table that no command has: {table:?}"
     );
 }

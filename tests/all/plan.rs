@@ -697,24 +697,9 @@ fn plan_shows_progress_on_a_terminal_and_nothing_otherwise() {
         !String::from_utf8_lossy(&out.stderr).contains("plan "),
         "no progress when standard error is not a terminal"
     );
-    // Through a pseudo-terminal (util-linux `script`, on every Debian machine).
-    let has_script = std::process::Command::new("script")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !has_script {
-        eprintln!("`script` is not installed: the pseudo-terminal half of this test did not run");
+    let Some(text) = crate::support::pinfeed_on_terminal(&args, &tmp("progress.tty")) else {
         return;
-    }
-    let log = tmp("progress.tty");
-    let cmd = format!("{} {}", env!("CARGO_BIN_EXE_pinfeed"), args.join(" "));
-    let o = std::process::Command::new("script")
-        .args(["-qec", &cmd, log.to_str().unwrap()])
-        .stdin(std::process::Stdio::null())
-        .output()
-        .unwrap();
-    assert!([0, 3].contains(&o.status.code().unwrap_or(-1)), "{o:?}");
-    let text = String::from_utf8_lossy(&std::fs::read(&log).unwrap()).to_string();
+    };
     assert!(
         text.contains("plan ") && text.contains("searching"),
         "{text}"

@@ -60,3 +60,41 @@ pub fn report_text(dir: &std::path::Path, name: &str) -> String {
         .unwrap_or_else(|e| panic!("reading {}: {e}", dir.join(name).display()));
     without_dir(&text, dir)
 }
+
+/// What `pinfeed ARGS` shows on a terminal: run through a pseudo-terminal (util-linux `script`,
+/// on every Debian machine), the bytes the terminal received, standard output and error together
+/// (a copy is left in `log`). None, with a note, when `script` is not installed.
+pub fn pinfeed_on_terminal(args: &[&str], log: &Path) -> Option<String> {
+    let has_script = Command::new("script")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_script {
+        eprintln!("`script` is not installed: the pseudo-terminal half of this test did not run");
+        return None;
+    }
+    let quoted: Vec<String> = std::iter::once(env!("CARGO_BIN_EXE_pinfeed"))
+        .chain(args.iter().copied())
+        .map(|a| format!("'{}'", a.replace('\'', r"'\''")))
+        .collect();
+    let o = Command::new("script")
+        .args([
+            "-qec",
+            &quoted.join(" "),
+            log.to_str().expect("a UTF-8 path"),
+        ])
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("run script");
+    assert!([0, 3].contains(&o.status.code().unwrap_or(-1)), "{o:?}");
+    Some(String::from_utf8_lossy(&std::fs::read(log).expect("the terminal's log")).to_string())
+}
+
+/// A fresh, empty folder `pinfeed-<tag>-<process id>` in the system's temporary folder (a test
+/// names it after its module and itself, so no other test uses it).
+pub fn fresh_dir(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("pinfeed-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("creating a temporary folder");
+    d
+}

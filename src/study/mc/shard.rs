@@ -129,8 +129,8 @@ pub struct ShardPoint {
     pub sensor_correct: u64,
 }
 
-fn is_zero(n: &u64) -> bool {
-    *n == 0
+fn is_zero<T: Default + PartialEq>(n: &T) -> bool {
+    *n == T::default()
 }
 
 /// Which shard a file holds.
@@ -145,6 +145,12 @@ pub struct ShardId {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShardFile {
+    /// [`crate::SCHEMA_VERSION`] and the version of the binary that wrote the shard (absent from
+    /// shards written before they were added: such a file keeps its checksum and merges as before).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub schema_version: u32,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub pinfeed_version: String,
     pub format: String,
     pub format_version: u32,
     pub header: StudyHeader,
@@ -191,6 +197,8 @@ impl ShardFile {
             })
             .collect();
         ShardFile {
+            schema_version: crate::SCHEMA_VERSION,
+            pinfeed_version: header.pinfeed_version.clone(),
             format: FORMAT.to_string(),
             format_version: FORMAT_VERSION,
             header: header.clone(),
