@@ -1,4 +1,4 @@
-//! Time per classification (issue 12: one likelihood classification of 3 hypotheses × 64
+//! Time per classification (one likelihood classification of 3 hypotheses × 64
 //! templates ≤ 50 µs). Run: `cargo bench --bench classify`.
 
 use criterion::{criterion_group, criterion_main, Criterion};

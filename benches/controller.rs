@@ -1,4 +1,4 @@
-//! What the online controller costs (issue 13: ≤ 5% of a sensed line's run time). The bundled
+//! What the online controller costs (≤ 5% of a sensed line's run time). The bundled
 //! sensing line, 150 parts, three ways:
 //! * `no_controller`: the moving pin stays home, no rules (the sensor still reads every part);
 //! * `controller_home`: the controller runs — decisions, commands, the per-part service of the

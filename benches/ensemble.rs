@@ -1,4 +1,4 @@
-//! Ensemble maps (issue 16): tripoly1, 200 members × 6 d × 360 θ0 (432 000 passes, exact model)
+//! Ensemble maps: tripoly1, 200 members × 6 d × 360 θ0 (432 000 passes, exact model)
 //! with μc, support, pin radius and pose all uncertain; the target is under a minute on 2 cores.
 //! The timed CLI run and its figure are in results/validation.md.
 

@@ -1,4 +1,4 @@
-//! The map tier against the exact model on the same pushes (issue 15 item 3: ≥ 100× faster per
+//! The map tier against the exact model on the same pushes (≥ 100× faster per
 //! contact). tripoly2, a pin of radius 0.1 a, μc 0.5, tol 1e-6, the default grid (read from the
 //! cache folder, built on the first run). Three measurements over 256 random pushes (θ0 uniform,
 //! d uniform in ±0.6): `served` — the pushes the map answers (ray cast + interpolation),

@@ -1,4 +1,4 @@
-//! The sensorless pin planner (issue 14): tripoly2's shortest plan with the CLI's defaults (the
+//! The sensorless pin planner: tripoly2's shortest plan with the CLI's defaults (the
 //! target is < 1 s on 2 cores), and an exhaustive depth-8 search (random:18, whose answer is
 //! "none up to depth 8"; the target is < 30 s), each from a cold memo every iteration. The other
 //! exhaustive searches are measured by `pinfeed plan` itself and reported in results/plans.md.

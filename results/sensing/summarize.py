@@ -84,7 +84,7 @@ def pct(x):
 def main():
     out = []
     w = out.append
-    w("# What a sensor pin can tell: TriPoly1 and TriPoly2 (issue 12, item 6)\n")
+    w("# What a sensor pin can tell: TriPoly1 and TriPoly2\n")
     w("Regenerate from the repository root with\n")
     w("    sh results/sensing/regenerate.sh\n")
     w(

@@ -305,7 +305,7 @@ fn bench_maps(repeats: usize, out: &std::path::Path) -> Result<()> {
          (6480 contacts: sampling, bands and runs; no printing, files or figures), point pin, \
          μc = 0.5, uniform pressure, tolerance 1e-6: median, min and max of {repeats} runs after \
          one warm-up. *µs per contact* is thread-time per contact (median × threads / contacts). \
-         Target (issue 4): under 0.5 s with the exact model on 2 cores.\n\n{table}",
+         Target: under 0.5 s with the exact model on 2 cores.\n\n{table}",
         out.display()
     );
     if let Some(dir) = out.parent() {

@@ -1,5 +1,5 @@
 //! `pinfeed compare A.toml B.toml ...`: run line designs on the same part stream and print one
-//! table (issue 5: pin layouts measured against fence designs; [`crate::study::compare`]).
+//! table (pin layouts measured against fence designs; [`crate::study::compare`]).
 //!
 //! The same part stream: the first scenario's feed (number of parts, arrivals, orientation and
 //! lateral distributions) and seed are imposed on every scenario ([`crate::scenario::FeedSource`]),

@@ -1,4 +1,4 @@
-//! `pinfeed map … --uncertain LIST`: ensemble maps (issue 16, [`crate::maps::ensemble`]). Every
+//! `pinfeed map … --uncertain LIST`: ensemble maps ([`crate::maps::ensemble`]). Every
 //! member passes at every (d, θ0 on the grid); per d and input state (all θ0, and each stable
 //! state) the pooled θf give the predicted bands (smallest arcs holding 90%) and the share of the
 //! circle they cover. Standard output gets the band table; unless `--no-write`, the report directory

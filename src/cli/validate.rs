@@ -1,4 +1,4 @@
-//! `pinfeed validate MEASURED.csv`: measured bands against an ensemble's predictions (issue 16,
+//! `pinfeed validate MEASURED.csv`: measured bands against an ensemble's predictions (
 //! [`crate::validate`]). Standard output gets one line per measured row (contained, overlapping,
 //! centre offset, predicted probability of the measured band, log score, predicted bands) and the
 //! summary; `--json` prints the whole report instead. Unless `--no-write`, the report directory

@@ -1,4 +1,4 @@
-//! What a run measures, accumulated as events happen (docs/physics.md#the-line; issue 7 "Metrics"), and the
+//! What a run measures, accumulated as events happen (docs/physics.md#the-line), and the
 //! deterministic [`Summary`] built from it.
 //!
 //! Definitions:

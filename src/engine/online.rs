@@ -482,57 +482,78 @@ impl Evidence {
 /// Both powers are chosen together on held-out members (readings neither channel was built from;
 /// `trials` holds their true hypothesis and raw evidence), each from 1 down to 10⁻⁶ in
 /// half-decades or 0 (the channel unused): the pair whose decisions do best on them (the mean
-/// success(a*, h_true) of the command the belief after their reading chooses); among pairs whose
-/// decisions do as well (within [`TIE`]), one without the matched filter (which costs far more per
-/// reading than the classifier; a channel with power 0 is not computed), then the best mean log
-/// posterior of their true hypothesis — a tempered likelihood, calibrated by cross-validation on
-/// what the controller does with it.
+/// success(a*, h_true) of the command the belief after their reading chooses), within [`TIE`] the
+/// best mean log posterior of their true hypothesis. The matched filter costs far more per reading
+/// than the classifier (a channel with power 0 is not computed), so the best pair with it is
+/// taken over the best without it only when its decisions do better by more than twice the
+/// standard error of the paired differences over the held-out trials — a tempered likelihood,
+/// calibrated by cross-validation on what the controller does with it.
 fn temper(model: &OnlineModel, i: usize, trials: &[(usize, Evidence)]) -> (f64, f64) {
     if trials.is_empty() {
         return (1.0, 1.0);
     }
     let p_touch = &model.sensors[i].p_touch;
-    let score = |tau: f64, sigma: f64| -> (f64, f64) {
-        let mut won = 0.0;
+    // Per trial: the success of the command chosen, and the log posterior of the truth.
+    let score = |tau: f64, sigma: f64| -> (Vec<f64>, f64, f64) {
+        let mut won = Vec::with_capacity(trials.len());
         let mut log = 0.0;
         for (h, ev) in trials {
             let mut b = model.prior.clone();
             b.observe_reading(p_touch, ev.combine(tau, sigma).as_deref());
-            won += model.success_of(model.choose(&b).action)[*h];
+            won.push(model.success_of(model.choose(&b).action)[*h]);
             log += b.probability(*h).max(1e-300).ln();
         }
         let n = trials.len() as f64;
-        (won / n, log / n)
+        let mean = won.iter().sum::<f64>() / n;
+        (won, mean, log / n)
     };
-    // From both channels off up.
     let powers: Vec<f64> = std::iter::once(0.0)
         .chain((0..=12).rev().map(|k| 10f64.powf(-(k as f64) / 2.0)))
         .collect();
-    let mut pairs: Vec<(f64, f64)> = Vec::new();
-    for &tau in &powers {
-        for &sigma in &powers {
-            pairs.push((tau, sigma));
+    let pairs: Vec<(f64, f64)> = powers
+        .iter()
+        .flat_map(|&tau| powers.iter().map(move |&sigma| (tau, sigma)))
+        .collect();
+    let scores: Vec<(Vec<f64>, f64, f64)> = pairs.par_iter().map(|&(t, s)| score(t, s)).collect();
+    // The best pair of a class: the best mean success, within TIE the best log score.
+    let best_of = |filter: bool| -> usize {
+        let mut best: Option<usize> = None;
+        for (k, sc) in scores.iter().enumerate() {
+            if (pairs[k].0 > 0.0) != filter {
+                continue;
+            }
+            let better = best.is_none_or(|b| {
+                let b = &scores[b];
+                if (sc.1 - b.1).abs() > TIE {
+                    sc.1 > b.1
+                } else {
+                    sc.2 > b.2 + 1e-9
+                }
+            });
+            if better {
+                best = Some(k);
+            }
         }
+        best.expect("both classes have pairs")
+    };
+    let (cheap, costly) = (best_of(false), best_of(true));
+    // The filter costs far more per reading than the classifier: it is kept only when its
+    // decisions beat the best without it by more than twice the standard error of the paired
+    // differences over the held-out trials.
+    let d: Vec<f64> = scores[costly]
+        .0
+        .iter()
+        .zip(&scores[cheap].0)
+        .map(|(a, b)| a - b)
+        .collect();
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    if mean > 2.0 * (var / n).sqrt() && mean > TIE {
+        pairs[costly]
+    } else {
+        pairs[cheap]
     }
-    // The filter costs far more per reading than the classifier: every pair without it first.
-    pairs.sort_by_key(|&(tau, _)| tau > 0.0);
-    let scores: Vec<(f64, f64)> = pairs.par_iter().map(|&(t, s)| score(t, s)).collect();
-    let mut best = 0;
-    let costly = |k: usize| pairs[k].0 > 0.0;
-    for (k, sc) in scores.iter().enumerate() {
-        let b = scores[best];
-        let better = if (sc.0 - b.0).abs() > TIE {
-            sc.0 > b.0
-        } else if costly(k) != costly(best) {
-            !costly(k)
-        } else {
-            sc.1 > b.1 + 1e-9
-        };
-        if better {
-            best = k;
-        }
-    }
-    pairs[best]
 }
 
 /// Each sensor's clean signal when a part entering as `e` meets it on the line `base` (None:

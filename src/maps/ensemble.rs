@@ -1,4 +1,4 @@
-//! Ensemble maps (issue 16): configuration maps under uncertain physics. Each ensemble *member*
+//! Ensemble maps: configuration maps under uncertain physics. Each ensemble *member*
 //! is one draw of the uncertain parameters — pin–part friction μc, the support (uniform pressure,
 //! or with probability `support_share` a random tripod or random smooth density, drawn as the
 //! Monte Carlo studies draw them: [`crate::mechanics::support::draw_support`]), the pin radius — and

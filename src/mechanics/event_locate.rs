@@ -121,7 +121,7 @@ const ANCHOR_REACH: f64 = 1e-4;
 /// A Dormand–Prince sub-step of fraction `t` of the accepted `step` from the cursor, when it is
 /// valid (its own error estimate within 10× the tolerance, the step guard, and within 1e3·tol
 /// of the dense output): its end state and the rates there. An untrusted sub-step's state means
-/// nothing (the −880° case of issue 11 landed on one): the landing then uses the dense output.
+/// nothing (the −880° case landed on one): the landing then uses the dense output.
 fn real_substep(
     ctx: &mut Ctx,
     at: &Cursor,

@@ -1,4 +1,4 @@
-//! Tabulated sliding twists: the exact model's slide solves without solving (issue 15, "per-part
+//! Tabulated sliding twists: the exact model's slide solves without solving ("per-part
 //! precomputed" data for the exact contact).
 //!
 //! While a pin slides on a part, the contact force lies on one edge of the friction cone,

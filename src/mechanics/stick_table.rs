@@ -1,4 +1,4 @@
-//! Tabulated sticking twists: the exact model's stick solves on an edge without solving (issue 15;
+//! Tabulated sticking twists: the exact model's stick solves on an edge without solving (
 //! the companion of `mechanics::slide_table`).
 //!
 //! While a pin sticks on edge k at ℓ, the contact point p = a_k + ℓ e_k moves with the pin: its

@@ -1,5 +1,5 @@
 //! The actions of a state: not a blind grid, but one pin position per interval of the lateral
-//! grid over which no particle's pass changes qualitatively (issue 14; thesis ch. 4's band and
+//! grid over which no particle's pass changes qualitatively (thesis ch. 4's band and
 //! no-contact edges).
 //!
 //! Every pin position on the grid (step = the lateral quantum) within reach of some particle and on

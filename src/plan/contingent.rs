@@ -1,4 +1,4 @@
-//! The **contingent planner with sensing** (issue 14 part 2): a sensor pin reads which stable
+//! The **contingent planner with sensing**: a sensor pin reads which stable
 //! state a part arrived in, and each decision gets its own continuation on `k` moving pins.
 //!
 //! The line: a sensor pin (it pushes like any pin) at `spacing`, then `k` moving pins at

@@ -1,4 +1,4 @@
-//! The **fence planner** (issue 14 part 3): the same breadth-first search, each action a fence
+//! The **fence planner**: the same breadth-first search, each action a fence
 //! (SPEC §6) instead of a pin.
 //!
 //! A fence action is an angle α from a candidate set (±15° … ±60° in 5° steps by default, only

@@ -1,4 +1,4 @@
-//! Planning pin layouts (issue 14, thesis ch. 4 "Fixed Pins"): the **sensorless pin planner**.
+//! Planning pin layouts (thesis ch. 4 "Fixed Pins"): the **sensorless pin planner**.
 //!
 //! Given a part, a feed (its stable states with jitter and a lateral offset range, or any
 //! orientation), the physics (μc, pin radius, optionally a μc range and tripod supports to be

@@ -1,4 +1,4 @@
-//! SVG figures of ensemble predictions and measured bands (issue 16):
+//! SVG figures of ensemble predictions and measured bands:
 //! [`plot_band_distributions`] draws, at each d, the predicted distribution of θf as a violin
 //! (width ∝ share per 1° bin, scaled to the largest bin of the figure), its 90% predicted bands as
 //! bars beside it, and optionally the measured bands as red bars with end ticks on the other side.

@@ -1,4 +1,4 @@
-//! Several line designs on one part stream (`pinfeed compare`, issue 5: pin layouts measured
+//! Several line designs on one part stream (`pinfeed compare`: pin layouts measured
 //! against fence designs). Each scene runs on the same parts ([`crate::scenario::FeedSource`]);
 //! the runs are independent and go in parallel, each a pure function of its scene, so the rows do
 //! not depend on the thread count.

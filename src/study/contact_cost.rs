@@ -385,7 +385,7 @@ pub fn scaling_markdown(rows: &[ScalingRow]) -> String {
     s
 }
 
-/// Where the contact targets of issue 15 land, from the reference parts' rows.
+/// Where the contact targets land, from the reference parts' rows.
 pub fn targets(rows: &[ContactCostRow], scaling: &[ScalingRow]) -> String {
     let medians = |fid: &str| -> Vec<String> {
         rows.iter()

@@ -1,4 +1,4 @@
-//! What the line adds to its contacts (issue 15 item 2): a scenario's run against the very pushes
+//! What the line adds to its contacts: a scenario's run against the very pushes
 //! it asked for, run again as a bare batch.
 //!
 //! The line is run once with [`engine::run_capturing`] to collect every push (part model, obstacle,

@@ -1,4 +1,4 @@
-//! Measured bands against the model (issue 16): `pinfeed validate` and `pinfeed calibrate`.
+//! Measured bands against the model: `pinfeed validate` and `pinfeed calibrate`.
 //!
 //! * [`measured`]: the measured-bands CSV and its located errors;
 //! * [`input`]: the member count, the ensemble and the measured file, checked;

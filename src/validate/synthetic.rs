@@ -1,4 +1,4 @@
-//! A synthetic measured-bands file the project makes itself (issue 16): bands drawn from a hidden
+//! A synthetic measured-bands file the project makes itself: bands drawn from a hidden
 //! parameter set, so that calibration and validation can be checked against a known truth.
 //!
 //! Row (d, input) of the design summarises `trials` trials; trial t of row r is one pass (pass 0)
@@ -120,7 +120,7 @@ pub fn synthesize(design: &SyntheticDesign) -> Result<String, String> {
         .collect();
     let mut out = String::new();
     out.push_str(&format!(
-        "# Synthetic measured bands (pinfeed issue 16): part {}, {} trials a row, seed {}.\n",
+        "# Synthetic measured bands: part {}, {} trials a row, seed {}.\n",
         design.part, design.trials, design.seed
     ));
     out.push_str("# Regenerate: pinfeed calibrate tests/fixtures/validate/synthetic.csv --synthesize --jitter 3\n");

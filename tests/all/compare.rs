@@ -1,4 +1,4 @@
-//! `pinfeed compare` (issue 5): several designs on the same part stream, one row each, the same
+//! `pinfeed compare`: several designs on the same part stream, one row each, the same
 //! JSON byte for byte on every run; scenarios that cannot share the stream are refused.
 
 use crate::support::pinfeed;

@@ -1,4 +1,4 @@
-//! Fuzzing the command line and polygon validation (issue 11), bounded to run in CI.
+//! Fuzzing the command line and polygon validation, bounded to run in CI.
 //!
 //! * Random and mutated argument vectors for `part`, `contact` and `map --no-write` (small grids),
 //!   built from the real flags with numbers drawn across every magnitude and from the awkward

@@ -1,4 +1,4 @@
-//! Property tests over generated and mutated scenario and study files (issue 11): the bundled
+//! Property tests over generated and mutated scenario and study files: the bundled
 //! scenarios/*.toml and studies/*.toml and the fixtures, with numbers set to extremes (0,
 //! negatives, 5e-324, 1e-200, 1e308, nan, ±inf, huge integers), keys set, deleted, duplicated or
 //! renamed, types changed, sections dropped and files truncated

@@ -1,4 +1,4 @@
-//! Named regression tests for the command-line and polygon failures of issue 11 (fuzzing found
+//! Named regression tests for the command-line and polygon failures (fuzzing found
 //! them on main at 844e5c1): huge polygons that printed inf/NaN or panicked, misleading refusals,
 //! `Polygon::scaled` panicking at extreme factors, and nonsense numbers accepted with status `ok`.
 //! Each test runs the reproducer from the issue and asserts the clean outcome: a refusal naming the

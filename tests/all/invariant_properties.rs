@@ -1,4 +1,4 @@
-//! Physics invariants of the contact model as property tests over random polygons (issue 11):
+//! Physics invariants of the contact model as property tests over random polygons:
 //! mirror symmetry, scale invariance (point and disc pins, tripods, fences), Mason's vote along whole
 //! pushes, convergence under tolerance refinement, continuity as the pin radius goes to 0, and the
 //! fence jam rule for both signs of the fence angle. Each property says how it would fail.

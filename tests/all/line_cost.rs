@@ -1,4 +1,4 @@
-//! `pinfeed bench line` (issue 15 item 2): the pushes the line captures are exactly the pushes it
+//! `pinfeed bench line`: the pushes the line captures are exactly the pushes it
 //! computed, the bare batch replays them with the same work, and the section lands in the report.
 
 use pinfeed::engine::{run, run_capturing, RunOptions};

@@ -1,4 +1,4 @@
-//! Fences on the line (issue 5): a long fence delivers every part in the orientation it leaves a
+//! Fences on the line: a long fence delivers every part in the orientation it leaves a
 //! flush edge in; a fence at the jam angle jams parts (and just below it does not, but holds them
 //! so long that the next part catches up: a collision); a fence that carries parts over the belt's
 //! edge drops them; a pin beside a fence is a second contact; the per-obstacle counters include

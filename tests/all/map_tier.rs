@@ -1,4 +1,4 @@
-//! The certified map tier (issue 15 item 3): answers within 0.05° of the exact model where it
+//! The certified map tier: answers within 0.05° of the exact model where it
 //! serves, the exact model near a jump, a cache keyed by every input, corrupted files refused and
 //! rebuilt, a build independent of the thread count, and a line with `fidelity = "map"` that
 //! ends every part in the class the exact line does.

@@ -1,4 +1,4 @@
-//! Monte Carlo studies perturb every obstacle (issue 29, item 3): the fence parameters (μf,
+//! Monte Carlo studies perturb every obstacle: the fence parameters (μf,
 //! angle, upstream end, length), the actuator parameters (speed, acceleration, settle) and the
 //! controller's latency each change what they should and nothing else, each from its own stream;
 //! a fence μf drawn into the jam region is reported as jams; a parameter that reaches nothing in

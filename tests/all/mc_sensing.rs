@@ -1,4 +1,4 @@
-//! Monte Carlo studies with sensor pins (issue 12, item 5): the sensor parameters parse, describe
+//! Monte Carlo studies with sensor pins: the sensor parameters parse, describe
 //! themselves and are refused with a location when out of range or when the scenario has no
 //! sensor pin; each sample perturbs every sensor pin's settings and keeps its trained classifier;
 //! a sensor pin is a pin for the pin errors; the report carries the sensors' accuracy, which falls

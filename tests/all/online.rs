@@ -1,4 +1,4 @@
-//! Dynamic pins and the online controller in the line (issue 13): the bundled sensing line, late
+//! Dynamic pins and the online controller in the line: the bundled sensing line, late
 //! actuations, retractable pins, determinism, zero controller work in passive scenes, and located
 //! errors for bad actuators, rules and policy files.
 

@@ -1,4 +1,4 @@
-//! `pinfeed plan` (issue 14, the sensorless pin planner): the default tripoly2 plan orients ≥ 99%
+//! `pinfeed plan` (the sensorless pin planner): the default tripoly2 plan orients ≥ 99%
 //! on the line; a returned plan is shortest (brute force over every action sequence of a small
 //! case); plans are deterministic for a seed; the emitted scenario parses and runs; bad inputs and
 //! searches that hit their limits end with a clear message and a non-zero exit; "no plan up to
@@ -436,7 +436,7 @@ fn survey_of_designs_agrees_with_the_planner_it_runs() {
 
 #[test]
 fn every_designed_bundled_scenario_names_the_plan_command_for_its_feed() {
-    // The scripts that designed the first bundled layouts are gone (issue 14); each designed
+    // The scripts that designed the first bundled layouts are gone; each designed
     // scenario's header names the `pinfeed plan` command that designs its line today, and that
     // command is a valid one (stopped here at once by a state limit of 1).
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));

@@ -1,4 +1,4 @@
-//! `pinfeed plan --fences` (issue 14 part 3, the fence planner): the tripoly1 fence plan orients
+//! `pinfeed plan --fences` (the fence planner): the tripoly1 fence plan orients
 //! ≥ 99% on the line and runs unchanged through `pinfeed run`; the emitted fences respect the jam
 //! limit (|α| + atan μf < 90°) and lie over the belt; a belt too narrow for any fence (the pin
 //! planner's 10 cm) is a reported answer; plans are deterministic; `--fences` with `--sensor` allows

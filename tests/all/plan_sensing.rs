@@ -1,4 +1,4 @@
-//! `pinfeed plan --sensor` (issue 14 part 2, the contingent planner): tripoly1 gets a sensor pin
+//! `pinfeed plan --sensor` (the contingent planner): tripoly1 gets a sensor pin
 //! and per-decision moving pins whose scenario and policy file `pinfeed run` executes unchanged
 //! and that orient ≥ 95% on the line; the policy names the part; plans are deterministic for a
 //! seed.

@@ -1,4 +1,4 @@
-//! Classifier tests (issue 12, "Classifiers" and the classifier bullets of "Acceptance"): zero
+//! Classifier tests ("Classifiers" and the classifier bullets of "Acceptance"): zero
 //! noise classifies the templates' own pushes, unbounded noise falls to chance or Unknown, the
 //! posterior and the reject option, the zero-crossing rule on synthetic profiles, bad names.
 

@@ -1,6 +1,6 @@
 //! The independent slow reference (module `reference`) checked on its own, then compared with the
 //! production contact model (`pinfeed::mechanics::push`, exact fidelity, default tolerance) over
-//! random whole pushes (issue 11, "an independent slow reference inside the tests").
+//! random whole pushes ("an independent slow reference inside the tests").
 //!
 //! Cases (seeded, deterministic): random convex polygons with 3–8 vertices (points on a random
 //! ellipse, at a random scale), θ0 uniform, d uniform over the range that touches, μc ∈ [0, 1.5]

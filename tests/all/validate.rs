@@ -1,4 +1,4 @@
-//! Measured bands against the model (issue 16): the synthetic recovery, scoring on hand-made cases
+//! Measured bands against the model: the synthetic recovery, scoring on hand-made cases
 //! (bands across 0°/360° included), thread-count independence, located errors for bad files.
 
 use crate::support::pinfeed;

@@ -1,4 +1,4 @@
-//! The certified map tier (issue 15, item 3): a pin's whole push, tabulated over initial
+//! The certified map tier: a pin's whole push, tabulated over initial
 //! orientation θ0 × contact parameter d for one (part, support, pin radius, μc, tolerance, travel
 //! and evaluation budgets, grid), answered by interpolation where the table is certified and by the
 //! exact model everywhere else, so that every answer is within 0.05° of exact or is exact.

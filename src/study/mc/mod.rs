@@ -1,4 +1,4 @@
-//! Monte Carlo robustness studies (issue 6): how often a line orients its parts when the physics
+//! Monte Carlo robustness studies: how often a line orients its parts when the physics
 //! and the build are uncertain.
 //!
 //! A study file (TOML, docs/study-format.md) points at a scenario and declares uncertain

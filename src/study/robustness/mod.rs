@@ -1,4 +1,4 @@
-//! Fuzzing the simulator's inputs in-process (issue 11): generated and mutated scenario and study
+//! Fuzzing the simulator's inputs in-process: generated and mutated scenario and study
 //! files, random contacts and random polygons, each run under `catch_unwind` with a per-case
 //! watchdog, tallied into clean errors, successes, panics, hangs, non-finite outputs and contact
 //! self-check disagreements (`pinfeed fuzz`, results/robustness.md).
