@@ -201,9 +201,16 @@ fn online_block(
     let temper: Vec<String> = on
         .temper
         .iter()
-        .map(|(k, v)| {
+        .map(|(k, &v)| {
             let sigma = on.classifier_power.get(k).copied().unwrap_or(0.0);
-            format!("{k} filter {v:.0e}, classifier {sigma:.0e}")
+            let power = |p: f64| {
+                if p > 0.0 {
+                    format!("{p:.0e}")
+                } else {
+                    "off".to_string()
+                }
+            };
+            format!("{k} filter {}, classifier {}", power(v), power(sigma))
         })
         .collect();
     let _ = writeln!(

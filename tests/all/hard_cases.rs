@@ -464,8 +464,10 @@ fn star_polygon(radii: &[f64], jitter: &[f64]) -> Option<Polygon> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 96, .. ProptestConfig::default() })]
-    /// Random simple polygons, offsets, friction and pin radii: finite, bounded, never a solver failure.
+    #![proptest_config(ProptestConfig { cases: 96, rng_seed: proptest::test_runner::RngSeed::Fixed(20261127), .. ProptestConfig::default() })]
+    /// Random simple polygons, offsets, friction and pin radii: finite, bounded, never a solver
+    /// failure (a push that rides an unstable equilibrium ends `metastable`, an honest verdict).
+    /// The seed is fixed, so every run tries the same cases.
     #[test]
     fn random_polygons_stay_finite(
         radii in prop::collection::vec(0.3f64..1.5, 3..9),
@@ -483,7 +485,13 @@ proptest! {
         let o = run(&m, &p, theta, d, pin, &s);
         check(&o, "random polygon");
         prop_assert!(
-            matches!(o.status, ContactStatus::Ok | ContactStatus::MultiContact { .. } | ContactStatus::TravelLimit { .. }),
+            matches!(
+                o.status,
+                ContactStatus::Ok
+                    | ContactStatus::MultiContact { .. }
+                    | ContactStatus::TravelLimit { .. }
+                    | ContactStatus::Metastable { .. }
+            ),
             "status {:?}", o.status
         );
     }

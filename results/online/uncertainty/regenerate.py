@@ -221,7 +221,7 @@ def write_report(rows, details, bench):
     w("The bound does not depend on the sensor: it is what the moving pins of the line can do once everything the belief can name is known. What is left is the tripod itself — where the part's weight rests decides how a push turns it, and neither the state, the offset nor the friction tells it. A second sensor (the `online, 2 sensors` rows) makes the belief surer of the state but cannot lift the bound, and its own pushes change the line the mover and merge pins were laid out for. Reaching 95% under random tripods needs a line whose pushes do not depend on the support (the robust sensorless tripoly2 design, planned against random tripods, loses only a few points between nominal physics and the uncertainty), or hypotheses that describe the support well enough to be told apart by the readings. With one sensor and at most three dynamic pins on these layouts the measurements say it is out of reach; the bundled studies are the best online designs found, and the table above is their measurement.\n")
     w("## What the online controller knows and does\n")
     w(f"From `pinfeed run --json` of each online line, {RUN_PARTS} parts at nominal physics and {RUN_PARTS} on random tripods (μc 0.5). *State found*: decisions at which the true stable state was the most probable one. *Bounds* are what the controller's own model says the line can do: the best single command with no information, and the mean of each hypothesis's best command — a belief certain of the state, the offset bin, μ and the support class, which still cannot know the tripod itself or the jitter.\n")
-    w("*Powers*: per sensor, the power of the matched filter over the hypotheses' templates and of the sensor classifier's posterior over the states (0: the channel is not used), chosen on held-out members by the success of the decisions they lead to.\n")
+    w("*Powers*: per sensor, the power of the matched filter over the hypotheses' templates and of the sensor classifier's posterior over the states (off: the channel is not used), chosen on held-out members by the success of the decisions they lead to.\n")
     w("| part | physics | success | predicted | entropy before → after (bits) | state found | powers: filter, classifier | bound, no information | bound, certain hypothesis |")
     w("|---|---|---|---|---|---|---|---|---|")
     for d in details:
@@ -230,7 +230,8 @@ def write_report(rows, details, bench):
             o2 = s["controller"]["online"]
             b = [x for x in o2["bounds"] if x["support"] == support]
             b = b[0] if b else {"no_information": float("nan"), "certain_hypothesis": float("nan")}
-            t = ", ".join(f"{k} {v:.0e}, {o2.get('classifier_power', {}).get(k, 0.0):.0e}" for k, v in o2["temper"].items())
+            power = lambda p: f"{p:.0e}" if p > 0 else "off"
+            t = ", ".join(f"{k} {power(v)}, {power(o2.get('classifier_power', {}).get(k, 0.0))}" for k, v in o2["temper"].items())
             w(f"| {d['part']} | {phys} | {pct(s['success_rate'])} | {o2['predicted_mean']:.3f} | {o2['entropy_prior_bits']:.2f} → {o2['entropy_posterior_bits']:.2f} | {o2['state_correct']} of {o2['state_known']} | {t} | {b['no_information']:.3f} | {b['certain_hypothesis']:.3f} |")
     w("")
     w("### Calibration (predicted success against observed, same parts)\n")
