@@ -4,7 +4,8 @@
 //!   channels its model calibrated in), the belief's update, and the choice of the joint command
 //!   — what the controller computes when a reading arrives; and the choice alone;
 //! * `line_150_parts/*`: the same line driven by its rules and by the online controller (the
-//!   model is built once, outside the timing).
+//!   model is built once, outside the timing); `tripoly2_line_150_parts/*` the same for
+//!   tripoly2's line, whose model also uses the matched filter.
 //!
 //! `cargo bench --bench online`; figures in `results/online.md`.
 
@@ -61,9 +62,18 @@ fn line(c: &mut Criterion) {
     let rules_part = &text[text.find("# The bundled rules").unwrap()..];
     let rules = scenario::parse(Path::new("rules.toml"), &format!("{head}\n{rules_part}"))
         .expect("the rules variant parses");
-    let mut g = c.benchmark_group("line_150_parts");
+    pair(c, "line_150_parts", &rules, &online);
+    // tripoly2's line, where the model keeps the matched filter: the same layout with its rules.
+    let online = load("scenarios/tripoly2_online.toml");
+    let rules = load("results/online/uncertainty/designs/tripoly2_rules.toml");
+    pair(c, "tripoly2_line_150_parts", &rules, &online);
+}
+
+/// 150 parts through the same line driven by its rules and by the online controller.
+fn pair(c: &mut Criterion, group: &str, rules: &Scene, online: &Scene) {
+    let mut g = c.benchmark_group(group);
     g.sample_size(10);
-    for (name, s) in [("rules", &rules), ("online", &online)] {
+    for (name, s) in [("rules", rules), ("online", online)] {
         let mut opts = RunOptions::from_scene(s);
         opts.parts = 150;
         g.bench_function(name, |b| {

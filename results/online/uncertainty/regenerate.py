@@ -143,7 +143,8 @@ def main():
         os.remove(os.path.join(ROOT, t))
     sh(["cargo", "bench", "--bench", "online", "--quiet"])
     bench = {}
-    for name in ["decision/reading_update_choose", "decision/choose", "line_150_parts/rules", "line_150_parts/online"]:
+    for name in ["decision/reading_update_choose", "decision/choose", "line_150_parts/rules", "line_150_parts/online",
+                 "tripoly2_line_150_parts/rules", "tripoly2_line_150_parts/online"]:
         est = os.path.join(ROOT, "target", "criterion", *name.split("/"), "new", "estimates.json")
         bench[name] = json.load(open(est))["median"]["point_estimate"] * 1e-9
     json.dump({"rows": rows, "details": details, "bench": bench}, open(os.path.join(OUT, "all.json"), "w"), indent=1, default=str)
@@ -254,7 +255,16 @@ def write_report(rows, details, bench):
     w("")
     decision = bench['decision/reading_update_choose']
     extra = bench['line_150_parts/online'] / bench['line_150_parts/rules'] - 1
-    w(f"Criterion (`cargo bench --bench online`, medians, both variants in one run): a decision on tripoly1's online line — the sensor's classification, the reading's likelihood over the 54 hypotheses (the channels the model uses), the belief's update and the choice among the joint commands — takes **{decision * 1e6:.0f} µs**, the choice alone {bench['decision/choose'] * 1e6:.1f} µs. The line itself, 150 parts: {bench['line_150_parts/rules'] * 1e3:.1f} ms with its rules, {bench['line_150_parts/online'] * 1e3:.1f} ms online, **{100 * extra:+.0f}%** (the online parts also meet the mover at other positions, so part of the difference is other pushes; the work table above gives them). Targets: a median decision ≤ 1 ms ({'met' if decision <= 1e-3 else 'not met'}); a controller that adds ≤ 20% to the line's run time ({'met' if extra <= 0.2 else 'not met: the matched filter over every hypothesis member is most of it'}).\n")
+    extra2 = bench['tripoly2_line_150_parts/online'] / bench['tripoly2_line_150_parts/rules'] - 1
+    worst = max(extra, extra2)
+    if worst <= 0.2:
+        verdict = "met on both lines"
+    else:
+        verdict = ("met" if extra <= 0.2 else "not met") + " on tripoly1, " + ("met on tripoly2" if extra2 <= 0.2 else
+            "not met on tripoly2: its online parts do about as much contact work as with its rules (the work table), so the "
+            "difference is the controller, chiefly the matched filter, which only tripoly2's model keeps (tripoly1's, without it, "
+            "costs nothing measurable)")
+    w(f"Criterion (`cargo bench --bench online`, medians; each line's two variants in one run): a decision on tripoly1's online line — the sensor's classification, the reading's likelihood over the 54 hypotheses (the channels the model uses), the belief's update and the choice among the joint commands — takes **{decision * 1e6:.0f} µs**, the choice alone {bench['decision/choose'] * 1e6:.1f} µs. The lines themselves, 150 parts: tripoly1 {bench['line_150_parts/rules'] * 1e3:.1f} ms with its rules, {bench['line_150_parts/online'] * 1e3:.1f} ms online, **{100 * extra:+.0f}%**; tripoly2 (whose model also uses the matched filter) {bench['tripoly2_line_150_parts/rules'] * 1e3:.1f} ms with its rules, {bench['tripoly2_line_150_parts/online'] * 1e3:.1f} ms online, **{100 * extra2:+.0f}%** (the online parts also meet the movers at other positions, so part of each difference is other pushes; the work table above gives them). Targets: a median decision ≤ 1 ms ({'met' if decision <= 1e-3 else 'not met'}); a controller that adds ≤ 20% to the line's run time ({verdict}).\n")
     open(os.path.join(ROOT, "results", "online.md"), "w").write("\n".join(o) + "\n")
 
 
