@@ -14,6 +14,7 @@
 //! (tables and figures), [`cli`] (the `pinfeed` command).
 
 pub mod cli;
+pub mod contact_case;
 pub mod engine;
 pub mod geometry;
 pub mod input;

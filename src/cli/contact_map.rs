@@ -3,7 +3,9 @@
 //! of its (part, support, pin radius, μc, tolerance), or exactly where the map cannot vouch for it,
 //! and says which.
 
-use super::contact::{case_of, check_geometry, check_inputs, compile_part, report, ContactArgs};
+use super::contact::{case_of, ContactArgs};
+use crate::contact_case::report::report;
+use crate::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
 use crate::engine::contact_map::prepare;
 use crate::geometry::Polygon;
 use crate::maps::tier::{self, push_with_map, Loaded, Source, TierInputs, TierMap, TierSpec};
@@ -92,7 +94,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         args.map_grid.as_deref(),
         args.cache_dir.as_deref(),
     )?;
-    let (pose, start) = super::contact::case_geometry(&poly, &c);
+    let (pose, start) = case_geometry(&poly, &c);
     let started = Instant::now();
     let (out, why) = push_with_map(&loaded.map, &model, pose, start, c.pin_radius, &settings);
     let query_s = started.elapsed().as_secs_f64();
@@ -120,7 +122,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         r.part, r.theta0_deg, r.d, r.mu_c
     );
     if r.contact {
-        super::contact::print_motion(&r);
+        print!("{}", r.motion_text());
     } else {
         println!("no contact: the pin passes the part");
     }

@@ -3,14 +3,14 @@
 //!
 //! Each map samples θ0 over [0°, 360°) with the start convention of `pinfeed contact`
 //! ([`crate::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
-//! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`super::contact::case_fence`]);
+//! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`crate::contact_case::case_fence`]);
 //! a fence map has no contact parameter, so `--d` is not taken, and its report goes to
 //! `pinfeed-out/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
 //! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
 //! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
 
-use super::contact::{
+use crate::contact_case::{
     case_fence, check_geometry, check_inputs, compile_part, num, parse_fence, parse_model,
     settings_and_pin, Case,
 };

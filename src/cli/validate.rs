@@ -178,7 +178,7 @@ pub fn ensemble_spec(
     uncertain: Option<&str>,
     common: &ModelArgs,
 ) -> Result<EnsembleSpec> {
-    let model = super::contact::parse_model(&common.model)?;
+    let model = crate::contact_case::parse_model(&common.model)?;
     Ok(input::ensemble_spec(
         mu_c, pin_radius, model, common.tol, uncertain,
     )?)

@@ -18,6 +18,7 @@ pub mod plot_sensing;
 pub mod plot_sensitivity;
 pub mod plot_survey;
 pub mod plot_validate;
+pub mod sense;
 pub mod stale;
 pub mod versioned;
 
