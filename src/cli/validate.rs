@@ -88,10 +88,10 @@ impl ModelArgs {
         if !(1..=100).contains(&self.passes) {
             bail!("--passes must lie in [1, 100], got {}", self.passes);
         }
-        if self.threads > super::map::MAX_THREADS {
+        if self.threads > crate::maps::limits::MAX_THREADS {
             bail!(
                 "--threads must lie in [0, {}], got {}",
-                super::map::MAX_THREADS,
+                crate::maps::limits::MAX_THREADS,
                 self.threads
             );
         }

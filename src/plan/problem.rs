@@ -14,6 +14,40 @@ pub enum FeedKind {
     Uniform,
 }
 
+impl FeedKind {
+    /// `stable` or `uniform`.
+    pub fn from_name(s: &str) -> Option<FeedKind> {
+        match s.trim() {
+            "stable" => Some(FeedKind::Stable),
+            "uniform" => Some(FeedKind::Uniform),
+            _ => None,
+        }
+    }
+}
+
+/// An uncertain-μc range that is not `LO:HI` with two numbers.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RangeSpecError {
+    #[error("--mu-c-range '{0}': expected LO:HI, e.g. 0.3:0.7")]
+    Form(String),
+    #[error("--mu-c-range '{spec}': '{token}' is not a number")]
+    Number { spec: String, token: String },
+}
+
+/// Parse an uncertain μc range `LO:HI` (its bounds are checked with the problem).
+pub fn parse_mu_c_range(s: &str) -> Result<(f64, f64), RangeSpecError> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| RangeSpecError::Form(s.to_string()))?;
+    let p = |t: &str| {
+        t.trim().parse::<f64>().map_err(|_| RangeSpecError::Number {
+            spec: s.to_string(),
+            token: t.to_string(),
+        })
+    };
+    Ok((p(a)?, p(b)?))
+}
+
 /// Everything the sensorless planner needs. [`Problem::new`] gives the defaults.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Problem {

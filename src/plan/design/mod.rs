@@ -52,6 +52,20 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// The modes asked for by choosing pins, fences (both: also hybrid) and a sensor, in that
+    /// order (empty: none chosen).
+    pub fn selected(pins: bool, fences: bool, sensor: bool) -> Vec<Mode> {
+        [
+            (pins, Mode::Pins),
+            (fences, Mode::Fences),
+            (pins && fences, Mode::Hybrid),
+            (sensor, Mode::Sensor),
+        ]
+        .into_iter()
+        .filter_map(|(on, m)| on.then_some(m))
+        .collect()
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Mode::Pins => "pins",
@@ -373,6 +387,25 @@ pub struct Progress {
     pub stage: String,
     pub candidates: usize,
     pub line_runs: usize,
+}
+
+impl std::fmt::Display for Progress {
+    /// "pins round 2 · line check 3 (2000 parts) · 4 candidate(s), 3 line run(s)".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}{} · {} · {} candidate(s), {} line run(s)",
+            self.mode.map_or("", |m| m.name()),
+            if self.round > 0 {
+                format!(" round {}", self.round + 1)
+            } else {
+                String::new()
+            },
+            self.stage,
+            self.candidates,
+            self.line_runs,
+        )
+    }
 }
 
 /// Why a design could not be made.
