@@ -7,11 +7,10 @@
 //! interval holds the hidden value. Unless `--no-write`, `pinfeed-out/calibrate/<file stem>/` receives
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
-use super::validate::{
-    emit, ensemble_spec, pool, summary_text, write_report_files, ModelArgs, ReportHead,
-};
+use super::validate::{emit, ensemble_spec, pool, ModelArgs};
 use crate::mechanics::support::{SmoothParams, SupportChoice};
 use crate::report::shell_word;
+use crate::report::validate_report::{summary_text, write_report_files, ReportHead};
 use crate::validate::calibrate::{calibrate_observed, Calibration, CalibrationSettings};
 use crate::validate::input::{check_members, load_measured};
 use crate::validate::score::Summary;

@@ -7,15 +7,16 @@
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
 use super::map::{command_line, default_out_dir_for, MapArgs};
-use super::validate::{write_report_files, ReportHead};
 use crate::geometry::Polygon;
 use crate::maps::ensemble::{
     ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState, MemberDraw, PredictedBands,
 };
 use crate::maps::theta_grid;
 use crate::mechanics::Fidelity;
+use crate::report::map_table::predicted_bands_text;
 use crate::report::plot_validate::plot_band_distributions;
 use crate::report::shell_word;
+use crate::report::validate_report::{write_report_files, ReportHead};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -50,22 +51,6 @@ fn ensemble_command(args: &MapArgs, uncertain: &str) -> String {
     )
 }
 
-/// The text of predicted bands: `[lo, hi] mass%` per band.
-pub fn bands_text(p: &PredictedBands) -> String {
-    p.bands
-        .iter()
-        .map(|b| {
-            format!(
-                "[{:.1}, {:.1}] {:.0}%",
-                b.arc.lo,
-                b.arc.hi(),
-                100.0 * b.mass
-            )
-        })
-        .collect::<Vec<_>>()
-        .join("  ")
-}
-
 /// The band table: one line per (d, input).
 fn table(predicted: &[PredictedBands]) -> String {
     let mut s = String::from(
@@ -78,7 +63,7 @@ fn table(predicted: &[PredictedBands]) -> String {
             p.d,
             p.input,
             p.passes,
-            bands_text(p),
+            predicted_bands_text(p),
             100.0 * p.coverage
         );
     }

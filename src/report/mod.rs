@@ -22,6 +22,7 @@ pub mod plot_survey;
 pub mod plot_validate;
 pub mod sense;
 pub mod stale;
+pub mod validate_report;
 pub mod versioned;
 
 /// A word of a command line, quoted for a POSIX shell if it needs it (for the command lines that
