@@ -57,7 +57,7 @@ pub enum CaseError {
         a: f64,
         value: f64,
     },
-    #[error("--fence: the length must lie in [{}, {}] (part units: {}·a to {}·a, a = {}), got {}", num(*lo), num(*hi), crate::mechanics::limits::FENCE_LENGTH_A.0, crate::mechanics::limits::FENCE_LENGTH_A.1, num(*a), num(*value))]
+    #[error("--fence: the length must lie in [{}, {}] (part units: {}·a to {}·a, a = {}), got {}", num(*lo), num(*hi), num(crate::mechanics::limits::FENCE_LENGTH_A.0), num(crate::mechanics::limits::FENCE_LENGTH_A.1), num(*a), num(*value))]
     FenceLength {
         lo: f64,
         hi: f64,

@@ -202,15 +202,21 @@ impl Problem {
                 return Err(PlanError::input(flag, n, "must lie in 1..=2000"));
             }
         }
-        if !(self.mu_c.is_finite() && (0.0..=10.0).contains(&self.mu_c)) {
-            return Err(PlanError::input("--mu-c", self.mu_c, "must lie in [0, 10]"));
+        let (mu_lo, mu_hi) = crate::mechanics::limits::MU_C;
+        if !(self.mu_c.is_finite() && (mu_lo..=mu_hi).contains(&self.mu_c)) {
+            let range = crate::scenario::limits::show((mu_lo, mu_hi));
+            return Err(PlanError::input(
+                "--mu-c",
+                self.mu_c,
+                format!("must lie in {range}"),
+            ));
         }
         if let Some((lo, hi)) = self.mu_c_range {
-            if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo <= hi && hi <= 10.0) {
+            if !(lo.is_finite() && hi.is_finite() && mu_lo <= lo && lo <= hi && hi <= mu_hi) {
                 return Err(PlanError::input(
                     "--mu-c-range",
                     format!("{lo}:{hi}"),
-                    "must be LO:HI with 0 ≤ LO ≤ HI ≤ 10",
+                    format!("must be LO:HI with {mu_lo} ≤ LO ≤ HI ≤ {mu_hi}"),
                 ));
             }
         }
@@ -343,11 +349,13 @@ impl Problem {
                 "must be a positive number of seconds",
             ));
         }
-        if !(self.contact_tol.is_finite() && self.contact_tol > 0.0 && self.contact_tol <= 1e-2) {
+        let tol = crate::mechanics::limits::TOL;
+        if !crate::scenario::limits::contains(tol, self.contact_tol) {
+            let range = crate::scenario::limits::show(tol);
             return Err(PlanError::input(
                 "--contact-tol",
                 self.contact_tol,
-                "must lie in (0, 0.01]",
+                format!("must lie in {range}"),
             ));
         }
         // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform

@@ -501,8 +501,10 @@ pub fn check_goal(o: &DesignOptions) -> Result<(), DesignError> {
 fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignError> {
     let f = &o.fences;
     let mu_f = f.mu_f.unwrap_or(mu_c);
-    if !(mu_f.is_finite() && (0.0..=10.0).contains(&mu_f)) {
-        return Err(input("--mu-f", mu_f, "must lie in [0, 10]"));
+    let mu_range = crate::mechanics::limits::MU_C;
+    if !crate::scenario::limits::contains(mu_range, mu_f) {
+        let range = crate::scenario::limits::show(mu_range);
+        return Err(input("--mu-f", mu_f, format!("must lie in {range}")));
     }
     if !(f.overhang_a.is_finite() && (0.0..=10.0).contains(&f.overhang_a)) {
         return Err(input(
