@@ -266,7 +266,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     if let Some(l) = &tier {
         eprintln!(
             "{}",
-            super::contact_map::served_line(&l.map, &poly, &part_model, &ds, &settings)
+            crate::maps::tier::report::served_line(&l.map, &poly, &part_model, &ds, &settings)
         );
     }
     let contacts: usize = maps.iter().map(|m| m.samples.len()).sum();
