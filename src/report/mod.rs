@@ -3,6 +3,7 @@
 pub mod aligned;
 pub mod animate;
 pub mod atomic;
+pub mod calibrate_report;
 pub mod compare_table;
 pub mod ensemble_report;
 pub mod line_table;
