@@ -2,7 +2,9 @@
 //! * `decision/*`: one decision on `scenarios/tripoly1_online.toml` (54 hypotheses, 28 joint
 //!   commands): the sensor's classification, the reading's likelihood over the hypotheses (the
 //!   channels its model calibrated in), the belief's update, and the choice of the joint command
-//!   — what the controller computes when a reading arrives; and the choice alone;
+//!   — what the controller computes when a reading arrives; the likelihood alone; the choice
+//!   alone; `decision/tripoly2_*` the same on `scenarios/tripoly2_online.toml`, whose
+//!   likelihood includes the matched filter over its 324 simulated members;
 //! * `line_150_parts/*`: the same line driven by its rules and by the online controller (the
 //!   model is built once, outside the timing); `tripoly2_line_150_parts/*` the same for
 //!   tripoly2's line, whose model also uses the matched filter.
@@ -23,35 +25,45 @@ fn load(path: &str) -> Scene {
 }
 
 fn decision(c: &mut Criterion) {
-    let scene = load("scenarios/tripoly1_online.toml");
-    let model = scene.online_model().expect("an online model").clone();
-    let sm = &model.sensors[0];
-    let Obstacle::Pin(pin) = &scene.obstacles[sm.obstacle] else {
-        panic!("the sensor is a pin")
-    };
-    let settings = pin.sensor.as_ref().unwrap().settings;
-    let classifier = pin.sensor.as_ref().unwrap().classifier.clone();
-    // A reading of state 135° at the sensor's d, read through the sensor's noise.
-    let mut setup = PushSetup::nominal(scene.part.polygon.clone(), -0.22);
-    setup.pin_radius = pin.radius;
-    setup.mass = scene.part.mass;
-    let pass = simulate(&setup, &scene.part.model, 135.0, -0.22, 0.5);
-    let reading = read(&pass.signal, &settings, &mut stream(1, 7)).expect("a reading");
     let mut g = c.benchmark_group("decision");
-    g.bench_function("reading_update_choose", |b| {
-        b.iter(|| {
-            let mut belief = model.prior.clone();
-            let post = classifier.classify(&reading).posterior;
-            let ll = sm.log_likelihood(Some(&reading), post.as_deref());
-            belief.observe_reading(&sm.p_touch, ll.as_deref());
-            model.choose(&belief).action
-        })
-    });
-    let mut belief = model.prior.clone();
-    let post = classifier.classify(&reading).posterior;
-    let ll = sm.log_likelihood(Some(&reading), post.as_deref());
-    belief.observe_reading(&sm.p_touch, ll.as_deref());
-    g.bench_function("choose", |b| b.iter(|| model.choose(&belief).action));
+    for (name, path, d) in [
+        ("", "scenarios/tripoly1_online.toml", -0.22),
+        ("tripoly2_", "scenarios/tripoly2_online.toml", 0.3),
+    ] {
+        let scene = load(path);
+        let model = scene.online_model().expect("an online model").clone();
+        let sm = &model.sensors[0];
+        let Obstacle::Pin(pin) = &scene.obstacles[sm.obstacle] else {
+            panic!("the sensor is a pin")
+        };
+        let settings = pin.sensor.as_ref().unwrap().settings;
+        let classifier = pin.sensor.as_ref().unwrap().classifier.clone();
+        // A reading of state 135° at offset d, read through the sensor's noise.
+        let mut setup = PushSetup::nominal(scene.part.polygon.clone(), d);
+        setup.pin_radius = pin.radius;
+        setup.mass = scene.part.mass;
+        let pass = simulate(&setup, &scene.part.model, 135.0, d, 0.5);
+        let reading = read(&pass.signal, &settings, &mut stream(1, 7)).expect("a reading");
+        g.bench_function(format!("{name}reading_update_choose"), |b| {
+            b.iter(|| {
+                let mut belief = model.prior.clone();
+                let post = classifier.classify(&reading).posterior;
+                let ll = sm.log_likelihood(Some(&reading), post.as_deref());
+                belief.observe_reading(&sm.p_touch, ll.as_deref());
+                model.choose(&belief).action
+            })
+        });
+        let post = classifier.classify(&reading).posterior;
+        g.bench_function(format!("{name}likelihood"), |b| {
+            b.iter(|| sm.log_likelihood(Some(&reading), post.as_deref()))
+        });
+        let mut belief = model.prior.clone();
+        let ll = sm.log_likelihood(Some(&reading), post.as_deref());
+        belief.observe_reading(&sm.p_touch, ll.as_deref());
+        g.bench_function(format!("{name}choose"), |b| {
+            b.iter(|| model.choose(&belief).action)
+        });
+    }
     g.finish();
 }
 

@@ -169,6 +169,10 @@ struct OnlineRun {
     summary: OnlineSummary,
     /// Per calibration bin: parts, Σ predicted, successes.
     bins: [(u64, f64, u64); 10],
+    /// Per joint command of the model: how often it was chosen; and the names of the model's
+    /// pins, to describe the commands in the summary at the end.
+    chosen: Vec<u64>,
+    pin_names: Vec<String>,
 }
 
 /// The controller's run state.
@@ -230,6 +234,13 @@ impl Control {
         summary.latency_s = spec.latency;
         summary.on_late = spec.on_late.name();
         let online = spec.online.as_ref().map(|h| OnlineRun {
+            chosen: vec![0; h.0.actions.len()],
+            pin_names: h
+                .0
+                .pins
+                .iter()
+                .map(|&j| scene.obstacles[j].name().to_string())
+                .collect(),
             model: h.0.clone(),
             summary: OnlineSummary {
                 hypotheses: h.0.hypotheses.len(),
@@ -383,10 +394,27 @@ impl Control {
                     observed: b.2 as f64 / b.0 as f64,
                 })
                 .collect();
+            s.chosen = o
+                .chosen
+                .iter()
+                .enumerate()
+                .filter(|(_, &n)| n > 0)
+                .map(|(a, &n)| (describe_action(&o.pin_names, &o.model.actions[a]), n))
+                .collect();
             self.summary.online = Some(s.clone());
         }
         self.summary.clone()
     }
+}
+
+/// A joint command as `pin=target, …` (the online summary's and the control log's words).
+fn describe_action(pin_names: &[String], action: &[Target]) -> String {
+    pin_names
+        .iter()
+        .zip(action)
+        .map(|(name, t)| format!("{name}={}", describe_target(*t)))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// A decision of sensor pin `sensor` as its hypothesis label, or `unknown`.
@@ -631,13 +659,6 @@ impl Line<'_> {
         part.predicted = Some(choice.predicted);
         let (h0, h1) = (model.prior.entropy_bits(), belief.entropy_bits());
         let action = &model.actions[choice.action];
-        let described: Vec<String> = model
-            .pins
-            .iter()
-            .zip(action)
-            .map(|(&j, t)| format!("{}={}", self.scene.obstacles[j].name(), describe_target(*t)))
-            .collect();
-        let described = described.join(", ");
         let truth = part.decided.iter().find_map(|d| d.2);
         let states = model
             .hypotheses
@@ -656,19 +677,27 @@ impl Line<'_> {
             o.summary.decisions += 1;
             o.summary.entropy_prior_bits += h0;
             o.summary.entropy_posterior_bits += h1;
-            *o.summary.chosen.entry(described.clone()).or_default() += 1;
+            o.chosen[choice.action] += 1;
         }
-        c.log(ControlRecord {
-            t,
-            part: index,
-            obstacle: "online".into(),
-            kind: "decision",
-            what: format!(
-                "{described} (P = {:.3}; entropy {h0:.2} → {h1:.2} bits)",
-                choice.predicted
-            ),
-            motion: None,
-        });
+        if c.log.is_some() {
+            let names: Vec<String> = model
+                .pins
+                .iter()
+                .map(|&j| self.scene.obstacles[j].name().to_string())
+                .collect();
+            let described = describe_action(&names, action);
+            c.log(ControlRecord {
+                t,
+                part: index,
+                obstacle: "online".into(),
+                kind: "decision",
+                what: format!(
+                    "{described} (P = {:.3}; entropy {h0:.2} → {h1:.2} bits)",
+                    choice.predicted
+                ),
+                motion: None,
+            });
+        }
         for (&pin, &target) in model.pins.iter().zip(action) {
             self.metrics.work.actuator_commands += 1;
             c.queues[pin].insert(index, target);

@@ -351,25 +351,29 @@ impl OnlineModel {
                 w.iter().zip(row).map(|(w, s)| w * s).sum()
             })
             .collect();
-        let key = |a: usize| {
+        // The tie-breakers are computed only for actions within TIE of the best so far: the
+        // same sequential comparison, without the neighbours of every action.
+        let around = |a: usize| {
             let nb = self.neighbours(a);
-            let around = nb.iter().map(|&b| p[b]).sum::<f64>() / nb.len().max(1) as f64;
-            (p[a], around, -travel(&self.actions[a], current))
+            nb.iter().map(|&b| p[b]).sum::<f64>() / nb.len().max(1) as f64
         };
         let mut best = 0;
-        let mut best_key = key(0);
+        let mut best_around: Option<f64> = None;
         for a in 1..self.actions.len() {
-            let k = key(a);
-            let better = if (k.0 - best_key.0).abs() > TIE {
-                k.0 > best_key.0
-            } else if (k.1 - best_key.1).abs() > TIE {
-                k.1 > best_key.1
+            let better = if (p[a] - p[best]).abs() > TIE {
+                p[a] > p[best]
             } else {
-                k.2 > best_key.2 + 1e-12
+                let (ka, kb) = (around(a), *best_around.get_or_insert_with(|| around(best)));
+                if (ka - kb).abs() > TIE {
+                    ka > kb
+                } else {
+                    -travel(&self.actions[a], current)
+                        > -travel(&self.actions[best], current) + 1e-12
+                }
             };
             if better {
                 best = a;
-                best_key = k;
+                best_around = None;
             }
         }
         Choice {

@@ -268,6 +268,67 @@ fn online_runs_are_identical_for_any_thread_count() {
     }
     assert_eq!(reports[0], reports[2]);
     assert_eq!(reports[1], reports[3]);
+    // The report tells what the controller decided and predicted, against what happened.
+    let json: serde_json::Value = serde_json::from_str(&reports[0]).unwrap();
+    let o = &json["results"][0]["online"];
+    let decisions = o["decisions"].as_u64().expect("an online section");
+    assert!(decisions > 100 && decisions <= 120, "{o}");
+    let bins = o["calibration"].as_array().unwrap();
+    let parts: u64 = bins.iter().map(|b| b["parts"].as_u64().unwrap()).sum();
+    assert_eq!(parts, decisions);
+    let observed = o["observed"].as_f64().unwrap();
+    let weighted: f64 = bins
+        .iter()
+        .map(|b| b["observed"].as_f64().unwrap() * b["parts"].as_u64().unwrap() as f64)
+        .sum::<f64>()
+        / decisions as f64;
+    assert!(
+        (weighted - observed).abs() < 1e-12,
+        "{weighted} vs {observed}"
+    );
+    assert!(
+        o["entropy_posterior_bits"].as_f64().unwrap() < o["entropy_prior_bits"].as_f64().unwrap()
+    );
+    assert!(
+        reports[1].contains("## Online controller"),
+        "{}",
+        reports[1]
+    );
+    // Shards carry the online counts and merge to the bytes of one run.
+    let shards = dir.path().join("shards");
+    let s = study.to_str().unwrap();
+    for k in ["0/3", "1/3", "2/3"] {
+        pinfeed_ok(&[
+            "mc",
+            s,
+            "--shard",
+            k,
+            "--quiet",
+            "--out",
+            shards.to_str().unwrap(),
+        ]);
+    }
+    let files: Vec<String> = (0..3)
+        .map(|k| {
+            let f = shards.join(format!("shard-000{k}-of-0003.json"));
+            f.to_str().unwrap().to_string()
+        })
+        .collect();
+    assert!(std::fs::read_to_string(&files[1])
+        .unwrap()
+        .contains("\"online\""));
+    let merged = dir.path().join("merged");
+    let mut args = vec!["merge", "--quiet", "--out", merged.to_str().unwrap()];
+    args.extend(files.iter().map(String::as_str));
+    pinfeed_ok(&args);
+    let one = dir.path().join("t1");
+    for f in ["report.json", "report.md"] {
+        assert_eq!(
+            crate::support::report_text(&one, f),
+            crate::support::report_text(&merged, f),
+            "{f}"
+        );
+    }
     let r = run(
         &parse(&online_text("offsets = 2\nsamples = 3\ntargets = 7")),
         40,

@@ -61,6 +61,9 @@ struct Member {
     vidx: Vec<u32>,
     /// Per entry and lag: w/B · (S_lag − S_base).
     dlin: Vec<f64>,
+    /// The chunks of eight entries of the member's base vector that hold a non-zero value (a
+    /// template is quiet outside its contact, so the rest of its frame adds nothing).
+    chunks: Vec<std::ops::Range<u32>>,
 }
 
 pub struct Likelihood {
@@ -222,7 +225,14 @@ impl Likelihood {
                         cst[o] -= 0.5 * wb(d) * (so[d] * so[d] - sb[d] * sb[d]);
                     }
                 }
-                members.push(Member { cst, vidx, dlin });
+                let row = &base[base.len() - dims..];
+                let chunks = nonzero_chunks(row);
+                members.push(Member {
+                    cst,
+                    vidx,
+                    dlin,
+                    chunks,
+                });
             }
             ranges.push(start..members.len());
         }
@@ -269,19 +279,32 @@ impl Likelihood {
         Some(y)
     }
 
-    /// log p(reading | h) per hypothesis (up to a common constant); `None` when no contact is
-    /// detected.
-    pub fn log_likelihoods(&self, r: &Reading) -> Option<Vec<f64>> {
-        if self.members.is_empty() {
-            return None;
+    /// Each member's profile log-likelihood of the block sums `y`: the base dot product plus the
+    /// best lag's correction. The same arithmetic in the same order on every CPU; where the CPU
+    /// has AVX2 the loops are compiled for its wider registers (four sums at once instead of two).
+    fn member_scores(&self, y: &[f64]) -> Vec<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.member_scores_avx2(y) };
         }
-        let y = self.block_sums(r)?;
+        self.member_scores_plain(y)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn member_scores_avx2(&self, y: &[f64]) -> Vec<f64> {
+        self.member_scores_plain(y)
+    }
+
+    #[inline(always)]
+    fn member_scores_plain(&self, y: &[f64]) -> Vec<f64> {
         let dims = y.len();
         let mut acc = vec![0.0; self.lags];
         let mut per_member = Vec::with_capacity(self.members.len());
         for (m, mem) in self.members.iter().enumerate() {
             let a = &self.base[m * dims..(m + 1) * dims];
-            let lin = dot(a, &y);
+            let lin = dot_chunks(a, y, &mem.chunks);
             acc.copy_from_slice(&mem.cst);
             for (e, &d) in mem.vidx.iter().enumerate() {
                 let yd = y[d as usize];
@@ -293,6 +316,17 @@ impl Likelihood {
             let best = acc.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             per_member.push(lin + best);
         }
+        per_member
+    }
+
+    /// log p(reading | h) per hypothesis (up to a common constant); `None` when no contact is
+    /// detected.
+    pub fn log_likelihoods(&self, r: &Reading) -> Option<Vec<f64>> {
+        if self.members.is_empty() {
+            return None;
+        }
+        let y = self.block_sums(r)?;
+        let per_member = self.member_scores(&y);
         Some(
             self.ranges
                 .iter()
@@ -310,7 +344,44 @@ impl Likelihood {
     }
 }
 
+/// The runs of whole chunks of eight entries of `a` that hold a non-zero value, as chunk index
+/// ranges; the entries after the last whole chunk are always summed (see [`dot_chunks`]).
+fn nonzero_chunks(a: &[f64]) -> Vec<std::ops::Range<u32>> {
+    let mut out: Vec<std::ops::Range<u32>> = Vec::new();
+    for (k, c) in a.chunks_exact(8).enumerate() {
+        if c.iter().all(|&x| x == 0.0) {
+            continue;
+        }
+        let k = k as u32;
+        match out.last_mut() {
+            Some(r) if r.end == k => r.end = k + 1,
+            _ => out.push(k..k + 1),
+        }
+    }
+    out
+}
+
+/// [`dot`] over the chunks of eight entries listed in `chunks` (and the tail after the last
+/// whole chunk): the same sums in the same order, without the chunks of `a` that are all zero
+/// (each of their products is ±0, which leaves every accumulator as it was).
+#[inline(always)]
+fn dot_chunks(a: &[f64], b: &[f64], chunks: &[std::ops::Range<u32>]) -> f64 {
+    let mut acc = [0.0; 8];
+    let whole = a.len() / 8 * 8;
+    let tail: f64 = a[whole..].iter().zip(&b[whole..]).map(|(x, y)| x * y).sum();
+    for r in chunks {
+        let (lo, hi) = (r.start as usize * 8, r.end as usize * 8);
+        for (x, y) in a[lo..hi].chunks_exact(8).zip(b[lo..hi].chunks_exact(8)) {
+            for i in 0..8 {
+                acc[i] += x[i] * y[i];
+            }
+        }
+    }
+    acc.iter().sum::<f64>() + tail
+}
+
 /// A dot product with eight independent accumulators (a plain sequential sum cannot vectorise).
+#[cfg(test)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let mut acc = [0.0; 8];
     let ca = a.chunks_exact(8);
@@ -341,5 +412,84 @@ impl Classifier for Likelihood {
             }
             _ => Classification::unknown(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::RngExt;
+
+    /// Skipping the all-zero chunks of a template's base vector gives the full dot product bit
+    /// for bit, for every pattern of quiet runs and lengths that are not a multiple of eight.
+    #[test]
+    fn dot_over_nonzero_chunks_is_the_full_dot_bit_for_bit() {
+        let mut rng = crate::random::stream(7, 0);
+        for n in [1usize, 7, 8, 9, 40, 235, 240] {
+            for _ in 0..200 {
+                let a: Vec<f64> = (0..n)
+                    .map(|i| {
+                        // Quiet runs of random length, as a template outside its contact.
+                        if (i / 5 + rng.random_range(0..3)) % 3 == 0 {
+                            rng.random_range(-1e6..1e6)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                let b: Vec<f64> = (0..n).map(|_| rng.random_range(-1e3..1e3)).collect();
+                let chunks = nonzero_chunks(&a);
+                assert!(chunks.iter().all(|r| r.start < r.end));
+                assert_eq!(dot_chunks(&a, &b, &chunks).to_bits(), dot(&a, &b).to_bits());
+            }
+            let zero = vec![0.0; n];
+            assert!(nonzero_chunks(&zero).is_empty());
+        }
+    }
+
+    /// The scores compiled for AVX2 (where the CPU has it) are those of the plain loops, bit for
+    /// bit: the dispatch changes the registers, not the arithmetic.
+    #[test]
+    fn member_scores_are_the_same_on_every_code_path() {
+        use crate::mechanics::{PartModel, Support};
+        use crate::sensing::templates::{simulate, PushSetup};
+        let poly = crate::geometry::part_from_spec("tripoly1").unwrap();
+        let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+        let setup = PushSetup::nominal(poly.clone(), -0.2);
+        let members: Vec<Vec<_>> = [45.0, 135.0, 260.0]
+            .iter()
+            .map(|&deg| {
+                [-0.25, -0.2, -0.15]
+                    .iter()
+                    .map(|&d| simulate(&setup, &model, deg, d, 0.5).signal)
+                    .collect()
+            })
+            .collect();
+        let templates = TemplateSet {
+            labels: vec!["a".into(), "b".into(), "c".into()],
+            members,
+        };
+        let sensor = SensorSettings::default();
+        let lik = Likelihood::new(&templates, &sensor, &ClassifierOptions::default()).unwrap();
+        let mut rng = crate::random::stream(3, 1);
+        let mut compared = 0;
+        for deg in [50.0, 140.0, 250.0] {
+            let pass = simulate(&setup, &model, deg, -0.2, 0.5);
+            let r = reading::read(&pass.signal, &sensor, &mut rng).expect("a reading");
+            let Some(y) = lik.block_sums(&r) else {
+                continue;
+            };
+            let plain = lik.member_scores_plain(&y);
+            let used = lik.member_scores(&y);
+            assert_eq!(plain.len(), 9);
+            assert!(plain.iter().all(|x| x.is_finite()));
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&plain), bits(&used));
+            compared += 1;
+        }
+        assert!(
+            compared >= 2,
+            "readings with a detected contact: {compared}"
+        );
     }
 }

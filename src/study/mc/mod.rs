@@ -22,7 +22,8 @@
 //! * [`distribution`], [`perturbations`]: what is uncertain and how it is drawn (the support
 //!   models in [`crate::mechanics::support`]);
 //! * [`sample`]: one perturbed line and its one part; [`run`]: many samples in parallel;
-//! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report;
+//! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report; [`online`]:
+//!   what an online controller decided and predicted, against what happened;
 //! * [`atomic`]: files written by rename; [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
 
 pub use crate::report::atomic;
@@ -30,6 +31,7 @@ pub mod compile;
 pub use crate::random::distribution;
 pub mod error;
 pub mod hash;
+pub mod online;
 pub mod perturbations;
 pub mod precision;
 pub mod raw;

@@ -171,6 +171,9 @@ pub struct PointReport {
     /// Sensor accuracy; only when the line has sensor pins.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sensor: Option<SensorShare>,
+    /// What an online controller decided and predicted; only when the line has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub online: Option<super::online::OnlineShare>,
 }
 
 /// The whole report.
@@ -241,6 +244,7 @@ fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
             },
             ci95: wilson_interval(t.sensor_correct, t.sensor_readings),
         }),
+        online: t.online.report(),
     }
 }
 
@@ -387,5 +391,22 @@ pub fn markdown(r: &McReport, figure: &str) -> String {
     }
     s.push_str(&format!("\n![sensitivity]({figure})\n\n"));
     s.push_str(&table(r));
+    let online: Vec<(String, &super::online::OnlineShare)> = r
+        .results
+        .iter()
+        .filter_map(|p| {
+            let name = if p.values.is_empty() {
+                "all".to_string()
+            } else {
+                p.values
+                    .iter()
+                    .map(|(k, v)| format!("{k} = {v}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            p.online.as_ref().map(|o| (name, o))
+        })
+        .collect();
+    s.push_str(&super::online::markdown(&online));
     s
 }

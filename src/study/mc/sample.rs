@@ -91,6 +91,8 @@ pub struct SampleResult {
     /// Readings taken by the line's sensor pins, and those decided correctly (0 without sensors).
     pub sensor_readings: u32,
     pub sensor_correct: u32,
+    /// The online controller's decision on the part (None without one, or without a decision).
+    pub online: Option<super::online::OnlineSample>,
 }
 
 /// The per-parameter random streams of one sample.
@@ -874,5 +876,6 @@ pub fn run_sample(
         other_redraws: drawn.other_redraws,
         sensor_readings: sensed(|s| s.readings),
         sensor_correct: sensed(|s| s.confusion.correct()),
+        online: super::online::OnlineSample::of(&run),
     })
 }

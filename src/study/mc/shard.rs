@@ -127,6 +127,9 @@ pub struct ShardPoint {
     pub sensor_readings: u64,
     #[serde(default, skip_serializing_if = "is_zero")]
     pub sensor_correct: u64,
+    /// An online controller's counts; left out without decisions.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub online: super::online::OnlineTally,
 }
 
 fn is_zero<T: Default + PartialEq>(n: &T) -> bool {
@@ -193,6 +196,7 @@ impl ShardFile {
                     latency_us_hdr_v2: base64::engine::general_purpose::STANDARD.encode(bytes),
                     sensor_readings: t.sensor_readings,
                     sensor_correct: t.sensor_correct,
+                    online: t.online.clone(),
                 }
             })
             .collect();
@@ -273,6 +277,15 @@ impl ShardPoint {
                 self.point, self.sensor_correct, self.sensor_readings
             ));
         }
+        self.online
+            .check()
+            .map_err(|e| format!("point {}: {e}", self.point))?;
+        if self.online.decisions > self.samples {
+            return Err(format!(
+                "point {}: {} online decisions out of {} samples",
+                self.point, self.online.decisions, self.samples
+            ));
+        }
         Ok(PointTally {
             samples: self.samples,
             outcomes,
@@ -282,6 +295,7 @@ impl ShardPoint {
             latency_us,
             sensor_readings: self.sensor_readings,
             sensor_correct: self.sensor_correct,
+            online: self.online.clone(),
         })
     }
 }

@@ -2,6 +2,7 @@
 //! and an HDR histogram of latencies (µs, 3 significant digits, as the line's metrics). Adding two
 //! tallies is exact and commutative, so shards merge to the same numbers as one run.
 
+use super::online::OnlineTally;
 use super::sample::SampleResult;
 use crate::engine::{OutcomeCounts, PartOutcome};
 use hdrhistogram::Histogram;
@@ -21,6 +22,8 @@ pub struct PointTally {
     /// the samples and the line's sensor pins (0 without sensors).
     pub sensor_readings: u64,
     pub sensor_correct: u64,
+    /// What an online controller decided and predicted (empty without one).
+    pub online: OnlineTally,
 }
 
 /// An empty latency histogram: 1 µs to 10⁶ s, 3 significant digits.
@@ -40,6 +43,7 @@ impl Default for PointTally {
             latency_us: latency_histogram(),
             sensor_readings: 0,
             sensor_correct: 0,
+            online: OnlineTally::default(),
         }
     }
 }
@@ -54,6 +58,9 @@ impl PointTally {
         self.other_redraws += r.other_redraws as u64;
         self.sensor_readings += r.sensor_readings as u64;
         self.sensor_correct += r.sensor_correct as u64;
+        if let Some(o) = &r.online {
+            self.online.add(o, r.outcome == PartOutcome::Success);
+        }
         if let Some(us) = r.latency_us {
             self.latency_us.saturating_record(us);
         }
@@ -70,6 +77,7 @@ impl PointTally {
         self.other_redraws += o.other_redraws;
         self.sensor_readings += o.sensor_readings;
         self.sensor_correct += o.sensor_correct;
+        self.online.merge(&o.online);
         self.latency_us
             .add(&o.latency_us)
             .map_err(|e| format!("latency histograms do not add up: {e:?}"))
