@@ -11,9 +11,15 @@
 //! Modules: [`geometry`] (polygons, stable states, first contact), [`mechanics`] (the contact
 //! model), [`maps`] (configuration maps and their bands), [`scenario`] (TOML scenarios compiled to
 //! an immutable scene), [`engine`] (the discrete-event feeder line and its metrics), [`report`]
-//! (tables and figures), [`cli`] (the `pinfeed` command).
+//! (tables, reports and figures), [`contact_case`] (one fully specified pin or fence pass, as
+//! `pinfeed contact` runs it); the `pinfeed` command itself (`cli`) only maps its arguments to
+//! these modules and prints, and is not part of the documented API.
 
+// The `pinfeed` command's argument parsing and printing: public for `main.rs` and the tests, not
+// part of the documented library API (its workflows live in the modules below).
+#[doc(hidden)]
 pub mod cli;
+pub mod contact_case;
 pub mod engine;
 pub mod geometry;
 pub mod input;

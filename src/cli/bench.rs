@@ -140,15 +140,8 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
                 std::fs::create_dir_all(dir).ok();
             }
             let p_md = out.with_extension("md");
-            // Keep the Monte Carlo precision section (`bench mc-precision`) of the old report.
-            let mut md = crate::study::accuracy::report_markdown(&st, &cmd);
             let old = std::fs::read_to_string(&p_md).unwrap_or_default();
-            if let Some(section) = crate::study::mc::precision::existing(&old) {
-                md = crate::study::mc::precision::splice(&md, &section);
-            }
-            if let Some(section) = crate::study::map_tier::existing(&old) {
-                md = crate::study::map_tier::splice(&md, &section);
-            }
+            let md = crate::study::accuracy::report_keeping(&st, &cmd, &old);
             let p_csv = out.with_extension("csv");
             let p_svg = out.with_extension("svg");
             crate::report::atomic::write_atomic(&p_md, md)
@@ -183,50 +176,13 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
             spin.set_message(format!("contact: {contacts} contacts per part and model"));
             let rows = contact_cost::measure(&parts, &fids, *contacts, *tol, *seed, true)?;
             spin.set_message("contact: cost against the vertex count");
-            let table = contact_cost::markdown(&rows);
             let scaling = contact_cost::vertex_scaling(
                 &[3, 6, 12, 24, 48],
                 (*contacts / 4).max(1),
                 *tol,
                 *seed,
             )?;
-            let targets = contact_cost::targets(&rows, &scaling);
-            let tables = contact_cost::tables_markdown(&rows);
-            let scaling_table = contact_cost::scaling_markdown(&scaling);
-            let cmd = format!(
-                "cargo run --release -- bench contact --contacts {contacts} --tol {tol:e} --seed {seed} --out {}",
-                out.display()
-            );
-            let doc = format!(
-                "# Contact model: cost and self-accuracy per contact\n\n\
-                 Regenerate with:\n\n```\n{cmd}\n```\n\n\
-                 Machine: {} cores. Each row: {contacts} random contacts (θ0 uniform, d uniform in \
-                 [−0.9, 0.9], point pin, μc = 0.5, uniform pressure). Times are wall-clock per contact \
-                 (single thread; each contact's fastest of three passes over them all, so that the \
-                 machine's spread stays out of the medians), including contacts where the pin \
-                 misses. *Evaluations* are limit-surface evaluations per touching contact (exact: dissipation evaluations \
-                 inside the Newton solves; tip/ellipsoid: closed-form solves). *Self-error* is \
-                 |θf(tol) − θf(tol/1000)| with the same model: the integration error at the \
-                 default tolerance, not the model error (see the accuracy-vs-time report for that).\n\n\
-                 `exact+tables` is the exact model with its tables (the default for a scene's, a \
-                 map's and a planner's model): a pin sliding on an edge (or a disc riding a \
-                 vertex) gets the exact twist from per-(μc, edge or vertex, side) tables of \
-                 certified cubic Hermite pieces (`src/mechanics/slide_table.rs`) instead of a \
-                 Newton solve. `exact+sticks` adds what a map tier's build uses: a pin sticking on \
-                 an edge gets its twist from per-edge tables over (ℓ, direction of the pin's \
-                 velocity) of certified Chebyshev pieces (`src/mechanics/stick_table.rs`). The \
-                 tables are built before the timed runs (a line or a map build builds them on \
-                 first use); the build is in the table below, with what the tables change against \
-                 the solves at the same tolerance.\n\n\
-                 {table}\n### Tables (exact+tables rows)\n\n{tables}\n{targets}\n\
-                 ### Cost against the vertex count (exact model, regular N-gons)\n\n\
-                 One evaluation of D, ∇D and H (20 000 twists, the centre of rotation within 2a: the \
-                 closed form, one term per edge; at 8a: the far-field quadrature, 64 nodes per \
-                 triangle of the part), and whole contacts ({quarter} per part, as above). × is \
-                 relative to the triangle.\n\n{scaling_table}\n",
-                std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
-                quarter = (*contacts / 4).max(1),
-            );
+            let (table, doc) = contact_cost::report(&rows, &scaling, *contacts, *tol, *seed, out);
             if let Some(dir) = out.parent() {
                 std::fs::create_dir_all(dir).ok();
             }
@@ -294,20 +250,7 @@ fn bench_maps(repeats: usize, out: &std::path::Path) -> Result<()> {
     let load_before = load();
     let rows = map_cost::measure(&["tripoly1", "tripoly2"], &fids, &threads, 1.0, repeats)?;
     let load_after = load();
-    let table = map_cost::markdown(&rows);
-    let doc = format!(
-        "# Configuration maps: wall time\n\n\
-         Regenerate with:\n\n```\ncargo run --release -- bench maps --repeats {repeats} --out {}\n```\n\n\
-         Machine: {cores} cores, shared with other work (1-minute load average {load_before} before, \
-         {load_after} after this run; with a load near the core count the 2-thread rows cannot \
-         show their speed-up). Each row \
-         times `maps::compute_maps` for the 18 thesis maps d = ±0.1 … ±0.9 with θ0 every 1° \
-         (6480 contacts: sampling, bands and runs; no printing, files or figures), point pin, \
-         μc = 0.5, uniform pressure, tolerance 1e-6: median, min and max of {repeats} runs after \
-         one warm-up. *µs per contact* is thread-time per contact (median × threads / contacts). \
-         Target: under 0.5 s with the exact model on 2 cores.\n\n{table}",
-        out.display()
-    );
+    let (table, doc) = map_cost::report(&rows, repeats, cores, (&load_before, &load_after), out);
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

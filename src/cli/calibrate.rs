@@ -7,20 +7,16 @@
 //! interval holds the hidden value. Unless `--no-write`, `pinfeed-out/calibrate/<file stem>/` receives
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
-use super::validate::{
-    emit, ensemble_spec, pool, summary_text, write_report_files, ModelArgs, ReportHead,
-};
+use super::validate::{emit, ensemble_spec, pool, ModelArgs};
 use crate::mechanics::support::{SmoothParams, SupportChoice};
+use crate::report::calibrate_report::{calibration_text, write_report, CalibrateReport};
 use crate::report::shell_word;
-use crate::validate::calibrate::{calibrate_observed, Calibration, CalibrationSettings};
+use crate::validate::calibrate::{calibrate_observed, CalibrationSettings};
 use crate::validate::input::{check_members, load_measured};
-use crate::validate::score::Summary;
 use crate::validate::synthetic::{synthesize, SyntheticDesign};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
-use serde::Serialize;
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `pinfeed calibrate`.
 #[derive(Debug, Args)]
@@ -97,58 +93,10 @@ pub(crate) fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
         pin_radius_sd: args.pin_radius_sd,
         support,
         jitter_deg: args.jitter,
-        fidelity: super::contact::parse_model(&c.model)?,
+        fidelity: crate::contact_case::parse_model(&c.model)?,
         tol: c.tol,
         score: c.score()?,
     })
-}
-
-/// The document `calibration.json`.
-#[derive(Debug, Serialize)]
-struct CalibrateReport<'a> {
-    command: String,
-    measured: String,
-    calibration: &'a Calibration,
-    nominal: Vec<String>,
-    nominal_score: &'a Summary,
-    fitted: Vec<String>,
-    fitted_score: &'a Summary,
-    /// With --synthesize: the hidden values, in the order of the parameters.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    hidden: Option<[f64; 4]>,
-}
-
-fn parameter_table(c: &Calibration, hidden: Option<[f64; 4]>) -> String {
-    let mut s = String::from("| parameter | estimate | 95% interval | searched | hidden value |\n|---|---|---|---|---|\n");
-    for (k, p) in c.parameters.iter().enumerate() {
-        let open = |o: bool| if o { " (open: grid end)" } else { "" };
-        let truth = match hidden {
-            Some(h) => format!(
-                "{} ({})",
-                h[k],
-                if p.covers(h[k]) { "inside" } else { "OUTSIDE" }
-            ),
-            None => "—".into(),
-        };
-        let _ = writeln!(
-            s,
-            "| {} | {:.3} | [{:.3}{}, {:.3}{}] | [{}, {}] | {truth} |",
-            p.name,
-            p.estimate,
-            p.lo,
-            open(p.open_low),
-            p.hi,
-            open(p.open_high),
-            p.grid_min,
-            p.grid_max
-        );
-    }
-    let _ = writeln!(
-        s,
-        "\nlog-likelihood at the estimate {:.2} ({} grid points); effective members {:.0} of {}",
-        c.log_likelihood, c.grid_points, c.effective_members, c.members
-    );
-    s
 }
 
 pub fn run(args: &CalibrateArgs) -> Result<()> {
@@ -191,14 +139,13 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     let nominal_score = run_score(&nominal, "the nominal model")?;
     let fitted_score = run_score(&fitted, "the fit")?;
     bar.finish_and_clear();
-    let mut text = parameter_table(&cal, hidden);
-    let _ = writeln!(
-        text,
-        "\nnominal model ({}): {}",
-        nominal.describe()[..3].join("; "),
-        summary_text(&nominal_score)
+    let text = calibration_text(
+        &cal,
+        hidden,
+        &nominal.describe(),
+        &nominal_score,
+        &fitted_score,
     );
-    let _ = writeln!(text, "fitted ensemble: {}", summary_text(&fitted_score));
     let report = CalibrateReport {
         command: command_line(args),
         measured: args.measured.display().to_string(),
@@ -229,16 +176,4 @@ fn command_line(args: &CalibrateArgs) -> String {
         args.score_members,
         args.common.words()
     )
-}
-
-fn write_report(report: &CalibrateReport, text: &str, out_dir: &Path) -> Result<()> {
-    let head = ReportHead {
-        title: format!("Calibration: {}", report.measured),
-        command: &report.command,
-        intro: "Fitted ensemble:".into(),
-        bullets: &report.fitted,
-    };
-    write_report_files(out_dir, "calibration.json", report, head, |_| {
-        Ok(text.to_string())
-    })
 }

@@ -3,11 +3,11 @@
 //! of its (part, support, pin radius, μc, tolerance), or exactly where the map cannot vouch for it,
 //! and says which.
 
-use super::contact::{case_of, check_geometry, check_inputs, compile_part, report, ContactArgs};
+use super::contact::{case_of, ContactArgs};
+use crate::contact_case::report::report;
+use crate::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
 use crate::engine::contact_map::prepare;
-use crate::geometry::Polygon;
-use crate::maps::tier::{self, push_with_map, Loaded, Source, TierInputs, TierMap, TierSpec};
-use crate::maps::MapSettings;
+use crate::maps::tier::{self, push_with_map, Loaded, TierInputs, TierSpec};
 use crate::mechanics::{ContactSettings, Fidelity, PartModel, Support};
 use crate::scenario::Scene;
 use anyhow::{bail, Result};
@@ -18,21 +18,6 @@ use std::time::Instant;
 /// The cache folder: the one given, else the default (see [`tier::default_cache_dir`]).
 fn cache_dir(dir: Option<&Path>) -> PathBuf {
     dir.map_or_else(tier::default_cache_dir, Path::to_path_buf)
-}
-
-/// One line on where a map came from.
-fn describe(loaded: &Loaded) -> String {
-    let st = &loaded.map.stats;
-    let what = format!(
-        "{} exact pushes, {:.1}% of θ0 × d certified",
-        st.exact_samples,
-        100.0 * st.certified_area
-    );
-    match &loaded.source {
-        Source::Built { seconds } => format!("built in {seconds:.2} s ({what})"),
-        Source::Disk(p) => format!("read from {} ({what})", p.display()),
-        Source::Memory => format!("already loaded ({what})"),
-    }
 }
 
 /// For a scene with `fidelity = "map"`: load or build its maps into `dir` before the run and
@@ -54,7 +39,7 @@ pub fn prepare_maps(scene: &Scene, dir: Option<&Path>, quiet: bool) -> String {
             eprintln!("warning: {w}");
         }
         if seen.insert(loaded.map.key) {
-            text.push_str(&format!("map {}  {}\n", loaded.map.key, describe(loaded)));
+            text.push_str(&format!("map {}  {}\n", loaded.map.key, loaded.describe()));
         }
     }
     text.push_str(&format!(
@@ -92,7 +77,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         args.map_grid.as_deref(),
         args.cache_dir.as_deref(),
     )?;
-    let (pose, start) = super::contact::case_geometry(&poly, &c);
+    let (pose, start) = case_geometry(&poly, &c);
     let started = Instant::now();
     let (out, why) = push_with_map(&loaded.map, &model, pose, start, c.pin_radius, &settings);
     let query_s = started.elapsed().as_secs_f64();
@@ -109,7 +94,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             "answered_by": served,
             "key": loaded.map.key.to_string(),
             "file": file,
-            "source": describe(&loaded),
+            "source": loaded.describe(),
             "query_s": query_s,
         });
         print!("{}", crate::report::versioned::pretty(&v)?);
@@ -120,7 +105,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         r.part, r.theta0_deg, r.d, r.mu_c
     );
     if r.contact {
-        super::contact::print_motion(&r);
+        print!("{}", r.motion_text());
     } else {
         println!("no contact: the pin passes the part");
     }
@@ -129,7 +114,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     println!(
         "map                 {}  {}",
         loaded.map.key,
-        describe(&loaded)
+        loaded.describe()
     );
     if let Some(f) = file {
         println!("map file            {f}");
@@ -149,7 +134,7 @@ pub fn load_tier(
     dir: Option<&Path>,
 ) -> Result<Loaded> {
     let spec = match grid {
-        Some(g) => parse_grid(g)?,
+        Some(g) => TierSpec::parse_grid(g)?,
         None => TierSpec::default(),
     };
     let inputs = TierInputs {
@@ -164,56 +149,4 @@ pub fn load_tier(
         eprintln!("warning: {w}");
     }
     Ok(loaded)
-}
-
-/// How many of a configuration map's passes (`pinfeed map --model map`) the map answered, how
-/// many the exact model computed and why.
-pub fn served_line(
-    map: &TierMap,
-    poly: &Polygon,
-    model: &PartModel,
-    ds: &[f64],
-    settings: &MapSettings,
-) -> String {
-    let grid = crate::maps::theta_grid(settings.theta_step_deg).unwrap_or_default();
-    let mut served = 0usize;
-    let mut why: std::collections::BTreeMap<&'static str, usize> = Default::default();
-    for &d in ds {
-        for &t in &grid {
-            let (pose, start) = crate::maps::pass_start(poly, t, d, settings.pin.radius);
-            match map.answer(model, pose, start, settings.pin.radius) {
-                Ok(_) => served += 1,
-                Err(w) => *why.entry(w.name()).or_default() += 1,
-            }
-        }
-    }
-    let total = ds.len() * grid.len();
-    let exact: Vec<String> = why.iter().map(|(k, n)| format!("{k} {n}")).collect();
-    format!(
-        "map tier: {served} of {total} passes ({:.1}%) answered by the map (misses by the exact ray cast), {} exact ({})",
-        100.0 * served as f64 / total.max(1) as f64,
-        total - served,
-        if exact.is_empty() { "none".to_string() } else { exact.join(", ") }
-    )
-}
-
-/// `--map-grid T,D,DEPTH`.
-pub fn parse_grid(s: &str) -> Result<TierSpec> {
-    let v: Vec<u32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<u32>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| anyhow::anyhow!("--map-grid '{s}': expected T,D,DEPTH (whole numbers)"))?;
-    let [t, d, depth] = v[..] else {
-        bail!("--map-grid '{s}': expected three numbers T,D,DEPTH");
-    };
-    if !((4..=720).contains(&t) && (2..=200).contains(&d) && depth <= 8) {
-        bail!("--map-grid must lie in [4, 720] × [2, 200] × [0, 8], got {t},{d},{depth}");
-    }
-    Ok(TierSpec {
-        theta_cells: t,
-        d_cells: d,
-        max_depth: depth,
-        ..TierSpec::default()
-    })
 }

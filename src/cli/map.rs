@@ -3,24 +3,23 @@
 //!
 //! Each map samples θ0 over [0°, 360°) with the start convention of `pinfeed contact`
 //! ([`crate::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
-//! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`super::contact::case_fence`]);
+//! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`crate::contact_case::case_fence`]);
 //! a fence map has no contact parameter, so `--d` is not taken, and its report goes to
 //! `pinfeed-out/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
 //! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
 //! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
 
-use super::contact::{
-    case_fence, check_geometry, check_inputs, compile_part, num, parse_fence, parse_model,
+use crate::contact_case::{
+    case_fence, check_geometry, check_inputs, compile_part, parse_fence, parse_model,
     settings_and_pin, Case,
 };
-use crate::maps::{compute_maps_with, ConfigurationMap, MapFence, MapSettings};
+use crate::maps::{compute_maps_with, MapFence, MapSettings};
+use crate::report::map_report::{write_csv, write_report, MapReport};
 use crate::report::shell_word;
-use crate::report::{map_table, plot_map};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
-use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `pinfeed map`.
 #[derive(Debug, Args)]
@@ -108,40 +107,6 @@ pub struct MapArgs {
     pub seed: u64,
 }
 
-/// The JSON document of `pinfeed map --json` (and `map.json`).
-#[derive(Debug, Serialize)]
-pub struct MapReport<'a> {
-    /// The command that regenerates this report.
-    pub command: String,
-    pub part: &'a str,
-    pub model: &'a str,
-    pub mu_c: f64,
-    pub pin_radius: f64,
-    pub support: &'a str,
-    pub theta_step_deg: f64,
-    pub threshold_deg: f64,
-    pub tol: f64,
-    /// The fence of a fence map, placed as `pinfeed contact --fence` places it (part units at θ0 = 0,
-    /// the part's centroid at the origin).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub fence: Option<crate::mechanics::FenceSpec>,
-    pub maps: &'a [ConfigurationMap],
-}
-
-/// One CSV row: a sample of one map.
-#[derive(Debug, Serialize)]
-struct SampleRow {
-    d: f64,
-    theta0_deg: f64,
-    theta_final_deg: f64,
-    rotation_deg: f64,
-    contact: bool,
-    com_final_y: f64,
-    contact_length: f64,
-    band: Option<usize>,
-    status: &'static str,
-}
-
 /// The command line that regenerates a report, every setting explicit.
 pub fn command_line(args: &MapArgs) -> String {
     let ds: Vec<String> = args.d.iter().map(|d| d.to_string()).collect();
@@ -206,71 +171,6 @@ pub fn default_out_dir(part: &str) -> PathBuf {
     crate::default_out(&["maps", &super::part_folder(part)])
 }
 
-/// The angle of a fence map as the user gave it (degrees; 0 for pin maps).
-fn fence_angle_deg(maps: &[ConfigurationMap]) -> f64 {
-    maps.first()
-        .and_then(|m| m.fence)
-        .map_or(0.0, |f| f.angle_deg)
-}
-
-fn figure_name(m: &ConfigurationMap) -> String {
-    match m.fence {
-        None => format!("map_d{:+}.svg", m.d),
-        Some(_) => "map_fence.svg".into(),
-    }
-}
-
-/// Most contact parameters in one map command.
-pub const MAX_DS: usize = 1000;
-/// Most contacts (maps × θ0 samples) in one map command: bounds the memory (about 100 bytes each)
-/// and the time.
-pub const MAX_CONTACTS: usize = 3_600_000;
-/// Most worker threads.
-pub const MAX_THREADS: usize = 1024;
-
-/// Refuse out-of-range map settings with the flag, the range and the value.
-fn check_map_args(args: &MapArgs) -> Result<()> {
-    if args.threads > MAX_THREADS {
-        bail!(
-            "--threads must lie in [0, {MAX_THREADS}] (0: one per core), got {}",
-            args.threads
-        );
-    }
-    if args.d.len() > MAX_DS {
-        bail!(
-            "--d takes at most {MAX_DS} contact parameters, got {}",
-            args.d.len()
-        );
-    }
-    if !(args.theta_step.is_finite() && args.theta_step > 0.0 && args.theta_step <= 360.0) {
-        bail!(
-            "--theta-step: theta step must be a finite number of degrees in (0, 360] dividing 360, got {}",
-            num(args.theta_step)
-        );
-    }
-    let grid =
-        crate::maps::theta_grid(args.theta_step).map_err(|e| anyhow!("--theta-step: {e}"))?;
-    let maps = if args.fence.is_some() {
-        1
-    } else {
-        args.d.len()
-    };
-    if maps * grid.len() > MAX_CONTACTS {
-        bail!(
-            "{maps} maps × {} θ0 samples = {} contacts; at most {MAX_CONTACTS} are allowed in one command (raise --theta-step or give fewer --d)",
-            grid.len(),
-            maps * grid.len()
-        );
-    }
-    if !(args.threshold.is_finite() && args.threshold > 0.0 && args.threshold <= 360.0) {
-        bail!(
-            "--threshold must be a finite number of degrees in (0, 360], got {}",
-            num(args.threshold)
-        );
-    }
-    Ok(())
-}
-
 pub fn run(args: &MapArgs) -> Result<()> {
     // The map tier answers over the exact model, which computes what it cannot vouch for.
     let use_tier = args.model.trim() == "map";
@@ -295,7 +195,9 @@ pub fn run(args: &MapArgs) -> Result<()> {
         fence,
     };
     check_inputs(&template)?;
-    check_map_args(args)?;
+    let fenced = args.fence.is_some();
+    let (step, threshold) = (args.theta_step, args.threshold);
+    crate::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold)?;
     let (poly, part_model) = compile_part(&args.part, &args.support)?;
     if fence.is_some() {
         check_geometry(&template, &poly)?;
@@ -364,7 +266,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     if let Some(l) = &tier {
         eprintln!(
             "{}",
-            super::contact_map::served_line(&l.map, &poly, &part_model, &ds, &settings)
+            crate::maps::tier::report::served_line(&l.map, &poly, &part_model, &ds, &settings)
         );
     }
     let contacts: usize = maps.iter().map(|m| m.samples.len()).sum();
@@ -398,20 +300,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     } else if args.csv {
         write_csv(std::io::stdout().lock(), &maps)?;
     } else {
-        let obstacle = match &report.fence {
-            Some(f) => format!(
-                "fence {}° length {} μf {}",
-                fence_angle_deg(report.maps),
-                f.length,
-                f.mu_f
-            ),
-            None => format!("μc {}  pin radius {}", args.mu_c, args.pin_radius),
-        };
-        println!(
-            "{}  model {}  {obstacle}  support {}  θ0 step {}°  threshold {}°",
-            args.part, report.model, args.support, args.theta_step, args.threshold
-        );
-        print!("{}", map_table::bands_text(&maps));
+        print!("{}", report.text());
     }
     if !args.no_write {
         let out_dir = args
@@ -424,173 +313,11 @@ pub fn run(args: &MapArgs) -> Result<()> {
     Ok(())
 }
 
-fn write_csv<W: std::io::Write>(w: W, maps: &[ConfigurationMap]) -> Result<()> {
-    let mut wtr = csv::Writer::from_writer(w);
-    for m in maps {
-        for s in &m.samples {
-            wtr.serialize(SampleRow {
-                d: m.d,
-                theta0_deg: s.theta0_deg,
-                theta_final_deg: s.theta_final_deg,
-                rotation_deg: s.rotation_deg,
-                contact: s.contact,
-                com_final_y: s.com_final_y,
-                contact_length: s.contact_length,
-                band: s.band,
-                status: s.status.name(),
-            })?;
-        }
-    }
-    wtr.flush()?;
-    Ok(())
-}
-
-/// Write README.md, map.json, samples.csv and the figures.
-fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> Result<()> {
-    let plot_dir = plot_dir.unwrap_or(out_dir);
-    for dir in [out_dir, plot_dir] {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let json_path = out_dir.join("map.json");
-    // Compact: the document holds every sample (README.md is the readable summary).
-    crate::report::atomic::write_atomic(&json_path, crate::report::versioned::compact(report)?)
-        .with_context(|| format!("writing {}", json_path.display()))?;
-    let csv_path = out_dir.join("samples.csv");
-    crate::report::atomic::produce_atomic(&csv_path, |tmp| {
-        write_csv(
-            std::io::BufWriter::new(std::fs::File::create(tmp)?),
-            report.maps,
-        )
-    })
-    .with_context(|| format!("writing {}", csv_path.display()))?;
-
-    let describe = match &report.fence {
-        Some(f) => format!(
-            "{} ({}, fence {}° length {}, μf {})",
-            report.part,
-            report.model,
-            fence_angle_deg(report.maps),
-            f.length,
-            report.mu_c
-        ),
-        None => format!("{} ({}, μc {})", report.part, report.model, report.mu_c),
-    };
-    let mut figures: Vec<(String, PathBuf)> = Vec::new();
-    // Band intervals against d: only pin maps have a d to plot against.
-    let against_d: &[(bool, &str, &str)] = if report.fence.is_some() {
-        &[]
-    } else {
-        &[
-            (false, "band_intervals.svg", "Band intervals against d"),
-            (
-                true,
-                "band_intervals_adjusted.svg",
-                "Adjusted band intervals (mean ± sd) against d",
-            ),
-        ]
-    };
-    for &(adjusted, file, what) in against_d {
-        let path = plot_dir.join(file);
-        plot_map::plot_band_intervals(report.maps, adjusted, &format!("{what}: {describe}"), &path)
-            .with_context(|| format!("writing {}", path.display()))?;
-        figures.push((what.to_string(), path));
-    }
-    for m in report.maps {
-        let path = plot_dir.join(figure_name(m));
-        let (title, what) = match m.fence {
-            Some(_) => (format!("{describe}: θ0 → θf"), "θ0 → θf".to_string()),
-            None => (
-                format!("{describe}, d = {:+}: θ0 → θf", m.d),
-                format!("d = {:+}", m.d),
-            ),
-        };
-        plot_map::plot_map(m, &title, report.theta_step_deg, &path)
-            .with_context(|| format!("writing {}", path.display()))?;
-        figures.push((what, path));
-    }
-
-    let link = |p: &Path| -> String {
-        if plot_dir == out_dir {
-            p.file_name()
-                .map_or_else(String::new, |f| f.to_string_lossy().into_owned())
-        } else {
-            p.display().to_string()
-        }
-    };
-    let samples = report.maps.first().map_or(0, |m| m.samples.len());
-    let non_ok: usize = report.maps.iter().map(|m| m.non_ok_samples()).sum();
-    let mut md = format!(
-        "# Configuration maps: {part}\n\nRegenerate from the repository root with\n\n    cargo run --release -- {cmd}\n\n",
-        part = report.part,
-        cmd = report.command.trim_start_matches("pinfeed "),
-    );
-    let obstacle = match &report.fence {
-        Some(f) => format!(
-            "a fence at {}° of length {} (part units) with friction μf = {}, its upstream end at \
-             ({:.4}, {:.4}) when the part's centroid is at the origin (the placement of \
-             `pinfeed contact --fence`, `src/maps/start.rs`)",
-            fence_angle_deg(report.maps),
-            f.length,
-            f.mu_f,
-            f.start.x,
-            f.start.y
-        ),
-        None => format!(
-            "contact friction μc = {}, pin radius {} (part units)",
-            report.mu_c, report.pin_radius
-        ),
-    };
-    md += &format!(
-        "Part `{}`, model `{}`, {obstacle}, support `{}`, \
-         θ0 every {}° ({samples} samples per map), band threshold T = {}°, integration tolerance {}. \
-         Conventions: docs/physics.md#configuration-maps and the module docs of `src/maps/` (bands group neighbours in sorted \
-         final angle, circularly; an interval [a, b] with b < a straddles 0°/360°; sd uses n − 1; \
-         adjusted band = mean ± sd, thesis eq. 3-2). Contacts that did not end `ok`: {non_ok}.\n\n",
-        report.part,
-        report.model,
-        report.support,
-        report.theta_step_deg,
-        report.threshold_deg,
-        report.tol
-    );
-    md += "Files: `map.json` (every sample, band and no-contact interval), `samples.csv` \
-           (one row per sample), and the figures below.\n\n";
-    md += if report.fence.is_some() {
-        "## Bands\n\n"
-    } else {
-        "## Bands per d\n\n"
-    };
-    md += &map_table::bands_markdown(report.maps);
-    md += "\n## Figures\n\n";
-    for (what, path) in &figures {
-        md += &format!("### {what}\n\n![{what}]({})\n\n", link(path));
-    }
-    let readme = out_dir.join("README.md");
-    crate::report::atomic::write_atomic(&readme, md)
-        .with_context(|| format!("writing {}", readme.display()))?;
-    // The folder holds this run's figures only: a figure of an earlier run for a d not asked
-    // for now goes.
-    let written: Vec<String> = figures
-        .iter()
-        .filter_map(|(_, p)| p.file_name().map(|f| f.to_string_lossy().into_owned()))
-        .collect();
-    crate::report::stale::remove_stale(plot_dir, &written, is_map_figure)
-        .with_context(|| format!("removing earlier figures from {}", plot_dir.display()))?;
-    Ok(())
-}
-
-/// The names of the figures `pinfeed map` writes.
-fn is_map_figure(name: &str) -> bool {
-    name.ends_with(".svg")
-        && (name.starts_with("map_d")
-            || name == "map_fence.svg"
-            || name.starts_with("band_intervals"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use clap::Parser;
+    use std::path::Path;
 
     fn parse(args: &[&str]) -> MapArgs {
         let cli =

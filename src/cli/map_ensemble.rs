@@ -7,37 +7,18 @@
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
 use super::map::{command_line, default_out_dir_for, MapArgs};
-use super::validate::{write_report_files, ReportHead};
 use crate::geometry::Polygon;
-use crate::maps::ensemble::{
-    ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState, MemberDraw, PredictedBands,
-};
+use crate::maps::ensemble::{ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState};
 use crate::maps::theta_grid;
 use crate::mechanics::Fidelity;
-use crate::report::plot_validate::plot_band_distributions;
+use crate::report::ensemble_report::{table, write_report, EnsembleReport};
 use crate::report::shell_word;
-use anyhow::{anyhow, bail, Context, Result};
-use serde::Serialize;
-use std::fmt::Write as _;
-use std::path::Path;
+use anyhow::{anyhow, bail, Result};
 
 /// Most members of an ensemble.
 pub const MAX_MEMBERS: usize = 100_000;
 /// Most passes (members × d × θ0) in one command.
 pub const MAX_PASSES: usize = 20_000_000;
-
-/// The document `ensemble.json`.
-#[derive(Debug, Serialize)]
-struct EnsembleReport<'a> {
-    command: String,
-    part: &'a str,
-    uncertain: Vec<String>,
-    members: usize,
-    seed: u64,
-    theta_step_deg: f64,
-    predicted: &'a [PredictedBands],
-    draws: &'a [MemberDraw],
-}
 
 /// The regenerating command of an ensemble map.
 fn ensemble_command(args: &MapArgs, uncertain: &str) -> String {
@@ -48,41 +29,6 @@ fn ensemble_command(args: &MapArgs, uncertain: &str) -> String {
         args.members,
         args.seed
     )
-}
-
-/// The text of predicted bands: `[lo, hi] mass%` per band.
-pub fn bands_text(p: &PredictedBands) -> String {
-    p.bands
-        .iter()
-        .map(|b| {
-            format!(
-                "[{:.1}, {:.1}] {:.0}%",
-                b.arc.lo,
-                b.arc.hi(),
-                100.0 * b.mass
-            )
-        })
-        .collect::<Vec<_>>()
-        .join("  ")
-}
-
-/// The band table: one line per (d, input).
-fn table(predicted: &[PredictedBands]) -> String {
-    let mut s = String::from(
-        "| d | input | passes | predicted bands (90%) | circle covered |\n|---|---|---|---|---|\n",
-    );
-    for p in predicted {
-        let _ = writeln!(
-            s,
-            "| {:+} | {} | {} | {} | {:.1}% |",
-            p.d,
-            p.input,
-            p.passes,
-            bands_text(p),
-            100.0 * p.coverage
-        );
-    }
-    s
 }
 
 pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> Result<()> {
@@ -162,41 +108,4 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
     write_report(&report, &inputs, &text, &out_dir, args.plot_dir.as_deref())?;
     eprintln!("report written to {}", out_dir.display());
     Ok(())
-}
-
-fn write_report(
-    report: &EnsembleReport,
-    inputs: &[InputState],
-    table: &str,
-    out_dir: &Path,
-    plot_dir: Option<&Path>,
-) -> Result<()> {
-    let head = ReportHead {
-        title: format!("Ensemble map: {}", report.part),
-        command: &report.command,
-        intro: format!(
-            "{} members, seed {}; uncertain:",
-            report.members, report.seed
-        ),
-        bullets: &report.uncertain,
-    };
-    write_report_files(out_dir, "ensemble.json", report, head, |out_dir| {
-        let plot_dir = plot_dir.unwrap_or(out_dir);
-        std::fs::create_dir_all(plot_dir)
-            .with_context(|| format!("creating {}", plot_dir.display()))?;
-        let mut md = format!("Predicted bands: the smallest arcs (1° resolution, gaps under 5° closed, ends at the extreme passes they hold) that hold 90% of the passes pooled over the members and the input's θ0 (a stable state: the grid θ0 nearest it).\n\n{table}\n");
-        for input in inputs {
-            let label = input.label();
-            let name = format!("ensemble_{}.svg", label.replace(':', ""));
-            let of_input: Vec<&PredictedBands> = report
-                .predicted
-                .iter()
-                .filter(|p| p.input == label)
-                .collect();
-            let title = format!("{}: predicted θf against d, input {label}", report.part);
-            plot_band_distributions(&of_input, &[], &title, &plot_dir.join(&name))?;
-            let _ = writeln!(md, "![{label}]({name})\n");
-        }
-        Ok(md)
-    })
 }

@@ -32,23 +32,7 @@ pub mod validate;
 
 use clap::{Parser, Subcommand};
 
-/// The folder name of a part's reports: the part spec with anything but letters, digits, `-` and
-/// `.` replaced by `_` (`rect:2:1` → `rect_2_1`); a vertex list is `custom`.
-pub fn part_folder(part: &str) -> String {
-    let p = part.trim();
-    if p.to_lowercase().starts_with("vertices:") {
-        return "custom".into();
-    }
-    p.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
-}
+pub use crate::geometry::named::part_folder;
 
 /// pinfeed: orient planar parts on a conveyor with overhead pins and fences.
 #[derive(Debug, Parser)]

@@ -7,16 +7,15 @@
 //! confirmed design.
 
 use super::stdout::print_result;
-use crate::plan::design::{
-    self, describe_obstacles, Candidate, Design, DesignOptions, FenceSettings, Layout, Mode,
-    Objective, Status,
-};
+use crate::plan::design::{self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status};
+use crate::plan::problem::parse_mu_c_range;
 use crate::plan::{FeedKind, Problem};
+use crate::report::plan_summary::{self as summary, write_design, DesignPaths};
 use crate::report::shell_word;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::fmt::Display;
+use std::path::PathBuf;
 
 /// Arguments of `pinfeed plan`.
 #[derive(Debug, Args)]
@@ -168,34 +167,27 @@ pub struct PlanArgs {
     pub threads: usize,
 }
 
-fn parse_range(s: &str) -> Result<(f64, f64)> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or_else(|| anyhow!("--mu-c-range '{s}': expected LO:HI, e.g. 0.3:0.7"))?;
-    let p = |t: &str| -> Result<f64> {
-        t.trim()
-            .parse::<f64>()
-            .map_err(|_| anyhow!("--mu-c-range '{s}': '{t}' is not a number"))
-    };
-    Ok((p(a)?, p(b)?))
-}
-
 /// The problem described by the arguments.
 pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     let mut p = Problem::new(&args.part);
     p.scale = args.scale;
-    p.feed = match args.feed.trim() {
-        "stable" => FeedKind::Stable,
-        "uniform" => FeedKind::Uniform,
-        other => bail!("--feed '{other}': expected 'stable' or 'uniform'"),
-    };
+    p.feed = FeedKind::from_name(&args.feed).ok_or_else(|| {
+        anyhow!(
+            "--feed '{}': expected 'stable' or 'uniform'",
+            args.feed.trim()
+        )
+    })?;
     p.jitter_deg = args.jitter;
     p.lateral_m = args.lateral;
     p.jitter_samples = args.jitter_samples;
     p.offset_samples = args.offset_samples;
     p.orientation_samples = args.orientation_samples;
     p.mu_c = args.mu_c;
-    p.mu_c_range = args.mu_c_range.as_deref().map(parse_range).transpose()?;
+    p.mu_c_range = args
+        .mu_c_range
+        .as_deref()
+        .map(parse_mu_c_range)
+        .transpose()?;
     p.tripod = args.tripod;
     p.pin_radius_m = args.pin_radius;
     if let Some(w) = args.belt_width {
@@ -223,19 +215,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
 pub fn options_of(args: &PlanArgs) -> Result<DesignOptions> {
     let problem = problem_of(args)?;
     let mut o = DesignOptions::new(problem);
-    let mut modes = Vec::new();
-    if args.pins {
-        modes.push(Mode::Pins);
-    }
-    if args.fences {
-        modes.push(Mode::Fences);
-    }
-    if args.pins && args.fences {
-        modes.push(Mode::Hybrid);
-    }
-    if args.sensor {
-        modes.push(Mode::Sensor);
-    }
+    let modes = Mode::selected(args.pins, args.fences, args.sensor);
     if !modes.is_empty() {
         o.modes = modes;
     }
@@ -272,128 +252,58 @@ pub fn options_of(args: &PlanArgs) -> Result<DesignOptions> {
 pub fn command_line(args: &PlanArgs) -> String {
     let mut w = vec!["pinfeed plan --part".to_string(), shell_word(&args.part)];
     let d = Problem::new(&args.part);
-    let mut opt = |flag: &str, v: String, default: String| {
-        if v != default {
+    let a = args;
+    let mut opt = |flag: &str, v: &dyn Display, default: &dyn Display| {
+        let v = v.to_string();
+        if v != default.to_string() {
             w.push(format!("{flag} {}", shell_word(&v)));
         }
     };
-    opt("--scale", args.scale.to_string(), d.scale.to_string());
-    opt("--objective", args.objective.clone(), "belt-length".into());
-    opt("--feed", args.feed.clone(), "stable".into());
-    opt(
-        "--jitter",
-        args.jitter.to_string(),
-        d.jitter_deg.to_string(),
-    );
-    opt(
-        "--lateral",
-        args.lateral.to_string(),
-        d.lateral_m.to_string(),
-    );
-    opt(
-        "--jitter-samples",
-        args.jitter_samples.to_string(),
-        "5".into(),
-    );
-    opt(
-        "--offset-samples",
-        args.offset_samples.to_string(),
-        "5".into(),
-    );
-    opt(
-        "--orientation-samples",
-        args.orientation_samples.to_string(),
-        "72".into(),
-    );
-    opt("--mu-c", args.mu_c.to_string(), d.mu_c.to_string());
+    opt("--scale", &a.scale, &d.scale);
+    opt("--objective", &a.objective, &"belt-length");
+    opt("--feed", &a.feed, &"stable");
+    opt("--jitter", &a.jitter, &d.jitter_deg);
+    opt("--lateral", &a.lateral, &d.lateral_m);
+    opt("--jitter-samples", &a.jitter_samples, &"5");
+    opt("--offset-samples", &a.offset_samples, &"5");
+    opt("--orientation-samples", &a.orientation_samples, &"72");
+    opt("--mu-c", &a.mu_c, &d.mu_c);
     opt(
         "--mu-c-range",
-        args.mu_c_range.clone().unwrap_or_default(),
-        String::new(),
+        &a.mu_c_range.clone().unwrap_or_default(),
+        &"",
     );
-    opt(
-        "--pin-radius",
-        args.pin_radius.to_string(),
-        d.pin_radius_m.to_string(),
-    );
+    opt("--pin-radius", &a.pin_radius, &d.pin_radius_m);
     opt(
         "--belt-width",
-        args.belt_width.map_or(String::new(), |b| b.to_string()),
-        String::new(),
+        &a.belt_width.map_or(String::new(), |b| b.to_string()),
+        &"",
     );
-    opt(
-        "--spacing",
-        args.spacing.to_string(),
-        d.spacing_m.to_string(),
-    );
-    opt(
-        "--max-pins",
-        args.max_pins.to_string(),
-        d.max_pins.to_string(),
-    );
-    opt(
-        "--tolerance",
-        args.tolerance.to_string(),
-        d.tolerance_deg.to_string(),
-    );
-    opt("--target", args.target.to_string(), d.target.to_string());
-    opt("--min-margin", args.min_margin.to_string(), "0.5".into());
-    opt("--y-quantum", args.y_quantum.to_string(), "0.25".into());
-    opt(
-        "--theta-quantum",
-        args.theta_quantum.to_string(),
-        "0.25".into(),
-    );
-    opt("--coarse", args.coarse.to_string(), "4".into());
-    opt("--refine", args.refine.to_string(), "2".into());
-    opt(
-        "--max-states",
-        args.max_states.to_string(),
-        d.max_states.to_string(),
-    );
-    opt("--time-limit", args.time_limit.to_string(), "110".into());
-    opt(
-        "--contact-tol",
-        args.contact_tol.to_string(),
-        d.contact_tol.to_string(),
-    );
-    opt("--seed", args.seed.to_string(), "1".into());
-    opt(
-        "--check-parts",
-        args.check_parts.to_string(),
-        "10000".into(),
-    );
-    opt(
-        "--screen-parts",
-        args.screen_parts.to_string(),
-        "2000".into(),
-    );
+    opt("--spacing", &a.spacing, &d.spacing_m);
+    opt("--max-pins", &a.max_pins, &d.max_pins);
+    opt("--tolerance", &a.tolerance, &d.tolerance_deg);
+    opt("--target", &a.target, &d.target);
+    opt("--min-margin", &a.min_margin, &"0.5");
+    opt("--y-quantum", &a.y_quantum, &"0.25");
+    opt("--theta-quantum", &a.theta_quantum, &"0.25");
+    opt("--coarse", &a.coarse, &"4");
+    opt("--refine", &a.refine, &"2");
+    opt("--max-states", &a.max_states, &d.max_states);
+    opt("--time-limit", &a.time_limit, &"110");
+    opt("--contact-tol", &a.contact_tol, &d.contact_tol);
+    opt("--seed", &a.seed, &"1");
+    opt("--check-parts", &a.check_parts, &"10000");
+    opt("--screen-parts", &a.screen_parts, &"2000");
     opt(
         "--mu-f",
-        args.mu_f.map_or(String::new(), |m| m.to_string()),
-        String::new(),
+        &a.mu_f.map_or(String::new(), |m| m.to_string()),
+        &"",
     );
-    opt(
-        "--fence-overhang",
-        args.fence_overhang.to_string(),
-        "0".into(),
-    );
-    opt(
-        "--max-fence-angle",
-        args.max_fence_angle.to_string(),
-        "55".into(),
-    );
-    opt(
-        "--fence-angle-step",
-        args.fence_angle_step.to_string(),
-        "5".into(),
-    );
-    opt("--max-moving", args.max_moving.to_string(), "3".into());
-    opt(
-        "--sensor-candidates",
-        args.sensor_candidates.to_string(),
-        "6".into(),
-    );
+    opt("--fence-overhang", &a.fence_overhang, &"0");
+    opt("--max-fence-angle", &a.max_fence_angle, &"55");
+    opt("--fence-angle-step", &a.fence_angle_step, &"5");
+    opt("--max-moving", &a.max_moving, &"3");
+    opt("--sensor-candidates", &a.sensor_candidates, &"6");
     for (on, flag) in [
         (args.tripod, "--tripod"),
         (args.fewest_sets, "--fewest-sets"),
@@ -409,51 +319,6 @@ pub fn command_line(args: &PlanArgs) -> String {
     w.join(" ")
 }
 
-/// The files a design writes: (scenario, policy if any, drawing).
-fn paths(args: &PlanArgs, o: &DesignOptions, sensor: bool) -> (PathBuf, Option<PathBuf>, PathBuf) {
-    let scenario = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from("pinfeed-out")
-            .join("plans")
-            .join(format!("{}.toml", o.name))
-    });
-    let policy = sensor.then(|| scenario.with_file_name(format!("{}.policy.toml", o.name)));
-    let draw = args
-        .draw
-        .clone()
-        .unwrap_or_else(|| scenario.with_extension("svg"));
-    (scenario, policy, draw)
-}
-
-/// The JSON document of `pinfeed plan --json`.
-#[derive(Debug, Serialize)]
-struct PlanJson<'a> {
-    schema_version: u32,
-    pinfeed_version: &'static str,
-    command: &'a str,
-    /// confirmed | not_confirmed | unchecked | no_design
-    status: Status,
-    message: &'a str,
-    name: &'a str,
-    mode: Option<Mode>,
-    predicted_success: Option<f64>,
-    line_check: Option<&'a design::LineCheck>,
-    uncertain_check: Option<&'a design::LineCheck>,
-    obstacles: Option<&'a [design::ObstacleInfo]>,
-    belt_length_m: Option<f64>,
-    belt_width_m: Option<f64>,
-    headway_s: Option<f64>,
-    oriented_per_min: Option<f64>,
-    files: Vec<String>,
-    limit: Option<&'a str>,
-    elapsed_s: f64,
-    candidates: &'a [Candidate],
-    /// The chosen candidate (also in `candidates`).
-    chosen: Option<&'a Candidate>,
-    problem: &'a Problem,
-    objective: Objective,
-    scenario: Option<&'a str>,
-}
-
 /// Run `pinfeed plan`.
 pub fn run(args: &PlanArgs) -> Result<()> {
     let o = options_of(args)?;
@@ -464,18 +329,7 @@ pub fn run(args: &PlanArgs) -> Result<()> {
     let bar = progress_bar(args.quiet || args.json);
     let tell = |p: &design::Progress| {
         if let Some(b) = &bar {
-            b.set_message(format!(
-                "{}{} · {} · {} candidate(s), {} line run(s)",
-                p.mode.map_or("", |m| m.name()),
-                if p.round > 0 {
-                    format!(" round {}", p.round + 1)
-                } else {
-                    String::new()
-                },
-                p.stage,
-                p.candidates,
-                p.line_runs,
-            ));
+            b.set_message(p.to_string());
         }
     };
     let d = pool.install(|| design::design(&o, &tell))?;
@@ -485,69 +339,16 @@ pub fn run(args: &PlanArgs) -> Result<()> {
     let sensor = d
         .chosen()
         .is_some_and(|c| matches!(c.layout, Layout::Contingent(_)));
-    let (scenario, policy, draw) = paths(args, &o, sensor);
-    let mut files = Vec::new();
-    if let (Some(c), Some(toml), false) = (d.chosen(), &d.scenario_toml, args.no_write) {
-        write(&scenario, toml)?;
-        files.push(scenario.display().to_string());
-        if let (Some(p), Some((_, text))) = (&policy, &d.policy_toml) {
-            write(p, text)?;
-            files.push(p.display().to_string());
-        }
-        draw_design(&o, c, &d, &draw)?;
-        files.push(draw.display().to_string());
-        if let Some(u) = &c.uncertain_check {
-            let file = scenario
-                .file_name()
-                .map_or("plan.toml".into(), |f| f.to_string_lossy().to_string());
-            let study_path = scenario.with_file_name(format!("{}.uncertain.toml", o.name));
-            let study_file = study_path
-                .file_name()
-                .map_or(String::new(), |f| f.to_string_lossy().to_string());
-            let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind).collect();
-            if let Some(study) = crate::plan::check::uncertainty_study(
-                &c.problem,
-                &kinds,
-                o.fences.mu_f.is_some(),
-                &file,
-                &study_file,
-                u.parts,
-            ) {
-                write(&study_path, &study)?;
-                files.push(study_path.display().to_string());
-            }
-        }
-    }
-    let out = if args.json {
-        let c = d.chosen();
-        let doc = PlanJson {
-            schema_version: crate::SCHEMA_VERSION,
-            pinfeed_version: env!("CARGO_PKG_VERSION"),
-            command: &o.command,
-            status: d.status,
-            message: &d.message,
-            name: &o.name,
-            mode: c.map(|c| c.mode),
-            predicted_success: c.map(|c| c.predicted_success),
-            line_check: c.and_then(|c| c.line_check.as_ref()),
-            uncertain_check: c.and_then(|c| c.uncertain_check.as_ref()),
-            obstacles: c.map(|c| c.obstacles.as_slice()),
-            belt_length_m: c.map(|c| c.belt_length_m),
-            belt_width_m: c.map(|c| c.belt_width_m),
-            headway_s: c.map(|c| c.headway_s),
-            oriented_per_min: c.map(|c| c.oriented_per_min),
-            files,
-            limit: d.limit.as_deref(),
-            elapsed_s: d.elapsed_s,
-            candidates: &d.candidates,
-            chosen: c,
-            problem: &o.problem,
-            objective: o.objective,
-            scenario: d.scenario_toml.as_deref(),
-        };
-        crate::report::versioned::pretty(&doc)?
+    let paths = DesignPaths::new(args.out.as_deref(), args.draw.as_deref(), &o, sensor);
+    let files = if args.no_write {
+        Vec::new()
     } else {
-        text(&o, &d, &files)
+        write_design(&o, &d, &paths)?
+    };
+    let out = if args.json {
+        summary::json(&o, &d, files)?
+    } else {
+        summary::text(&o, &d, &files)
     };
     print_result(&out)?;
     match (d.status, &d.limit) {
@@ -558,192 +359,7 @@ pub fn run(args: &PlanArgs) -> Result<()> {
     }
 }
 
-fn write(path: &Path, text: &str) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    crate::report::atomic::write_atomic(path, text.as_bytes())
-        .with_context(|| format!("writing {}", path.display()))
-}
-
 /// A spinner on standard error when it is a terminal (and not `quiet`).
 fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
     super::progress::shown(quiet).then(|| super::progress::spinner("plan", quiet))
-}
-
-/// The drawing's title: the verdict with the line's number beside the prediction.
-fn title(o: &DesignOptions, c: &Candidate, d: &Design) -> String {
-    let verdict = match c.verdict_check() {
-        Some(l) => format!(
-            "{}: line {:.3} [{:.3}, {:.3}] of {} parts, target {}",
-            d.status.word(),
-            l.success_rate,
-            l.ci95[0],
-            l.ci95[1],
-            l.parts,
-            o.problem.target
-        ),
-        None => "unchecked".into(),
-    };
-    format!(
-        "{} — {}; {verdict}; predicted {:.3}",
-        o.name,
-        describe_obstacles(c),
-        c.predicted_success
-    )
-}
-
-fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) -> Result<()> {
-    let t = title(o, c, d);
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    // The plots write whole files or none (report::atomic).
-    match &c.layout {
-        Layout::Sequence(plan) => crate::report::plot_plan::plot_plan(&c.problem, plan, &t, path),
-        Layout::Contingent(plan) => {
-            let mut planner = crate::plan::search::Planner::new(&c.problem)?;
-            let stages = crate::plan::contingent::stage_states(&mut planner, plan)?;
-            crate::report::plot_plan::plot_contingent(&c.problem, plan, &stages, &t, path)
-        }
-    }
-    .with_context(|| format!("drawing {}", path.display()))
-}
-
-/// The printed result.
-fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
-    let p = &o.problem;
-    let mut t = format!("{}\n", o.command);
-    t += &format!(
-        "design      {}: modes {}; objective {:?}; goal ≥ {} of the parts in one ±{}° window, on the line\n",
-        o.name,
-        o.modes.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "),
-        o.objective,
-        p.target,
-        p.tolerance_deg
-    );
-    t += "candidates  mode     round  particles  search                obstacles                        belt (m)  width (m)  predicted  line (parts, headway)\n";
-    for (i, c) in d.candidates.iter().enumerate() {
-        let line = match c.measured() {
-            Some(l) => format!(
-                "{:.4} [{:.4}, {:.4}] ({}, {} s){}",
-                l.success_rate,
-                l.ci95[0],
-                l.ci95[1],
-                l.parts,
-                design::line::fmt_headway(l.headway_s),
-                if c.line_check.is_some() {
-                    ""
-                } else {
-                    " screen"
-                }
-            ),
-            None => "not run".into(),
-        };
-        t += &format!(
-            "  {}{:<2}      {:<8} {:<6} {:>9}  {:<21} {:<32} {:>8.3}  {:>9.3}  {:>9.4}  {line}\n",
-            if Some(i) == d.chosen { "*" } else { " " },
-            i + 1,
-            c.mode.name(),
-            c.round,
-            c.search.particles,
-            format!("{} {:.1} s", c.search.result, c.search.elapsed_s),
-            describe_obstacles(c),
-            c.belt_length_m,
-            c.belt_width_m,
-            c.predicted_success
-        );
-    }
-    t += &format!("result      {}\n", d.message);
-    if let Some(c) = d.chosen() {
-        if let Some(l) = &c.line_check {
-            t += &format!(
-                "line check  {} parts at headway {} s: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}{}; {} ({:.1} s)\n",
-                l.parts,
-                design::line::fmt_headway(l.headway_s),
-                l.success_rate,
-                l.ci95[0],
-                l.ci95[1],
-                c.predicted_success,
-                c.predicted_with_confusion.map_or(String::new(), |w| format!(
-                    " (perfect classifier), {w:.4} with the line's confusion (sensor accuracy {:.4})",
-                    c.sensor_accuracy.unwrap_or(0.0)
-                )),
-                outcome_mix(&l.outcomes),
-                l.elapsed_s
-            );
-            if let Some(u) = &c.uncertain_check {
-                t += &format!(
-                    "uncertain   {} samples under the planned μc range / tripods: success {:.4} (95% CI {:.4}–{:.4}); {} — the verdict\n",
-                    u.parts,
-                    u.success_rate,
-                    u.ci95[0],
-                    u.ci95[1],
-                    outcome_mix(&u.outcomes)
-                );
-            }
-            t += &format!(
-                "headway     {} s, the shortest with no collision and no loss of success over {} probe(s), with a 25% reserve: {:.2} oriented parts per minute\n",
-                design::line::fmt_headway(c.headway_s),
-                c.headway_probes.len(),
-                c.oriented_per_min
-            );
-        }
-        t += &format!(
-            "belt        length {:.3} m, width {:.3} m\n",
-            c.belt_length_m, c.belt_width_m
-        );
-        for ob in &c.obstacles {
-            t += &format!(
-                "  {:<10} {:<8} x {:.3} m  y {:+7.2} mm{}{}\n",
-                ob.kind,
-                ob.name,
-                ob.x_m,
-                ob.y_m * 1e3,
-                ob.angle_deg.map_or(String::new(), |a| format!(
-                    "  angle {a:+}°  length {:.4} m",
-                    ob.length_m.unwrap_or(0.0)
-                )),
-                if ob.targets_m.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        "  targets (mm) [{}]",
-                        ob.targets_m
-                            .iter()
-                            .map(|y| format!("{:+.2}", y * 1e3))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )
-                }
-            );
-        }
-    }
-    if let Some(l) = &d.limit {
-        t += &format!("limit       {l}\n");
-    }
-    t += &format!("time        {:.1} s\n", d.elapsed_s);
-    if !files.is_empty() {
-        t += &format!("wrote       {}\n", files.join(", "));
-    }
-    t
-}
-
-/// "success 9987, wrong_orientation 13".
-pub(crate) fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
-    let parts = [
-        ("success", o.success),
-        ("wrong_orientation", o.wrong_orientation),
-        ("collision", o.collision),
-        ("multi_contact", o.multi_contact),
-        ("off_belt", o.off_belt),
-        ("jam", o.jam),
-        ("solver", o.solver),
-    ];
-    parts
-        .iter()
-        .filter(|(_, n)| *n > 0)
-        .map(|(k, n)| format!("{k} {n}"))
-        .collect::<Vec<_>>()
-        .join(", ")
 }

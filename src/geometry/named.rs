@@ -212,6 +212,24 @@ pub fn part_from_spec(spec: &str) -> Result<Polygon, PartSpecError> {
     Ok(Polygon::new(&v)?)
 }
 
+/// The folder name of a part's reports: the part spec with anything but letters, digits, `-` and
+/// `.` replaced by `_` (`rect:2:1` → `rect_2_1`); a vertex list is `custom`.
+pub fn part_folder(part: &str) -> String {
+    let p = part.trim();
+    if p.to_lowercase().starts_with("vertices:") {
+        return "custom".into();
+    }
+    p.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -24,6 +24,7 @@
 pub mod arcs;
 pub mod bands;
 pub mod ensemble;
+pub mod limits;
 pub mod runs;
 pub mod sample;
 pub mod start;

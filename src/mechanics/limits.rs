@@ -1,20 +1,28 @@
 //! Ranges of the numeric settings of a contact (docs/commands.md#one-contact-pinfeed-contact). Lengths relative to the part
 //! are in units of `a`, so the ranges mean the same at any magnitude of the part.
+//!
+//! This is the one table of the ranges a contact, a scenario (`scenario::limits` re-exports
+//! [`MU_C`], [`TOL`] and [`FENCE_LENGTH_A`]), a study and the planner share: μc and μf, the
+//! integration tolerance and a fence's length are refused alike by every command and file.
 
 /// |θ0| in degrees: any angle within it is represented to better than 1e-11 rad.
 pub const THETA0_DEG: f64 = 1e6;
-/// Pin–part (or fence) friction μc.
-pub const MU_C: (f64, f64) = (0.0, 10.0);
+/// Pin–part (or fence) friction μc (and μf): measured values lie below about 2.
+pub const MU_C: (f64, f64) = (0.0, 5.0);
 /// Part–belt friction μs (it scales forces only).
 pub const MU_S: (f64, f64) = (1e-6, 100.0);
 /// Pin radius in units of a.
 pub const PIN_RADIUS_A: f64 = 10.0;
 /// |w|: lateral pin speed as a fraction of the belt speed.
 pub const PIN_SPEED: f64 = 10.0;
-/// Integration tolerance per step.
-pub const TOL: (f64, f64) = (1e-12, 1e-2);
-/// Fence length in units of a.
-pub const FENCE_LENGTH_A: (f64, f64) = (1e-3, 1e3);
+/// Integration tolerance per step (relative, in units of a): tighter than 1e-10 buys no accuracy
+/// in f64 and multiplies the steps.
+pub const TOL: (f64, f64) = (1e-10, 1e-2);
+/// Fence length in units of a: shorter is a point. A flush edge translates along the fence in a
+/// handful of steps whatever its length, but a vertex held on the fence line is integrated in
+/// steps of at most 2a: 10⁶ a (a 0.1 mm part along a 100 m fence) bounds that worst case to
+/// 5·10⁵ steps.
+pub const FENCE_LENGTH_A: (f64, f64) = (1e-6, 1e6);
 /// |d| for a fence pass (the fence's placement does not depend on d; beyond this its start
 /// would lose precision).
 pub const FENCE_D: f64 = 100.0;

@@ -14,6 +14,40 @@ pub enum FeedKind {
     Uniform,
 }
 
+impl FeedKind {
+    /// `stable` or `uniform`.
+    pub fn from_name(s: &str) -> Option<FeedKind> {
+        match s.trim() {
+            "stable" => Some(FeedKind::Stable),
+            "uniform" => Some(FeedKind::Uniform),
+            _ => None,
+        }
+    }
+}
+
+/// An uncertain-μc range that is not `LO:HI` with two numbers.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RangeSpecError {
+    #[error("--mu-c-range '{0}': expected LO:HI, e.g. 0.3:0.7")]
+    Form(String),
+    #[error("--mu-c-range '{spec}': '{token}' is not a number")]
+    Number { spec: String, token: String },
+}
+
+/// Parse an uncertain μc range `LO:HI` (its bounds are checked with the problem).
+pub fn parse_mu_c_range(s: &str) -> Result<(f64, f64), RangeSpecError> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or_else(|| RangeSpecError::Form(s.to_string()))?;
+    let p = |t: &str| {
+        t.trim().parse::<f64>().map_err(|_| RangeSpecError::Number {
+            spec: s.to_string(),
+            token: t.to_string(),
+        })
+    };
+    Ok((p(a)?, p(b)?))
+}
+
 /// Everything the sensorless planner needs. [`Problem::new`] gives the defaults.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Problem {
@@ -168,15 +202,21 @@ impl Problem {
                 return Err(PlanError::input(flag, n, "must lie in 1..=2000"));
             }
         }
-        if !(self.mu_c.is_finite() && (0.0..=10.0).contains(&self.mu_c)) {
-            return Err(PlanError::input("--mu-c", self.mu_c, "must lie in [0, 10]"));
+        let (mu_lo, mu_hi) = crate::mechanics::limits::MU_C;
+        if !(self.mu_c.is_finite() && (mu_lo..=mu_hi).contains(&self.mu_c)) {
+            let range = crate::scenario::limits::show((mu_lo, mu_hi));
+            return Err(PlanError::input(
+                "--mu-c",
+                self.mu_c,
+                format!("must lie in {range}"),
+            ));
         }
         if let Some((lo, hi)) = self.mu_c_range {
-            if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo <= hi && hi <= 10.0) {
+            if !(lo.is_finite() && hi.is_finite() && mu_lo <= lo && lo <= hi && hi <= mu_hi) {
                 return Err(PlanError::input(
                     "--mu-c-range",
                     format!("{lo}:{hi}"),
-                    "must be LO:HI with 0 ≤ LO ≤ HI ≤ 10",
+                    format!("must be LO:HI with {mu_lo} ≤ LO ≤ HI ≤ {mu_hi}"),
                 ));
             }
         }
@@ -309,11 +349,13 @@ impl Problem {
                 "must be a positive number of seconds",
             ));
         }
-        if !(self.contact_tol.is_finite() && self.contact_tol > 0.0 && self.contact_tol <= 1e-2) {
+        let tol = crate::mechanics::limits::TOL;
+        if !crate::scenario::limits::contains(tol, self.contact_tol) {
+            let range = crate::scenario::limits::show(tol);
             return Err(PlanError::input(
                 "--contact-tol",
                 self.contact_tol,
-                "must lie in (0, 0.01]",
+                format!("must lie in {range}"),
             ));
         }
         // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform

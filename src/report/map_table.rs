@@ -103,3 +103,19 @@ pub fn bands_markdown(maps: &[ConfigurationMap]) -> String {
     }
     s
 }
+
+/// The text of predicted bands: `[lo, hi] mass%` per band.
+pub fn predicted_bands_text(p: &crate::maps::ensemble::PredictedBands) -> String {
+    p.bands
+        .iter()
+        .map(|b| {
+            format!(
+                "[{:.1}, {:.1}] {:.0}%",
+                b.arc.lo,
+                b.arc.hi(),
+                100.0 * b.mass
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("  ")
+}

@@ -3,10 +3,14 @@
 pub mod aligned;
 pub mod animate;
 pub mod atomic;
+pub mod calibrate_report;
 pub mod compare_table;
+pub mod ensemble_report;
 pub mod line_table;
+pub mod map_report;
 pub mod map_table;
 pub mod parts_csv;
+pub mod plan_summary;
 pub mod plot_accuracy;
 pub mod plot_contact;
 pub mod plot_line;
@@ -18,7 +22,10 @@ pub mod plot_sensing;
 pub mod plot_sensitivity;
 pub mod plot_survey;
 pub mod plot_validate;
+pub mod run_folder;
+pub mod sense;
 pub mod stale;
+pub mod validate_report;
 pub mod versioned;
 
 /// A word of a command line, quoted for a POSIX shell if it needs it (for the command lines that

@@ -36,8 +36,8 @@ pub const PART_SCALE: (f64, f64) = (1e-9, 1e3);
 pub const PART_RADIUS: (f64, f64) = (1e-9, 1e3);
 /// Largest magnitude of a vertex coordinate, in the file's units.
 pub const VERTEX_MAGNITUDE: (f64, f64) = (1e-9, 1e9);
-/// Friction coefficients (μc, μs, μf).
-pub const FRICTION: (f64, f64) = (0.0, 5.0);
+/// Friction coefficients (μc, μs, μf): the contact's range ([`crate::mechanics::limits::MU_C`]).
+pub use crate::mechanics::limits::MU_C as FRICTION;
 /// Part mass (kg): from a microgram to a tonne (sensor forces scale with it).
 pub const MASS_KG: (f64, f64) = (1e-9, 1e3);
 /// Seconds between arrivals.
@@ -50,15 +50,13 @@ pub const WEIGHT: (f64, f64) = (0.0, 1e6);
 pub const JITTER_DEG: (f64, f64) = (0.0, 180.0);
 /// Goal orientations, degrees.
 pub const ORIENTATION_DEG: (f64, f64) = (-360.0, 360.0);
-/// Integration tolerance (relative).
-pub const TOL: (f64, f64) = (1e-10, 1e-2);
+/// Integration tolerance (relative): the contact's range ([`crate::mechanics::limits::TOL`]).
+pub use crate::mechanics::limits::TOL;
 /// Orientation histogram bin width, degrees.
 pub const HISTOGRAM_BIN_DEG: (f64, f64) = (0.01, 90.0);
-/// Fence length, in units of the part's a: shorter is a point. A flush edge translates along
-/// the fence in a handful of steps whatever its length, but a vertex held on the fence line is
-/// integrated in steps of at most 2a: 10⁶ a (a 0.1 mm part along a 100 m fence) bounds that
-/// worst case to 5·10⁵ steps.
-pub const FENCE_LENGTH_OF_A: (f64, f64) = (1e-6, 1e6);
+/// Fence length, in units of the part's a: the contact's range
+/// ([`crate::mechanics::limits::FENCE_LENGTH_A`]).
+pub use crate::mechanics::limits::FENCE_LENGTH_A as FENCE_LENGTH_OF_A;
 
 /// A number as a message shows it: plain between 10⁻⁴ and 10¹⁵, else in exponent notation (so
 /// 1e-300 is not printed with 300 zeros).

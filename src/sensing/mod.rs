@@ -15,6 +15,7 @@ pub mod belief;
 pub mod classify;
 pub mod confusion;
 pub mod evaluate;
+pub mod experiment;
 pub mod placement;
 pub mod reading;
 pub mod settings;

@@ -256,7 +256,10 @@ pub fn draw_pass(
     index: u64,
 ) -> Result<Pass, String> {
     let mut rng = stream(seed, index);
-    let (mu_c, _) = unc.mu_c.draw(&mut rng, |v| (0.0..=10.0).contains(&v))?;
+    let (mu_c, _) = unc.mu_c.draw(&mut rng, |v| {
+        let (lo, hi) = crate::mechanics::limits::MU_C;
+        (lo..=hi).contains(&v)
+    })?;
     let tripod;
     let model = if unc.tripod {
         let support = Support::random_tripod(&setup.polygon, &mut rng)?;

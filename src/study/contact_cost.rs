@@ -460,3 +460,54 @@ pub fn targets(rows: &[ContactCostRow], scaling: &[ScalingRow]) -> String {
         if worst("tip") <= 3.0 { "yes" } else { "no" },
     )
 }
+
+/// The report `bench contact` writes (its Markdown document) and the main table it prints, from
+/// the measured rows, the vertex-count scaling and the settings (`out` is named in the command).
+pub fn report(
+    rows: &[ContactCostRow],
+    scaling: &[ScalingRow],
+    contacts: usize,
+    tol: f64,
+    seed: u64,
+    out: &std::path::Path,
+) -> (String, String) {
+    let table = markdown(rows);
+    let targets = targets(rows, scaling);
+    let tables = tables_markdown(rows);
+    let scaling_table = scaling_markdown(scaling);
+    let cmd = format!(
+        "cargo run --release -- bench contact --contacts {contacts} --tol {tol:e} --seed {seed} --out {}",
+        out.display()
+    );
+    let doc = format!(
+        "# Contact model: cost and self-accuracy per contact\n\n\
+         Regenerate with:\n\n```\n{cmd}\n```\n\n\
+         Machine: {} cores. Each row: {contacts} random contacts (θ0 uniform, d uniform in \
+         [−0.9, 0.9], point pin, μc = 0.5, uniform pressure). Times are wall-clock per contact \
+         (single thread; each contact's fastest of three passes over them all, so that the \
+         machine's spread stays out of the medians), including contacts where the pin \
+         misses. *Evaluations* are limit-surface evaluations per touching contact (exact: dissipation evaluations \
+         inside the Newton solves; tip/ellipsoid: closed-form solves). *Self-error* is \
+         |θf(tol) − θf(tol/1000)| with the same model: the integration error at the \
+         default tolerance, not the model error (see the accuracy-vs-time report for that).\n\n\
+         `exact+tables` is the exact model with its tables (the default for a scene's, a \
+         map's and a planner's model): a pin sliding on an edge (or a disc riding a \
+         vertex) gets the exact twist from per-(μc, edge or vertex, side) tables of \
+         certified cubic Hermite pieces (`src/mechanics/slide_table.rs`) instead of a \
+         Newton solve. `exact+sticks` adds what a map tier's build uses: a pin sticking on \
+         an edge gets its twist from per-edge tables over (ℓ, direction of the pin's \
+         velocity) of certified Chebyshev pieces (`src/mechanics/stick_table.rs`). The \
+         tables are built before the timed runs (a line or a map build builds them on \
+         first use); the build is in the table below, with what the tables change against \
+         the solves at the same tolerance.\n\n\
+         {table}\n### Tables (exact+tables rows)\n\n{tables}\n{targets}\n\
+         ### Cost against the vertex count (exact model, regular N-gons)\n\n\
+         One evaluation of D, ∇D and H (20 000 twists, the centre of rotation within 2a: the \
+         closed form, one term per edge; at 8a: the far-field quadrature, 64 nodes per \
+         triangle of the part), and whole contacts ({quarter} per part, as above). × is \
+         relative to the triangle.\n\n{scaling_table}\n",
+        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        quarter = (contacts / 4).max(1),
+    );
+    (table, doc)
+}

@@ -94,3 +94,29 @@ pub fn markdown(rows: &[MapCostRow]) -> String {
     }
     s
 }
+
+/// The report `bench maps` writes (its Markdown document) and the table it prints: `cores` and the
+/// load averages before and after describe the machine; `out` is named in the command.
+pub fn report(
+    rows: &[MapCostRow],
+    repeats: usize,
+    cores: usize,
+    (load_before, load_after): (&str, &str),
+    out: &std::path::Path,
+) -> (String, String) {
+    let table = markdown(rows);
+    let doc = format!(
+        "# Configuration maps: wall time\n\n\
+         Regenerate with:\n\n```\ncargo run --release -- bench maps --repeats {repeats} --out {}\n```\n\n\
+         Machine: {cores} cores, shared with other work (1-minute load average {load_before} before, \
+         {load_after} after this run; with a load near the core count the 2-thread rows cannot \
+         show their speed-up). Each row \
+         times `maps::compute_maps` for the 18 thesis maps d = ±0.1 … ±0.9 with θ0 every 1° \
+         (6480 contacts: sampling, bands and runs; no printing, files or figures), point pin, \
+         μc = 0.5, uniform pressure, tolerance 1e-6: median, min and max of {repeats} runs after \
+         one warm-up. *µs per contact* is thread-time per contact (median × threads / contacts). \
+         Target: under 0.5 s with the exact model on 2 cores.\n\n{table}",
+        out.display()
+    );
+    (table, doc)
+}

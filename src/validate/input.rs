@@ -4,7 +4,7 @@
 
 use crate::maps::ensemble::EnsembleSpec;
 use crate::mechanics::{limits, Fidelity};
-use crate::scenario::limits::num;
+use crate::scenario::limits::{num, show};
 use crate::validate::measured::{self, Measured, MeasuredError};
 use std::path::{Path, PathBuf};
 
@@ -17,7 +17,7 @@ pub enum InputError {
     /// A member count (given by `flag`) outside [1, [`MAX_MEMBERS`]].
     #[error("{flag} must lie in [1, {MAX_MEMBERS}], got {members}")]
     Members { flag: &'static str, members: usize },
-    #[error("--mu-c must lie in [0, 10], got {0}")]
+    #[error("--mu-c must lie in {}, got {}", show(limits::MU_C), .0)]
     MuC(f64),
     #[error("--pin-radius must be a finite number ≥ 0, got {0}")]
     PinRadius(f64),
@@ -54,7 +54,7 @@ pub fn ensemble_spec(
     tol: f64,
     uncertain: Option<&str>,
 ) -> Result<EnsembleSpec, InputError> {
-    if !(mu_c.is_finite() && (0.0..=10.0).contains(&mu_c)) {
+    if !crate::scenario::limits::contains(limits::MU_C, mu_c) {
         return Err(InputError::MuC(mu_c));
     }
     if !(pin_radius.is_finite() && pin_radius >= 0.0) {

@@ -286,6 +286,48 @@ fn scenario_format_quotes_the_range_table() {
     );
 }
 
+/// docs/commands.md quotes the contact's ranges from the one table the scenarios, studies and the
+/// planner share (`pinfeed::mechanics::limits`): μc, the integration tolerance and a fence's length.
+#[test]
+fn commands_quote_the_shared_range_table() {
+    use pinfeed::mechanics::limits::{FENCE_LENGTH_A, MU_C, TOL};
+    let text = std::fs::read_to_string(root().join("docs/commands.md")).unwrap();
+    let row = |key: &str| -> &str {
+        text.lines()
+            .find(|l| l.starts_with("| `") && l.contains(key))
+            .unwrap_or_else(|| panic!("no row for {key}"))
+    };
+    let quotes = |line: &str, (lo, hi): (f64, f64), unit: &str| {
+        forms(lo).iter().any(|a| {
+            forms(hi)
+                .iter()
+                .any(|b| line.contains(&format!("[{a}{unit}, {b}{unit}]")))
+        })
+    };
+    let cases = [
+        ("`--mu-c`, `--mu-s`", MU_C, ""),
+        ("`--tol T`", TOL, ""),
+        ("`--fence ANGLE[:LENGTH]`", FENCE_LENGTH_A, "·a"),
+    ];
+    for (key, range, unit) in cases {
+        assert!(
+            quotes(row(key), range, unit),
+            "{key}: {range:?} not quoted in\n{}",
+            row(key)
+        );
+    }
+    // The scenario table reads the same ranges.
+    use pinfeed::scenario::limits as scenario;
+    assert_eq!(
+        (
+            scenario::FRICTION,
+            scenario::TOL,
+            scenario::FENCE_LENGTH_OF_A
+        ),
+        (MU_C, TOL, FENCE_LENGTH_A)
+    );
+}
+
 /// The flags that take a length (or a ratio of lengths): each is in docs/commands.md's table of
 /// units with the unit its `--help` names, and no command has one the table leaves out.
 #[test]

@@ -16,7 +16,7 @@
 //! Failing cases proptest finds are kept in `fuzz_cli.proptest-regressions` and re-run first.
 
 use clap::Parser;
-use pinfeed::cli::contact::{run_case, Case};
+use pinfeed::contact_case::{run_case, Case};
 use pinfeed::geometry::{Polygon, PolygonError};
 use pinfeed::mechanics::Fidelity;
 use proptest::prelude::*;

@@ -723,7 +723,7 @@ fn pin_stop_at_says_where_the_pin_stops() {
 /// still, and the report's stop and offsets say the same.
 #[test]
 fn pin_stop_after_touch_stops_the_pin_that_far_past_the_first_touch() {
-    use pinfeed::cli::contact::{run_case, Case};
+    use pinfeed::contact_case::{run_case, Case};
     use pinfeed::mechanics::Fidelity;
     let (w, t) = (1.0, 0.25);
     let case = Case {

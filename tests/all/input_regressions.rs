@@ -229,9 +229,10 @@ fn polygons_at_extreme_magnitudes_are_accepted_or_refused_for_their_size() {
 fn contact_fence_length_1e20_is_refused() {
     contact_refused_saying(
         &["--fence=30:1e20"],
-        &["--fence", "length", "1000·a", "got 1e20"],
+        &["--fence", "length", "1e6·a", "got 1e20"],
     );
-    // The longest allowed fence still works.
+    // The longest allowed fence (mechanics::limits::FENCE_LENGTH_A: 1e6·a, a = √½ for the
+    // square) still works.
     let v = json(&[
         "contact",
         "--part",
@@ -240,7 +241,7 @@ fn contact_fence_length_1e20_is_refused() {
         "10",
         "--d",
         "0",
-        "--fence=30:707",
+        "--fence=30:707106",
         "--json",
     ]);
     assert_eq!(v["contact"], true);
@@ -312,10 +313,10 @@ fn contact_d_beyond_reach_is_refused() {
 #[test]
 fn contact_friction_and_tolerance_ranges() {
     for (extra, words) in [
-        (["--mu-c", "11"], ["--mu-c", "[0, 10]"]),
+        (["--mu-c", "5.5"], ["--mu-c", "[0, 5]"]),
         (["--mu-s", "1e308"], ["--mu-s", "got 1e308"]),
         (["--mu-s", "5e-324"], ["--mu-s", "[1e-6, 100]"]),
-        (["--tol", "1e-13"], ["--tol", "[1e-12, 0.01]"]),
+        (["--tol", "1e-11"], ["--tol", "[1e-10, 0.01]"]),
         (["--tol", "0.5"], ["--tol", "got 0.5"]),
     ] {
         contact_refused_saying(&extra, &words);

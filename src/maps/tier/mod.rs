@@ -33,6 +33,7 @@ pub mod build;
 pub mod cache;
 pub mod key;
 pub mod query;
+pub mod report;
 
 pub use build::build;
 pub use cache::{default_cache_dir, load_or_build, shared, CacheError, Loaded, Source};

@@ -52,6 +52,20 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// The modes asked for by choosing pins, fences (both: also hybrid) and a sensor, in that
+    /// order (empty: none chosen).
+    pub fn selected(pins: bool, fences: bool, sensor: bool) -> Vec<Mode> {
+        [
+            (pins, Mode::Pins),
+            (fences, Mode::Fences),
+            (pins && fences, Mode::Hybrid),
+            (sensor, Mode::Sensor),
+        ]
+        .into_iter()
+        .filter_map(|(on, m)| on.then_some(m))
+        .collect()
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Mode::Pins => "pins",
@@ -375,6 +389,25 @@ pub struct Progress {
     pub line_runs: usize,
 }
 
+impl std::fmt::Display for Progress {
+    /// "pins round 2 · line check 3 (2000 parts) · 4 candidate(s), 3 line run(s)".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}{} · {} · {} candidate(s), {} line run(s)",
+            self.mode.map_or("", |m| m.name()),
+            if self.round > 0 {
+                format!(" round {}", self.round + 1)
+            } else {
+                String::new()
+            },
+            self.stage,
+            self.candidates,
+            self.line_runs,
+        )
+    }
+}
+
 /// Why a design could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum DesignError {
@@ -468,8 +501,10 @@ pub fn check_goal(o: &DesignOptions) -> Result<(), DesignError> {
 fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignError> {
     let f = &o.fences;
     let mu_f = f.mu_f.unwrap_or(mu_c);
-    if !(mu_f.is_finite() && (0.0..=10.0).contains(&mu_f)) {
-        return Err(input("--mu-f", mu_f, "must lie in [0, 10]"));
+    let mu_range = crate::mechanics::limits::MU_C;
+    if !crate::scenario::limits::contains(mu_range, mu_f) {
+        let range = crate::scenario::limits::show(mu_range);
+        return Err(input("--mu-f", mu_f, format!("must lie in {range}")));
     }
     if !(f.overhang_a.is_finite() && (0.0..=10.0).contains(&f.overhang_a)) {
         return Err(input(

@@ -23,6 +23,7 @@
 
 pub mod contacts;
 pub mod files;
+pub mod measured_csv;
 pub mod merges;
 pub mod pairs;
 pub mod polygons;

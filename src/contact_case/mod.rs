@@ -1,0 +1,241 @@
+//! One fully specified pin (or fence) pass over one part, as `pinfeed contact` runs it and as
+//! `sense`, `map`, `validate` and `calibrate` describe theirs (docs/commands.md#one-contact-pinfeed-contact).
+//!
+//! The part starts with its centroid at the origin of the belt frame at orientation θ0; the pin
+//! starts just clear of the part's circumscribed circle, at x = a + ρ + 0.01a, y = d·a, and travels
+//! in −x relative to the belt (plus w per unit travel for a moving pin). All lengths are in the
+//! part's units. [`check`] holds the input ranges, [`report`] the summary of an outcome and
+//! [`batch`] the CSV batch of cases.
+
+pub mod batch;
+pub mod check;
+pub mod report;
+
+pub use check::{check_geometry, check_inputs, in_range, num, reach, OutOfRange};
+pub use report::ContactReport;
+
+use crate::geometry::{named, Polygon, Pose, Vec2};
+use crate::mechanics::{
+    push, push_fence, push_path, ContactOutcome, ContactSettings, FenceSpec, Fidelity, PartModel,
+    Pin, PinPath, Support, TraceSample, Turn,
+};
+
+/// One fully specified contact case.
+#[derive(Debug, Clone)]
+pub struct Case {
+    pub part: String,
+    pub theta0_deg: f64,
+    pub d: f64,
+    pub mu_c: f64,
+    pub mu_s: f64,
+    pub model: Fidelity,
+    pub pin_radius: f64,
+    pub pin_speed: f64,
+    /// A moving pin stops after this much belt travel (units of a).
+    pub pin_stop: Option<f64>,
+    /// A moving pin stops after this much belt travel (units of a) past its first touch.
+    pub pin_stop_after_touch: Option<f64>,
+    pub support: String,
+    pub tol: f64,
+    /// A fence (angle in degrees, length in part units; None = default length) instead of a pin.
+    pub fence: Option<(f64, Option<f64>)>,
+}
+
+/// A case that cannot be run; the messages name the flag (or batch column) of each setting.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error(transparent)]
+    OutOfRange(#[from] OutOfRange),
+    #[error("{name} must be a finite number, got {}", num(*value))]
+    NotFinite { name: String, value: f64 },
+    #[error("{name} must be a finite number >= 0 (part units, at most {}·a), got {}", crate::mechanics::limits::PIN_RADIUS_A, num(*value))]
+    PinRadius { name: String, value: f64 },
+    #[error("{name} must lie in [0, {}] (part units: at most {}·a, a = {}), got {}", num(*max), crate::mechanics::limits::PIN_RADIUS_A, num(*a), num(*value))]
+    PinRadiusForPart {
+        name: String,
+        max: f64,
+        a: f64,
+        value: f64,
+    },
+    #[error("--fence: the length must lie in [{}, {}] (part units: {}·a to {}·a, a = {}), got {}", num(*lo), num(*hi), num(crate::mechanics::limits::FENCE_LENGTH_A.0), num(crate::mechanics::limits::FENCE_LENGTH_A.1), num(*a), num(*value))]
+    FenceLength {
+        lo: f64,
+        hi: f64,
+        a: f64,
+        value: f64,
+    },
+    #[error("{name} = {} is out of range: it must lie in [-{}, {}] (units of a: beyond it this pin cannot touch the part)", num(*d), num(*limit), num(*limit))]
+    Unreachable { name: String, d: f64, limit: f64 },
+    /// `--fence ANGLE[:LENGTH]` with a part that is not a number.
+    #[error("--fence '{spec}': the {what} is not a number")]
+    FenceNumber {
+        spec: String,
+        what: &'static str,
+        #[source]
+        source: std::num::ParseFloatError,
+    },
+    #[error("--fence '{spec}': the angle must be strictly between -90 and 90 degrees, got {}", num(*angle))]
+    FenceAngle { spec: String, angle: f64 },
+    #[error("--fence '{spec}': the length must be a positive number (part units), got {}", num(*length))]
+    FenceLengthSign { spec: String, length: f64 },
+    #[error("unknown model '{0}'; expected exact, ellipsoid or tip")]
+    Model(String),
+    #[error("part '{part}'")]
+    Part {
+        part: String,
+        #[source]
+        source: named::PartSpecError,
+    },
+    /// The support or the part's contact model could not be built.
+    #[error("{0}")]
+    Compile(String),
+    #[error("--pin-stop-at {}: a pin starting at d = {} and moving {} per unit of travel reaches it after {} units of a; that must lie in [1e-9, 1000] (Y on the side the pin moves to, within 1000·|w| of d)", num(*y), num(*d), num(*w), num(*travel))]
+    StopAt { y: f64, d: f64, w: f64, travel: f64 },
+}
+
+/// Parse `ANGLE_DEG[:LENGTH]`.
+pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>), CaseError> {
+    let number = |what: &'static str, t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|source| CaseError::FenceNumber {
+                spec: spec.to_string(),
+                what,
+                source,
+            })
+    };
+    let mut it = spec.splitn(2, ':');
+    let angle = number("angle", it.next().unwrap_or(""))?;
+    if !(angle.is_finite() && angle.abs() < 90.0) {
+        return Err(CaseError::FenceAngle {
+            spec: spec.to_string(),
+            angle,
+        });
+    }
+    let length = match it.next() {
+        None => None,
+        Some(l) => {
+            let l = number("length", l)?;
+            if !(l.is_finite() && l > 0.0) {
+                return Err(CaseError::FenceLengthSign {
+                    spec: spec.to_string(),
+                    length: l,
+                });
+            }
+            Some(l)
+        }
+    };
+    Ok((angle, length))
+}
+
+/// Parse a fidelity name: exact, ellipsoid or tip.
+pub fn parse_model(s: &str) -> Result<Fidelity, CaseError> {
+    Fidelity::parse(s.trim()).ok_or_else(|| CaseError::Model(s.to_string()))
+}
+
+/// The belt travel (units of a) after which a pin starting at lateral offset `d` and moving at
+/// `w` (lateral per unit of travel) stands at offset `y`: (y − d)/w, in `--pin-stop-after`'s range.
+pub fn stop_travel(y: f64, d: f64, w: f64) -> Result<f64, CaseError> {
+    let s = (y - d) / w;
+    if !(y.is_finite() && s.is_finite() && (1e-9..=1e3).contains(&s)) {
+        return Err(CaseError::StopAt { y, d, w, travel: s });
+    }
+    Ok(s)
+}
+
+/// The fence of a case: the convention of [`crate::maps::fence_pass_start`] (its line 1.01a clear of
+/// the centroid, crossing y = d·a; its upstream end 1.5a beyond the part's band on the side it
+/// comes from), with the case's μc as the fence friction μf.
+pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>) -> FenceSpec {
+    crate::maps::fence_pass_start(poly, c.d, angle_deg, length, c.mu_c)
+}
+
+/// The initial pose and pin start for a case (part centred at the origin, pin just clear of it):
+/// the convention of [`crate::maps::pass_start`], shared with configuration maps.
+pub fn case_geometry(poly: &Polygon, c: &Case) -> (Pose, Vec2) {
+    crate::maps::pass_start(poly, c.theta0_deg, c.d, c.pin_radius)
+}
+
+/// Resolve a part spec and a support spec into the polygon and its compiled contact model.
+pub fn compile_part(part: &str, support: &str) -> Result<(Polygon, PartModel), CaseError> {
+    let poly = named::part_from_spec(part).map_err(|source| CaseError::Part {
+        part: part.to_string(),
+        source,
+    })?;
+    let support = Support::parse(support, &poly).map_err(CaseError::Compile)?;
+    let model = PartModel::new(&poly, &support).map_err(CaseError::Compile)?;
+    Ok((poly, model))
+}
+
+/// The contact-model settings and the pin of a case.
+pub fn settings_and_pin(c: &Case) -> (ContactSettings, Pin) {
+    let settings = ContactSettings {
+        fidelity: c.model,
+        mu_c: c.mu_c,
+        mu_s: c.mu_s,
+        tol: c.tol,
+        ..ContactSettings::default()
+    };
+    let pin = Pin {
+        radius: c.pin_radius,
+        lateral_speed: c.pin_speed,
+    };
+    (settings, pin)
+}
+
+/// Run one case; returns the polygon, the outcome and (if asked) the trace.
+pub fn run_case(
+    c: &Case,
+    want_trace: bool,
+) -> Result<(Polygon, ContactOutcome, Vec<TraceSample>), CaseError> {
+    check_inputs(c)?;
+    let (poly, model) = compile_part(&c.part, &c.support)?;
+    check_geometry(c, &poly)?;
+    let (out, trace) = run_compiled(c, &poly, &model, want_trace);
+    Ok((poly, out, trace))
+}
+
+/// Run a validated case on an already compiled part.
+pub fn run_compiled(
+    c: &Case,
+    poly: &Polygon,
+    model: &PartModel,
+    want_trace: bool,
+) -> (ContactOutcome, Vec<TraceSample>) {
+    let (settings, pin) = settings_and_pin(c);
+    let (pose, start) = case_geometry(poly, c);
+    let mut trace: Vec<TraceSample> = Vec::new();
+    let recorder: Option<&mut dyn crate::mechanics::Recorder> =
+        if want_trace { Some(&mut trace) } else { None };
+    let out = match c.fence {
+        Some((angle, length)) => {
+            let fence = case_fence(poly, c, angle, length);
+            push_fence(model, pose, &fence, &settings, recorder)
+        }
+        None => match c.pin_stop {
+            _ if c.pin_stop_after_touch.is_some() => {
+                let t = c.pin_stop_after_touch.unwrap_or(0.0) * poly.radius();
+                let path = crate::mechanics::stop_after_touch(
+                    model,
+                    pose,
+                    start,
+                    pin.radius,
+                    c.pin_speed,
+                    t,
+                )
+                .expect("checked by check_inputs");
+                push_path(model, pose, start, pin.radius, &path, &settings, recorder)
+            }
+            Some(s_stop) => {
+                let turn = Turn {
+                    s: s_stop * poly.radius(),
+                    w: 0.0,
+                };
+                let path = PinPath::new(c.pin_speed, vec![turn]).expect("checked by check_inputs");
+                push_path(model, pose, start, pin.radius, &path, &settings, recorder)
+            }
+            None => push(model, pose, start, &pin, &settings, recorder),
+        },
+    };
+    (out, trace)
+}

@@ -1,0 +1,89 @@
+//! What the map tier tells a user: where a map came from, how many passes of a configuration map
+//! it answered, and the grid of `--map-grid T,D,DEPTH`.
+
+use super::{Loaded, Source, TierMap, TierSpec};
+use crate::geometry::Polygon;
+use crate::maps::MapSettings;
+use crate::mechanics::PartModel;
+
+impl Loaded {
+    /// One line on where the map came from.
+    pub fn describe(&self) -> String {
+        let st = &self.map.stats;
+        let what = format!(
+            "{} exact pushes, {:.1}% of θ0 × d certified",
+            st.exact_samples,
+            100.0 * st.certified_area
+        );
+        match &self.source {
+            Source::Built { seconds } => format!("built in {seconds:.2} s ({what})"),
+            Source::Disk(p) => format!("read from {} ({what})", p.display()),
+            Source::Memory => format!("already loaded ({what})"),
+        }
+    }
+}
+
+/// How many of a configuration map's passes (`pinfeed map --model map`) the map answered, how
+/// many the exact model computed and why.
+pub fn served_line(
+    map: &TierMap,
+    poly: &Polygon,
+    model: &PartModel,
+    ds: &[f64],
+    settings: &MapSettings,
+) -> String {
+    let grid = crate::maps::theta_grid(settings.theta_step_deg).unwrap_or_default();
+    let mut served = 0usize;
+    let mut why: std::collections::BTreeMap<&'static str, usize> = Default::default();
+    for &d in ds {
+        for &t in &grid {
+            let (pose, start) = crate::maps::pass_start(poly, t, d, settings.pin.radius);
+            match map.answer(model, pose, start, settings.pin.radius) {
+                Ok(_) => served += 1,
+                Err(w) => *why.entry(w.name()).or_default() += 1,
+            }
+        }
+    }
+    let total = ds.len() * grid.len();
+    let exact: Vec<String> = why.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    format!(
+        "map tier: {served} of {total} passes ({:.1}%) answered by the map (misses by the exact ray cast), {} exact ({})",
+        100.0 * served as f64 / total.max(1) as f64,
+        total - served,
+        if exact.is_empty() { "none".to_string() } else { exact.join(", ") }
+    )
+}
+
+/// A `--map-grid` that is not three whole numbers in range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GridError {
+    #[error("--map-grid '{0}': expected T,D,DEPTH (whole numbers)")]
+    Numbers(String),
+    #[error("--map-grid '{0}': expected three numbers T,D,DEPTH")]
+    Count(String),
+    #[error("--map-grid must lie in [4, 720] × [2, 200] × [0, 8], got {0},{1},{2}")]
+    Range(u32, u32, u32),
+}
+
+impl TierSpec {
+    /// Parse `T,D,DEPTH`: θ0 base cells, d base cells, refinement depth (the rest default).
+    pub fn parse_grid(s: &str) -> Result<TierSpec, GridError> {
+        let v: Vec<u32> = s
+            .split(',')
+            .map(|x| x.trim().parse::<u32>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| GridError::Numbers(s.to_string()))?;
+        let [t, d, depth] = v[..] else {
+            return Err(GridError::Count(s.to_string()));
+        };
+        if !((4..=720).contains(&t) && (2..=200).contains(&d) && depth <= 8) {
+            return Err(GridError::Range(t, d, depth));
+        }
+        Ok(TierSpec {
+            theta_cells: t,
+            d_cells: d,
+            max_depth: depth,
+            ..TierSpec::default()
+        })
+    }
+}

@@ -1,0 +1,336 @@
+//! The result of `pinfeed plan` ([`crate::plan::design`]) as printed and written: the text
+//! summary, the JSON document, and the design's files (scenario, policy, uncertainty study and
+//! drawing).
+
+use crate::plan::design::{
+    self, describe_obstacles, Candidate, Design, DesignOptions, Layout, Mode, Objective, Status,
+};
+use crate::plan::Problem;
+use anyhow::{Context, Result};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Where a design's files go: the scenario, the policy (a contingent design's) and the drawing.
+#[derive(Debug, Clone)]
+pub struct DesignPaths {
+    pub scenario: PathBuf,
+    pub policy: Option<PathBuf>,
+    pub draw: PathBuf,
+}
+
+impl DesignPaths {
+    /// The files of design `o`: the scenario at `out` (default `pinfeed-out/plans/<name>.toml`),
+    /// the policy beside it when `sensor`, the drawing at `draw` (default the scenario's `.svg`).
+    pub fn new(
+        out: Option<&Path>,
+        draw: Option<&Path>,
+        o: &DesignOptions,
+        sensor: bool,
+    ) -> DesignPaths {
+        let scenario = out.map_or_else(
+            || {
+                PathBuf::from("pinfeed-out")
+                    .join("plans")
+                    .join(format!("{}.toml", o.name))
+            },
+            Path::to_path_buf,
+        );
+        let policy = sensor.then(|| scenario.with_file_name(format!("{}.policy.toml", o.name)));
+        let draw = draw.map_or_else(|| scenario.with_extension("svg"), Path::to_path_buf);
+        DesignPaths {
+            scenario,
+            policy,
+            draw,
+        }
+    }
+}
+
+/// Write the chosen design's files (nothing when there is none) and return their names.
+pub fn write_design(o: &DesignOptions, d: &Design, paths: &DesignPaths) -> Result<Vec<String>> {
+    let mut files = Vec::new();
+    let DesignPaths {
+        scenario,
+        policy,
+        draw,
+    } = paths;
+    if let (Some(c), Some(toml)) = (d.chosen(), &d.scenario_toml) {
+        write(scenario, toml)?;
+        files.push(scenario.display().to_string());
+        if let (Some(p), Some((_, text))) = (policy, &d.policy_toml) {
+            write(p, text)?;
+            files.push(p.display().to_string());
+        }
+        draw_design(o, c, d, draw)?;
+        files.push(draw.display().to_string());
+        if let Some(u) = &c.uncertain_check {
+            let file = scenario
+                .file_name()
+                .map_or("plan.toml".into(), |f| f.to_string_lossy().to_string());
+            let study_path = scenario.with_file_name(format!("{}.uncertain.toml", o.name));
+            let study_file = study_path
+                .file_name()
+                .map_or(String::new(), |f| f.to_string_lossy().to_string());
+            let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind).collect();
+            if let Some(study) = crate::plan::check::uncertainty_study(
+                &c.problem,
+                &kinds,
+                o.fences.mu_f.is_some(),
+                &file,
+                &study_file,
+                u.parts,
+            ) {
+                write(&study_path, &study)?;
+                files.push(study_path.display().to_string());
+            }
+        }
+    }
+    Ok(files)
+}
+
+/// The JSON document of `pinfeed plan --json`.
+#[derive(Debug, Serialize)]
+pub struct PlanJson<'a> {
+    pub schema_version: u32,
+    pub pinfeed_version: &'static str,
+    pub command: &'a str,
+    /// confirmed | not_confirmed | unchecked | no_design
+    pub status: Status,
+    pub message: &'a str,
+    pub name: &'a str,
+    pub mode: Option<Mode>,
+    pub predicted_success: Option<f64>,
+    pub line_check: Option<&'a design::LineCheck>,
+    pub uncertain_check: Option<&'a design::LineCheck>,
+    pub obstacles: Option<&'a [design::ObstacleInfo]>,
+    pub belt_length_m: Option<f64>,
+    pub belt_width_m: Option<f64>,
+    pub headway_s: Option<f64>,
+    pub oriented_per_min: Option<f64>,
+    pub files: Vec<String>,
+    pub limit: Option<&'a str>,
+    pub elapsed_s: f64,
+    pub candidates: &'a [Candidate],
+    /// The chosen candidate (also in `candidates`).
+    pub chosen: Option<&'a Candidate>,
+    pub problem: &'a Problem,
+    pub objective: Objective,
+    pub scenario: Option<&'a str>,
+}
+
+/// The JSON document of a design, `files` being the ones written.
+pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> Result<String> {
+    let c = d.chosen();
+    let doc = PlanJson {
+        schema_version: crate::SCHEMA_VERSION,
+        pinfeed_version: env!("CARGO_PKG_VERSION"),
+        command: &o.command,
+        status: d.status,
+        message: &d.message,
+        name: &o.name,
+        mode: c.map(|c| c.mode),
+        predicted_success: c.map(|c| c.predicted_success),
+        line_check: c.and_then(|c| c.line_check.as_ref()),
+        uncertain_check: c.and_then(|c| c.uncertain_check.as_ref()),
+        obstacles: c.map(|c| c.obstacles.as_slice()),
+        belt_length_m: c.map(|c| c.belt_length_m),
+        belt_width_m: c.map(|c| c.belt_width_m),
+        headway_s: c.map(|c| c.headway_s),
+        oriented_per_min: c.map(|c| c.oriented_per_min),
+        files,
+        limit: d.limit.as_deref(),
+        elapsed_s: d.elapsed_s,
+        candidates: &d.candidates,
+        chosen: c,
+        problem: &o.problem,
+        objective: o.objective,
+        scenario: d.scenario_toml.as_deref(),
+    };
+    Ok(crate::report::versioned::pretty(&doc)?)
+}
+
+/// Write `text` to `path` (creating its folder), whole or not at all.
+fn write(path: &Path, text: &str) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    crate::report::atomic::write_atomic(path, text.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// The drawing's title: the verdict with the line's number beside the prediction.
+fn title(o: &DesignOptions, c: &Candidate, d: &Design) -> String {
+    let verdict = match c.verdict_check() {
+        Some(l) => format!(
+            "{}: line {:.3} [{:.3}, {:.3}] of {} parts, target {}",
+            d.status.word(),
+            l.success_rate,
+            l.ci95[0],
+            l.ci95[1],
+            l.parts,
+            o.problem.target
+        ),
+        None => "unchecked".into(),
+    };
+    format!(
+        "{} — {}; {verdict}; predicted {:.3}",
+        o.name,
+        describe_obstacles(c),
+        c.predicted_success
+    )
+}
+
+/// Draw the chosen candidate of a design into `path`.
+pub fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) -> Result<()> {
+    let t = title(o, c, d);
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    // The plots write whole files or none (report::atomic).
+    match &c.layout {
+        Layout::Sequence(plan) => crate::report::plot_plan::plot_plan(&c.problem, plan, &t, path),
+        Layout::Contingent(plan) => {
+            let mut planner = crate::plan::search::Planner::new(&c.problem)?;
+            let stages = crate::plan::contingent::stage_states(&mut planner, plan)?;
+            crate::report::plot_plan::plot_contingent(&c.problem, plan, &stages, &t, path)
+        }
+    }
+    .with_context(|| format!("drawing {}", path.display()))
+}
+
+/// The printed result: the command, the candidates, the verdict, the chosen layout and the files.
+pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
+    let p = &o.problem;
+    let mut t = format!("{}\n", o.command);
+    t += &format!(
+        "design      {}: modes {}; objective {:?}; goal ≥ {} of the parts in one ±{}° window, on the line\n",
+        o.name,
+        o.modes.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "),
+        o.objective,
+        p.target,
+        p.tolerance_deg
+    );
+    t += "candidates  mode     round  particles  search                obstacles                        belt (m)  width (m)  predicted  line (parts, headway)\n";
+    for (i, c) in d.candidates.iter().enumerate() {
+        let line = match c.measured() {
+            Some(l) => format!(
+                "{:.4} [{:.4}, {:.4}] ({}, {} s){}",
+                l.success_rate,
+                l.ci95[0],
+                l.ci95[1],
+                l.parts,
+                design::line::fmt_headway(l.headway_s),
+                if c.line_check.is_some() {
+                    ""
+                } else {
+                    " screen"
+                }
+            ),
+            None => "not run".into(),
+        };
+        t += &format!(
+            "  {}{:<2}      {:<8} {:<6} {:>9}  {:<21} {:<32} {:>8.3}  {:>9.3}  {:>9.4}  {line}\n",
+            if Some(i) == d.chosen { "*" } else { " " },
+            i + 1,
+            c.mode.name(),
+            c.round,
+            c.search.particles,
+            format!("{} {:.1} s", c.search.result, c.search.elapsed_s),
+            describe_obstacles(c),
+            c.belt_length_m,
+            c.belt_width_m,
+            c.predicted_success
+        );
+    }
+    t += &format!("result      {}\n", d.message);
+    if let Some(c) = d.chosen() {
+        if let Some(l) = &c.line_check {
+            t += &format!(
+                "line check  {} parts at headway {} s: success {:.4} (95% CI {:.4}–{:.4}) against predicted {:.4}{}; {} ({:.1} s)\n",
+                l.parts,
+                design::line::fmt_headway(l.headway_s),
+                l.success_rate,
+                l.ci95[0],
+                l.ci95[1],
+                c.predicted_success,
+                c.predicted_with_confusion.map_or(String::new(), |w| format!(
+                    " (perfect classifier), {w:.4} with the line's confusion (sensor accuracy {:.4})",
+                    c.sensor_accuracy.unwrap_or(0.0)
+                )),
+                outcome_mix(&l.outcomes),
+                l.elapsed_s
+            );
+            if let Some(u) = &c.uncertain_check {
+                t += &format!(
+                    "uncertain   {} samples under the planned μc range / tripods: success {:.4} (95% CI {:.4}–{:.4}); {} — the verdict\n",
+                    u.parts,
+                    u.success_rate,
+                    u.ci95[0],
+                    u.ci95[1],
+                    outcome_mix(&u.outcomes)
+                );
+            }
+            t += &format!(
+                "headway     {} s, the shortest with no collision and no loss of success over {} probe(s), with a 25% reserve: {:.2} oriented parts per minute\n",
+                design::line::fmt_headway(c.headway_s),
+                c.headway_probes.len(),
+                c.oriented_per_min
+            );
+        }
+        t += &format!(
+            "belt        length {:.3} m, width {:.3} m\n",
+            c.belt_length_m, c.belt_width_m
+        );
+        for ob in &c.obstacles {
+            t += &format!(
+                "  {:<10} {:<8} x {:.3} m  y {:+7.2} mm{}{}\n",
+                ob.kind,
+                ob.name,
+                ob.x_m,
+                ob.y_m * 1e3,
+                ob.angle_deg.map_or(String::new(), |a| format!(
+                    "  angle {a:+}°  length {:.4} m",
+                    ob.length_m.unwrap_or(0.0)
+                )),
+                if ob.targets_m.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "  targets (mm) [{}]",
+                        ob.targets_m
+                            .iter()
+                            .map(|y| format!("{:+.2}", y * 1e3))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                }
+            );
+        }
+    }
+    if let Some(l) = &d.limit {
+        t += &format!("limit       {l}\n");
+    }
+    t += &format!("time        {:.1} s\n", d.elapsed_s);
+    if !files.is_empty() {
+        t += &format!("wrote       {}\n", files.join(", "));
+    }
+    t
+}
+
+/// "success 9987, wrong_orientation 13".
+pub fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
+    let parts = [
+        ("success", o.success),
+        ("wrong_orientation", o.wrong_orientation),
+        ("collision", o.collision),
+        ("multi_contact", o.multi_contact),
+        ("off_belt", o.off_belt),
+        ("jam", o.jam),
+        ("solver", o.solver),
+    ];
+    parts
+        .iter()
+        .filter(|(_, n)| *n > 0)
+        .map(|(k, n)| format!("{k} {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}

@@ -1,0 +1,127 @@
+//! The folder of a line run (`pinfeed run`): `summary.json` and, as the scenario's `[output]`
+//! asks, the per-part CSV, the orientation histogram, the event and control logs, and the drawing
+//! and animation asked for, written together ([`crate::report::atomic::Batch`]).
+
+use crate::engine::RunResult;
+use crate::report::atomic::Batch;
+use crate::report::{animate, parts_csv, plot_line, plot_orientations};
+use crate::scenario::Scene;
+use anyhow::{bail, Context, Result};
+use std::path::Path;
+
+/// The pictures a run asks for besides the scenario's files.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunFiles<'a> {
+    /// A drawing of sample parts on the line (SVG).
+    pub draw: Option<&'a Path>,
+    /// An animation of the line (SVG).
+    pub animate: Option<&'a Path>,
+    /// The animation's speed-up over real time.
+    pub animate_speed: Option<f64>,
+}
+
+/// The files `pinfeed run` writes into a run's folder.
+const RUN_FILES: [&str; 5] = [
+    "summary.json",
+    "parts.csv",
+    "orientation_histogram.svg",
+    "events.json",
+    "control.json",
+];
+
+/// Write a run's files into `dir` (created), whole and together, and remove the files of an
+/// earlier run that this one does not write; returns the summary's JSON.
+pub fn write_run(
+    scene: &Scene,
+    result: &RunResult,
+    dir: &Path,
+    files: &RunFiles,
+) -> Result<String> {
+    let summary = &result.summary;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    // The run's files appear whole and together, or not at all (a full disk leaves the previous
+    // run's files as they were, never a new summary beside a truncated figure).
+    let mut batch = Batch::new();
+    let json = crate::report::versioned::pretty(summary)?;
+    let summary_path = dir.join("summary.json");
+    batch
+        .write(&summary_path, &json)
+        .with_context(|| format!("writing {}", summary_path.display()))?;
+    if scene.output.parts_csv {
+        let p = dir.join("parts.csv");
+        batch
+            .produce(&p, |tmp| parts_csv::write_parts_csv(tmp, &result.records))
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    if scene.output.histogram_svg {
+        let p = dir.join("orientation_histogram.svg");
+        batch
+            .produce(&p, |tmp| {
+                plot_orientations::plot_orientation_histogram(scene, summary, tmp)
+            })
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    if scene.effects.event_log {
+        let p = dir.join("events.json");
+        batch
+            .write(&p, event_log("events", &result.events)?)
+            .with_context(|| format!("writing {}", p.display()))?;
+        if !result.control.is_empty() {
+            let p = dir.join("control.json");
+            batch
+                .write(&p, event_log("control", &result.control)?)
+                .with_context(|| format!("writing {}", p.display()))?;
+        }
+    }
+    if let Some(p) = files.draw {
+        let samples = plot_line::choose_samples(&result.paths, scene.output.draw_parts as usize);
+        batch
+            .produce(p, |tmp| plot_line::plot_line(scene, &samples, tmp))
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    if let Some(p) = files.animate {
+        let anim = animate::from_run(scene, result, animate::DEFAULT_PARTS);
+        let aopts = animate::AnimateOptions {
+            speedup: files.animate_speed,
+        };
+        let dur = (anim.t_end - anim.t_start) / aopts.speedup.unwrap_or(1.0);
+        if files.animate_speed.is_some() && dur > animate::MAX_DURATION_S {
+            bail!(
+                "--animate-speed {} would make the animation last {dur:.0} s; at most {} s (choose a larger speed-up)",
+                aopts.speedup.unwrap_or(1.0),
+                animate::MAX_DURATION_S
+            );
+        }
+        batch
+            .write(p, animate::render(&anim, &aopts))
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    batch
+        .commit()
+        .with_context(|| format!("writing the results into {}", dir.display()))?;
+    // The folder holds this run's files only (a parts.csv or events.json of an earlier run whose
+    // scenario asked for it does not outlive it).
+    let written: Vec<String> = [
+        Some("summary.json"),
+        scene.output.parts_csv.then_some("parts.csv"),
+        scene
+            .output
+            .histogram_svg
+            .then_some("orientation_histogram.svg"),
+        scene.effects.event_log.then_some("events.json"),
+        (scene.effects.event_log && !result.control.is_empty()).then_some("control.json"),
+    ]
+    .into_iter()
+    .flatten()
+    .map(String::from)
+    .collect();
+    crate::report::stale::remove_stale(dir, &written, |n| RUN_FILES.contains(&n))
+        .with_context(|| format!("removing earlier files from {}", dir.display()))?;
+    Ok(json)
+}
+
+/// An event log's file: one compact JSON object, the version fields and the log under `key`.
+fn event_log<T: serde::Serialize>(key: &str, log: &[T]) -> serde_json::Result<String> {
+    let body: std::collections::BTreeMap<&str, &[T]> = [(key, log)].into();
+    crate::report::versioned::compact(&body)
+}

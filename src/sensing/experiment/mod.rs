@@ -1,0 +1,410 @@
+//! One sensing experiment as `pinfeed sense` runs it (docs/commands.md): the request (a part, one
+//! push, hypotheses, a sensor, classifiers, a noise sweep and the declared uncertainty), its
+//! checks ([`check`], errors naming the command's flags), the evaluation with the policy for
+//! classifiers that cannot be trained ([`Checked::evaluate`]), the placement search
+//! ([`Checked::place`]) and the typed result ([`SenseReport`]). The text and Markdown reports are
+//! in `report::sense`.
+
+mod run;
+
+pub use run::{Evaluated, Placeholder, SenseReport, Skipped, Sweep, UncertaintyReport, Untrained};
+
+use crate::contact_case::{in_range, num, parse_model, CaseError, OutOfRange};
+use crate::geometry::{named, Polygon};
+use crate::mechanics::{limits, PartModel, Support};
+use crate::random::distribution::Distribution;
+use crate::sensing::classify;
+use crate::sensing::evaluate::{applicable, TruthDraw, MAX_TEMPLATES, MAX_TRIALS};
+use crate::sensing::templates::{Hypotheses, PushSetup, Uncertainty};
+use crate::sensing::{SensorKind, SensorSettings};
+
+/// Most noise factors, placement offsets, threads (hypotheses: [`Hypotheses::orientations`]).
+pub const MAX_FACTORS: usize = 64;
+pub const MAX_PLACEMENT_D: usize = 201;
+pub const MAX_THREADS: usize = 1024;
+
+/// Everything a sensing experiment is asked for, unchecked (lengths in metres; `d` in units of a).
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// A part spec (`tripoly1`, `rect:W:H`, `vertices:…`).
+    pub part: String,
+    pub scale: f64,
+    pub mass: f64,
+    pub belt_speed: f64,
+    pub d: f64,
+    pub pin_radius: f64,
+    pub mu_c: f64,
+    pub mu_s: f64,
+    /// Fidelity name.
+    pub model: String,
+    pub tol: f64,
+    /// `stable`, `vertex-edge` or degrees.
+    pub hypotheses: String,
+    /// The sensor at noise factor 1; its kind is given by `sensor_kind`.
+    pub sensor: SensorSettings,
+    /// `ft` or `timing`.
+    pub sensor_kind: String,
+    /// Classifier names (empty: the defaults for the sensor and hypotheses).
+    pub classifiers: Vec<String>,
+    pub reject_below: f64,
+    pub noise: Vec<f64>,
+    /// `LO:HI`.
+    pub mu_c_range: Option<String>,
+    pub tripod: bool,
+    pub theta_jitter: f64,
+    pub d_jitter: f64,
+    pub templates: usize,
+    pub trials: usize,
+    /// `cycle` or `uniform`.
+    pub truth: String,
+    pub seed: u64,
+    pub threads: usize,
+    pub placement: bool,
+    pub placement_d: Vec<f64>,
+}
+
+/// A request that cannot be run (messages name the flags of `pinfeed sense`).
+#[derive(Debug, thiserror::Error)]
+pub enum SenseError {
+    #[error(transparent)]
+    Range(#[from] OutOfRange),
+    #[error("{flag} must be a finite number > 0 and at most {} ({what}), got {}", num(*hi), num(*value))]
+    Positive {
+        flag: &'static str,
+        value: f64,
+        hi: f64,
+        what: &'static str,
+    },
+    #[error("{flag} must lie in [1, {max}], got {value}")]
+    Count {
+        flag: &'static str,
+        max: usize,
+        value: usize,
+    },
+    #[error("--threads must lie in [0, {MAX_THREADS}] (0: one per core), got {0}")]
+    Threads(usize),
+    #[error("{flag} takes 1 to {max} {unit}, got {value}")]
+    ListLength {
+        flag: &'static str,
+        max: usize,
+        unit: &'static str,
+        value: usize,
+    },
+    #[error("{flag} must be {expected}, got '{got}'")]
+    Choice {
+        flag: &'static str,
+        expected: &'static str,
+        got: String,
+    },
+    #[error("--model: {0}")]
+    Model(CaseError),
+    #[error("--{}: {message}", field.replace('_', "-"))]
+    Sensor {
+        field: &'static str,
+        message: String,
+    },
+    #[error("--noise {}: the sensor's {field} leaves its range: {message}", num(*factor))]
+    NoiseSensor {
+        factor: f64,
+        field: &'static str,
+        message: String,
+    },
+    #[error("--part '{spec}': {error}")]
+    Part {
+        spec: String,
+        error: named::PartSpecError,
+    },
+    #[error("--part: {0}")]
+    PartModel(String),
+    #[error("--hypotheses: '{0}' is not a number of degrees (or give stable or vertex-edge)")]
+    HypothesisDegrees(String),
+    #[error("--hypotheses {spec}: {message}")]
+    Hypotheses { spec: String, message: String },
+    #[error("--mu-c-range must be LO:HI (e.g. 0.3:0.7), got '{0}'")]
+    MuCRangeForm(String),
+    #[error("--mu-c-range: '{0}' is not a number")]
+    MuCRangeNumber(String),
+    #[error("--mu-c-range: LO must not exceed HI, got {}:{}", num(*lo), num(*hi))]
+    MuCRangeOrder { lo: f64, hi: f64 },
+    #[error("--classifiers: unknown classifier '{name}'; known: {}", classify::NAMES.join(", "))]
+    UnknownClassifier { name: String },
+    #[error("--classifiers: '{0}' is listed twice")]
+    ClassifierTwice(String),
+    /// A classifier asked for by name could not be trained at any sweep point.
+    #[error("--classifiers: {0}")]
+    Untrainable(String),
+    #[error("no classifier could be trained for these hypotheses and this sensor")]
+    NoClassifier,
+    /// The evaluation or the placement search failed.
+    #[error("{0}")]
+    Evaluate(String),
+}
+
+/// A request checked: the push, its part model, hypotheses, uncertainty, sensor and classifiers.
+pub struct Checked {
+    pub part_name: String,
+    pub setup: PushSetup,
+    pub model: PartModel,
+    pub hyps: Hypotheses,
+    pub unc: Uncertainty,
+    pub sensor: SensorSettings,
+    pub classifiers: Vec<String>,
+    /// Classifiers named by the request (not the defaults).
+    pub explicit: bool,
+    pub truth: TruthDraw,
+}
+
+/// `flag must be > 0 …` for strictly positive quantities.
+fn positive(flag: &'static str, v: f64, hi: f64, what: &'static str) -> Result<(), SenseError> {
+    if !(v.is_finite() && v > 0.0 && v <= hi) {
+        return Err(SenseError::Positive {
+            flag,
+            value: v,
+            hi,
+            what,
+        });
+    }
+    Ok(())
+}
+
+/// Parse hypotheses for a part: `stable`, `vertex-edge` or a list of degrees.
+pub fn parse_hypotheses(spec: &str, poly: &Polygon) -> Result<Hypotheses, SenseError> {
+    let s = spec.trim();
+    let hyps = match s.to_lowercase().as_str() {
+        "stable" => Hypotheses::stable_states(poly),
+        "vertex-edge" => Ok(Hypotheses::vertex_edge_sweep()),
+        _ => {
+            let degrees = s
+                .split(',')
+                .map(|tok| {
+                    let t = tok.trim();
+                    t.parse::<f64>()
+                        .map_err(|_| SenseError::HypothesisDegrees(t.to_string()))
+                })
+                .collect::<Result<Vec<f64>, SenseError>>()?;
+            Hypotheses::orientations(degrees)
+        }
+    };
+    hyps.map_err(|message| SenseError::Hypotheses {
+        spec: s.to_string(),
+        message,
+    })
+}
+
+/// Parse an uncertain μc `LO:HI` (uniform; fixed when LO = HI).
+fn parse_range(spec: &str) -> Result<Distribution, SenseError> {
+    let (lo, hi) = spec
+        .split_once(':')
+        .ok_or_else(|| SenseError::MuCRangeForm(spec.to_string()))?;
+    let p = |t: &str| -> Result<f64, SenseError> {
+        t.trim()
+            .parse::<f64>()
+            .map_err(|_| SenseError::MuCRangeNumber(t.to_string()))
+    };
+    let (lo, hi) = (p(lo)?, p(hi)?);
+    let (min, max) = limits::MU_C;
+    in_range("--mu-c-range LO", lo, min, max, "friction coefficient")?;
+    in_range("--mu-c-range HI", hi, min, max, "friction coefficient")?;
+    if lo > hi {
+        return Err(SenseError::MuCRangeOrder { lo, hi });
+    }
+    Ok(if lo == hi {
+        Distribution::Fixed(lo)
+    } else {
+        Distribution::Uniform { min: lo, max: hi }
+    })
+}
+
+/// The sensor of the request (noise factor 1), validated; errors name the flag.
+pub fn sensor_settings(r: &Request) -> Result<SensorSettings, SenseError> {
+    let kind = match r.sensor_kind.trim() {
+        "ft" => SensorKind::Ft,
+        "timing" => SensorKind::Timing,
+        other => {
+            return Err(SenseError::Choice {
+                flag: "--sensor",
+                expected: "ft or timing",
+                got: other.to_string(),
+            })
+        }
+    };
+    let s = SensorSettings { kind, ..r.sensor };
+    s.validate().map_err(|e| SenseError::Sensor {
+        field: e.field,
+        message: e.message,
+    })?;
+    Ok(s)
+}
+
+/// Check every setting of a request and build what it fixes.
+pub fn check(a: &Request) -> Result<Checked, SenseError> {
+    positive("--scale", a.scale, 100.0, "metres per part unit")?;
+    positive("--mass", a.mass, 1e3, "kg")?;
+    positive("--belt-speed", a.belt_speed, 100.0, "m/s")?;
+    in_range(
+        "--mu-c",
+        a.mu_c,
+        limits::MU_C.0,
+        limits::MU_C.1,
+        "friction coefficient",
+    )?;
+    in_range(
+        "--mu-s",
+        a.mu_s,
+        limits::MU_S.0,
+        limits::MU_S.1,
+        "support friction",
+    )?;
+    in_range(
+        "--tol",
+        a.tol,
+        limits::TOL.0,
+        limits::TOL.1,
+        "integration tolerance per step",
+    )?;
+    in_range("--theta-jitter", a.theta_jitter, 0.0, 180.0, "degrees")?;
+    in_range("--d-jitter", a.d_jitter, 0.0, 1.0, "units of a")?;
+    in_range(
+        "--reject-below",
+        a.reject_below,
+        0.0,
+        1.0,
+        "largest posterior",
+    )?;
+    if !(1..=MAX_TRIALS).contains(&a.trials) {
+        return Err(SenseError::Count {
+            flag: "--trials",
+            max: MAX_TRIALS,
+            value: a.trials,
+        });
+    }
+    if !(1..=MAX_TEMPLATES).contains(&a.templates) {
+        return Err(SenseError::Count {
+            flag: "--templates",
+            max: MAX_TEMPLATES,
+            value: a.templates,
+        });
+    }
+    if a.threads > MAX_THREADS {
+        return Err(SenseError::Threads(a.threads));
+    }
+    if a.noise.is_empty() || a.noise.len() > MAX_FACTORS {
+        return Err(SenseError::ListLength {
+            flag: "--noise",
+            max: MAX_FACTORS,
+            unit: "factors",
+            value: a.noise.len(),
+        });
+    }
+    for &f in &a.noise {
+        in_range("--noise", f, 0.0, 1e6, "factor on the nominal noise, ≥ 0")?;
+    }
+    if a.placement && (a.placement_d.is_empty() || a.placement_d.len() > MAX_PLACEMENT_D) {
+        return Err(SenseError::ListLength {
+            flag: "--placement-d",
+            max: MAX_PLACEMENT_D,
+            unit: "offsets",
+            value: a.placement_d.len(),
+        });
+    }
+    let truth = match a.truth.trim() {
+        "cycle" => TruthDraw::Cycle,
+        "uniform" => TruthDraw::Uniform,
+        other => {
+            return Err(SenseError::Choice {
+                flag: "--truth",
+                expected: "cycle or uniform",
+                got: other.to_string(),
+            })
+        }
+    };
+    let fidelity = parse_model(&a.model).map_err(SenseError::Model)?;
+    let sensor = sensor_settings(a)?;
+    for &f in &a.noise {
+        sensor
+            .with_noise_factor(f)
+            .validate()
+            .map_err(|e| SenseError::NoiseSensor {
+                factor: f,
+                field: e.field,
+                message: e.message,
+            })?;
+    }
+    let part = named::part_from_spec(&a.part).map_err(|error| SenseError::Part {
+        spec: a.part.clone(),
+        error,
+    })?;
+    let poly = part.scaled(a.scale);
+    let radius_a = poly.radius();
+    in_range(
+        "--pin-radius",
+        a.pin_radius,
+        0.0,
+        limits::PIN_RADIUS_A * radius_a,
+        &format!(
+            "m; at most {}·a, a = {} m",
+            limits::PIN_RADIUS_A,
+            num(radius_a)
+        ),
+    )?;
+    let reach = 1.0 + a.pin_radius / radius_a;
+    let beyond = "units of a; beyond it the pin cannot touch the part";
+    in_range("--d", a.d, -reach, reach, beyond)?;
+    if a.placement {
+        for &d in &a.placement_d {
+            in_range("--placement-d", d, -reach, reach, beyond)?;
+        }
+    }
+    let hyps = parse_hypotheses(&a.hypotheses, &part)?;
+    let mu_c = match &a.mu_c_range {
+        Some(r) => parse_range(r)?,
+        None => Distribution::Fixed(a.mu_c),
+    };
+    let unc = Uncertainty {
+        mu_c,
+        tripod: a.tripod,
+        theta_sd_deg: a.theta_jitter,
+        d_sd: a.d_jitter,
+    };
+    let explicit = !a.classifiers.is_empty();
+    let classifiers: Vec<String> = if explicit {
+        let mut v: Vec<String> = Vec::new();
+        for c in &a.classifiers {
+            let c = c.trim().to_string();
+            if !classify::NAMES.contains(&c.as_str()) {
+                return Err(SenseError::UnknownClassifier { name: c });
+            }
+            if v.contains(&c) {
+                return Err(SenseError::ClassifierTwice(c));
+            }
+            v.push(c);
+        }
+        v
+    } else {
+        applicable(sensor.kind, &hyps)
+    };
+    let model = PartModel::new(&poly, &Support::Uniform).map_err(SenseError::PartModel)?;
+    let setup = PushSetup {
+        polygon: poly,
+        d: a.d,
+        pin_radius: a.pin_radius,
+        mu_c: a.mu_c,
+        mu_s: a.mu_s,
+        fidelity,
+        tol: a.tol,
+        mass: a.mass,
+        belt_speed: a.belt_speed,
+        height: sensor.height,
+    };
+    Ok(Checked {
+        part_name: a.part.clone(),
+        setup,
+        model,
+        hyps,
+        unc,
+        sensor,
+        classifiers,
+        explicit,
+        truth,
+    })
+}
