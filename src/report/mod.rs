@@ -9,6 +9,7 @@ pub mod map_table;
 pub mod parts_csv;
 pub mod plot_accuracy;
 pub mod plot_contact;
+pub mod plot_labels;
 pub mod plot_line;
 pub mod plot_map;
 pub mod plot_orientations;
@@ -18,6 +19,7 @@ pub mod plot_sensing;
 pub mod plot_sensitivity;
 pub mod plot_survey;
 pub mod plot_validate;
+pub mod plot_zoom;
 pub mod stale;
 pub mod versioned;
 
