@@ -178,6 +178,16 @@ impl BeltView {
     }
 }
 
+/// The label of the goal silhouette past the exit, centred on `cx` (mm).
+fn exit_label(centre_deg: f64, tol_deg: f64, cx: f64) -> Label {
+    Label {
+        text: format!("exit: goal {centre_deg:.2}° ± {tol_deg}°"),
+        colour: RGBColor(20, 110, 40),
+        x_mm: cx,
+        above: false,
+    }
+}
+
 /// Pins, fences, labels: one dark colour, not the outcome colours of a run.
 const OBSTACLE: RGBColor = RGBColor(40, 50, 70);
 
@@ -340,15 +350,11 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> an
             }
         }
     }
-    labels.push(Label {
-        text: format!(
-            "exit: goal {:.2}° ± {}°",
-            plan.window.centre_deg, problem.tolerance_deg
-        ),
-        colour: RGBColor(20, 110, 40),
-        x_mm: cx,
-        above: false,
-    });
+    labels.push(exit_label(
+        plan.window.centre_deg,
+        problem.tolerance_deg,
+        cx,
+    ));
     let view = BeltView::new(length, half, exit_room, &ys, labels);
     let head_h = 34;
     let top_h = view.height();
@@ -462,15 +468,7 @@ pub fn plot_contingent(
             above: top >= 0.0,
         });
     }
-    labels.push(Label {
-        text: format!(
-            "exit: goal {:.2}° ± {}°",
-            plan.centre_deg, problem.tolerance_deg
-        ),
-        colour: RGBColor(20, 110, 40),
-        x_mm: cx,
-        above: false,
-    });
+    labels.push(exit_label(plan.centre_deg, problem.tolerance_deg, cx));
     let view = BeltView::new(length, half, exit_room, &ys, labels);
     let head_h = 50;
     let top_h = view.height();

@@ -121,6 +121,16 @@ fn validation_plots_zoom_and_say_the_bands_are_offset() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The numbers of an element's `points`.
+fn points(e: &Element) -> Vec<f64> {
+    e.attr("points")
+        .unwrap()
+        .split([' ', ','])
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().unwrap())
+        .collect()
+}
+
 /// The (x1, y1, x2, y2) of every `polyline` drawn with `stroke` at width 3.
 fn thick_lines(svg: &Element, stroke: &str) -> Vec<[f64; 4]> {
     svg.all()
@@ -131,13 +141,7 @@ fn thick_lines(svg: &Element, stroke: &str) -> Vec<[f64; 4]> {
                 && e.attr("stroke-width") == Some("3")
         })
         .map(|e| {
-            let p: Vec<f64> = e
-                .attr("points")
-                .unwrap()
-                .split([' ', ','])
-                .filter(|s| !s.is_empty())
-                .map(|s| s.parse().unwrap())
-                .collect();
+            let p = points(e);
             [p[0], p[1], p[p.len() - 2], p[p.len() - 1]]
         })
         .collect()
@@ -149,13 +153,7 @@ fn polygons(svg: &Element) -> Vec<[f64; 4]> {
         .into_iter()
         .filter(|e| e.name == "polygon")
         .map(|e| {
-            let p: Vec<f64> = e
-                .attr("points")
-                .unwrap()
-                .split([' ', ','])
-                .filter(|s| !s.is_empty())
-                .map(|s| s.parse().unwrap())
-                .collect();
+            let p = points(e);
             let xs = p.iter().step_by(2);
             let ys = p.iter().skip(1).step_by(2);
             [
