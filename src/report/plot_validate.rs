@@ -116,7 +116,8 @@ pub fn plot_band_distributions(
             (x + 20, 42),
             font.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center)),
         ))?;
-        x += 20 + text_width(label, 12.0, false) as i32 + 16;
+        // plotters draws a 12 px font about 9.7 px high: estimate at that size.
+        x += 20 + text_width(label, 10.0, false) as i32 + 16;
     }
     let mut ch = ChartBuilder::on(&body)
         .margin(14)
