@@ -61,6 +61,16 @@ pub fn layout(problem: &Problem, plan: &Plan, radius_m: f64) -> (Vec<f64>, f64) 
     (xs, length)
 }
 
+/// A count of orientation sets for people: `usize::MAX` (the particles lost alone miss the
+/// target, [`super::particles::orientation_sets`]) is no count, and reads "unbounded".
+pub fn sets_text(sets: usize) -> String {
+    if sets == usize::MAX {
+        "sets unbounded (the lost parts alone miss the target)".to_string()
+    } else {
+        format!("{sets} set(s)")
+    }
+}
+
 /// The body of a sequence plan's scenario (pins, fences, or both in belt order), without the
 /// header ([`header`]): the line of `line`, the feed the plan was made for and the goal.
 pub fn sequence_toml(
@@ -79,9 +89,9 @@ pub fn sequence_toml(
             Action::Pin(pin) => {
                 pins += 1;
                 t += &format!(
-                    "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"pin\"\nname = \"pin{pins}\"\nx = {}\ny = {}\nradius = {}\n",
+                    "\n[[obstacles]]   # margin {:.2} mm; after it: {}, best window {:.3}\nkind = \"pin\"\nname = \"pin{pins}\"\nx = {}\ny = {}\nradius = {}\n",
                     pin.margin_m * 1e3,
-                    step.sets,
+                    sets_text(step.sets),
                     step.window.share,
                     num(*x, 6),
                     num(pin.y_m, 6),
@@ -91,9 +101,9 @@ pub fn sequence_toml(
             Action::Fence(f) => {
                 fences += 1;
                 t += &format!(
-                    "\n[[obstacles]]   # margin {:.2} mm; after it: {} set(s), best window {:.3}\nkind = \"fence\"\nname = \"fence{fences}\"\nx = {}             # m: the upstream end\ny = {}\nangle = {}          # degrees\nlength = {}\nmu_f = {}\n",
+                    "\n[[obstacles]]   # margin {:.2} mm; after it: {}, best window {:.3}\nkind = \"fence\"\nname = \"fence{fences}\"\nx = {}             # m: the upstream end\ny = {}\nangle = {}          # degrees\nlength = {}\nmu_f = {}\n",
                     f.margin_m * 1e3,
-                    step.sets,
+                    sets_text(step.sets),
                     step.window.share,
                     num(*x, 6),
                     num(f.y0_m, 6),

@@ -41,7 +41,9 @@ pub struct PlanStep {
     pub state: State,
     /// Best window after this pin.
     pub window: Window,
-    /// Orientation sets after this pin (see [`orientation_sets`]).
+    /// Orientation sets after this pin (see [`orientation_sets`]; `usize::MAX`, written null,
+    /// when the lost particles alone miss the target).
+    #[serde(serialize_with = "sets_or_null")]
     pub sets: usize,
 }
 
@@ -51,13 +53,24 @@ pub struct Plan {
     #[serde(skip)]
     pub initial: State,
     pub initial_window: Window,
+    #[serde(serialize_with = "sets_or_null")]
     pub initial_sets: usize,
     pub steps: Vec<PlanStep>,
     /// The goal window (the final best window).
     pub window: Window,
     /// Predicted success: the share of the particles inside the goal window.
     pub predicted_success: f64,
+    #[serde(serialize_with = "sets_or_null")]
     pub sets: usize,
+}
+
+/// A count of orientation sets as JSON: null for `usize::MAX` (no count reaches the target).
+fn sets_or_null<S: serde::Serializer>(sets: &usize, s: S) -> Result<S::Ok, S::Error> {
+    if *sets == usize::MAX {
+        s.serialize_none()
+    } else {
+        s.serialize_u64(*sets as u64)
+    }
 }
 
 /// How a search ended.

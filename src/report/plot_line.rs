@@ -1,14 +1,23 @@
 //! `pinfeed run --draw FILE.svg`: the line seen from above, to scale (equal metres on both axes).
 //! One panel per sample part: belt edges, entry and exit, every obstacle, and the part's outline
 //! at successive instants along its path — every few part sizes while it rides the belt, and along
-//! each push — coloured by the class it ended in.
+//! each push — coloured by the class it ended in. Obstacles are drawn in their own colour (never an
+//! outcome's) and named beyond the belt edge on their side.
 
 use crate::engine::{PartOutcome, SamplePath};
 use crate::geometry::{wrap_deg, Pose};
 use crate::report::atomic::Staged;
+use crate::report::plot_labels::{text_width, LabelRows};
 use crate::scenario::{Obstacle, Scene};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
+
+/// Pins and fences: a dark slate, apart from every outcome colour; sensor pins blue.
+pub const OBSTACLE_COLOUR: RGBColor = RGBColor(40, 50, 70);
+pub const SENSOR_COLOUR: RGBColor = RGBColor(31, 111, 208);
+const LABEL_FONT: f64 = 12.0;
+const LABEL_ROW_PX: f64 = 15.0;
 
 /// The colour of an outcome class.
 pub fn outcome_colour(o: PartOutcome) -> RGBColor {
@@ -94,9 +103,39 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
     let a = scene.part.radius;
     let margin = 2.0 * a;
     let (x0, x1) = (-margin, belt.length + margin);
-    let (y0, y1) = (-belt.width / 2.0 - margin, belt.width / 2.0 + margin);
     let plot_w = 1500.0;
     let px_per_m = plot_w / (x1 - x0);
+    // Every obstacle named in a row beyond the belt edge on its side, no two overlapping.
+    let mut rows = LabelRows::new();
+    let labels: Vec<(String, f64, bool, usize, RGBColor)> = scene
+        .obstacles
+        .iter()
+        .map(|ob| {
+            let (text, x, y, colour) = match ob {
+                Obstacle::Pin(p) if p.sensor.is_some() => (
+                    format!("{} (sensor)", p.name),
+                    p.centre.x,
+                    p.centre.y,
+                    SENSOR_COLOUR,
+                ),
+                Obstacle::Pin(p) => (p.name.clone(), p.centre.x, p.centre.y, OBSTACLE_COLOUR),
+                Obstacle::Fence(f) => {
+                    let m = (f.start + f.end()) * 0.5;
+                    (f.name.clone(), m.x, m.y, OBSTACLE_COLOUR)
+                }
+            };
+            let cx = (x - x0) * px_per_m;
+            let w = text_width(&text, LABEL_FONT, false);
+            let above = y >= 0.0;
+            let row = rows.place(above, cx - w / 2.0, cx + w / 2.0, (0.0, 1.0), 0);
+            (text, x, above, row, colour)
+        })
+        .collect();
+    let room = |above: bool| (10.0 + LABEL_ROW_PX * rows.rows(above) as f64) / px_per_m;
+    let (y0, y1) = (
+        -belt.width / 2.0 - margin.max(room(false)),
+        belt.width / 2.0 + margin.max(room(true)),
+    );
     let plot_h = ((y1 - y0) * px_per_m).max(40.0);
     let (left, bottom, top) = (60u32, 35u32, 30u32);
     let panel_h = plot_h as u32 + bottom + top + 10;
@@ -134,6 +173,7 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
             .disable_mesh()
             .x_desc("x along the belt (m)")
             .y_desc("y (m)")
+            .y_label_formatter(&|v| crate::report::fixed(*v, 2, false))
             .draw()?;
         // Belt edges, entry and exit.
         for y in [-belt.width / 2.0, belt.width / 2.0] {
@@ -154,20 +194,41 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
             match ob {
                 Obstacle::Pin(pin) => {
                     let r = ((pin.radius * px_per_m).round() as i32).max(2);
+                    let fill = if pin.sensor.is_some() {
+                        SENSOR_COLOUR
+                    } else {
+                        OBSTACLE_COLOUR
+                    };
                     ch.draw_series(std::iter::once(Circle::new(
                         (pin.centre.x, pin.centre.y),
                         r,
-                        RED.filled(),
+                        fill.filled(),
                     )))?;
                 }
                 Obstacle::Fence(fence) => {
                     let (p, q) = (fence.start, fence.end());
                     ch.draw_series(LineSeries::new(
                         vec![(p.x, p.y), (q.x, q.y)],
-                        RED.stroke_width(3),
+                        OBSTACLE_COLOUR.stroke_width(3),
                     ))?;
                 }
             }
+        }
+        for (text, x, above, row, colour) in &labels {
+            let gap = (6.0 + LABEL_ROW_PX * *row as f64) / px_per_m;
+            let (y, v) = if *above {
+                (belt.width / 2.0 + gap, VPos::Bottom)
+            } else {
+                (-belt.width / 2.0 - gap + 2.0 / px_per_m, VPos::Top)
+            };
+            ch.draw_series(std::iter::once(Text::new(
+                text.clone(),
+                (*x, y),
+                ("sans-serif", LABEL_FONT)
+                    .into_font()
+                    .color(colour)
+                    .pos(Pos::new(HPos::Center, v)),
+            )))?;
         }
         let Some(sample) = sample else { continue };
         let colour = outcome_colour(sample.outcome);

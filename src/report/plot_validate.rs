@@ -1,21 +1,24 @@
 //! SVG figures of ensemble predictions and measured bands:
 //! [`plot_band_distributions`] draws, at each d, the predicted distribution of θf as a violin
-//! (width ∝ share per 1° bin, scaled to the largest bin of the figure), its 90% predicted bands as
-//! bars beside it, and optionally the measured bands as red bars with end ticks on the other side.
-//! Arcs straddling 0°/360° are drawn as two pieces (as in [`super::plot_map`]).
+//! (width ∝ share per 1° bin, scaled to the largest bin of the figure) centred on d, its 90%
+//! predicted bands as bars just left of it, and optionally the measured bands as red bars with end
+//! ticks just right of it — offsets for legibility only, said in the legend and on the axis; a
+//! dotted guide marks each d. The θf axis zooms on the data ([`super::plot_zoom`]), so an arc
+//! across 0°/360° is drawn in one piece.
 
-use super::plot_map::{arc_pieces, d_axis_mesh, degree_chart, draw_legend, Chart, PALETTE};
+use super::plot_labels::text_width;
+use super::plot_map::PALETTE;
+use super::plot_zoom::{degree_view, DegreeView};
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::PredictedBands;
 use crate::report::atomic::Staged;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// Smallest spacing between distinct d (0.2 for a single d).
 fn spacing(ds: &[f64]) -> f64 {
-    let mut v = ds.to_vec();
-    v.sort_by(f64::total_cmp);
-    v.dedup();
+    let v = distinct(ds);
     if v.len() < 2 {
         return 0.2;
     }
@@ -25,12 +28,29 @@ fn spacing(ds: &[f64]) -> f64 {
         .clamp(0.05, 0.4)
 }
 
-/// A legend entry: a thick line of `colour` (the series itself draws nothing).
-fn legend_line(ch: &mut Chart, label: &str, colour: RGBColor) -> anyhow::Result<()> {
-    ch.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())?
-        .label(label)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], colour.stroke_width(3)));
-    Ok(())
+/// The distinct values of `ds`, ascending.
+fn distinct(ds: &[f64]) -> Vec<f64> {
+    let mut v = ds.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+/// The θf axis: every occupied 1° bin of the predictions, every predicted and measured band.
+fn view_of(predicted: &[&PredictedBands], measured: &[(f64, Arc)]) -> DegreeView {
+    let mut arcs: Vec<(f64, f64)> = Vec::new();
+    for p in predicted {
+        arcs.extend(
+            p.histogram
+                .iter()
+                .enumerate()
+                .filter(|(_, &s)| s > 0.0)
+                .map(|(b, _)| (b as f64, 1.0)),
+        );
+        arcs.extend(p.bands.iter().map(|b| (b.arc.lo, b.arc.width.max(0.5))));
+    }
+    arcs.extend(measured.iter().map(|(_, a)| (a.lo, a.width.max(0.5))));
+    degree_view(&arcs, 5.0, 30.0, 40.0)
 }
 
 /// Predicted θf distributions and bands against d; `measured` are (d, band) pairs to draw over them.
@@ -48,22 +68,86 @@ pub fn plot_band_distributions(
     let step = spacing(&ds);
     let lo = ds.iter().copied().fold(f64::INFINITY, f64::min) - step;
     let hi = ds.iter().copied().fold(f64::NEG_INFINITY, f64::max) + step;
+    let view = view_of(predicted, measured);
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
     let root = SVGBackend::new(&tmp, (900, 640)).into_drawing_area();
-    let mut ch = degree_chart(&root, title, lo..hi, 420.0)?;
-    d_axis_mesh(&mut ch, "final orientation θf (deg)")?;
-    ch.draw_series(LineSeries::new(
-        vec![(lo, 360.0), (hi, 360.0)],
-        BLACK.mix(0.6),
+    root.fill(&WHITE)?;
+    let (head, body) = root.split_vertically(62);
+    head.draw(&Text::new(
+        title.to_string(),
+        (450, 8),
+        ("sans-serif", 18)
+            .into_font()
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Center, VPos::Top)),
     ))?;
+    let blue = PALETTE[0];
+    let dark = RGBColor(20, 40, 110);
+    let red = RGBColor(200, 30, 30);
+    // The legend, in one row above the chart.
+    let mut entries: Vec<(&str, RGBColor, bool)> = vec![
+        (
+            "predicted θf distribution at d (width ∝ √share per 1°)",
+            blue,
+            true,
+        ),
+        ("90% predicted bands (left of d)", dark, false),
+    ];
+    if !measured.is_empty() {
+        entries.push(("measured bands [min, max] (right of d)", red, false));
+    }
+    let font = ("sans-serif", 12).into_font();
+    let mut x = 40;
+    for (label, colour, filled) in entries {
+        if filled {
+            head.draw(&Rectangle::new(
+                [(x, 38), (x + 14, 46)],
+                colour.mix(0.55).filled(),
+            ))?;
+        } else {
+            head.draw(&PathElement::new(
+                vec![(x, 42), (x + 14, 42)],
+                colour.stroke_width(3),
+            ))?;
+        }
+        head.draw(&Text::new(
+            label.to_string(),
+            (x + 20, 42),
+            font.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+        // plotters draws a 12 px font about 9.7 px high: estimate at that size.
+        x += 20 + text_width(label, 10.0, false) as i32 + 16;
+    }
+    let mut ch = ChartBuilder::on(&body)
+        .margin(14)
+        .margin_top(4)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(lo..hi, view.lo..view.hi)?;
+    ch.configure_mesh()
+        .y_labels(15)
+        .y_label_formatter(&|v| DegreeView::label(*v))
+        .light_line_style(WHITE)
+        .x_desc(
+            "contact parameter d (dotted guides; bands beside each d are offset only to be seen)",
+        )
+        .y_desc("final orientation θf (deg)")
+        .draw()?;
+    for d in distinct(&ds) {
+        ch.draw_series(DashedLineSeries::new(
+            vec![(d, view.lo), (d, view.hi)],
+            2,
+            4,
+            BLACK.mix(0.35).stroke_width(1),
+        ))?;
+    }
     let top = predicted
         .iter()
         .flat_map(|p| p.histogram.iter().copied())
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
     let half = 0.32 * step;
-    let blue = PALETTE[0];
     let violins = predicted.iter().flat_map(|p| {
         p.histogram
             .iter()
@@ -71,21 +155,14 @@ pub fn plot_band_distributions(
             .filter(|(_, &s)| s > 0.0)
             .map(move |(b, &s)| {
                 let w = half * (s / top).sqrt().max(0.04);
-                Rectangle::new(
-                    [(p.d - w, b as f64), (p.d + w, b as f64 + 1.0)],
-                    blue.mix(0.55).filled(),
-                )
+                let y = view.place(b as f64);
+                Rectangle::new([(p.d - w, y), (p.d + w, y + 1.0)], blue.mix(0.55).filled())
             })
     });
-    ch.draw_series(violins)?
-        .label("predicted θf distribution (width ∝ √share per 1°)")
-        .legend(move |(x, y)| {
-            Rectangle::new([(x, y - 4), (x + 14, y + 4)], blue.mix(0.55).filled())
-        });
-    let dark = RGBColor(20, 40, 110);
+    ch.draw_series(violins)?;
     for p in predicted {
         for b in &p.bands {
-            for (y0, y1) in arc_pieces(b.arc.lo, b.arc.width.max(0.5)) {
+            for (y0, y1) in view.pieces(b.arc.lo, b.arc.width.max(0.5)) {
                 let x = p.d - half - 0.08 * step;
                 ch.draw_series(LineSeries::new(
                     vec![(x, y0), (x, y1)],
@@ -94,25 +171,23 @@ pub fn plot_band_distributions(
             }
         }
     }
-    legend_line(&mut ch, "90% predicted bands", dark)?;
-    if !measured.is_empty() {
-        let red = RGBColor(200, 30, 30);
-        for &(d, arc) in measured {
-            let x = d + half + 0.08 * step;
-            for (y0, y1) in arc_pieces(arc.lo, arc.width.max(0.5)) {
-                ch.draw_series(LineSeries::new(vec![(x, y0), (x, y1)], red.stroke_width(3)))?;
-            }
-            for y in [arc.lo, arc.hi()] {
-                let t = 0.04 * step;
-                ch.draw_series(LineSeries::new(
-                    vec![(x - t, y), (x + t, y)],
-                    red.stroke_width(2),
-                ))?;
-            }
+    for &(d, arc) in measured {
+        let x = d + half + 0.08 * step;
+        for (y0, y1) in view.pieces(arc.lo, arc.width.max(0.5)) {
+            ch.draw_series(LineSeries::new(vec![(x, y0), (x, y1)], red.stroke_width(3)))?;
         }
-        legend_line(&mut ch, "measured bands [min, max]", red)?;
+        for y in [arc.lo, arc.hi()] {
+            if !view.shows(y) {
+                continue;
+            }
+            let y = view.place(y);
+            let t = 0.04 * step;
+            ch.draw_series(LineSeries::new(
+                vec![(x - t, y), (x + t, y)],
+                red.stroke_width(2),
+            ))?;
+        }
     }
-    draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
     root.present()?;
     staged.commit()?;
     Ok(())

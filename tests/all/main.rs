@@ -15,6 +15,7 @@ mod plan_cli;
 mod reference;
 mod shapes;
 mod support;
+mod xml;
 
 mod accuracy_study;
 mod animate;
@@ -28,6 +29,7 @@ mod contact_regressions;
 mod docs;
 mod examples;
 mod fences;
+mod figures;
 mod first_contact;
 mod fuzz_cli;
 mod fuzz_files;

@@ -56,6 +56,9 @@ pub(super) fn decimals_for(step: f64) -> usize {
     (-(step.log10().floor())).clamp(0.0, 6.0) as usize
 }
 
+/// SVG y of the drawing's top (the title and subtitle are above).
+const TOP: f64 = 64.0;
+
 /// The world → SVG mapping and the page layout.
 pub(super) struct Layout {
     /// px per metre (both axes).
@@ -112,7 +115,7 @@ impl Layout {
         let x_range = length + 2.0 * margin;
         let k = (1230.0 / x_range).min(560.0 / (y_hi - y_lo));
         let left = 30.0;
-        let top = 64.0;
+        let top = TOP;
         let draw_w = x_range * k;
         // Room on the right for the axes' names.
         let page_w = (draw_w + 2.0 * left + 110.0).max(1000.0);
@@ -131,6 +134,20 @@ impl Layout {
             t_start: anim.t_start,
             span: span(anim),
         }
+    }
+    /// Make room for `above` px of labels beyond the belt's upper edge and `below` px beyond its
+    /// lower edge (`half`: half the belt's width, m), moving the drawing down and the axes below
+    /// it as needed.
+    pub(super) fn reserve(&mut self, half: f64, above: f64, below: f64) {
+        let room_above = self.oy - half * self.k - TOP;
+        let extra_top = (above - room_above).max(0.0);
+        self.oy += extra_top;
+        self.below += extra_top;
+        self.height += extra_top;
+        let room_below = self.below - (self.oy + half * self.k);
+        let extra_bottom = (below - room_below).max(0.0);
+        self.below += extra_bottom;
+        self.height += extra_bottom;
     }
     pub(super) fn x(&self, x: f64) -> f64 {
         self.ox + x * self.k

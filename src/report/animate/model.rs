@@ -92,16 +92,6 @@ impl MarkKind {
             MarkKind::Late => "#d01010",
         }
     }
-    /// Which text line (away from the point) its label takes, so that kinds at one place at one
-    /// time do not overprint.
-    pub(super) fn line(self) -> usize {
-        match self {
-            MarkKind::Reading => 0,
-            MarkKind::Decision => 1,
-            MarkKind::Actuation => 2,
-            MarkKind::Late => 3,
-        }
-    }
 }
 
 /// A short timed label (with a flash) at a place: a reading, a decision, an actuation.

@@ -5,13 +5,15 @@ use super::keyframes::{part_keys, thin, thin_track};
 use super::layout::{decimals_for, finite_or, key, nice_step, num, px, Layout};
 use super::model::*;
 use crate::engine::PartOutcome;
+use crate::report::plot_labels::{text_width, LabelRows};
 use crate::report::plot_line::outcome_colour;
 use std::fmt::Write;
 
 /// Fill of a part still riding the line.
 const RIDING_FILL: &str = "#a9c1db";
 const PART_STROKE: &str = "#223344";
-const PIN_FILL: &str = "#b01818";
+/// Pins and fences: a dark slate, apart from every outcome colour (as in `--draw`).
+const PIN_FILL: &str = "#283246";
 const SENSOR_FILL: &str = "#1f6fd0";
 
 /// Escape text for XML content and attributes.
@@ -98,10 +100,134 @@ fn linear_lists(points: &[(f64, String)]) -> (String, String) {
     (vals.join(";"), times.join(";"))
 }
 
+/// Label rows beyond the belt's edges: a row's height (px).
+const ROW_PX: f64 = 15.0;
+/// Font sizes of obstacle names and of marks (bold).
+const NAME_FONT: f64 = 11.0;
+const MARK_FONT: f64 = 12.0;
+
+/// Half the belt's width (m), as drawn.
+fn half_width(anim: &Animation) -> f64 {
+    finite_or(anim.belt_width, 0.1).max(1e-6) / 2.0
+}
+
+/// Where each label goes: (above the belt?, row beyond its edge).
+struct Rows {
+    obstacles: Vec<(bool, usize)>,
+    marks: Vec<(bool, usize)>,
+    used_above: usize,
+    used_below: usize,
+}
+
+/// The text of an obstacle's name label.
+fn obstacle_label(ob: &AnimObstacle) -> String {
+    format!("{}{}", ob.name, if ob.sensor { " (sensor)" } else { "" })
+}
+
+/// An obstacle's (x of its label, m; above the belt?).
+fn obstacle_anchor(ob: &AnimObstacle, lay: &Layout) -> (f64, bool) {
+    match ob.shape {
+        AnimShape::Fence { p0, p1 } => ((p0.x + p1.x) / 2.0, p0.y + p1.y >= 0.0),
+        AnimShape::Pin { x, .. } => {
+            let track: Vec<(f64, f64, bool)> = ob
+                .track
+                .iter()
+                .copied()
+                .filter(|k| k.0.is_finite() && k.1.is_finite())
+                .collect();
+            let y0 = pin_state(&track, lay.t_start).map_or(0.0, |p| p.0);
+            (x, y0 >= 0.0)
+        }
+    }
+}
+
+/// Place every label in a row where nothing shown at the same time overlaps it: entry and exit,
+/// the obstacles' names (shown throughout), then the marks in time order (each shown from its
+/// time until it has faded), on the side of the belt where its place is.
+fn place_labels(anim: &Animation, lay: &Layout, marks: &[&AnimMark]) -> Rows {
+    let mut rows = LabelRows::new();
+    let always = (0.0, 1.0);
+    // A label centred on x (m), `size` px, in the first free row on its side.
+    let centred = |rows: &mut LabelRows, x_m: f64, text: &str, size: f64, bold, above, t| {
+        let (cx, w) = (lay.x(x_m), text_width(text, size, bold));
+        rows.place(above, cx - w / 2.0, cx + w / 2.0, t, 0)
+    };
+    let length = finite_or(anim.belt_length, 1.0).max(1e-6);
+    centred(&mut rows, 0.0, "entry", NAME_FONT, false, true, always);
+    centred(&mut rows, length, "exit", NAME_FONT, false, true, always);
+    let obstacles = anim
+        .obstacles
+        .iter()
+        .map(|ob| {
+            let (x, above) = obstacle_anchor(ob, lay);
+            let x = finite_or(x, 0.0);
+            (
+                above,
+                centred(
+                    &mut rows,
+                    x,
+                    &obstacle_label(ob),
+                    NAME_FONT,
+                    false,
+                    above,
+                    always,
+                ),
+            )
+        })
+        .collect();
+    let marks = marks
+        .iter()
+        .map(|m| {
+            let (u0, u2) = mark_span(m, lay);
+            let above = m.at.y >= 0.0;
+            (
+                above,
+                centred(&mut rows, m.at.x, &m.text, MARK_FONT, true, above, (u0, u2)),
+            )
+        })
+        .collect();
+    Rows {
+        obstacles,
+        marks,
+        used_above: rows.rows(true),
+        used_below: rows.rows(false),
+    }
+}
+
+/// SVG y of the baseline of a label in `row` beyond the belt's upper (`above`) or lower edge.
+fn label_y(lay: &Layout, half: f64, (above, row): (bool, usize)) -> f64 {
+    if above {
+        lay.y(half) - 6.0 - ROW_PX * row as f64
+    } else {
+        lay.y(-half) + 14.0 + ROW_PX * row as f64
+    }
+}
+
+/// Key times a mark's label is shown over: from its time until it has faded.
+fn mark_span(m: &AnimMark, lay: &Layout) -> (f64, f64) {
+    let u0 = lay.u(m.t);
+    let u1 = (u0 + MARK_SHOW_S / lay.dur).min(1.0);
+    let u2 = (u1 + MARK_FADE_S / lay.dur).min(1.0);
+    (u0, u2)
+}
+
 /// Render the animation as an SVG document.
 pub fn render(anim: &Animation, opts: &AnimateOptions) -> String {
     let dur = duration(anim, opts);
-    let lay = Layout::new(anim, dur);
+    let mut lay = Layout::new(anim, dur);
+    let mut marks: Vec<&AnimMark> = anim
+        .marks
+        .iter()
+        .filter(|m| m.t.is_finite() && m.at.x.is_finite() && m.at.y.is_finite())
+        .collect();
+    marks.sort_by(|a, b| a.t.total_cmp(&b.t));
+    marks.truncate(MAX_MARKS);
+    let rows = place_labels(anim, &lay, &marks);
+    lay.reserve(
+        half_width(anim),
+        8.0 + ROW_PX * rows.used_above as f64,
+        8.0 + ROW_PX * rows.used_below as f64,
+    );
     let speedup = span(anim) / dur;
     let mut s = String::with_capacity(64 * 1024);
     let (w, h) = (lay.width, lay.height);
@@ -146,17 +272,11 @@ pub fn render(anim: &Animation, opts: &AnimateOptions) -> String {
     for p in &parts {
         part(&mut s, p, &outline, &lay, anim.t_end);
     }
-    for ob in &anim.obstacles {
-        obstacle(&mut s, ob, &lay, anim);
+    for (ob, &row) in anim.obstacles.iter().zip(&rows.obstacles) {
+        obstacle(&mut s, ob, &lay, anim, row);
     }
-    let mut marks: Vec<&AnimMark> = anim
-        .marks
-        .iter()
-        .filter(|m| m.t.is_finite() && m.at.x.is_finite() && m.at.y.is_finite())
-        .collect();
-    marks.sort_by(|a, b| a.t.total_cmp(&b.t));
-    for m in marks.iter().take(MAX_MARKS) {
-        mark(&mut s, m, &lay);
+    for (m, &row) in marks.iter().zip(&rows.marks) {
+        mark(&mut s, m, &lay, half_width(anim), row);
     }
     clock(&mut s, anim, &lay);
     legend(&mut s, anim, &parts, &lay);
@@ -245,7 +365,7 @@ fn belt(s: &mut String, anim: &Animation, lay: &Layout) {
             px(x),
             px(y_bot),
             px(x),
-            px(y_top - 4.0)
+            px(label_y(lay, width / 2.0, (true, 0)))
         );
     }
     let _ = writeln!(
@@ -364,20 +484,20 @@ fn part(s: &mut String, p: &AnimPart, outline: &str, lay: &Layout, t_end: f64) {
 
 /// One obstacle: a group holding its drawing (and label); a pin that moves animates `cy`, one
 /// that withdraws animates its opacity.
-fn obstacle(s: &mut String, ob: &AnimObstacle, lay: &Layout, anim: &Animation) {
+fn obstacle(s: &mut String, ob: &AnimObstacle, lay: &Layout, anim: &Animation, row: (bool, usize)) {
     let name = esc(&ob.name);
-    let width = finite_or(anim.belt_width, 0.1);
+    let half = half_width(anim);
     match ob.shape {
         AnimShape::Fence { p0, p1 } => {
             let _ = writeln!(
                 s,
-                r#"<g class="obstacle" data-name="{name}" data-kind="fence"><line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{PIN_FILL}" stroke-width="3" stroke-linecap="round"/><text x="{}" y="{}" font-size="11" fill="{PIN_FILL}">{name}</text></g>"#,
+                r#"<g class="obstacle" data-name="{name}" data-kind="fence"><line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{PIN_FILL}" stroke-width="3" stroke-linecap="round"/><text x="{}" y="{}" font-size="11" fill="{PIN_FILL}" text-anchor="middle">{name}</text></g>"#,
                 px(lay.x(p0.x)),
                 px(lay.y(p0.y)),
                 px(lay.x(p1.x)),
                 px(lay.y(p1.y)),
-                px(lay.x(p0.x)),
-                px(lay.y(p0.y.max(p1.y)) - 6.0),
+                px(lay.x((p0.x + p1.x) / 2.0)),
+                px(label_y(lay, half, row)),
             );
         }
         AnimShape::Pin { x, radius } => {
@@ -454,37 +574,26 @@ fn obstacle(s: &mut String, ob: &AnimObstacle, lay: &Layout, anim: &Animation) {
                 s.push_str(&a);
             }
             s.push_str("</circle>");
-            // The name just outside the belt's nearer edge.
-            let (ly, anchor_y) = if y0 >= 0.0 {
-                (lay.y(width / 2.0) - 6.0, "auto")
-            } else {
-                (lay.y(-width / 2.0) + 14.0, "auto")
-            };
+            // The name beyond the belt's nearer edge, in its row.
             let _ = writeln!(
                 s,
-                r#"<text x="{}" y="{}" font-size="11" fill="{fill}" text-anchor="middle" dominant-baseline="{anchor_y}">{name}{}</text></g>"#,
+                r#"<text x="{}" y="{}" font-size="11" fill="{fill}" text-anchor="middle">{}</text></g>"#,
                 px(cx),
-                px(ly),
-                if ob.sensor { " (sensor)" } else { "" }
+                px(label_y(lay, half, row)),
+                esc(&obstacle_label(ob))
             );
         }
     }
 }
 
-/// A mark: a label (and a ring flashing at the place) shown for [`MARK_SHOW_S`] from its time.
-fn mark(s: &mut String, m: &AnimMark, lay: &Layout) {
-    let u0 = lay.u(m.t);
+/// A mark: a label (and a ring flashing at the place) shown for [`MARK_SHOW_S`] from its time,
+/// the label in its row beyond the belt's edge ([`place_labels`]).
+fn mark(s: &mut String, m: &AnimMark, lay: &Layout, half: f64, row: (bool, usize)) {
+    let (u0, u2) = mark_span(m, lay);
     let u1 = (u0 + MARK_SHOW_S / lay.dur).min(1.0);
-    let u2 = (u1 + MARK_FADE_S / lay.dur).min(1.0);
     let (x, y) = (lay.x(m.at.x), lay.y(m.at.y));
     let colour = m.kind.colour();
-    // Labels go away from the belt's centre line, beyond the part's reach.
-    let line = m.kind.line() as f64;
-    let ty = if m.at.y > 0.0 {
-        y - lay.a_px - 8.0 - line * 13.0
-    } else {
-        y + lay.a_px + 16.0 + line * 13.0
-    };
+    let ty = label_y(lay, half, row);
     let opacity = format!(
         r#"<animate attributeName="opacity" values="0;0;1;1;0;0" keyTimes="0;{};{};{};{};1" {}/>"#,
         key(u0),
