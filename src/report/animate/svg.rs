@@ -124,17 +124,21 @@ fn obstacle_label(ob: &AnimObstacle) -> String {
     format!("{}{}", ob.name, if ob.sensor { " (sensor)" } else { "" })
 }
 
+/// The keyframes of an obstacle's track with a finite time and position.
+fn finite_track(ob: &AnimObstacle) -> Vec<(f64, f64, bool)> {
+    ob.track
+        .iter()
+        .copied()
+        .filter(|k| k.0.is_finite() && k.1.is_finite())
+        .collect()
+}
+
 /// An obstacle's (x of its label, m; above the belt?).
 fn obstacle_anchor(ob: &AnimObstacle, lay: &Layout) -> (f64, bool) {
     match ob.shape {
         AnimShape::Fence { p0, p1 } => ((p0.x + p1.x) / 2.0, p0.y + p1.y >= 0.0),
         AnimShape::Pin { x, .. } => {
-            let track: Vec<(f64, f64, bool)> = ob
-                .track
-                .iter()
-                .copied()
-                .filter(|k| k.0.is_finite() && k.1.is_finite())
-                .collect();
+            let track = finite_track(ob);
             let y0 = pin_state(&track, lay.t_start).map_or(0.0, |p| p.0);
             (x, y0 >= 0.0)
         }
@@ -501,12 +505,7 @@ fn obstacle(s: &mut String, ob: &AnimObstacle, lay: &Layout, anim: &Animation, r
             );
         }
         AnimShape::Pin { x, radius } => {
-            let track: Vec<(f64, f64, bool)> = ob
-                .track
-                .iter()
-                .copied()
-                .filter(|k| k.0.is_finite() && k.1.is_finite())
-                .collect();
+            let track = finite_track(ob);
             let (t0, t1) = (lay.t_start, lay.t_start + lay.span);
             let (y0, raised0) = pin_state(&track, t0).unwrap_or((0.0, true));
             let moving = track.iter().any(|k| (k.1 - y0).abs() * lay.k > 0.05);
