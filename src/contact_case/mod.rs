@@ -41,6 +41,29 @@ pub struct Case {
     pub fence: Option<(f64, Option<f64>)>,
 }
 
+impl Case {
+    /// A pin pass over `part` (a name as `named::part_from_spec` reads it) at θ0 (degrees), d and
+    /// μc, with the command line's defaults for the rest: exact fidelity, μs 0.3, a point pin
+    /// standing still, uniform support, tolerance 1e-6, no fence.
+    pub fn new(part: &str, theta0_deg: f64, d: f64, mu_c: f64) -> Case {
+        Case {
+            part: part.to_string(),
+            theta0_deg,
+            d,
+            mu_c,
+            mu_s: 0.3,
+            model: Fidelity::Exact,
+            pin_radius: 0.0,
+            pin_speed: 0.0,
+            pin_stop: None,
+            pin_stop_after_touch: None,
+            support: "uniform".into(),
+            tol: 1e-6,
+            fence: None,
+        }
+    }
+}
+
 /// A case that cannot be run; the messages name the flag (or batch column) of each setting.
 #[derive(Debug, thiserror::Error)]
 pub enum CaseError {

@@ -18,7 +18,6 @@
 use clap::Parser;
 use pinfeed::contact_case::{run_case, Case};
 use pinfeed::geometry::{Polygon, PolygonError};
-use pinfeed::mechanics::Fidelity;
 use proptest::prelude::*;
 use std::process::Command;
 
@@ -550,22 +549,16 @@ proptest! {
     ) {
         let k = 2f64.powi(j);
         let case = |scale: f64| Case {
-            part: format!(
-                "vertices:{}",
-                vertex_text(&v.iter().map(|&(x, y)| (x * scale, y * scale)).collect::<Vec<_>>())
-            ),
-            theta0_deg: theta0,
-            d,
-            mu_c,
-            mu_s: 0.3,
-            model: Fidelity::Exact,
             pin_radius: rho * scale,
-            pin_speed: 0.0,
-            pin_stop: None,
-            pin_stop_after_touch: None,
-            support: "uniform".into(),
-            tol: 1e-6,
-            fence: None,
+            ..Case::new(
+                &format!(
+                    "vertices:{}",
+                    vertex_text(&v.iter().map(|&(x, y)| (x * scale, y * scale)).collect::<Vec<_>>())
+                ),
+                theta0,
+                d,
+                mu_c,
+            )
         };
         let (pu, u, _) = run_case(&case(1.0), false).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
         let (pk, s, _) = run_case(&case(k), false).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
