@@ -7,6 +7,7 @@ use super::contact::{case_of, ContactArgs};
 use crate::contact_case::report::report;
 use crate::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
 use crate::engine::contact_map::prepare;
+use crate::geometry::{Pose, Vec2};
 use crate::maps::tier::{self, push_with_map, Loaded, TierInputs, TierSpec};
 use crate::mechanics::{ContactSettings, Fidelity, PartModel, Support};
 use crate::scenario::Scene;
@@ -69,6 +70,8 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         tol: c.tol,
         ..ContactSettings::default()
     };
+    let (pose, start) = case_geometry(&poly, &c);
+    // Only the base cell of the query is built (and kept in the cache beside any built before).
     let loaded = load_tier(
         &model,
         &support,
@@ -76,8 +79,8 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         settings,
         args.map_grid.as_deref(),
         args.cache_dir.as_deref(),
+        Some(&[(pose, start)]),
     )?;
-    let (pose, start) = case_geometry(&poly, &c);
     let started = Instant::now();
     let (out, why) = push_with_map(&loaded.map, &model, pose, start, c.pin_radius, &settings);
     let query_s = started.elapsed().as_secs_f64();
@@ -123,8 +126,9 @@ pub fn run(args: &ContactArgs) -> Result<()> {
 }
 
 /// The map of (part, support, pin radius, contact settings) on the grid `--map-grid` (default
-/// [`TierSpec::default`]), read from the cache folder or built and written there; its warnings
-/// (a stale or corrupted file) go to standard error.
+/// [`TierSpec::default`]), read from the cache folder or built and written there — only the base
+/// cells of `queries` (pose, pin start) when they are given; its warnings (a stale or corrupted
+/// file) go to standard error.
 pub fn load_tier(
     model: &PartModel,
     support: &Support,
@@ -132,6 +136,7 @@ pub fn load_tier(
     settings: ContactSettings,
     grid: Option<&str>,
     dir: Option<&Path>,
+    queries: Option<&[(Pose, Vec2)]>,
 ) -> Result<Loaded> {
     let spec = match grid {
         Some(g) => TierSpec::parse_grid(g)?,
@@ -144,7 +149,12 @@ pub fn load_tier(
         settings,
         spec,
     };
-    let loaded = tier::load_or_build(&inputs, Some(&cache_dir(dir)));
+    let cells: Option<Vec<usize>> = queries.map(|q| {
+        q.iter()
+            .filter_map(|&(pose, start)| tier::cell_of_query(&inputs, pose, start))
+            .collect()
+    });
+    let loaded = tier::load_or_build_cells(&inputs, Some(&cache_dir(dir)), cells.as_deref());
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }

@@ -236,6 +236,13 @@ pub fn run(args: &MapArgs) -> Result<()> {
         .build()
         .context("starting the worker threads")?;
     let tier = if use_tier {
+        // Only the base cells the maps' passes fall in are built.
+        let grid = crate::maps::theta_grid(args.theta_step).unwrap_or_default();
+        let passes: Vec<_> = ds
+            .iter()
+            .flat_map(|&d| grid.iter().map(move |&t| (t, d)))
+            .map(|(t, d)| crate::maps::pass_start(&poly, t, d, pin.radius))
+            .collect();
         let support =
             crate::mechanics::Support::parse(&args.support, &poly).map_err(anyhow::Error::msg)?;
         let loaded = pool.install(|| {
@@ -246,6 +253,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
                 contact,
                 args.map_grid.as_deref(),
                 args.cache_dir.as_deref(),
+                Some(&passes),
             )
         })?;
         Some(loaded)

@@ -89,6 +89,14 @@ pub struct MapTierCounters {
     pub fallback_fence: u64,
     /// … because the part has its own support (a random tripod per part).
     pub fallback_part_support: u64,
+    /// … because the query fell in a base cell the map has not built (never for a line, whose
+    /// maps are built whole; absent from the summary when 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub fallback_unbuilt: u64,
+}
+
+fn is_zero(k: &u64) -> bool {
+    *k == 0
 }
 
 impl MapTierCounters {
@@ -104,6 +112,7 @@ impl MapTierCounters {
             + self.fallback_moving_pin
             + self.fallback_fence
             + self.fallback_part_support
+            + self.fallback_unbuilt
     }
     /// The fallbacks by reason, `name count` joined by commas (`none` without any).
     pub fn fallback_reasons(&self) -> String {
@@ -114,6 +123,7 @@ impl MapTierCounters {
             ("moving_pin", self.fallback_moving_pin),
             ("fence", self.fallback_fence),
             ("part_support", self.fallback_part_support),
+            ("unbuilt", self.fallback_unbuilt),
         ]
         .iter()
         .filter(|(_, k)| *k > 0)
@@ -135,6 +145,7 @@ impl MapTierCounters {
             F::MovingPin => &mut self.fallback_moving_pin,
             F::Fence => &mut self.fallback_fence,
             F::PartSupport => &mut self.fallback_part_support,
+            F::Unbuilt => &mut self.fallback_unbuilt,
         } += 1;
     }
 }

@@ -64,7 +64,7 @@ pub fn contact_row(part: &str, contacts: usize, seed: u64) -> Result<ContactRow>
     };
     let loaded = tier::load_or_build(&inputs, None);
     let build_s = match loaded.source {
-        Source::Built { seconds } => seconds,
+        Source::Built { seconds, .. } => seconds,
         _ => f64::NAN,
     };
     let map = loaded.map;

@@ -538,3 +538,68 @@ fn configuration_maps_from_the_map_tier_match_exact_and_refuse_what_it_cannot_ta
 fn se_samples(e: &serde_json::Value) -> impl Iterator<Item = &serde_json::Value> {
     e["samples"].as_array().unwrap().iter()
 }
+
+/// A map built cell by cell, as single queries need them (and kept in the cache between
+/// queries), answers every query in a built cell exactly as the whole map does; a query in a cell
+/// not built yet is answered exactly, with the reason `unbuilt`.
+#[test]
+fn cells_built_on_demand_answer_as_the_whole_map() {
+    let spec = TierSpec {
+        theta_cells: 8,
+        d_cells: 4,
+        max_depth: 1,
+        ..TierSpec::default()
+    };
+    let a = inputs(spec);
+    let whole = tier::build(&a);
+    assert!(whole.is_complete());
+    let dir = temp_dir("on-demand");
+    let mut rng = stream(7, 0);
+    let mut built = std::collections::BTreeSet::new();
+    for _ in 0..24 {
+        let theta = rng.random::<f64>() * std::f64::consts::TAU;
+        let d = (rng.random::<f64>() - 0.5) * 1.8;
+        let (pose, pin) = query(theta, d);
+        let cell = tier::cell_of_query(&a, pose, pin).expect("inside the d range");
+        let loaded = tier::load_or_build_cells(&a, Some(&dir), Some(&[cell]));
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+        match (built.insert(cell), &loaded.source) {
+            (true, Source::Built { cells, .. }) => assert_eq!(*cells, 1),
+            (false, Source::Disk(_)) => {}
+            (new, s) => panic!("cell {cell} new {new}: {s:?}"),
+        }
+        assert_eq!(loaded.map.stats.built_cells as usize, built.len());
+        let want = whole.answer(model(), pose, pin, RADIUS);
+        let got = loaded.map.answer(model(), pose, pin, RADIUS);
+        match (want, got) {
+            (Ok(w), Ok(g)) => assert_eq!(
+                (w.pose_final, w.contact, w.contact_length),
+                (g.pose_final, g.contact, g.contact_length)
+            ),
+            (w, g) => assert_eq!(w.err(), g.err()),
+        }
+        // Some cell not built yet answers exactly, saying why (a miss is the ray cast's answer).
+        let unbuilt = loaded
+            .map
+            .unbuilt_cells()
+            .next()
+            .expect("not all cells built");
+        let (nd, reach) = (spec.d_cells as usize, loaded.map.reach);
+        let t = ((unbuilt / nd) as f64 + 0.5) / spec.theta_cells as f64 * std::f64::consts::TAU;
+        let dd = -reach + 2.0 * reach * ((unbuilt % nd) as f64 + 0.5) / nd as f64;
+        let (pose, pin) = query(t, dd);
+        assert_eq!(tier::cell_of_query(&a, pose, pin), Some(unbuilt));
+        if let Err(why) = loaded.map.answer(model(), pose, pin, RADIUS) {
+            assert!(
+                matches!(why, Fallback::Unbuilt | Fallback::PinInside),
+                "{why:?}"
+            );
+        }
+    }
+    // The rest, all at once: now whole, with the whole map's certified area.
+    let rest = tier::load_or_build_cells(&a, Some(&dir), None);
+    assert!(rest.map.is_complete());
+    assert!((rest.map.stats.certified_area - whole.stats.certified_area).abs() < 1e-12);
+    assert_eq!(rest.map.stats.certified_cells, whole.stats.certified_cells);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

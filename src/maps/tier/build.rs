@@ -6,8 +6,7 @@
 //! points in one parallel, order-preserving batch (sorted lattice keys), then decides every cell in
 //! order: the result does not depend on the thread count.
 
-use super::key::TierKey;
-use super::{BuildStats, Node, Sample, TierInputs, TierMap};
+use super::{Node, Sample, TierInputs, TierMap};
 use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{push_path, ContactFeature, PinPath};
 use rayon::prelude::*;
@@ -198,8 +197,27 @@ fn fill(cells: &[Cell], at: &mut BTreeMap<u64, Sample>, inputs: &TierInputs, lat
     }
 }
 
-/// Build the map of `inputs` (deterministic; parallel over samples).
+/// Build the whole map of `inputs` (deterministic; parallel over samples).
 pub fn build(inputs: &TierInputs) -> TierMap {
+    let mut map = TierMap::unbuilt(inputs);
+    let roots: Vec<usize> = map.unbuilt_cells().collect();
+    extend(&mut map, inputs, &roots);
+    map
+}
+
+/// Build the base cells `roots` of `map` (the map of `inputs`) that are not built yet, in
+/// parallel over samples. A base cell's quadtree and samples depend on that cell alone (every
+/// sample sits on the lattice, and a cell is decided by its own points), so a map answers every
+/// query in a built cell the same way whichever other cells were built, in whatever order.
+pub fn extend(map: &mut TierMap, inputs: &TierInputs, roots: &[usize]) {
+    let todo: BTreeSet<usize> = roots
+        .iter()
+        .copied()
+        .filter(|&r| map.nodes.get(r) == Some(&Node::Unbuilt))
+        .collect();
+    if todo.is_empty() {
+        return;
+    }
     // A map's build is a batch of ~10⁵ exact pushes over one part: its sticks pay for stick tables.
     let model = inputs.model.clone().with_stick_tables();
     let inputs = &TierInputs {
@@ -213,22 +231,25 @@ pub fn build(inputs: &TierInputs) -> TierMap {
         per_cell,
         theta_points: nt * per_cell,
         d_points: nd * per_cell,
-        reach: reach(inputs),
+        reach: map.reach,
     };
-    let mut nodes = vec![Node::Fallback; (nt * nd) as usize];
-    let mut cells: Vec<Cell> = (0..nt)
-        .flat_map(|it| (0..nd).map(move |id| (it, id)))
-        .map(|(it, id)| Cell {
-            i: it * per_cell,
-            j: id * per_cell,
+    let mut cells: Vec<Cell> = todo
+        .iter()
+        .map(|&r| Cell {
+            i: (r as u64 / nd) * per_cell,
+            j: (r as u64 % nd) * per_cell,
             size: per_cell,
-            node: (it * nd + id) as usize,
+            node: r,
         })
         .collect();
+    for &r in &todo {
+        map.nodes[r] = Node::Fallback;
+    }
     let mut at: BTreeMap<u64, Sample> = BTreeMap::new();
-    let mut samples: Vec<Sample> = Vec::new();
     let mut index: BTreeMap<u64, u32> = BTreeMap::new();
-    let mut stats = BuildStats::default();
+    let stats = &mut map.stats;
+    let (nodes, samples) = (&mut map.nodes, &mut map.samples);
+    let mut area = 0.0;
     while !cells.is_empty() {
         fill(&cells, &mut at, inputs, &lat);
         let mut next = Vec::new();
@@ -243,7 +264,7 @@ pub fn build(inputs: &TierInputs) -> TierMap {
                 });
                 nodes[cell.node] = Node::Certified { points };
                 stats.certified_cells += 1;
-                stats.certified_area += (cell.size as f64 / per_cell as f64).powi(2);
+                area += (cell.size as f64 / per_cell as f64).powi(2);
             } else if cell.size > 4 && any_servable(cell, &at) {
                 let first = nodes.len();
                 nodes.extend([Node::Fallback; 4]);
@@ -265,14 +286,7 @@ pub fn build(inputs: &TierInputs) -> TierMap {
         }
         cells = next;
     }
-    stats.exact_samples = at.len() as u64;
-    stats.certified_area /= (nt * nd) as f64;
-    TierMap {
-        key: TierKey::of(inputs),
-        spec,
-        reach: lat.reach,
-        nodes,
-        samples,
-        stats,
-    }
+    stats.exact_samples += at.len() as u64;
+    stats.certified_area += area / (nt * nd) as f64;
+    stats.built_cells += todo.len() as u64;
 }

@@ -2,7 +2,8 @@
 //!
 //! Layout (little-endian): magic `PINFEED-MAPTIER\n` (16 bytes), format version (u32), key (16
 //! bytes), payload length (u64), payload, FNV-1a 64 checksum of everything before it (u64). The
-//! payload is the grid (spec, reach), the build statistics, the nodes and the corner samples. A
+//! payload is the grid (spec, reach), the build statistics, the nodes (a base cell not built yet is
+//! an `Unbuilt` root) and the corner samples. A
 //! file whose magic, version, key, length or checksum does not match is refused with a message
 //! naming the file and the reason, and the map is rebuilt and written again.
 //!
@@ -10,7 +11,7 @@
 //! `$HOME/.cache/pinfeed/maps`, else `target/pinfeed-cache` ([`default_cache_dir`]).
 
 use super::key::{fnv1a64, TierKey, BASIS, FORMAT_VERSION};
-use super::{build, BuildStats, Node, Sample, TierInputs, TierMap, TierSpec};
+use super::{BuildStats, Node, Sample, TierInputs, TierMap, TierSpec};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
@@ -40,8 +41,8 @@ pub enum Source {
     Memory,
     /// Read from a cache file.
     Disk(PathBuf),
-    /// Built now, in `seconds`.
-    Built { seconds: f64 },
+    /// Built now (`cells` base cells, added to those a cache file held), in `seconds`.
+    Built { seconds: f64, cells: u64 },
 }
 
 /// A map ready for use, where it came from, and what went wrong on the way (a refused file, a
@@ -79,28 +80,54 @@ pub fn file_of(dir: &Path, key: &TierKey) -> PathBuf {
 }
 
 /// Read the map of `inputs` from `dir` if a valid file is there, else build it and write it
-/// (`dir` None: build, no file).
+/// (`dir` None: build, no file). The whole map: every base cell.
 pub fn load_or_build(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
+    load_or_build_cells(inputs, dir, None)
+}
+
+/// [`load_or_build`] for the base cells `cells` only (None: all): a file that holds them is
+/// used as it is; otherwise the missing ones are built into the map the file holds (or into an
+/// empty map) and the file is written again. A query in a built cell gets the same answer
+/// whichever other cells are built ([`super::build::extend`]).
+pub fn load_or_build_cells(
+    inputs: &TierInputs,
+    dir: Option<&Path>,
+    cells: Option<&[usize]>,
+) -> Loaded {
     let key = TierKey::of(inputs);
     let mut warnings = Vec::new();
     let file = dir.map(|d| file_of(d, &key));
+    let mut map = None;
     if let Some(path) = &file {
         if path.exists() {
             match read(path, &key) {
-                Ok(map) => {
-                    return Loaded {
-                        map: Arc::new(map),
-                        source: Source::Disk(path.clone()),
-                        file,
-                        warnings,
-                    }
-                }
+                Ok(m) => map = Some((m, path.clone())),
                 Err(e) => warnings.push(e.to_string()),
             }
         }
     }
+    let (mut map, from) = match map {
+        Some((m, path)) => (m, Some(path)),
+        None => (TierMap::unbuilt(inputs), None),
+    };
+    let wanted: Vec<usize> = match cells {
+        Some(c) => c
+            .iter()
+            .copied()
+            .filter(|&r| map.nodes.get(r) == Some(&Node::Unbuilt))
+            .collect(),
+        None => map.unbuilt_cells().collect(),
+    };
+    if let (true, Some(path)) = (wanted.is_empty(), from) {
+        return Loaded {
+            map: Arc::new(map),
+            source: Source::Disk(path),
+            file,
+            warnings,
+        };
+    }
     let started = Instant::now();
-    let map = build(inputs);
+    super::build::extend(&mut map, inputs, &wanted);
     let seconds = started.elapsed().as_secs_f64();
     if let Some(path) = &file {
         if let Err(e) = write(path, &map) {
@@ -109,7 +136,10 @@ pub fn load_or_build(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
     }
     Loaded {
         map: Arc::new(map),
-        source: Source::Built { seconds },
+        source: Source::Built {
+            seconds,
+            cells: wanted.len() as u64,
+        },
         file,
         warnings,
     }
@@ -177,12 +207,14 @@ pub fn encode(map: &TierMap) -> Vec<u8> {
     p.u64(st.certified_cells);
     p.u64(st.fallback_cells);
     p.f64(st.certified_area);
+    p.u64(st.built_cells);
     p.u64(map.nodes.len() as u64);
     for n in &map.nodes {
         let (tag, v) = match *n {
             Node::Split { first } => (0u8, [first, 0, 0, 0, 0, 0, 0, 0, 0]),
             Node::Certified { points } => (1, points),
             Node::Fallback => (2, [0; 9]),
+            Node::Unbuilt => (3, [0; 9]),
         };
         p.0.push(tag);
         v.iter().for_each(|&x| p.u32(x));
@@ -250,6 +282,7 @@ fn payload(r: &mut Reader, key: TierKey) -> Result<TierMap, String> {
         certified_cells: r.u64()?,
         fallback_cells: r.u64()?,
         certified_area: r.f64()?,
+        built_cells: r.u64()?,
     };
     let n_nodes = r.count(37)?;
     let mut nodes = Vec::with_capacity(n_nodes);
@@ -263,6 +296,7 @@ fn payload(r: &mut Reader, key: TierKey) -> Result<TierMap, String> {
             0 => Node::Split { first: v[0] },
             1 => Node::Certified { points: v },
             2 => Node::Fallback,
+            3 => Node::Unbuilt,
             t => return Err(format!("unknown node tag {t}")),
         });
     }
@@ -303,6 +337,7 @@ fn check_links(map: &TierMap) -> Result<(), String> {
         Node::Split { first } => (first as usize) > i && first as usize + 4 <= map.nodes.len(),
         Node::Certified { points } => points.iter().all(|&c| (c as usize) < map.samples.len()),
         Node::Fallback => true,
+        Node::Unbuilt => i < roots,
     });
     if ok {
         Ok(())

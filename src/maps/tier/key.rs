@@ -8,7 +8,7 @@ use crate::mechanics::{Support, MODEL_VERSION};
 use std::fmt;
 
 /// Bumped whenever the tier's sampling, certification or file layout changes meaning.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// A 128-bit map key.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]

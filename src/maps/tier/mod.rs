@@ -23,6 +23,11 @@
 //! sampled certificate (a discontinuity island smaller than a cell and missed by all nine points
 //! would go unseen by all 21 points), not a proof.
 //!
+//! Base cells are built on demand ([`build::extend`], [`load_or_build_cells`]): a single query
+//! needs only its own cell, a scene the whole map ([`build()`]). A cell's quadtree and samples depend
+//! on that cell alone, so an answer does not depend on which other cells are built; a query in a
+//! cell not built yet is answered by the exact model ([`Fallback::Unbuilt`]).
+//!
 //! Cached on disk ([`cache`]) under a 128-bit hash of a canonical encoding of every input and of
 //! the contact model's version ([`key`], [`crate::mechanics::MODEL_VERSION`]: a map an older
 //! model built is rebuilt, not reused); the file carries a magic, a format version, the key and a checksum, so a stale or
@@ -36,9 +41,11 @@ pub mod query;
 pub mod report;
 
 pub use build::build;
-pub use cache::{default_cache_dir, load_or_build, shared, CacheError, Loaded, Source};
+pub use cache::{
+    default_cache_dir, load_or_build, load_or_build_cells, shared, CacheError, Loaded, Source,
+};
 pub use key::TierKey;
-pub use query::{push_with_map, Fallback};
+pub use query::{cell_of_query, push_with_map, Fallback};
 
 use crate::mechanics::{ContactSettings, PartModel, Support};
 
@@ -108,6 +115,9 @@ pub enum Node {
     Certified { points: [u32; 9] },
     /// Not certified at the finest level: the exact model answers here.
     Fallback,
+    /// A base cell not built yet ([`build::extend`] builds base cells on demand: a single query
+    /// needs only its own); the exact model answers a query here.
+    Unbuilt,
 }
 
 /// How a map was built.
@@ -120,6 +130,8 @@ pub struct BuildStats {
     pub fallback_cells: u64,
     /// Fraction of the (θ0, d) rectangle covered by certified cells.
     pub certified_area: f64,
+    /// Base cells built (of `theta_cells · d_cells`).
+    pub built_cells: u64,
 }
 
 /// A built map: the base grid, the quadtrees (roots first, θ-major), the corner samples.
@@ -134,19 +146,49 @@ pub struct TierMap {
     pub stats: BuildStats,
 }
 
+/// The base cell (θ-major index) holding (θ0 ∈ [0, 2π), d ∈ [−r, r]) on a grid of `spec` with
+/// half-width `reach`, and the local coordinates (u, v) ∈ [0, 1]² in it; None outside the d range.
+pub fn base_cell(spec: &TierSpec, reach: f64, theta: f64, d: f64) -> Option<(usize, f64, f64)> {
+    let (nt, nd) = (spec.theta_cells as usize, spec.d_cells as usize);
+    let ft = theta / std::f64::consts::TAU * nt as f64;
+    let fd = (d + reach) / (2.0 * reach) * nd as f64;
+    if !(ft >= 0.0 && fd >= 0.0 && fd <= nd as f64 && ft <= nt as f64) {
+        return None;
+    }
+    let (it, id) = ((ft as usize).min(nt - 1), (fd as usize).min(nd - 1));
+    Some((it * nd + id, ft - it as f64, fd - id as f64))
+}
+
 impl TierMap {
+    /// An empty map of `inputs`: every base cell unbuilt.
+    pub fn unbuilt(inputs: &TierInputs) -> TierMap {
+        let roots = inputs.spec.theta_cells as usize * inputs.spec.d_cells as usize;
+        TierMap {
+            key: TierKey::of(inputs),
+            spec: inputs.spec,
+            reach: build::reach(inputs),
+            nodes: vec![Node::Unbuilt; roots],
+            samples: Vec::new(),
+            stats: BuildStats::default(),
+        }
+    }
+
+    /// Every base cell is built.
+    pub fn is_complete(&self) -> bool {
+        self.unbuilt_cells().next().is_none()
+    }
+
+    /// The base cells not built yet.
+    pub fn unbuilt_cells(&self) -> impl Iterator<Item = usize> + '_ {
+        let roots = self.spec.theta_cells as usize * self.spec.d_cells as usize;
+        (0..roots).filter(|&r| self.nodes[r] == Node::Unbuilt)
+    }
+
     /// The leaf holding (θ0 ∈ [0, 2π), d ∈ [−r, r]) and the local coordinates (u, v) ∈ [0, 1]² in
     /// it; None outside the d range.
     pub fn leaf(&self, theta: f64, d: f64) -> Option<(Node, f64, f64)> {
-        let (nt, nd) = (self.spec.theta_cells as usize, self.spec.d_cells as usize);
-        let ft = theta / std::f64::consts::TAU * nt as f64;
-        let fd = (d + self.reach) / (2.0 * self.reach) * nd as f64;
-        if !(ft >= 0.0 && fd >= 0.0 && fd <= nd as f64 && ft <= nt as f64) {
-            return None;
-        }
-        let (it, id) = ((ft as usize).min(nt - 1), (fd as usize).min(nd - 1));
-        let (mut u, mut v) = (ft - it as f64, fd - id as f64);
-        let mut node = self.nodes[it * nd + id];
+        let (root, mut u, mut v) = base_cell(&self.spec, self.reach, theta, d)?;
+        let mut node = self.nodes[root];
         while let Node::Split { first } = node {
             let (hu, hv) = (usize::from(u >= 0.5), usize::from(v >= 0.5));
             u = 2.0 * u - hu as f64;

@@ -2,7 +2,7 @@
 //! interpolation, or the exact model where the map cannot vouch for the answer.
 
 use super::build::interpolate;
-use super::{Node, TierMap};
+use super::{Node, TierInputs, TierMap};
 use crate::geometry::{wrap_2pi, Pose, Vec2};
 use crate::mechanics::{
     pin_first_touch, push_path, untouched, ContactOutcome, ContactSettings, ContactStatus,
@@ -27,6 +27,8 @@ pub enum Fallback {
     Fence,
     /// The part has its own support (a random tripod per part).
     PartSupport,
+    /// The query lies in a base cell the map has not built (a map built for other queries).
+    Unbuilt,
 }
 
 impl Fallback {
@@ -38,6 +40,7 @@ impl Fallback {
             Fallback::MovingPin => "moving_pin",
             Fallback::Fence => "fence",
             Fallback::PartSupport => "part_support",
+            Fallback::Unbuilt => "unbuilt",
         }
     }
 }
@@ -68,8 +71,10 @@ impl TierMap {
         let Some((node, u, v)) = self.leaf(wrap_2pi(pose.theta), d) else {
             return Err(Fallback::Uncertified);
         };
-        let Node::Certified { points } = node else {
-            return Err(Fallback::Uncertified);
+        let points = match node {
+            Node::Certified { points } => points,
+            Node::Unbuilt => return Err(Fallback::Unbuilt),
+            Node::Split { .. } | Node::Fallback => return Err(Fallback::Uncertified),
         };
         let c = points.map(|i| &self.samples[i as usize]);
         let [rotation, dx, dy, span] = interpolate(c, u, v);
@@ -87,6 +92,20 @@ impl TierMap {
             status: ContactStatus::Ok,
         })
     }
+}
+
+/// The base cell a query of [`TierMap::answer`] falls in (None: outside the map's d range), for
+/// building only the cells a batch of queries needs ([`super::load_or_build_cells`]).
+pub fn cell_of_query(inputs: &TierInputs, pose: Pose, pin_start: Vec2) -> Option<usize> {
+    let k = inputs.model.scale();
+    let d = (pin_start.y - pose.y) / k;
+    super::base_cell(
+        &inputs.spec,
+        super::build::reach(inputs),
+        wrap_2pi(pose.theta),
+        d,
+    )
+    .map(|(root, _, _)| root)
 }
 
 /// The push from the map where it can answer, else from the exact model (with the reason).

@@ -10,13 +10,18 @@ impl Loaded {
     /// One line on where the map came from.
     pub fn describe(&self) -> String {
         let st = &self.map.stats;
+        let spec = &self.map.spec;
         let what = format!(
-            "{} exact pushes, {:.1}% of θ0 × d certified",
+            "{} of {} base cells, {} exact pushes, {:.1}% of θ0 × d certified",
+            st.built_cells,
+            spec.theta_cells * spec.d_cells,
             st.exact_samples,
             100.0 * st.certified_area
         );
         match &self.source {
-            Source::Built { seconds } => format!("built in {seconds:.2} s ({what})"),
+            Source::Built { seconds, cells } => {
+                format!("{cells} base cell(s) built in {seconds:.2} s ({what})")
+            }
             Source::Disk(p) => format!("read from {} ({what})", p.display()),
             Source::Memory => format!("already loaded ({what})"),
         }
