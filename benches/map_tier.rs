@@ -4,7 +4,9 @@
 //! d uniform in ±0.6): `served` — the pushes the map answers (ray cast + interpolation),
 //! `exact_served` — the same pushes by the exact model, `mixed` — every push through
 //! `push_with_map` (the exact model where the map is not certified), `exact_all` — every push
-//! exact. Run: `cargo bench --bench map_tier`.
+//! exact. And the build (no cache): `build/query cell` — the one base cell a single query needs
+//! (`contact --model map`: θ0 100°, d 0.3), `build/whole map 36x12x2` — every base cell of a
+//! coarser grid than the default. Run: `cargo bench --bench map_tier`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::geometry::{part_from_spec, Pose, Vec2};
@@ -82,9 +84,43 @@ fn bench_map_tier(c: &mut Criterion) {
     group.finish();
 }
 
+fn bench_build(c: &mut Criterion) {
+    let poly = part_from_spec("tripoly2").unwrap();
+    let poly = poly.scaled(1.0 / poly.radius());
+    let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+    let inputs = TierInputs {
+        model: &model,
+        support: &Support::Uniform,
+        radius: RADIUS,
+        settings: ContactSettings::default(),
+        spec: TierSpec::default(),
+    };
+    let pose = Pose::new(0.0, 0.0, 100f64.to_radians());
+    let cell = tier::cell_of_query(&inputs, pose, Vec2::new(2.5, 0.3)).unwrap();
+    let mut group = c.benchmark_group("map_tier_build");
+    group.sample_size(10);
+    group.bench_function("query cell", |b| {
+        b.iter(|| {
+            let loaded = tier::load_or_build_cells(&inputs, None, Some(&[cell]));
+            black_box(loaded.map.stats.exact_samples)
+        })
+    });
+    let coarse = TierInputs {
+        spec: TierSpec {
+            max_depth: 2,
+            ..TierSpec::default()
+        },
+        ..inputs
+    };
+    group.bench_function("whole map 36x12x2", |b| {
+        b.iter(|| black_box(tier::build(&coarse).stats.exact_samples))
+    });
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10).measurement_time(std::time::Duration::from_secs(3));
-    targets = bench_map_tier
+    targets = bench_map_tier, bench_build
 }
 criterion_main!(benches);

@@ -114,10 +114,11 @@ struct CaseOut<'a> {
 /// Run every case of the CSV file `path` and write one CSV row per case to `out`.
 ///
 /// Every row is read and checked before any contact runs, so a refused row leaves `out` empty.
-/// Rows that share a part and support share one compiled model, whose slide tables serve the μc
-/// values those rows use (`PartModel::with_slide_tables`: answers agree with the untabled solve
-/// within the tolerance, docs/physics.md); the contacts then run in parallel on rayon and are
-/// written in row order, so the output does not depend on the thread count.
+/// Rows that share a part and support share one compiled model, whose slide tables serve each μc
+/// value that at least [`TABLED_ROWS`] of those rows use (`PartModel::with_slide_tables`: answers
+/// agree with the untabled solve within the tolerance, docs/physics.md); the contacts then run in
+/// parallel on rayon and are written in row order, so the output does not depend on the thread
+/// count.
 pub fn run_batch<W: std::io::Write>(
     defaults: &BatchDefaults,
     path: &Path,
@@ -156,6 +157,19 @@ pub fn run_batch<W: std::io::Write>(
     Ok(())
 }
 
+/// Rows of one part and μc that pay for that μc's slide tables: building a part's tables costs
+/// about as much as 300–1 000 of its untabled contacts save (tripoly2, L-shape; `cargo bench
+/// --bench contact`, `contact_batch`), so smaller groups solve untabled.
+pub const TABLED_ROWS: usize = 500;
+
+/// The μc values of one part's rows that have at least [`TABLED_ROWS`] rows.
+fn tabled(mu: &[(f64, usize)]) -> Vec<f64> {
+    mu.iter()
+        .filter(|&&(_, n)| n >= TABLED_ROWS)
+        .map(|&(m, _)| m)
+        .collect()
+}
+
 /// Every case of the batch, checked, each with the index of its part's shared model.
 type Batch = (Vec<(Case, usize)>, Vec<(Polygon, PartModel)>);
 
@@ -169,7 +183,8 @@ fn read_batch(defaults: &BatchDefaults, path: &Path) -> Result<Batch, BatchError
         .from_reader(text.as_bytes());
     let mut index: std::collections::HashMap<String, usize> = Default::default();
     let mut models: Vec<(Polygon, PartModel)> = Vec::new();
-    let mut mu_values: Vec<Vec<f64>> = Vec::new();
+    // Per part, each μc value with its number of rows.
+    let mut mu_values: Vec<Vec<(f64, usize)>> = Vec::new();
     let mut cases = Vec::new();
     let args = defaults;
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;
@@ -237,15 +252,16 @@ fn read_batch(defaults: &BatchDefaults, path: &Path) -> Result<Batch, BatchError
             }
         };
         check_geometry_named(&c, &models[k].0, &name).map_err(row_err)?;
-        if !mu_values[k].contains(&c.mu_c) {
-            mu_values[k].push(c.mu_c);
+        match mu_values[k].iter_mut().find(|(m, _)| *m == c.mu_c) {
+            Some((_, n)) => *n += 1,
+            None => mu_values[k].push((c.mu_c, 1)),
         }
         cases.push((c, k));
     }
     let models = models
         .into_iter()
         .zip(&mu_values)
-        .map(|((poly, model), mu)| (poly, model.with_slide_tables(mu)))
+        .map(|((poly, model), mu)| (poly, model.with_slide_tables(&tabled(mu))))
         .collect();
     Ok((cases, models))
 }
@@ -277,10 +293,16 @@ mod tests {
     #[test]
     fn a_batch_agrees_with_single_runs_for_any_thread_count() {
         let mut rows = Vec::new();
-        for (part, mu) in [("tripoly1", 0.3), ("tripoly2", 0.5), ("tripoly2", 0.7)] {
-            for i in 0..12 {
-                let theta = 30.0 * i as f64 + 7.0;
-                let d = -0.6 + 0.1 * i as f64;
+        // One group large enough for tables, two solved untabled.
+        let groups = [
+            ("tripoly1", 0.3, 12),
+            ("tripoly2", 0.5, TABLED_ROWS),
+            ("tripoly2", 0.7, 12),
+        ];
+        for (part, mu, n) in groups {
+            for i in 0..n {
+                let theta = (137.5 * i as f64 + 7.0) % 360.0;
+                let d = -0.6 + 1.2 * ((i * 37 % n) as f64) / n as f64;
                 rows.push(format!("{part},{theta},{d},{mu}"));
             }
         }
@@ -290,6 +312,7 @@ mod tests {
         assert_eq!(one, two);
         let mut rdr = csv::Reader::from_reader(one.as_bytes());
         let mut n = 0;
+        let (mut tabled_evals, mut untabled_evals) = (0u64, 0u64);
         for (rec, row) in rdr.records().zip(&rows) {
             let rec = rec.unwrap();
             let f: Vec<&str> = row.split(',').collect();
@@ -302,9 +325,20 @@ mod tests {
             let diff = (batch - want + 180.0).rem_euclid(360.0) - 180.0;
             assert!(diff.abs() < 1e-4, "{row}: batch {batch}, single {want}");
             assert_eq!(&rec[15], single.status.name(), "{row}");
+            if c.part == "tripoly2" && c.mu_c == 0.5 {
+                tabled_evals += rec[14].parse::<u64>().unwrap();
+                untabled_evals += single.evaluations;
+            } else {
+                assert_eq!(rec[14].parse::<u64>().unwrap(), single.evaluations, "{row}");
+            }
             n += 1;
         }
         assert_eq!(n, rows.len());
+        // The large group's slides came from tables: far fewer model evaluations.
+        assert!(
+            2 * tabled_evals < untabled_evals,
+            "{tabled_evals} {untabled_evals}"
+        );
         std::fs::remove_file(&path).unwrap();
     }
 
