@@ -101,7 +101,7 @@ fn bench_build(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("query cell", |b| {
         b.iter(|| {
-            let loaded = tier::load_or_build_cells(&inputs, None, Some(&[cell]));
+            let loaded = tier::load_or_build_cells(&inputs, None, Some(&[cell]), &|_, _| {});
             black_box(loaded.map.stats.exact_samples)
         })
     });

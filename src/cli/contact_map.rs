@@ -6,7 +6,7 @@
 use super::contact::{case_of, ContactArgs};
 use crate::contact_case::report::report;
 use crate::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
-use crate::engine::contact_map::prepare;
+use crate::engine::contact_map::prepare_observed;
 use crate::geometry::{Pose, Vec2};
 use crate::maps::tier::{self, push_with_map, Loaded, TierInputs, TierSpec};
 use crate::mechanics::{ContactSettings, Fidelity, PartModel, Support};
@@ -32,7 +32,13 @@ pub fn prepare_maps(scene: &Scene, dir: Option<&Path>, quiet: bool) -> String {
         eprintln!("map tier: loading or building maps in {}", dir.display());
     }
     let started = Instant::now();
-    let prepared = prepare(scene, Some(&dir));
+    let bar = super::progress::bar(0, "base cells built", quiet);
+    let count = super::progress::counter(&bar);
+    let prepared = prepare_observed(scene, Some(&dir), &|j, done, total| {
+        bar.set_message(format!("map of obstacle {} ", j + 1));
+        count(done, total)
+    });
+    bar.finish_and_clear();
     let mut seen = BTreeSet::new();
     let mut text = String::new();
     for (_, loaded) in &prepared {
@@ -73,13 +79,11 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     let (pose, start) = case_geometry(&poly, &c);
     // Only the base cell of the query is built (and kept in the cache beside any built before).
     let loaded = load_tier(
-        &model,
-        &support,
-        c.pin_radius,
-        settings,
+        (&model, &support, c.pin_radius, settings),
         args.map_grid.as_deref(),
         args.cache_dir.as_deref(),
         Some(&[(pose, start)]),
+        args.json,
     )?;
     let started = Instant::now();
     let (out, why) = push_with_map(&loaded.map, &model, pose, start, c.pin_radius, &settings);
@@ -130,14 +134,13 @@ pub fn run(args: &ContactArgs) -> Result<()> {
 /// cells of `queries` (pose, pin start) when they are given; its warnings (a stale or corrupted
 /// file) go to standard error.
 pub fn load_tier(
-    model: &PartModel,
-    support: &Support,
-    radius: f64,
-    settings: ContactSettings,
+    inputs: (&PartModel, &Support, f64, ContactSettings),
     grid: Option<&str>,
     dir: Option<&Path>,
     queries: Option<&[(Pose, Vec2)]>,
+    quiet: bool,
 ) -> Result<Loaded> {
+    let (model, support, radius, settings) = inputs;
     let spec = match grid {
         Some(g) => TierSpec::parse_grid(g)?,
         None => TierSpec::default(),
@@ -154,7 +157,15 @@ pub fn load_tier(
             .filter_map(|&(pose, start)| tier::cell_of_query(&inputs, pose, start))
             .collect()
     });
-    let loaded = tier::load_or_build_cells(&inputs, Some(&cache_dir(dir)), cells.as_deref());
+    let bar = super::progress::bar(0, "base cells of the map built", quiet);
+    bar.set_message("map tier ");
+    let loaded = tier::load_or_build_cells(
+        &inputs,
+        Some(&cache_dir(dir)),
+        cells.as_deref(),
+        &super::progress::counter(&bar),
+    );
+    bar.finish_and_clear();
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }

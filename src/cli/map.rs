@@ -247,13 +247,11 @@ pub fn run(args: &MapArgs) -> Result<()> {
             crate::mechanics::Support::parse(&args.support, &poly).map_err(anyhow::Error::msg)?;
         let loaded = pool.install(|| {
             super::contact_map::load_tier(
-                &part_model,
-                &support,
-                args.pin_radius,
-                contact,
+                (&part_model, &support, args.pin_radius, contact),
                 args.map_grid.as_deref(),
                 args.cache_dir.as_deref(),
                 Some(&passes),
+                args.json || args.csv,
             )
         })?;
         Some(loaded)

@@ -44,6 +44,16 @@ fn inputs_for<'s>(scene: &'s Scene, radius: f64, mu_c: f64) -> Option<TierInputs
 /// Load or build the maps of every pin of a scene that uses the tier (nothing otherwise), from
 /// and into the cache folder `dir`; each pin with where its map came from.
 pub fn prepare(scene: &Scene, dir: Option<&Path>) -> Vec<(usize, Loaded)> {
+    prepare_observed(scene, dir, &|_, _, _| {})
+}
+
+/// [`prepare`], telling `progress` (pin number, base cells built, of those missing) as each
+/// pin's map is built.
+pub fn prepare_observed(
+    scene: &Scene,
+    dir: Option<&Path>,
+    progress: &(dyn Fn(usize, u64, u64) + Sync),
+) -> Vec<(usize, Loaded)> {
     scene
         .obstacles
         .iter()
@@ -52,7 +62,10 @@ pub fn prepare(scene: &Scene, dir: Option<&Path>) -> Vec<(usize, Loaded)> {
             Obstacle::Pin(p) => inputs_for(scene, p.radius, p.mu_c).map(|i| (j, i)),
             Obstacle::Fence(_) => None,
         })
-        .map(|(j, inputs)| (j, tier::shared(&inputs, dir)))
+        .map(|(j, inputs)| {
+            let report = |done, total| progress(j, done, total);
+            (j, tier::shared_observed(&inputs, dir, &report))
+        })
         .collect()
 }
 

@@ -561,7 +561,7 @@ fn cells_built_on_demand_answer_as_the_whole_map() {
         let d = (rng.random::<f64>() - 0.5) * 1.8;
         let (pose, pin) = query(theta, d);
         let cell = tier::cell_of_query(&a, pose, pin).expect("inside the d range");
-        let loaded = tier::load_or_build_cells(&a, Some(&dir), Some(&[cell]));
+        let loaded = tier::load_or_build_cells(&a, Some(&dir), Some(&[cell]), &|_, _| {});
         assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
         match (built.insert(cell), &loaded.source) {
             (true, Source::Built { cells, .. }) => assert_eq!(*cells, 1),
@@ -596,8 +596,15 @@ fn cells_built_on_demand_answer_as_the_whole_map() {
             );
         }
     }
-    // The rest, all at once: now whole, with the whole map's certified area.
-    let rest = tier::load_or_build_cells(&a, Some(&dir), None);
+    // The rest, all at once (in batches, counted): now whole, with the whole map's certified area.
+    let missing = 32 - built.len() as u64;
+    let seen = std::sync::Mutex::new(Vec::new());
+    let report = |done: u64, total: u64| seen.lock().unwrap().push((done, total));
+    let rest = tier::load_or_build_cells(&a, Some(&dir), None, &report);
+    let seen = seen.into_inner().unwrap();
+    assert_eq!(seen.first(), Some(&(0, missing)));
+    assert_eq!(seen.last(), Some(&(missing, missing)));
+    assert!(seen.windows(2).all(|w| w[0].0 <= w[1].0));
     assert!(rest.map.is_complete());
     assert!((rest.map.stats.certified_area - whole.stats.certified_area).abs() < 1e-12);
     assert_eq!(rest.map.stats.certified_cells, whole.stats.certified_cells);

@@ -210,6 +210,21 @@ pub fn build(inputs: &TierInputs) -> TierMap {
 /// sample sits on the lattice, and a cell is decided by its own points), so a map answers every
 /// query in a built cell the same way whichever other cells were built, in whatever order.
 pub fn extend(map: &mut TierMap, inputs: &TierInputs, roots: &[usize]) {
+    extend_observed(map, inputs, roots, &crate::progress::silent);
+}
+
+/// Base cells built per batch by [`extend_observed`]: enough for the samples of a refinement
+/// level to fill both cores, few enough for the progress to move.
+const CELLS_PER_BATCH: usize = 24;
+
+/// [`extend`], telling `progress` the base cells built of those asked for. The cells are built in
+/// batches of consecutive cells (θ-major), one after another, each batch in parallel.
+pub fn extend_observed(
+    map: &mut TierMap,
+    inputs: &TierInputs,
+    roots: &[usize],
+    progress: crate::progress::Report,
+) {
     let todo: BTreeSet<usize> = roots
         .iter()
         .copied()
@@ -224,6 +239,16 @@ pub fn extend(map: &mut TierMap, inputs: &TierInputs, roots: &[usize]) {
         model: &model,
         ..*inputs
     };
+    let todo: Vec<usize> = todo.into_iter().collect();
+    let tally = crate::progress::Tally::new(todo.len() as u64, progress);
+    for batch in todo.chunks(CELLS_PER_BATCH) {
+        build_cells(map, inputs, batch);
+        tally.add(batch.len() as u64);
+    }
+}
+
+/// Build the unbuilt base cells `todo` of `map` (the model of `inputs` already has its tables).
+fn build_cells(map: &mut TierMap, inputs: &TierInputs, todo: &[usize]) {
     let spec = inputs.spec;
     let per_cell = 1u64 << (spec.max_depth + 2);
     let (nt, nd) = (u64::from(spec.theta_cells), u64::from(spec.d_cells));
@@ -242,7 +267,7 @@ pub fn extend(map: &mut TierMap, inputs: &TierInputs, roots: &[usize]) {
             node: r,
         })
         .collect();
-    for &r in &todo {
+    for &r in todo {
         map.nodes[r] = Node::Fallback;
     }
     let mut at: BTreeMap<u64, Sample> = BTreeMap::new();

@@ -82,17 +82,19 @@ pub fn file_of(dir: &Path, key: &TierKey) -> PathBuf {
 /// Read the map of `inputs` from `dir` if a valid file is there, else build it and write it
 /// (`dir` None: build, no file). The whole map: every base cell.
 pub fn load_or_build(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
-    load_or_build_cells(inputs, dir, None)
+    load_or_build_cells(inputs, dir, None, &crate::progress::silent)
 }
 
 /// [`load_or_build`] for the base cells `cells` only (None: all): a file that holds them is
 /// used as it is; otherwise the missing ones are built into the map the file holds (or into an
 /// empty map) and the file is written again. A query in a built cell gets the same answer
-/// whichever other cells are built ([`super::build::extend`]).
+/// whichever other cells are built ([`super::build::extend`]). `progress` is told the base cells
+/// built of those missing.
 pub fn load_or_build_cells(
     inputs: &TierInputs,
     dir: Option<&Path>,
     cells: Option<&[usize]>,
+    progress: crate::progress::Report,
 ) -> Loaded {
     let key = TierKey::of(inputs);
     let mut warnings = Vec::new();
@@ -127,7 +129,7 @@ pub fn load_or_build_cells(
         };
     }
     let started = Instant::now();
-    super::build::extend(&mut map, inputs, &wanted);
+    super::build::extend_observed(&mut map, inputs, &wanted, progress);
     let seconds = started.elapsed().as_secs_f64();
     if let Some(path) = &file {
         if let Err(e) = write(path, &map) {
@@ -147,6 +149,15 @@ pub fn load_or_build_cells(
 
 /// [`load_or_build`], remembered in this process by key (a map is built or read once per run).
 pub fn shared(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
+    shared_observed(inputs, dir, &crate::progress::silent)
+}
+
+/// [`shared`], telling `progress` the base cells built of those missing.
+pub fn shared_observed(
+    inputs: &TierInputs,
+    dir: Option<&Path>,
+    progress: crate::progress::Report,
+) -> Loaded {
     static MEMO: OnceLock<Mutex<BTreeMap<TierKey, Arc<TierMap>>>> = OnceLock::new();
     let memo = MEMO.get_or_init(|| Mutex::new(BTreeMap::new()));
     let key = TierKey::of(inputs);
@@ -158,7 +169,7 @@ pub fn shared(inputs: &TierInputs, dir: Option<&Path>) -> Loaded {
             warnings: Vec::new(),
         };
     }
-    let loaded = load_or_build(inputs, dir);
+    let loaded = load_or_build_cells(inputs, dir, None, progress);
     memo.lock()
         .expect("map memo")
         .insert(key, loaded.map.clone());

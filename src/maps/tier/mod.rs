@@ -42,7 +42,8 @@ pub mod report;
 
 pub use build::build;
 pub use cache::{
-    default_cache_dir, load_or_build, load_or_build_cells, shared, CacheError, Loaded, Source,
+    default_cache_dir, load_or_build, load_or_build_cells, shared, shared_observed, CacheError,
+    Loaded, Source,
 };
 pub use key::TierKey;
 pub use query::{cell_of_query, push_with_map, Fallback};
