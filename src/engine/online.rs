@@ -688,7 +688,7 @@ fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, 
     };
     Ok(Entry {
         x: 0.0,
-        theta: theta_deg.to_radians().rem_euclid(std::f64::consts::TAU),
+        theta_rad: theta_deg.to_radians().rem_euclid(std::f64::consts::TAU),
         y,
         model,
     })
@@ -810,7 +810,11 @@ impl Staging {
     /// [`Staging::prefix_of_actions`] maps them), and the line runs it took.
     fn success(&self, mu: usize, e: &Entry) -> Result<(Vec<bool>, [u64; 2]), String> {
         use std::collections::HashMap;
-        let mut states = vec![Cont::Going(crate::geometry::Pose::new(e.x, e.y, e.theta))];
+        let mut states = vec![Cont::Going(crate::geometry::Pose::new(
+            e.x,
+            e.y,
+            e.theta_rad,
+        ))];
         let mut prefix: Vec<usize> = vec![0];
         let mut runs = [0, 0];
         for (s, stage) in self.scenes.iter().enumerate() {
@@ -839,7 +843,7 @@ impl Staging {
                         for per_mu in stage {
                             runs[0] += 1;
                             let entry = Entry {
-                                theta: pose.theta,
+                                theta_rad: pose.theta,
                                 y: pose.y,
                                 x: pose.x,
                                 model: e.model.clone(),

@@ -18,7 +18,7 @@ pub struct PartDraw {
     /// Seconds between the previous part's arrival and this one's (Poisson), or the headway.
     pub gap: f64,
     /// Entry orientation θ (radians, [0, 2π)).
-    pub theta: f64,
+    pub theta_rad: f64,
     /// Entry lateral offset of the centroid (m).
     pub y: f64,
     /// The part's own contact model (random tripod), when the scene asks for one.
@@ -76,7 +76,7 @@ pub fn draw_part(scene: &Scene, seed: u64, index: u64) -> Result<PartDraw, Strin
     };
     Ok(PartDraw {
         gap,
-        theta,
+        theta_rad: theta,
         y,
         model,
     })
