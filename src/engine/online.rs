@@ -597,7 +597,9 @@ fn sensor_signals(
 fn hypotheses(scene: &Scene, spec: &BeliefSpec) -> (Vec<Hypothesis>, Vec<f64>) {
     let states: Vec<(f64, f64)> = match &scene.feed.orientation {
         Orientation::Stable {
-            thetas, weights, ..
+            thetas_rad: thetas,
+            weights,
+            ..
         } => thetas
             .iter()
             .zip(weights)
@@ -668,7 +670,9 @@ fn offset_bins(lateral: &Lateral, n: usize) -> Vec<(f64, f64, f64)> {
 fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, String> {
     let mut rng = stream(scene.seed, MEMBER_STREAMS | ((h as u64) << 16) | m as u64);
     let theta_deg = match &scene.feed.orientation {
-        Orientation::Stable { jitter, .. } => {
+        Orientation::Stable {
+            jitter_rad: jitter, ..
+        } => {
             let z: f64 = StandardNormal.sample(&mut rng);
             hyp.state_deg + jitter.to_degrees() * z
         }

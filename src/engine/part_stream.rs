@@ -48,9 +48,9 @@ pub fn draw_part(scene: &Scene, seed: u64, index: u64) -> Result<PartDraw, Strin
     let theta = match &scene.feed.orientation {
         Orientation::Uniform => std::f64::consts::TAU * rng.random::<f64>(),
         Orientation::Stable {
-            thetas,
+            thetas_rad: thetas,
             weights,
-            jitter,
+            jitter_rad: jitter,
         } => {
             let u: f64 = rng.random();
             let mut acc = 0.0;

@@ -410,9 +410,9 @@ fn feed_orientation(c: &Checker, rf: &RawFeed, stable_states: &[StableState]) ->
                 return Err(c.err("feed.weights", "at least one weight must be positive"));
             }
             Ok(Orientation::Stable {
-                thetas,
+                thetas_rad: thetas,
                 weights: weights.iter().map(|w| w / total).collect(),
-                jitter,
+                jitter_rad: jitter,
             })
         }
     }

@@ -63,11 +63,11 @@ impl Arrival {
 pub enum Orientation {
     /// θ uniform on [0, 2π).
     Uniform,
-    /// A stable state chosen with the given (normalised) weights, plus normal jitter.
+    /// A stable state chosen with the given (normalised) weights, plus normal jitter (its sd).
     Stable {
-        thetas: Vec<f64>,
+        thetas_rad: Vec<f64>,
         weights: Vec<f64>,
-        jitter: f64,
+        jitter_rad: f64,
     },
 }
 

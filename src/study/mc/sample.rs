@@ -809,9 +809,9 @@ pub fn draw_scene(
             headway: base.feed.arrival.headway(),
         },
         orientation: Orientation::Stable {
-            thetas: vec![crate::geometry::wrap_2pi(theta)],
+            thetas_rad: vec![crate::geometry::wrap_2pi(theta)],
             weights: vec![1.0],
-            jitter: 0.0,
+            jitter_rad: 0.0,
         },
         lateral: Lateral::Fixed(y),
     };
