@@ -177,7 +177,7 @@ pub fn run_batch<W: std::io::Write>(
             pin_radius: c.pin_radius,
             mu_s: c.mu_s,
             contact: out.contact,
-            theta_final_deg: wrap_deg(out.pose_final.theta.to_degrees()),
+            theta_final_deg: wrap_deg(out.pose_final.theta_rad.to_degrees()),
             rotation_deg: out.rotation.to_degrees(),
             com_final_x: out.pose_final.x,
             com_final_y: out.pose_final.y,

@@ -522,7 +522,7 @@ impl Line<'_> {
             return;
         }
         let end = plan.outcome.pose_final;
-        let pose = Pose::new(end.x + plan.s_end, end.y, end.theta);
+        let pose = Pose::new(end.x + plan.s_end, end.y, end.theta_rad);
         if let Some(path) = part.path.as_mut() {
             path.push((t, pose));
         }
@@ -547,7 +547,7 @@ impl Line<'_> {
             return;
         };
         let pose = part.motion.world_pose(t, self.speed());
-        let outcome = if self.scene.goal.matching_set(pose.theta).is_some() {
+        let outcome = if self.scene.goal.matching_set(pose.theta_rad).is_some() {
             PartOutcome::Success
         } else {
             PartOutcome::WrongOrientation
@@ -561,7 +561,7 @@ impl Line<'_> {
             return;
         };
         let pose = part.motion.world_pose(t, self.speed());
-        let theta_deg = wrap_deg(pose.theta.to_degrees());
+        let theta_deg = wrap_deg(pose.theta_rad.to_degrees());
         self.last_end = Some((outcome, pose));
         self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
         if let Some(c) = self.control.as_mut() {

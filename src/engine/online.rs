@@ -834,7 +834,7 @@ impl Staging {
                 match c {
                     Cont::Done(b) => *done[usize::from(b)].get_or_insert_with(push),
                     Cont::Going(p) => *seen
-                        .entry((p.x.to_bits(), p.y.to_bits(), p.theta.to_bits()))
+                        .entry((p.x.to_bits(), p.y.to_bits(), p.theta_rad.to_bits()))
                         .or_insert_with(push),
                 }
             };
@@ -847,7 +847,7 @@ impl Staging {
                         for per_mu in stage {
                             runs[0] += 1;
                             let entry = Entry {
-                                theta_rad: pose.theta,
+                                theta_rad: pose.theta_rad,
                                 y: pose.y,
                                 x: pose.x,
                                 model: e.model.clone(),
