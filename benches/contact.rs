@@ -44,7 +44,7 @@ fn bench_contacts(c: &mut Criterion) {
                             &settings,
                             None,
                         );
-                        acc += o.pose_final.theta;
+                        acc += o.pose_final.theta_rad;
                     }
                     black_box(acc)
                 })

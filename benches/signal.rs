@@ -41,7 +41,7 @@ fn bench_signal(c: &mut Criterion) {
                 let start = Vec2::new(1.01 * a, d * a);
                 if mode == 0 {
                     let o = push(&model, pose, start, &Pin::point(), &settings, None);
-                    acc += o.pose_final.theta;
+                    acc += o.pose_final.theta_rad;
                     continue;
                 }
                 let mut rec = KnotRecorder::default();
@@ -54,7 +54,7 @@ fn bench_signal(c: &mut Criterion) {
                     Some(&mut rec),
                 );
                 let signal = ContactSignal::new(&o, &rec.samples, &scale);
-                acc += o.pose_final.theta + signal.duration();
+                acc += o.pose_final.theta_rad + signal.duration();
                 if mode == 2 {
                     if let Some(r) = sample_ft(&signal, &sensor, &mut stream(1, i as u64)) {
                         acc += r.values.len() as f64;

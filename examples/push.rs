@@ -30,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "rotation: {:+.2}°, final orientation {:.2}°",
         out.rotation.to_degrees(),
-        pinfeed::geometry::wrap_deg(out.pose_final.theta.to_degrees())
+        pinfeed::geometry::wrap_deg(out.pose_final.theta_rad.to_degrees())
     );
     println!(
         "pin travel to contact {:.4} m, in contact over {:.4} m, {} segment(s)",

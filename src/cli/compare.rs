@@ -49,9 +49,9 @@ pub fn feed_line(file: &str, source: &FeedSource, parts: u64) -> String {
     let orientation = match &feed.orientation {
         Orientation::Uniform => "uniform on [0°, 360°)".to_string(),
         Orientation::Stable {
-            thetas,
+            thetas_rad: thetas,
             weights,
-            jitter,
+            jitter_rad: jitter,
         } => {
             let states: Vec<String> = thetas
                 .iter()

@@ -90,7 +90,7 @@ pub fn run(args: &PartArgs) -> Result<()> {
         stable_states_deg: poly
             .stable_states()
             .iter()
-            .map(|s| s.theta.to_degrees())
+            .map(|s| s.theta_rad.to_degrees())
             .collect(),
         part_frame_vertices: poly.vertices().iter().map(|p| [p.x, p.y]).collect(),
     };

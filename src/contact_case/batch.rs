@@ -143,7 +143,7 @@ pub fn run_batch<W: std::io::Write>(
             pin_radius: c.pin_radius,
             mu_s: c.mu_s,
             contact: out.contact,
-            theta_final_deg: wrap_deg(out.pose_final.theta.to_degrees()),
+            theta_final_deg: wrap_deg(out.pose_final.theta_rad.to_degrees()),
             rotation_deg: out.rotation.to_degrees(),
             com_final_x: out.pose_final.x,
             com_final_y: out.pose_final.y,
@@ -321,7 +321,7 @@ mod tests {
             let (poly, model) = compile_part(&c.part, &c.support).unwrap();
             let (single, _) = run_compiled(&c, &poly, &model, false);
             let batch: f64 = rec[8].parse().unwrap();
-            let want = wrap_deg(single.pose_final.theta.to_degrees());
+            let want = wrap_deg(single.pose_final.theta_rad.to_degrees());
             let diff = (batch - want + 180.0).rem_euclid(360.0) - 180.0;
             assert!(diff.abs() < 1e-4, "{row}: batch {batch}, single {want}");
             assert_eq!(&rec[15], single.status.name(), "{row}");

@@ -92,7 +92,8 @@ impl Line<'_> {
         part.grazes = 0;
         let mut reading = None;
         if let Some(sensor) = sensor {
-            let (decision, sensed) = self.sense(index, j, sensor, &out, &knots.samples, pose.theta);
+            let (decision, sensed) =
+                self.sense(index, j, sensor, &out, &knots.samples, pose.theta_rad);
             part.sensed.push((j, decision));
             reading = Some(sensed);
         }
@@ -361,7 +362,7 @@ pub(super) fn sweep_neighbours(
             },
             &|ta, tb| {
                 let (p, q) = (held.world_pose(ta, v), held.world_pose(tb, v));
-                (q.position() - p.position()).norm() + a * (q.theta - p.theta).abs()
+                (q.position() - p.position()).norm() + a * (q.theta_rad - p.theta_rad).abs()
             },
             1e-6 * a,
             &mut evals,

@@ -119,7 +119,7 @@ pub(super) struct Line<'a> {
 #[derive(Debug, Clone)]
 pub struct Entry {
     /// Orientation at entry (radians).
-    pub theta: f64,
+    pub theta_rad: f64,
     /// Lateral offset of the centroid at entry (m).
     pub y: f64,
     /// Position of the centroid along the belt at entry (m; 0 is the line's start). The part
@@ -383,7 +383,7 @@ impl Line<'_> {
                 x0 = e.x;
                 super::part_stream::PartDraw {
                     gap: 0.0,
-                    theta: e.theta,
+                    theta_rad: e.theta_rad,
                     y: e.y,
                     model: e.model,
                 }
@@ -403,10 +403,10 @@ impl Line<'_> {
             self.queue
                 .schedule(next, EventKind::Arrival { part: index + 1 });
         }
-        let pose = Pose::new(x0, d.y, d.theta);
+        let pose = Pose::new(x0, d.y, d.theta_rad);
         let mut part = ActivePart {
             arrival: t,
-            theta_in: d.theta,
+            theta_in: d.theta_rad,
             y_in: d.y,
             motion: Motion::Free {
                 t0: t,
@@ -522,7 +522,7 @@ impl Line<'_> {
             return;
         }
         let end = plan.outcome.pose_final;
-        let pose = Pose::new(end.x + plan.s_end, end.y, end.theta);
+        let pose = Pose::new(end.x + plan.s_end, end.y, end.theta_rad);
         if let Some(path) = part.path.as_mut() {
             path.push((t, pose));
         }
@@ -547,7 +547,7 @@ impl Line<'_> {
             return;
         };
         let pose = part.motion.world_pose(t, self.speed());
-        let outcome = if self.scene.goal.matching_set(pose.theta).is_some() {
+        let outcome = if self.scene.goal.matching_set(pose.theta_rad).is_some() {
             PartOutcome::Success
         } else {
             PartOutcome::WrongOrientation
@@ -561,7 +561,7 @@ impl Line<'_> {
             return;
         };
         let pose = part.motion.world_pose(t, self.speed());
-        let theta_deg = wrap_deg(pose.theta.to_degrees());
+        let theta_deg = wrap_deg(pose.theta_rad.to_degrees());
         self.last_end = Some((outcome, pose));
         self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
         if let Some(c) = self.control.as_mut() {

@@ -154,7 +154,7 @@ impl ContactPlan {
             return Pose::new(
                 p0.x + u * (p1.x - p0.x),
                 p0.y + u * (p1.y - p0.y),
-                p0.theta + u * (p1.theta - p0.theta),
+                p0.theta_rad + u * (p1.theta_rad - p0.theta_rad),
             );
         };
         let i = tr.partition_point(|(si, _)| *si <= s);
@@ -170,7 +170,7 @@ impl ContactPlan {
         Pose::new(
             p0.x + u * (p1.x - p0.x),
             p0.y + u * (p1.y - p0.y),
-            p0.theta + u * (p1.theta - p0.theta),
+            p0.theta_rad + u * (p1.theta_rad - p0.theta_rad),
         )
     }
 
@@ -218,12 +218,12 @@ impl Motion {
     pub fn world_pose(&self, t: f64, speed: f64) -> Pose {
         match self {
             Motion::Free { t0, pose, .. } => {
-                Pose::new(pose.x + speed * (t - t0), pose.y, pose.theta)
+                Pose::new(pose.x + speed * (t - t0), pose.y, pose.theta_rad)
             }
             Motion::Held(p) => {
                 let s = p.travel_at(t, speed);
                 let b = p.belt_pose(s);
-                Pose::new(b.x + s, b.y, b.theta)
+                Pose::new(b.x + s, b.y, b.theta_rad)
             }
         }
     }
@@ -232,6 +232,6 @@ impl Motion {
     /// differences matter). Free parts are still in it; held parts move.
     pub fn belt_pose(&self, t: f64, speed: f64) -> Pose {
         let w = self.world_pose(t, speed);
-        Pose::new(w.x - speed * t, w.y, w.theta)
+        Pose::new(w.x - speed * t, w.y, w.theta_rad)
     }
 }

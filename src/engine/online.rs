@@ -597,7 +597,9 @@ fn sensor_signals(
 fn hypotheses(scene: &Scene, spec: &BeliefSpec) -> (Vec<Hypothesis>, Vec<f64>) {
     let states: Vec<(f64, f64)> = match &scene.feed.orientation {
         Orientation::Stable {
-            thetas, weights, ..
+            thetas_rad: thetas,
+            weights,
+            ..
         } => thetas
             .iter()
             .zip(weights)
@@ -668,7 +670,9 @@ fn offset_bins(lateral: &Lateral, n: usize) -> Vec<(f64, f64, f64)> {
 fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, String> {
     let mut rng = stream(scene.seed, MEMBER_STREAMS | ((h as u64) << 16) | m as u64);
     let theta_deg = match &scene.feed.orientation {
-        Orientation::Stable { jitter, .. } => {
+        Orientation::Stable {
+            jitter_rad: jitter, ..
+        } => {
             let z: f64 = StandardNormal.sample(&mut rng);
             hyp.state_deg + jitter.to_degrees() * z
         }
@@ -688,7 +692,7 @@ fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, 
     };
     Ok(Entry {
         x: 0.0,
-        theta: theta_deg.to_radians().rem_euclid(std::f64::consts::TAU),
+        theta_rad: theta_deg.to_radians().rem_euclid(std::f64::consts::TAU),
         y,
         model,
     })
@@ -810,7 +814,11 @@ impl Staging {
     /// [`Staging::prefix_of_actions`] maps them), and the line runs it took.
     fn success(&self, mu: usize, e: &Entry) -> Result<(Vec<bool>, [u64; 2]), String> {
         use std::collections::HashMap;
-        let mut states = vec![Cont::Going(crate::geometry::Pose::new(e.x, e.y, e.theta))];
+        let mut states = vec![Cont::Going(crate::geometry::Pose::new(
+            e.x,
+            e.y,
+            e.theta_rad,
+        ))];
         let mut prefix: Vec<usize> = vec![0];
         let mut runs = [0, 0];
         for (s, stage) in self.scenes.iter().enumerate() {
@@ -826,7 +834,7 @@ impl Staging {
                 match c {
                     Cont::Done(b) => *done[usize::from(b)].get_or_insert_with(push),
                     Cont::Going(p) => *seen
-                        .entry((p.x.to_bits(), p.y.to_bits(), p.theta.to_bits()))
+                        .entry((p.x.to_bits(), p.y.to_bits(), p.theta_rad.to_bits()))
                         .or_insert_with(push),
                 }
             };
@@ -839,7 +847,7 @@ impl Staging {
                         for per_mu in stage {
                             runs[0] += 1;
                             let entry = Entry {
-                                theta: pose.theta,
+                                theta_rad: pose.theta_rad,
                                 y: pose.y,
                                 x: pose.x,
                                 model: e.model.clone(),

@@ -110,7 +110,7 @@ fn first_overlap(
     let belt_motion = |m: &Motion, ta: f64, tb: f64| -> f64 {
         let (p, q) = (m.world_pose(ta, v), m.world_pose(tb, v));
         let d = q.position() - p.position() - Vec2::new(v * (tb - ta), 0.0);
-        d.norm() + a * (q.theta - p.theta).abs()
+        d.norm() + a * (q.theta_rad - p.theta_rad).abs()
     };
     let (mut wa, mut wb) = (Vec::new(), Vec::new());
     first_touch(

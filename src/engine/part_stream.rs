@@ -18,7 +18,7 @@ pub struct PartDraw {
     /// Seconds between the previous part's arrival and this one's (Poisson), or the headway.
     pub gap: f64,
     /// Entry orientation θ (radians, [0, 2π)).
-    pub theta: f64,
+    pub theta_rad: f64,
     /// Entry lateral offset of the centroid (m).
     pub y: f64,
     /// The part's own contact model (random tripod), when the scene asks for one.
@@ -48,9 +48,9 @@ pub fn draw_part(scene: &Scene, seed: u64, index: u64) -> Result<PartDraw, Strin
     let theta = match &scene.feed.orientation {
         Orientation::Uniform => std::f64::consts::TAU * rng.random::<f64>(),
         Orientation::Stable {
-            thetas,
+            thetas_rad: thetas,
             weights,
-            jitter,
+            jitter_rad: jitter,
         } => {
             let u: f64 = rng.random();
             let mut acc = 0.0;
@@ -76,7 +76,7 @@ pub fn draw_part(scene: &Scene, seed: u64, index: u64) -> Result<PartDraw, Strin
     };
     Ok(PartDraw {
         gap,
-        theta,
+        theta_rad: theta,
         y,
         model,
     })

@@ -71,7 +71,7 @@ pub fn first_contact(
     min_travel: f64,
 ) -> Option<FirstContact> {
     let p = pose.apply_inverse(start);
-    let d = dir.rotate(-pose.theta).normalized();
+    let d = dir.rotate(-pose.theta_rad).normalized();
     let scale = poly.radius();
     let tol_t = 1e-12 * scale;
     let m = poly.len();
@@ -176,7 +176,7 @@ pub fn first_contact(
         point: pose.apply(point),
         pin_centre: pose.apply(centre),
         feature,
-        normal: normal.rotate(pose.theta),
+        normal: normal.rotate(pose.theta_rad),
         grazing,
     })
 }

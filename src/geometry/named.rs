@@ -293,7 +293,7 @@ mod tests {
         let p = part_from_spec("ngon:5").unwrap();
         let s = p.stable_states();
         assert_eq!(s.len(), 5);
-        assert!(s[0].theta.abs() < 1e-12);
+        assert!(s[0].theta_rad.abs() < 1e-12);
     }
 
     #[test]

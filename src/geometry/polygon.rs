@@ -91,8 +91,9 @@ fn edge_data(vertices: &[Vec2]) -> (Vec<Vec2>, Vec<f64>) {
 /// A stable state of a part: orientation and the hull edge it rests on.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct StableState {
-    /// Orientation θ in radians, in [0, 2π).
-    pub theta: f64,
+    /// Orientation θ in radians, in [0, 2π) (serialized as `theta`).
+    #[serde(rename = "theta")]
+    pub theta_rad: f64,
     /// Index of the hull edge (into [`Polygon::hull`]) whose outward normal points along −y.
     pub hull_edge: usize,
     /// Distance from the centroid to that edge (the radius function's local minimum).
@@ -586,7 +587,7 @@ impl Polygon {
     /// [`Polygon::world_vertices`] into a buffer the caller reuses (one sine and cosine per call;
     /// the same values, bit for bit, as `pose.apply` of each vertex).
     pub fn world_vertices_into(&self, pose: &super::vec2::Pose, out: &mut Vec<Vec2>) {
-        let (s, c) = pose.theta.sin_cos();
+        let (s, c) = pose.theta_rad.sin_cos();
         let at = pose.position();
         out.clear();
         out.extend(self.vertices.iter().map(|&p| p.rotate_sc(s, c) + at));
@@ -627,12 +628,12 @@ impl Polygon {
             let theta = wrap_2pi(-std::f64::consts::FRAC_PI_2 - outward.angle());
             let height = a.dot(outward);
             out.push(StableState {
-                theta,
+                theta_rad: theta,
                 hull_edge: i,
                 height,
             });
         }
-        out.sort_by(|x, y| x.theta.total_cmp(&y.theta));
+        out.sort_by(|x, y| x.theta_rad.total_cmp(&y.theta_rad));
         out
     }
 
@@ -738,7 +739,7 @@ mod tests {
         assert!(p.offset().norm() < 1e-12);
         assert!(p.is_convex());
         assert!((p.radius() - (1.5f64.powi(2) + 0.25).sqrt()).abs() < 1e-12);
-        let s: Vec<f64> = p.stable_states().iter().map(|s| deg(s.theta)).collect();
+        let s: Vec<f64> = p.stable_states().iter().map(|s| deg(s.theta_rad)).collect();
         assert_eq!(s.len(), 3);
         for (got, want) in s.iter().zip([0.0, 135.0, 225.0]) {
             assert!((got - want).abs() < 1e-9, "{got} vs {want}");
@@ -855,7 +856,7 @@ mod tests {
             let thetas = |x: &Polygon| {
                 x.stable_states()
                     .iter()
-                    .map(|s| s.theta)
+                    .map(|s| s.theta_rad)
                     .collect::<Vec<_>>()
             };
             assert_eq!(thetas(&q), thetas(&p));

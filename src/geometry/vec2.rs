@@ -147,17 +147,19 @@ impl Neg for Vec2 {
     }
 }
 
-/// A planar pose: position of the part's centroid and rotation θ of the part frame (radians).
+/// A planar pose: position of the part's centroid and rotation θ of the part frame (radians;
+/// serialized as `theta`).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Pose {
     pub x: f64,
     pub y: f64,
-    pub theta: f64,
+    #[serde(rename = "theta")]
+    pub theta_rad: f64,
 }
 
 impl Pose {
-    pub const fn new(x: f64, y: f64, theta: f64) -> Self {
-        Pose { x, y, theta }
+    pub const fn new(x: f64, y: f64, theta_rad: f64) -> Self {
+        Pose { x, y, theta_rad }
     }
     #[inline]
     pub fn position(&self) -> Vec2 {
@@ -166,12 +168,12 @@ impl Pose {
     /// Map a point from the part frame to the world frame.
     #[inline]
     pub fn apply(&self, p: Vec2) -> Vec2 {
-        p.rotate(self.theta) + self.position()
+        p.rotate(self.theta_rad) + self.position()
     }
     /// Map a point from the world frame to the part frame.
     #[inline]
     pub fn apply_inverse(&self, q: Vec2) -> Vec2 {
-        (q - self.position()).rotate(-self.theta)
+        (q - self.position()).rotate(-self.theta_rad)
     }
 }
 
@@ -210,6 +212,14 @@ pub fn wrap_pi(a: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pose_is_written_and_read_with_the_key_theta() {
+        let p = Pose::new(1.0, 2.0, 0.5);
+        let v = serde_json::to_value(p).unwrap();
+        assert_eq!(v, serde_json::json!({"x": 1.0, "y": 2.0, "theta": 0.5}));
+        assert_eq!(serde_json::from_value::<Pose>(v).unwrap(), p);
+    }
 
     #[test]
     fn pose_round_trip() {

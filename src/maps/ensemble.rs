@@ -214,7 +214,7 @@ impl InputState {
 pub fn stable_states_deg(poly: &Polygon) -> Vec<f64> {
     poly.stable_states()
         .iter()
-        .map(|s| s.theta.to_degrees())
+        .map(|s| s.theta_rad.to_degrees())
         .collect()
 }
 

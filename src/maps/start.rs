@@ -89,7 +89,7 @@ mod tests {
         let a = poly.radius();
         let (pose, pin) = pass_start(&poly, 30.0, -0.3, 0.2);
         assert_eq!((pose.x, pose.y), (0.0, 0.0));
-        assert!((pose.theta - 30f64.to_radians()).abs() < 1e-15);
+        assert!((pose.theta_rad - 30f64.to_radians()).abs() < 1e-15);
         assert!(pin.x - 0.2 > a, "pin disc must start clear of the part");
         assert!((pin.y - (-0.3 * a)).abs() < 1e-15);
     }

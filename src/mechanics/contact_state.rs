@@ -415,7 +415,7 @@ impl Ctx<'_, '_> {
         let k = self.scale;
         let sample = TraceSample {
             s: s * k,
-            pose: Pose::new(pose.x * k, pose.y * k, pose.theta),
+            pose: Pose::new(pose.x * k, pose.y * k, pose.theta_rad),
             pin_centre: self.pin_at(s) * k,
             contact_point: pose.apply(g.p) * k,
             force: self.to_world(inst.force, y[0]) * self.mu_s,
@@ -437,7 +437,7 @@ pub(super) fn initial_state(
     feature: Feature,
     normal_world: Vec2,
 ) -> (Feat, [f64; 2]) {
-    let theta = pose.theta;
+    let theta = pose.theta_rad;
     match feature {
         Feature::Edge { index, t } => {
             let (a, b) = ctx.poly.edge(index);

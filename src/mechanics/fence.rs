@@ -348,9 +348,11 @@ pub(super) fn next_fence_touch(
 ) -> Option<(f64, Feat, [f64; 2])> {
     match first_touch(ctx.poly, cur, f, ctx.vdir, s_from)? {
         (t, FenceTouch::LineVertex { k, sigma }) => {
-            Some((t, Feat::FenceVertex(k), [cur.theta, sigma]))
+            Some((t, Feat::FenceVertex(k), [cur.theta_rad, sigma]))
         }
-        (t, FenceTouch::LineEdge { k, sigma }) => Some((t, Feat::FenceEdge(k), [cur.theta, sigma])),
+        (t, FenceTouch::LineEdge { k, sigma }) => {
+            Some((t, Feat::FenceEdge(k), [cur.theta_rad, sigma]))
+        }
         (t, FenceTouch::End { end, feature }) => {
             ctx.start = if end == 0 { f.p0 } else { f.p1() };
             let n = ctx.vdir.normalized();

@@ -124,7 +124,7 @@ pub(crate) fn untouched(pose: Pose, status: ContactStatus) -> ContactOutcome {
 /// Run the passes of one obstacle over the part until it no longer touches it.
 fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactOutcome {
     let k = ctx.scale;
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta_rad);
     let mut out = untouched(pose, ContactStatus::Ok);
     let mut s = 0.0;
     let mut cur = pose_n;
@@ -148,7 +148,7 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
         }
         out.contacts += 1;
         let (end, s_end, pose_end) = integrate_contact(ctx, settings, s_touch, feat, y, &mut segs);
-        if ![s_end, pose_end.x, pose_end.y, pose_end.theta]
+        if ![s_end, pose_end.x, pose_end.y, pose_end.theta_rad]
             .iter()
             .all(|v| v.is_finite())
         {
@@ -156,7 +156,7 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
             out.status = non_finite(s_touch, k);
             break;
         }
-        segs.close(s_end, pose_end.theta, k);
+        segs.close(s_end, pose_end.theta_rad, k);
         out.contact_length += (s_end - s_touch) * k;
         s = s_end;
         cur = pose_end;
@@ -170,8 +170,8 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
     }
     out.contact = out.contacts > 0;
     out.segments = segs.list;
-    out.pose_final = Pose::new(cur.x * k, cur.y * k, cur.theta);
-    out.rotation = cur.theta - pose.theta;
+    out.pose_final = Pose::new(cur.x * k, cur.y * k, cur.theta_rad);
+    out.rotation = cur.theta_rad - pose.theta_rad;
     out.evaluations = ctx.evals;
     out.steps = segs.steps;
     out
@@ -222,7 +222,7 @@ pub fn push_path(
     let k = model.scale();
     let mut ctx = pin_ctx(model, pin_start, radius, path, settings, recorder);
     // The pin must start clear of the part.
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta_rad);
     let local = pose_n.apply_inverse(ctx.start);
     if ctx.poly.contains(local) || ctx.poly.distance_to_boundary(local).0 < ctx.rho * (1.0 - 1e-12)
     {
@@ -268,7 +268,7 @@ pub fn pin_first_touch(
     let k = model.scale();
     let settings = ContactSettings::default();
     let mut ctx = pin_ctx(model, pin_start, radius, path, &settings, None);
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta_rad);
     match next_touch(&mut ctx, &pose_n, 0.0, false) {
         Touch::At(s, ..) => Some(s * k),
         Touch::Stop(ContactStatus::MultiContact { s }) => Some(s),
@@ -348,7 +348,7 @@ pub fn first_instant(
     settings: &ContactSettings,
 ) -> Option<(ContactGeom, Instant)> {
     let k = model.scale();
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta_rad);
     let path = PinPath::constant(pin.lateral_speed);
     let mut ctx = pin_ctx(model, pin_start, pin.radius, &path, settings, None);
     let dir = ctx.vdir.normalized();
@@ -367,7 +367,7 @@ pub fn first_instant(
 pub fn fence_first_touch(model: &PartModel, pose: Pose, fence: &FenceSpec) -> Option<f64> {
     let k = model.scale();
     let geom = FenceGeom::new(fence, k);
-    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta);
+    let pose_n = Pose::new(pose.x / k, pose.y / k, pose.theta_rad);
     first_touch(model.hull(), &pose_n, &geom, Vec2::new(-1.0, 0.0), 0.0).map(|(s, _)| s * k)
 }
 

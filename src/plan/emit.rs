@@ -338,3 +338,87 @@ pub fn contingent_toml(
     t += &goal_and_model(problem, plan.centre_deg, symmetry);
     (t, rules)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::fences::FenceAction;
+    use crate::plan::particles::{State, Window};
+    use crate::plan::search::PlanStep;
+
+    /// A best-effort fence plan whose lost particles alone miss the target: its sets are
+    /// `usize::MAX`, which the scenario's comments and the JSON must not print as a number.
+    #[test]
+    fn unbounded_sets_read_as_a_word_in_the_scenario_and_null_in_json() {
+        let problem = Problem::new("tripoly2");
+        let window = Window {
+            centre_deg: 10.0,
+            inside: 1,
+            share: 0.5,
+        };
+        let fence = FenceAction {
+            angle_deg: 25.0,
+            y0_m: -0.02,
+            y1_m: 0.02,
+            length_m: 0.1,
+            mu_f: 0.5,
+            lo_m: -0.03,
+            hi_m: -0.01,
+            margin_m: 0.01,
+            max_lag_m: 0.0,
+        };
+        let state = State::canonical(vec![], 1);
+        let plan = Plan {
+            initial: state.clone(),
+            initial_window: window,
+            initial_sets: usize::MAX,
+            steps: vec![
+                PlanStep {
+                    action: Action::Fence(fence),
+                    state: state.clone(),
+                    window,
+                    sets: 2,
+                },
+                PlanStep {
+                    action: Action::Fence(FenceAction {
+                        angle_deg: -25.0,
+                        ..fence
+                    }),
+                    state,
+                    window,
+                    sets: usize::MAX,
+                },
+            ],
+            window,
+            predicted_success: 0.5,
+            sets: usize::MAX,
+        };
+        let line = LineSpec {
+            name: "t".into(),
+            headway_s: 4.0,
+            belt_width_m: 0.12,
+            parts: 10,
+        };
+        let toml = sequence_toml(&problem, &plan, 3, 1, &line);
+        assert!(!toml.contains(&usize::MAX.to_string()), "{toml}");
+        let comments: Vec<&str> = toml.lines().filter(|l| l.contains("after it:")).collect();
+        assert_eq!(comments.len(), 2, "{toml}");
+        assert!(
+            comments[0].contains("after it: 2 set(s)"),
+            "{}",
+            comments[0]
+        );
+        assert!(
+            comments[1].contains("after it: sets unbounded"),
+            "{}",
+            comments[1]
+        );
+        let json = serde_json::to_value(&plan).unwrap();
+        assert!(
+            json["sets"].is_null() && json["initial_sets"].is_null(),
+            "{json}"
+        );
+        assert_eq!(json["steps"][0]["sets"], 2);
+        assert!(json["steps"][1]["sets"].is_null(), "{json}");
+    }
+}

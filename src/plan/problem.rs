@@ -373,7 +373,7 @@ impl Problem {
         let stable: Vec<f64> = unit
             .stable_states()
             .iter()
-            .map(|s| s.theta.to_degrees())
+            .map(|s| s.theta_rad.to_degrees())
             .collect();
         if self.feed == FeedKind::Stable && stable.is_empty() {
             return Err(PlanError::input(

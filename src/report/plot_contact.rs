@@ -77,7 +77,7 @@ pub fn plot_contact(
         .caption(
             format!(
                 "{title} → θf={:.2}°",
-                crate::geometry::wrap_deg(out.pose_final.theta.to_degrees())
+                crate::geometry::wrap_deg(out.pose_final.theta_rad.to_degrees())
             ),
             ("sans-serif", 18),
         )

@@ -68,7 +68,7 @@ fn display_poses(path: &SamplePath, gap: f64) -> Vec<Pose> {
     let push = |p: Pose, out: &mut Vec<Pose>| {
         if let Some(l) = out.last() {
             let moved = ((p.x - l.x).powi(2) + (p.y - l.y).powi(2)).sqrt();
-            if moved < gap && (p.theta - l.theta).abs() < 20f64.to_radians() {
+            if moved < gap && (p.theta_rad - l.theta_rad).abs() < 20f64.to_radians() {
                 return;
             }
         }
@@ -85,7 +85,7 @@ fn display_poses(path: &SamplePath, gap: f64) -> Vec<Pose> {
                 Pose::new(
                     p.x + u * (q.x - p.x),
                     p.y + u * (q.y - p.y),
-                    p.theta + u * (q.theta - p.theta),
+                    p.theta_rad + u * (q.theta_rad - p.theta_rad),
                 ),
                 &mut out,
             );
@@ -150,8 +150,8 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
         let sample = samples.get(k);
         let caption = match sample {
             Some(s) => {
-                let first = s.poses.first().map(|p| p.1.theta).unwrap_or(0.0);
-                let last = s.poses.last().map(|p| p.1.theta).unwrap_or(0.0);
+                let first = s.poses.first().map(|p| p.1.theta_rad).unwrap_or(0.0);
+                let last = s.poses.last().map(|p| p.1.theta_rad).unwrap_or(0.0);
                 format!(
                     "{} — part {}: {} (θ {:.1}° → {:.1}°)",
                     scene.name,

@@ -6,10 +6,14 @@
 //!   it, and samples whose contact did not end `ok` ringed in black.
 //! * [`plot_band_intervals`]: band intervals against d for every map given (Figure 3-6), with "+"
 //!   at the ends and a dot at the mean; with `adjusted` the intervals are mean ± sd (Figure 3-8),
-//!   drawn over the raw ones in grey.
+//!   drawn over the raw ones in grey. Its orientation axis zooms on the bands
+//!   ([`super::plot_zoom`]; an interval across 0°/360° is then one piece) and its legend stands in
+//!   a row above the chart, where it hides no interval.
 //!
-//! Intervals straddling 0°/360° are drawn as two pieces.
+//! In the map figure, intervals straddling 0°/360° are drawn as two pieces.
 
+use super::plot_labels::text_width;
+use super::plot_zoom::{degree_view, DegreeView};
 use crate::geometry::wrap_deg;
 use crate::maps::{Band, ConfigurationMap};
 use crate::report::atomic::Staged;
@@ -17,6 +21,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::ComposedElement;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 pub(crate) const PALETTE: [RGBColor; 8] = [
@@ -54,10 +59,6 @@ fn raw_arc(b: &Band) -> Vec<(f64, f64)> {
     arc_pieces(b.final_min_deg, b.width_deg)
 }
 
-fn adjusted_arc(b: &Band) -> Vec<(f64, f64)> {
-    arc_pieces(b.mean_deg - b.sd_deg, 2.0 * b.sd_deg)
-}
-
 pub(crate) type Chart<'a, 'b> =
     ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
@@ -77,22 +78,62 @@ pub(crate) fn degree_chart<'a, 'b>(
         .build_cartesian_2d(x, 0.0..y_top)?)
 }
 
-/// The mesh of a chart of orientations (0°…360°, unlabelled above) against contact parameter d.
-pub(crate) fn d_axis_mesh(ch: &mut Chart, y_desc: &str) -> anyhow::Result<()> {
-    ch.configure_mesh()
-        .y_labels(15)
-        .y_label_formatter(&|v| {
-            if *v <= 360.0 {
-                format!("{v:.0}")
-            } else {
-                String::new()
-            }
-        })
-        .light_line_style(WHITE)
-        .x_desc("contact parameter d")
-        .y_desc(y_desc)
-        .draw()?;
-    Ok(())
+/// How a legend entry in a header row ([`header_with_legend`]) is marked.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Swatch {
+    /// A filled box (a shaded area).
+    Filled(RGBColor),
+    /// A thick line (an interval).
+    Line(RGBColor),
+    /// A "+" (an interval's end).
+    Plus(RGBColor),
+    /// A dot (a mean).
+    Dot(RGBColor),
+}
+
+/// Fill `root` white and split off a header of `height` px (at least 62): `title` centred at its
+/// top and, in one row below it, the legend `entries`; returns the body below the header.
+pub(crate) fn header_with_legend<'a>(
+    root: &DrawingArea<SVGBackend<'a>, Shift>,
+    title: &str,
+    entries: &[(&str, Swatch)],
+    height: u32,
+) -> anyhow::Result<DrawingArea<SVGBackend<'a>, Shift>> {
+    root.fill(&WHITE)?;
+    let (head, body) = root.split_vertically(height.max(62));
+    let centre = root.dim_in_pixel().0 as i32 / 2;
+    head.draw(&Text::new(
+        title.to_string(),
+        (centre, 8),
+        ("sans-serif", 18)
+            .into_font()
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Center, VPos::Top)),
+    ))?;
+    let font = ("sans-serif", 12).into_font();
+    let mut x = 40;
+    for &(label, swatch) in entries {
+        match swatch {
+            Swatch::Filled(c) => head.draw(&Rectangle::new(
+                [(x, 38), (x + 14, 46)],
+                c.mix(0.55).filled(),
+            ))?,
+            Swatch::Line(c) => head.draw(&PathElement::new(
+                vec![(x, 42), (x + 14, 42)],
+                c.stroke_width(3),
+            ))?,
+            Swatch::Plus(c) => head.draw(&plus((x + 7, 42), 5, c.into()))?,
+            Swatch::Dot(c) => head.draw(&Circle::new((x + 7, 42), 3, c.filled()))?,
+        }
+        head.draw(&Text::new(
+            label.to_string(),
+            (x + 20, 42),
+            font.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+        // plotters draws a 12 px font about 9.7 px high: estimate at that size.
+        x += 20 + text_width(label, 10.0, false) as i32 + 16;
+    }
+    Ok(body)
 }
 
 pub(crate) fn draw_legend<'a, 'b: 'a>(
@@ -220,6 +261,59 @@ fn plus<C, DB: DrawingBackend>(at: C, r: i32, style: ShapeStyle) -> Plus<C, DB> 
         + PathElement::new(vec![(0, -r), (0, r)], style)
 }
 
+/// The orientation axis of a band figure: every band's interval and, with `adjusted`, its
+/// mean ± sd, with a margin of 5° (at least 30° in all; the whole circle when the bands leave no
+/// gap of 40°).
+fn band_view(maps: &[ConfigurationMap], adjusted: bool) -> DegreeView {
+    let arcs: Vec<(f64, f64)> = maps
+        .iter()
+        .flat_map(|m| &m.bands)
+        .flat_map(|b| {
+            let raw = (b.final_min_deg, b.width_deg.max(0.5));
+            let adj = (b.mean_deg - b.sd_deg, (2.0 * b.sd_deg).max(0.5));
+            std::iter::once(raw).chain(adjusted.then_some(adj))
+        })
+        .collect();
+    degree_view(&arcs, 5.0, 30.0, 40.0)
+}
+
+/// A tick label of d: at most three decimals, trailing zeros dropped, never "-0".
+fn d_label(v: f64) -> String {
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+/// A chart of orientations on `view` (up, tick labels wrapped into [0, 360)) against contact
+/// parameter d over `x`, on the body below a [`header_with_legend`].
+pub(crate) fn d_chart<'a, 'b>(
+    body: &'a DrawingArea<SVGBackend<'b>, Shift>,
+    x: std::ops::Range<f64>,
+    view: DegreeView,
+    x_desc: &str,
+    y_desc: &str,
+) -> anyhow::Result<Chart<'a, 'b>> {
+    let mut ch = ChartBuilder::on(body)
+        .margin(14)
+        .margin_top(4)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(x, view.lo..view.hi)?;
+    ch.configure_mesh()
+        .y_labels(15)
+        .y_label_formatter(&|v| DegreeView::label(*v))
+        .x_label_formatter(&|v| d_label(*v))
+        .light_line_style(WHITE)
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .draw()?;
+    Ok(ch)
+}
+
 /// Draw the band intervals of all maps against d (Figure 3-6; with `adjusted`, Figure 3-8).
 pub fn plot_band_intervals(
     maps: &[ConfigurationMap],
@@ -236,38 +330,51 @@ pub fn plot_band_intervals(
         (dmin, dmax) = (-1.0, 1.0);
     }
     let pad = ((dmax - dmin) * 0.06).max(0.1);
-    let staged = Staged::new(path);
-    let tmp = staged.tmp().to_path_buf();
-    let root = SVGBackend::new(&tmp, (900, 620)).into_drawing_area();
-    // Room above 360° for the legend, so it never hides an interval.
-    let mut ch = degree_chart(&root, title, (dmin - pad)..(dmax + pad), 420.0)?;
-    d_axis_mesh(
-        &mut ch,
-        if adjusted {
-            "adjusted band mean ± sd (deg)"
-        } else {
-            "final orientation band (deg)"
-        },
-    )?;
+    let view = band_view(maps, adjusted);
     let blue = PALETTE[0];
     let grey = RGBColor(185, 185, 185);
-    // The top of the circle: intervals above it continue from 0°.
-    ch.draw_series(LineSeries::new(
-        vec![(dmin - pad, 360.0), (dmax + pad, 360.0)],
-        BLACK.mix(0.6),
-    ))?;
+    let staged = Staged::new(path);
+    let tmp = staged.tmp().to_path_buf();
+    let root = SVGBackend::new(&tmp, (900, 640)).into_drawing_area();
+    let legend: Vec<(&str, Swatch)> = if adjusted {
+        vec![
+            ("adjusted band (mean ± sd)", Swatch::Line(blue)),
+            ("raw band [min, max]", Swatch::Line(grey)),
+            ("adjusted band ends", Swatch::Plus(BLACK)),
+            ("band mean", Swatch::Dot(RED)),
+        ]
+    } else {
+        vec![
+            ("band [min, max]", Swatch::Line(blue)),
+            ("band ends", Swatch::Plus(BLACK)),
+            ("band mean", Swatch::Dot(RED)),
+        ]
+    };
+    let body = header_with_legend(&root, title, &legend, 62)?;
+    let y_desc = if adjusted {
+        "adjusted band mean ± sd (deg)"
+    } else {
+        "final orientation band (deg)"
+    };
+    let mut ch = d_chart(
+        &body,
+        (dmin - pad)..(dmax + pad),
+        view,
+        "contact parameter d",
+        y_desc,
+    )?;
     for m in maps {
         for b in &m.bands {
-            for (y0, y1) in raw_arc(b) {
-                let style = if adjusted {
-                    grey.stroke_width(5)
-                } else {
-                    blue.stroke_width(2)
-                };
+            let style = if adjusted {
+                grey.stroke_width(5)
+            } else {
+                blue.stroke_width(2)
+            };
+            for (y0, y1) in view.pieces(b.final_min_deg, b.width_deg) {
                 ch.draw_series(LineSeries::new(vec![(m.d, y0), (m.d, y1)], style))?;
             }
             if adjusted {
-                for (y0, y1) in adjusted_arc(b) {
+                for (y0, y1) in view.pieces(b.mean_deg - b.sd_deg, 2.0 * b.sd_deg) {
                     ch.draw_series(LineSeries::new(
                         vec![(m.d, y0), (m.d, y1)],
                         blue.stroke_width(2),
@@ -276,6 +383,7 @@ pub fn plot_band_intervals(
             }
         }
     }
+    let shown = |d: f64, deg: f64| view.shows(deg).then(|| (d, view.place(deg)));
     let ends = maps.iter().flat_map(|m| {
         m.bands.iter().flat_map(move |b| {
             let (lo, hi) = if adjusted {
@@ -283,28 +391,14 @@ pub fn plot_band_intervals(
             } else {
                 (b.final_min_deg, b.final_max_deg)
             };
-            [
-                plus((m.d, lo), 5, BLACK.into()),
-                plus((m.d, hi), 5, BLACK.into()),
-            ]
+            [shown(m.d, lo), shown(m.d, hi)]
         })
     });
-    ch.draw_series(ends)?
-        .label(if adjusted {
-            "adjusted band ends (mean ± sd); grey: raw band"
-        } else {
-            "band ends [min, max]"
-        })
-        .legend(|(x, y)| plus((x + 8, y), 5, BLACK.into()));
-    let means = maps.iter().flat_map(|m| {
-        m.bands
-            .iter()
-            .map(move |b| Circle::new((m.d, b.mean_deg), 3, RED.filled()))
-    });
-    ch.draw_series(means)?
-        .label("band mean")
-        .legend(|(x, y)| Circle::new((x + 8, y), 3, RED.filled()));
-    draw_legend(&mut ch, SeriesLabelPosition::UpperMiddle)?;
+    ch.draw_series(ends.flatten().map(|at| plus(at, 5, BLACK.into())))?;
+    let means = maps
+        .iter()
+        .flat_map(|m| m.bands.iter().filter_map(move |b| shown(m.d, b.mean_deg)));
+    ch.draw_series(means.map(|at| Circle::new(at, 3, RED.filled())))?;
     root.present()?;
     staged.commit()?;
     Ok(())

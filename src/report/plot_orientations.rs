@@ -30,10 +30,10 @@ pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> an
     let mut goals: Vec<(f64, f64, String)> = Vec::new();
     if let Goal::Sets(sets) = &scene.goal {
         for set in sets {
-            for &o in &set.orientations {
+            for &o in &set.orientations_rad {
                 goals.push((
                     wrap_deg(o.to_degrees()),
-                    set.tolerance.to_degrees(),
+                    set.tolerance_rad.to_degrees(),
                     set.name.clone(),
                 ));
             }
@@ -53,7 +53,7 @@ pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> an
         .part
         .stable_states
         .iter()
-        .map(|st| wrap_deg(st.theta.to_degrees()))
+        .map(|st| wrap_deg(st.theta_rad.to_degrees()))
         .collect();
     let hidden: Vec<String> = stable
         .iter()

@@ -75,14 +75,14 @@ pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> anyhow::Result<()>
         .draw()?;
     ch2.draw_series(LineSeries::new(samples, BLACK))?;
     for s in poly.stable_states() {
-        let phi = crate::geometry::wrap_deg(-90.0 - s.theta.to_degrees());
+        let phi = crate::geometry::wrap_deg(-90.0 - s.theta_rad.to_degrees());
         ch2.draw_series(std::iter::once(Circle::new(
             (phi, s.height),
             5,
             RED.filled(),
         )))?;
         ch2.draw_series(std::iter::once(Text::new(
-            format!("θ={:.1}°", s.theta.to_degrees()),
+            format!("θ={:.1}°", s.theta_rad.to_degrees()),
             (phi, s.height - rmax * 0.06),
             ("sans-serif", 13).into_font().color(&RED),
         )))?;

@@ -30,7 +30,7 @@ pub fn plot_survey(rows: &[(String, [bool; 3])], path: &Path) -> Result<()> {
             40.0 + CELL * (k / COLS) as f64 + CELL / 2.0 - 10.0,
         );
         let poly = part_from_spec(spec)?;
-        let theta = poly.stable_states().first().map_or(0.0, |st| st.theta);
+        let theta = poly.stable_states().first().map_or(0.0, |st| st.theta_rad);
         let pts: Vec<_> = poly.vertices().iter().map(|v| v.rotate(theta)).collect();
         let r = pts.iter().map(|p| p.norm()).fold(0.0, f64::max).max(1e-9);
         let scale = 0.36 * CELL / r;

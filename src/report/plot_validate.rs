@@ -6,14 +6,12 @@
 //! dotted guide marks each d. The θf axis zooms on the data ([`super::plot_zoom`]), so an arc
 //! across 0°/360° is drawn in one piece.
 
-use super::plot_labels::text_width;
-use super::plot_map::PALETTE;
+use super::plot_map::{d_chart, header_with_legend, Swatch, PALETTE};
 use super::plot_zoom::{degree_view, DegreeView};
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::PredictedBands;
 use crate::report::atomic::Staged;
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// Smallest spacing between distinct d (0.2 for a single d).
@@ -72,68 +70,28 @@ pub fn plot_band_distributions(
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
     let root = SVGBackend::new(&tmp, (900, 640)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (head, body) = root.split_vertically(62);
-    head.draw(&Text::new(
-        title.to_string(),
-        (450, 8),
-        ("sans-serif", 18)
-            .into_font()
-            .color(&BLACK)
-            .pos(Pos::new(HPos::Center, VPos::Top)),
-    ))?;
     let blue = PALETTE[0];
     let dark = RGBColor(20, 40, 110);
     let red = RGBColor(200, 30, 30);
     // The legend, in one row above the chart.
-    let mut entries: Vec<(&str, RGBColor, bool)> = vec![
+    let mut entries = vec![
         (
             "predicted θf distribution at d (width ∝ √share per 1°)",
-            blue,
-            true,
+            Swatch::Filled(blue),
         ),
-        ("90% predicted bands (left of d)", dark, false),
+        ("90% predicted bands (left of d)", Swatch::Line(dark)),
     ];
     if !measured.is_empty() {
-        entries.push(("measured bands [min, max] (right of d)", red, false));
+        entries.push(("measured bands [min, max] (right of d)", Swatch::Line(red)));
     }
-    let font = ("sans-serif", 12).into_font();
-    let mut x = 40;
-    for (label, colour, filled) in entries {
-        if filled {
-            head.draw(&Rectangle::new(
-                [(x, 38), (x + 14, 46)],
-                colour.mix(0.55).filled(),
-            ))?;
-        } else {
-            head.draw(&PathElement::new(
-                vec![(x, 42), (x + 14, 42)],
-                colour.stroke_width(3),
-            ))?;
-        }
-        head.draw(&Text::new(
-            label.to_string(),
-            (x + 20, 42),
-            font.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center)),
-        ))?;
-        // plotters draws a 12 px font about 9.7 px high: estimate at that size.
-        x += 20 + text_width(label, 10.0, false) as i32 + 16;
-    }
-    let mut ch = ChartBuilder::on(&body)
-        .margin(14)
-        .margin_top(4)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d(lo..hi, view.lo..view.hi)?;
-    ch.configure_mesh()
-        .y_labels(15)
-        .y_label_formatter(&|v| DegreeView::label(*v))
-        .light_line_style(WHITE)
-        .x_desc(
-            "contact parameter d (dotted guides; bands beside each d are offset only to be seen)",
-        )
-        .y_desc("final orientation θf (deg)")
-        .draw()?;
+    let body = header_with_legend(&root, title, &entries, 62)?;
+    let mut ch = d_chart(
+        &body,
+        lo..hi,
+        view,
+        "contact parameter d (dotted guides; bands beside each d are offset only to be seen)",
+        "final orientation θf (deg)",
+    )?;
     for d in distinct(&ds) {
         ch.draw_series(DashedLineSeries::new(
             vec![(d, view.lo), (d, view.hi)],

@@ -397,7 +397,7 @@ fn feed_orientation(c: &Checker, rf: &RawFeed, stable_states: &[StableState]) ->
             Ok(Orientation::Uniform)
         }
         OrientationKind::Stable => {
-            let thetas: Vec<f64> = stable_states.iter().map(|s| s.theta).collect();
+            let thetas: Vec<f64> = stable_states.iter().map(|s| s.theta_rad).collect();
             if thetas.is_empty() {
                 return Err(c.err(
                     "feed.orientation",
@@ -410,9 +410,9 @@ fn feed_orientation(c: &Checker, rf: &RawFeed, stable_states: &[StableState]) ->
                 return Err(c.err("feed.weights", "at least one weight must be positive"));
             }
             Ok(Orientation::Stable {
-                thetas,
+                thetas_rad: thetas,
                 weights: weights.iter().map(|w| w / total).collect(),
-                jitter,
+                jitter_rad: jitter,
             })
         }
     }
@@ -608,8 +608,8 @@ fn goal_set(c: &Checker, i: usize, s: &RawGoalSet) -> R<GoalSet> {
     let name = s.name.clone().unwrap_or_else(|| format!("set{}", i + 1));
     Ok(GoalSet {
         name,
-        orientations: os,
-        tolerance: tol.to_radians(),
+        orientations_rad: os,
+        tolerance_rad: tol.to_radians(),
     })
 }
 

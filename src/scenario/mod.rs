@@ -167,7 +167,7 @@ any = true
             (f.start.x, f.start.y, f.length, f.mu_f),
             (0.4, -0.09, 0.1, 0.5)
         );
-        assert!((f.angle - 30f64.to_radians()).abs() < 1e-15);
+        assert!((f.angle_rad - 30f64.to_radians()).abs() < 1e-15);
         assert!((f.end().y - (-0.09 + 0.05)).abs() < 1e-12);
         assert_eq!(s.obstacles[1].x_range(), [0.4, f.end().x]);
         // The pin at (0.3, 0) is 0.107 m from the fence: beyond 2a = 0.055 m, not a neighbour.

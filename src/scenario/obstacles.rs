@@ -275,7 +275,7 @@ fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
     let f = FenceObstacle {
         name: at.name(&ro.name, "fence")?,
         start: Vec2::new(x, y),
-        angle: angle.to_radians(),
+        angle_rad: angle.to_radians(),
         length,
         mu_f: at.friction("mu_f", ro.mu_f)?,
     };

@@ -63,11 +63,11 @@ impl Arrival {
 pub enum Orientation {
     /// θ uniform on [0, 2π).
     Uniform,
-    /// A stable state chosen with the given (normalised) weights, plus normal jitter.
+    /// A stable state chosen with the given (normalised) weights, plus normal jitter (its sd).
     Stable {
-        thetas: Vec<f64>,
+        thetas_rad: Vec<f64>,
         weights: Vec<f64>,
-        jitter: f64,
+        jitter_rad: f64,
     },
 }
 
@@ -170,7 +170,7 @@ pub struct FenceObstacle {
     /// Upstream end, world frame (m).
     pub start: Vec2,
     /// Angle from the belt direction (radians, strictly inside (−π/2, π/2)).
-    pub angle: f64,
+    pub angle_rad: f64,
     /// Length (m, > 0).
     pub length: f64,
     /// Fence–part friction μf.
@@ -180,13 +180,13 @@ pub struct FenceObstacle {
 impl FenceObstacle {
     /// Downstream end, world frame (m).
     pub fn end(&self) -> Vec2 {
-        self.start + Vec2::from_angle(self.angle) * self.length
+        self.start + Vec2::from_angle(self.angle_rad) * self.length
     }
     /// The fence as the contact model takes it (world frame, metres).
     pub fn spec(&self) -> FenceSpec {
         FenceSpec {
             start: self.start,
-            angle: self.angle,
+            angle: self.angle_rad,
             length: self.length,
             mu_f: self.mu_f,
         }
@@ -243,8 +243,8 @@ impl Obstacle {
 #[derive(Debug, Clone, PartialEq)]
 pub struct GoalSet {
     pub name: String,
-    pub orientations: Vec<f64>,
-    pub tolerance: f64,
+    pub orientations_rad: Vec<f64>,
+    pub tolerance_rad: f64,
 }
 
 /// Which final orientations count as correct.
@@ -257,14 +257,14 @@ pub enum Goal {
 }
 
 impl Goal {
-    /// The index of the first goal set containing `theta` (radians), `Some(0)` for `Any`.
-    pub fn matching_set(&self, theta: f64) -> Option<usize> {
+    /// The index of the first goal set containing `theta_rad`, `Some(0)` for `Any`.
+    pub fn matching_set(&self, theta_rad: f64) -> Option<usize> {
         match self {
             Goal::Any => Some(0),
             Goal::Sets(sets) => sets.iter().position(|s| {
-                s.orientations
+                s.orientations_rad
                     .iter()
-                    .any(|&o| crate::geometry::wrap_pi(theta - o).abs() <= s.tolerance)
+                    .any(|&o| crate::geometry::wrap_pi(theta_rad - o).abs() <= s.tolerance_rad)
             }),
         }
     }

@@ -155,14 +155,18 @@ pub(super) fn train(
     let template_d = (pin.centre.y - y_mean) / a;
     let template_d_sd = y_sd / a;
     let theta_sd_deg = match &feed.orientation {
-        Orientation::Stable { jitter, .. } => jitter.to_degrees(),
+        Orientation::Stable {
+            jitter_rad: jitter, ..
+        } => jitter.to_degrees(),
         Orientation::Uniform => 0.0,
     };
     let at_hypotheses = |e: String| c.err(&format!("obstacles[{i}].sensor.hypotheses"), e);
     let hypotheses = if draft.vertex_edge {
         match &feed.orientation {
             // Parts fed in their stable states meet the pin in those states.
-            Orientation::Stable { thetas, .. } => Hypotheses::VertexEdge {
+            Orientation::Stable {
+                thetas_rad: thetas, ..
+            } => Hypotheses::VertexEdge {
                 degrees: thetas.iter().map(|t| t.to_degrees()).collect(),
             },
             Orientation::Uniform => Hypotheses::vertex_edge_sweep(),

@@ -139,7 +139,7 @@ mod tests {
                 crate::engine::part_stream::draw_part(&reference, 9, i).unwrap(),
                 crate::engine::part_stream::draw_part(&other, 9, i).unwrap(),
             );
-            assert_eq!((p.gap, p.theta, p.y), (q.gap, q.theta, q.y));
+            assert_eq!((p.gap, p.theta_rad, p.y), (q.gap, q.theta_rad, q.y));
         }
         let uniform = source.clone().with_uniform_orientation();
         uniform.apply(&mut other).unwrap();

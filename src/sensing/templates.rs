@@ -137,7 +137,7 @@ impl Hypotheses {
         let degrees: Vec<f64> = poly
             .stable_states()
             .iter()
-            .map(|s| s.theta.to_degrees())
+            .map(|s| s.theta_rad.to_degrees())
             .collect();
         if degrees.len() < 2 {
             return Err(format!(

@@ -125,7 +125,9 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
         .iter()
         .map(|c| {
             let o = run_one(c, Fidelity::Exact, 1e-10);
-            o.status.is_ok().then(|| o.pose_final.theta.to_degrees())
+            o.status
+                .is_ok()
+                .then(|| o.pose_final.theta_rad.to_degrees())
         })
         .collect();
     let kept: Vec<usize> = (0..cases.len())
@@ -163,7 +165,7 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
             times.push(t0.elapsed().as_secs_f64() * 1e6);
             evals += o.evaluations;
             errors.push(ang_err(
-                o.pose_final.theta.to_degrees(),
+                o.pose_final.theta_rad.to_degrees(),
                 reference[i].expect("kept cases have a reference"),
             ));
         }
@@ -184,7 +186,7 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
                 };
                 grid[di * 360 + th] = run_one(&c, Fidelity::Exact, 1e-6)
                     .pose_final
-                    .theta
+                    .theta_rad
                     .to_degrees();
             }
         }

@@ -76,8 +76,8 @@ pub fn goal_windows(goal: &Goal) -> Vec<GoalWindow> {
             .iter()
             .map(|s| GoalWindow {
                 name: s.name.clone(),
-                orientations_deg: s.orientations.iter().map(|&o| deg(o)).collect(),
-                tolerance_deg: deg(s.tolerance),
+                orientations_deg: s.orientations_rad.iter().map(|&o| deg(o)).collect(),
+                tolerance_deg: deg(s.tolerance_rad),
             })
             .collect(),
     }

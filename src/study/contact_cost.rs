@@ -188,10 +188,16 @@ impl Bench<'_> {
             evals += o.evaluations;
             steps += o.steps as u64;
             let r = self.push(model, &tight, th, d);
-            errors.push(angle_between_deg(o.pose_final.theta, r.pose_final.theta));
+            errors.push(angle_between_deg(
+                o.pose_final.theta_rad,
+                r.pose_final.theta_rad,
+            ));
             if let Some((plain, _)) = solves {
                 let p = self.push(plain, &s, th, d);
-                table_diffs.push(angle_between_deg(o.pose_final.theta, p.pose_final.theta));
+                table_diffs.push(angle_between_deg(
+                    o.pose_final.theta_rad,
+                    p.pose_final.theta_rad,
+                ));
             }
         }
         // Further passes over all the contacts (not one contact again and again, which would

@@ -86,7 +86,7 @@ pub fn contact_row(part: &str, contacts: usize, seed: u64) -> Result<ContactRow>
         if let Ok(out) = answer {
             if out.contact {
                 errs.push(
-                    (out.pose_final.theta - ex.pose_final.theta)
+                    (out.pose_final.theta_rad - ex.pose_final.theta_rad)
                         .abs()
                         .to_degrees(),
                 );

@@ -174,8 +174,8 @@ fn self_convergence_under_tolerance() {
             s.tol *= 0.01;
             let b = run(&m, &p, th, d, Pin::point(), &s);
             let diff = ang_diff_deg(
-                a.pose_final.theta.to_degrees(),
-                b.pose_final.theta.to_degrees(),
+                a.pose_final.theta_rad.to_degrees(),
+                b.pose_final.theta_rad.to_degrees(),
             );
             assert!(diff.abs() < 0.01, "{fid} {name} θ0={th} d={d}: {diff}°");
         }
@@ -202,8 +202,8 @@ fn disc_pin_converges_to_point_pin() {
                 };
                 let o = run(&m, &p, th, d, pin, &s);
                 let diff = ang_diff_deg(
-                    o.pose_final.theta.to_degrees(),
-                    point.pose_final.theta.to_degrees(),
+                    o.pose_final.theta_rad.to_degrees(),
+                    point.pose_final.theta_rad.to_degrees(),
                 )
                 .abs();
                 assert!(

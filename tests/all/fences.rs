@@ -187,7 +187,7 @@ fn short_fence_leaves_intermediate_orientations() {
         let f = fence(&p, angle, 0.0, 1.6, 0.3);
         let o = run_fence(&m, &p, th, &f, Fidelity::Exact);
         assert!(o.status.is_ok(), "θ0={th}: {:?}", o.status);
-        let th_f = wrap_deg(o.pose_final.theta.to_degrees());
+        let th_f = wrap_deg(o.pose_final.theta_rad.to_degrees());
         if flush.iter().all(|&q| ang_diff_deg(q, th_f).abs() > 0.5) {
             intermediate += 1;
         }

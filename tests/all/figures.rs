@@ -28,6 +28,15 @@ fn ticks(boxes: &[TextBox], anchor: &str) -> Vec<(f64, TextBox)> {
         .collect()
 }
 
+/// At least three y tick labels (a plotters chart's, anchored at their end), each in `range`.
+fn y_ticks_within(boxes: &[TextBox], range: std::ops::RangeInclusive<f64>, what: &str) {
+    let ys = ticks(boxes, "end");
+    assert!(ys.len() >= 3, "{ys:?}");
+    for (v, _) in &ys {
+        assert!(range.contains(v), "y tick {v} far from {what}");
+    }
+}
+
 fn no_overlaps(boxes: &[TextBox], what: &str) {
     let clash = overlapping(boxes);
     assert!(clash.is_empty(), "{what}: labels overlap: {clash:?}");
@@ -104,20 +113,70 @@ fn validation_plots_zoom_and_say_the_bands_are_offset() {
         .unwrap();
     let svg = read_svg(&path);
     let boxes = text_boxes(&svg);
-    let ys = ticks(&boxes, "end");
-    assert!(ys.len() >= 3, "{ys:?}");
-    for (v, _) in &ys {
-        assert!(
-            (80.0..=125.0).contains(v),
-            "θf tick {v} far from the data 95–108°"
-        );
-    }
+    y_ticks_within(&boxes, 80.0..=125.0, "the data 95–108°");
     let texts: String = boxes.iter().map(|b| b.text.clone() + "\n").collect();
     assert!(
         texts.contains("left of d") && texts.contains("right of d"),
         "{texts}"
     );
     no_overlaps(&boxes, "validation plot");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A band of a configuration map from its ends and mean ± sd (degrees).
+fn band(lo: f64, hi: f64, mean: f64, sd: f64) -> pinfeed::maps::Band {
+    pinfeed::maps::Band {
+        final_min_deg: lo,
+        final_max_deg: hi,
+        width_deg: hi - lo,
+        mean_deg: mean,
+        sd_deg: sd,
+        adjusted_min_deg: mean - sd,
+        adjusted_max_deg: mean + sd,
+        initial_ranges_deg: vec![[0.0, 359.0]],
+        com_y_min: 0.0,
+        com_y_max: 0.0,
+        samples: 10,
+    }
+}
+
+#[test]
+fn band_interval_figures_zoom_on_the_bands() {
+    let dir = fresh_dir("figures-bands");
+    // Bands between 92° and 121° at three d: the θf axis should hold them, not 0–420°.
+    let maps: Vec<pinfeed::maps::ConfigurationMap> = [
+        (-0.4, band(92.0, 104.0, 98.0, 3.0)),
+        (0.0, band(100.0, 112.0, 106.0, 2.5)),
+        (0.4, band(108.0, 121.0, 115.0, 4.0)),
+    ]
+    .into_iter()
+    .map(|(d, b)| pinfeed::maps::ConfigurationMap {
+        d,
+        samples: vec![],
+        bands: vec![b],
+        no_contact_ranges_deg: vec![],
+        fence: None,
+    })
+    .collect();
+    for adjusted in [false, true] {
+        let path = dir.join(format!("bands-{adjusted}.svg"));
+        pinfeed::report::plot_map::plot_band_intervals(&maps, adjusted, "t", &path).unwrap();
+        let boxes = text_boxes(&read_svg(&path));
+        let what = format!("the bands 92–121° (adjusted: {adjusted})");
+        y_ticks_within(&boxes, 70.0..=145.0, &what);
+        let xs: Vec<String> = ticks(&boxes, "middle")
+            .into_iter()
+            .map(|t| t.1.text)
+            .collect();
+        assert!(
+            !xs.iter()
+                .any(|t| t.starts_with("-0") && t.parse() == Ok(0.0)),
+            "{xs:?}"
+        );
+        let texts: String = boxes.iter().map(|b| b.text.clone() + "\n").collect();
+        assert!(texts.contains("band mean"), "{texts}");
+        no_overlaps(&boxes, "band intervals");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -463,7 +463,7 @@ fn travelling_x_is_the_belt_frame_picture() {
         let a = first_contact_travelling_x(&p, &pose, pin, r).unwrap();
         let b = first_contact(&p, &pose, pin, LEFT, r, 0.0).unwrap();
         assert_eq!(a, b);
-        let moved = Pose::new(pose.x + a.travel, pose.y, pose.theta);
+        let moved = Pose::new(pose.x + a.travel, pose.y, pose.theta_rad);
         let (dist, _) = p.distance_to_boundary(moved.apply_inverse(pin));
         near(dist, r, "pin on the moved part's boundary");
     }

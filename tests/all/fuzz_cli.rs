@@ -501,7 +501,7 @@ proptest! {
                 let (su, sp) = (u.stable_states(), p.stable_states());
                 prop_assert_eq!(su.len(), sp.len());
                 for (a, b) in su.iter().zip(&sp) {
-                    prop_assert!((a.theta - b.theta).abs() < 1e-9, "{} vs {}", a.theta, b.theta);
+                    prop_assert!((a.theta_rad - b.theta_rad).abs() < 1e-9, "{} vs {}", a.theta_rad, b.theta_rad);
                     prop_assert_eq!(a.hull_edge, b.hull_edge);
                 }
                 prop_assert!(representable_at(u, k, 1.0));

@@ -13,7 +13,7 @@ const DEG_TOL: f64 = 1e-6;
 fn stable_deg(p: &Polygon) -> Vec<f64> {
     p.stable_states()
         .iter()
-        .map(|s| s.theta.to_degrees())
+        .map(|s| s.theta_rad.to_degrees())
         .collect()
 }
 
@@ -88,10 +88,13 @@ fn stable_state_heights_are_radius_function_minima() {
     for name in ["tripoly1", "tripoly2", "lshape", "ngon:7", "rect:3:1"] {
         let p = part_from_spec(name).unwrap();
         for s in p.stable_states() {
-            assert!((p.depth_below(s.theta) - s.height).abs() < 1e-12, "{name}");
+            assert!(
+                (p.depth_below(s.theta_rad) - s.height).abs() < 1e-12,
+                "{name}"
+            );
             for dt in [-1e-3, 1e-3] {
                 assert!(
-                    p.depth_below(s.theta + dt) > s.height,
+                    p.depth_below(s.theta_rad + dt) > s.height,
                     "{name}: not a minimum"
                 );
             }

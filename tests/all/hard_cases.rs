@@ -134,7 +134,7 @@ fn cor_inside_the_part_and_on_an_edge() {
         let (mut inside, mut outside) = (0, 0);
         for w in trace.windows(2) {
             let (a0, b0) = (w[0].pose, w[1].pose);
-            let dth = b0.theta - a0.theta;
+            let dth = b0.theta_rad - a0.theta_rad;
             if dth.abs() < 1e-6 {
                 continue;
             }
@@ -169,7 +169,7 @@ fn pin_level_with_a_vertex() {
             .enumerate()
             .max_by(|a, b| a.1.x.total_cmp(&b.1.x))
             .unwrap();
-        let d_part = Vec2::new(-1.0, 0.0).rotate(-pose.theta);
+        let d_part = Vec2::new(-1.0, 0.0).rotate(-pose.theta_rad);
         assert!(
             pinfeed::geometry::first_contact::enters_at_vertex(&p, k, d_part),
             "{name}: test setup"

@@ -207,7 +207,7 @@ fn polygons_at_extreme_magnitudes_are_accepted_or_refused_for_their_size() {
         );
         assert_eq!(p.stable_states().len(), 3);
         for (s, u) in p.stable_states().iter().zip(unit.stable_states()) {
-            assert!((s.theta - u.theta).abs() < 1e-12, "{k}");
+            assert!((s.theta_rad - u.theta_rad).abs() < 1e-12, "{k}");
         }
     }
     // A power-of-two scale gives bit-identical results scaled back.

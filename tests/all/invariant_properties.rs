@@ -297,7 +297,7 @@ proptest! {
         s.tol *= 0.01;
         let b = run(&m, &p, theta, d, disc(&p, rho), &s);
         if a.status.is_ok() && b.status.is_ok() {
-            let diff = ang_diff_deg(a.pose_final.theta.to_degrees(), b.pose_final.theta.to_degrees());
+            let diff = ang_diff_deg(a.pose_final.theta_rad.to_degrees(), b.pose_final.theta_rad.to_degrees());
             prop_assert!(diff.abs() < 0.01, "{diff}° between tol 1e-6 and 1e-8");
             prop_assert!((a.rotation - b.rotation).abs().to_degrees() < 0.01);
         }

@@ -91,7 +91,7 @@ fn exit_orientations(angle_deg: f64, mu_f: f64) -> Vec<f64> {
                 None,
             );
             assert!(o.status.is_ok(), "flush {flush}°: {:?}", o.status);
-            wrap_deg(o.pose_final.theta.to_degrees())
+            wrap_deg(o.pose_final.theta_rad.to_degrees())
         })
         .collect()
 }

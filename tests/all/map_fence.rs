@@ -59,7 +59,7 @@ fn a_long_fence_maps_every_orientation_into_narrow_bands() {
             &ContactSettings::default(),
             None,
         );
-        let direct = wrap_deg(o.pose_final.theta.to_degrees());
+        let direct = wrap_deg(o.pose_final.theta_rad.to_degrees());
         assert!(
             ang_diff(direct, b["mean_deg"].as_f64().unwrap()).abs() < 1e-6,
             "θ0 {th0}: {direct} vs {b}"

@@ -94,7 +94,7 @@ fn served_answers_are_within_0_05_degrees_of_exact_and_fallbacks_are_exact() {
             continue;
         }
         served += 1;
-        let err = (out.pose_final.theta - ex.pose_final.theta)
+        let err = (out.pose_final.theta_rad - ex.pose_final.theta_rad)
             .abs()
             .to_degrees();
         assert!(err <= 0.05, "θ0 {theta} d {d}: θf off by {err}°");

@@ -206,7 +206,7 @@ fn changed(a: &Scene, b: &Scene) -> BTreeSet<String> {
             (Obstacle::Fence(f), Obstacle::Fence(g)) => {
                 note(f.name != g.name, format!("{n}.name"));
                 note(f.mu_f != g.mu_f, format!("{n}.mu_f"));
-                note(f.angle != g.angle, format!("{n}.angle"));
+                note(f.angle_rad != g.angle_rad, format!("{n}.angle"));
                 note(f.start.x != g.start.x, format!("{n}.x"));
                 note(f.start.y != g.start.y, format!("{n}.y"));
                 note(f.length != g.length, format!("{n}.length"));
@@ -323,7 +323,7 @@ fn each_new_parameter_changes_what_it_should_and_nothing_else() {
         .zip(&nominal)
         .map(|(a, b)| {
             let e = |s: &Scene, k: usize| match &s.obstacles[k] {
-                Obstacle::Fence(f) => f.angle,
+                Obstacle::Fence(f) => f.angle_rad,
                 Obstacle::Pin(_) => panic!(),
             };
             format!(

@@ -23,7 +23,7 @@ fn moving(
 
 fn rot(p: Pose, beta: f64) -> Pose {
     let c = p.position().rotate(beta);
-    Pose::new(c.x, c.y, p.theta + beta)
+    Pose::new(c.x, c.y, p.theta_rad + beta)
 }
 
 /// Galilean check (docs/physics.md#moving-and-retractable-pins): a pin moving at constant lateral speed w relative to the belt pushes
@@ -67,8 +67,10 @@ fn constant_lateral_speed_is_a_rotated_still_push() {
                         assert!(
                             (f.x - back.x).abs() < tol
                                 && (f.y - back.y).abs() < tol
-                                && ang_diff_deg(f.theta.to_degrees(), back.theta.to_degrees())
-                                    < 1e-3,
+                                && ang_diff_deg(
+                                    f.theta_rad.to_degrees(),
+                                    back.theta_rad.to_degrees()
+                                ) < 1e-3,
                             "{name} {fid} w={w} d={d} ρ={rho}: {f:?} vs {back:?}"
                         );
                         compared += usize::from(mv.contact);
@@ -119,7 +121,7 @@ fn stop_mid_contact_is_a_moving_push_then_a_still_one() {
                 };
                 let (at, pa) = (knot(&st), knot(&mt));
                 assert!(
-                    (at.pose.theta - pa.pose.theta).abs() < 1e-12
+                    (at.pose.theta_rad - pa.pose.theta_rad).abs() < 1e-12
                         && (at.pose.position() - pa.pose.position()).norm() < 1e-12 * a,
                     "{name} {fid}: {:?} vs {:?}",
                     at.pose,
@@ -138,14 +140,14 @@ fn stop_mid_contact_is_a_moving_push_then_a_still_one() {
                 );
                 assert!(resumed.status.is_ok(), "{:?}", resumed.status);
                 let (f, g) = (stopped.pose_final, resumed.pose_final);
-                let dth = ang_diff_deg(f.theta.to_degrees(), g.theta.to_degrees());
+                let dth = ang_diff_deg(f.theta_rad.to_degrees(), g.theta_rad.to_degrees());
                 assert!(
                     dth < 1e-2 && (f.y - g.y).abs() < 1e-4 * a,
                     "{name} {fid} θ0={theta0}: stopped {f:?} vs resumed {g:?} ({dth}°)"
                 );
                 // And the stop matters: a pin that keeps moving mostly ends elsewhere.
                 let kept = first.pose_final;
-                if ang_diff_deg(kept.theta.to_degrees(), f.theta.to_degrees()) > 0.1
+                if ang_diff_deg(kept.theta_rad.to_degrees(), f.theta_rad.to_degrees()) > 0.1
                     || (kept.y - f.y).abs() > 1e-2 * a
                 {
                     differs += 1;
@@ -177,7 +179,7 @@ fn piecewise_constant_acceleration_converges() {
         moving(&m, pose, start, 0.0, &ramp(n), &s)
             .0
             .pose_final
-            .theta
+            .theta_rad
     };
     let o = moving(&m, pose, start, 0.0, &ramp(8), &s).0;
     assert!(o.contact && o.status.is_ok(), "{:?}", o.status);

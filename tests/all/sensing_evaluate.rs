@@ -102,7 +102,7 @@ fn tripoly1(d: f64) -> Fixture {
     let degrees: Vec<f64> = poly
         .stable_states()
         .iter()
-        .map(|s| s.theta.to_degrees())
+        .map(|s| s.theta_rad.to_degrees())
         .collect();
     let hyps = Hypotheses::Orientations {
         labels: degrees.iter().map(|d| format!("{d:.0}")).collect(),

@@ -63,7 +63,7 @@ fn contacts_with_tables_match_the_solves_they_replace() {
                         "{part} μc {mu_c} {pin:?} θ0 {th} d {d}"
                     );
                     assert_eq!(p.contacts, t.contacts);
-                    let dtheta = (p.pose_final.theta - t.pose_final.theta).abs();
+                    let dtheta = (p.pose_final.theta_rad - t.pose_final.theta_rad).abs();
                     let dpos = ((p.pose_final.x - t.pose_final.x).powi(2)
                         + (p.pose_final.y - t.pose_final.y).powi(2))
                     .sqrt()

@@ -68,7 +68,7 @@ impl TierMap {
             return Ok(untouched(pose, ContactStatus::Ok));
         };
         let d = (pin_start.y - pose.y) / k;
-        let Some((node, u, v)) = self.leaf(wrap_2pi(pose.theta), d) else {
+        let Some((node, u, v)) = self.leaf(wrap_2pi(pose.theta_rad), d) else {
             return Err(Fallback::Uncertified);
         };
         let points = match node {
@@ -81,7 +81,7 @@ impl TierMap {
         Ok(ContactOutcome {
             contact: true,
             pose_initial: pose,
-            pose_final: Pose::new(pose.x + dx * k, pose.y + dy * k, pose.theta + rotation),
+            pose_final: Pose::new(pose.x + dx * k, pose.y + dy * k, pose.theta_rad + rotation),
             rotation,
             travel_to_contact: touch,
             contact_length: span * k,
@@ -102,7 +102,7 @@ pub fn cell_of_query(inputs: &TierInputs, pose: Pose, pin_start: Vec2) -> Option
     super::base_cell(
         &inputs.spec,
         super::build::reach(inputs),
-        wrap_2pi(pose.theta),
+        wrap_2pi(pose.theta_rad),
         d,
     )
     .map(|(root, _, _)| root)

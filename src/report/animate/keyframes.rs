@@ -34,14 +34,14 @@ pub(super) fn part_keys(lay: &Layout, poses: &[(f64, Pose)], t0: f64, t1: f64) -
     let mut keys: Vec<Key> = Vec::new();
     let mut prev_theta: Option<(f64, f64)> = None; // (raw, unwrapped)
     for &(t, p) in poses {
-        if !(t.is_finite() && p.x.is_finite() && p.y.is_finite() && p.theta.is_finite()) {
+        if !(t.is_finite() && p.x.is_finite() && p.y.is_finite() && p.theta_rad.is_finite()) {
             continue;
         }
         let theta = match prev_theta {
-            Some((raw, unwrapped)) => unwrapped + wrap_pi(p.theta - raw),
-            None => p.theta,
+            Some((raw, unwrapped)) => unwrapped + wrap_pi(p.theta_rad - raw),
+            None => p.theta_rad,
         };
-        prev_theta = Some((p.theta, theta));
+        prev_theta = Some((p.theta_rad, theta));
         // Keep times in order (a recorded path is; guard against a bad one).
         let t = keys.last().map_or(t, |k| t.max(k.t));
         keys.push(Key {

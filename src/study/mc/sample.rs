@@ -544,12 +544,12 @@ fn draw_fence(
         let drawn = FenceObstacle {
             name: fence.name.clone(),
             start: fence.start + Vec2::new(ex.unwrap_or(0.0), ey.unwrap_or(0.0)),
-            angle: fence.angle + ea.unwrap_or(0.0).to_radians(),
+            angle_rad: fence.angle_rad + ea.unwrap_or(0.0).to_radians(),
             length: fence.length + el.unwrap_or(0.0),
             mu_f,
         };
         let end = drawn.end();
-        let valid = drawn.angle.abs() < std::f64::consts::FRAC_PI_2
+        let valid = drawn.angle_rad.abs() < std::f64::consts::FRAC_PI_2
             && drawn.start.x > radius
             && drawn.start.x < belt.length
             && drawn.start.y.abs() <= half
@@ -800,7 +800,7 @@ pub fn draw_scene(
         &mut other,
     )?;
     let d_y = draw_value(&p.pose_y, &mut st.pose_y, "pose_y", any, &mut other)?;
-    let theta = entry.theta + d_theta.unwrap_or(0.0).to_radians();
+    let theta = entry.theta_rad + d_theta.unwrap_or(0.0).to_radians();
     let reach = (scene.belt.width / 2.0 - radius).max(0.0);
     let y = (entry.y + d_y.unwrap_or(0.0)).clamp(-reach, reach);
     scene.feed = Feed {
@@ -809,9 +809,9 @@ pub fn draw_scene(
             headway: base.feed.arrival.headway(),
         },
         orientation: Orientation::Stable {
-            thetas: vec![crate::geometry::wrap_2pi(theta)],
+            thetas_rad: vec![crate::geometry::wrap_2pi(theta)],
             weights: vec![1.0],
-            jitter: 0.0,
+            jitter_rad: 0.0,
         },
         lateral: Lateral::Fixed(y),
     };

@@ -202,7 +202,7 @@ fn outcome_numbers(o: &ContactOutcome) -> Vec<f64> {
     vec![
         o.pose_final.x,
         o.pose_final.y,
-        o.pose_final.theta,
+        o.pose_final.theta_rad,
         o.rotation,
         o.travel_to_contact,
         o.contact_length,

@@ -628,7 +628,7 @@ fn run_numbers(r: &engine::RunResult) -> Vec<f64> {
     }
     for path in &r.paths {
         for (t, pose) in &path.poses {
-            v.extend([*t, pose.x, pose.y, pose.theta]);
+            v.extend([*t, pose.x, pose.y, pose.theta_rad]);
         }
     }
     v

@@ -97,7 +97,7 @@ pub fn run(v: &[Vec2]) -> CaseReport {
         poly.offset().y,
     ];
     numbers.extend(poly.vertices().iter().flat_map(|p| [p.x, p.y]));
-    numbers.extend(poly.stable_states().iter().map(|s| s.theta));
+    numbers.extend(poly.stable_states().iter().map(|s| s.theta_rad));
     let positive = poly.area() > 0.0 && poly.radius() > 0.0 && poly.polar_moment() > 0.0;
     if !all_finite(&numbers) || !positive {
         return CaseReport::with(

@@ -43,7 +43,7 @@ pub fn run(
 pub fn assert_finite(o: &ContactOutcome, what: &str) {
     let p = o.pose_final;
     assert!(
-        p.x.is_finite() && p.y.is_finite() && p.theta.is_finite(),
+        p.x.is_finite() && p.y.is_finite() && p.theta_rad.is_finite(),
         "{what}: non-finite pose {p:?}"
     );
     assert!(o.rotation.is_finite(), "{what}: rotation");
