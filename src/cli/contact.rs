@@ -30,7 +30,7 @@ pub struct ContactArgs {
     /// largest centroid–vertex distance), a ratio without a length unit.
     #[arg(long, allow_hyphen_values = true, required_unless_present = "cases")]
     pub d: Option<f64>,
-    /// Pin–part friction coefficient μc (≥ 0).
+    /// Pin–part friction coefficient μc, in [0, 5].
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
     /// Part–belt friction coefficient μs (> 0; scales forces only).
@@ -47,8 +47,8 @@ pub struct ContactArgs {
     /// (default 36,12,4).
     #[arg(long, value_name = "T,D,DEPTH")]
     pub map_grid: Option<String>,
-    /// Pin radius in part units: the coordinates the part is given in,
-    /// not metres (`plan` and `sense`, which take `--scale`, use metres); 0: point pin.
+    /// Pin radius in part units (the coordinates the part is given in), as in every command;
+    /// 0: point pin.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Lateral pin speed as a fraction of the belt speed (moving pin).

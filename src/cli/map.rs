@@ -56,11 +56,11 @@ pub struct MapArgs {
     /// (default 36,12,4).
     #[arg(long, value_name = "T,D,DEPTH")]
     pub map_grid: Option<String>,
-    /// Pin–part friction coefficient μc (≥ 0).
+    /// Pin–part friction coefficient μc, in [0, 5].
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
-    /// Pin radius in part units: the coordinates the part is given in,
-    /// not metres (`plan` and `sense`, which take `--scale`, use metres); 0: point pin.
+    /// Pin radius in part units (the coordinates the part is given in), as in every command;
+    /// 0: point pin.
     #[arg(
         long,
         default_value_t = 0.0,
