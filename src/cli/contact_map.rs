@@ -74,8 +74,8 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         &support,
         c.pin_radius,
         settings,
-        args.map_grid.as_deref(),
-        args.cache_dir.as_deref(),
+        args.push.map_grid.as_deref(),
+        args.push.cache_dir.as_deref(),
     )?;
     let (pose, start) = case_geometry(&poly, &c);
     let started = Instant::now();
