@@ -4,7 +4,7 @@
 use crate::plan::design::survey::{page, survey_part, SurveyPart, SurveySettings};
 use crate::plan::problem::parse_mu_c_range;
 use crate::report::shell_word;
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use std::path::PathBuf;
 
 /// The arguments of `bench designs`.
@@ -43,7 +43,8 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar) -> Result<()> {
     if a.random > 10_000 {
         bail!("--random {}: must lie in 0..=10000", a.random);
     }
-    let mu_c_range = a.mu_c_range.as_deref().map(parse_mu_c_range).transpose()?;
+    let mu_c_range = (a.mu_c_range.as_deref().map(parse_mu_c_range).transpose())
+        .map_err(|e| anyhow!("--mu-c-range {e}"))?;
     let mut parts: Vec<SurveyPart> = a.parts.iter().map(|s| SurveyPart::parse(s)).collect();
     parts.extend(
         (a.first..a.first.saturating_add(a.random))

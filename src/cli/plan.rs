@@ -189,7 +189,8 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
         .mu_c_range
         .as_deref()
         .map(parse_mu_c_range)
-        .transpose()?;
+        .transpose()
+        .map_err(|e| anyhow!("--mu-c-range {e}"))?;
     p.tripod = args.tripod;
     if let Some(r) = args.pin_radius {
         p.pin_radius_m = pin_radius_m(&args.part, r, args.scale)?;
@@ -212,8 +213,8 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.contact_tol = args.contact_tol;
     p.seed = args.seed;
     match p.compile() {
-        Err(PlanError::Input { flag, .. })
-            if flag == "--pin-radius" && args.pin_radius.is_none() =>
+        Err(PlanError::Input { field, .. })
+            if field == "pin_radius" && args.pin_radius.is_none() =>
         {
             Err(anyhow!(
                 "the default pin radius, 2 mm, is larger than the part at --scale {} (its largest \
@@ -221,8 +222,49 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
                 args.scale
             ))
         }
-        r => r.map(|_| p).map_err(Into::into),
+        r => r.map(|_| p).map_err(|e| flagged(e.into())),
     }
+}
+
+/// The flag of a planner field the library names in its errors (`tolerance` → `--tolerance`,
+/// `modes` → `--pins/--fences/--sensor`).
+fn flag_of(field: &str) -> String {
+    match field {
+        "modes" => "--pins/--fences/--sensor".into(),
+        f => f
+            .split('/')
+            .map(|f| format!("--{}", f.replace('_', "-")))
+            .collect::<Vec<_>>()
+            .join("/"),
+    }
+}
+
+/// A planner error with the field it names replaced by the flag that set it.
+fn flagged(e: anyhow::Error) -> anyhow::Error {
+    let input = match e.downcast_ref::<design::DesignError>() {
+        Some(design::DesignError::Plan(p)) => Some(p),
+        _ => e.downcast_ref::<PlanError>(),
+    };
+    let (field, value, reason) = match (input, e.downcast_ref::<design::DesignError>()) {
+        (
+            Some(PlanError::Input {
+                field,
+                value,
+                reason,
+            }),
+            _,
+        )
+        | (
+            _,
+            Some(design::DesignError::Input {
+                field,
+                value,
+                reason,
+            }),
+        ) => (field, value, reason),
+        _ => return e,
+    };
+    anyhow!("{} {value}: {reason}", flag_of(field))
 }
 
 /// `--pin-radius R` (part units) in metres: R × scale, once R is checked against the part
@@ -364,7 +406,9 @@ pub fn run(args: &PlanArgs) -> Result<()> {
             b.set_message(p.to_string());
         }
     };
-    let d = pool.install(|| design::design(&o, &tell))?;
+    let d = pool
+        .install(|| design::design(&o, &tell))
+        .map_err(|e| flagged(e.into()))?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }

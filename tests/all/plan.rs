@@ -276,7 +276,7 @@ fn impossible_constraints_are_refused_with_the_flag_named() {
         (vec!["--tolerance", "0.1"], "--tolerance"),
         (vec!["--belt-width", "1e308"], "--belt-width"),
         (vec!["--spacing", "1e6"], "--spacing"),
-        (vec!["--depth", "0"], "--depth"),
+        (vec!["--depth", "0"], "--max-pins"),
         (vec!["--target", "1.5"], "--target"),
         (vec!["--mu-c-range", "0.7:x"], "--mu-c-range"),
         (vec!["--mu-c-range", "0.7:0.3"], "--mu-c-range"),
