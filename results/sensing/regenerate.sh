@@ -19,9 +19,9 @@ for part in tripoly1 tripoly2; do
     --out results/sensing/$part/placement/nominal > /dev/null
   $P sense --part $part --d=-0.2 --trials 300 --noise 1 --placement --mu-c-range 0.3:0.7 --tripod \
     --out results/sensing/$part/placement/uncertain > /dev/null
-  # Vertex or edge first contact (a pin of 3 mm radius: a point pin meets edges only).
+  # Vertex or edge first contact (a pin of 3 mm radius, 0.15 part units at the default scale: a point pin meets edges only).
   for d in -0.2 0.2; do
-    $P sense --part $part --d=$d --hypotheses vertex-edge --pin-radius 0.003 --trials 300 \
+    $P sense --part $part --d=$d --hypotheses vertex-edge --pin-radius 0.15 --trials 300 \
       --out results/sensing/$part/vertex-edge/d$d > /dev/null
   done
 done

@@ -4,7 +4,7 @@ use crate::mechanics::Fidelity;
 use crate::study::{contact_cost, map_cost};
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
 pub struct BenchArgs {
@@ -63,34 +63,7 @@ pub enum BenchWhat {
     },
     /// Designs for many parts: each mode alone and all modes together, every verdict from the
     /// line; writes results/designs.md (or --out).
-    Designs {
-        /// Polygons random:FIRST … random:FIRST+N−1 (0: none).
-        #[arg(long, default_value_t = 20)]
-        random: u64,
-        #[arg(long, default_value_t = 1)]
-        first: u64,
-        /// More parts (`;`-separated specs, each `SPEC` or `SPEC@SCALE`, e.g.
-        /// "tripoly1;vertices:0,0 40,0 20,30@0.001").
-        #[arg(long, value_delimiter = ';')]
-        parts: Vec<String>,
-        /// Each design's time limit (s).
-        #[arg(long, default_value_t = 110.0)]
-        time_limit: f64,
-        /// Parts of each line check.
-        #[arg(long, default_value_t = 10_000)]
-        check_parts: u64,
-        /// Robust designs: μc uniform in LO:HI per part, checked the same way.
-        #[arg(long, value_name = "LO:HI")]
-        mu_c_range: Option<String>,
-        /// Robust designs: random tripod supports.
-        #[arg(long)]
-        tripod: bool,
-        /// Worker threads (0: one per core); the results do not depend on it.
-        #[arg(long, default_value_t = 0)]
-        threads: usize,
-        #[arg(long, default_value = "pinfeed-out/designs.md")]
-        out: PathBuf,
-    },
+    Designs(super::bench_designs::DesignsArgs),
     /// Wall time of the 18 thesis configuration maps (d = ±0.1 … ±0.9, 360 θ0 each) per part,
     /// model and thread count; writes --out (the committed report: results/maps/timing.md).
     Maps {
@@ -136,18 +109,13 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
                 "cargo run --release -- bench accuracy --contacts {contacts} --seed {seed} --out {}",
                 out.display()
             );
-            if let Some(dir) = out.parent() {
-                std::fs::create_dir_all(dir).ok();
-            }
             let p_md = out.with_extension("md");
             let old = std::fs::read_to_string(&p_md).unwrap_or_default();
             let md = crate::study::accuracy::report_keeping(&st, &cmd, &old);
             let p_csv = out.with_extension("csv");
             let p_svg = out.with_extension("svg");
-            crate::report::atomic::write_atomic(&p_md, md)
-                .with_context(|| format!("writing {}", p_md.display()))?;
-            crate::report::atomic::write_atomic(&p_csv, crate::study::accuracy::csv(&st))
-                .with_context(|| format!("writing {}", p_csv.display()))?;
+            write_file(&p_md, md)?;
+            write_file(&p_csv, crate::study::accuracy::csv(&st))?;
             crate::report::plot_accuracy::plot_accuracy(&st, &p_svg)
                 .with_context(|| format!("writing {}", p_svg.display()))?;
             print!("{}", crate::study::accuracy::markdown_table(&st));
@@ -183,11 +151,7 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
                 *seed,
             )?;
             let (table, doc) = contact_cost::report(&rows, &scaling, *contacts, *tol, *seed, out);
-            if let Some(dir) = out.parent() {
-                std::fs::create_dir_all(dir).ok();
-            }
-            crate::report::atomic::write_atomic(out, &doc)
-                .with_context(|| format!("writing {}", out.display()))?;
+            write_file(out, &doc)?;
             print!("{table}");
             eprintln!("wrote {}", out.display());
             Ok(())
@@ -196,30 +160,7 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
             spin.set_message(format!("maps: {repeats} timed runs per row"));
             bench_maps(*repeats, out)
         }
-        BenchWhat::Designs {
-            random,
-            first,
-            parts,
-            time_limit,
-            check_parts,
-            mu_c_range,
-            tripod,
-            threads,
-            out,
-        } => super::bench_designs::run(
-            &super::bench_designs::DesignsArgs {
-                random: *random,
-                first: *first,
-                parts: parts.clone(),
-                time_limit: *time_limit,
-                check_parts: *check_parts,
-                mu_c_range: mu_c_range.clone(),
-                tripod: *tripod,
-                threads: *threads,
-                out: out.clone(),
-            },
-            spin,
-        ),
+        BenchWhat::Designs(a) => super::bench_designs::run(a, spin),
         BenchWhat::McPrecision {
             study,
             samples,
@@ -231,7 +172,21 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
     }
 }
 
-fn bench_maps(repeats: usize, out: &std::path::Path) -> Result<()> {
+/// Write a report file (creating its folder), naming it on failure.
+pub(super) fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
+    crate::report::create_parent(path)?;
+    crate::report::atomic::write_atomic(path, bytes)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Rewrite a report file from its current text (empty when it does not exist yet): for the
+/// commands that replace their own marked section of a shared report.
+pub(super) fn rewrite_file(path: &Path, edit: impl FnOnce(&str) -> String) -> Result<()> {
+    let old = std::fs::read_to_string(path).unwrap_or_default();
+    write_file(path, edit(&old))
+}
+
+fn bench_maps(repeats: usize, out: &Path) -> Result<()> {
     if repeats == 0 || repeats > 1000 {
         anyhow::bail!("--repeats must be between 1 and 1000, got {repeats}");
     }
@@ -241,21 +196,12 @@ fn bench_maps(repeats: usize, out: &std::path::Path) -> Result<()> {
     threads.dedup();
     let fids = [Fidelity::Exact, Fidelity::Ellipsoid, Fidelity::Tip];
     // Other work on the machine slows every row: say how busy it was (Linux only).
-    let load = || {
-        std::fs::read_to_string("/proc/loadavg")
-            .ok()
-            .and_then(|l| l.split_whitespace().next().map(str::to_string))
-            .unwrap_or_else(|| "unknown".into())
-    };
+    let load = super::bench_mc::load_average;
     let load_before = load();
     let rows = map_cost::measure(&["tripoly1", "tripoly2"], &fids, &threads, 1.0, repeats)?;
     let load_after = load();
     let (table, doc) = map_cost::report(&rows, repeats, cores, (&load_before, &load_after), out);
-    if let Some(dir) = out.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    crate::report::atomic::write_atomic(out, &doc)
-        .with_context(|| format!("writing {}", out.display()))?;
+    write_file(out, &doc)?;
     print!("{table}");
     eprintln!("wrote {}", out.display());
     Ok(())

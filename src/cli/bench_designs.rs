@@ -1,23 +1,40 @@
 //! `pinfeed bench designs`: maps its arguments to [`crate::plan::design::survey`] and writes the
 //! Markdown report (rewritten after every part, so a long survey shows its progress).
 
-use crate::plan::design::survey::{markdown, survey_part, SurveyPart, SurveySettings};
-use crate::report::atomic::write_atomic;
+use crate::plan::design::survey::{page, survey_part, SurveyPart, SurveySettings};
+use crate::plan::problem::parse_mu_c_range;
 use crate::report::shell_word;
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::PathBuf;
 
 /// The arguments of `bench designs`.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct DesignsArgs {
+    /// Polygons random:FIRST … random:FIRST+N−1 (0: none).
+    #[arg(long, default_value_t = 20)]
     pub random: u64,
+    #[arg(long, default_value_t = 1)]
     pub first: u64,
+    /// More parts (`;`-separated specs, each `SPEC` or `SPEC@SCALE`, e.g.
+    /// "tripoly1;vertices:0,0 40,0 20,30@0.001").
+    #[arg(long, value_delimiter = ';')]
     pub parts: Vec<String>,
+    /// Each design's time limit (s).
+    #[arg(long, default_value_t = 110.0)]
     pub time_limit: f64,
+    /// Parts of each line check.
+    #[arg(long, default_value_t = 10_000)]
     pub check_parts: u64,
+    /// Robust designs: μc uniform in LO:HI per part, checked the same way.
+    #[arg(long, value_name = "LO:HI")]
     pub mu_c_range: Option<String>,
+    /// Robust designs: random tripod supports.
+    #[arg(long)]
     pub tripod: bool,
+    /// Worker threads (0: one per core); the results do not depend on it.
+    #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    #[arg(long, default_value = "pinfeed-out/designs.md")]
     pub out: PathBuf,
 }
 
@@ -26,22 +43,8 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar) -> Result<()> {
     if a.random > 10_000 {
         bail!("--random {}: must lie in 0..=10000", a.random);
     }
-    let mu_c_range = match &a.mu_c_range {
-        None => None,
-        Some(r) => {
-            let (lo, hi) = r
-                .split_once(':')
-                .ok_or_else(|| anyhow!("--mu-c-range '{r}': expected LO:HI"))?;
-            Some((
-                lo.trim()
-                    .parse::<f64>()
-                    .map_err(|_| anyhow!("--mu-c-range '{r}': '{lo}' is not a number"))?,
-                hi.trim()
-                    .parse::<f64>()
-                    .map_err(|_| anyhow!("--mu-c-range '{r}': '{hi}' is not a number"))?,
-            ))
-        }
-    };
+    let mu_c_range = (a.mu_c_range.as_deref().map(parse_mu_c_range).transpose())
+        .map_err(|e| anyhow!("--mu-c-range {e}"))?;
     let mut parts: Vec<SurveyPart> = a.parts.iter().map(|s| SurveyPart::parse(s)).collect();
     parts.extend(
         (a.first..a.first.saturating_add(a.random))
@@ -90,26 +93,8 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar) -> Result<()> {
             p.label
         ));
         rows.push(pool.install(|| survey_part(&s, p)));
-        let mut m = format!(
-            "# Designs the line confirms (`pinfeed bench designs`)\n\nRegenerate:\n\n    {command}\n\n"
-        );
-        m += "Each cell is one run of `pinfeed plan` (the design workflow) allowed one mode — fixed pins, fences, a sensor pin with moving pins — or all of them together with lines that mix pins and fences (the default). Every other setting is `pinfeed plan`'s default: a stable-state feed with equal weights, 2° jitter, ±2 mm lateral; μc 0.5 (fences μf = μc), 2 mm pins 15 cm apart, a 10 cm belt for pins (fences may widen it: the width is reported); goal ≥ 0.99 of the parts in one ±3° window modulo the part's symmetry. A design is **confirmed** when its line check (the parts below, at the headway the workflow chose on the line) holds the goal; otherwise the best design the line measured is reported **not confirmed** with its number. Cells: verdict, line success [95% CI] of N parts; obstacles (the mode chosen); belt length × width; headway and oriented parts per minute; wall time of the whole design on this 2-core machine.\n\n";
-        let title = match (&s.mu_c_range, s.tripod) {
-            (None, false) => "Nominal physics".to_string(),
-            (r, t) => format!(
-                "Under uncertainty:{}{} (planned and checked against it)",
-                r.map_or(String::new(), |(lo, hi)| format!(
-                    " μc uniform in [{lo}, {hi}]"
-                )),
-                if t { ", random tripod supports" } else { "" }
-            ),
-        };
-        m += &markdown(&title, &rows);
-        if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        }
-        write_atomic(&a.out, m.as_bytes())
-            .with_context(|| format!("writing {}", a.out.display()))?;
+        let m = page(&command, &s, &rows);
+        super::bench::write_file(&a.out, m)?;
     }
     eprintln!("wrote {}", a.out.display());
     Ok(())

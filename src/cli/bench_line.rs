@@ -63,10 +63,7 @@ pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar) -> Result<()> {
         a.out.display()
     );
     let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, &cmd), MARKERS.1);
-    crate::report::create_parent(&a.out)?;
-    let old = std::fs::read_to_string(&a.out).unwrap_or_default();
-    crate::report::atomic::write_atomic(&a.out, splice_between(&old, &marked, MARKERS))
-        .with_context(|| format!("writing {}", a.out.display()))?;
+    super::bench::rewrite_file(&a.out, |old| splice_between(old, &marked, MARKERS))?;
     eprintln!("wrote {}", a.out.display());
     Ok(())
 }

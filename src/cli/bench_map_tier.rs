@@ -4,7 +4,7 @@
 use crate::study::map_tier::{
     contact_row, contact_section, line_row, line_section, marked, splice,
 };
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -31,10 +31,7 @@ pub struct MapTierArgs {
 }
 
 fn write_section(path: &Path, section: &str) -> Result<()> {
-    crate::report::create_parent(path)?;
-    let old = std::fs::read_to_string(path).unwrap_or_default();
-    crate::report::atomic::write_atomic(path, splice(&old, &marked(section)))
-        .with_context(|| format!("writing {}", path.display()))?;
+    super::bench::rewrite_file(path, |old| splice(old, &marked(section)))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }

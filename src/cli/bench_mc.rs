@@ -6,11 +6,11 @@
 
 use crate::mechanics::Fidelity;
 use crate::study::mc::{self, precision};
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use std::path::Path;
 
 /// The machine's 1-minute load average (Linux), for the record.
-fn load_average() -> String {
+pub(super) fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
         .ok()
         .and_then(|l| l.split_whitespace().next().map(str::to_string))
@@ -97,10 +97,7 @@ pub fn run(
             load_after,
         },
     );
-    crate::report::create_parent(out)?;
-    let doc = std::fs::read_to_string(out).unwrap_or_default();
-    crate::report::atomic::write_atomic(out, precision::splice(&doc, &section))
-        .with_context(|| format!("writing {}", out.display()))?;
+    super::bench::rewrite_file(out, |doc| precision::splice(doc, &section))?;
     print!("{section}");
     eprintln!(
         "wrote the Monte Carlo precision section of {}",

@@ -38,7 +38,7 @@ pub struct CalibrateArgs {
     /// Range of the μc mean searched (and of the proposal): MIN:MAX.
     #[arg(long, default_value = "0.05:1", allow_hyphen_values = true)]
     pub mu_c_range: String,
-    /// Largest pin radius searched (part units, not metres, as `validate --pin-radius`).
+    /// Largest pin radius searched (part units, as `validate --pin-radius`).
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub pin_radius_max: f64,
     /// σρ: spread of the pin radius under every fitted ensemble (part units).

@@ -30,27 +30,11 @@ pub struct ContactArgs {
     /// largest centroid–vertex distance), a ratio without a length unit.
     #[arg(long, allow_hyphen_values = true, required_unless_present = "cases")]
     pub d: Option<f64>,
-    /// Pin–part friction coefficient μc (≥ 0).
-    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
-    pub mu_c: f64,
+    #[command(flatten)]
+    pub push: super::physics::PushArgs,
     /// Part–belt friction coefficient μs (> 0; scales forces only).
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub mu_s: f64,
-    /// Fidelity: exact, ellipsoid or tip; or map (the certified map tier over exact, still pins).
-    #[arg(long, default_value = "exact")]
-    pub model: String,
-    /// With --model map: the folder of the map cache files (default $XDG_CACHE_HOME/pinfeed/maps
-    /// or ~/.cache/pinfeed/maps).
-    #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
-    pub cache_dir: Option<PathBuf>,
-    /// With --model map: the map's grid, θ0 base cells, d base cells, refinement depth
-    /// (default 36,12,4).
-    #[arg(long, value_name = "T,D,DEPTH")]
-    pub map_grid: Option<String>,
-    /// Pin radius in part units: the coordinates the part is given in,
-    /// not metres (`plan` and `sense`, which take `--scale`, use metres); 0: point pin.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    pub pin_radius: f64,
     /// Lateral pin speed as a fraction of the belt speed (moving pin).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_speed: f64,
@@ -88,12 +72,6 @@ pub struct ContactArgs {
         conflicts_with_all = ["pin_stop", "pin_stop_at", "fence"]
     )]
     pub pin_stop_after_touch: Option<f64>,
-    /// Support: uniform or tripod:SEED.
-    #[arg(long, default_value = "uniform")]
-    pub support: String,
-    /// Integration tolerance (absolute, radians / units of a, per step).
-    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
-    pub tol: f64,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -166,42 +144,38 @@ pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
         Some(y) => Some(stop_travel(y, d, args.pin_speed)?),
         None => args.pin_stop,
     };
+    let part = args.part.clone().unwrap_or_default();
     Ok(Case {
-        part: args.part.clone().unwrap_or_default(),
         theta0_deg: args.theta0.unwrap_or(0.0),
         d,
-        mu_c: args.mu_c,
         mu_s: args.mu_s,
-        model,
-        pin_radius: args.pin_radius,
         pin_speed: args.pin_speed,
         pin_stop,
         pin_stop_after_touch: args.pin_stop_after_touch,
-        support: args.support.clone(),
-        tol: args.tol,
         fence: args.fence.as_deref().map(parse_fence).transpose()?,
+        ..args.push.case(part, model)
     })
 }
 
 pub fn run(args: &ContactArgs) -> Result<()> {
     if let Some(path) = &args.cases {
         let defaults = BatchDefaults {
-            model: args.model.clone(),
+            model: args.push.model.clone(),
             mu_s: args.mu_s,
-            pin_radius: args.pin_radius,
+            pin_radius: args.push.pin_radius,
             pin_speed: args.pin_speed,
             pin_stop: args.pin_stop,
             pin_stop_after_touch: args.pin_stop_after_touch,
-            support: args.support.clone(),
-            tol: args.tol,
+            support: args.push.support.clone(),
+            tol: args.push.tol,
             fence: args.fence.clone(),
         };
         return Ok(run_batch(&defaults, path, std::io::stdout().lock())?);
     }
-    if args.model.trim() == "map" {
+    if args.push.map_tier() {
         return super::contact_map::run(args);
     }
-    let c = case_of(args, parse_model(&args.model)?)?;
+    let c = case_of(args, parse_model(&args.push.model)?)?;
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
     if let Some(path) = &args.trace {

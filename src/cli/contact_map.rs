@@ -80,8 +80,8 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     // Only the base cell of the query is built (and kept in the cache beside any built before).
     let loaded = load_tier(
         (&model, &support, c.pin_radius, settings),
-        args.map_grid.as_deref(),
-        args.cache_dir.as_deref(),
+        args.push.map_grid.as_deref(),
+        args.push.cache_dir.as_deref(),
         Some(&[(pose, start)]),
         args.json,
     )?;

@@ -40,43 +40,21 @@ pub struct MapArgs {
     /// Map a fence instead of a pin: angle from the belt direction in degrees (−90 < α < 90;
     /// positive fences deflect parts to the left) and optional length in part units (default 20a),
     /// placed as `pinfeed contact --fence` places it; `--mu-c` is the fence friction μf.
-    #[arg(long, value_name = "ANGLE_DEG[:LENGTH]", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "ANGLE_DEG[:LENGTH]",
+        allow_hyphen_values = true,
+        conflicts_with = "pin_radius"
+    )]
     pub fence: Option<String>,
     /// Spacing of the initial orientations θ0 (degrees; must divide 360).
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub theta_step: f64,
-    /// Fidelity: exact, ellipsoid or tip; or map (the certified map tier over exact, pins only).
-    #[arg(long, default_value = "exact")]
-    pub model: String,
-    /// With --model map: the folder of the map cache files (default $XDG_CACHE_HOME/pinfeed/maps
-    /// or ~/.cache/pinfeed/maps).
-    #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
-    pub cache_dir: Option<PathBuf>,
-    /// With --model map: the map's grid, θ0 base cells, d base cells, refinement depth
-    /// (default 36,12,4).
-    #[arg(long, value_name = "T,D,DEPTH")]
-    pub map_grid: Option<String>,
-    /// Pin–part friction coefficient μc (≥ 0).
-    #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
-    pub mu_c: f64,
-    /// Pin radius in part units: the coordinates the part is given in,
-    /// not metres (`plan` and `sense`, which take `--scale`, use metres); 0: point pin.
-    #[arg(
-        long,
-        default_value_t = 0.0,
-        allow_hyphen_values = true,
-        conflicts_with = "fence"
-    )]
-    pub pin_radius: f64,
-    /// Support: uniform or tripod:SEED.
-    #[arg(long, default_value = "uniform")]
-    pub support: String,
+    #[command(flatten)]
+    pub push: super::physics::PushArgs,
     /// Band threshold T (degrees): neighbouring final angles at least T apart start a new band.
     #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub threshold: f64,
-    /// Integration tolerance (absolute, radians / units of a, per step).
-    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
-    pub tol: f64,
     /// Print the maps as one JSON document.
     #[arg(long, conflicts_with = "csv")]
     pub json: bool,
@@ -124,20 +102,20 @@ pub fn command_line(args: &MapArgs) -> String {
         "--theta-step".into(),
         args.theta_step.to_string(),
         "--model".into(),
-        shell_word(&args.model),
+        shell_word(&args.push.model),
         "--mu-c".into(),
-        args.mu_c.to_string(),
+        args.push.mu_c.to_string(),
     ]);
     if args.fence.is_none() {
-        words.extend(["--pin-radius".into(), args.pin_radius.to_string()]);
+        words.extend(["--pin-radius".into(), args.push.pin_radius.to_string()]);
     }
     words.extend([
         "--support".into(),
-        shell_word(&args.support),
+        shell_word(&args.push.support),
         "--threshold".into(),
         args.threshold.to_string(),
         "--tol".into(),
-        args.tol.to_string(),
+        args.push.tol.to_string(),
     ]);
     for (flag, dir) in [("--out-dir", &args.out_dir), ("--plot-dir", &args.plot_dir)] {
         if let Some(dir) = dir {
@@ -173,32 +151,21 @@ pub fn default_out_dir(part: &str) -> PathBuf {
 
 pub fn run(args: &MapArgs) -> Result<()> {
     // The map tier answers over the exact model, which computes what it cannot vouch for.
-    let use_tier = args.model.trim() == "map";
+    let use_tier = args.push.map_tier();
     if use_tier && (args.fence.is_some() || args.uncertain.is_some()) {
         bail!("--model map: the map tier tabulates still pins with one support; use --model exact with --fence or --uncertain");
     }
-    let model = parse_model(if use_tier { "exact" } else { &args.model })?;
+    let model = parse_model(if use_tier { "exact" } else { &args.push.model })?;
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;
     let template = Case {
-        part: args.part.clone(),
-        theta0_deg: 0.0,
-        d: 0.0,
-        mu_c: args.mu_c,
-        mu_s: crate::mechanics::ContactSettings::default().mu_s,
-        model,
-        pin_radius: args.pin_radius,
-        pin_speed: 0.0,
-        pin_stop: None,
-        pin_stop_after_touch: None,
-        support: args.support.clone(),
-        tol: args.tol,
         fence,
+        ..args.push.case(args.part.clone(), model)
     };
     check_inputs(&template)?;
     let fenced = args.fence.is_some();
     let (step, threshold) = (args.theta_step, args.threshold);
     crate::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold)?;
-    let (poly, part_model) = compile_part(&args.part, &args.support)?;
+    let (poly, part_model) = compile_part(&args.part, &args.push.support)?;
     if fence.is_some() {
         check_geometry(&template, &poly)?;
     } else {
@@ -243,13 +210,13 @@ pub fn run(args: &MapArgs) -> Result<()> {
             .flat_map(|&d| grid.iter().map(move |&t| (t, d)))
             .map(|(t, d)| crate::maps::pass_start(&poly, t, d, pin.radius))
             .collect();
-        let support =
-            crate::mechanics::Support::parse(&args.support, &poly).map_err(anyhow::Error::msg)?;
+        let support = crate::mechanics::Support::parse(&args.push.support, &poly)
+            .map_err(anyhow::Error::msg)?;
         let loaded = pool.install(|| {
             super::contact_map::load_tier(
-                (&part_model, &support, args.pin_radius, contact),
-                args.map_grid.as_deref(),
-                args.cache_dir.as_deref(),
+                (&part_model, &support, args.push.pin_radius, contact),
+                args.push.map_grid.as_deref(),
+                args.push.cache_dir.as_deref(),
                 Some(&passes),
                 args.json || args.csv,
             )
@@ -292,12 +259,12 @@ pub fn run(args: &MapArgs) -> Result<()> {
         command: command_line(args),
         part: &args.part,
         model: if use_tier { "map" } else { model.name() },
-        mu_c: args.mu_c,
-        pin_radius: args.pin_radius,
-        support: &args.support,
+        mu_c: args.push.mu_c,
+        pin_radius: args.push.pin_radius,
+        support: &args.push.support,
         theta_step_deg: args.theta_step,
         threshold_deg: args.threshold,
-        tol: args.tol,
+        tol: args.push.tol,
         fence: fence.map(|(angle, length)| case_fence(&poly, &template, angle, length)),
         maps: &maps,
     };
@@ -367,8 +334,8 @@ mod tests {
         let refs: Vec<&str> = words.iter().skip(1).map(String::as_str).collect();
         let b = parse(&refs);
         assert_eq!(
-            (b.part, b.d, b.mu_c, b.theta_step),
-            (a.part, a.d, a.mu_c, a.theta_step)
+            (b.part, b.d, b.push.mu_c, b.theta_step),
+            (a.part, a.d, a.push.mu_c, a.theta_step)
         );
         assert_eq!(b.out_dir, a.out_dir);
         assert_eq!(command_line(&parse(&refs)), cmd);

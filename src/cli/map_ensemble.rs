@@ -32,7 +32,7 @@ fn ensemble_command(args: &MapArgs, uncertain: &str) -> String {
 }
 
 pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> Result<()> {
-    if args.support.trim() != "uniform" {
+    if args.push.support.trim() != "uniform" {
         bail!("--support: with --uncertain the support is set by `support=` in the uncertain list; leave --support at uniform");
     }
     if !(1..=MAX_MEMBERS).contains(&args.members) {
@@ -41,7 +41,7 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
             args.members
         );
     }
-    let spec = EnsembleSpec::nominal(args.mu_c, args.pin_radius, model, args.tol)
+    let spec = EnsembleSpec::nominal(args.push.mu_c, args.push.pin_radius, model, args.push.tol)
         .with_settings(uncertain)
         .map_err(|e| anyhow!("--uncertain: {e}"))?;
     let grid = theta_grid(args.theta_step).map_err(|e| anyhow!("--theta-step: {e}"))?;

@@ -23,6 +23,7 @@ pub mod map_ensemble;
 pub mod mc;
 pub mod merge;
 pub mod part;
+pub mod physics;
 pub mod plan;
 pub mod progress;
 pub mod run;

@@ -7,9 +7,10 @@
 //! confirmed design.
 
 use super::stdout::print_result;
+use crate::geometry::part_from_spec;
 use crate::plan::design::{self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status};
 use crate::plan::problem::parse_mu_c_range;
-use crate::plan::{FeedKind, Problem};
+use crate::plan::{FeedKind, PlanError, Problem};
 use crate::report::plan_summary::{self as summary, write_design, DesignPaths};
 use crate::report::shell_word;
 use anyhow::{anyhow, Context, Result};
@@ -69,9 +70,10 @@ pub struct PlanArgs {
     /// Be robust against the support: each particle gets its own random tripod.
     #[arg(long)]
     pub tripod: bool,
-    /// Pin radius in metres (0 = point pin); `contact`, `map` and `validate` take part units.
-    #[arg(long, default_value_t = 0.002, allow_hyphen_values = true)]
-    pub pin_radius: f64,
+    /// Pin radius in part units, like the part's vertices and as in every command (0 = point pin;
+    /// metres = part units × --scale) [default: 2 mm, i.e. 0.002/--scale part units].
+    #[arg(long, allow_hyphen_values = true)]
+    pub pin_radius: Option<f64>,
     /// Belt width in metres [default: 0.1; without it fence designs may use a wider belt, reported].
     #[arg(long, allow_hyphen_values = true)]
     pub belt_width: Option<f64>,
@@ -187,9 +189,12 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
         .mu_c_range
         .as_deref()
         .map(parse_mu_c_range)
-        .transpose()?;
+        .transpose()
+        .map_err(|e| anyhow!("--mu-c-range {e}"))?;
     p.tripod = args.tripod;
-    p.pin_radius_m = args.pin_radius;
+    if let Some(r) = args.pin_radius {
+        p.pin_radius_m = pin_radius_m(&args.part, r, args.scale)?;
+    }
     if let Some(w) = args.belt_width {
         p.belt_width_m = w;
     }
@@ -207,8 +212,73 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.time_limit_s = args.time_limit;
     p.contact_tol = args.contact_tol;
     p.seed = args.seed;
-    p.compile()?;
-    Ok(p)
+    match p.compile() {
+        Err(PlanError::Input { field, .. })
+            if field == "pin_radius" && args.pin_radius.is_none() =>
+        {
+            Err(anyhow!(
+                "the default pin radius, 2 mm, is larger than the part at --scale {} (its largest \
+                 centroid–vertex distance a); give --pin-radius in part units, at most a",
+                args.scale
+            ))
+        }
+        r => r.map(|_| p).map_err(|e| flagged(e.into())),
+    }
+}
+
+/// The flag of a planner field the library names in its errors (`tolerance` → `--tolerance`,
+/// `modes` → `--pins/--fences/--sensor`).
+fn flag_of(field: &str) -> String {
+    match field {
+        "modes" => "--pins/--fences/--sensor".into(),
+        f => f
+            .split('/')
+            .map(|f| format!("--{}", f.replace('_', "-")))
+            .collect::<Vec<_>>()
+            .join("/"),
+    }
+}
+
+/// A planner error with the field it names replaced by the flag that set it.
+fn flagged(e: anyhow::Error) -> anyhow::Error {
+    let input = match e.downcast_ref::<design::DesignError>() {
+        Some(design::DesignError::Plan(p)) => Some(p),
+        _ => e.downcast_ref::<PlanError>(),
+    };
+    let (field, value, reason) = match (input, e.downcast_ref::<design::DesignError>()) {
+        (
+            Some(PlanError::Input {
+                field,
+                value,
+                reason,
+            }),
+            _,
+        )
+        | (
+            _,
+            Some(design::DesignError::Input {
+                field,
+                value,
+                reason,
+            }),
+        ) => (field, value, reason),
+        _ => return e,
+    };
+    anyhow!("{} {value}: {reason}", flag_of(field))
+}
+
+/// `--pin-radius R` (part units) in metres: R × scale, once R is checked against the part
+/// (0 ≤ R ≤ a, a in part units); a part that cannot be built is left to [`Problem::compile`].
+fn pin_radius_m(part: &str, r: f64, scale: f64) -> Result<f64> {
+    let a = part_from_spec(part).map(|p| p.radius()).ok();
+    if !(r.is_finite() && r >= 0.0 && a.is_none_or(|a| r <= a)) {
+        let bound = a.map_or(String::new(), |a| format!(", a = {a:.6}"));
+        return Err(anyhow!(
+            "--pin-radius {r}: must lie in [0, a] part units (a: the part's largest \
+             centroid–vertex distance{bound}; metres = part units × --scale)"
+        ));
+    }
+    Ok(r * scale)
 }
 
 /// The design options of the arguments.
@@ -273,7 +343,11 @@ pub fn command_line(args: &PlanArgs) -> String {
         &a.mu_c_range.clone().unwrap_or_default(),
         &"",
     );
-    opt("--pin-radius", &a.pin_radius, &d.pin_radius_m);
+    opt(
+        "--pin-radius",
+        &a.pin_radius.map_or(String::new(), |r| r.to_string()),
+        &"",
+    );
     opt(
         "--belt-width",
         &a.belt_width.map_or(String::new(), |b| b.to_string()),
@@ -332,7 +406,9 @@ pub fn run(args: &PlanArgs) -> Result<()> {
             b.set_message(p.to_string());
         }
     };
-    let d = pool.install(|| design::design(&o, &tell))?;
+    let d = pool
+        .install(|| design::design(&o, &tell))
+        .map_err(|e| flagged(e.into()))?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }

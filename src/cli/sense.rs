@@ -44,7 +44,8 @@ pub struct SenseArgs {
     /// largest centroid–vertex distance), a ratio without a length unit.
     #[arg(long, allow_hyphen_values = true)]
     pub d: f64,
-    /// Pin radius in metres (0: point pin); `contact`, `map` and `validate` take part units.
+    /// Pin radius in part units, like the part's vertices and as in every command (0: point pin;
+    /// metres = part units × --scale).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Pin–part friction μc (nominal).

@@ -147,7 +147,7 @@ pub struct ValidateArgs {
     /// Nominal pin–part friction μc (replaced by `mu_c=` in --uncertain).
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
-    /// Nominal pin radius in part units, not metres, as `contact --pin-radius` (replaced by
+    /// Nominal pin radius in part units, as `contact --pin-radius` (replaced by
     /// `pin_radius=` in --uncertain).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,

@@ -223,15 +223,15 @@ pub fn branch_states(planner: &Planner) -> Result<Vec<State>, PlanError> {
     let p = &planner.problem;
     if p.feed != FeedKind::Stable {
         return Err(PlanError::input(
-            "--feed",
+            "feed",
             "uniform",
-            "the contingent planner senses the stable state: use --feed stable",
+            "the contingent planner senses the stable state: use a stable feed",
         ));
     }
     let c = &planner.compiled;
     if c.stable_deg.len() < 2 {
         return Err(PlanError::input(
-            "--sensor",
+            "sensor",
             c.stable_deg.len(),
             "the part has fewer than two stable states: there is nothing to sense",
         ));
@@ -307,9 +307,9 @@ pub fn search(
     }
     if sensors.is_empty() {
         return Err(PlanError::input(
-            "--min-margin",
+            "min_margin",
             format!("{} mm", planner.problem.min_margin_m * 1e3),
-            "no sensor pin position touches every part with this margin from a band edge: try a smaller --min-margin",
+            "no sensor pin position touches every part with this margin from a band edge: try a smaller min_margin",
         ));
     }
     let total: u32 = branches.iter().map(|b| b.total()).sum();

@@ -68,10 +68,11 @@ pub use search::{search, Outcome, Plan, PlanStep, SearchStats};
 /// Bad planner input, or a planner that cannot start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanError {
-    /// A value out of range; `flag` names the CLI flag (or problem field) it came from.
-    #[error("{flag} {value}: {reason}")]
+    /// A value out of range; `field` names the quantity (the [`Problem`] or design option it came
+    /// from, without its unit suffix: `tolerance`, `pin_radius`, `modes`, …).
+    #[error("{field} {value}: {reason}")]
     Input {
-        flag: &'static str,
+        field: &'static str,
         value: String,
         reason: String,
     },
@@ -81,9 +82,9 @@ pub enum PlanError {
 }
 
 impl PlanError {
-    pub(crate) fn input(flag: &'static str, value: impl ToString, reason: impl ToString) -> Self {
+    pub(crate) fn input(field: &'static str, value: impl ToString, reason: impl ToString) -> Self {
         PlanError::Input {
-            flag,
+            field,
             value: value.to_string(),
             reason: reason.to_string(),
         }

@@ -28,9 +28,9 @@ impl FeedKind {
 /// An uncertain-μc range that is not `LO:HI` with two numbers.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RangeSpecError {
-    #[error("--mu-c-range '{0}': expected LO:HI, e.g. 0.3:0.7")]
+    #[error("'{0}': expected LO:HI, e.g. 0.3:0.7")]
     Form(String),
-    #[error("--mu-c-range '{spec}': '{token}' is not a number")]
+    #[error("'{spec}': '{token}' is not a number")]
     Number { spec: String, token: String },
 }
 
@@ -149,20 +149,20 @@ impl Problem {
         }
     }
 
-    /// Check every value and build the part in metres. Errors name the flag.
+    /// Check every value and build the part in metres. Errors name the field.
     pub fn compile(&self) -> Result<Compiled, PlanError> {
-        let finite_pos = |flag: &'static str, v: f64| -> Result<(), PlanError> {
+        let finite_pos = |field: &'static str, v: f64| -> Result<(), PlanError> {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
                 Err(PlanError::input(
-                    flag,
+                    field,
                     v,
                     "must be a positive finite number",
                 ))
             }
         };
-        finite_pos("--scale", self.scale)?;
+        finite_pos("scale", self.scale)?;
         let unit = part_from_spec(&self.part).map_err(|err| PlanError::Part {
             part: self.part.clone(),
             reason: err.to_string(),
@@ -174,39 +174,39 @@ impl Problem {
         let a = polygon.radius();
         if !(1e-4..=1.0).contains(&a) {
             return Err(PlanError::input(
-                "--scale",
+                "scale",
                 self.scale,
                 format!("gives a part of size a = {a} m; it must lie in [0.1 mm, 1 m]"),
             ));
         }
         if !(self.jitter_deg.is_finite() && (0.0..=45.0).contains(&self.jitter_deg)) {
             return Err(PlanError::input(
-                "--jitter",
+                "jitter",
                 self.jitter_deg,
                 "must lie in [0, 45] degrees",
             ));
         }
         if !(self.lateral_m.is_finite() && self.lateral_m >= 0.0) {
             return Err(PlanError::input(
-                "--lateral",
+                "lateral",
                 self.lateral_m,
                 "must be a finite length ≥ 0 (m)",
             ));
         }
-        for (flag, n) in [
-            ("--jitter-samples", self.jitter_samples),
-            ("--offset-samples", self.offset_samples),
-            ("--orientation-samples", self.orientation_samples),
+        for (field, n) in [
+            ("jitter_samples", self.jitter_samples),
+            ("offset_samples", self.offset_samples),
+            ("orientation_samples", self.orientation_samples),
         ] {
             if !(1..=2000).contains(&n) {
-                return Err(PlanError::input(flag, n, "must lie in 1..=2000"));
+                return Err(PlanError::input(field, n, "must lie in 1..=2000"));
             }
         }
         let (mu_lo, mu_hi) = crate::mechanics::limits::MU_C;
         if !(self.mu_c.is_finite() && (mu_lo..=mu_hi).contains(&self.mu_c)) {
             let range = crate::scenario::limits::show((mu_lo, mu_hi));
             return Err(PlanError::input(
-                "--mu-c",
+                "mu_c",
                 self.mu_c,
                 format!("must lie in {range}"),
             ));
@@ -214,7 +214,7 @@ impl Problem {
         if let Some((lo, hi)) = self.mu_c_range {
             if !(lo.is_finite() && hi.is_finite() && mu_lo <= lo && lo <= hi && hi <= mu_hi) {
                 return Err(PlanError::input(
-                    "--mu-c-range",
+                    "mu_c_range",
                     format!("{lo}:{hi}"),
                     format!("must be LO:HI with {mu_lo} ≤ LO ≤ HI ≤ {mu_hi}"),
                 ));
@@ -222,25 +222,25 @@ impl Problem {
         }
         if !(self.pin_radius_m.is_finite() && self.pin_radius_m >= 0.0 && self.pin_radius_m <= a) {
             return Err(PlanError::input(
-                "--pin-radius",
+                "pin_radius",
                 self.pin_radius_m,
                 format!("must lie in [0, a = {a:.4} m] (m)"),
             ));
         }
-        finite_pos("--belt-width", self.belt_width_m)?;
+        finite_pos("belt_width", self.belt_width_m)?;
         if self.belt_width_m > 10.0 {
             return Err(PlanError::input(
-                "--belt-width",
+                "belt_width",
                 self.belt_width_m,
                 "must lie in (0, 10] m",
             ));
         }
         if self.belt_width_m < 2.0 * a {
             return Err(PlanError::input(
-                "--belt-width",
+                "belt_width",
                 self.belt_width_m,
                 format!(
-                    "the belt is narrower than the part (2a = {:.4} m at --scale {})",
+                    "the belt is narrower than the part (2a = {:.4} m at scale {})",
                     2.0 * a,
                     self.scale
                 ),
@@ -248,7 +248,7 @@ impl Problem {
         }
         if self.lateral_m + a > self.belt_width_m / 2.0 {
             return Err(PlanError::input(
-                "--lateral",
+                "lateral",
                 self.lateral_m,
                 format!(
                     "parts at ±{} m would overhang the belt (half-width {} m, a = {a:.4} m)",
@@ -257,17 +257,17 @@ impl Problem {
                 ),
             ));
         }
-        finite_pos("--spacing", self.spacing_m)?;
+        finite_pos("spacing", self.spacing_m)?;
         if self.spacing_m > 10.0 {
             return Err(PlanError::input(
-                "--spacing",
+                "spacing",
                 self.spacing_m,
                 "must lie in [2.5a, 10] m",
             ));
         }
         if self.spacing_m < 2.5 * a {
             return Err(PlanError::input(
-                "--spacing",
+                "spacing",
                 self.spacing_m,
                 format!(
                     "pins closer than 2.5a = {:.4} m can touch a part at once",
@@ -277,14 +277,14 @@ impl Problem {
         }
         if self.max_pins == 0 {
             return Err(PlanError::input(
-                "--depth",
+                "max_pins",
                 0,
                 "the plan must be allowed at least one pin",
             ));
         }
         if self.max_pins > 64 {
             return Err(PlanError::input(
-                "--depth",
+                "max_pins",
                 self.max_pins,
                 "at most 64 pins",
             ));
@@ -294,21 +294,21 @@ impl Problem {
             && self.tolerance_deg < 180.0)
         {
             return Err(PlanError::input(
-                "--tolerance",
+                "tolerance",
                 self.tolerance_deg,
                 "the goal window would be empty: the tolerance must lie in (0, 180) degrees",
             ));
         }
         if !(self.target.is_finite() && self.target > 0.0 && self.target <= 1.0) {
             return Err(PlanError::input(
-                "--target",
+                "target",
                 self.target,
                 "must lie in (0, 1]",
             ));
         }
         if !(self.min_margin_m.is_finite() && self.min_margin_m >= 0.0 && self.min_margin_m < a) {
             return Err(PlanError::input(
-                "--min-margin",
+                "min_margin",
                 self.min_margin_m,
                 format!("must lie in [0, a = {a:.4} m)"),
             ));
@@ -318,7 +318,7 @@ impl Problem {
             && self.y_quantum_m <= a / 4.0)
         {
             return Err(PlanError::input(
-                "--y-quantum",
+                "y_quantum",
                 self.y_quantum_m,
                 format!("must lie in [1 µm, a/4 = {:.4} m]", a / 4.0),
             ));
@@ -327,24 +327,24 @@ impl Problem {
         let n = (360.0 / q).round();
         if !(q.is_finite() && (0.01..=10.0).contains(&q)) || (n * q - 360.0).abs() > 1e-9 {
             return Err(PlanError::input(
-                "--theta-quantum",
+                "theta_quantum",
                 q,
                 "must lie in [0.01, 10] degrees and divide 360",
             ));
         }
         if !(1..=64).contains(&self.coarse) {
             return Err(PlanError::input(
-                "--coarse",
+                "coarse",
                 self.coarse,
                 "must lie in 1..=64",
             ));
         }
         if self.max_states == 0 {
-            return Err(PlanError::input("--max-states", 0, "must be at least 1"));
+            return Err(PlanError::input("max_states", 0, "must be at least 1"));
         }
         if !(self.time_limit_s.is_finite() && self.time_limit_s > 0.0) {
             return Err(PlanError::input(
-                "--time-limit",
+                "time_limit",
                 self.time_limit_s,
                 "must be a positive number of seconds",
             ));
@@ -353,7 +353,7 @@ impl Problem {
         if !crate::scenario::limits::contains(tol, self.contact_tol) {
             let range = crate::scenario::limits::show(tol);
             return Err(PlanError::input(
-                "--contact-tol",
+                "contact_tol",
                 self.contact_tol,
                 format!("must lie in {range}"),
             ));
@@ -377,7 +377,7 @@ impl Problem {
             .collect();
         if self.feed == FeedKind::Stable && stable.is_empty() {
             return Err(PlanError::input(
-                "--feed",
+                "feed",
                 "stable",
                 "the part has no stable state",
             ));
@@ -460,12 +460,12 @@ mod tests {
             let msg = q.compile().unwrap_err().to_string();
             assert!(msg.starts_with(flag), "{msg}");
         };
-        bad(&|q| q.belt_width_m = 0.03, "--belt-width");
-        bad(&|q| q.tolerance_deg = 0.0, "--tolerance");
-        bad(&|q| q.max_pins = 0, "--depth");
-        bad(&|q| q.mu_c = f64::NAN, "--mu-c");
-        bad(&|q| q.theta_quantum_deg = 0.7, "--theta-quantum");
-        bad(&|q| q.mu_c_range = Some((0.7, 0.3)), "--mu-c-range");
+        bad(&|q| q.belt_width_m = 0.03, "belt_width");
+        bad(&|q| q.tolerance_deg = 0.0, "tolerance");
+        bad(&|q| q.max_pins = 0, "max_pins");
+        bad(&|q| q.mu_c = f64::NAN, "mu_c");
+        bad(&|q| q.theta_quantum_deg = 0.7, "theta_quantum");
+        bad(&|q| q.mu_c_range = Some((0.7, 0.3)), "mu_c_range");
         bad(&|q| q.part = "blob".into(), "part");
     }
 }

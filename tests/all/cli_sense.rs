@@ -97,3 +97,62 @@ fn bad_input_is_refused_naming_the_flag() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--part"));
 }
+
+/// `--pin-radius` is in part units, as in every command: 0.15 at the default scale 0.02 is a
+/// 3 mm pin, and the same part in millimetres takes 3; a radius over 10·a is refused in part units.
+#[test]
+fn pin_radius_is_in_part_units() {
+    let radius_m = |extra: &[&str]| {
+        let mut a = vec![
+            "sense",
+            "--d=0.2",
+            "--trials",
+            "5",
+            "--templates",
+            "2",
+            "--noise",
+            "1",
+            "--json",
+            "--no-write",
+        ];
+        a.extend_from_slice(extra);
+        let out = pinfeed(&a);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        v["pin_radius_m"].as_f64().unwrap()
+    };
+    assert_eq!(
+        radius_m(&["--part", "tripoly1", "--pin-radius", "0.15"]),
+        0.003
+    );
+    assert_eq!(
+        radius_m(&[
+            "--part",
+            "rect:40:20",
+            "--scale",
+            "0.001",
+            "--pin-radius",
+            "3"
+        ]),
+        0.003
+    );
+    let out = pinfeed(&[
+        "sense",
+        "--part",
+        "tripoly1",
+        "--d=0.2",
+        "--pin-radius",
+        "20",
+        "--no-write",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("--pin-radius") && err.contains("part units"),
+        "{err}"
+    );
+}

@@ -276,7 +276,7 @@ fn impossible_constraints_are_refused_with_the_flag_named() {
         (vec!["--tolerance", "0.1"], "--tolerance"),
         (vec!["--belt-width", "1e308"], "--belt-width"),
         (vec!["--spacing", "1e6"], "--spacing"),
-        (vec!["--depth", "0"], "--depth"),
+        (vec!["--depth", "0"], "--max-pins"),
         (vec!["--target", "1.5"], "--target"),
         (vec!["--mu-c-range", "0.7:x"], "--mu-c-range"),
         (vec!["--mu-c-range", "0.7:0.3"], "--mu-c-range"),
@@ -737,5 +737,70 @@ fn without_out_a_design_is_written_under_pinfeed_out_by_its_name() {
     assert!(
         !text.contains("dir = \"results\""),
         "a planned line writes outside results/"
+    );
+}
+
+/// `--pin-radius` is in part units, like the part's vertices (as in `contact`, `map`, `validate`):
+/// the same part in millimetres (`--scale 0.001 --pin-radius 2`) and in units of 20 mm (`--scale
+/// 0.02 --pin-radius 0.1`) is the same physical problem with a 2 mm pin, and so is the default;
+/// a radius larger than the part is refused in part units.
+#[test]
+fn pin_radius_is_in_part_units_and_defaults_to_two_millimetres() {
+    let design = |part: &str, extra: &[&str]| {
+        let mut a = vec![
+            "plan",
+            "--part",
+            part,
+            "--pins",
+            "--check-parts",
+            "300",
+            "--screen-parts",
+            "100",
+            "--no-write",
+            "--json",
+        ];
+        a.extend_from_slice(extra);
+        plan_ok(&a)
+    };
+    let mm = design(
+        "vertices:0,0 36,0 8,22",
+        &["--scale", "0.001", "--pin-radius", "2"],
+    );
+    let units = design(
+        "vertices:0,0 1.8,0 0.4,1.1",
+        &["--scale", "0.02", "--pin-radius", "0.1"],
+    );
+    let default = design("vertices:0,0 36,0 8,22", &["--scale", "0.001"]);
+    let thin = design(
+        "vertices:0,0 36,0 8,22",
+        &["--scale", "0.001", "--pin-radius", "0.1"],
+    );
+    for v in [&mm, &units, &default] {
+        assert_eq!(v["problem"]["pin_radius_m"].as_f64(), Some(0.002), "{v}");
+        assert!(
+            v["scenario"].as_str().unwrap().contains("radius = 0.002\n"),
+            "{v}"
+        );
+        assert_eq!(v["obstacles"], mm["obstacles"], "{v}");
+    }
+    assert_eq!(thin["problem"]["pin_radius_m"].as_f64(), Some(0.0001));
+    assert!(mm["command"].as_str().unwrap().contains("--pin-radius 2"));
+    // Larger than the part (a ≈ 1.58 part units for tripoly1): refused, in part units.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args([
+            "plan",
+            "--part",
+            "tripoly1",
+            "--pin-radius",
+            "5",
+            "--no-write",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--pin-radius 5") && err.contains("part units"),
+        "{err}"
     );
 }

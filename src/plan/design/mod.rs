@@ -415,17 +415,18 @@ pub enum DesignError {
     Plan(#[from] PlanError),
     #[error(transparent)]
     Line(#[from] LineError),
-    #[error("{flag} {value}: {reason}")]
+    /// A design option out of range; `field` names it as [`PlanError::Input`] does.
+    #[error("{field} {value}: {reason}")]
     Input {
-        flag: &'static str,
+        field: &'static str,
         value: String,
         reason: String,
     },
 }
 
-fn input(flag: &'static str, value: impl ToString, reason: impl ToString) -> DesignError {
+fn input(field: &'static str, value: impl ToString, reason: impl ToString) -> DesignError {
     DesignError::Input {
-        flag,
+        field,
         value: value.to_string(),
         reason: reason.to_string(),
     }
@@ -438,43 +439,39 @@ pub fn check_goal(o: &DesignOptions) -> Result<(), DesignError> {
     p.compile()?;
     if p.tolerance_deg < p.theta_quantum_deg {
         return Err(input(
-            "--tolerance",
+            "tolerance",
             p.tolerance_deg,
             format!(
-                "the window ±{}° is finer than the planner's orientation quantum {}° (--theta-quantum): it cannot tell orientations that close apart; use a tolerance ≥ the quantum",
+                "the window ±{}° is finer than the planner's orientation quantum {}°: it cannot tell orientations that close apart; use a tolerance ≥ the quantum",
                 p.tolerance_deg, p.theta_quantum_deg
             ),
         ));
     }
     if o.modes.is_empty() {
-        return Err(input("--pins/--fences/--sensor", "", "no mode left to try"));
+        return Err(input("modes", "", "no mode left to try"));
     }
     if !(o.time_limit_s.is_finite() && o.time_limit_s > 0.0 && o.time_limit_s <= 86_400.0) {
         return Err(input(
-            "--time-limit",
+            "time_limit",
             o.time_limit_s,
             "must lie in (0, 86400] seconds",
         ));
     }
     if o.check_parts > 10_000_000 {
-        return Err(input("--check-parts", o.check_parts, "must lie in 0..=10⁷"));
+        return Err(input("check_parts", o.check_parts, "must lie in 0..=10⁷"));
     }
     if !(1..=1_000_000).contains(&o.screen_parts) {
-        return Err(input(
-            "--screen-parts",
-            o.screen_parts,
-            "must lie in 1..=10⁶",
-        ));
+        return Err(input("screen_parts", o.screen_parts, "must lie in 1..=10⁶"));
     }
     if o.refine > 10 {
-        return Err(input("--refine", o.refine, "must lie in 0..=10"));
+        return Err(input("refine", o.refine, "must lie in 0..=10"));
     }
     if o.max_moving > 8 {
-        return Err(input("--max-moving", o.max_moving, "must lie in 0..=8"));
+        return Err(input("max_moving", o.max_moving, "must lie in 0..=8"));
     }
     if !(1..=64).contains(&o.sensor_candidates) {
         return Err(input(
-            "--sensor-candidates",
+            "sensor_candidates",
             o.sensor_candidates,
             "must lie in 1..=64",
         ));
@@ -488,7 +485,7 @@ pub fn check_goal(o: &DesignOptions) -> Result<(), DesignError> {
         || o.name.starts_with('.')
     {
         return Err(input(
-            "--name",
+            "name",
             &o.name,
             "must be 1–100 characters of letters, digits, '-', '_' or '.', not starting with '.'",
         ));
@@ -504,25 +501,25 @@ fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignErr
     let mu_range = crate::mechanics::limits::MU_C;
     if !crate::scenario::limits::contains(mu_range, mu_f) {
         let range = crate::scenario::limits::show(mu_range);
-        return Err(input("--mu-f", mu_f, format!("must lie in {range}")));
+        return Err(input("mu_f", mu_f, format!("must lie in {range}")));
     }
     if !(f.overhang_a.is_finite() && (0.0..=10.0).contains(&f.overhang_a)) {
         return Err(input(
-            "--fence-overhang",
+            "fence_overhang",
             f.overhang_a,
             "must lie in [0, 10] (units of a)",
         ));
     }
     if !(f.max_angle_deg.is_finite() && (15.0..90.0).contains(&f.max_angle_deg)) {
         return Err(input(
-            "--max-fence-angle",
+            "max_fence_angle",
             f.max_angle_deg,
             "must lie in [15, 90) degrees",
         ));
     }
     if !(f.angle_step_deg.is_finite() && (0.5..=45.0).contains(&f.angle_step_deg)) {
         return Err(input(
-            "--fence-angle-step",
+            "fence_angle_step",
             f.angle_step_deg,
             "must lie in [0.5, 45] degrees",
         ));
@@ -531,7 +528,7 @@ fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignErr
     opts.overhang_a = f.overhang_a;
     if opts.angles_deg.is_empty() && o.modes.contains(&Mode::Fences) {
         return Err(input(
-            "--max-fence-angle",
+            "max_fence_angle",
             f.max_angle_deg,
             format!(
                 "no candidate angle (from ±15°, below the jam limit {:.1}° for μf {mu_f}) is left",
@@ -1075,7 +1072,7 @@ impl Work<'_> {
                 "design.toml",
                 "design.uncertain.toml",
             )
-            .map_err(|e| input("--mu-c-range/--tripod", "", e))?;
+            .map_err(|e| input("mu_c_range/tripod", "", e))?;
             self.line_runs += 1;
             let c = &mut self.candidates[i];
             c.uncertain_check = Some(LineCheck::of(&outcomes, n, h, started));

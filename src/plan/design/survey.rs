@@ -205,3 +205,24 @@ pub fn markdown(title: &str, rows: &[SurveyRow]) -> String {
     }
     m
 }
+
+/// The whole report of a survey: its title, the command that regenerates it, what a cell means,
+/// and the table of `rows` under a heading that names the physics (nominal or uncertain).
+pub fn page(command: &str, s: &SurveySettings, rows: &[SurveyRow]) -> String {
+    let mut m = format!(
+        "# Designs the line confirms (`pinfeed bench designs`)\n\nRegenerate:\n\n    {command}\n\n"
+    );
+    m += "Each cell is one run of `pinfeed plan` (the design workflow) allowed one mode — fixed pins, fences, a sensor pin with moving pins — or all of them together with lines that mix pins and fences (the default). Every other setting is `pinfeed plan`'s default: a stable-state feed with equal weights, 2° jitter, ±2 mm lateral; μc 0.5 (fences μf = μc), 2 mm pins 15 cm apart, a 10 cm belt for pins (fences may widen it: the width is reported); goal ≥ 0.99 of the parts in one ±3° window modulo the part's symmetry. A design is **confirmed** when its line check (the parts below, at the headway the workflow chose on the line) holds the goal; otherwise the best design the line measured is reported **not confirmed** with its number. Cells: verdict, line success [95% CI] of N parts; obstacles (the mode chosen); belt length × width; headway and oriented parts per minute; wall time of the whole design on this 2-core machine.\n\n";
+    let title = match (&s.mu_c_range, s.tripod) {
+        (None, false) => "Nominal physics".to_string(),
+        (r, t) => format!(
+            "Under uncertainty:{}{} (planned and checked against it)",
+            r.map_or(String::new(), |(lo, hi)| format!(
+                " μc uniform in [{lo}, {hi}]"
+            )),
+            if t { ", random tripod supports" } else { "" }
+        ),
+    };
+    m += &markdown(&title, rows);
+    m
+}

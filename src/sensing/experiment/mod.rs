@@ -23,7 +23,9 @@ pub const MAX_FACTORS: usize = 64;
 pub const MAX_PLACEMENT_D: usize = 201;
 pub const MAX_THREADS: usize = 1024;
 
-/// Everything a sensing experiment is asked for, unchecked (lengths in metres; `d` in units of a).
+/// Everything a sensing experiment is asked for, unchecked (the pin radius in part units, the
+/// unit of the part's vertices, as `scale` makes them metres; other lengths in metres; `d` in
+/// units of a).
 #[derive(Debug, Clone)]
 pub struct Request {
     /// A part spec (`tripoly1`, `rect:W:H`, `vertices:…`).
@@ -335,19 +337,19 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
         error,
     })?;
     let poly = part.scaled(a.scale);
-    let radius_a = poly.radius();
+    let radius_units = part.radius();
     in_range(
         "--pin-radius",
         a.pin_radius,
         0.0,
-        limits::PIN_RADIUS_A * radius_a,
+        limits::PIN_RADIUS_A * radius_units,
         &format!(
-            "m; at most {}·a, a = {} m",
+            "part units; at most {}·a, a = {} part units",
             limits::PIN_RADIUS_A,
-            num(radius_a)
+            num(radius_units)
         ),
     )?;
-    let reach = 1.0 + a.pin_radius / radius_a;
+    let reach = 1.0 + a.pin_radius / radius_units;
     let beyond = "units of a; beyond it the pin cannot touch the part";
     in_range("--d", a.d, -reach, reach, beyond)?;
     if a.placement {
@@ -387,7 +389,7 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
     let setup = PushSetup {
         polygon: poly,
         d: a.d,
-        pin_radius: a.pin_radius,
+        pin_radius: a.pin_radius * a.scale,
         mu_c: a.mu_c,
         mu_s: a.mu_s,
         fidelity,

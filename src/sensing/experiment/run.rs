@@ -279,7 +279,7 @@ impl Checked {
             mass_kg: r.mass,
             belt_speed_m_s: r.belt_speed,
             d: r.d,
-            pin_radius_m: r.pin_radius,
+            pin_radius_m: self.setup.pin_radius,
             mu_c: r.mu_c,
             mu_s: r.mu_s,
             model: self.setup.fidelity.name().to_string(),
