@@ -75,6 +75,10 @@ pub struct ContactArgs {
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// No progress bar while a map-tier build runs (as with --json, or when standard error is not
+    /// a terminal).
+    #[arg(long, short)]
+    pub quiet: bool,
     /// Write the trajectory and contact force per step to this CSV file.
     #[arg(long, value_name = "FILE.csv")]
     pub trace: Option<PathBuf>,

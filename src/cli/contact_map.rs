@@ -83,7 +83,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         args.push.map_grid.as_deref(),
         args.push.cache_dir.as_deref(),
         Some(&[(pose, start)]),
-        args.json,
+        args.json || args.quiet,
     )?;
     let started = Instant::now();
     let (out, why) = push_with_map(&loaded.map, &model, pose, start, c.pin_radius, &settings);

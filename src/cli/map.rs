@@ -61,6 +61,9 @@ pub struct MapArgs {
     /// Print the samples as CSV.
     #[arg(long)]
     pub csv: bool,
+    /// No progress bar (as with --json or --csv, or when standard error is not a terminal).
+    #[arg(long, short)]
+    pub quiet: bool,
     /// Report directory (README.md, map.json, samples.csv, figures) [default: pinfeed-out/maps/<part>].
     #[arg(long, value_name = "DIR")]
     pub out_dir: Option<PathBuf>,
@@ -218,7 +221,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
                 args.push.map_grid.as_deref(),
                 args.push.cache_dir.as_deref(),
                 Some(&passes),
-                args.json || args.csv,
+                args.json || args.csv || args.quiet,
             )
         })?;
         Some(loaded)

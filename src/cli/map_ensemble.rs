@@ -51,7 +51,7 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
     }
     let pool = super::validate::pool(args.threads)?;
     let started = std::time::Instant::now();
-    let bar = super::progress::bar(passes as u64, "passes", args.json || args.csv);
+    let bar = super::progress::bar(passes as u64, "passes", args.json || args.csv || args.quiet);
     let maps = pool
         .install(|| {
             ensemble_maps_observed(
