@@ -25,6 +25,7 @@ pub mod merge;
 pub mod part;
 pub mod physics;
 pub mod plan;
+pub mod plan_command;
 pub mod progress;
 pub mod run;
 pub mod sense;

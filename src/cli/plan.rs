@@ -7,15 +7,12 @@
 //! confirmed design.
 
 use super::stdout::print_result;
-use crate::geometry::part_from_spec;
 use crate::plan::design::{self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status};
 use crate::plan::problem::parse_mu_c_range;
 use crate::plan::{FeedKind, PlanError, Problem};
 use crate::report::plan_summary::{self as summary, write_design, DesignPaths};
-use crate::report::shell_word;
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use std::fmt::Display;
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed plan`.
@@ -193,7 +190,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
         .map_err(|e| anyhow!("--mu-c-range {e}"))?;
     p.tripod = args.tripod;
     if let Some(r) = args.pin_radius {
-        p.pin_radius_m = pin_radius_m(&args.part, r, args.scale)?;
+        p.set_pin_radius_units(r).map_err(|e| flagged(e.into()))?;
     }
     if let Some(w) = args.belt_width {
         p.belt_width_m = w;
@@ -241,44 +238,15 @@ fn flag_of(field: &str) -> String {
 
 /// A planner error with the field it names replaced by the flag that set it.
 fn flagged(e: anyhow::Error) -> anyhow::Error {
-    let input = match e.downcast_ref::<design::DesignError>() {
-        Some(design::DesignError::Plan(p)) => Some(p),
-        _ => e.downcast_ref::<PlanError>(),
+    let field = match e.downcast_ref::<design::DesignError>() {
+        Some(d) => d.field(),
+        None => e.downcast_ref::<PlanError>().and_then(PlanError::field),
     };
-    let (field, value, reason) = match (input, e.downcast_ref::<design::DesignError>()) {
-        (
-            Some(PlanError::Input {
-                field,
-                value,
-                reason,
-            }),
-            _,
-        )
-        | (
-            _,
-            Some(design::DesignError::Input {
-                field,
-                value,
-                reason,
-            }),
-        ) => (field, value, reason),
-        _ => return e,
-    };
-    anyhow!("{} {value}: {reason}", flag_of(field))
-}
-
-/// `--pin-radius R` (part units) in metres: R × scale, once R is checked against the part
-/// (0 ≤ R ≤ a, a in part units); a part that cannot be built is left to [`Problem::compile`].
-fn pin_radius_m(part: &str, r: f64, scale: f64) -> Result<f64> {
-    let a = part_from_spec(part).map(|p| p.radius()).ok();
-    if !(r.is_finite() && r >= 0.0 && a.is_none_or(|a| r <= a)) {
-        let bound = a.map_or(String::new(), |a| format!(", a = {a:.6}"));
-        return Err(anyhow!(
-            "--pin-radius {r}: must lie in [0, a] part units (a: the part's largest \
-             centroid–vertex distance{bound}; metres = part units × --scale)"
-        ));
+    match field {
+        // The message is "FIELD VALUE: REASON".
+        Some(f) => anyhow!("{}{}", flag_of(f), &e.to_string()[f.len()..]),
+        None => e,
     }
-    Ok(r * scale)
 }
 
 /// The design options of the arguments.
@@ -313,84 +281,8 @@ pub fn options_of(args: &PlanArgs) -> Result<DesignOptions> {
             .map_or(o.name.clone(), |s| s.to_string_lossy().to_string()),
         (None, None) => o.name,
     };
-    o.command = command_line(args);
+    o.command = super::plan_command::command_line(args);
     Ok(o)
-}
-
-/// The command line that reproduces a design: the part and every setting given (the output
-/// options are not part of it).
-pub fn command_line(args: &PlanArgs) -> String {
-    let mut w = vec!["pinfeed plan --part".to_string(), shell_word(&args.part)];
-    let d = Problem::new(&args.part);
-    let a = args;
-    let mut opt = |flag: &str, v: &dyn Display, default: &dyn Display| {
-        let v = v.to_string();
-        if v != default.to_string() {
-            w.push(format!("{flag} {}", shell_word(&v)));
-        }
-    };
-    opt("--scale", &a.scale, &d.scale);
-    opt("--objective", &a.objective, &"belt-length");
-    opt("--feed", &a.feed, &"stable");
-    opt("--jitter", &a.jitter, &d.jitter_deg);
-    opt("--lateral", &a.lateral, &d.lateral_m);
-    opt("--jitter-samples", &a.jitter_samples, &"5");
-    opt("--offset-samples", &a.offset_samples, &"5");
-    opt("--orientation-samples", &a.orientation_samples, &"72");
-    opt("--mu-c", &a.mu_c, &d.mu_c);
-    opt(
-        "--mu-c-range",
-        &a.mu_c_range.clone().unwrap_or_default(),
-        &"",
-    );
-    opt(
-        "--pin-radius",
-        &a.pin_radius.map_or(String::new(), |r| r.to_string()),
-        &"",
-    );
-    opt(
-        "--belt-width",
-        &a.belt_width.map_or(String::new(), |b| b.to_string()),
-        &"",
-    );
-    opt("--spacing", &a.spacing, &d.spacing_m);
-    opt("--max-pins", &a.max_pins, &d.max_pins);
-    opt("--tolerance", &a.tolerance, &d.tolerance_deg);
-    opt("--target", &a.target, &d.target);
-    opt("--min-margin", &a.min_margin, &"0.5");
-    opt("--y-quantum", &a.y_quantum, &"0.25");
-    opt("--theta-quantum", &a.theta_quantum, &"0.25");
-    opt("--coarse", &a.coarse, &"4");
-    opt("--refine", &a.refine, &"2");
-    opt("--max-states", &a.max_states, &d.max_states);
-    opt("--time-limit", &a.time_limit, &"110");
-    opt("--contact-tol", &a.contact_tol, &d.contact_tol);
-    opt("--seed", &a.seed, &"1");
-    opt("--check-parts", &a.check_parts, &"10000");
-    opt("--screen-parts", &a.screen_parts, &"2000");
-    opt(
-        "--mu-f",
-        &a.mu_f.map_or(String::new(), |m| m.to_string()),
-        &"",
-    );
-    opt("--fence-overhang", &a.fence_overhang, &"0");
-    opt("--max-fence-angle", &a.max_fence_angle, &"55");
-    opt("--fence-angle-step", &a.fence_angle_step, &"5");
-    opt("--max-moving", &a.max_moving, &"3");
-    opt("--sensor-candidates", &a.sensor_candidates, &"6");
-    for (on, flag) in [
-        (args.tripod, "--tripod"),
-        (args.fewest_sets, "--fewest-sets"),
-        (args.no_bound, "--no-bound"),
-        (args.pins, "--pins"),
-        (args.fences, "--fences"),
-        (args.sensor, "--sensor"),
-    ] {
-        if on {
-            w.push(flag.into());
-        }
-    }
-    w.join(" ")
 }
 
 /// Run `pinfeed plan`.

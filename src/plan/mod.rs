@@ -82,6 +82,14 @@ pub enum PlanError {
 }
 
 impl PlanError {
+    /// The field an [`PlanError::Input`] names (its message starts with it).
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            PlanError::Input { field, .. } => Some(field),
+            PlanError::Part { .. } => None,
+        }
+    }
+
     pub(crate) fn input(field: &'static str, value: impl ToString, reason: impl ToString) -> Self {
         PlanError::Input {
             field,

@@ -149,6 +149,27 @@ impl Problem {
         }
     }
 
+    /// Set the pin radius from a length in part units (the unit of the part's vertices, as every
+    /// command takes it): metres = `r` × [`Problem::scale`], so set the scale first. A radius
+    /// that is negative, not finite or larger than the part (its a, in part units) is refused;
+    /// a part that cannot be built is left to [`Problem::compile`].
+    pub fn set_pin_radius_units(&mut self, r: f64) -> Result<(), PlanError> {
+        let a = part_from_spec(&self.part).map(|p| p.radius()).ok();
+        if !(r.is_finite() && r >= 0.0 && a.is_none_or(|a| r <= a)) {
+            let bound = a.map_or(String::new(), |a| format!(", a = {a:.6}"));
+            return Err(PlanError::input(
+                "pin_radius",
+                r,
+                format!(
+                    "must lie in [0, a] part units (a: the part's largest centroid–vertex \
+                     distance{bound}; metres = part units × scale)"
+                ),
+            ));
+        }
+        self.pin_radius_m = r * self.scale;
+        Ok(())
+    }
+
     /// Check every value and build the part in metres. Errors name the field.
     pub fn compile(&self) -> Result<Compiled, PlanError> {
         let finite_pos = |field: &'static str, v: f64| -> Result<(), PlanError> {

@@ -424,6 +424,18 @@ pub enum DesignError {
     },
 }
 
+impl DesignError {
+    /// The field a bad input names (its message starts with it), from the design options or the
+    /// problem.
+    pub fn field(&self) -> Option<&'static str> {
+        match self {
+            DesignError::Input { field, .. } => Some(field),
+            DesignError::Plan(p) => p.field(),
+            DesignError::Line(_) => None,
+        }
+    }
+}
+
 fn input(field: &'static str, value: impl ToString, reason: impl ToString) -> DesignError {
     DesignError::Input {
         field,
