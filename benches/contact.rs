@@ -96,7 +96,7 @@ fn bench_batch(c: &mut Criterion) {
                 let (poly, model) = compiled
                     .entry(p)
                     .or_insert_with(|| compile_part(p, "uniform").unwrap());
-                acc += run_compiled(&c, poly, model, false).0.rotation;
+                acc += run_compiled(&c, poly, model, false).0.rotation_rad;
             }
             black_box(acc)
         })

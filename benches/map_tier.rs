@@ -54,7 +54,7 @@ fn bench_map_tier(c: &mut Criterion) {
     let exact = |set: &[(Pose, Vec2)]| {
         let mut acc = 0.0;
         for &(pose, pin) in set {
-            acc += push_path(&model, pose, pin, RADIUS, &path, &settings, None).rotation;
+            acc += push_path(&model, pose, pin, RADIUS, &path, &settings, None).rotation_rad;
         }
         acc
     };
@@ -63,7 +63,7 @@ fn bench_map_tier(c: &mut Criterion) {
         b.iter(|| {
             let mut acc = 0.0;
             for &(pose, pin) in &served {
-                acc += map.answer(&model, pose, pin, RADIUS).unwrap().rotation;
+                acc += map.answer(&model, pose, pin, RADIUS).unwrap().rotation_rad;
             }
             black_box(acc)
         })
@@ -75,7 +75,7 @@ fn bench_map_tier(c: &mut Criterion) {
             for &(pose, pin) in &all {
                 acc += push_with_map(&map, &model, pose, pin, RADIUS, &settings)
                     .0
-                    .rotation;
+                    .rotation_rad;
             }
             black_box(acc)
         })

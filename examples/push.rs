@@ -29,7 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("status: {}", out.status.name());
     println!(
         "rotation: {:+.2}°, final orientation {:.2}°",
-        out.rotation.to_degrees(),
+        out.rotation_rad.to_degrees(),
         pinfeed::geometry::wrap_deg(out.pose_final.theta_rad.to_degrees())
     );
     println!(

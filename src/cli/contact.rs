@@ -106,7 +106,7 @@ fn pass_obstacle(poly: &Polygon, c: &Case) -> (Pose, PassObstacle) {
             let fence = case_fence(poly, c, angle, length);
             PassObstacle::Fence {
                 start: fence.start,
-                end: fence.start + Vec2::from_angle(fence.angle) * fence.length,
+                end: fence.start + Vec2::from_angle(fence.angle_rad) * fence.length,
             }
         }
         None => PassObstacle::Pin {

@@ -144,7 +144,7 @@ pub fn run_batch<W: std::io::Write>(
             mu_s: c.mu_s,
             contact: out.contact,
             theta_final_deg: wrap_deg(out.pose_final.theta_rad.to_degrees()),
-            rotation_deg: out.rotation.to_degrees(),
+            rotation_deg: out.rotation_rad.to_degrees(),
             com_final_x: out.pose_final.x,
             com_final_y: out.pose_final.y,
             contact_length: out.contact_length,

@@ -61,7 +61,7 @@ pub fn report(c: &Case, out: &ContactOutcome) -> ContactReport {
         pin_stop_d: None,
         contact: out.contact,
         theta_final_deg: wrap_deg(out.pose_final.theta_rad.to_degrees()),
-        rotation_deg: out.rotation.to_degrees(),
+        rotation_deg: out.rotation_rad.to_degrees(),
         com_final: [out.pose_final.x, out.pose_final.y],
         travel_to_contact: out.travel_to_contact,
         contact_length: out.contact_length,

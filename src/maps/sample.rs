@@ -79,14 +79,14 @@ pub fn sample_one_with(
     };
     // Without contact the orientation is untouched by definition: θf = θ0 exactly.
     let theta_final_deg = if out.contact {
-        wrap_deg(theta0_deg + out.rotation.to_degrees())
+        wrap_deg(theta0_deg + out.rotation_rad.to_degrees())
     } else {
         theta0_deg
     };
     MapSample {
         theta0_deg,
         theta_final_deg,
-        rotation_deg: out.rotation.to_degrees(),
+        rotation_deg: out.rotation_rad.to_degrees(),
         contact: out.contact,
         com_final_y: out.pose_final.y,
         contact_length: out.contact_length,

@@ -52,7 +52,7 @@ pub fn fence_pass_start(
     };
     FenceSpec {
         start: cross - e * back,
-        angle,
+        angle_rad: angle,
         length: length.unwrap_or(20.0 * a),
         mu_f,
     }
@@ -68,7 +68,7 @@ mod tests {
         let a = poly.radius();
         for angle in [-60.0, 30.0, 45.0] {
             let f0 = fence_pass_start(&poly, 0.0, angle, None, 0.3);
-            let e = Vec2::from_angle(f0.angle);
+            let e = Vec2::from_angle(f0.angle_rad);
             let sign = f64::signum(angle);
             assert!((f0.start.y + sign * 1.5 * a).abs() < 1e-12, "{f0:?}");
             // The line lies 1.01a from the centroid, upstream.

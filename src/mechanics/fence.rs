@@ -37,7 +37,8 @@ pub struct FenceSpec {
     pub start: Vec2,
     /// Angle α of the fence from the belt direction, radians in (−π/2, π/2): positive fences run
     /// downstream to the left (+y), deflecting parts to the left.
-    pub angle: f64,
+    #[serde(rename = "angle")]
+    pub angle_rad: f64,
     /// Length along the fence.
     pub length: f64,
     /// Fence–part friction coefficient μf ≥ 0.
@@ -56,7 +57,7 @@ pub(crate) struct FenceGeom {
 
 impl FenceGeom {
     pub fn new(spec: &FenceSpec, scale: f64) -> FenceGeom {
-        let e = Vec2::from_angle(spec.angle);
+        let e = Vec2::from_angle(spec.angle_rad);
         // The normal facing upstream (−x): parts arrive from there.
         let mut n = e.perp();
         if n.x > 0.0 {
@@ -373,7 +374,7 @@ mod tests {
             let g = FenceGeom::new(
                 &FenceSpec {
                     start: Vec2::ZERO,
-                    angle: a.to_radians(),
+                    angle_rad: a.to_radians(),
                     length: 1.0,
                     mu_f: 0.3,
                 },
@@ -389,7 +390,7 @@ mod tests {
         let f = FenceGeom::new(
             &FenceSpec {
                 start: Vec2::new(2.0, -3.0),
-                angle: 45f64.to_radians(),
+                angle_rad: 45f64.to_radians(),
                 length: 10.0,
                 mu_f: 0.3,
             },

@@ -86,7 +86,7 @@ impl Tally {
         match self.list.last() {
             Some(last) if last.feature == feat.public() && last.mode == mode => {
                 let last = self.list.pop().expect("checked above");
-                self.open = Some((feat, mode, last.s_begin / scale, last.theta_begin));
+                self.open = Some((feat, mode, last.s_begin / scale, last.theta_begin_rad));
             }
             _ => self.open(feat, mode, s, theta),
         }
@@ -102,8 +102,8 @@ impl Tally {
                 mode: m,
                 s_begin: s0 * scale,
                 s_end: s * scale,
-                theta_begin: t0,
-                theta_end: theta,
+                theta_begin_rad: t0,
+                theta_end_rad: theta,
             });
         }
     }

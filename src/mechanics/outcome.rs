@@ -48,8 +48,10 @@ pub struct Segment {
     pub s_begin: f64,
     pub s_end: f64,
     /// Part orientation (radians, unwrapped) at the start and end.
-    pub theta_begin: f64,
-    pub theta_end: f64,
+    #[serde(rename = "theta_begin")]
+    pub theta_begin_rad: f64,
+    #[serde(rename = "theta_end")]
+    pub theta_end_rad: f64,
 }
 
 /// How a contact computation ended.
@@ -145,7 +147,8 @@ pub struct ContactOutcome {
     /// Pose after the pin has passed (or at the moment a non-ok status stopped the computation).
     pub pose_final: Pose,
     /// Signed total rotation θ_final − θ_initial (radians, not wrapped).
-    pub rotation: f64,
+    #[serde(rename = "rotation")]
+    pub rotation_rad: f64,
     /// Pin travel relative to the belt before the first touch (caller's units).
     pub travel_to_contact: f64,
     /// Pin travel while in contact (caller's units); time in contact = contact_length / V.

@@ -110,7 +110,7 @@ pub(crate) fn untouched(pose: Pose, status: ContactStatus) -> ContactOutcome {
         contact: false,
         pose_initial: pose,
         pose_final: pose,
-        rotation: 0.0,
+        rotation_rad: 0.0,
         travel_to_contact: 0.0,
         contact_length: 0.0,
         contacts: 0,
@@ -171,7 +171,7 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
     out.contact = out.contacts > 0;
     out.segments = segs.list;
     out.pose_final = Pose::new(cur.x * k, cur.y * k, cur.theta_rad);
-    out.rotation = cur.theta_rad - pose.theta_rad;
+    out.rotation_rad = cur.theta_rad - pose.theta_rad;
     out.evaluations = ctx.evals;
     out.steps = segs.steps;
     out

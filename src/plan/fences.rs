@@ -142,7 +142,7 @@ impl FenceTransition {
         let length = (y1 - y0).abs() / angle.sin().abs();
         let spec = FenceSpec {
             start: Vec2::new(x0, y0),
-            angle,
+            angle_rad: angle,
             length,
             mu_f: self.options.mu_f,
         };
@@ -167,7 +167,7 @@ impl FenceTransition {
             return None;
         }
         Some((
-            wrap_deg(theta_deg + out.rotation.to_degrees()),
+            wrap_deg(theta_deg + out.rotation_rad.to_degrees()),
             out.pose_final.y,
             true,
             (-out.pose_final.x).max(0.0),

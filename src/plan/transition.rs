@@ -242,7 +242,7 @@ impl Transition {
             out.status,
             ContactStatus::Ok | ContactStatus::Metastable { .. }
         );
-        let theta_final = wrap_deg(theta_deg + out.rotation.to_degrees());
+        let theta_final = wrap_deg(theta_deg + out.rotation_rad.to_degrees());
         if !ok {
             return PassOutcome {
                 signature: FAILED,
@@ -272,7 +272,7 @@ impl Transition {
                 last = Some(f);
             }
         }
-        mix(if out.rotation >= 0.0 { 7 } else { 9 });
+        mix(if out.rotation_rad >= 0.0 { 7 } else { 9 });
         mix(matches!(out.status, ContactStatus::Metastable { .. }) as u32);
         PassOutcome {
             signature: h.max(2),

@@ -186,7 +186,7 @@ impl FenceObstacle {
     pub fn spec(&self) -> FenceSpec {
         FenceSpec {
             start: self.start,
-            angle: self.angle_rad,
+            angle_rad: self.angle_rad,
             length: self.length,
             mu_f: self.mu_f,
         }

@@ -102,10 +102,11 @@ pub fn contact_row(part: &str, contacts: usize, seed: u64) -> Result<ContactRow>
         best / served.len().max(1) as f64
     };
     let served_us = per_push(7, &|p, s| {
-        map.answer(&model, p, s, 0.0).map_or(0.0, |o| o.rotation)
+        map.answer(&model, p, s, 0.0)
+            .map_or(0.0, |o| o.rotation_rad)
     });
     let exact_served_us = per_push(3, &|p, s| {
-        push(&model, p, s, &Pin::point(), &settings, None).rotation
+        push(&model, p, s, &Pin::point(), &settings, None).rotation_rad
     });
     let served = errs.len();
     let err_mean = errs.iter().sum::<f64>() / served.max(1) as f64;

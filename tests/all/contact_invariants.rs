@@ -28,7 +28,10 @@ fn every_case_touches() {
             Pin::point(),
             &settings(Fidelity::Exact, 0.5),
         );
-        assert!(o.contact && o.rotation.abs() > 1e-3, "{name} θ0={th} d={d}");
+        assert!(
+            o.contact && o.rotation_rad.abs() > 1e-3,
+            "{name} θ0={th} d={d}"
+        );
     }
 }
 
@@ -80,10 +83,10 @@ fn scale_invariance() {
                 let o = run(&model(&q), &q, th, d, Pin::point(), &settings(fid, 0.5));
                 assert_eq!(o.status, base.status, "{fid} {name} k={k}");
                 assert!(
-                    (o.rotation - base.rotation).abs() < 1e-9,
+                    (o.rotation_rad - base.rotation_rad).abs() < 1e-9,
                     "{fid} {name} k={k}: {} vs {}",
-                    o.rotation,
-                    base.rotation
+                    o.rotation_rad,
+                    base.rotation_rad
                 );
                 assert!((o.pose_final.x / k - base.pose_final.x).abs() < 1e-8);
                 assert!((o.pose_final.y / k - base.pose_final.y).abs() < 1e-8);
@@ -109,10 +112,10 @@ fn mirror_symmetry() {
                 let b = run(&model(&q), &q, -th, -d, Pin::point(), &settings(fid, mu));
                 assert_eq!(a.contact, b.contact);
                 assert!(
-                    (a.rotation + b.rotation).abs() < 1e-7,
+                    (a.rotation_rad + b.rotation_rad).abs() < 1e-7,
                     "{fid} μc={mu} {name} θ0={th} d={d}: {} vs {}",
-                    a.rotation.to_degrees(),
-                    b.rotation.to_degrees()
+                    a.rotation_rad.to_degrees(),
+                    b.rotation_rad.to_degrees()
                 );
                 assert!((a.pose_final.y + b.pose_final.y).abs() < 1e-7);
                 assert!((a.pose_final.x - b.pose_final.x).abs() < 1e-7);

@@ -38,12 +38,12 @@ fn contact(
 fn agrees(a: &ContactOutcome, b: &ContactOutcome, deg: f64) {
     assert!(a.status.is_ok(), "default tolerance: {:?}", a.status);
     assert!(b.status.is_ok(), "tight tolerance: {:?}", b.status);
-    let diff = (a.rotation - b.rotation).to_degrees();
+    let diff = (a.rotation_rad - b.rotation_rad).to_degrees();
     assert!(
         diff.abs() < deg,
         "{}° vs {}°",
-        a.rotation.to_degrees(),
-        b.rotation.to_degrees()
+        a.rotation_rad.to_degrees(),
+        b.rotation_rad.to_degrees()
     );
 }
 
@@ -56,7 +56,7 @@ fn issue11_wild_landing_step_with_a_high_friction_disc_pin() {
     let a = contact(&p, &Support::Uniform, 20.5181, 0.3438, 1.7193, 0.2773, 1e-6);
     let b = contact(&p, &Support::Uniform, 20.5181, 0.3438, 1.7193, 0.2773, 1e-9);
     agrees(&a, &b, 1.0);
-    assert!(a.rotation.to_degrees().abs() < 180.0);
+    assert!(a.rotation_rad.to_degrees().abs() < 180.0);
     let moved = a.pose_final.x.hypot(a.pose_final.y);
     assert!(
         moved < 5.0 * p.radius(),
@@ -78,10 +78,10 @@ fn issue11_tiny_pin_radii_behave_like_a_point_pin() {
                 let o = contact(&p, &Support::Uniform, th, 0.3, 0.5, r * p.radius(), 1e-6);
                 assert_eq!(o.status.name(), point.status.name(), "{name} θ0={th} ρ={r}");
                 assert!(
-                    (o.rotation - point.rotation).abs() < 1e-4 + 1e3 * r,
+                    (o.rotation_rad - point.rotation_rad).abs() < 1e-4 + 1e3 * r,
                     "{name} θ0={th} ρ={r}: {} vs {}",
-                    o.rotation.to_degrees(),
-                    point.rotation.to_degrees()
+                    o.rotation_rad.to_degrees(),
+                    point.rotation_rad.to_degrees()
                 );
             }
         }
@@ -156,7 +156,7 @@ fn triple_point_of_sliding_sticking_and_separation() {
         let b = contact(&p, &sup, th, d, 0.5, 0.0, 1e-9);
         agrees(&a, &b, 0.01);
         if let Some(g) = geometric_deg {
-            assert!((b.rotation.to_degrees() - g).abs() < 1e-3, "{name}");
+            assert!((b.rotation_rad.to_degrees() - g).abs() < 1e-3, "{name}");
         }
     }
 }
@@ -306,7 +306,7 @@ fn tangential_release_into_a_reflex_corner_is_a_multi_contact() {
         );
         assert_eq!(o.contacts, 1, "tol {tol}");
         assert!(
-            (o.rotation - fine.rotation).abs().to_degrees() < 0.01,
+            (o.rotation_rad - fine.rotation_rad).abs().to_degrees() < 0.01,
             "tol {tol}"
         );
     }

@@ -59,8 +59,11 @@ fn long_fence_leaves_an_edge_flush() {
                     .find(|s| matches!(s.feature, ContactFeature::FenceEdge(_)))
                     .unwrap_or_else(|| panic!("{fid} α={angle} θ0={th}: never flush"));
                 assert!(seg.s_end > seg.s_begin, "the flush edge translates");
-                assert_eq!(seg.theta_begin, seg.theta_end, "a flush edge does not turn");
-                let th_f = wrap_deg(seg.theta_end.to_degrees());
+                assert_eq!(
+                    seg.theta_begin_rad, seg.theta_end_rad,
+                    "a flush edge does not turn"
+                );
+                let th_f = wrap_deg(seg.theta_end_rad.to_degrees());
                 let best = flush
                     .iter()
                     .map(|&q| ang_diff_deg(q, th_f).abs())
@@ -120,7 +123,7 @@ fn exact_aligns_no_later_than_the_cor_tip_bound() {
                         .segments
                         .iter()
                         .find(|s| matches!(s.feature, ContactFeature::FenceEdge(_)))
-                        .map(|s| (s.s_begin, s.theta_begin))
+                        .map(|s| (s.s_begin, s.theta_begin_rad))
                 };
                 let (Some(exact), Some(tip)) =
                     (first_flush(Fidelity::Exact), first_flush(Fidelity::Tip))
@@ -235,10 +238,10 @@ fn fence_mirror_symmetry() {
             let a = run_fence(&mp, &p, th, &fence(&p, 35.0, 0.1, 12.0, 0.3), fid);
             let b = run_fence(&mq, &q, -th, &fence(&q, -35.0, -0.1, 12.0, 0.3), fid);
             assert!(
-                (a.rotation + b.rotation).abs() < 1e-7,
+                (a.rotation_rad + b.rotation_rad).abs() < 1e-7,
                 "{fid} θ0={th}: {} vs {}",
-                a.rotation.to_degrees(),
-                b.rotation.to_degrees()
+                a.rotation_rad.to_degrees(),
+                b.rotation_rad.to_degrees()
             );
         }
     }

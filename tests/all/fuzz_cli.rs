@@ -565,7 +565,7 @@ proptest! {
         prop_assert_eq!(pk.radius(), pu.radius() * k);
         prop_assert_eq!(u.status.name(), s.status.name());
         prop_assert_eq!(u.contact, s.contact);
-        prop_assert_eq!(u.rotation, s.rotation);
+        prop_assert_eq!(u.rotation_rad, s.rotation_rad);
         prop_assert_eq!(u.pose_final.x * k, s.pose_final.x);
         prop_assert_eq!(u.pose_final.y * k, s.pose_final.y);
     }

@@ -46,7 +46,11 @@ fn push_through_centroid() {
         for mu in [0.0, 0.5] {
             let o = run(&model(&p), &p, 0.0, 0.0, Pin::point(), &settings(fid, mu));
             check(&o, "central push");
-            assert!(o.rotation.abs() < 1e-9, "{fid}: rotation {}", o.rotation);
+            assert!(
+                o.rotation_rad.abs() < 1e-9,
+                "{fid}: rotation {}",
+                o.rotation_rad
+            );
             assert!(
                 matches!(o.status, ContactStatus::TravelLimit { .. }),
                 "{:?}",
@@ -106,8 +110,8 @@ fn continuity_through_pure_translation() {
         let minus = run(&m, &p, 0.0, -0.1, Pin::point(), &s);
         check(&plus, "d=+0.1");
         assert!(plus.status.is_ok() && minus.status.is_ok());
-        assert!(plus.rotation > 0.0 && minus.rotation < 0.0);
-        assert!((plus.rotation + minus.rotation).abs() < 1e-6);
+        assert!(plus.rotation_rad > 0.0 && minus.rotation_rad < 0.0);
+        assert!((plus.rotation_rad + minus.rotation_rad).abs() < 1e-6);
     }
 }
 
@@ -219,7 +223,7 @@ fn pin_grazing_the_extreme_y() {
         );
         check(&o, "graze");
         assert!(!o.contact);
-        assert_eq!(o.rotation, 0.0);
+        assert_eq!(o.rotation_rad, 0.0);
         let o = push(
             &m,
             Pose::default(),
@@ -342,7 +346,7 @@ fn extreme_scales() {
                 &settings(fid, 0.5),
             );
             check(&o, "scaled");
-            assert!((o.rotation - base.rotation).abs() < 1e-9);
+            assert!((o.rotation_rad - base.rotation_rad).abs() < 1e-9);
         }
     }
 }
@@ -423,10 +427,10 @@ fn moving_pin() {
             &settings(fid, 0.4),
         );
         assert!(
-            (a.rotation + b.rotation).abs() < 1e-7,
+            (a.rotation_rad + b.rotation_rad).abs() < 1e-7,
             "{fid}: {} vs {}",
-            a.rotation,
-            b.rotation
+            a.rotation_rad,
+            b.rotation_rad
         );
     }
 }

@@ -783,7 +783,10 @@ fn pin_stop_after_touch_stops_the_pin_that_far_past_the_first_touch() {
     assert!((ys - yt - w * t).abs() < 1e-12, "{j}");
     // On the way in the pin moved too: it touches above d = −0.1.
     assert!(yt > -0.1 + 0.01, "{j}");
-    assert_eq!(j["rotation_deg"].as_f64(), Some(out.rotation.to_degrees()));
+    assert_eq!(
+        j["rotation_deg"].as_f64(),
+        Some(out.rotation_rad.to_degrees())
+    );
     // Out of range: refused, naming the flag.
     let o = pinfeed(
         &[

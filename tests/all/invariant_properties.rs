@@ -140,8 +140,8 @@ proptest! {
         prop_assert_eq!(a.status.name(), b.status.name());
         prop_assert_eq!(a.contact, b.contact);
         if trusted(&a) {
-            prop_assert!((a.rotation + b.rotation).abs() < 1e-6,
-                "rotation {} vs {}", a.rotation.to_degrees(), b.rotation.to_degrees());
+            prop_assert!((a.rotation_rad + b.rotation_rad).abs() < 1e-6,
+                "rotation {} vs {}", a.rotation_rad.to_degrees(), b.rotation_rad.to_degrees());
             let r = p.radius();
             prop_assert!((a.pose_final.y + b.pose_final.y).abs() < 1e-6 * r);
             prop_assert!((a.pose_final.x - b.pose_final.x).abs() < 1e-6 * r);
@@ -171,8 +171,8 @@ proptest! {
             disc(&q, rho), &s);
         prop_assert_eq!(a.status.name(), b.status.name());
         if trusted(&a) {
-            prop_assert!((a.rotation - b.rotation).abs() < 1e-6,
-                "k={k}: rotation {} vs {}", a.rotation.to_degrees(), b.rotation.to_degrees());
+            prop_assert!((a.rotation_rad - b.rotation_rad).abs() < 1e-6,
+                "k={k}: rotation {} vs {}", a.rotation_rad.to_degrees(), b.rotation_rad.to_degrees());
             prop_assert!((b.pose_final.x / k - a.pose_final.x).abs() < 1e-6 * p.radius());
             prop_assert!((b.pose_final.y / k - a.pose_final.y).abs() < 1e-6 * p.radius());
             prop_assert!((b.contact_length / k - a.contact_length).abs() < 1e-6 * p.radius());
@@ -201,16 +201,16 @@ proptest! {
         let b = fence_push(&model(&q), theta, &fk, fid);
         prop_assert_eq!(a.status.name(), b.status.name());
         if trusted(&a) {
-            prop_assert!((a.rotation - b.rotation).abs() < 1e-6,
-                "k={k}: {} vs {}", a.rotation.to_degrees(), b.rotation.to_degrees());
+            prop_assert!((a.rotation_rad - b.rotation_rad).abs() < 1e-6,
+                "k={k}: {} vs {}", a.rotation_rad.to_degrees(), b.rotation_rad.to_degrees());
         }
         let r = p.mirrored_y();
         let fm = fence_pass_start(&r, -d, -angle, Some(len * p.radius()), mu_f);
         let c = fence_push(&model(&r), -theta, &fm, fid);
         prop_assert_eq!(a.status.name(), c.status.name());
         if trusted(&a) {
-            prop_assert!((a.rotation + c.rotation).abs() < 1e-6,
-                "mirror: {} vs {}", a.rotation.to_degrees(), c.rotation.to_degrees());
+            prop_assert!((a.rotation_rad + c.rotation_rad).abs() < 1e-6,
+                "mirror: {} vs {}", a.rotation_rad.to_degrees(), c.rotation_rad.to_degrees());
         }
     }
 
@@ -299,7 +299,7 @@ proptest! {
         if a.status.is_ok() && b.status.is_ok() {
             let diff = ang_diff_deg(a.pose_final.theta_rad.to_degrees(), b.pose_final.theta_rad.to_degrees());
             prop_assert!(diff.abs() < 0.01, "{diff}° between tol 1e-6 and 1e-8");
-            prop_assert!((a.rotation - b.rotation).abs().to_degrees() < 0.01);
+            prop_assert!((a.rotation_rad - b.rotation_rad).abs().to_degrees() < 0.01);
         }
     }
 
@@ -324,8 +324,8 @@ proptest! {
             // O(ρ) from the disc's ride round a vertex and its start offset, plus the point
             // pin's own error at the default tolerance (up to ~5e-5 rad on such cases).
             let bound = 1e-4 + 1e3 * rho;
-            prop_assert!((o.rotation - point.rotation).abs() < bound,
-                "ρ={rho}: {} vs {}", o.rotation.to_degrees(), point.rotation.to_degrees());
+            prop_assert!((o.rotation_rad - point.rotation_rad).abs() < bound,
+                "ρ={rho}: {} vs {}", o.rotation_rad.to_degrees(), point.rotation_rad.to_degrees());
         }
     }
 

@@ -123,7 +123,7 @@ fn near_a_jump_the_exact_model_answers() {
     let d = 0.3;
     let rot = |t: f64| {
         let (pose, pin) = query(t.to_radians(), d);
-        exact(pose, pin).rotation.to_degrees()
+        exact(pose, pin).rotation_rad.to_degrees()
     };
     let (mut lo, mut hi) = (20.0, 34.0);
     assert!((rot(hi) - rot(lo)).abs() > 30.0, "no jump where expected");

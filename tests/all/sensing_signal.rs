@@ -376,8 +376,8 @@ fn sweep_sampling_equals_pointwise_evaluation() {
         mode,
         s_begin: a,
         s_end: b,
-        theta_begin: 0.0,
-        theta_end: 0.0,
+        theta_begin_rad: 0.0,
+        theta_end_rad: 0.0,
     };
     let mut outcome = push(
         &setup("square", 1.0, 0.5).1,

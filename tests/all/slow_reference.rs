@@ -479,7 +479,7 @@ fn compare_case(seed: u64, fidelity: Fidelity, geometric_skips: bool) -> Verdict
         .map(|p| format!("{:.6},{:.6}", p.x, p.y))
         .collect();
     Verdict::Compared(Compared {
-        dtheta: (prod.rotation - (r.theta - c.theta0)).abs().to_degrees(),
+        dtheta: (prod.rotation_rad - (r.theta - c.theta0)).abs().to_degrees(),
         tol_theta: (3.0 * et.to_degrees()).max(0.05),
         est_theta: et.to_degrees(),
         dc: (prod.pose_final.x - r.x).hypot(prod.pose_final.y - r.y) / a,
@@ -496,7 +496,7 @@ fn compare_case(seed: u64, fidelity: Fidelity, geometric_skips: bool) -> Verdict
             c.theta0.to_degrees(),
             c.d,
             c.mu,
-            prod.rotation.to_degrees(),
+            prod.rotation_rad.to_degrees(),
             (r.theta - c.theta0).to_degrees(),
             et.to_degrees()
         ),
@@ -695,7 +695,7 @@ fn one_case() {
         let o = run_production(&c, &poly, &settings);
         eprintln!(
             "production tol {tol:e}: rotation {:.5}°, centroid ({}, {}), contacts {}, {}",
-            o.rotation.to_degrees(),
+            o.rotation_rad.to_degrees(),
             o.pose_final.x,
             o.pose_final.y,
             o.contacts,

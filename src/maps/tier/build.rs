@@ -77,7 +77,7 @@ pub fn exact_sample(inputs: &TierInputs, reach: f64, theta: f64, d: f64) -> Samp
     Sample {
         servable: single && consistent && last.is_some(),
         feature: last.map_or(u32::MAX, |s| feature_code(s.feature)),
-        rotation: out.rotation,
+        rotation: out.rotation_rad,
         dx: out.pose_final.x / k,
         dy: out.pose_final.y / k,
         span,

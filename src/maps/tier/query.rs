@@ -82,7 +82,7 @@ impl TierMap {
             contact: true,
             pose_initial: pose,
             pose_final: Pose::new(pose.x + dx * k, pose.y + dy * k, pose.theta_rad + rotation),
-            rotation,
+            rotation_rad: rotation,
             travel_to_contact: touch,
             contact_length: span * k,
             contacts: 1,

@@ -203,7 +203,7 @@ fn outcome_numbers(o: &ContactOutcome) -> Vec<f64> {
         o.pose_final.x,
         o.pose_final.y,
         o.pose_final.theta_rad,
-        o.rotation,
+        o.rotation_rad,
         o.travel_to_contact,
         o.contact_length,
     ]
@@ -283,15 +283,15 @@ fn run_unlabelled(c: &ContactCase) -> CaseReport {
             ),
         );
     }
-    let diff = (a.rotation - b.rotation).to_degrees();
+    let diff = (a.rotation_rad - b.rotation_rad).to_degrees();
     if diff.is_nan() || diff.abs() > SELF_CHECK_DEG {
         return report(
             Class::Disagreement,
             format!(
                 "rotation {:.3}° at tol {:e} but {:.3}° at {:e} (add --tol {:e}): {}",
-                a.rotation.to_degrees(),
+                a.rotation_rad.to_degrees(),
                 base.tol,
-                b.rotation.to_degrees(),
+                b.rotation_rad.to_degrees(),
                 tight.tol,
                 tight.tol,
                 c.command(rho, None)

@@ -46,7 +46,7 @@ pub fn assert_finite(o: &ContactOutcome, what: &str) {
         p.x.is_finite() && p.y.is_finite() && p.theta_rad.is_finite(),
         "{what}: non-finite pose {p:?}"
     );
-    assert!(o.rotation.is_finite(), "{what}: rotation");
+    assert!(o.rotation_rad.is_finite(), "{what}: rotation");
     assert!(
         o.contact_length.is_finite() && o.contact_length >= 0.0,
         "{what}: length"
