@@ -192,7 +192,7 @@ fn run_passes(ctx: &mut Ctx, settings: &ContactSettings, pose: Pose) -> ContactO
 /// let out = push(&model, pose, pin_start, &Pin::point(), &ContactSettings::default(), None);
 /// assert_eq!(out.status, ContactStatus::Ok);
 /// assert!(out.contact);
-/// assert!((out.rotation.to_degrees() - -19.05).abs() < 0.01);
+/// assert!((out.rotation_rad.to_degrees() - -19.05).abs() < 0.01);
 /// ```
 pub fn push(
     model: &PartModel,
