@@ -5,7 +5,7 @@
 //! shared tables. Run: `cargo bench --bench contact`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use pinfeed::contact_case::batch::{run_batch, BatchDefaults};
+use pinfeed::contact_case::batch::run_batch;
 use pinfeed::contact_case::{compile_part, run_compiled, Case};
 use pinfeed::geometry::{part_from_spec, Pose, Vec2};
 use pinfeed::mechanics::{push, ContactSettings, Fidelity, PartModel, Pin, Support};
@@ -77,7 +77,7 @@ fn bench_batch(c: &mut Criterion) {
         text.push_str(&format!("{p},{t},{d},{mu}\n"));
     }
     std::fs::write(&file, text).unwrap();
-    let defaults = BatchDefaults::default();
+    let defaults = Case::new("", 0.0, 0.0, 0.0);
     let mut group = c.benchmark_group("contact_batch");
     group.sample_size(10);
     group.bench_function("1200 cases (shared tabled models, parallel)", |b| {

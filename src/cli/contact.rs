@@ -5,7 +5,7 @@
 //! in −x relative to the belt (plus w per unit travel for a moving pin). All lengths in the output
 //! are in the part's units.
 
-use crate::contact_case::batch::{run_batch, BatchDefaults};
+use crate::contact_case::batch::run_batch;
 use crate::contact_case::report::{report, trace_csv};
 use crate::contact_case::{
     case_fence, case_geometry, parse_fence, parse_model, run_case, stop_travel, Case,
@@ -163,17 +163,7 @@ pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
 
 pub fn run(args: &ContactArgs) -> Result<()> {
     if let Some(path) = &args.cases {
-        let defaults = BatchDefaults {
-            model: args.push.model.clone(),
-            mu_s: args.mu_s,
-            pin_radius: args.push.pin_radius,
-            pin_speed: args.pin_speed,
-            pin_stop: args.pin_stop,
-            pin_stop_after_touch: args.pin_stop_after_touch,
-            support: args.push.support.clone(),
-            tol: args.push.tol,
-            fence: args.fence.clone(),
-        };
+        let defaults = case_of(args, parse_model(&args.push.model)?)?;
         return Ok(run_batch(&defaults, path, std::io::stdout().lock())?);
     }
     if args.push.map_tier() {

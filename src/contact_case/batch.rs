@@ -4,46 +4,12 @@
 use super::check::{
     check_flag_settings, check_geometry_named, check_inputs_named, check_stop_after_touch, flag,
 };
-use super::{compile_part, parse_fence, parse_model, run_compiled, Case, CaseError};
+use super::{compile_part, parse_model, run_compiled, Case, CaseError};
 use crate::geometry::{wrap_deg, Polygon};
 use crate::mechanics::{ContactOutcome, PartModel};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-
-/// The settings every row takes unless the row gives its own (model, pin radius, μs), and the
-/// ones only flags give (pin path, support, tolerance, fence).
-#[derive(Debug, Clone)]
-pub struct BatchDefaults {
-    pub model: String,
-    pub mu_s: f64,
-    pub pin_radius: f64,
-    pub pin_speed: f64,
-    pub pin_stop: Option<f64>,
-    pub pin_stop_after_touch: Option<f64>,
-    pub support: String,
-    pub tol: f64,
-    /// `ANGLE_DEG[:LENGTH]`.
-    pub fence: Option<String>,
-}
-
-impl Default for BatchDefaults {
-    /// The defaults of [`Case::new`].
-    fn default() -> Self {
-        let c = Case::new("", 0.0, 0.0, 0.0);
-        BatchDefaults {
-            model: c.model.name().to_string(),
-            mu_s: c.mu_s,
-            pin_radius: c.pin_radius,
-            pin_speed: c.pin_speed,
-            pin_stop: c.pin_stop,
-            pin_stop_after_touch: c.pin_stop_after_touch,
-            support: c.support,
-            tol: c.tol,
-            fence: None,
-        }
-    }
-}
 
 /// A batch that cannot be run; a row's error names the file and line.
 #[derive(Debug, thiserror::Error)]
@@ -111,7 +77,10 @@ struct CaseOut<'a> {
     status: &'a str,
 }
 
-/// Run every case of the CSV file `path` and write one CSV row per case to `out`.
+/// Run every case of the CSV file `path` and write one CSV row per case to `out`. `defaults`
+/// holds the settings every row takes unless the row gives its own (model, pin radius, μs) and
+/// the ones only flags give (pin path, support, tolerance, fence); its part, θ0, d and μc are
+/// not used.
 ///
 /// Every row is read and checked before any contact runs, so a refused row leaves `out` empty.
 /// Rows that share a part and support share one compiled model, whose slide tables serve each μc
@@ -120,7 +89,7 @@ struct CaseOut<'a> {
 /// parallel on rayon and are written in row order, so the output does not depend on the thread
 /// count.
 pub fn run_batch<W: std::io::Write>(
-    defaults: &BatchDefaults,
+    defaults: &Case,
     path: &Path,
     out: W,
 ) -> Result<(), BatchError> {
@@ -173,7 +142,7 @@ fn tabled(mu: &[(f64, usize)]) -> Vec<f64> {
 /// Every case of the batch, checked, each with the index of its part's shared model.
 type Batch = (Vec<(Case, usize)>, Vec<(Polygon, PartModel)>);
 
-fn read_batch(defaults: &BatchDefaults, path: &Path) -> Result<Batch, BatchError> {
+fn read_batch(defaults: &Case, path: &Path) -> Result<Batch, BatchError> {
     let text = crate::input::read_text(path).map_err(|source| BatchError::Read {
         path: path.to_path_buf(),
         source,
@@ -187,12 +156,10 @@ fn read_batch(defaults: &BatchDefaults, path: &Path) -> Result<Batch, BatchError
     let mut mu_values: Vec<Vec<(f64, usize)>> = Vec::new();
     let mut cases = Vec::new();
     let args = defaults;
-    let fence = args.fence.as_deref().map(parse_fence).transpose()?;
     // Flags that apply to every row are checked once, before any row (an error there is the
     // flag's, not a row's).
     check_flag_settings(args.pin_speed, args.pin_stop, args.tol, &flag)?;
     check_stop_after_touch(args.pin_stop_after_touch)?;
-    let default_model = parse_model(&args.model)?;
     for (i, row) in rdr.deserialize::<CaseRow>().enumerate() {
         let row = row.map_err(|error| {
             let line = error.position().map(|p| p.line()).unwrap_or(i as u64 + 2);
@@ -207,7 +174,7 @@ fn read_batch(defaults: &BatchDefaults, path: &Path) -> Result<Batch, BatchError
             Some(m) if !m.is_empty() => {
                 parse_model(m).map_err(|source| BatchError::RowModel { at: at(), source })?
             }
-            _ => default_model,
+            _ => args.model,
         };
         let c = Case {
             part: row.part.clone(),
@@ -217,12 +184,7 @@ fn read_batch(defaults: &BatchDefaults, path: &Path) -> Result<Batch, BatchError
             mu_s: row.mu_s.unwrap_or(args.mu_s),
             model,
             pin_radius: row.pin_radius.unwrap_or(args.pin_radius),
-            pin_speed: args.pin_speed,
-            pin_stop: args.pin_stop,
-            pin_stop_after_touch: args.pin_stop_after_touch,
-            support: args.support.clone(),
-            tol: args.tol,
-            fence,
+            ..args.clone()
         };
         // A setting given in the row is named by its column, one taken from a flag by the flag.
         let in_row = |field: &str| match field {
@@ -283,7 +245,7 @@ mod tests {
             .build()
             .unwrap();
         let mut out = Vec::new();
-        pool.install(|| run_batch(&BatchDefaults::default(), path, &mut out))?;
+        pool.install(|| run_batch(&Case::new("", 0.0, 0.0, 0.0), path, &mut out))?;
         Ok(String::from_utf8(out).unwrap())
     }
 
@@ -351,7 +313,7 @@ mod tests {
         ];
         let path = write_cases("bad", &rows);
         let mut out = Vec::new();
-        let e = run_batch(&BatchDefaults::default(), &path, &mut out)
+        let e = run_batch(&Case::new("", 0.0, 0.0, 0.0), &path, &mut out)
             .unwrap_err()
             .to_string();
         assert!(e.contains(":3"), "{e}");
