@@ -1,5 +1,3 @@
-use clap::Parser;
-
 fn main() {
     // Set but empty means unset, as the map cache's default folder reads it (clap would refuse
     // `--cache-dir` "a value is required" for an option the user never gave).

@@ -1,10 +1,9 @@
 //! `pinfeed bench`: measurements that produce the reports in `results/`.
 
-use crate::mechanics::Fidelity;
 use crate::study::{contact_cost, map_cost};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct BenchArgs {
@@ -82,49 +81,29 @@ pub enum BenchWhat {
     Line(super::bench_line::LineArgs),
 }
 
-pub fn run(args: &BenchArgs) -> Result<()> {
+/// Run `pinfeed bench`; `recorded` is the command line its report records.
+pub fn run(args: &BenchArgs, recorded: &str) -> Result<()> {
     // The measurements run for seconds to hours: a spinner with the elapsed time and the stage.
     let spin = super::progress::spinner("bench", false);
-    let result = measure(&args.what, &spin);
+    let result = measure(&args.what, &spin, recorded);
     spin.finish_and_clear();
     result
 }
 
-fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
+fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()> {
     match what {
         BenchWhat::Accuracy {
             contacts,
             seed,
             out,
         } => {
-            if *contacts < 4 || *contacts > 1_000_000 {
-                anyhow::bail!("--contacts must be between 4 and 1000000, got {contacts}");
-            }
-            let parts = ["tripoly1", "tripoly2", "square", "lshape"];
             spin.set_message(format!(
                 "accuracy: {contacts} contacts against the reference"
             ));
-            let st = crate::study::accuracy::run(&parts, *contacts, *seed)?;
-            let cmd = format!(
-                "cargo run --release -- bench accuracy --contacts {contacts} --seed {seed} --out {}",
-                out.display()
-            );
-            let p_md = out.with_extension("md");
-            let old = std::fs::read_to_string(&p_md).unwrap_or_default();
-            let md = crate::study::accuracy::report_keeping(&st, &cmd, &old);
-            let p_csv = out.with_extension("csv");
-            let p_svg = out.with_extension("svg");
-            write_file(&p_md, md)?;
-            write_file(&p_csv, crate::study::accuracy::csv(&st))?;
-            crate::report::plot_accuracy::plot_accuracy(&st, &p_svg)
-                .with_context(|| format!("writing {}", p_svg.display()))?;
-            print!("{}", crate::study::accuracy::markdown_table(&st));
-            eprintln!(
-                "wrote {}, {}, {}",
-                p_md.display(),
-                p_csv.display(),
-                p_svg.display()
-            );
+            let (table, files) = crate::study::accuracy::bench(*contacts, *seed, cmd, out)?;
+            print!("{table}");
+            let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+            eprintln!("wrote {}", files.join(", "));
             Ok(())
         }
         BenchWhat::Contact {
@@ -133,76 +112,32 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar) -> Result<()> {
             seed,
             out,
         } => {
-            if *contacts == 0 || *contacts > 1_000_000 {
-                anyhow::bail!("--contacts must be between 1 and 1000000, got {contacts}");
-            }
-            if !(*tol > 0.0 && *tol <= 1e-2) {
-                anyhow::bail!("--tol must be in (0, 0.01], got {tol}");
-            }
-            let parts = ["tripoly1", "tripoly2", "square", "lshape"];
-            let fids = [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact];
-            spin.set_message(format!("contact: {contacts} contacts per part and model"));
-            let rows = contact_cost::measure(&parts, &fids, *contacts, *tol, *seed, true)?;
-            spin.set_message("contact: cost against the vertex count");
-            let scaling = contact_cost::vertex_scaling(
-                &[3, 6, 12, 24, 48],
-                (*contacts / 4).max(1),
-                *tol,
-                *seed,
-            )?;
-            let (table, doc) = contact_cost::report(&rows, &scaling, *contacts, *tol, *seed, out);
-            write_file(out, &doc)?;
-            print!("{table}");
+            let stage = |s: &str| spin.set_message(s.to_string());
+            print!(
+                "{}",
+                contact_cost::bench(*contacts, *tol, *seed, cmd, out, &stage)?
+            );
             eprintln!("wrote {}", out.display());
             Ok(())
         }
         BenchWhat::Maps { repeats, out } => {
             spin.set_message(format!("maps: {repeats} timed runs per row"));
-            bench_maps(*repeats, out)
+            // Other work on the machine slows every row: say how busy it was (Linux only).
+            print!(
+                "{}",
+                map_cost::bench(*repeats, cmd, out, &super::bench_mc::load_average)?
+            );
+            eprintln!("wrote {}", out.display());
+            Ok(())
         }
-        BenchWhat::Designs(a) => super::bench_designs::run(a, spin),
+        BenchWhat::Designs(a) => super::bench_designs::run(a, spin, cmd),
         BenchWhat::McPrecision {
             study,
             samples,
             repeats,
             out,
-        } => super::bench_mc::run(study, samples, *repeats, out, spin),
-        BenchWhat::MapTier(a) => super::bench_map_tier::run(a, spin),
-        BenchWhat::Line(a) => super::bench_line::run(a, spin),
+        } => super::bench_mc::run(study, samples, *repeats, out, spin, cmd),
+        BenchWhat::MapTier(a) => super::bench_map_tier::run(a, spin, cmd),
+        BenchWhat::Line(a) => super::bench_line::run(a, spin, cmd),
     }
-}
-
-/// Write a report file (creating its folder), naming it on failure.
-pub(super) fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
-    crate::report::create_parent(path)?;
-    crate::report::atomic::write_atomic(path, bytes)
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// Rewrite a report file from its current text (empty when it does not exist yet): for the
-/// commands that replace their own marked section of a shared report.
-pub(super) fn rewrite_file(path: &Path, edit: impl FnOnce(&str) -> String) -> Result<()> {
-    let old = std::fs::read_to_string(path).unwrap_or_default();
-    write_file(path, edit(&old))
-}
-
-fn bench_maps(repeats: usize, out: &Path) -> Result<()> {
-    if repeats == 0 || repeats > 1000 {
-        anyhow::bail!("--repeats must be between 1 and 1000, got {repeats}");
-    }
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut threads = vec![1, 2, cores];
-    threads.sort_unstable();
-    threads.dedup();
-    let fids = [Fidelity::Exact, Fidelity::Ellipsoid, Fidelity::Tip];
-    // Other work on the machine slows every row: say how busy it was (Linux only).
-    let load = super::bench_mc::load_average;
-    let load_before = load();
-    let rows = map_cost::measure(&["tripoly1", "tripoly2"], &fids, &threads, 1.0, repeats)?;
-    let load_after = load();
-    let (table, doc) = map_cost::report(&rows, repeats, cores, (&load_before, &load_after), out);
-    write_file(out, &doc)?;
-    print!("{table}");
-    eprintln!("wrote {}", out.display());
-    Ok(())
 }

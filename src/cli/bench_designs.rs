@@ -3,7 +3,6 @@
 
 use crate::plan::design::survey::{page, survey_part, SurveyPart, SurveySettings};
 use crate::plan::problem::parse_mu_c_range;
-use crate::report::shell_word;
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::PathBuf;
 
@@ -39,7 +38,7 @@ pub struct DesignsArgs {
 }
 
 /// Run the survey.
-pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar) -> Result<()> {
+pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()> {
     if a.random > 10_000 {
         bail!("--random {}: must lie in 0..=10000", a.random);
     }
@@ -61,24 +60,6 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar) -> Result<()> {
         tripod: a.tripod,
         seed: 1,
     };
-    let mut command = format!(
-        "cargo run --release -- bench designs --random {} --first {}",
-        a.random, a.first
-    );
-    if !a.parts.is_empty() {
-        command += &format!(" --parts {}", shell_word(&a.parts.join(";")));
-    }
-    command += &format!(
-        " --time-limit {} --check-parts {}",
-        a.time_limit, a.check_parts
-    );
-    if let Some(r) = &a.mu_c_range {
-        command += &format!(" --mu-c-range {r}");
-    }
-    if a.tripod {
-        command += " --tripod";
-    }
-    command += &format!(" --out {}", a.out.display());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.threads)
         .build()
@@ -93,8 +74,8 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar) -> Result<()> {
             p.label
         ));
         rows.push(pool.install(|| survey_part(&s, p)));
-        let m = page(&command, &s, &rows);
-        super::bench::write_file(&a.out, m)?;
+        let m = page(cmd, &s, &rows);
+        crate::report::atomic::write_file(&a.out, m)?;
     }
     eprintln!("wrote {}", a.out.display());
     Ok(())

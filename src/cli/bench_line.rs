@@ -26,7 +26,7 @@ pub struct LineArgs {
     pub out: PathBuf,
 }
 
-pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar) -> Result<()> {
+pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()> {
     if a.parts == 0 || a.parts > 10_000_000 {
         bail!("--parts must be between 1 and 10000000, got {}", a.parts);
     }
@@ -50,20 +50,8 @@ pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar) -> Result<()> {
         super::progress::note(spin, &line);
         rows.push(row);
     }
-    let list: Vec<String> = a
-        .scenarios
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect();
-    let cmd = format!(
-        "cargo run --release -- bench line --scenarios {} --parts {} --reps {} --out {}",
-        list.join(","),
-        a.parts,
-        a.reps,
-        a.out.display()
-    );
-    let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, &cmd), MARKERS.1);
-    super::bench::rewrite_file(&a.out, |old| splice_between(old, &marked, MARKERS))?;
+    let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, cmd), MARKERS.1);
+    crate::report::atomic::rewrite_file(&a.out, |old| splice_between(old, &marked, MARKERS))?;
     eprintln!("wrote {}", a.out.display());
     Ok(())
 }

@@ -31,12 +31,12 @@ pub struct MapTierArgs {
 }
 
 fn write_section(path: &Path, section: &str) -> Result<()> {
-    super::bench::rewrite_file(path, |old| splice(old, &marked(section)))?;
+    crate::report::atomic::rewrite_file(path, |old| splice(old, &marked(section)))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }
 
-pub fn run(a: &MapTierArgs, spin: &indicatif::ProgressBar) -> Result<()> {
+pub fn run(a: &MapTierArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()> {
     if a.contacts == 0 || a.contacts > 1_000_000 {
         bail!(
             "--contacts must be between 1 and 1000000, got {}",
@@ -49,16 +49,6 @@ pub fn run(a: &MapTierArgs, spin: &indicatif::ProgressBar) -> Result<()> {
             a.line_parts
         );
     }
-    let cmd = format!(
-        "cargo run --release -- bench map-tier --parts {} --contacts {} --seed {} --scenario {} --line-parts {} --accuracy-out {} --line-out {}",
-        a.parts.join(","),
-        a.contacts,
-        a.seed,
-        a.scenario.display(),
-        a.line_parts,
-        a.accuracy_out.display(),
-        a.line_out.display()
-    );
     let mut rows = Vec::new();
     for part in &a.parts {
         let stage = format!("map tier: building and measuring {part}");
@@ -66,14 +56,14 @@ pub fn run(a: &MapTierArgs, spin: &indicatif::ProgressBar) -> Result<()> {
         spin.set_message(stage);
         rows.push(contact_row(part, a.contacts, a.seed)?);
     }
-    let section = contact_section(&rows, &cmd);
+    let section = contact_section(&rows, cmd);
     print!("{section}");
     write_section(&a.accuracy_out, &section)?;
     let stage = format!("map tier: line runs of {}", a.scenario.display());
     super::progress::note(spin, &stage);
     spin.set_message(stage);
     let line = line_row(&a.scenario, a.line_parts)?;
-    let section = line_section(&line, &a.scenario, &cmd);
+    let section = line_section(&line, &a.scenario, cmd);
     print!("{section}");
     write_section(&a.line_out, &section)
 }

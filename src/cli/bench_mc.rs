@@ -24,6 +24,7 @@ pub fn run(
     repeats: usize,
     out: &Path,
     spin: &indicatif::ProgressBar,
+    cmd: &str,
 ) -> Result<()> {
     if !(1..=100).contains(&repeats) {
         bail!("--repeats must lie in [1, 100], got {repeats}");
@@ -74,18 +75,8 @@ pub fn run(
         fidelities.push((fid.name().to_string(), row[0].clone()));
     }
     let load_after = load_average();
-    let counts_text = counts
-        .iter()
-        .map(|n| n.to_string())
-        .collect::<Vec<_>>()
-        .join(",");
-    let cmd = format!(
-        "cargo run --release -- bench mc-precision --study {} --samples {counts_text} --repeats {repeats} --out {}",
-        study_file.display(),
-        out.display()
-    );
     let section = precision::section(
-        &cmd,
+        cmd,
         &study_file.display().to_string(),
         &rows,
         &fidelities,
@@ -97,7 +88,7 @@ pub fn run(
             load_after,
         },
     );
-    super::bench::rewrite_file(out, |doc| precision::splice(doc, &section))?;
+    crate::report::atomic::rewrite_file(out, |doc| precision::splice(doc, &section))?;
     print!("{section}");
     eprintln!(
         "wrote the Monte Carlo precision section of {}",

@@ -10,7 +10,6 @@
 use super::validate::{emit, ensemble_spec, pool, ModelArgs};
 use crate::mechanics::support::{SmoothParams, SupportChoice};
 use crate::report::calibrate_report::{calibration_text, write_report, CalibrateReport};
-use crate::report::shell_word;
 use crate::validate::calibrate::{calibrate_observed, CalibrationSettings};
 use crate::validate::input::{check_members, load_measured};
 use crate::validate::synthetic::{synthesize, SyntheticDesign};
@@ -61,8 +60,9 @@ pub(crate) fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
         .split_once(':')
         .and_then(|(a, b)| Some((a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?)))
         .ok_or_else(|| anyhow!("--mu-c-range must be MIN:MAX, got '{}'", args.mu_c_range))?;
-    if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo + 0.05 <= hi && hi <= 10.0) {
-        bail!("--mu-c-range: need 0 ≤ MIN, MIN + 0.05 ≤ MAX ≤ 10, got {lo}:{hi}");
+    let (mu_lo, mu_hi) = crate::mechanics::limits::MU_C;
+    if !(lo.is_finite() && hi.is_finite() && mu_lo <= lo && lo + 0.05 <= hi && hi <= mu_hi) {
+        bail!("--mu-c-range: need {mu_lo} ≤ MIN, MIN + 0.05 ≤ MAX ≤ {mu_hi}, got {lo}:{hi}");
     }
     let positive = [
         ("--pin-radius-max", args.pin_radius_max),
@@ -99,7 +99,8 @@ pub(crate) fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
     })
 }
 
-pub fn run(args: &CalibrateArgs) -> Result<()> {
+/// Run `pinfeed calibrate`; `recorded` is the command line its report records.
+pub fn run(args: &CalibrateArgs, recorded: &str) -> Result<()> {
     let s = settings(args)?;
     let c = &args.common;
     let hidden = if args.synthesize {
@@ -147,7 +148,7 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
         &fitted_score,
     );
     let report = CalibrateReport {
-        command: command_line(args),
+        command: recorded.to_string(),
         measured: args.measured.display().to_string(),
         calibration: &cal,
         nominal: nominal.describe(),
@@ -159,21 +160,4 @@ pub fn run(args: &CalibrateArgs) -> Result<()> {
     emit(&report, &text, c, "calibrate", &args.measured, |dir| {
         write_report(&report, &text, dir)
     })
-}
-
-fn command_line(args: &CalibrateArgs) -> String {
-    format!(
-        "pinfeed calibrate {}{} --members {} --support {} --jitter {} --mu-c-range {} --pin-radius-max {} --pin-radius-sd {} --mu-c {} --score-members {} {}",
-        shell_word(&args.measured.display().to_string()),
-        if args.synthesize { " --synthesize" } else { "" },
-        args.members,
-        shell_word(&args.support),
-        args.jitter,
-        shell_word(&args.mu_c_range),
-        args.pin_radius_max,
-        args.pin_radius_sd,
-        args.mu_c,
-        args.score_members,
-        args.common.words()
-    )
 }

@@ -11,7 +11,7 @@
 //! [0°, 360°) instead of the first file's distribution. Nothing is written to disk.
 
 use crate::report::compare_table;
-use crate::scenario::{FeedSource, Lateral, Orientation};
+use crate::scenario::FeedSource;
 use crate::study::compare::compare_observed;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -41,45 +41,6 @@ pub struct CompareArgs {
     /// No progress display.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// One line saying which part stream every design ran on.
-pub fn feed_line(file: &str, source: &FeedSource, parts: u64) -> String {
-    let feed = &source.feed;
-    let orientation = match &feed.orientation {
-        Orientation::Uniform => "uniform on [0°, 360°)".to_string(),
-        Orientation::Stable {
-            thetas_rad: thetas,
-            weights,
-            jitter_rad: jitter,
-        } => {
-            let states: Vec<String> = thetas
-                .iter()
-                .zip(weights)
-                .map(|(t, w)| format!("{:.3}° ×{w:.3}", t.to_degrees()))
-                .collect();
-            format!(
-                "stable states {} ± {:.3}° (sd)",
-                states.join(", "),
-                jitter.to_degrees()
-            )
-        }
-    };
-    let lateral = match feed.lateral {
-        Lateral::Fixed(y) => format!("at y = {y} m"),
-        Lateral::Uniform { min, max } => format!("y uniform on [{min}, {max}] m"),
-        Lateral::Normal { mean, sd, .. } => format!("y normal, mean {mean} m, sd {sd} m"),
-    };
-    let arrival = match feed.arrival {
-        crate::scenario::Arrival::Periodic { headway } => format!("one every {headway} s"),
-        crate::scenario::Arrival::Poisson { headway } => {
-            format!("Poisson, mean headway {headway} s")
-        }
-    };
-    format!(
-        "part stream of {file}: seed {}, {parts} parts, {arrival}, orientation {orientation}, {lateral}",
-        source.seed
-    )
 }
 
 pub fn run(args: &CompareArgs) -> Result<()> {
@@ -118,7 +79,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         }
         crate::report::versioned::pretty(&Designs { designs: &rows })?
     } else {
-        let feed = feed_line(&files[0], &source, parts);
+        let feed = compare_table::feed_line(&files[0], &source, parts);
         if args.markdown {
             format!("{feed}\n\n{}", compare_table::markdown(&rows))
         } else {

@@ -7,12 +7,8 @@
 
 use crate::contact_case::batch::run_batch;
 use crate::contact_case::report::{report, trace_csv};
-use crate::contact_case::{
-    case_fence, case_geometry, parse_fence, parse_model, run_case, stop_travel, Case,
-};
-use crate::geometry::{Polygon, Pose, Vec2};
+use crate::contact_case::{parse_fence, parse_model, run_case, stop_travel, Case};
 use crate::mechanics::Fidelity;
-use crate::report::plot_contact::{plot_contact, PassObstacle};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -97,50 +93,6 @@ pub struct ContactArgs {
     pub cases: Option<PathBuf>,
 }
 
-/// The initial pose of a case and its obstacle as the plot draws it: the pin (start, radius,
-/// lateral speed) or the fence segment.
-fn pass_obstacle(poly: &Polygon, c: &Case) -> (Pose, PassObstacle) {
-    let (pose, start) = case_geometry(poly, c);
-    let obstacle = match c.fence {
-        Some((angle, length)) => {
-            let fence = case_fence(poly, c, angle, length);
-            PassObstacle::Fence {
-                start: fence.start,
-                end: fence.start + Vec2::from_angle(fence.angle_rad) * fence.length,
-            }
-        }
-        None => PassObstacle::Pin {
-            start,
-            radius: c.pin_radius,
-            lateral_speed: c.pin_speed,
-        },
-    };
-    (pose, obstacle)
-}
-
-/// The plot's title: the part, θ0, d, the friction and the model (and the fence's angle).
-fn plot_title(c: &Case) -> String {
-    match c.fence {
-        Some((angle, _)) => format!(
-            "{} θ0={}° d={} fence α={}° μf={} ({})",
-            c.part,
-            c.theta0_deg,
-            c.d,
-            angle,
-            c.mu_c,
-            c.model.name()
-        ),
-        None => format!(
-            "{} θ0={}° d={} μc={} ({})",
-            c.part,
-            c.theta0_deg,
-            c.d,
-            c.mu_c,
-            c.model.name()
-        ),
-    }
-}
-
 /// The single case the arguments describe, with fidelity `model`.
 pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
     let d = args.d.unwrap_or(0.0);
@@ -177,8 +129,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        let (pose, obstacle) = pass_obstacle(&poly, &c);
-        plot_contact(&poly, pose, &obstacle, &out, &trace, &plot_title(&c), path)
+        crate::contact_case::plot::plot(&c, &poly, &out, &trace, path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     let r = report(&c, &out).with_pin_positions(&c, poly.radius(), &out);

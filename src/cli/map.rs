@@ -16,7 +16,6 @@ use crate::contact_case::{
 };
 use crate::maps::{compute_maps_with, MapFence, MapSettings};
 use crate::report::map_report::{write_csv, write_report, MapReport};
-use crate::report::shell_word;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -88,47 +87,6 @@ pub struct MapArgs {
     pub seed: u64,
 }
 
-/// The command line that regenerates a report, every setting explicit.
-pub fn command_line(args: &MapArgs) -> String {
-    let ds: Vec<String> = args.d.iter().map(|d| d.to_string()).collect();
-    let mut words = vec![
-        "pinfeed".to_string(),
-        "map".into(),
-        "--part".into(),
-        shell_word(&args.part),
-    ];
-    match &args.fence {
-        Some(f) => words.extend(["--fence".to_string(), shell_word(f)]),
-        None => words.push(format!("--d={}", ds.join(","))),
-    }
-    words.extend([
-        "--theta-step".into(),
-        args.theta_step.to_string(),
-        "--model".into(),
-        shell_word(&args.push.model),
-        "--mu-c".into(),
-        args.push.mu_c.to_string(),
-    ]);
-    if args.fence.is_none() {
-        words.extend(["--pin-radius".into(), args.push.pin_radius.to_string()]);
-    }
-    words.extend([
-        "--support".into(),
-        shell_word(&args.push.support),
-        "--threshold".into(),
-        args.threshold.to_string(),
-        "--tol".into(),
-        args.push.tol.to_string(),
-    ]);
-    for (flag, dir) in [("--out-dir", &args.out_dir), ("--plot-dir", &args.plot_dir)] {
-        if let Some(dir) = dir {
-            words.push(flag.into());
-            words.push(shell_word(&dir.display().to_string()));
-        }
-    }
-    words.join(" ")
-}
-
 /// The default report directory of a map command: `pinfeed-out/maps/<part>` (a vertex list is
 /// `custom`), and below it `fence_<angle>[_<length>]` for a fence map.
 pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
@@ -152,7 +110,8 @@ pub fn default_out_dir(part: &str) -> PathBuf {
     crate::default_out(&["maps", &super::part_folder(part)])
 }
 
-pub fn run(args: &MapArgs) -> Result<()> {
+/// Run `pinfeed map`; `recorded` is the command line its report records.
+pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     // The map tier answers over the exact model, which computes what it cannot vouch for.
     let use_tier = args.push.map_tier();
     if use_tier && (args.fence.is_some() || args.uncertain.is_some()) {
@@ -183,7 +142,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         }
     }
     if let Some(uncertain) = &args.uncertain {
-        return super::map_ensemble::run(args, uncertain, model, &poly);
+        return super::map_ensemble::run(args, recorded, uncertain, model, &poly);
     }
     let (contact, pin) = settings_and_pin(&template);
     // Every pass of the maps shares the model: its exact slides come from tables.
@@ -259,7 +218,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
 
     let report = MapReport {
-        command: command_line(args),
+        command: recorded.to_string(),
         part: &args.part,
         model: if use_tier { "map" } else { model.name() },
         mu_c: args.push.mu_c,
@@ -292,57 +251,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::Parser;
     use std::path::Path;
-
-    fn parse(args: &[&str]) -> MapArgs {
-        let cli =
-            crate::cli::Cli::parse_from(std::iter::once("pinfeed").chain(args.iter().copied()));
-        match cli.command {
-            crate::cli::Command::Map(a) => a,
-            other => panic!("not a map command: {other:?}"),
-        }
-    }
-
-    #[test]
-    fn the_recorded_command_parses_back_to_the_same_settings() {
-        let a = parse(&[
-            "map",
-            "--part",
-            "vertices:0,0 2,0 0,1",
-            "--d",
-            "-0.5,0.25",
-            "--mu-c",
-            "0.7",
-            "--theta-step",
-            "2",
-            "--out-dir",
-            "out dir",
-        ]);
-        let cmd = command_line(&a);
-        assert!(cmd.contains("--part 'vertices:0,0 2,0 0,1'"), "{cmd}");
-        assert!(cmd.contains("--out-dir 'out dir'"), "{cmd}");
-        // Split the shell words back (single quotes only) and parse them again.
-        let mut words: Vec<String> = Vec::new();
-        let mut quoted = false;
-        let mut cur = String::new();
-        for c in cmd.chars() {
-            match c {
-                '\'' => quoted = !quoted,
-                ' ' if !quoted => words.push(std::mem::take(&mut cur)),
-                _ => cur.push(c),
-            }
-        }
-        words.push(cur);
-        let refs: Vec<&str> = words.iter().skip(1).map(String::as_str).collect();
-        let b = parse(&refs);
-        assert_eq!(
-            (b.part, b.d, b.push.mu_c, b.theta_step),
-            (a.part, a.d, a.push.mu_c, a.theta_step)
-        );
-        assert_eq!(b.out_dir, a.out_dir);
-        assert_eq!(command_line(&parse(&refs)), cmd);
-    }
 
     #[test]
     fn default_report_directory_is_per_part() {

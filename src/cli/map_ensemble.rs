@@ -6,13 +6,12 @@
 //! command, `ensemble.json` and one figure per input state (`ensemble_all.svg`,
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
-use super::map::{command_line, default_out_dir_for, MapArgs};
+use super::map::{default_out_dir_for, MapArgs};
 use crate::geometry::Polygon;
 use crate::maps::ensemble::{ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState};
 use crate::maps::theta_grid;
 use crate::mechanics::Fidelity;
 use crate::report::ensemble_report::{table, write_report, EnsembleReport};
-use crate::report::shell_word;
 use anyhow::{anyhow, bail, Result};
 
 /// Most members of an ensemble.
@@ -20,18 +19,13 @@ pub const MAX_MEMBERS: usize = 100_000;
 /// Most passes (members × d × θ0) in one command.
 pub const MAX_PASSES: usize = 20_000_000;
 
-/// The regenerating command of an ensemble map.
-fn ensemble_command(args: &MapArgs, uncertain: &str) -> String {
-    format!(
-        "{} --uncertain {} --members {} --seed {}",
-        command_line(args),
-        shell_word(uncertain),
-        args.members,
-        args.seed
-    )
-}
-
-pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> Result<()> {
+pub fn run(
+    args: &MapArgs,
+    recorded: &str,
+    uncertain: &str,
+    model: Fidelity,
+    poly: &Polygon,
+) -> Result<()> {
     if args.push.support.trim() != "uniform" {
         bail!("--support: with --uncertain the support is set by `support=` in the uncertain list; leave --support at uniform");
     }
@@ -92,7 +86,7 @@ pub fn run(args: &MapArgs, uncertain: &str, model: Fidelity, poly: &Polygon) -> 
         return Ok(());
     }
     let report = EnsembleReport {
-        command: ensemble_command(args, uncertain),
+        command: recorded.to_string(),
         part: &args.part,
         uncertain: spec.describe(),
         members: args.members,

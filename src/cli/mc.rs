@@ -5,14 +5,11 @@
 //! (`<out>/shard-K-of-N.json`, default `<out>` = `pinfeed-out/mc/<study name>/shards/`) for
 //! `pinfeed merge`.
 
-use crate::report::atomic::Batch;
-use crate::report::plot_sensitivity::plot_sensitivity;
 use crate::study::mc::report::{self, McReport, StudyHeader};
 use crate::study::mc::shard::{self, ShardFile, ShardSpec};
 use crate::study::mc::{self, run};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -109,7 +106,7 @@ pub fn run(args: &McArgs) -> Result<()> {
         .map(|j| tallies.get(&j).cloned().unwrap_or_default())
         .collect();
     let dir = args.out.clone().unwrap_or_else(|| default_dir(&study.name));
-    let r = report::build(&with_out(header, &dir), &tallies);
+    let r = report::build(&report::with_out(header, &dir), &tallies);
     publish(&r, &dir, args.json, args.quiet)?;
     if !args.quiet && !args.json {
         eprintln!("{speed}");
@@ -117,40 +114,10 @@ pub fn run(args: &McArgs) -> Result<()> {
     Ok(())
 }
 
-/// The header with `--out DIR` on its regenerating command: the report names the folder it was
-/// written to, so its command rewrites exactly that report (and never the default folder in
-/// place of a committed one).
-pub fn with_out(mut header: StudyHeader, dir: &Path) -> StudyHeader {
-    header.command.push_str(" --out ");
-    header
-        .command
-        .push_str(&crate::report::shell_word(&dir.display().to_string()));
-    header
-}
-
-/// Write a report's files (`report.md`, `report.json`, `sensitivity.svg`) to `dir` and print the
-/// table or the JSON. `mc` and `merge` share it, so their outputs are the same bytes.
+/// Write a report's files to `dir` ([`report::write_files`]) and print the table or the JSON.
+/// `mc` and `merge` share it, so their outputs are the same bytes.
 pub fn publish(r: &McReport, dir: &Path, json: bool, quiet: bool) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let figure = "sensitivity.svg";
-    // The three files appear whole, and together, or not at all.
-    let md = dir.join("report.md");
-    let js = dir.join("report.json");
-    let svg = dir.join(figure);
-    let json_text = report::json(r);
-    let mut batch = Batch::new();
-    batch
-        .write(&md, report::markdown(r, figure))
-        .with_context(|| format!("writing {}", md.display()))?;
-    batch
-        .write(&js, &json_text)
-        .with_context(|| format!("writing {}", js.display()))?;
-    batch
-        .produce(&svg, |tmp| plot_sensitivity(r, tmp))
-        .with_context(|| format!("writing {}", svg.display()))?;
-    batch
-        .commit()
-        .with_context(|| format!("writing the report into {}", dir.display()))?;
+    let (json_text, md) = report::write_files(r, dir)?;
     let text = if json {
         json_text
     } else if quiet {
@@ -158,12 +125,5 @@ pub fn publish(r: &McReport, dir: &Path, json: bool, quiet: bool) -> Result<()> 
     } else {
         format!("{}\nreport: {}\n", report::table(r), md.display())
     };
-    let mut stdout = std::io::stdout().lock();
-    match stdout
-        .write_all(text.as_bytes())
-        .and_then(|_| stdout.flush())
-    {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e).context("writing to stdout"),
-        _ => Ok(()),
-    }
+    super::stdout::print_result(&text)
 }

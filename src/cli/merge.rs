@@ -35,6 +35,6 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| default_dir(&header.study));
-    let r = report::build(&super::mc::with_out(header, &dir), &tallies);
+    let r = report::build(&crate::study::mc::report::with_out(header, &dir), &tallies);
     publish(&r, &dir, args.json, args.quiet)
 }

@@ -25,14 +25,14 @@ pub mod merge;
 pub mod part;
 pub mod physics;
 pub mod plan;
-pub mod plan_command;
 pub mod progress;
+pub mod record;
 pub mod run;
 pub mod sense;
 pub mod stdout;
 pub mod validate;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 pub use crate::geometry::named::part_folder;
 
@@ -42,6 +42,30 @@ pub use crate::geometry::named::part_folder;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// The command line as outputs record it ([`record::command_line`]); filled by
+    /// [`Cli::parse`] and [`Cli::try_parse_from`], which shadow clap's own.
+    #[arg(skip)]
+    pub recorded: String,
+}
+
+impl Cli {
+    /// Parse an argument vector (the program name first) and record its command line.
+    pub fn try_parse_from<I, T>(argv: I) -> Result<Cli, clap::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        let cmd = <Cli as CommandFactory>::command();
+        let matches = cmd.clone().try_get_matches_from(argv)?;
+        let mut cli = <Cli as FromArgMatches>::from_arg_matches(&matches)?;
+        cli.recorded = record::command_line(&cmd, &matches);
+        Ok(cli)
+    }
+
+    /// Parse the process's arguments (exiting with clap's message on an error).
+    pub fn parse() -> Cli {
+        Cli::try_parse_from(std::env::args_os()).unwrap_or_else(|e| e.exit())
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -82,20 +106,22 @@ pub enum Command {
 
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
-    match cli.command {
+    let Cli { command, recorded } = cli;
+    let recorded = recorded.as_str();
+    match command {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),
-        Command::Map(a) => map::run(&a),
+        Command::Map(a) => map::run(&a, recorded),
         Command::Run(a) => run::run(&a),
         Command::Compare(a) => compare::run(&a),
         Command::Mc(a) => mc::run(&a),
         Command::Merge(a) => merge::run(&a),
-        Command::Sense(a) => sense::run(&a),
-        Command::Plan(a) => plan::run(&a),
-        Command::Bench(a) => bench::run(&a),
-        Command::Fuzz(a) => fuzz::run(&a),
-        Command::Validate(a) => validate::run(&a),
-        Command::Calibrate(a) => calibrate::run(&a),
+        Command::Sense(a) => sense::run(&a, recorded),
+        Command::Plan(a) => plan::run(&a, recorded),
+        Command::Bench(a) => bench::run(&a, recorded),
+        Command::Fuzz(a) => fuzz::run(&a, recorded),
+        Command::Validate(a) => validate::run(&a, recorded),
+        Command::Calibrate(a) => calibrate::run(&a, recorded),
         Command::Examples(a) => examples::run(&a),
         Command::Completions(a) => completions::run(&a),
     }

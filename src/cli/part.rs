@@ -1,9 +1,9 @@
 //! `pinfeed part`: describe a part (area, centroid, a, convexity, stable states) and plot it.
 
 use crate::geometry::{named, Polygon};
+use crate::report::part_report::PartReport;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use serde::Serialize;
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed part`.
@@ -32,22 +32,6 @@ pub struct PartArgs {
     /// Draw the part and its radius function into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub plot: Option<PathBuf>,
-}
-
-/// What `pinfeed part --json` prints.
-#[derive(Debug, Serialize)]
-pub struct PartReport {
-    pub name: String,
-    pub vertices: usize,
-    pub area: f64,
-    /// Centroid of the input vertices, in the input's coordinates.
-    pub centroid: [f64; 2],
-    pub a: f64,
-    pub polar_moment: f64,
-    pub convex: bool,
-    pub stable_states_deg: Vec<f64>,
-    /// Vertices in the part frame (counter-clockwise, centroid at the origin).
-    pub part_frame_vertices: Vec<[f64; 2]>,
 }
 
 /// Resolve a part spec (`--part`, or the positional name) or `--vertices` to a validated polygon
@@ -79,21 +63,7 @@ pub fn run(args: &PartArgs) -> Result<()> {
     }
     let spec = args.part.as_deref().or(args.name.as_deref());
     let (poly, name) = resolve_part(spec, args.vertices.as_deref())?;
-    let report = PartReport {
-        name: name.clone(),
-        vertices: poly.len(),
-        area: poly.area(),
-        centroid: [poly.offset().x, poly.offset().y],
-        a: poly.radius(),
-        polar_moment: poly.polar_moment(),
-        convex: poly.is_convex(),
-        stable_states_deg: poly
-            .stable_states()
-            .iter()
-            .map(|s| s.theta_rad.to_degrees())
-            .collect(),
-        part_frame_vertices: poly.vertices().iter().map(|p| [p.x, p.y]).collect(),
-    };
+    let report = PartReport::of(&poly, &name);
     if let Some(path) = &args.plot {
         crate::report::plot_part::plot_part(&poly, &name, path)
             .with_context(|| format!("writing {}", path.display()))?;
@@ -101,25 +71,7 @@ pub fn run(args: &PartArgs) -> Result<()> {
     if args.json {
         print!("{}", crate::report::versioned::pretty(&report)?);
     } else {
-        println!("part            {}", report.name);
-        println!("vertices        {}", report.vertices);
-        println!("area            {:.6}", report.area);
-        println!(
-            "centroid        ({:.6}, {:.6})",
-            report.centroid[0], report.centroid[1]
-        );
-        println!("a               {:.6}", report.a);
-        println!("polar moment    {:.6}", report.polar_moment);
-        println!(
-            "convex          {}",
-            if report.convex { "yes" } else { "no" }
-        );
-        let s: Vec<String> = report
-            .stable_states_deg
-            .iter()
-            .map(|d| format!("{d:.3}"))
-            .collect();
-        println!("stable states   {} (deg)", s.join(", "));
+        print!("{}", report.text());
         if let Some(p) = &args.plot {
             println!("plot            {}", p.display());
         }

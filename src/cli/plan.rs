@@ -249,8 +249,8 @@ fn flagged(e: anyhow::Error) -> anyhow::Error {
     }
 }
 
-/// The design options of the arguments.
-pub fn options_of(args: &PlanArgs) -> Result<DesignOptions> {
+/// The design options of the arguments; `recorded` is the command line the design's files record.
+pub fn options_of(args: &PlanArgs, recorded: &str) -> Result<DesignOptions> {
     let problem = problem_of(args)?;
     let mut o = DesignOptions::new(problem);
     let modes = Mode::selected(args.pins, args.fences, args.sensor);
@@ -281,13 +281,13 @@ pub fn options_of(args: &PlanArgs) -> Result<DesignOptions> {
             .map_or(o.name.clone(), |s| s.to_string_lossy().to_string()),
         (None, None) => o.name,
     };
-    o.command = super::plan_command::command_line(args);
+    o.command = recorded.to_string();
     Ok(o)
 }
 
-/// Run `pinfeed plan`.
-pub fn run(args: &PlanArgs) -> Result<()> {
-    let o = options_of(args)?;
+/// Run `pinfeed plan`; `recorded` is the command line the design's files record.
+pub fn run(args: &PlanArgs, recorded: &str) -> Result<()> {
+    let o = options_of(args, recorded)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()

@@ -6,7 +6,6 @@
 //! [`crate::report::animate`]).
 
 use crate::engine::{self, RunOptions};
-use crate::report::animate;
 use crate::report::line_table;
 use crate::report::run_folder::{write_run, RunFiles};
 use anyhow::{bail, Context, Result};
@@ -52,9 +51,6 @@ pub struct RunArgs {
     pub cache_dir: Option<PathBuf>,
 }
 
-/// How many of the first parts have their paths recorded when drawing.
-const SAMPLE_POOL: usize = 64;
-
 pub fn run(args: &RunArgs) -> Result<()> {
     let scene = crate::study::bundled::load_scenario(&args.scenario)?;
     let mut opts = RunOptions::from_scene(&scene);
@@ -67,24 +63,17 @@ pub fn run(args: &RunArgs) -> Result<()> {
     if let Some(s) = args.seed {
         opts.seed = s;
     }
-    opts.keep_records = scene.output.parts_csv;
-    if args.draw.is_some() {
-        opts.sample_paths = SAMPLE_POOL;
-    }
-    if args.animate.is_some() {
-        if let Some(x) = args.animate_speed {
-            if !(x.is_finite() && x > 0.0 && x <= 1e6) {
-                bail!("--animate-speed must lie in (0, 1000000], got {x}");
-            }
+    if let Some(x) = args.animate_speed.filter(|_| args.animate.is_some()) {
+        if !(x.is_finite() && x > 0.0 && x <= 1e6) {
+            bail!("--animate-speed must lie in (0, 1000000], got {x}");
         }
-        opts.sample_paths = opts.sample_paths.max(animate::DEFAULT_PARTS);
-        // Sensor decisions reach the animation through the per-part records.
-        let sensors = scene
-            .obstacles
-            .iter()
-            .any(|o| matches!(o, crate::scenario::Obstacle::Pin(p) if p.sensor.is_some()));
-        opts.keep_records |= sensors;
     }
+    let files = RunFiles {
+        draw: args.draw.as_deref(),
+        animate: args.animate.as_deref(),
+        animate_speed: args.animate_speed,
+    };
+    files.record_into(&scene, &mut opts);
     let bar = super::progress::bar(opts.parts, "parts", args.quiet);
     let maps = super::contact_map::prepare_maps(&scene, args.cache_dir.as_deref(), args.quiet);
     let started = Instant::now();
@@ -99,11 +88,6 @@ pub fn run(args: &RunArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(&scene.output.dir))
         .join(&scene.name);
-    let files = RunFiles {
-        draw: args.draw.as_deref(),
-        animate: args.animate.as_deref(),
-        animate_speed: args.animate_speed,
-    };
     let json = write_run(&scene, &result, &dir, &files)?;
     let mut text = String::new();
     if args.json {
@@ -115,23 +99,9 @@ pub fn run(args: &RunArgs) -> Result<()> {
         text.push_str(&format!(
             "simulator speed           {parts_per_s:.0} parts/s, {contacts_per_s:.0} contacts/s ({wall:.2} s wall)\n"
         ));
-        text.push_str(&tables_line(&scene.part.model));
+        text.push_str(&line_table::tables_line(&scene.part.model));
         text.push_str(&maps);
         text.push_str(&format!("results                   {}\n", dir.display()));
     }
     super::stdout::print_result(&text)
-}
-
-/// What the exact model's slide tables built during the run (they are built on first use and
-/// serve every later contact; the line's own work counters leave them out): nothing for a model
-/// without tables (tip or ellipsoid fidelity, a part with its own tripod). A scene's model has no
-/// stick tables (`PartModel::with_stick_tables`: a map tier's build makes them).
-fn tables_line(model: &crate::mechanics::PartModel) -> String {
-    match model.slide_table_stats() {
-        Some(slide) if slide.tables > 0 => format!(
-            "exact model's tables      {} slide tables ({} nodes); {} evaluations to build\n",
-            slide.tables, slide.nodes, slide.evaluations
-        ),
-        _ => String::new(),
-    }
 }

@@ -13,7 +13,6 @@
 //! to standard error.
 
 use crate::report::sense::{text_summary, write_report};
-use crate::report::shell_word;
 use crate::sensing::experiment::{self, Request, SenseError};
 use crate::sensing::placement;
 use crate::sensing::SensorSettings;
@@ -168,72 +167,6 @@ pub struct SenseArgs {
     pub quiet: bool,
 }
 
-fn list(v: &[f64]) -> String {
-    v.iter()
-        .map(|x| x.to_string())
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// The command line that regenerates a report, every setting explicit.
-pub fn command_line(a: &SenseArgs) -> String {
-    let mut w: Vec<String> = vec!["pinfeed".into(), "sense".into()];
-    let mut kv = |k: &str, v: String| w.push(format!("--{k}={v}"));
-    kv("part", shell_word(&a.part));
-    kv("scale", a.scale.to_string());
-    kv("mass", a.mass.to_string());
-    kv("belt-speed", a.belt_speed.to_string());
-    kv("d", a.d.to_string());
-    kv("pin-radius", a.pin_radius.to_string());
-    kv("mu-c", a.mu_c.to_string());
-    kv("mu-s", a.mu_s.to_string());
-    kv("model", shell_word(&a.model));
-    kv("tol", a.tol.to_string());
-    kv("hypotheses", shell_word(&a.hypotheses));
-    kv("sensor", shell_word(&a.sensor));
-    kv("rate", a.rate.to_string());
-    kv("height", a.height.to_string());
-    kv("noise-force", a.noise_force.to_string());
-    kv("noise-torque", a.noise_torque.to_string());
-    kv("bias-force", a.bias_force.to_string());
-    kv("bias-torque", a.bias_torque.to_string());
-    kv("drift-force", a.drift_force.to_string());
-    kv("drift-torque", a.drift_torque.to_string());
-    kv("resolution-force", a.resolution_force.to_string());
-    if let Some(l) = a.lowpass {
-        kv("lowpass", l.to_string());
-    }
-    kv("threshold", a.threshold.to_string());
-    kv("jitter", a.jitter.to_string());
-    if !a.classifiers.is_empty() {
-        kv("classifiers", shell_word(&a.classifiers.join(",")));
-    }
-    kv("reject-below", a.reject_below.to_string());
-    kv("noise", list(&a.noise));
-    if let Some(r) = &a.mu_c_range {
-        kv("mu-c-range", shell_word(r));
-    }
-    kv("theta-jitter", a.theta_jitter.to_string());
-    kv("d-jitter", a.d_jitter.to_string());
-    kv("templates", a.templates.to_string());
-    kv("trials", a.trials.to_string());
-    kv("truth", shell_word(&a.truth));
-    kv("seed", a.seed.to_string());
-    if a.placement {
-        kv("placement-d", list(&a.placement_d));
-    }
-    if let Some(o) = &a.out {
-        kv("out", shell_word(&o.display().to_string()));
-    }
-    if a.tripod {
-        w.push("--tripod".into());
-    }
-    if a.placement {
-        w.push("--placement".into());
-    }
-    w.join(" ")
-}
-
 /// The default report directory: `pinfeed-out/sensing/<part>` (a vertex list is `custom`).
 pub fn default_out_dir(part: &str) -> PathBuf {
     crate::default_out(&["sensing", &super::part_folder(part)])
@@ -286,7 +219,8 @@ pub fn request(a: &SenseArgs) -> Request {
     }
 }
 
-pub fn run(a: &SenseArgs) -> Result<()> {
+/// Run `pinfeed sense`; `recorded` is the command line its report records.
+pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
     let req = request(a);
     let p = experiment::check(&req)?;
     let pool = rayon::ThreadPoolBuilder::new()
@@ -354,7 +288,7 @@ pub fn run(a: &SenseArgs) -> Result<()> {
         None
     };
 
-    let (report, templates) = p.report(&req, command_line(a), evaluated, placement);
+    let (report, templates) = p.report(&req, recorded.to_string(), evaluated, placement);
     if a.json {
         print!("{}", crate::report::versioned::pretty(&report)?);
     } else {

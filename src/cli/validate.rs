@@ -7,7 +7,6 @@
 //! distributions and bands against d.
 
 use crate::maps::ensemble::EnsembleSpec;
-use crate::report::shell_word;
 use crate::report::validate_report::{containment_text, rows_text, write_report, ValidateReport};
 use crate::validate::input::{self, check_members, load_measured};
 use crate::validate::measured::Measured;
@@ -97,31 +96,6 @@ impl ModelArgs {
             window_deg: self.window,
             contained_share: self.contained_share,
         })
-    }
-
-    /// The flags as they regenerate a report.
-    pub fn words(&self) -> String {
-        let mut s = format!(
-            "--model {} --tol {} --passes {} --seed {} --kernel {} --floor {} --window {} --contained-share {}",
-            shell_word(&self.model),
-            self.tol,
-            self.passes,
-            self.seed,
-            self.kernel,
-            self.floor,
-            self.window,
-            self.contained_share
-        );
-        if let Some(p) = &self.part {
-            s.push_str(&format!(" --part {}", shell_word(p)));
-        }
-        if let Some(d) = &self.out_dir {
-            s.push_str(&format!(
-                " --out-dir {}",
-                shell_word(&d.display().to_string())
-            ));
-        }
-        s
     }
 
     /// The report directory for `command` and the measured file.
@@ -219,7 +193,8 @@ impl ValidateArgs {
     }
 }
 
-pub fn run(args: &ValidateArgs) -> Result<()> {
+/// Run `pinfeed validate`; `recorded` is the command line its report records.
+pub fn run(args: &ValidateArgs, recorded: &str) -> Result<()> {
     let (score, spec, measured) = args.inputs()?;
     let c = &args.common;
     let bar = super::progress::bar(0, "passes", c.quiet || c.json);
@@ -231,19 +206,8 @@ pub fn run(args: &ValidateArgs) -> Result<()> {
         })
         .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
-    let mut command = format!(
-        "pinfeed validate {} --mu-c {} --pin-radius {} --members {} {}",
-        shell_word(&args.measured.display().to_string()),
-        args.mu_c,
-        args.pin_radius,
-        args.members,
-        c.words()
-    );
-    if let Some(u) = &args.uncertain {
-        command.push_str(&format!(" --uncertain {}", shell_word(u)));
-    }
     let report = ValidateReport {
-        command,
+        command: recorded.to_string(),
         measured: args.measured.display().to_string(),
         uncertain: spec.describe(),
         members: args.members,

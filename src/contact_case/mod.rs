@@ -9,6 +9,7 @@
 
 pub mod batch;
 pub mod check;
+pub mod plot;
 pub mod report;
 
 pub use check::{check_geometry, check_inputs, in_range, num, reach, OutOfRange};

@@ -168,6 +168,19 @@ impl Batch {
     }
 }
 
+/// Write a report file whole (creating its folder), naming the file on failure.
+pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> anyhow::Result<()> {
+    super::create_parent(path)?;
+    write_atomic(path, bytes).map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))
+}
+
+/// Rewrite a report file from its current text (empty when it does not exist yet), whole: for
+/// the benchmarks that replace their own marked section of a shared report.
+pub fn rewrite_file(path: &Path, edit: impl FnOnce(&str) -> String) -> anyhow::Result<()> {
+    let old = std::fs::read_to_string(path).unwrap_or_default();
+    write_file(path, edit(&old))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

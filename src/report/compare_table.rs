@@ -1,6 +1,7 @@
 //! The table of `pinfeed compare`: one row per line design run on the same part stream (definitions
 //! in [`crate::study::compare`]), as aligned plain text for the terminal or as Markdown.
 
+use crate::scenario::{FeedSource, Lateral, Orientation};
 use crate::study::compare::{ComparisonRow, GoalWindow};
 
 const HEADER: [&str; 11] = [
@@ -79,4 +80,43 @@ pub fn markdown(rows: &[ComparisonRow]) -> String {
         s += &format!("| {} |\n", cells(r).join(" | "));
     }
     s
+}
+
+/// One line saying which part stream every design ran on.
+pub fn feed_line(file: &str, source: &FeedSource, parts: u64) -> String {
+    let feed = &source.feed;
+    let orientation = match &feed.orientation {
+        Orientation::Uniform => "uniform on [0°, 360°)".to_string(),
+        Orientation::Stable {
+            thetas_rad: thetas,
+            weights,
+            jitter_rad: jitter,
+        } => {
+            let states: Vec<String> = thetas
+                .iter()
+                .zip(weights)
+                .map(|(t, w)| format!("{:.3}° ×{w:.3}", t.to_degrees()))
+                .collect();
+            format!(
+                "stable states {} ± {:.3}° (sd)",
+                states.join(", "),
+                jitter.to_degrees()
+            )
+        }
+    };
+    let lateral = match feed.lateral {
+        Lateral::Fixed(y) => format!("at y = {y} m"),
+        Lateral::Uniform { min, max } => format!("y uniform on [{min}, {max}] m"),
+        Lateral::Normal { mean, sd, .. } => format!("y normal, mean {mean} m, sd {sd} m"),
+    };
+    let arrival = match feed.arrival {
+        crate::scenario::Arrival::Periodic { headway } => format!("one every {headway} s"),
+        crate::scenario::Arrival::Poisson { headway } => {
+            format!("Poisson, mean headway {headway} s")
+        }
+    };
+    format!(
+        "part stream of {file}: seed {}, {parts} parts, {arrival}, orientation {orientation}, {lateral}",
+        source.seed
+    )
 }

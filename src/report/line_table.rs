@@ -279,3 +279,17 @@ fn sensor_table(o: &mut String, s: &crate::engine::sensing::SensorStats) {
         let _ = writeln!(o, "{line}");
     }
 }
+
+/// What the exact model's slide tables built during a run, as a line of the run table (they are
+/// built on first use and serve every later contact; the line's own work counters leave them
+/// out): empty for a model without tables (tip or ellipsoid fidelity, a part with its own
+/// tripod). A scene's model has no stick tables (a map tier's build makes them).
+pub fn tables_line(model: &crate::mechanics::PartModel) -> String {
+    match model.slide_table_stats() {
+        Some(slide) if slide.tables > 0 => format!(
+            "exact model's tables      {} slide tables ({} nodes); {} evaluations to build\n",
+            slide.tables, slide.nodes, slide.evaluations
+        ),
+        _ => String::new(),
+    }
+}

@@ -9,6 +9,7 @@ pub mod ensemble_report;
 pub mod line_table;
 pub mod map_report;
 pub mod map_table;
+pub mod part_report;
 pub mod parts_csv;
 pub mod plan_summary;
 pub mod plot_accuracy;

@@ -20,6 +20,29 @@ pub struct RunFiles<'a> {
     pub animate_speed: Option<f64>,
 }
 
+/// How many of the first parts have their paths recorded for a drawing.
+pub const SAMPLE_POOL: usize = 64;
+
+impl RunFiles<'_> {
+    /// Set in `opts` what the run must record for these files and the scene's own outputs: the
+    /// per-part records for the scenario's CSV and for an animation that shows sensor decisions,
+    /// the paths of the first parts for a drawing ([`SAMPLE_POOL`]) or an animation.
+    pub fn record_into(&self, scene: &Scene, opts: &mut crate::engine::RunOptions) {
+        opts.keep_records = scene.output.parts_csv;
+        if self.draw.is_some() {
+            opts.sample_paths = SAMPLE_POOL;
+        }
+        if self.animate.is_some() {
+            opts.sample_paths = opts.sample_paths.max(animate::DEFAULT_PARTS);
+            let sensors = scene
+                .obstacles
+                .iter()
+                .any(|o| matches!(o, crate::scenario::Obstacle::Pin(p) if p.sensor.is_some()));
+            opts.keep_records |= sensors;
+        }
+    }
+}
+
 /// The files `pinfeed run` writes into a run's folder.
 const RUN_FILES: [&str; 5] = [
     "summary.json",

@@ -473,18 +473,12 @@ pub fn report(
     rows: &[ContactCostRow],
     scaling: &[ScalingRow],
     contacts: usize,
-    tol: f64,
-    seed: u64,
-    out: &std::path::Path,
+    cmd: &str,
 ) -> (String, String) {
     let table = markdown(rows);
     let targets = targets(rows, scaling);
     let tables = tables_markdown(rows);
     let scaling_table = scaling_markdown(scaling);
-    let cmd = format!(
-        "cargo run --release -- bench contact --contacts {contacts} --tol {tol:e} --seed {seed} --out {}",
-        out.display()
-    );
     let doc = format!(
         "# Contact model: cost and self-accuracy per contact\n\n\
          Regenerate with:\n\n```\n{cmd}\n```\n\n\
@@ -516,4 +510,32 @@ pub fn report(
         quarter = (contacts / 4).max(1),
     );
     (table, doc)
+}
+
+/// `pinfeed bench contact`: `contacts` contacts (1 to 10⁶) per part and model at tolerance `tol`
+/// (in (0, 0.01]) and the cost against the vertex count, written to `out` headed by `cmd`.
+/// Returns the table printed.
+pub fn bench(
+    contacts: usize,
+    tol: f64,
+    seed: u64,
+    cmd: &str,
+    out: &std::path::Path,
+    stage: &dyn Fn(&str),
+) -> anyhow::Result<String> {
+    if contacts == 0 || contacts > 1_000_000 {
+        anyhow::bail!("--contacts must be between 1 and 1000000, got {contacts}");
+    }
+    if !(tol > 0.0 && tol <= 1e-2) {
+        anyhow::bail!("--tol must be in (0, 0.01], got {tol}");
+    }
+    let parts = ["tripoly1", "tripoly2", "square", "lshape"];
+    let fids = [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact];
+    stage(&format!("contact: {contacts} contacts per part and model"));
+    let rows = measure(&parts, &fids, contacts, tol, seed, true)?;
+    stage("contact: cost against the vertex count");
+    let scaling = vertex_scaling(&[3, 6, 12, 24, 48], (contacts / 4).max(1), tol, seed)?;
+    let (table, doc) = report(&rows, &scaling, contacts, cmd);
+    crate::report::atomic::write_file(out, &doc)?;
+    Ok(table)
 }

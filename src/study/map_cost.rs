@@ -102,12 +102,12 @@ pub fn report(
     repeats: usize,
     cores: usize,
     (load_before, load_after): (&str, &str),
-    out: &std::path::Path,
+    cmd: &str,
 ) -> (String, String) {
     let table = markdown(rows);
     let doc = format!(
         "# Configuration maps: wall time\n\n\
-         Regenerate with:\n\n```\ncargo run --release -- bench maps --repeats {repeats} --out {}\n```\n\n\
+         Regenerate with:\n\n```\n{cmd}\n```\n\n\
          Machine: {cores} cores, shared with other work (1-minute load average {load_before} before, \
          {load_after} after this run; with a load near the core count the 2-thread rows cannot \
          show their speed-up). Each row \
@@ -115,8 +115,32 @@ pub fn report(
          (6480 contacts: sampling, bands and runs; no printing, files or figures), point pin, \
          μc = 0.5, uniform pressure, tolerance 1e-6: median, min and max of {repeats} runs after \
          one warm-up. *µs per contact* is thread-time per contact (median × threads / contacts). \
-         Target: under 0.5 s with the exact model on 2 cores.\n\n{table}",
-        out.display()
+         Target: under 0.5 s with the exact model on 2 cores.\n\n{table}"
     );
     (table, doc)
+}
+
+/// `pinfeed bench maps`: `repeats` timed runs (1 to 1000) per part, model and thread count (1, 2
+/// and every core), written to `out` headed by `cmd` with the machine's load before and after
+/// (`load` reads it). Returns the table printed.
+pub fn bench(
+    repeats: usize,
+    cmd: &str,
+    out: &std::path::Path,
+    load: &dyn Fn() -> String,
+) -> anyhow::Result<String> {
+    if repeats == 0 || repeats > 1000 {
+        anyhow::bail!("--repeats must be between 1 and 1000, got {repeats}");
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut threads = vec![1, 2, cores];
+    threads.sort_unstable();
+    threads.dedup();
+    let fids = [Fidelity::Exact, Fidelity::Ellipsoid, Fidelity::Tip];
+    let load_before = load();
+    let rows = measure(&["tripoly1", "tripoly2"], &fids, &threads, 1.0, repeats)?;
+    let load_after = load();
+    let (table, doc) = report(&rows, repeats, cores, (&load_before, &load_after), cmd);
+    crate::report::atomic::write_file(out, &doc)?;
+    Ok(table)
 }

@@ -3,7 +3,6 @@
 //! parses with the command line the binary uses (flags, values, subcommands), so a renamed or
 //! removed option cannot leave the guide behind.
 
-use clap::Parser;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {

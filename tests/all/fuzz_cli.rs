@@ -15,7 +15,6 @@
 //!
 //! Failing cases proptest finds are kept in `fuzz_cli.proptest-regressions` and re-run first.
 
-use clap::Parser;
 use pinfeed::contact_case::{run_case, Case};
 use pinfeed::geometry::{Polygon, PolygonError};
 use proptest::prelude::*;

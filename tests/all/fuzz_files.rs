@@ -252,7 +252,7 @@ fn merge_tampering_is_refused_and_an_untouched_set_merges() {
 
 /// `pinfeed plan` arguments for a test: part, time limit, check parts, then `extra`.
 fn plan_args(part: &str, time: &str, check: &str, extra: &[&str]) -> Vec<String> {
-    let mut a = pinfeed::cli::fuzz::plans::base_arguments(part, time, check, "50");
+    let mut a = pinfeed::study::robustness::commands::base_arguments(part, time, check, "50");
     a.extend(extra.iter().map(|s| s.to_string()));
     a
 }

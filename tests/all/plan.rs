@@ -431,7 +431,10 @@ fn survey_of_designs_agrees_with_the_planner_it_runs() {
         "0 of 1 (0%)"
     };
     assert!(md.contains(&format!("| all | {share} |")), "{md}");
-    assert!(md.contains("cargo run --release -- bench designs --random 1 --first 2"));
+    assert!(
+        md.contains("pinfeed bench designs --random 1 --first 2"),
+        "{md}"
+    );
 }
 
 #[test]

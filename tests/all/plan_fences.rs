@@ -38,7 +38,8 @@ fn tripoly1_fence_plan_orients_the_line_and_runs() {
     // The scenario: fences only, each below the jam limit and with both ends over the belt.
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(
-        text.contains("pinfeed plan --part tripoly1 --belt-width 0.18")
+        text.contains("pinfeed plan --part tripoly1 ")
+            && text.contains(" --belt-width 0.18")
             && text.contains(" --fences"),
         "{text}"
     );

@@ -12,6 +12,7 @@
 pub mod csvs;
 pub mod plans;
 
+use crate::study::robustness::counts::MAX_CASES;
 use crate::study::robustness::{self, Class, Corpus, Options, Target};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
@@ -93,75 +94,23 @@ fn targets(t: FuzzTarget) -> Vec<Target> {
     }
 }
 
-/// `--counts TARGET=N,...`: the targets' own case counts.
-fn parse_counts(text: &str) -> Result<Vec<(Target, u64)>> {
-    text.split(',')
-        .filter(|w| !w.trim().is_empty())
-        .map(|w| {
-            let (name, n) = w
-                .split_once('=')
-                .with_context(|| format!("--counts: `{w}` is not TARGET=N"))?;
-            let t = Target::ALL
-                .into_iter()
-                .find(|t| t.name() == name.trim())
-                .with_context(|| {
-                    format!(
-                        "--counts: unknown target `{}` (expected one of {})",
-                        name.trim(),
-                        Target::ALL.map(|t| t.name()).join(", ")
-                    )
-                })?;
-            let n: u64 = n
-                .trim()
-                .parse()
-                .ok()
-                .filter(|&n| n <= 100_000_000)
-                .with_context(|| {
-                    format!(
-                        "--counts: {} must be a count in [0, 100000000], got `{n}`",
-                        t.name()
-                    )
-                })?;
-            Ok((t, n))
-        })
-        .collect()
-}
-
-/// The command line that regenerates the report.
-fn command_line(args: &FuzzArgs) -> String {
-    let target = format!("{:?}", args.target).to_lowercase();
-    let mut c = format!(
-        "pinfeed fuzz {target} --count {} --seed {} --budget {}",
-        args.count, args.seed, args.budget
-    );
-    if let Some(n) = args.contacts {
-        c.push_str(&format!(" --contacts {n}"));
-    }
-    if let Some(n) = &args.counts {
-        c.push_str(&format!(" --counts {n}"));
-    }
-    if let Some(n) = args.threads {
-        c.push_str(&format!(" --threads {n}"));
-    }
-    c.push_str(&format!(" --report {}", args.report.display()));
-    c
-}
-
-pub fn run(args: &FuzzArgs) -> Result<()> {
+/// Run `pinfeed fuzz`; `recorded` is the command line its report records.
+pub fn run(args: &FuzzArgs, recorded: &str) -> Result<()> {
     if !(args.budget.is_finite() && args.budget > 0.0 && args.budget <= 86_400.0) {
         bail!(
             "--budget must lie in (0, 86400] seconds, got {}",
             args.budget
         );
     }
-    if args.count > 100_000_000 || args.contacts.is_some_and(|n| n > 100_000_000) {
-        bail!("--count and --contacts must be at most 100000000");
+    if args.count > MAX_CASES || args.contacts.is_some_and(|n| n > MAX_CASES) {
+        bail!("--count and --contacts must be at most {MAX_CASES}");
     }
     let overrides = args
         .counts
         .as_deref()
-        .map(parse_counts)
-        .transpose()?
+        .map(robustness::counts::parse_counts)
+        .transpose()
+        .map_err(anyhow::Error::msg)?
         .unwrap_or_default();
     let corpus = Arc::new(corpus(&args.root).map_err(anyhow::Error::msg)?);
     let threads = match args.threads {
@@ -183,22 +132,7 @@ pub fn run(args: &FuzzArgs) -> Result<()> {
     };
     if let Some(i) = args.case {
         for t in targets(args.target) {
-            println!("== {} case {i}", t.name());
-            println!("{}", robustness::case_input(t, &corpus, args.seed, i));
-            let r = robustness::run_case(t, &corpus, args.seed, i);
-            println!(
-                "-> {:?}{}{}",
-                r.class,
-                r.status
-                    .as_ref()
-                    .map(|s| format!(" (status {s})"))
-                    .unwrap_or_default(),
-                if r.detail.is_empty() {
-                    String::new()
-                } else {
-                    format!(": {}", r.detail)
-                }
-            );
+            print!("{}", robustness::counts::replay(t, &corpus, args.seed, i));
         }
         return Ok(());
     }
@@ -227,7 +161,7 @@ pub fn run(args: &FuzzArgs) -> Result<()> {
         );
         tallies.push((t, tally));
     }
-    let text = robustness::report(&command_line(args), &opts, &tallies);
+    let text = robustness::report(recorded, &opts, &tallies);
     if let Some(dir) = args.report.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

@@ -21,7 +21,9 @@
 //! is reported as a hang and left to finish in the background (after [`MAX_HANGS`] hangs the run
 //! stops, so runaway threads cannot pile up).
 
+pub mod commands;
 pub mod contacts;
+pub mod counts;
 pub mod files;
 pub mod measured_csv;
 pub mod merges;
