@@ -22,6 +22,8 @@ fn deg(x: f64) -> String {
     }
 }
 
+/// Draw the histogram of a line run's final part orientations, the scenario's goal windows
+/// marked, to the SVG file `path` (written whole or not at all).
 pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> anyhow::Result<()> {
     let h = &s.orientation_histogram;
     let top = h.counts.iter().copied().max().unwrap_or(0).max(1);
