@@ -23,11 +23,13 @@ use crate::mechanics::{
 /// One fully specified contact case.
 #[derive(Debug, Clone)]
 pub struct Case {
-    /// The part: a name or spec as [`named::part_from_spec`] reads it (`tripoly1`, `rect:W:H`, `vertices:…`).
+    /// The part: a name or spec as [`named::part_from_spec`] reads it (`tripoly1`, `rect:W:H`,
+    /// `vertices:…`).
     pub part: String,
     /// Initial orientation θ0 of the part (degrees, counter-clockwise).
     pub theta0_deg: f64,
-    /// Lateral offset of the pin's start, d = y/a (units of a; beyond the reach the pin cannot touch the part).
+    /// Lateral offset of the pin's start, d = y/a (units of a; beyond the reach the pin cannot
+    /// touch the part).
     pub d: f64,
     /// Pin–part friction coefficient μc.
     pub mu_c: f64,

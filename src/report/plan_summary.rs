@@ -111,7 +111,8 @@ pub struct PlanJson<'a> {
     pub predicted_success: Option<f64>,
     /// The full line check of the chosen design.
     pub line_check: Option<&'a design::LineCheck>,
-    /// The line check under the problem's uncertainty (a Monte Carlo study), when planned against one.
+    /// The line check under the problem's uncertainty (a Monte Carlo study), when planned against
+    /// one.
     pub uncertain_check: Option<&'a design::LineCheck>,
     /// The chosen design's obstacles.
     pub obstacles: Option<&'a [design::ObstacleInfo]>,

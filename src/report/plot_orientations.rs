@@ -1,5 +1,5 @@
 //! SVG histogram of the final orientations of the parts that reached the end of the belt, zoomed
-//! on the data ([`super::plot_zoom`]): the part's stable states marked (dashed, labelled; those
+//! on the data (`plot_zoom`): the part's stable states marked (dashed, labelled; those
 //! outside the view named in the caption below the axis) and the goal's tolerance bands shaded and
 //! labelled. Counts are whole numbers.
 

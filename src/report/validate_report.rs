@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The head of a report's README.md: title, regenerating command, a sentence and a bullet list.
-pub struct ReportHead<'a> {
+pub(crate) struct ReportHead<'a> {
     /// The report's title.
     pub title: String,
     /// The command that regenerates the report.
@@ -27,7 +27,7 @@ pub struct ReportHead<'a> {
 
 /// Create `out_dir`, write `report` there as `json_name`, then README.md: the head followed by
 /// what `body` returns (it may write figures into `out_dir`).
-pub fn write_report_files<T: Serialize>(
+pub(crate) fn write_report_files<T: Serialize>(
     out_dir: &Path,
     json_name: &str,
     report: &T,

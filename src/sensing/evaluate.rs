@@ -88,7 +88,8 @@ pub struct SensorPoint {
 pub struct Config {
     /// Templates built per hypothesis (1 to [`MAX_TEMPLATES`]).
     pub templates_per_hypothesis: usize,
-    /// Trials per evaluation (1 to [`MAX_TRIALS`]).
+    /// Trials: simulated pushes, each read at every sensor point and classified by every
+    /// classifier there (1 to [`MAX_TRIALS`]).
     pub trials: usize,
     /// How each trial's hypothesis is chosen.
     pub truth: TruthDraw,
@@ -147,7 +148,7 @@ pub struct Evaluation {
     pub labels: Vec<String>,
     /// Templates built per hypothesis (vertex/edge: a class that never occurred has none).
     pub template_counts: Vec<usize>,
-    /// Trials per evaluation.
+    /// Trials: simulated pushes, each read at every sensor point.
     pub trials: usize,
     /// Trials with no truth (vertex/edge: the pin never touched).
     pub unscored: u64,

@@ -11,7 +11,7 @@
 //! the fitted range, the random support with probability ½, pin radius uniform on [0, ρmax]. Each
 //! measured row is predicted once ([`super::predict`]). Under φ member i weighs
 //! wᵢ(φ) = N(μcᵢ; m, s) · N(ρᵢ; ρ, σρ) · (t or 1 − t)/½ — importance sampling, with common random
-//! numbers for every φ — and the row's log-likelihood ([`super::score::RowKernel`]) is a function of
+//! numbers for every φ — and the row's log-likelihood (`score::RowKernel`) is a function of
 //! four weighted sums, so a grid of tens of thousands of φ costs a few seconds and no new contact.
 //! The effective number of members at the optimum, (Σw)²/Σw², says how well the proposal covers it.
 //!
@@ -145,7 +145,7 @@ impl CalibrationSettings {
 pub struct Fitted {
     /// The parameter's name.
     pub name: &'static str,
-    /// Its maximum-likelihood estimate.
+    /// Its estimate: the searched grid's value at the likelihood's maximum.
     pub estimate: f64,
     /// 95% profile-likelihood interval.
     pub lo: f64,

@@ -113,7 +113,7 @@ fn kernel_mass(theta: f64, arc: &Arc, h: f64) -> f64 {
 
 /// A row's likelihood as a function of the weights: each pass's contributions to the four sums.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RowKernel {
+pub(crate) struct RowKernel {
     /// n (the trial count; 2 when not given).
     pub n: u32,
     /// Widths (degrees) of the band widened by h/2 and of the window (360 without one).

@@ -38,7 +38,8 @@ pub struct Request {
     pub mass: f64,
     /// Belt speed (m/s, in (0, 100]).
     pub belt_speed: f64,
-    /// Lateral offset of the pin, d = (y_pin − y_com)/a (units of a; the pin must be able to touch the part).
+    /// Lateral offset of the pin, d = (y_pin − y_com)/a (units of a; the pin must be able to touch
+    /// the part).
     pub d: f64,
     /// Pin radius (part units, at most the limit's multiple of a; 0: a point pin).
     pub pin_radius: f64,
@@ -60,7 +61,8 @@ pub struct Request {
     pub classifiers: Vec<String>,
     /// Classifiers decide "unknown" when their largest posterior is below this (in [0, 1]).
     pub reject_below: f64,
-    /// Noise factors of the sweep, each ≥ 0, applied to the sensor's nominal noise (1 to [`MAX_FACTORS`] of them).
+    /// Noise factors of the sweep, each ≥ 0, applied to the sensor's nominal noise (1 to
+    /// [`MAX_FACTORS`] of them).
     pub noise: Vec<f64>,
     /// `LO:HI`.
     pub mu_c_range: Option<String>,
@@ -72,7 +74,8 @@ pub struct Request {
     pub d_jitter: f64,
     /// Templates per hypothesis (1 to [`MAX_TEMPLATES`]).
     pub templates: usize,
-    /// Trials per evaluation (1 to [`MAX_TRIALS`]).
+    /// Trials: simulated pushes, each read at every sensor point and classified by every
+    /// classifier there (1 to [`MAX_TRIALS`]).
     pub trials: usize,
     /// `cycle` or `uniform`.
     pub truth: String,

@@ -79,7 +79,7 @@ pub struct SenseReport {
     pub uncertainty: UncertaintyReport,
     /// Templates built per hypothesis (asked for).
     pub templates_per_hypothesis: usize,
-    /// Trials per evaluation.
+    /// Trials: simulated pushes, each read at every sensor point.
     pub trials: usize,
     /// How each trial's hypothesis is chosen.
     pub truth: TruthDraw,

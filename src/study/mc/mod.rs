@@ -66,7 +66,8 @@ pub struct Study {
     pub scenario_file: PathBuf,
     /// The nominal line.
     pub scene: Scene,
-    /// Seed of the study's random streams: sample i draws only from streams derived from (seed, i), so the same seed gives the same samples.
+    /// Seed of the study's random streams: sample i draws only from streams derived from (seed, i),
+    /// so the same seed gives the same samples.
     pub seed: u64,
     /// Samples per sweep point.
     pub samples: u64,

@@ -57,7 +57,8 @@ pub struct Perturbations {
     /// `pins = [...]`), by parameter name; a parameter absent here reaches every obstacle it
     /// applies to.
     pub only: BTreeMap<String, Vec<String>>,
-    /// How the part's weight rests on the belt (uniform, a random tripod or a random smooth density).
+    /// How the part's weight rests on the belt (uniform, a random tripod or a random smooth
+    /// density).
     pub support: SupportChoice,
 }
 

@@ -112,7 +112,7 @@ pub enum DistributionKind {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawDistribution {
-    /// The kind of distribution (required when any field is given).
+    /// The kind of distribution (required).
     pub distribution: Option<DistributionKind>,
     /// `fixed`: the value.
     pub value: Option<f64>,
@@ -149,7 +149,7 @@ pub enum SupportModel {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSupport {
-    /// The support model (default: uniform).
+    /// The support model (required).
     pub model: Option<SupportModel>,
     /// Smooth: number of Gaussian bumps (default 3).
     pub bumps: Option<f64>,

@@ -23,7 +23,8 @@ pub struct StudyHeader {
     pub scenario_file: String,
     /// The scenario's name.
     pub scenario: String,
-    /// The contact model the samples run (`exact`, `map`, … with the reason when the map tier is off).
+    /// The contact model the samples run (`exact`, `map`, … with the reason when the map tier is
+    /// off).
     pub fidelity: String,
     /// Content hash of the study (hex).
     pub study_hash: String,

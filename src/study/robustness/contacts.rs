@@ -80,11 +80,6 @@ impl Motion {
         }
     }
 
-    /// Does the pin move at all (anything but [`Motion::Still`])?
-    pub fn is_moving(&self) -> bool {
-        !matches!(self, Motion::Still)
-    }
-
     /// The kind of case in the report.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -137,7 +132,8 @@ pub struct ContactCase {
     pub vertices: Vec<Vec2>,
     /// Entry orientation of the part (degrees, in [0, 360)).
     pub theta0_deg: f64,
-    /// Lateral offset of the pin against the part, in units of a (in [−1.2, 1.2]), as `pinfeed contact --d`.
+    /// Lateral offset of the pin against the part, in units of a (in [−1.2, 1.2]), as `pinfeed
+    /// contact --d`.
     pub d: f64,
     /// Pin–part friction coefficient μc (in [0, 2]).
     pub mu_c: f64,

@@ -61,7 +61,8 @@ pub enum Target {
     Pairs,
     /// `pinfeed plan` argument sets (cases supplied by the command line, [`CommandCases`]).
     Plans,
-    /// Measured-band CSV files with `validate` or `calibrate` flags (cases supplied by the command line).
+    /// Measured-band CSV files with `validate` or `calibrate` flags (cases supplied by the command
+    /// line).
     Csvs,
     /// Edited Monte Carlo shard sets given to `merge`.
     Merges,
@@ -281,7 +282,8 @@ impl Tally {
 /// Settings of a fuzzing run.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// Seed of the cases: case i of a target draws from a stream derived from (seed, target, i), so the same seed gives the same cases on any thread count.
+    /// Seed of the cases: case i of a target draws from a stream derived from (seed, target, i), so
+    /// the same seed gives the same cases on any thread count.
     pub seed: u64,
     /// Worker threads running cases in parallel (the counts do not depend on it, hangs aside).
     pub threads: usize,
@@ -317,7 +319,8 @@ pub struct Corpus {
 }
 
 impl Corpus {
-    /// Read the seed files under the project root `root`; Err names the file or folder that could not be read.
+    /// Read the seed files under the project root `root`; Err names the file or folder that could
+    /// not be read.
     pub fn load(root: &Path) -> Result<Corpus, String> {
         let files = files::Seeds::load(root)?;
         Ok(Corpus {
@@ -356,11 +359,12 @@ impl Corpus {
 }
 
 /// A fresh folder for case `index` of `target` (removed when the case ends).
-pub struct Scratch(PathBuf);
+struct Scratch(PathBuf);
 
 impl Scratch {
-    /// The folder for case `index` of `target` in a run seeded with `seed`, under the system's temporary folder (emptied if left over; not created).
-    pub fn new(target: Target, seed: u64, index: u64) -> Scratch {
+    /// The folder for case `index` of `target` in a run seeded with `seed`, under the system's
+    /// temporary folder (emptied if left over; not created).
+    fn new(target: Target, seed: u64, index: u64) -> Scratch {
         let d = std::env::temp_dir().join(format!(
             "pinfeed-fuzz-{}-{}-{seed}-{index}",
             std::process::id(),
@@ -370,7 +374,7 @@ impl Scratch {
         Scratch(d)
     }
     /// The folder's path.
-    pub fn path(&self) -> &Path {
+    fn path(&self) -> &Path {
         &self.0
     }
 }
