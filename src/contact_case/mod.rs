@@ -37,7 +37,8 @@ pub struct Case {
     pub mu_s: f64,
     /// The contact model (exact, ellipsoid or tip).
     pub model: Fidelity,
-    /// Pin radius (part units, at most the limit's multiple of a; 0: a point pin).
+    /// Pin radius (part units, at most [`crate::mechanics::limits::PIN_RADIUS_A`]·a; 0: a point
+    /// pin).
     pub pin_radius: f64,
     /// Lateral speed w of the pin as a fraction of the belt speed (0: a still pin).
     pub pin_speed: f64,
@@ -90,7 +91,8 @@ pub enum CaseError {
         /// The value given.
         value: f64,
     },
-    /// A pin radius that is negative, not finite or above the limit's multiple of a.
+    /// A pin radius that is negative, not finite or above
+    /// [`crate::mechanics::limits::PIN_RADIUS_A`]·a.
     #[error("{name} must be a finite number >= 0 (part units, at most {}·a), got {}", crate::mechanics::limits::PIN_RADIUS_A, num(*value))]
     PinRadius {
         /// The flag or column.

@@ -40,7 +40,7 @@ pub struct ContactReport {
     pub pin_stop_d: Option<f64>,
     /// Did the pin push the part at all?
     pub contact: bool,
-    /// Final orientation (degrees, wrapped).
+    /// Final orientation (degrees, in [0, 360)).
     pub theta_final_deg: f64,
     /// Signed total rotation (degrees, not wrapped).
     pub rotation_deg: f64,

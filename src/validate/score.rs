@@ -220,7 +220,7 @@ pub struct RowScore {
     pub overlapping: bool,
     /// Measured centre minus the nearest predicted band's centre (degrees, signed).
     pub centre_offset_deg: Option<f64>,
-    /// Share of the passes that end inside the measured band.
+    /// Weighted share of the passes that end inside the measured band.
     pub predicted_probability: f64,
     /// The row's log-likelihood (natural log; higher is better).
     pub log_score: f64,
@@ -284,7 +284,7 @@ pub struct Summary {
     pub coverage: f64,
     /// Sum of the rows' log-likelihoods (natural log; higher is better).
     pub log_score: f64,
-    /// `log_score` per row.
+    /// Mean log score per row (`log_score` over `rows`).
     pub mean_log_score: f64,
 }
 

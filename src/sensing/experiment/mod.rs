@@ -41,7 +41,8 @@ pub struct Request {
     /// Lateral offset of the pin, d = (y_pin − y_com)/a (units of a; the pin must be able to touch
     /// the part).
     pub d: f64,
-    /// Pin radius (part units, at most the limit's multiple of a; 0: a point pin).
+    /// Pin radius (part units, at most [`crate::mechanics::limits::PIN_RADIUS_A`]·a; 0: a point
+    /// pin).
     pub pin_radius: f64,
     /// Pin–part friction coefficient μc (nominal; see `mu_c_range`).
     pub mu_c: f64,

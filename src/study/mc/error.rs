@@ -28,7 +28,7 @@ pub enum StudyError {
     Sample {
         /// Index of the sweep point (0-based).
         point: usize,
-        /// Index of the sample within the study's sample range (0-based).
+        /// Index of the sample within its sweep point (0-based).
         sample: u64,
         /// Why no valid sample came out.
         reason: String,
@@ -38,7 +38,7 @@ pub enum StudyError {
     Engine {
         /// Index of the sweep point (0-based).
         point: usize,
-        /// Index of the sample (0-based).
+        /// Index of the sample within its sweep point (0-based).
         sample: u64,
         /// What the engine refused.
         #[source]

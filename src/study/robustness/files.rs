@@ -163,7 +163,7 @@ pub enum Mutation {
     Number {
         /// Index of the numeric token (modulo their number).
         which: usize,
-        /// Index into `EXTREMES` of the new value.
+        /// Index into `EXTREMES` of the new value (modulo their number).
         value: usize,
     },
     /// Multiply numeric token `which` by 10^power (written as `{token}e{power}` when possible).
