@@ -14,33 +14,48 @@ use std::path::{Path, PathBuf};
 /// A batch that cannot be run; a row's error names the file and line.
 #[derive(Debug, thiserror::Error)]
 pub enum BatchError {
+    /// The batch file could not be read.
     #[error("reading {}", path.display())]
     Read {
+        /// The batch file.
         path: PathBuf,
+        /// Why it could not be read.
         #[source]
         source: std::io::Error,
     },
     /// A row the CSV reader refuses (`at` is `file:line`).
     #[error("{at}: {error}")]
-    Row { at: String, error: csv::Error },
+    Row {
+        /// Where: `file:line`.
+        at: String,
+        /// What the reader refused.
+        error: csv::Error,
+    },
+    /// A row's `model` field names no contact model (`at` is `file:line`).
     #[error("{at}: field 'model'")]
     RowModel {
+        /// Where: `file:line`.
         at: String,
+        /// Why the model is refused.
         #[source]
         source: CaseError,
     },
     /// A row's case is refused (`at` is `file:line`).
     #[error("{at}")]
     Case {
+        /// Where: `file:line`.
         at: String,
+        /// Why the case is refused.
         #[source]
         source: CaseError,
     },
     /// A setting of the flags is refused.
     #[error(transparent)]
     Flags(#[from] CaseError),
+    /// The output CSV could not be written.
     #[error(transparent)]
     Write(#[from] csv::Error),
+    /// The output could not be written.
     #[error(transparent)]
     Io(#[from] std::io::Error),
 }

@@ -22,8 +22,11 @@ pub fn num(v: f64) -> String {
 pub struct OutOfRange {
     /// The setting (a flag such as `--mu-c`, or `column mu_c`).
     pub name: String,
+    /// The value given.
     pub value: f64,
+    /// The lower end of the range.
     pub lo: f64,
+    /// The upper end of the range.
     pub hi: f64,
     /// What the number is (its unit or meaning).
     pub what: String,

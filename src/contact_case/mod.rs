@@ -24,19 +24,32 @@ use crate::mechanics::{
 /// One fully specified contact case.
 #[derive(Debug, Clone)]
 pub struct Case {
+    /// The part: a name or spec as [`named::part_from_spec`] reads it (`tripoly1`, `rect:W:H`,
+    /// `vertices:…`).
     pub part: String,
+    /// Initial orientation θ0 of the part (degrees, counter-clockwise).
     pub theta0_deg: f64,
+    /// Lateral offset of the pin's start, d = y/a (units of a; beyond the reach the pin cannot
+    /// touch the part).
     pub d: f64,
+    /// Pin–part friction coefficient μc.
     pub mu_c: f64,
+    /// Part–belt (support) friction coefficient μs.
     pub mu_s: f64,
+    /// The contact model (exact, ellipsoid or tip).
     pub model: Fidelity,
+    /// Pin radius (part units, at most [`crate::mechanics::limits::PIN_RADIUS_A`]·a; 0: a point
+    /// pin).
     pub pin_radius: f64,
+    /// Lateral speed w of the pin as a fraction of the belt speed (0: a still pin).
     pub pin_speed: f64,
     /// A moving pin stops after this much belt travel (units of a).
     pub pin_stop: Option<f64>,
     /// A moving pin stops after this much belt travel (units of a) past its first touch.
     pub pin_stop_after_touch: Option<f64>,
+    /// The support spec: `uniform` or `tripod:SEED`.
     pub support: String,
+    /// Integration tolerance per step.
     pub tol: f64,
     /// A fence (angle in degrees, length in part units; None = default length) instead of a pin.
     pub fence: Option<(f64, Option<f64>)>,
@@ -68,53 +81,114 @@ impl Case {
 /// A case that cannot be run; the messages name the flag (or batch column) of each setting.
 #[derive(Debug, thiserror::Error)]
 pub enum CaseError {
+    /// A number outside its range.
     #[error(transparent)]
     OutOfRange(#[from] OutOfRange),
+    /// A setting that is NaN or infinite.
     #[error("{name} must be a finite number, got {}", num(*value))]
-    NotFinite { name: String, value: f64 },
+    NotFinite {
+        /// The flag or column.
+        name: String,
+        /// The value given.
+        value: f64,
+    },
+    /// A pin radius that is negative, not finite or above
+    /// [`crate::mechanics::limits::PIN_RADIUS_A`]·a.
     #[error("{name} must be a finite number >= 0 (part units, at most {}·a), got {}", crate::mechanics::limits::PIN_RADIUS_A, num(*value))]
-    PinRadius { name: String, value: f64 },
+    PinRadius {
+        /// The flag or column.
+        name: String,
+        /// The radius given (part units).
+        value: f64,
+    },
+    /// A pin radius above the limit for this part.
     #[error("{name} must lie in [0, {}] (part units: at most {}·a, a = {}), got {}", num(*max), crate::mechanics::limits::PIN_RADIUS_A, num(*a), num(*value))]
     PinRadiusForPart {
+        /// The flag or column.
         name: String,
+        /// The largest radius allowed (part units).
         max: f64,
+        /// The part's circumradius a (part units).
         a: f64,
+        /// The radius given (part units).
         value: f64,
     },
+    /// A fence length outside its range for this part.
     #[error("--fence: the length must lie in [{}, {}] (part units: {}·a to {}·a, a = {}), got {}", num(*lo), num(*hi), num(crate::mechanics::limits::FENCE_LENGTH_A.0), num(crate::mechanics::limits::FENCE_LENGTH_A.1), num(*a), num(*value))]
     FenceLength {
+        /// The shortest length allowed (part units).
         lo: f64,
+        /// The longest length allowed (part units).
         hi: f64,
+        /// The part's circumradius a (part units).
         a: f64,
+        /// The length given (part units).
         value: f64,
     },
+    /// An offset d at which the pin cannot touch the part.
     #[error("{name} = {} is out of range: it must lie in [-{}, {}] (units of a: beyond it this pin cannot touch the part)", num(*d), num(*limit), num(*limit))]
-    Unreachable { name: String, d: f64, limit: f64 },
+    Unreachable {
+        /// The flag or column.
+        name: String,
+        /// The offset given (units of a).
+        d: f64,
+        /// The largest |d| at which the pin can touch the part (units of a).
+        limit: f64,
+    },
     /// `--fence ANGLE[:LENGTH]` with a part that is not a number.
     #[error("--fence '{spec}': the {what} is not a number")]
     FenceNumber {
+        /// The `--fence` value given.
         spec: String,
+        /// Which part of it: the angle or the length.
         what: &'static str,
+        /// Why it is not a number.
         #[source]
         source: std::num::ParseFloatError,
     },
+    /// A fence angle outside (−90°, 90°).
     #[error("--fence '{spec}': the angle must be strictly between -90 and 90 degrees, got {}", num(*angle))]
-    FenceAngle { spec: String, angle: f64 },
+    FenceAngle {
+        /// The `--fence` value given.
+        spec: String,
+        /// The angle given (degrees).
+        angle: f64,
+    },
+    /// A fence length that is not positive.
     #[error("--fence '{spec}': the length must be a positive number (part units), got {}", num(*length))]
-    FenceLengthSign { spec: String, length: f64 },
+    FenceLengthSign {
+        /// The `--fence` value given.
+        spec: String,
+        /// The length given (part units).
+        length: f64,
+    },
+    /// An unknown contact model name (not exact, ellipsoid or tip).
     #[error("unknown model '{0}'; expected exact, ellipsoid or tip")]
     Model(String),
+    /// A part spec that names no part.
     #[error("part '{part}'")]
     Part {
+        /// The part spec given.
         part: String,
+        /// Why it names no part.
         #[source]
         source: named::PartSpecError,
     },
     /// The support or the part's contact model could not be built.
     #[error("{0}")]
     Compile(String),
+    /// A `--pin-stop-at` the moving pin never reaches, or reaches too late.
     #[error("--pin-stop-at {}: a pin starting at d = {} and moving {} per unit of travel reaches it after {} units of a; that must lie in [1e-9, 1000] (Y on the side the pin moves to, within 1000·|w| of d)", num(*y), num(*d), num(*w), num(*travel))]
-    StopAt { y: f64, d: f64, w: f64, travel: f64 },
+    StopAt {
+        /// The lateral position to stop at (units of a).
+        y: f64,
+        /// The pin's starting offset (units of a).
+        d: f64,
+        /// The pin's lateral speed (fraction of the belt speed).
+        w: f64,
+        /// The belt travel to reach `y` (units of a).
+        travel: f64,
+    },
 }
 
 /// Parse `ANGLE_DEG[:LENGTH]`.

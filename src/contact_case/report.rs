@@ -10,13 +10,21 @@ use std::fmt::Write as _;
 /// The JSON printed by `pinfeed contact --json`.
 #[derive(Debug, Serialize)]
 pub struct ContactReport {
+    /// The part spec, as given.
     pub part: String,
+    /// The contact model's name.
     pub model: String,
+    /// Initial orientation θ0 (degrees).
     pub theta0_deg: f64,
+    /// Lateral offset of the pin's start (units of a).
     pub d: f64,
+    /// Pin–part friction coefficient μc.
     pub mu_c: f64,
+    /// Part–belt friction coefficient μs.
     pub mu_s: f64,
+    /// Pin radius (part units).
     pub pin_radius: f64,
+    /// Lateral speed of the pin as a fraction of the belt speed.
     pub pin_speed: f64,
     /// Belt travel (units of a) from the pin's start to where it stops.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -30,17 +38,29 @@ pub struct ContactReport {
     /// A moving pin's lateral offset (units of a) where it stops.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pin_stop_d: Option<f64>,
+    /// Did the pin push the part at all?
     pub contact: bool,
+    /// Final orientation (degrees, in [0, 360)).
     pub theta_final_deg: f64,
+    /// Signed total rotation (degrees, not wrapped).
     pub rotation_deg: f64,
+    /// Final centroid position [x, y] (belt frame, part units).
     pub com_final: [f64; 2],
+    /// Pin travel relative to the belt before the first touch (part units).
     pub travel_to_contact: f64,
+    /// Pin travel while in contact (part units).
     pub contact_length: f64,
+    /// Number of separate contacts during the pass.
     pub contacts: u32,
+    /// The stretches of contact, each with one feature in one mode.
     pub segments: Vec<crate::mechanics::Segment>,
+    /// Limit-surface evaluations (exact model: dissipation evaluations; closed forms: solves).
     pub evaluations: u64,
+    /// Accepted integration steps.
     pub steps: u32,
+    /// The status's name (`ok` when the pass completed).
     pub status: String,
+    /// The status with its details.
     pub status_detail: crate::mechanics::ContactStatus,
 }
 

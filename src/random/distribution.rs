@@ -19,21 +19,33 @@ pub const MAX_REDRAWS: u32 = 1000;
 /// A compiled distribution.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Distribution {
+    /// Always this value.
     Fixed(f64),
+    /// Uniform on [min, max].
     Uniform {
+        /// Lower end.
         min: f64,
+        /// Upper end.
         max: f64,
     },
     /// Normal, optionally truncated to [lo, hi] by redrawing.
     Normal {
+        /// Mean.
         mean: f64,
+        /// Standard deviation.
         sd: f64,
+        /// Lower truncation (−∞ when not truncated).
         lo: f64,
+        /// Upper truncation (+∞ when not truncated).
         hi: f64,
     },
+    /// Triangular on [min, max] with its peak at `mode` (drawn by inverse CDF).
     Triangular {
+        /// Lower end.
         min: f64,
+        /// The peak, in [min, max].
         mode: f64,
+        /// Upper end.
         max: f64,
     },
 }

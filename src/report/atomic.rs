@@ -23,6 +23,8 @@ use std::sync::OnceLock;
 
 /// The environment variable that injects a fault, and its one value.
 pub const FAULT_VAR: &str = "PINFEED_FAULT";
+/// The one value of [`FAULT_VAR`] that injects a fault: abort after the first temporary file is
+/// written.
 pub const FAULT_AFTER_TEMP_WRITE: &str = "after-temp-write";
 
 /// Whether `PINFEED_FAULT=after-temp-write` is set (read once).
@@ -54,6 +56,8 @@ pub struct Staged {
 }
 
 impl Staged {
+    /// A file to be produced at `path`: its content goes to a temporary path beside it until
+    /// committed.
     pub fn new(path: &Path) -> Staged {
         Staged {
             path: path.to_path_buf(),
@@ -134,6 +138,7 @@ pub struct Batch {
 }
 
 impl Batch {
+    /// An empty batch.
     pub fn new() -> Batch {
         Batch::default()
     }

@@ -12,12 +12,19 @@ use std::path::Path;
 /// The document `calibration.json`.
 #[derive(Debug, Serialize)]
 pub struct CalibrateReport<'a> {
+    /// The command that regenerates the report.
     pub command: String,
+    /// The measured-band CSV file, as given.
     pub measured: String,
+    /// The fit: the parameters found and how.
     pub calibration: &'a Calibration,
+    /// The nominal (starting) parameters, one line each.
     pub nominal: Vec<String>,
+    /// The score of the nominal parameters against the measured bands.
     pub nominal_score: &'a Summary,
+    /// The fitted parameters, one line each.
     pub fitted: Vec<String>,
+    /// The score of the fitted parameters against the measured bands.
     pub fitted_score: &'a Summary,
     /// With --synthesize: the hidden values, in the order of the parameters.
     #[serde(skip_serializing_if = "Option::is_none")]

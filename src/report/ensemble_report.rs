@@ -13,13 +13,21 @@ use std::path::Path;
 /// The document `ensemble.json`.
 #[derive(Debug, Serialize)]
 pub struct EnsembleReport<'a> {
+    /// The command that regenerates the report.
     pub command: String,
+    /// The part spec, as given.
     pub part: &'a str,
+    /// The uncertain parameters, one line each.
     pub uncertain: Vec<String>,
+    /// Members of the ensemble (one drawn set of parameters each).
     pub members: usize,
+    /// Seed of the members' draws; the same seed gives the same members.
     pub seed: u64,
+    /// Spacing of the initial orientations θ0 (degrees).
     pub theta_step_deg: f64,
+    /// The predicted bands per (d, input state).
     pub predicted: &'a [PredictedBands],
+    /// What each member drew.
     pub draws: &'a [MemberDraw],
 }
 

@@ -13,18 +13,27 @@ use std::path::{Path, PathBuf};
 pub struct MapReport<'a> {
     /// The command that regenerates this report.
     pub command: String,
+    /// The part spec, as given.
     pub part: &'a str,
+    /// The contact model's name (`map` when the map tier ran).
     pub model: &'a str,
+    /// Pin–part friction coefficient μc.
     pub mu_c: f64,
+    /// Pin radius (part units).
     pub pin_radius: f64,
+    /// The support spec (`uniform`, `tripod:SEED`).
     pub support: &'a str,
+    /// Spacing of the initial orientations θ0 (degrees; divides 360).
     pub theta_step_deg: f64,
+    /// Band threshold T (degrees): neighbouring final angles at least T apart start a new band.
     pub threshold_deg: f64,
+    /// Integration tolerance per step.
     pub tol: f64,
     /// The fence of a fence map, placed as `pinfeed contact --fence` places it (part units at θ0 = 0,
     /// the part's centroid at the origin).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fence: Option<crate::mechanics::FenceSpec>,
+    /// One configuration map per offset d.
     pub maps: &'a [ConfigurationMap],
 }
 

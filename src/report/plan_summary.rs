@@ -13,8 +13,11 @@ use std::path::{Path, PathBuf};
 /// Where a design's files go: the scenario, the policy (a contingent design's) and the drawing.
 #[derive(Debug, Clone)]
 pub struct DesignPaths {
+    /// The scenario file.
     pub scenario: PathBuf,
+    /// The policy file, for a design with a sensor.
     pub policy: Option<PathBuf>,
+    /// The drawing (SVG).
     pub draw: PathBuf,
 }
 
@@ -90,30 +93,52 @@ pub fn write_design(o: &DesignOptions, d: &Design, paths: &DesignPaths) -> Resul
 /// The JSON document of `pinfeed plan --json`.
 #[derive(Debug, Serialize)]
 pub struct PlanJson<'a> {
+    /// [`crate::SCHEMA_VERSION`].
     pub schema_version: u32,
+    /// The version of pinfeed that planned.
     pub pinfeed_version: &'static str,
+    /// The command that regenerates the design.
     pub command: &'a str,
     /// confirmed | not_confirmed | unchecked | no_design
     pub status: Status,
+    /// One sentence: what was found and what the line says.
     pub message: &'a str,
+    /// The design's name (its files are named after it).
     pub name: &'a str,
+    /// The chosen design's mode (none without a design).
     pub mode: Option<Mode>,
+    /// The particle abstraction's predicted success of the chosen design, in [0, 1].
     pub predicted_success: Option<f64>,
+    /// The full line check of the chosen design.
     pub line_check: Option<&'a design::LineCheck>,
+    /// The line check under the problem's uncertainty (a Monte Carlo study), when planned against
+    /// one.
     pub uncertain_check: Option<&'a design::LineCheck>,
+    /// The chosen design's obstacles.
     pub obstacles: Option<&'a [design::ObstacleInfo]>,
+    /// Belt length of the chosen design (m).
     pub belt_length_m: Option<f64>,
+    /// Belt width the chosen design uses (m).
     pub belt_width_m: Option<f64>,
+    /// Seconds between parts of the chosen design.
     pub headway_s: Option<f64>,
+    /// Oriented parts per minute at that headway.
     pub oriented_per_min: Option<f64>,
+    /// The files written.
     pub files: Vec<String>,
+    /// A limit that cut the work short (the time limit), if any.
     pub limit: Option<&'a str>,
+    /// Wall time of the planning (s).
     pub elapsed_s: f64,
+    /// Every candidate considered.
     pub candidates: &'a [Candidate],
     /// The chosen candidate (also in `candidates`).
     pub chosen: Option<&'a Candidate>,
+    /// The planning problem.
     pub problem: &'a Problem,
+    /// What the planner optimised.
     pub objective: Objective,
+    /// The chosen design's scenario (TOML text).
     pub scenario: Option<&'a str>,
 }
 

@@ -7,6 +7,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
+/// Draw the accuracy-vs-time study to the SVG file `path` (written whole or not at all).
 pub fn plot_accuracy(st: &AccuracyStudy, path: &Path) -> anyhow::Result<()> {
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();

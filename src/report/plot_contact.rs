@@ -15,12 +15,20 @@ pub enum PassObstacle {
     /// A pin of radius `radius` whose centre starts at `start` and moves (−1, `lateral_speed`) per
     /// unit travel.
     Pin {
+        /// The centre's start (part units).
         start: Vec2,
+        /// The pin's radius (part units).
         radius: f64,
+        /// Lateral motion per unit of travel (fraction of the belt speed).
         lateral_speed: f64,
     },
     /// A fence segment from `start` to `end`.
-    Fence { start: Vec2, end: Vec2 },
+    Fence {
+        /// The segment's start (part units).
+        start: Vec2,
+        /// The segment's end (part units).
+        end: Vec2,
+    },
 }
 
 /// Stroke colour of the fence segments (the pin is red).

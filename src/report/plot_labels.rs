@@ -28,6 +28,7 @@ pub struct LabelRows {
 }
 
 impl LabelRows {
+    /// No labels placed yet.
     pub fn new() -> LabelRows {
         LabelRows::default()
     }

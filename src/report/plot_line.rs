@@ -15,6 +15,7 @@ use std::path::Path;
 
 /// Pins and fences: a dark slate, apart from every outcome colour; sensor pins blue.
 pub const OBSTACLE_COLOUR: RGBColor = RGBColor(40, 50, 70);
+/// Sensor pins' colour.
 pub const SENSOR_COLOUR: RGBColor = RGBColor(31, 111, 208);
 const LABEL_FONT: f64 = 12.0;
 const LABEL_ROW_PX: f64 = 15.0;

@@ -7,7 +7,7 @@
 //! * [`plot_band_intervals`]: band intervals against d for every map given (Figure 3-6), with "+"
 //!   at the ends and a dot at the mean; with `adjusted` the intervals are mean ± sd (Figure 3-8),
 //!   drawn over the raw ones in grey. Its orientation axis zooms on the bands
-//!   ([`super::plot_zoom`]; an interval across 0°/360° is then one piece) and its legend stands in
+//!   (`plot_zoom`; an interval across 0°/360° is then one piece) and its legend stands in
 //!   a row above the chart, where it hides no interval.
 //!
 //! In the map figure, intervals straddling 0°/360° are drawn as two pieces.

@@ -1,5 +1,5 @@
 //! SVG histogram of the final orientations of the parts that reached the end of the belt, zoomed
-//! on the data ([`super::plot_zoom`]): the part's stable states marked (dashed, labelled; those
+//! on the data (`plot_zoom`): the part's stable states marked (dashed, labelled; those
 //! outside the view named in the caption below the axis) and the goal's tolerance bands shaded and
 //! labelled. Counts are whole numbers.
 
@@ -22,6 +22,8 @@ fn deg(x: f64) -> String {
     }
 }
 
+/// Draw the histogram of a line run's final part orientations, the scenario's goal windows
+/// marked, to the SVG file `path` (written whole or not at all).
 pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> anyhow::Result<()> {
     let h = &s.orientation_histogram;
     let top = h.counts.iter().copied().max().unwrap_or(0).max(1);

@@ -2,7 +2,7 @@
 //! axes (a fence is drawn at its true angle; pins at their true radius), each pin with the
 //! interval of positions that act the same way, belt edges, entry and exit, and the part at its
 //! goal orientation past the exit; every label in a row above or below the belt where no other
-//! label overlaps it ([`super::plot_labels`]). Below it, the orientation sets after each obstacle —
+//! label overlaps it (`plot_labels`). Below it, the orientation sets after each obstacle —
 //! one row per stage (feed, pin1, fence2, …), a dot per particle orientation sized by its weight,
 //! the goal window shaded — as in the thesis's ch. 4 figures.
 

@@ -17,8 +17,11 @@ use std::path::Path;
 /// The noisy reading drawn over the templates: the reading, the true push's contact begin (s since
 /// the pass began) and its label.
 pub struct Overlay<'a> {
+    /// The noisy reading.
     pub reading: &'a Reading,
+    /// The true push's contact begin (s since the pass began).
     pub contact_begin: f64,
+    /// The true hypothesis's label.
     pub label: String,
 }
 

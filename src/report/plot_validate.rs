@@ -3,7 +3,7 @@
 //! (width ∝ share per 1° bin, scaled to the largest bin of the figure) centred on d, its 90%
 //! predicted bands as bars just left of it, and optionally the measured bands as red bars with end
 //! ticks just right of it — offsets for legibility only, said in the legend and on the axis; a
-//! dotted guide marks each d. The θf axis zooms on the data ([`super::plot_zoom`]), so an arc
+//! dotted guide marks each d. The θf axis zooms on the data (`plot_zoom`), so an arc
 //! across 0°/360° is drawn in one piece.
 
 use super::plot_map::{d_chart, header_with_legend, Swatch, PALETTE};

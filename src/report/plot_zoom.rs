@@ -8,7 +8,9 @@ use crate::geometry::wrap_deg;
 /// An unwrapped degree range of an axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DegreeView {
+    /// Lower end (degrees, may be negative).
     pub lo: f64,
+    /// Upper end (degrees, may exceed 360).
     pub hi: f64,
 }
 

@@ -14,16 +14,20 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// The head of a report's README.md: title, regenerating command, a sentence and a bullet list.
-pub struct ReportHead<'a> {
+pub(crate) struct ReportHead<'a> {
+    /// The report's title.
     pub title: String,
+    /// The command that regenerates the report.
     pub command: &'a str,
+    /// One paragraph after the command.
     pub intro: String,
+    /// The bullet list after it.
     pub bullets: &'a [String],
 }
 
 /// Create `out_dir`, write `report` there as `json_name`, then README.md: the head followed by
 /// what `body` returns (it may write figures into `out_dir`).
-pub fn write_report_files<T: Serialize>(
+pub(crate) fn write_report_files<T: Serialize>(
     out_dir: &Path,
     json_name: &str,
     report: &T,
@@ -52,14 +56,21 @@ pub fn write_report_files<T: Serialize>(
 /// The document `validate.json`.
 #[derive(Debug, Serialize)]
 pub struct ValidateReport<'a> {
+    /// The command that regenerates the report.
     pub command: String,
+    /// The measured-band CSV file, as given.
     pub measured: String,
+    /// The uncertain parameters, one line each.
     pub uncertain: Vec<String>,
+    /// Members of the ensemble.
     pub members: usize,
+    /// The settings of the score.
     pub score_settings: ScoreSettings,
     /// What `contained` and the verdicts mean ([`containment_text`]).
     pub containment: String,
+    /// The overall score.
     pub summary: &'a Summary,
+    /// The score of each measured row.
     pub rows: &'a [RowScore],
 }
 

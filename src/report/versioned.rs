@@ -7,8 +7,11 @@ use serde::Serialize;
 /// `body`'s fields after the two version fields (`body` serialises as a JSON object).
 #[derive(Debug, Serialize)]
 pub struct Versioned<'a, T: ?Sized + Serialize> {
+    /// [`crate::SCHEMA_VERSION`].
     pub schema_version: u32,
+    /// [`crate::PINFEED_VERSION`].
     pub pinfeed_version: &'static str,
+    /// The document's own fields.
     #[serde(flatten)]
     pub body: &'a T,
 }

@@ -9,6 +9,7 @@ use serde::Serialize;
 /// A confusion matrix: rows the true hypotheses, columns the decisions, the last column "unknown".
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Confusion {
+    /// The hypotheses' labels, in row order.
     pub labels: Vec<String>,
     /// `counts[true][decided]`, k rows of k + 1 columns (the last: unknown).
     pub counts: Vec<Vec<u64>>,
@@ -53,6 +54,7 @@ impl Confusion {
         self.counts[h].iter().sum()
     }
 
+    /// Trials counted.
     pub fn total(&self) -> u64 {
         self.counts.iter().flatten().sum()
     }

@@ -62,10 +62,13 @@ pub enum TruthDraw {
 /// The push being sensed.
 #[derive(Debug, Clone, Copy)]
 pub struct Problem<'a> {
+    /// The push.
     pub setup: &'a PushSetup,
     /// The part's model under uniform support (tripod supports are drawn per push when declared).
     pub model: &'a PartModel,
+    /// The hypotheses to tell apart.
     pub hypotheses: &'a Hypotheses,
+    /// The declared uncertainty of μc, the support and the pose.
     pub uncertainty: &'a Uncertainty,
 }
 
@@ -74,32 +77,50 @@ pub struct Problem<'a> {
 pub struct SensorPoint {
     /// The factor applied to the base sensor's noise ([`SensorSettings::with_noise_factor`]).
     pub noise_factor: f64,
+    /// The sensor at this noise factor.
     pub sensor: SensorSettings,
+    /// Names of the classifiers scored at this point.
     pub classifiers: Vec<String>,
 }
 
 /// Evaluation settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Config {
+    /// Templates built per hypothesis (1 to [`MAX_TEMPLATES`]).
     pub templates_per_hypothesis: usize,
+    /// Trials: simulated pushes, each read at every sensor point and classified by every
+    /// classifier there (1 to [`MAX_TRIALS`]).
     pub trials: usize,
+    /// How each trial's hypothesis is chosen.
     pub truth: TruthDraw,
+    /// Seed of the templates' and trials' streams; the same seed gives the same evaluation.
     pub seed: u64,
+    /// Options of the classifiers.
     pub options: ClassifierOptions,
 }
 
 /// One classifier at one sensor point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Cell {
+    /// The classifier's name.
     pub classifier: String,
+    /// The sensor kind's name (`ft`, `timing`).
     pub sensor: &'static str,
+    /// The factor on the sensor's noise.
     pub noise_factor: f64,
+    /// Trials counted.
     pub trials: u64,
+    /// Trials decided correctly.
     pub correct: u64,
+    /// Trials decided "unknown".
     pub unknown: u64,
+    /// `correct / trials` ("unknown" counts as wrong; 0 without trials).
     pub accuracy: f64,
+    /// 95% Wilson interval of the accuracy, [low, high].
     pub accuracy_ci95: [f64; 2],
+    /// Plug-in mutual information between true state and decision (bits).
     pub mutual_information_bits: f64,
+    /// The confusion matrix.
     pub confusion: Confusion,
 }
 
@@ -123,9 +144,11 @@ impl Cell {
 /// The scores of every classifier at every sensor point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Evaluation {
+    /// The hypotheses' labels.
     pub labels: Vec<String>,
     /// Templates built per hypothesis (vertex/edge: a class that never occurred has none).
     pub template_counts: Vec<usize>,
+    /// Trials: simulated pushes, each read at every sensor point.
     pub trials: usize,
     /// Trials with no truth (vertex/edge: the pin never touched).
     pub unscored: u64,

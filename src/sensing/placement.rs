@@ -19,12 +19,17 @@ pub fn default_grid() -> Vec<f64> {
 /// One placement (d, sensor kind) and its best classifier.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Row {
+    /// The pin's offset d (units of a).
     pub d: f64,
+    /// The sensor kind's name (`ft`, `timing`).
     pub sensor: &'static str,
     /// The best classifier (None when no classifier was scored).
     pub classifier: Option<String>,
+    /// The best classifier's mutual information between state and decision (bits).
     pub mutual_information_bits: f64,
+    /// The best classifier's accuracy, in [0, 1].
     pub accuracy: f64,
+    /// 95% Wilson interval of that accuracy, [low, high].
     pub accuracy_ci95: [f64; 2],
     /// H(state) of this placement's scored trials (bits).
     pub state_entropy_bits: f64,
@@ -35,7 +40,9 @@ pub struct Row {
 /// The placement search's result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Placement {
+    /// The offsets d tried (units of a).
     pub grid: Vec<f64>,
+    /// One row per (offset, sensor kind).
     pub rows: Vec<Row>,
     /// The best row per sensor kind (indices into `rows`), in the order the kinds were given.
     pub best_per_sensor: Vec<usize>,

@@ -15,16 +15,20 @@ use serde::Serialize;
 /// A sampled F/T signal: sample k is at time `t0 + k·dt` (s since the pass began).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Sampled {
+    /// Time of the first sample (s since the pass began).
     pub t0: f64,
+    /// Sampling period (s).
     pub dt: f64,
     /// Channels Fx, Fy, Fz (N), Tx, Ty, Tz (N·mm) per sample.
     pub values: Vec<[f64; CHANNELS]>,
 }
 
 impl Sampled {
+    /// Number of samples.
     pub fn len(&self) -> usize {
         self.values.len()
     }
+    /// No samples?
     pub fn is_empty(&self) -> bool {
         self.values.is_empty()
     }
@@ -42,6 +46,7 @@ impl Sampled {
 /// since the pass began, jitter included. Empty when |F| never crossed the threshold.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct ContactTimes {
+    /// Each detected contact as (begin, end) (s since the pass began).
     pub intervals: Vec<(f64, f64)>,
 }
 
@@ -60,7 +65,9 @@ impl ContactTimes {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Reading {
+    /// A force/torque sensor's sampled signal.
     Ft(Sampled),
+    /// A timing sensor's contact instants.
     Timing(ContactTimes),
 }
 

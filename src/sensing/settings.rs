@@ -38,6 +38,7 @@ pub enum SensorKind {
 }
 
 impl SensorKind {
+    /// The kind's name in files and reports (`ft`, `timing`).
     pub fn name(self) -> &'static str {
         match self {
             SensorKind::Ft => "ft",
@@ -54,6 +55,7 @@ pub const CHANNEL_NAMES: [&str; CHANNELS] = ["Fx", "Fy", "Fz", "Tx", "Ty", "Tz"]
 /// Everything about one sensor. Units: N, N·mm, m, s, Hz.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SensorSettings {
+    /// Force/torque signal or contact timing.
     pub kind: SensorKind,
     /// Sampling rate (Hz) of the F/T signal.
     pub rate: f64,
@@ -61,16 +63,21 @@ pub struct SensorSettings {
     pub height: f64,
     /// White-noise standard deviation per force channel (N) and per torque channel (N·mm).
     pub noise_force: f64,
+    /// White-noise standard deviation per torque channel (N·mm).
     pub noise_torque: f64,
     /// Constant offset per force channel (N) and per torque channel (N·mm).
     pub bias_force: f64,
+    /// Constant offset per torque channel (N·mm).
     pub bias_torque: f64,
     /// Linear drift per second of the force channels (N/s) and torque channels (N·mm/s).
     pub drift_force: f64,
+    /// Linear drift per second of the torque channels (N·mm/s).
     pub drift_torque: f64,
     /// Quantisation step of Fx/Fy (N), of Fz (N) and of the torques (N·mm); 0: no quantisation.
     pub resolution_force: f64,
+    /// Quantisation step of Fz (N); 0: none.
     pub resolution_force_z: f64,
+    /// Quantisation step of the torques (N·mm); 0: none.
     pub resolution_torque: f64,
     /// Cut-off (Hz) of a first-order low-pass applied before quantisation; `None`: none.
     pub lowpass: Option<f64>,
@@ -105,7 +112,9 @@ impl Default for SensorSettings {
 /// A setting out of its physical range: the field's name and the reason.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SettingError {
+    /// The setting's field name.
     pub field: &'static str,
+    /// Why the value is refused.
     pub message: String,
 }
 

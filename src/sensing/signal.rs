@@ -28,6 +28,7 @@ pub const GRAVITY: f64 = 9.80665;
 /// Collects the knots of a pass (a [`Recorder`]): every sample the integrator reports.
 #[derive(Debug, Default, Clone)]
 pub struct KnotRecorder {
+    /// Every sample the integrator reported, in order.
     pub samples: Vec<TraceSample>,
 }
 

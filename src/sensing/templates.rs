@@ -30,13 +30,19 @@ pub struct PushSetup {
     pub d: f64,
     /// Pin radius (m).
     pub pin_radius: f64,
+    /// Pin–part friction coefficient μc.
     pub mu_c: f64,
+    /// Part–belt (support) friction coefficient μs.
     pub mu_s: f64,
+    /// The contact model.
     pub fidelity: Fidelity,
+    /// Integration tolerance per step.
     pub tol: f64,
     /// Part mass (kg), belt speed (m/s), sensor height (m).
     pub mass: f64,
+    /// Belt speed (m/s).
     pub belt_speed: f64,
+    /// Height of the sensor origin above the contact plane (m).
     pub height: f64,
 }
 
@@ -93,6 +99,7 @@ impl Uncertainty {
             d_sd: 0.0,
         }
     }
+    /// No uncertainty at all (fixed μc, uniform support, no jitter)?
     pub fn is_none(&self) -> bool {
         self.mu_c.is_fixed() && !self.tripod && self.theta_sd_deg == 0.0 && self.d_sd == 0.0
     }
@@ -103,24 +110,32 @@ impl Uncertainty {
 pub enum Hypotheses {
     /// Initial orientations (degrees) with their labels.
     Orientations {
+        /// The hypotheses' labels.
         labels: Vec<String>,
+        /// The orientations (degrees), one per label.
         degrees: Vec<f64>,
     },
     /// Vertex or edge first contact; the pushes are drawn over `degrees` (orientations, e.g. the
     /// stable states or a uniform sweep) and labelled by the contact model's first feature.
-    VertexEdge { degrees: Vec<f64> },
+    VertexEdge {
+        /// The orientations the pushes are drawn over (degrees).
+        degrees: Vec<f64>,
+    },
 }
 
 impl Hypotheses {
+    /// The labels of the hypotheses (`vertex`, `edge` for a vertex/edge problem).
     pub fn labels(&self) -> Vec<String> {
         match self {
             Hypotheses::Orientations { labels, .. } => labels.clone(),
             Hypotheses::VertexEdge { .. } => vec!["vertex".into(), "edge".into()],
         }
     }
+    /// Number of hypotheses.
     pub fn len(&self) -> usize {
         self.labels().len()
     }
+    /// No hypotheses?
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -209,10 +224,15 @@ pub fn vertex_edge_class(f: ContactFeature) -> usize {
 /// One simulated pass: the push's outcome, its clean signal, and what was drawn for it.
 #[derive(Debug, Clone)]
 pub struct Pass {
+    /// The push's outcome.
     pub outcome: ContactOutcome,
+    /// The push's clean (noise-free) signal.
     pub signal: ContactSignal,
+    /// Entry orientation drawn (degrees).
     pub theta0_deg: f64,
+    /// Pin offset d drawn (units of a).
     pub d: f64,
+    /// Pin–part friction μc drawn.
     pub mu_c: f64,
 }
 
@@ -279,7 +299,9 @@ pub fn draw_pass(
 /// The templates of every hypothesis: `members[h]` holds hypothesis h's ensemble.
 #[derive(Debug, Clone)]
 pub struct TemplateSet {
+    /// The hypotheses' labels.
     pub labels: Vec<String>,
+    /// `members[h]`: the clean signals of hypothesis h's ensemble.
     pub members: Vec<Vec<ContactSignal>>,
 }
 

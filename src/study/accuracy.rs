@@ -29,27 +29,44 @@ pub const BAND_THRESHOLD_DEG: f64 = 5.0;
 /// One tier's row.
 #[derive(Debug, Clone, Serialize)]
 pub struct TierRow {
+    /// The tier's name (`tip`, `exact tol=1e-6`, `exact+tables tol=1e-6`, `map`, …).
     pub tier: String,
+    /// The contact model the tier runs.
     pub fidelity: String,
+    /// Integration tolerance per step.
     pub tol: f64,
+    /// Contacts compared with the reference.
     pub contacts: usize,
+    /// Mean of |θf − θf_ref| (degrees, wrapped).
     pub error_mean_deg: f64,
+    /// 95th percentile of |θf − θf_ref| (degrees).
     pub error_p95_deg: f64,
+    /// Largest |θf − θf_ref| (degrees).
     pub error_max_deg: f64,
+    /// Share of contacts more than [`BAND_THRESHOLD_DEG`] from the reference, in [0, 1].
     pub different_band_share: f64,
+    /// Median wall time per contact (µs, one thread).
     pub median_us: f64,
+    /// Mean wall time per contact (µs, one thread).
     pub mean_us: f64,
+    /// Mean limit-surface evaluations per contact.
     pub mean_evaluations: f64,
 }
 
 /// The whole study.
 #[derive(Debug, Clone, Serialize)]
 pub struct AccuracyStudy {
+    /// The reference parts' specs.
     pub parts: Vec<String>,
+    /// Contacts drawn (split evenly over the parts).
     pub contacts: usize,
+    /// Contacts left out because the reference itself did not end `ok`.
     pub reference_excluded: usize,
+    /// One-off build time of the map tier's maps (s).
     pub map_build_seconds: f64,
+    /// The map tier's grid, in words.
     pub map_grid: String,
+    /// One row per tier.
     pub rows: Vec<TierRow>,
 }
 

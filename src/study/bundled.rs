@@ -107,13 +107,18 @@ pub fn find(name: &str) -> Option<&'static Bundled> {
 /// Why bundled files could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
+    /// No bundled scenario or study has this name.
     #[error("no bundled scenario or study is called '{0}' (`pinfeed examples` lists them)")]
     Unknown(String),
+    /// The target file exists and overwriting was not asked for.
     #[error("{} already exists; nothing was written (--force overwrites)", .0.display())]
     Exists(PathBuf),
+    /// A file could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Io {
+        /// The file.
         path: PathBuf,
+        /// Why it could not be written.
         source: std::io::Error,
     },
 }

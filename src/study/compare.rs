@@ -29,14 +29,21 @@ use serde::Serialize;
 pub struct ComparisonRow {
     /// The scene's name and the file it came from.
     pub scenario: String,
+    /// The scenario file, as given.
     pub file: String,
+    /// Number of pins on the line.
     pub pins: usize,
+    /// Number of fences on the line.
     pub fences: usize,
+    /// Seed of the run's part stream.
     pub seed: u64,
+    /// Parts fed in.
     pub parts_in: u64,
     /// What counts as a success: the goal sets; empty when every exiting part does (`any`).
     pub goal: Vec<GoalWindow>,
+    /// Share of parts that ended in success, in [0, 1].
     pub success_rate: f64,
+    /// 95% Wilson interval of the success rate, [low, high].
     pub success_ci95: [f64; 2],
     /// [first, last] x of the obstacles (m).
     pub obstacle_span_m: Option<[f64; 2]>,
@@ -48,12 +55,19 @@ pub struct ComparisonRow {
     pub obstacle_y_span_m: Option<[f64; 2]>,
     /// Obstacle y span plus the part's length (m).
     pub across_m: Option<f64>,
+    /// The belt's width (m).
     pub belt_width_m: f64,
+    /// Oriented parts per minute over the steady window (None without one).
     pub throughput_ok_per_min: Option<f64>,
+    /// Mean entry → exit time of the exiting parts (s).
     pub latency_mean_s: Option<f64>,
+    /// 99th percentile of entry → exit time (s).
     pub latency_p99_s: Option<f64>,
+    /// Mean contacts per part.
     pub contacts_per_part: f64,
+    /// Parts that jammed.
     pub jams: u64,
+    /// Count per outcome class.
     pub outcomes: OutcomeCounts,
 }
 
@@ -61,8 +75,11 @@ pub struct ComparisonRow {
 /// `tolerance_deg` of one of `orientations_deg`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GoalWindow {
+    /// The goal set's name.
     pub name: String,
+    /// Its goal orientations (degrees).
     pub orientations_deg: Vec<f64>,
+    /// Largest distance to a goal orientation that still succeeds (degrees).
     pub tolerance_deg: f64,
 }
 

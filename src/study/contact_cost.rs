@@ -17,18 +17,27 @@ use std::time::Instant;
 /// One (part, fidelity) row of the contact-cost table.
 #[derive(Debug, Clone, Serialize)]
 pub struct ContactCostRow {
+    /// The part spec.
     pub part: String,
+    /// The fidelity (`exact`, `exact+tables`, `exact+sticks`, `ellipsoid`, `tip`).
     pub fidelity: String,
+    /// Contacts run.
     pub contacts: usize,
     /// Contacts that touched the part (the rest passed it).
     pub touching: usize,
+    /// Median wall time per contact (µs).
     pub median_us: f64,
+    /// 90th percentile of wall time per contact (µs).
     pub p90_us: f64,
+    /// Mean limit-surface evaluations per contact.
     pub mean_evaluations: f64,
+    /// Mean accepted integration steps per contact.
     pub mean_steps: f64,
     /// |θf(tol) − θf(tol/1000)| in degrees: mean, 95th percentile, max.
     pub self_error_mean_deg: f64,
+    /// 95th percentile of the self-error (degrees).
     pub self_error_p95_deg: f64,
+    /// Largest self-error (degrees).
     pub self_error_max_deg: f64,
     /// Contacts whose status was not ok, by status name.
     pub non_ok: Vec<(String, usize)>,
@@ -52,17 +61,21 @@ pub struct TableCost {
     pub build_ms: f64,
     /// Nodes over the part's slide tables, and dissipation evaluations spent building them.
     pub nodes: usize,
+    /// Dissipation evaluations spent building the slide tables.
     pub build_evaluations: u64,
     /// Slide-table intervals left to the solver (not certified).
     pub uncertified: usize,
     /// Certified pieces of the stick tables, pieces left to the solver, and dissipation
     /// evaluations spent building them.
     pub stick_pieces: usize,
+    /// Pieces of the stick tables left to the solver.
     pub stick_open: usize,
+    /// Dissipation evaluations spent building the stick tables.
     pub stick_evaluations: u64,
     /// max and mean |θf(tables) − θf(solves)| over the touching contacts at the same tolerance (°):
     /// what the tables change.
     pub vs_solves_max_deg: f64,
+    /// Mean |θf(tables) − θf(solves)| over the touching contacts (degrees).
     pub vs_solves_mean_deg: f64,
 }
 
@@ -311,9 +324,11 @@ pub fn tables_markdown(rows: &[ContactCostRow]) -> String {
 /// and far from it (quadrature), and the cost of a whole contact.
 #[derive(Debug, Clone, Serialize)]
 pub struct ScalingRow {
+    /// Vertices of the regular polygon.
     pub vertices: usize,
     /// ns per evaluation with the Hessian: centre of rotation within 2a, and at 8a.
     pub near_ns: f64,
+    /// ns per evaluation with the centre of rotation at 8a.
     pub far_ns: f64,
     /// The contact table's row for the exact model on this part.
     pub contact: ContactCostRow,

@@ -23,21 +23,29 @@ use std::time::Instant;
 /// One scenario's measurement.
 #[derive(Debug, Clone)]
 pub struct LineCost {
+    /// The scenario's name.
     pub scenario: String,
+    /// The scene's contact model.
     pub fidelity: String,
+    /// Parts the line ran.
     pub parts: u64,
+    /// Pushes the line computed.
     pub pushes: usize,
     /// Pushes whose path the line recorded as it computed them.
     pub recorded: usize,
+    /// Limit-surface evaluations over the pushes.
     pub evaluations: u64,
     /// Wall time (s, minimum over the repeats): the line, the bare batch, the batch recording
     /// what the line recorded.
     pub line_s: f64,
+    /// The bare batch of the same pushes (s).
     pub bare_s: f64,
+    /// The batch recording what the line recorded (s).
     pub bare_recorded_s: f64,
 }
 
 impl LineCost {
+    /// Parts per second of the line.
     pub fn parts_per_s(&self) -> f64 {
         self.parts as f64 / self.line_s
     }

@@ -17,12 +17,19 @@ pub const THESIS_DS: [f64; 18] = [
 /// One (part, fidelity, threads) row.
 #[derive(Debug, Clone)]
 pub struct MapCostRow {
+    /// The part spec.
     pub part: String,
+    /// The contact model.
     pub fidelity: Fidelity,
+    /// Threads of the pool.
     pub threads: usize,
+    /// Contacts in one computation of the maps (18 d × the θ0 count).
     pub contacts: usize,
+    /// Median wall time over the repeats (s).
     pub median_s: f64,
+    /// Fastest repeat (s).
     pub min_s: f64,
+    /// Slowest repeat (s).
     pub max_s: f64,
 }
 

@@ -22,25 +22,36 @@ use std::time::Instant;
 /// One part's map against the exact model.
 #[derive(Debug, Clone)]
 pub struct ContactRow {
+    /// The part spec.
     pub part: String,
+    /// Time to build the part's map (s; NaN when it was not built here).
     pub build_s: f64,
+    /// Exact pushes computed to build the map.
     pub exact_samples: u64,
+    /// Fraction of the (θ0, d) rectangle covered by certified cells.
     pub certified_area: f64,
+    /// Pushes drawn.
     pub contacts: usize,
+    /// Pushes that touched the part (exact model).
     pub touching: usize,
     /// Touching pushes the map served.
     pub served: usize,
     /// Pushes whose contact / no-contact answer differs from exact (must be 0).
     pub class_mismatch: usize,
+    /// Mean |θf(map) − θf(exact)| over the served pushes (degrees).
     pub err_mean: f64,
+    /// 95th percentile of that error (degrees).
     pub err_p95: f64,
+    /// Largest error (degrees).
     pub err_max: f64,
     /// µs per served push through the map and through the exact model (the same pushes timed as
     /// a batch, best of several batches).
     pub served_us: f64,
+    /// µs per served push through the exact model.
     pub exact_served_us: f64,
     /// Mean µs over all pushes: through `push_with_map` and exact.
     pub mixed_us: f64,
+    /// Mean µs over all pushes through the exact model.
     pub exact_us: f64,
 }
 
@@ -195,13 +206,21 @@ pub fn contact_section(rows: &[ContactRow], cmd: &str) -> String {
 /// The line: one scenario exact and on the map tier.
 #[derive(Debug, Clone)]
 pub struct LineRow {
+    /// Parts run on each model.
     pub parts: u64,
+    /// Wall time of the exact run (s).
     pub exact_s: f64,
+    /// Wall time of the map-tier run (s).
     pub map_s: f64,
+    /// Time to prepare the scene's maps (s).
     pub build_s: f64,
+    /// Parts whose outcome class is the same on both.
     pub same_class: u64,
+    /// Largest final-orientation difference among those parts (degrees).
     pub max_theta_diff_deg: f64,
+    /// The exact run.
     pub exact: RunResult,
+    /// The map-tier run.
     pub map: RunResult,
 }
 

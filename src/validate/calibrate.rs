@@ -11,7 +11,7 @@
 //! the fitted range, the random support with probability ½, pin radius uniform on [0, ρmax]. Each
 //! measured row is predicted once ([`super::predict`]). Under φ member i weighs
 //! wᵢ(φ) = N(μcᵢ; m, s) · N(ρᵢ; ρ, σρ) · (t or 1 − t)/½ — importance sampling, with common random
-//! numbers for every φ — and the row's log-likelihood ([`super::score::RowKernel`]) is a function of
+//! numbers for every φ — and the row's log-likelihood (`score::RowKernel`) is a function of
 //! four weighted sums, so a grid of tens of thousands of φ costs a few seconds and no new contact.
 //! The effective number of members at the optimum, (Σw)²/Σw², says how well the proposal covers it.
 //!
@@ -40,6 +40,7 @@ pub struct CalibrationSettings {
     pub members: usize,
     /// Passes per member and row.
     pub passes: usize,
+    /// Seed of the proposal ensemble; the same seed gives the same calibration.
     pub seed: u64,
     /// Range of the fitted μc mean (and of the proposal).
     pub mu_c_range: (f64, f64),
@@ -49,9 +50,13 @@ pub struct CalibrationSettings {
     pub pin_radius_sd: f64,
     /// The random support model (tripod or smooth).
     pub support: SupportChoice,
+    /// Standard deviation of the pose error added to θ0 on every pass (degrees).
     pub jitter_deg: f64,
+    /// The contact model.
     pub fidelity: Fidelity,
+    /// Integration tolerance per step.
     pub tol: f64,
+    /// How the prediction is scored against the measured bands.
     pub score: ScoreSettings,
 }
 
@@ -138,15 +143,21 @@ impl CalibrationSettings {
 /// One fitted parameter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Fitted {
+    /// The parameter's name.
     pub name: &'static str,
+    /// Its estimate: the searched grid's value at the likelihood's maximum.
     pub estimate: f64,
     /// 95% profile-likelihood interval.
     pub lo: f64,
+    /// Upper end of the 95% interval.
     pub hi: f64,
     /// The interval reaches the low / high end of the searched grid.
     pub open_low: bool,
+    /// The interval reaches the high end of the searched grid.
     pub open_high: bool,
+    /// Lowest value of the searched grid.
     pub grid_min: f64,
+    /// Highest value of the searched grid.
     pub grid_max: f64,
 }
 
@@ -162,9 +173,11 @@ impl Fitted {
 pub struct Calibration {
     /// μc mean, μc spread, support share, pin radius.
     pub parameters: Vec<Fitted>,
+    /// Log-likelihood (natural log) of the measured bands at the optimum.
     pub log_likelihood: f64,
     /// Effective members at the optimum, (Σw)²/Σw², out of `members`.
     pub effective_members: f64,
+    /// Members of the proposal ensemble.
     pub members: usize,
     /// Grid points evaluated.
     pub grid_points: usize,

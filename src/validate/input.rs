@@ -16,23 +16,36 @@ pub const MAX_MEMBERS: usize = 1_000_000;
 pub enum InputError {
     /// A member count (given by `flag`) outside [1, [`MAX_MEMBERS`]].
     #[error("{flag} must lie in [1, {MAX_MEMBERS}], got {members}")]
-    Members { flag: &'static str, members: usize },
+    Members {
+        /// The flag.
+        flag: &'static str,
+        /// The count given.
+        members: usize,
+    },
+    /// A μc outside its physical range.
     #[error("--mu-c must lie in {}, got {}", show(limits::MU_C), .0)]
     MuC(f64),
+    /// A pin radius that is negative or not finite.
     #[error("--pin-radius must be a finite number ≥ 0, got {0}")]
     PinRadius(f64),
     /// The uncertain parameters (`KEY=VALUE,...`) are refused.
     #[error("--uncertain: {0}")]
     Uncertain(String),
+    /// The measured-bands file is refused.
     #[error(transparent)]
     Measured(#[from] MeasuredError),
     /// The ensemble's largest pin radius exceeds [`limits::PIN_RADIUS_A`]·a of a part in the file.
     #[error("--pin-radius (or the largest pin_radius of --uncertain) must lie in [0, {}] for part {part} of {} (part units: at most {}·a, a = {}), got {}", num(*max), file.display(), limits::PIN_RADIUS_A, num(*a), num(*radius))]
     PinRadiusForPart {
+        /// The part spec.
         part: String,
+        /// The measured-bands file.
         file: PathBuf,
+        /// The part's circumradius a (part units).
         a: f64,
+        /// The largest pin radius allowed for it (part units).
         max: f64,
+        /// The pin radius given (part units).
         radius: f64,
     },
 }

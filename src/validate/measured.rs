@@ -35,10 +35,13 @@ pub const MAX_TRIALS: u32 = 1_000_000;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{}: {}{message}", self.place(), field.as_ref().map(|f| format!("field `{f}`: ")).unwrap_or_default())]
 pub struct MeasuredError {
+    /// The measured-bands file.
     pub file: PathBuf,
     /// 1-based line number (0: the file as a whole).
     pub line: usize,
+    /// The column at fault, if one.
     pub field: Option<String>,
+    /// What is wrong.
     pub message: String,
 }
 
@@ -57,20 +60,28 @@ impl MeasuredError {
 pub struct MeasuredRow {
     /// 1-based line in the file.
     pub line: usize,
+    /// The part spec (the `--part` given replaces the column).
     pub part: String,
+    /// Contact parameter d (units of a).
     pub d: f64,
+    /// How the part lies before the pass: a stable state, a θ0 arc or `all`.
     pub input: InputState,
     /// The measured band [min_deg, max_deg].
     pub band: Arc,
+    /// Start of the band, counter-clockwise (degrees, in [0, 360]).
     pub min_deg: f64,
+    /// End of the band (degrees, in [0, 360]; below `min_deg` the band straddles 0°).
     pub max_deg: f64,
+    /// How many trials the band summarises, if given (at most [`MAX_TRIALS`]).
     pub trials: Option<u32>,
 }
 
 /// A parsed file: its rows and the parts they name (compiled once each).
 #[derive(Debug, Clone)]
 pub struct Measured {
+    /// The file read.
     pub file: PathBuf,
+    /// Its measured bands, in file order.
     pub rows: Vec<MeasuredRow>,
     /// (part spec, polygon), in order of first appearance.
     pub parts: Vec<(String, Polygon)>,

@@ -15,7 +15,9 @@ use rayon::prelude::*;
 pub struct Predictions {
     /// θf (degrees) per row, index member · passes + q.
     pub rows: Vec<Vec<f64>>,
+    /// The members' draws, in member order.
     pub members: Vec<MemberDraw>,
+    /// Passes per member and row.
     pub passes: usize,
 }
 

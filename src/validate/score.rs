@@ -113,7 +113,7 @@ fn kernel_mass(theta: f64, arc: &Arc, h: f64) -> f64 {
 
 /// A row's likelihood as a function of the weights: each pass's contributions to the four sums.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RowKernel {
+pub(crate) struct RowKernel {
     /// n (the trial count; 2 when not given).
     pub n: u32,
     /// Widths (degrees) of the band widened by h/2 and of the window (360 without one).
@@ -122,12 +122,16 @@ pub struct RowKernel {
     /// Per pass: density at min (at the centre for n = 1), density at max, mass in the widened
     /// band, mass in the window.
     pub at_min: Vec<f64>,
+    /// Per pass: density at the band's max.
     pub at_max: Vec<f64>,
+    /// Per pass: mass in the widened band.
     pub in_band: Vec<f64>,
+    /// Per pass: mass in the window.
     pub in_window: Vec<f64>,
 }
 
 impl RowKernel {
+    /// The kernel of `row` for its passes' final orientations `values` (degrees).
     pub fn new(row: &MeasuredRow, values: &[f64], s: &ScoreSettings) -> RowKernel {
         let h = s.kernel_deg;
         let n = row.trials.unwrap_or(2);
@@ -190,12 +194,19 @@ impl RowKernel {
 /// The verdict on one measured row.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RowScore {
+    /// 1-based line in the measured-bands file.
     pub line: usize,
+    /// The part spec.
     pub part: String,
+    /// Contact parameter d (units of a).
     pub d: f64,
+    /// The input state, as written.
     pub input: String,
+    /// Start of the measured band (degrees).
     pub min_deg: f64,
+    /// End of the measured band (degrees).
     pub max_deg: f64,
+    /// Trials the band summarises, if given.
     pub trials: Option<u32>,
     /// The contained share is at least the threshold (the point estimate).
     pub contained: bool,
@@ -205,10 +216,13 @@ pub struct RowScore {
     pub contained_share_ci95: [f64; 2],
     /// The verdict with its uncertainty: contained, not_contained or undecided.
     pub containment: Verdict,
+    /// A predicted band shares an angle with the measured band.
     pub overlapping: bool,
     /// Measured centre minus the nearest predicted band's centre (degrees, signed).
     pub centre_offset_deg: Option<f64>,
+    /// Weighted share of the passes that end inside the measured band.
     pub predicted_probability: f64,
+    /// The row's log-likelihood (natural log; higher is better).
     pub log_score: f64,
     /// The row's predicted bands and the share of the circle they cover.
     pub predicted: PredictedBands,
@@ -227,6 +241,7 @@ pub enum Verdict {
 }
 
 impl Verdict {
+    /// The verdict for a contained share with 95% interval `ci95` against `threshold`.
     pub fn of(ci95: [f64; 2], threshold: f64) -> Verdict {
         if ci95[0] >= threshold {
             Verdict::Contained
@@ -236,6 +251,7 @@ impl Verdict {
             Verdict::Undecided
         }
     }
+    /// The verdict in the report's table (`yes`, `no`, `undecided`).
     pub fn label(self) -> &'static str {
         match self {
             Verdict::Contained => "yes",
@@ -248,6 +264,7 @@ impl Verdict {
 /// Counts and totals over all rows.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
+    /// Measured rows scored.
     pub rows: usize,
     /// Rows whose contained share is at least the threshold (point estimates).
     pub contained: usize,
@@ -255,14 +272,19 @@ pub struct Summary {
     pub contained_ci95: [usize; 2],
     /// Rows with verdict contained, not contained and undecided.
     pub verdict_contained: usize,
+    /// Rows with verdict not contained.
     pub verdict_not_contained: usize,
+    /// Rows with verdict undecided.
     pub verdict_undecided: usize,
     /// The threshold of the contained share.
     pub contained_share: f64,
+    /// Rows with a predicted band overlapping the measured one.
     pub overlapping: usize,
     /// Mean over rows of the share of the circle the predicted bands cover.
     pub coverage: f64,
+    /// Sum of the rows' log-likelihoods (natural log; higher is better).
     pub log_score: f64,
+    /// Mean log score per row (`log_score` over `rows`).
     pub mean_log_score: f64,
 }
 

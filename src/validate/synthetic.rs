@@ -20,11 +20,17 @@ pub const SYNTHETIC_SEED: u64 = 16;
 /// What to synthesise.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SyntheticDesign {
+    /// The part spec.
     pub part: String,
+    /// Contact parameters d of the rows (units of a).
     pub ds: Vec<f64>,
+    /// Input states of the rows (every d gets each).
     pub inputs: Vec<InputState>,
+    /// Trials per row.
     pub trials: u32,
+    /// The hidden ensemble the trials are drawn from.
     pub truth: EnsembleSpec,
+    /// Seed of the trials; the same seed gives the same data set.
     pub seed: u64,
 }
 
@@ -32,7 +38,9 @@ impl SyntheticDesign {
     /// The hidden parameters φ* = [μc mean, μc sd, tripod share, pin radius] and the known σρ
     /// and jitter of the bundled data set.
     pub const TRUTH: [f64; 4] = [0.45, 0.08, 0.6, 0.12];
+    /// The known σρ of the pin radius (part units).
     pub const PIN_RADIUS_SD: f64 = 0.03;
+    /// The known pose jitter (degrees).
     pub const JITTER_DEG: f64 = 3.0;
 }
 

@@ -8,6 +8,7 @@ use crate::geometry::{Pose, Vec2};
 /// Everything the animation shows (plain data; world frame, metres, seconds, radians).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Animation {
+    /// Title shown above the belt.
     pub title: String,
     /// m.
     pub belt_length: f64,
@@ -17,11 +18,15 @@ pub struct Animation {
     pub belt_speed: f64,
     /// The part's outline in its own frame (metres, centroid at the origin).
     pub outline: Vec<Vec2>,
+    /// The pins and fences.
     pub obstacles: Vec<AnimObstacle>,
+    /// The sample parts drawn (at most [`MAX_PARTS`]).
     pub parts: Vec<AnimPart>,
+    /// The timed labels (at most [`MAX_MARKS`]).
     pub marks: Vec<AnimMark>,
     /// Simulated time shown: [t_start, t_end] seconds.
     pub t_start: f64,
+    /// End of the simulated time shown (s).
     pub t_end: f64,
 }
 
@@ -29,15 +34,27 @@ pub struct Animation {
 #[derive(Debug, Clone, PartialEq)]
 pub enum AnimShape {
     /// A pin at `x` along the belt; its lateral position is the obstacle's `track`.
-    Pin { x: f64, radius: f64 },
+    Pin {
+        /// Position along the belt (m).
+        x: f64,
+        /// Radius (m).
+        radius: f64,
+    },
     /// A fence from `p0` to `p1`.
-    Fence { p0: Vec2, p1: Vec2 },
+    Fence {
+        /// One end (m).
+        p0: Vec2,
+        /// The other end (m).
+        p1: Vec2,
+    },
 }
 
 /// An obstacle and, for a pin, its lateral motion and raised state in time.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnimObstacle {
+    /// The obstacle's name in the scenario.
     pub name: String,
+    /// Its shape and place.
     pub shape: AnimShape,
     /// Does it carry a sensor?
     pub sensor: bool,
@@ -49,8 +66,11 @@ pub struct AnimObstacle {
 /// A sample part: its outcome and its world poses (time s, pose), in time order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnimPart {
+    /// Index of the part in the feed.
     pub part: u64,
+    /// How the part ended (its colour at the end).
     pub outcome: PartOutcome,
+    /// (time s, world pose: metres and radians), in time order.
     pub poses: Vec<(f64, Pose)>,
 }
 
@@ -68,6 +88,7 @@ pub enum MarkKind {
 }
 
 impl MarkKind {
+    /// Every kind, in legend order.
     pub const ALL: [MarkKind; 4] = [
         MarkKind::Reading,
         MarkKind::Decision,
@@ -101,7 +122,9 @@ pub struct AnimMark {
     pub t: f64,
     /// Where (world, m), usually the pin.
     pub at: Vec2,
+    /// What the mark reports (its colour).
     pub kind: MarkKind,
+    /// The label's text.
     pub text: String,
 }
 
@@ -126,9 +149,11 @@ pub const POSE_TOLERANCE_PX: f64 = 0.3;
 pub const END_HOLD_S: f64 = 1.5;
 /// A mark's label shows this long (animation seconds), then fades over [`MARK_FADE_S`].
 pub const MARK_SHOW_S: f64 = 1.8;
+/// How long a mark's label fades out (animation seconds).
 pub const MARK_FADE_S: f64 = 0.5;
 /// The loop lasts at least / at most this long (animation seconds), whatever the speed-up.
 pub const MIN_DURATION_S: f64 = 0.5;
+/// The loop's longest duration (animation seconds).
 pub const MAX_DURATION_S: f64 = 3600.0;
 
 /// Simulated seconds shown, at least a millisecond.

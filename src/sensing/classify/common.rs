@@ -34,6 +34,8 @@ pub struct Detector {
 }
 
 impl Detector {
+    /// The detector for `sensor`: the window grows with the noise (within fixed limits) so that the
+    /// threshold sits well above the smoothed noise.
     pub fn new(sensor: &SensorSettings) -> Detector {
         let sd = noise_var(sensor, 0).max(noise_var(sensor, 1)).sqrt();
         let want = (DETECT_SIGMAS * sd / sensor.threshold).powi(2).ceil();

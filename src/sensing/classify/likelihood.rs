@@ -66,6 +66,8 @@ struct Member {
     chunks: Vec<std::ops::Range<u32>>,
 }
 
+/// The `likelihood` classifier: a matched filter of the reading against the hypotheses' template
+/// ensembles under the sensor's noise model.
 pub struct Likelihood {
     /// Members' base vectors w/B · S_base, flat (member × dims).
     base: Vec<f64>,
@@ -83,6 +85,7 @@ pub struct Likelihood {
 }
 
 impl Likelihood {
+    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
     pub fn new(
         templates: &TemplateSet,
         sensor: &SensorSettings,

@@ -36,11 +36,14 @@ pub enum Decision {
 /// A decision and, where the method has one, the posterior over the hypotheses (sums to 1).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Classification {
+    /// The decision: a hypothesis or unknown.
     pub decision: Decision,
+    /// Posterior over the hypotheses (in label order, sums to 1); `None` for methods without one.
     pub posterior: Option<Vec<f64>>,
 }
 
 impl Classification {
+    /// No decision and no posterior.
     pub fn unknown() -> Classification {
         Classification {
             decision: Decision::Unknown,

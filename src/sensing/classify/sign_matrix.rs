@@ -42,6 +42,7 @@ pub const REGIONS: usize = 5;
 /// The 4 × 10 sign matrix (row-major).
 pub type SignMatrix = [[i8; 2 * REGIONS]; 4];
 
+/// The `sign-matrix` classifier: the thesis's sign patterns of the smoothed Fx and Fy profiles.
 pub struct SignMatrixClassifier {
     /// Per hypothesis, the members' sign matrices.
     matrices: Vec<Vec<SignMatrix>>,
@@ -109,6 +110,7 @@ pub fn score(a: &SignMatrix, b: &SignMatrix) -> usize {
 }
 
 impl SignMatrixClassifier {
+    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
     pub fn new(templates: &TemplateSet, sensor: &SensorSettings) -> Result<Self, String> {
         let thr = common::Detector::new(sensor);
         let mut matrices = Vec::new();

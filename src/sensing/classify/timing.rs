@@ -34,6 +34,7 @@ use crate::sensing::templates::TemplateSet;
 /// Floor (s) of the duration error's standard deviation.
 pub const FLOOR: f64 = 1e-6;
 
+/// The `timing` classifier: the reported contact durations against the templates' durations.
 pub struct Timing {
     /// Per hypothesis, per member: the durations a timing sensor reports without jitter.
     timing: Vec<Vec<Vec<f64>>>,
@@ -56,6 +57,7 @@ fn silverman_sq(v: &[f64]) -> f64 {
 }
 
 impl Timing {
+    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
     pub fn new(
         templates: &TemplateSet,
         sensor: &SensorSettings,

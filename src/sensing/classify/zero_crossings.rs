@@ -31,6 +31,8 @@ pub const VERTEX_CROSSINGS: usize = 3;
 /// Grid points over the contact at which the derivative's sign is examined.
 pub const GRID: usize = 2001;
 
+/// The `zero-crossings` classifier: vertex or edge contact by the zero crossings of a fitted force
+/// profile's slope.
 pub struct ZeroCrossings {
     vertex: usize,
     edge: usize,
@@ -65,6 +67,8 @@ fn profile(values: &[[f64; CHANNELS]], sensor: &SensorSettings) -> Option<Vec<f6
 }
 
 impl ZeroCrossings {
+    /// Train on `templates` for `sensor`; Err (the reason) when the labels are not `vertex` and
+    /// `edge` or the templates cannot be used.
     pub fn new(templates: &TemplateSet, sensor: &SensorSettings) -> Result<Self, String> {
         let find = |l: &str| templates.labels.iter().position(|x| x == l);
         match (find("vertex"), find("edge"), templates.labels.len()) {

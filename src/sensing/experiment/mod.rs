@@ -18,9 +18,11 @@ use crate::sensing::evaluate::{applicable, TruthDraw, MAX_TEMPLATES, MAX_TRIALS}
 use crate::sensing::templates::{Hypotheses, PushSetup, Uncertainty};
 use crate::sensing::{SensorKind, SensorSettings};
 
-/// Most noise factors, placement offsets, threads (hypotheses: [`Hypotheses::orientations`]).
+/// Most noise factors (`--noise`; for the most hypotheses see [`Hypotheses::orientations`]).
 pub const MAX_FACTORS: usize = 64;
+/// Most placement offsets (`--placement-d`).
 pub const MAX_PLACEMENT_D: usize = 201;
+/// Most threads (`--threads`; 0 means one per core).
 pub const MAX_THREADS: usize = 1024;
 
 /// Everything a sensing experiment is asked for, unchecked (the pin radius in part units, the
@@ -30,15 +32,25 @@ pub const MAX_THREADS: usize = 1024;
 pub struct Request {
     /// A part spec (`tripoly1`, `rect:W:H`, `vertices:…`).
     pub part: String,
+    /// Metres per part unit (in (0, 100]).
     pub scale: f64,
+    /// Part mass (kg, in (0, 1000]).
     pub mass: f64,
+    /// Belt speed (m/s, in (0, 100]).
     pub belt_speed: f64,
+    /// Lateral offset of the pin, d = (y_pin − y_com)/a (units of a; the pin must be able to touch
+    /// the part).
     pub d: f64,
+    /// Pin radius (part units, at most [`crate::mechanics::limits::PIN_RADIUS_A`]·a; 0: a point
+    /// pin).
     pub pin_radius: f64,
+    /// Pin–part friction coefficient μc (nominal; see `mu_c_range`).
     pub mu_c: f64,
+    /// Part–belt (support) friction coefficient μs.
     pub mu_s: f64,
     /// Fidelity name.
     pub model: String,
+    /// Integration tolerance per step of the contact model.
     pub tol: f64,
     /// `stable`, `vertex-edge` or degrees.
     pub hypotheses: String,
@@ -48,93 +60,159 @@ pub struct Request {
     pub sensor_kind: String,
     /// Classifier names (empty: the defaults for the sensor and hypotheses).
     pub classifiers: Vec<String>,
+    /// Classifiers decide "unknown" when their largest posterior is below this (in [0, 1]).
     pub reject_below: f64,
+    /// Noise factors of the sweep, each ≥ 0, applied to the sensor's nominal noise (1 to
+    /// [`MAX_FACTORS`] of them).
     pub noise: Vec<f64>,
     /// `LO:HI`.
     pub mu_c_range: Option<String>,
+    /// Draw a random tripod support per push instead of uniform pressure.
     pub tripod: bool,
+    /// Standard deviation of the orientation about each hypothesis (degrees, in [0, 180]).
     pub theta_jitter: f64,
+    /// Standard deviation of d (units of a, in [0, 1]).
     pub d_jitter: f64,
+    /// Templates per hypothesis (1 to [`MAX_TEMPLATES`]).
     pub templates: usize,
+    /// Trials: simulated pushes, each read at every sensor point and classified by every
+    /// classifier there (1 to [`MAX_TRIALS`]).
     pub trials: usize,
     /// `cycle` or `uniform`.
     pub truth: String,
+    /// Seed of the templates' and trials' random streams; the same seed gives the same report.
     pub seed: u64,
+    /// Worker threads (0: one per core; at most [`MAX_THREADS`]).
     pub threads: usize,
+    /// Also search the placement of the pin over `placement_d`.
     pub placement: bool,
+    /// Offsets d (units of a) the placement search tries (1 to [`MAX_PLACEMENT_D`]).
     pub placement_d: Vec<f64>,
 }
 
 /// A request that cannot be run (messages name the flags of `pinfeed sense`).
 #[derive(Debug, thiserror::Error)]
 pub enum SenseError {
+    /// A number outside its range.
     #[error(transparent)]
     Range(#[from] OutOfRange),
+    /// A quantity that must be positive and finite is not, or is too large.
     #[error("{flag} must be a finite number > 0 and at most {} ({what}), got {}", num(*hi), num(*value))]
     Positive {
+        /// The flag.
         flag: &'static str,
+        /// The value given.
         value: f64,
+        /// The largest value allowed.
         hi: f64,
+        /// The quantity's unit, in words.
         what: &'static str,
     },
+    /// A count outside [1, max].
     #[error("{flag} must lie in [1, {max}], got {value}")]
     Count {
+        /// The flag.
         flag: &'static str,
+        /// The largest count allowed.
         max: usize,
+        /// The count given.
         value: usize,
     },
+    /// More threads than [`MAX_THREADS`].
     #[error("--threads must lie in [0, {MAX_THREADS}] (0: one per core), got {0}")]
     Threads(usize),
+    /// A list with no entries or too many.
     #[error("{flag} takes 1 to {max} {unit}, got {value}")]
     ListLength {
+        /// The flag.
         flag: &'static str,
+        /// The most entries allowed.
         max: usize,
+        /// What the entries are, in words.
         unit: &'static str,
+        /// The number of entries given.
         value: usize,
     },
+    /// A word that is not one of the choices.
     #[error("{flag} must be {expected}, got '{got}'")]
     Choice {
+        /// The flag.
         flag: &'static str,
+        /// The choices, in words.
         expected: &'static str,
+        /// The word given.
         got: String,
     },
+    /// An unknown contact model (`--model`).
     #[error("--model: {0}")]
     Model(CaseError),
+    /// A sensor setting outside its range.
     #[error("--{}: {message}", field.replace('_', "-"))]
     Sensor {
+        /// The setting's field name (the flag is `--` and the name with dashes).
         field: &'static str,
+        /// Why it is refused.
         message: String,
     },
+    /// A sensor setting that leaves its range at one of the noise factors.
     #[error("--noise {}: the sensor's {field} leaves its range: {message}", num(*factor))]
     NoiseSensor {
+        /// The noise factor.
         factor: f64,
+        /// The setting's field name.
         field: &'static str,
+        /// Why it is refused.
         message: String,
     },
+    /// A part spec that names no part.
     #[error("--part '{spec}': {error}")]
     Part {
+        /// The spec given.
         spec: String,
+        /// Why it names no part.
         error: named::PartSpecError,
     },
+    /// A part whose model cannot be built (the reason).
     #[error("--part: {0}")]
     PartModel(String),
+    /// A hypothesis that is neither `stable`, `vertex-edge` nor a number of degrees.
     #[error("--hypotheses: '{0}' is not a number of degrees (or give stable or vertex-edge)")]
     HypothesisDegrees(String),
+    /// Hypotheses that cannot be told apart or built for the part.
     #[error("--hypotheses {spec}: {message}")]
-    Hypotheses { spec: String, message: String },
+    Hypotheses {
+        /// The `--hypotheses` value given.
+        spec: String,
+        /// Why it is refused.
+        message: String,
+    },
+    /// `--mu-c-range` without a colon.
     #[error("--mu-c-range must be LO:HI (e.g. 0.3:0.7), got '{0}'")]
     MuCRangeForm(String),
+    /// A bound of `--mu-c-range` that is not a number.
     #[error("--mu-c-range: '{0}' is not a number")]
     MuCRangeNumber(String),
+    /// `--mu-c-range` with LO above HI.
     #[error("--mu-c-range: LO must not exceed HI, got {}:{}", num(*lo), num(*hi))]
-    MuCRangeOrder { lo: f64, hi: f64 },
+    MuCRangeOrder {
+        /// The lower bound given.
+        lo: f64,
+        /// The upper bound given.
+        hi: f64,
+    },
+    /// A classifier name that is not in [`classify::NAMES`].
     #[error("--classifiers: unknown classifier '{name}'; known: {}", classify::NAMES.join(", "))]
-    UnknownClassifier { name: String },
+    UnknownClassifier {
+        /// The name given.
+        name: String,
+    },
+    /// A classifier listed twice.
     #[error("--classifiers: '{0}' is listed twice")]
     ClassifierTwice(String),
     /// A classifier asked for by name could not be trained at any sweep point.
     #[error("--classifiers: {0}")]
     Untrainable(String),
+    /// None of the classifiers could be trained.
     #[error("no classifier could be trained for these hypotheses and this sensor")]
     NoClassifier,
     /// The evaluation or the placement search failed.
@@ -144,15 +222,23 @@ pub enum SenseError {
 
 /// A request checked: the push, its part model, hypotheses, uncertainty, sensor and classifiers.
 pub struct Checked {
+    /// The part spec, as given.
     pub part_name: String,
+    /// The push: the part in metres, d, pin radius (m), frictions, model and tolerance.
     pub setup: PushSetup,
+    /// The part's model under uniform support.
     pub model: PartModel,
+    /// The hypotheses to tell apart.
     pub hyps: Hypotheses,
+    /// The declared uncertainty of μc, the support and the pose.
     pub unc: Uncertainty,
+    /// The sensor at noise factor 1.
     pub sensor: SensorSettings,
+    /// The classifiers to score: those named, or the defaults for the sensor and hypotheses.
     pub classifiers: Vec<String>,
     /// Classifiers named by the request (not the defaults).
     pub explicit: bool,
+    /// How each trial's hypothesis is chosen.
     pub truth: TruthDraw,
 }
 

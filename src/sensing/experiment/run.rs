@@ -16,24 +16,33 @@ use std::sync::Mutex;
 /// The declared uncertainty, as reported.
 #[derive(Debug, Serialize)]
 pub struct UncertaintyReport {
+    /// The distribution of μc, in words.
     pub mu_c: String,
+    /// A random tripod support per push.
     pub tripod: bool,
+    /// Standard deviation of the orientation (degrees).
     pub theta_jitter_deg: f64,
+    /// Standard deviation of d (units of a).
     pub d_jitter: f64,
 }
 
 /// A default classifier that could not be trained here, and why.
 #[derive(Debug, Serialize, Clone)]
 pub struct Skipped {
+    /// The classifier's name.
     pub classifier: String,
+    /// Why it could not be trained.
     pub reason: String,
 }
 
 /// A classifier that could not be trained at one sweep point, and why.
 #[derive(Debug, Serialize, Clone)]
 pub struct Untrained {
+    /// The classifier's name.
     pub classifier: String,
+    /// The noise factor of the sweep point.
     pub noise_factor: f64,
+    /// Why it could not be trained there.
     pub reason: String,
 }
 
@@ -42,30 +51,51 @@ pub struct Untrained {
 pub struct SenseReport {
     /// The command that regenerates this report.
     pub command: String,
+    /// The part spec, as given.
     pub part: String,
+    /// Metres per part unit.
     pub scale_m_per_unit: f64,
     /// The part's circumradius a (m).
     pub a_m: f64,
+    /// Part mass (kg).
     pub mass_kg: f64,
+    /// Belt speed (m/s).
     pub belt_speed_m_s: f64,
+    /// Lateral offset of the pin (units of a).
     pub d: f64,
+    /// Pin radius (m).
     pub pin_radius_m: f64,
+    /// Pin–part friction μc (nominal).
     pub mu_c: f64,
+    /// Part–belt friction μs.
     pub mu_s: f64,
+    /// The contact model's fidelity name.
     pub model: String,
+    /// The hypotheses told apart.
     pub hypotheses: Hypotheses,
+    /// The sensor at noise factor 1.
     pub sensor: SensorSettings,
+    /// The declared uncertainty.
     pub uncertainty: UncertaintyReport,
+    /// Templates built per hypothesis (asked for).
     pub templates_per_hypothesis: usize,
+    /// Trials: simulated pushes, each read at every sensor point.
     pub trials: usize,
+    /// How each trial's hypothesis is chosen.
     pub truth: TruthDraw,
+    /// Seed of the random streams.
     pub seed: u64,
+    /// The noise factors of the sweep.
     pub noise_factors: Vec<f64>,
+    /// The classifiers reported (those asked for, less the skipped).
     pub classifiers: Vec<String>,
+    /// Default classifiers that could be trained nowhere, left out.
     pub skipped: Vec<Skipped>,
     /// Sweep points where a classifier could not be trained (it decided "unknown" there).
     pub untrained: Vec<Untrained>,
+    /// The scores of every classifier at every noise factor.
     pub evaluation: Evaluation,
+    /// The placement search's result, when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub placement: Option<Placement>,
 }
@@ -85,20 +115,27 @@ impl Classifier for Placeholder {
 /// The noise sweep evaluated: the templates, the cells of the classifiers kept, and the ones
 /// skipped (trainable nowhere) or untrained at some sweep points.
 pub struct Evaluated {
+    /// The templates of every hypothesis.
     pub templates: TemplateSet,
+    /// The scores of the classifiers kept.
     pub evaluation: Evaluation,
     /// The classifiers reported (the ones asked for less the skipped).
     pub classifiers: Vec<String>,
+    /// Default classifiers trainable nowhere, left out.
     pub skipped: Vec<Skipped>,
+    /// Classifiers that could not be trained at some sweep points.
     pub untrained: Vec<Untrained>,
 }
 
 /// The noise sweep as evaluated, with the classifiers that could not be trained at some points.
 pub struct Sweep {
+    /// The templates of every hypothesis.
     pub templates: TemplateSet,
+    /// The scores of every classifier at every sweep point.
     pub evaluation: Evaluation,
     /// (classifier, sensor point, reason) per failed training.
     pub failures: Vec<(String, SensorSettings, String)>,
+    /// The sweep points (noise factor, sensor, classifiers).
     pub points: Vec<SensorPoint>,
 }
 

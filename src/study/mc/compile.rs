@@ -75,7 +75,11 @@ pub const SENSOR_PARAMETERS: [&str; 4] = [
 /// A swept parameter and its values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepAxis {
+    /// `NAME` (the parameter fixed at each value) or `NAME.FIELD` (one field of its distribution,
+    /// e.g. `shape.sd`).
     pub parameter: String,
+    /// The values the parameter takes, in order (1 to 1000 of them, each finite), in the
+    /// parameter's own unit.
     pub values: Vec<f64>,
 }
 

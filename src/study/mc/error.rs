@@ -12,7 +12,9 @@ pub enum StudyError {
     /// (The cause is in the message, not a `source`, so that it is printed once.)
     #[error("{}: cannot read the study: {error}", path.display())]
     Io {
+        /// The study file.
         path: PathBuf,
+        /// Why it could not be read.
         error: std::io::Error,
     },
     /// A located problem in the study file (file:line:column, key, what is allowed).
@@ -24,21 +26,32 @@ pub enum StudyError {
     /// A sample could not be drawn (e.g. a shape tolerance so large that no valid polygon comes out).
     #[error("sample {sample} of sweep point {point}: {reason}")]
     Sample {
+        /// Index of the sweep point (0-based).
         point: usize,
+        /// Index of the sample within its sweep point (0-based).
         sample: u64,
+        /// Why no valid sample came out.
         reason: String,
     },
     /// The line engine refused a sample.
     #[error("sample {sample} of sweep point {point}: {source}")]
     Engine {
+        /// Index of the sweep point (0-based).
         point: usize,
+        /// Index of the sample within its sweep point (0-based).
         sample: u64,
+        /// What the engine refused.
         #[source]
         source: EngineError,
     },
     /// The worker threads could not be started.
     #[error("cannot start {threads} worker threads: {reason}")]
-    Threads { threads: usize, reason: String },
+    Threads {
+        /// The number of threads asked for.
+        threads: usize,
+        /// Why the thread pool could not be built.
+        reason: String,
+    },
     /// A shard file or a set of shard files that cannot be used.
     #[error("{0}")]
     Shard(String),

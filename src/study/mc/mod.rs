@@ -66,9 +66,12 @@ pub struct Study {
     pub scenario_file: PathBuf,
     /// The nominal line.
     pub scene: Scene,
+    /// Seed of the study's random streams: sample i draws only from streams derived from (seed, i),
+    /// so the same seed gives the same samples.
     pub seed: u64,
     /// Samples per sweep point.
     pub samples: u64,
+    /// The swept parameters (none, one or two), in the order declared; the first varies slowest.
     pub axes: Vec<SweepAxis>,
     /// Parameter values of each point (one per axis), first axis slowest.
     pub point_values: Vec<Vec<f64>>,

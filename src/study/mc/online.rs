@@ -25,10 +25,12 @@ pub struct OnlineSample {
     pub predicted_micro: u64,
     /// Entropy of the belief before any observation and at the decision (millionths of a bit).
     pub entropy_prior_microbits: u64,
+    /// Entropy of the belief at the decision (millionths of a bit).
     pub entropy_posterior_microbits: u64,
     /// The part's true stable state is known to the simulator, and the belief's most probable
     /// state was it.
     pub state_known: bool,
+    /// The belief's most probable state was the true one (meaningful only when `state_known`).
     pub state_correct: bool,
 }
 
@@ -51,9 +53,11 @@ impl OnlineSample {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BinTally {
+    /// Decisions whose prediction fell in this bin.
     pub parts: u64,
     /// Σ predicted, in millionths.
     pub predicted_micro: u64,
+    /// Of those, the parts that ended in the goal.
     pub successes: u64,
 }
 
@@ -63,12 +67,17 @@ pub struct BinTally {
 pub struct OnlineTally {
     /// Samples whose part reached a decision, and those that ended in the goal.
     pub decisions: u64,
+    /// Of the decisions, the samples that ended in the goal.
     pub successes: u64,
     /// Σ predicted (millionths) and Σ entropies (millionths of a bit) over the decisions.
     pub predicted_micro: u64,
+    /// Σ entropy of the belief before any observation (millionths of a bit).
     pub entropy_prior_microbits: u64,
+    /// Σ entropy of the belief at the decision (millionths of a bit).
     pub entropy_posterior_microbits: u64,
+    /// Decisions whose part's true stable state is known to the simulator.
     pub state_known: u64,
+    /// Of those, the decisions whose most probable state was the true one.
     pub state_correct: u64,
     /// Per bin of the prediction ([`BINS`] of them).
     pub bins: Vec<BinTally>,
@@ -191,13 +200,17 @@ pub struct OnlineShare {
     /// Mean predicted success of the chosen commands, and the share of those parts that ended in
     /// the goal (95% Wilson interval).
     pub predicted_mean: f64,
+    /// Share of the decisions whose part ended in the goal, in [0, 1].
     pub observed: f64,
+    /// 95% Wilson interval of `observed`, [low, high].
     pub observed_ci95: [f64; 2],
     /// Mean entropy of the belief before any observation and at the decision (bits).
     pub entropy_prior_bits: f64,
+    /// Mean entropy of the belief at the decision (bits).
     pub entropy_posterior_bits: f64,
     /// Decisions whose most probable stable state was the true one, of those with a known state.
     pub state_correct: u64,
+    /// Decisions whose part's true stable state is known to the simulator.
     pub state_known: u64,
     /// Predicted against observed in bins of the prediction (empty bins left out).
     pub calibration: Vec<CalibrationBin>,

@@ -15,38 +15,50 @@ pub struct Perturbations {
     pub belt_speed: Option<Distribution>,
     /// Error of each vertex coordinate (m).
     pub shape: Option<Distribution>,
-    /// Errors of each pin's x, y and radius (m).
+    /// Error added to each pin's x (m).
     pub pin_x: Option<Distribution>,
+    /// Error added to each pin's y (m).
     pub pin_y: Option<Distribution>,
+    /// Error added to each pin's radius (m).
     pub pin_radius: Option<Distribution>,
-    /// Error of the entry orientation (degrees) and lateral offset (m).
+    /// Error added to the entry orientation (degrees).
     pub pose_theta: Option<Distribution>,
+    /// Error added to the entry lateral offset (m).
     pub pose_y: Option<Distribution>,
-    /// Sensor pins (one draw per sample, applied to every sensor pin): factor on the white-noise
-    /// σ and timing jitter, error added to the force bias (N), the timing threshold (N), error
-    /// added to the timing jitter (s).
+    /// Factor on every sensor's white-noise σ and timing jitter (one draw per sample, applied to
+    /// every sensor pin).
     pub sensor_noise: Option<Distribution>,
+    /// Error added to every sensor's force bias (N, each force channel).
     pub sensor_bias: Option<Distribution>,
+    /// Every sensor's timing threshold (N, its value).
     pub sensor_threshold: Option<Distribution>,
+    /// Error added to every sensor's timing jitter (s).
     pub sensor_jitter: Option<Distribution>,
-    /// Fences: μf (one draw per sample, at every fence it reaches), errors of each fence's angle
-    /// (degrees), upstream end x and y and length (m), drawn per fence.
+    /// Fence–part friction μf (one draw per sample, at every fence it reaches).
     pub fence_mu_f: Option<Distribution>,
+    /// Error added to each fence's angle (degrees), drawn per fence.
     pub fence_angle: Option<Distribution>,
+    /// Error added to each fence's upstream end x (m), drawn per fence.
     pub fence_x: Option<Distribution>,
+    /// Error added to each fence's upstream end y (m), drawn per fence.
     pub fence_y: Option<Distribution>,
+    /// Error added to each fence's length (m), drawn per fence.
     pub fence_length: Option<Distribution>,
-    /// Dynamic pins, drawn per pin: factors on the speed (a moving pin's limit, a retractable
-    /// pin's raise and lower rates) and on a moving pin's acceleration limit, error added to a
-    /// moving pin's settle time (s). The controller: error added to its latency (s), one draw.
+    /// Factor on each dynamic pin's speed (a moving pin's limit, a retractable pin's raise and
+    /// lower rates), drawn per pin.
     pub actuator_speed: Option<Distribution>,
+    /// Factor on each moving pin's acceleration limit, drawn per pin.
     pub actuator_accel: Option<Distribution>,
+    /// Error added to each moving pin's settle time (s), drawn per pin.
     pub actuator_settle: Option<Distribution>,
+    /// Error added to the controller's latency (s), one draw per sample.
     pub controller_latency: Option<Distribution>,
     /// The obstacles a fence or actuator parameter is restricted to (`fences = [...]`,
     /// `pins = [...]`), by parameter name; a parameter absent here reaches every obstacle it
     /// applies to.
     pub only: BTreeMap<String, Vec<String>>,
+    /// How the part's weight rests on the belt (uniform, a random tripod or a random smooth
+    /// density).
     pub support: SupportChoice,
 }
 

@@ -20,12 +20,19 @@ pub const END: &str = "<!-- mc-precision:end -->";
 /// One measured sample count.
 #[derive(Debug, Clone, Serialize)]
 pub struct PrecisionRow {
+    /// Samples run (the requested count, capped at the study's samples per point).
     pub samples: u64,
+    /// Samples that ended in success.
     pub successes: u64,
+    /// Success rate, `successes / samples`.
     pub rate: f64,
+    /// 95% Wilson interval of the rate, [low, high].
     pub ci95: [f64; 2],
+    /// Half the width of `ci95`.
     pub half_width: f64,
+    /// Fastest wall time of the repeats (s).
     pub wall_s: f64,
+    /// Samples per second of the fastest repeat.
     pub samples_per_s: f64,
 }
 
@@ -77,11 +84,13 @@ pub fn samples_for(p: f64, h: f64) -> f64 {
 pub struct Conditions {
     /// Samples/s of the largest count on 1 and on 2 threads.
     pub one_thread: f64,
+    /// Samples/s of the largest count on 2 threads.
     pub two_threads: f64,
     /// Timed runs per count (the fastest is kept).
     pub repeats: usize,
     /// 1-minute load average before and after.
     pub load_before: String,
+    /// 1-minute load average after the measurement.
     pub load_after: String,
 }
 

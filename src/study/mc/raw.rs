@@ -34,8 +34,10 @@ pub struct RawStudy {
     pub seed: Option<u64>,
     /// Samples per sweep point (default 1000).
     pub samples: Option<u64>,
+    /// `[uncertain]`: the uncertain parameters (none by default).
     #[serde(default)]
     pub uncertain: RawUncertain,
+    /// `[[sweep]]`: the swept parameters (none by default).
     #[serde(default)]
     pub sweep: Vec<RawSweep>,
 }
@@ -76,6 +78,7 @@ pub struct RawUncertain {
     pub fence_angle: Option<RawDistribution>,
     /// Errors added to each fence's upstream end, x and y (m), drawn per fence.
     pub fence_x: Option<RawDistribution>,
+    /// Error added to each fence's upstream end y (m), drawn per fence.
     pub fence_y: Option<RawDistribution>,
     /// Error added to each fence's length (m), drawn per fence.
     pub fence_length: Option<RawDistribution>,
@@ -94,9 +97,13 @@ pub struct RawUncertain {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DistributionKind {
+    /// Always `value`.
     Fixed,
+    /// Uniform on [min, max].
     Uniform,
+    /// Normal with `mean` and `sd`, optionally truncated to [min, max].
     Normal,
+    /// Triangular on [min, max] with its peak at `mode`.
     Triangular,
 }
 
@@ -105,12 +112,19 @@ pub enum DistributionKind {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawDistribution {
+    /// The kind of distribution (required).
     pub distribution: Option<DistributionKind>,
+    /// `fixed`: the value.
     pub value: Option<f64>,
+    /// `uniform`, `triangular`: the lower end; `normal`: optional lower truncation.
     pub min: Option<f64>,
+    /// `uniform`, `triangular`: the upper end; `normal`: optional upper truncation.
     pub max: Option<f64>,
+    /// `normal`: the mean.
     pub mean: Option<f64>,
+    /// `normal`: the standard deviation.
     pub sd: Option<f64>,
+    /// `triangular`: the peak, between `min` and `max`.
     pub mode: Option<f64>,
     /// Fence parameters only: the fences (by name) it perturbs (default: every fence).
     pub fences: Option<Vec<String>>,
@@ -135,6 +149,7 @@ pub enum SupportModel {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSupport {
+    /// The support model (required).
     pub model: Option<SupportModel>,
     /// Smooth: number of Gaussian bumps (default 3).
     pub bumps: Option<f64>,
@@ -151,9 +166,14 @@ pub struct RawSupport {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSweep {
+    /// `NAME` or `NAME.FIELD` of the swept parameter.
     pub parameter: String,
+    /// The values, listed (or give `from`, `to` and `steps`).
     pub values: Option<Vec<f64>>,
+    /// First value of an evenly spaced sweep.
     pub from: Option<f64>,
+    /// Last value of an evenly spaced sweep (included).
     pub to: Option<f64>,
+    /// Number of values of an evenly spaced sweep, ends included.
     pub steps: Option<u32>,
 }

@@ -15,16 +15,28 @@ use std::collections::BTreeMap;
 /// Everything about a study a report needs besides the counts; stored in every shard.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StudyHeader {
+    /// The study's name (its report folder).
     pub study: String,
+    /// The study file, as given.
     pub study_file: String,
+    /// The scenario file, resolved against the study file's folder.
     pub scenario_file: String,
+    /// The scenario's name.
     pub scenario: String,
+    /// The contact model the samples run (`exact`, `map`, … with the reason when the map tier is
+    /// off).
     pub fidelity: String,
+    /// Content hash of the study (hex).
     pub study_hash: String,
+    /// Content hash of the scenario (hex).
     pub scenario_hash: String,
+    /// Version of pinfeed that ran the study.
     pub pinfeed_version: String,
+    /// Seed of the study's random streams.
     pub seed: u64,
+    /// Samples per sweep point.
     pub samples_per_point: u64,
+    /// The swept parameters and their values.
     pub sweep: Vec<SweepOut>,
     /// Parameter values of each point (one per swept parameter).
     pub points: Vec<Vec<f64>>,
@@ -65,7 +77,9 @@ fn fidelity(study: &Study) -> String {
 /// A swept parameter in the report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepOut {
+    /// `NAME` or `NAME.FIELD` of the swept parameter.
     pub parameter: String,
+    /// Its values, in order.
     pub values: Vec<f64>,
 }
 
@@ -126,17 +140,24 @@ impl StudyHeader {
 /// A share with its 95% Wilson interval.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Share {
+    /// Samples of this class.
     pub count: u64,
+    /// `count` / samples, in [0, 1].
     pub rate: f64,
+    /// 95% Wilson interval of the rate, [low, high].
     pub ci95: [f64; 2],
 }
 
 /// Latency quantiles (s).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Latency {
+    /// Median.
     pub p50: f64,
+    /// 90th percentile.
     pub p90: f64,
+    /// 99th percentile.
     pub p99: f64,
+    /// Largest latency.
     pub max: f64,
 }
 
@@ -149,6 +170,7 @@ pub struct SensorShare {
     pub correct: u64,
     /// correct / readings (0 without readings), with its 95% Wilson interval.
     pub accuracy: f64,
+    /// 95% Wilson interval of the accuracy, [low, high].
     pub ci95: [f64; 2],
 }
 
@@ -157,16 +179,23 @@ pub struct SensorShare {
 pub struct PointReport {
     /// Swept parameter → value.
     pub values: BTreeMap<String, f64>,
+    /// Samples drawn at this point.
     pub samples: u64,
+    /// Count per outcome class.
     pub outcomes: OutcomeCounts,
+    /// Share of samples that ended in success, in [0, 1].
     pub success_rate: f64,
+    /// 95% Wilson interval of the success rate, [low, high].
     pub success_ci95: [f64; 2],
     /// Every class's share with its interval.
     pub shares: BTreeMap<String, Share>,
+    /// Mean pin encounters per sample.
     pub contacts_per_part: f64,
     /// Of the parts that reached the end of the belt.
     pub latency_s: Option<Latency>,
+    /// Perturbed polygons redrawn because they were invalid.
     pub shape_redraws: u64,
+    /// Other values redrawn because they left their domain.
     pub other_redraws: u64,
     /// Sensor accuracy; only when the line has sensor pins.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -181,11 +210,14 @@ pub struct PointReport {
 pub struct McReport {
     /// [`crate::SCHEMA_VERSION`] (the header carries `pinfeed_version`).
     pub schema_version: u32,
+    /// The study's description, flattened into the report.
     #[serde(flatten)]
     pub header: StudyHeader,
     /// What one sample is.
     pub sample: String,
+    /// Samples over every sweep point.
     pub total_samples: u64,
+    /// One entry per sweep point, in point order.
     pub results: Vec<PointReport>,
 }
 

@@ -79,6 +79,7 @@ pub const MAX_SHAPE_REDRAWS: u32 = 1000;
 /// What one sample produced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SampleResult {
+    /// The class the part ended in.
     pub outcome: PartOutcome,
     /// Pin encounters (pushes).
     pub contacts: u32,
@@ -90,6 +91,7 @@ pub struct SampleResult {
     pub other_redraws: u32,
     /// Readings taken by the line's sensor pins, and those decided correctly (0 without sensors).
     pub sensor_readings: u32,
+    /// Of those readings, the ones decided correctly.
     pub sensor_correct: u32,
     /// The online controller's decision on the part (None without one, or without a decision).
     pub online: Option<super::online::OnlineSample>,
@@ -134,6 +136,7 @@ struct ObstacleStreams {
 /// Sub-streams a sample seeds without fence and actuator parameters (the 14 parameter streams
 /// and the feed's and readings' seeds count as one each), and with them.
 pub const BASE_STREAMS: u32 = 15;
+/// Further sub-streams a sample seeds when a point declares fence or actuator parameters.
 pub const OBSTACLE_STREAMS: u32 = 9;
 
 impl Streams {
@@ -204,7 +207,9 @@ impl Streams {
 pub struct DrawnScene {
     /// The perturbed line with a one-part feed at the drawn pose.
     pub scene: Scene,
+    /// Perturbed polygons redrawn because they were invalid.
     pub shape_redraws: u32,
+    /// Other values redrawn because they left their domain.
     pub other_redraws: u32,
     /// The seed to run the scene with: it draws the sensor readings' noise (0 when the line has
     /// no sensor pin, as before sensors existed).

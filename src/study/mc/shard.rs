@@ -34,7 +34,9 @@ pub const FORMAT_VERSION: u32 = 1;
 /// Which shard to run: index k of n.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ShardSpec {
+    /// k, the 0-based index of this shard (k < n).
     pub index: u64,
+    /// n, the number of shards.
     pub count: u64,
 }
 
@@ -112,12 +114,17 @@ fn from_scheduler(env: &dyn Fn(&str) -> Option<String>) -> Result<u64, String> {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShardPoint {
+    /// Index of the sweep point (0-based).
     pub point: usize,
+    /// Samples of this point run in this shard.
     pub samples: u64,
     /// Count per outcome class (every class listed).
     pub outcomes: BTreeMap<String, u64>,
+    /// Pin encounters, summed over the samples.
     pub contacts: u64,
+    /// Perturbed polygons redrawn because they were invalid.
     pub shape_redraws: u64,
+    /// Other values redrawn because they left their domain.
     pub other_redraws: u64,
     /// Latency histogram (µs), HdrHistogram V2 serialisation, base64.
     pub latency_us_hdr_v2: String,
@@ -125,6 +132,7 @@ pub struct ShardPoint {
     /// the same shard files as before sensors existed).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub sensor_readings: u64,
+    /// Of those readings, the ones decided correctly.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub sensor_correct: u64,
     /// An online controller's counts; left out without decisions.
@@ -140,7 +148,9 @@ fn is_zero<T: Default + PartialEq>(n: &T) -> bool {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShardId {
+    /// 0-based index of the shard (less than `count`).
     pub index: u64,
+    /// Number of shards the study was split into.
     pub count: u64,
 }
 
@@ -152,14 +162,20 @@ pub struct ShardFile {
     /// shards written before they were added: such a file keeps its checksum and merges as before).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub schema_version: u32,
+    /// Version of the binary that wrote the shard (empty in older shards).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub pinfeed_version: String,
+    /// Always [`FORMAT`].
     pub format: String,
+    /// [`FORMAT_VERSION`] of the writer.
     pub format_version: u32,
+    /// The study the shard belongs to: every shard of a merge must have the same one.
     pub header: StudyHeader,
+    /// Which shard this file holds.
     pub shard: ShardId,
     /// Global sample range [start, end).
     pub samples: [u64; 2],
+    /// Counts of each sweep point the shard's range touches.
     pub points: Vec<ShardPoint>,
     /// FNV-1a of the file's content with this field empty ([`ShardFile::content_checksum`]):
     /// `merge` refuses a shard whose content was edited or damaged. Not cryptographic: it catches

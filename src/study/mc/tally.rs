@@ -10,17 +10,22 @@ use hdrhistogram::Histogram;
 /// Counts of one sweep point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointTally {
+    /// Samples counted.
     pub samples: u64,
+    /// Count per outcome class.
     pub outcomes: OutcomeCounts,
     /// Pin encounters, summed over the samples.
     pub contacts: u64,
+    /// Perturbed polygons redrawn because they were invalid.
     pub shape_redraws: u64,
+    /// Other values redrawn because they left their domain.
     pub other_redraws: u64,
     /// Entry → exit of the parts that reached the end of the belt (µs).
     pub latency_us: Histogram<u64>,
     /// Sensor readings (passes against sensor pins) and those decided correctly, summed over
     /// the samples and the line's sensor pins (0 without sensors).
     pub sensor_readings: u64,
+    /// Of those readings, the ones decided correctly.
     pub sensor_correct: u64,
     /// What an online controller decided and predicted (empty without one).
     pub online: OnlineTally,

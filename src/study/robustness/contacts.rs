@@ -22,6 +22,7 @@ use crate::random::ChaCha8Rng;
 use rand::RngExt;
 use std::f64::consts::TAU;
 
+/// What a case of the contacts target is (in the fuzz report).
 pub const DESCRIPTION: &str = "random star polygons (3–12 vertices at sorted random angles, radii in [0.1, 1]), μc ∈ [0, 2], d ∈ [−1.2, 1.2], θ0 ∈ [0°, 360°), half point pins and half disc pins of radius up to 0.3·a; half the pins still, half moving across the belt at |w| log-uniform in [0.01, 10] belt speeds (either sign), a third of those moving throughout, a third stopping S ∈ (0, 3]·a after the start, a third T ∈ [0, 2]·a after the first touch; each pushed at the default tolerance and at a 1000× tighter one";
 
 /// The tighter tolerance: the default 1e-6 divided by 1000, written exactly as the reproducer's
@@ -35,19 +36,25 @@ pub const SELF_CHECK_DEG: f64 = 1.0;
 /// How a generated pin moves across the belt.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Motion {
+    /// A still pin.
     Still,
     /// Lateral speed w (belt speeds), moving throughout.
     Moving {
+        /// Lateral speed, in belt speeds (either sign).
         w: f64,
     },
     /// Moving at w, stopping after S units of a of belt travel from the start.
     StopAfter {
+        /// Lateral speed, in belt speeds (either sign).
         w: f64,
+        /// Belt travel from the start after which the pin stops, in units of a.
         s: f64,
     },
     /// Moving at w, stopping T units of a of belt travel after the first touch.
     StopAfterTouch {
+        /// Lateral speed, in belt speeds (either sign).
         w: f64,
+        /// Belt travel after the first touch after which the pin stops, in units of a.
         t: f64,
     },
 }
@@ -71,10 +78,6 @@ impl Motion {
                 t: round6(2.0 * rng.random::<f64>()),
             },
         }
-    }
-
-    pub fn is_moving(&self) -> bool {
-        !matches!(self, Motion::Still)
     }
 
     /// The kind of case in the report.
@@ -125,12 +128,18 @@ impl Motion {
 /// One generated contact.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactCase {
+    /// The part's vertices (part units, counter-clockwise star polygon).
     pub vertices: Vec<Vec2>,
+    /// Entry orientation of the part (degrees, in [0, 360)).
     pub theta0_deg: f64,
+    /// Lateral offset of the pin against the part, in units of a (in [−1.2, 1.2]), as `pinfeed
+    /// contact --d`.
     pub d: f64,
+    /// Pin–part friction coefficient μc (in [0, 2]).
     pub mu_c: f64,
     /// Pin radius in part units (0: a point pin).
     pub pin_radius: f64,
+    /// How the pin moves across the belt.
     pub motion: Motion,
 }
 

@@ -22,7 +22,9 @@ use crate::study::mc::{self, StudyError};
 use rand::RngExt;
 use std::path::{Path, PathBuf};
 
+/// What a case of the scenarios target is (in the fuzz report).
 pub const SCENARIO_DESCRIPTION: &str = "the bundled scenarios/*.toml and tests/fixtures/scenarios/*.toml, three times in four a bundled one, with 1–4 text mutations (one half the time) (numbers set to extremes: 0, negatives, 5e-324, 1e-200, 1e308, nan, ±inf, huge integers, or scaled by 10^±k; known keys set to extremes or inserted; lines deleted, duplicated or swapped; keys renamed; types changed; sections dropped; truncation), parsed, compiled and run for at most 3 parts";
+/// What a case of the studies target is (in the fuzz report).
 pub const STUDY_DESCRIPTION: &str = "the bundled studies/*.toml and tests/fixtures/studies/*.toml, mutated as the scenarios are (plus [uncertain.*] tables, sweeps and the scenario path), parsed, compiled and run for 3 samples at the first and last sweep points";
 
 /// Parts run per accepted scenario (bounded: a case never runs a whole feed).
@@ -159,45 +161,64 @@ fn special_values(key: &str) -> &'static [&'static str] {
 pub enum Mutation {
     /// Replace numeric token `which` by `EXTREMES[value]`.
     Number {
+        /// Index of the numeric token (modulo their number).
         which: usize,
+        /// Index into `EXTREMES` of the new value (modulo their number).
         value: usize,
     },
     /// Multiply numeric token `which` by 10^power (written as `{token}e{power}` when possible).
     Scale {
+        /// Index of the numeric token (modulo their number).
         which: usize,
+        /// Power of ten to multiply by.
         power: i32,
     },
     /// Set `KNOWN_KEYS[key]` to value `value` (an extreme, or a word or list for such keys).
     SetKey {
+        /// Index into `KNOWN_KEYS` of the key.
         key: usize,
+        /// Picks the value (modulo the candidates for the key).
         value: usize,
     },
+    /// Delete line `which`.
     DeleteLine {
+        /// Index of the line (modulo the number of lines).
         which: usize,
     },
+    /// Insert a second copy of line `which`.
     DuplicateLine {
+        /// Index of the line (modulo the number of lines).
         which: usize,
     },
+    /// Swap lines `a` and `b`.
     SwapLines {
+        /// Index of the first line (modulo the number of lines).
         a: usize,
+        /// Index of the second line (modulo the number of lines).
         b: usize,
     },
     /// Rename the key on key line `which` (`how` picks: a suffix, another known key, upper case).
     RenameKey {
+        /// Index of the key line (modulo their number).
         which: usize,
+        /// Picks the new name.
         how: usize,
     },
     /// Replace the value on key line `which` by another type (`kind` picks string, bool, list, table).
     ChangeType {
+        /// Index of the key line (modulo their number).
         which: usize,
+        /// Picks the new type.
         kind: usize,
     },
     /// Drop the section starting at header `which` (the header and its lines).
     DropSection {
+        /// Index of the section header (modulo their number).
         which: usize,
     },
     /// Keep the first `permille`/1000 of the file.
     Truncate {
+        /// Thousandths of the file kept, in [0, 1000).
         permille: u32,
     },
 }
@@ -473,7 +494,9 @@ pub fn apply(text: &str, m: &Mutation) -> String {
 /// The seed files: (path, text), read from the project root.
 #[derive(Debug, Clone)]
 pub struct Seeds {
+    /// The seed scenarios: (path, text).
     pub scenarios: Vec<(PathBuf, String)>,
+    /// The seed studies: (path, text).
     pub studies: Vec<(PathBuf, String)>,
 }
 

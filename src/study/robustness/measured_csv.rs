@@ -86,31 +86,51 @@ const TRIALS: [&str; 7] = ["1", "0", "2", "1000000", "1000001", "-1", "1.5"];
 pub enum CsvMutation {
     /// Set field `col` of data row `row` to a value of the column's kind (`value` picks it).
     Field {
+        /// Data row (modulo their number).
         row: usize,
+        /// Column (modulo their number).
         col: usize,
+        /// Picks the new value among the column's candidates.
         value: usize,
     },
+    /// Remove field `col` of data row `row`.
     DropField {
+        /// Data row (modulo their number).
         row: usize,
+        /// Column (modulo the row's fields).
         col: usize,
     },
+    /// Append a field to data row `row`.
     AddField {
+        /// Data row (modulo their number).
         row: usize,
     },
+    /// Insert a second copy of data row `row`.
     DuplicateRow {
+        /// Data row (modulo their number).
         row: usize,
     },
+    /// Remove the header line.
     DropHeader,
+    /// Swap header fields `a` and `b`.
     SwapHeader {
+        /// First header field (modulo their number).
         a: usize,
+        /// Second header field (modulo their number).
         b: usize,
     },
+    /// Start the file with a UTF-8 byte-order mark.
     ByteOrderMark,
+    /// End lines with CRLF.
     Crlf,
+    /// Start data row `row` with an unclosed quote.
     OpenQuote {
+        /// Data row (modulo their number).
         row: usize,
     },
+    /// Keep the first `permille`/1000 of the file.
     Truncate {
+        /// Thousandths of the file kept, in [0, 1000).
         permille: u32,
     },
 }

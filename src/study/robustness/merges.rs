@@ -15,6 +15,7 @@ use rand::RngExt;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
+/// What a case of the merges target is (in the fuzz report).
 pub const DESCRIPTION: &str = "the three shards of studies/quickstart_mu_tripod.toml (3 samples per point) with 1–2 edits: a number or string of the JSON changed (counts, contacts, histograms, sample ranges, hashes, version, checksum), values swapped between points or shards, a field deleted or added, a shard left out or given twice, the text truncated or replaced; written to disk and merged as `pinfeed merge` does";
 
 /// Shards of the study.
@@ -47,29 +48,62 @@ pub fn make_shards(root: &Path) -> Result<Vec<(String, String)>, String> {
 pub enum Tamper {
     /// Change leaf `leaf` (numbers and strings, in document order) of shard `shard`.
     Leaf {
+        /// Index of the shard (modulo their number).
         shard: usize,
+        /// Index of the leaf in document order (modulo their number).
         leaf: usize,
+        /// Picks the change.
         how: usize,
     },
     /// Swap leaves `a` and `b` (of shards `sa` and `sb`).
     Swap {
+        /// Shard of the first leaf.
         sa: usize,
+        /// First leaf, in document order.
         a: usize,
+        /// Shard of the second leaf.
         sb: usize,
+        /// Second leaf, in document order.
         b: usize,
     },
     /// Delete the object member holding leaf `leaf`.
-    Delete { shard: usize, leaf: usize },
+    Delete {
+        /// Index of the shard (modulo their number).
+        shard: usize,
+        /// Index of the leaf in document order (modulo their number).
+        leaf: usize,
+    },
     /// Add a member `extra` next to leaf `leaf`.
-    Add { shard: usize, leaf: usize },
+    Add {
+        /// Index of the shard (modulo their number).
+        shard: usize,
+        /// Index of the leaf in document order (modulo their number).
+        leaf: usize,
+    },
     /// Leave shard `shard` out.
-    Missing { shard: usize },
+    Missing {
+        /// Index of the shard (modulo their number).
+        shard: usize,
+    },
     /// Give shard `shard` twice.
-    Twice { shard: usize },
+    Twice {
+        /// Index of the shard (modulo their number).
+        shard: usize,
+    },
     /// Keep the first `permille`/1000 of shard `shard`'s text.
-    Truncate { shard: usize, permille: u32 },
+    Truncate {
+        /// Index of the shard (modulo their number).
+        shard: usize,
+        /// Thousandths of the text kept, in [0, 1000).
+        permille: u32,
+    },
     /// Replace shard `shard`'s text by `{}` or an empty file.
-    Replace { shard: usize, empty: bool },
+    Replace {
+        /// Index of the shard (modulo their number).
+        shard: usize,
+        /// An empty file rather than `{}`.
+        empty: bool,
+    },
 }
 
 impl Tamper {

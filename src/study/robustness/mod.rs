@@ -51,17 +51,27 @@ pub const LISTED: usize = 5;
 /// What to fuzz.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Target {
+    /// Scenario files: the bundled and fixture scenarios, mutated.
     Scenarios,
+    /// Study files: the bundled and fixture studies, mutated.
     Studies,
+    /// Single contacts: random star polygons pushed by random pins.
     Contacts,
+    /// Vertex lists at extreme magnitudes and near-degenerate shapes.
     Polygons,
+    /// Sensing, actuator and controller scenarios with two keys moved together.
     Pairs,
+    /// `pinfeed plan` argument sets (cases supplied by the command line, [`CommandCases`]).
     Plans,
+    /// Measured-band CSV files with `validate` or `calibrate` flags (cases supplied by the command
+    /// line).
     Csvs,
+    /// Edited Monte Carlo shard sets given to `merge`.
     Merges,
 }
 
 impl Target {
+    /// Every target, in report order.
     pub const ALL: [Target; 8] = [
         Target::Scenarios,
         Target::Studies,
@@ -72,6 +82,7 @@ impl Target {
         Target::Csvs,
         Target::Merges,
     ];
+    /// The target's name on the command line and in the report (`scenarios`, `contacts`, …).
     pub fn name(self) -> &'static str {
         match self {
             Target::Scenarios => "scenarios",
@@ -133,11 +144,14 @@ pub enum Class {
     OkThenFailed,
     /// `merge` accepted shards whose content was edited.
     Accepted,
+    /// The case panicked.
     Panic,
+    /// The case ran longer than [`Options::budget`].
     Hang,
 }
 
 impl Class {
+    /// Every class, in report column order.
     pub const ALL: [Class; 11] = [
         Class::Located,
         Class::Named,
@@ -188,6 +202,7 @@ impl Class {
 /// The result of one case.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CaseReport {
+    /// How the case ended.
     pub class: Class,
     /// Contacts: the status at the default tolerance.
     pub status: Option<String>,
@@ -199,6 +214,7 @@ pub struct CaseReport {
 }
 
 impl CaseReport {
+    /// A report of class `class` with no status, detail or kind.
     pub fn new(class: Class) -> CaseReport {
         CaseReport {
             class,
@@ -207,6 +223,7 @@ impl CaseReport {
             kind: None,
         }
     }
+    /// A report of class `class` with `detail` (what happened and how to reproduce it).
     pub fn with(class: Class, detail: impl Into<String>) -> CaseReport {
         CaseReport {
             class,
@@ -220,7 +237,9 @@ impl CaseReport {
 /// Per-target counts.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Tally {
+    /// Cases generated and run.
     pub generated: u64,
+    /// Cases per class (a class with none may be absent; read with [`Tally::count`]).
     pub counts: BTreeMap<Class, u64>,
     /// Contacts: statuses at the default tolerance, by name.
     pub statuses: BTreeMap<String, u64>,
@@ -230,10 +249,12 @@ pub struct Tally {
     pub problems: BTreeMap<Class, Vec<(u64, String)>>,
     /// The run stopped early after too many hangs.
     pub stopped_early: bool,
+    /// Wall time of the target's run (s).
     pub seconds: f64,
 }
 
 impl Tally {
+    /// Cases of class `c` (0 when none).
     pub fn count(&self, c: Class) -> u64 {
         self.counts.get(&c).copied().unwrap_or(0)
     }
@@ -263,7 +284,10 @@ impl Tally {
 /// Settings of a fuzzing run.
 #[derive(Debug, Clone)]
 pub struct Options {
+    /// Seed of the cases: case i of a target draws from a stream derived from (seed, target, i), so
+    /// the same seed gives the same cases on any thread count.
     pub seed: u64,
+    /// Worker threads running cases in parallel (the counts do not depend on it, hangs aside).
     pub threads: usize,
     /// A case running longer than this is a hang.
     pub budget: Duration,
@@ -285,6 +309,7 @@ pub struct CommandCases {
 
 /// Everything the generators need, shared by the case threads.
 pub struct Corpus {
+    /// The seed scenario and study files.
     pub files: files::Seeds,
     /// The seed scenarios of the pairs target.
     pub pair_seeds: Vec<(PathBuf, String)>,
@@ -296,6 +321,8 @@ pub struct Corpus {
 }
 
 impl Corpus {
+    /// Read the seed files under the project root `root`; Err names the file or folder that could
+    /// not be read.
     pub fn load(root: &Path) -> Result<Corpus, String> {
         let files = files::Seeds::load(root)?;
         Ok(Corpus {
@@ -334,10 +361,12 @@ impl Corpus {
 }
 
 /// A fresh folder for case `index` of `target` (removed when the case ends).
-pub struct Scratch(PathBuf);
+struct Scratch(PathBuf);
 
 impl Scratch {
-    pub fn new(target: Target, seed: u64, index: u64) -> Scratch {
+    /// The folder for case `index` of `target` in a run seeded with `seed`, under the system's
+    /// temporary folder (emptied if left over; not created).
+    fn new(target: Target, seed: u64, index: u64) -> Scratch {
         let d = std::env::temp_dir().join(format!(
             "pinfeed-fuzz-{}-{}-{seed}-{index}",
             std::process::id(),
@@ -346,7 +375,8 @@ impl Scratch {
         let _ = std::fs::remove_dir_all(&d);
         Scratch(d)
     }
-    pub fn path(&self) -> &Path {
+    /// The folder's path.
+    fn path(&self) -> &Path {
         &self.0
     }
 }

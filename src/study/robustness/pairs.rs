@@ -14,6 +14,7 @@ use crate::random::ChaCha8Rng;
 use rand::RngExt;
 use std::path::{Path, PathBuf};
 
+/// What a case of the pairs target is (in the fuzz report).
 pub const DESCRIPTION: &str = "the bundled scenarios with a sensor pin, a moving or retractable pin or a controller, except those with the online controller (classifier templates cut to 4), as bundled or with their rules moved into a policy file, with two keys of the sensor, the actuators, the controller (its mode included: rules or the online belief), the rules or the policy set together to values inside, at the ends of and beyond their ranges; parsed, compiled and run for at most 3 parts";
 
 /// Where a key lives: a section, an obstacle of a kind, its sensor table, a rule, the policy.
@@ -263,8 +264,11 @@ fn retractable_variant(text: &str) -> Option<String> {
 /// A case: the seed, whether its rules move into a policy file, and the two (key, value) picks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PairCase {
+    /// Index of the seed scenario.
     pub seed: usize,
+    /// The scenario's rules move into a policy file.
     pub policy: bool,
+    /// The two (key, value) picks: an index of the key, and of its candidate value.
     pub picks: [(usize, usize); 2],
 }
 

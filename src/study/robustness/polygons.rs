@@ -11,6 +11,7 @@ use crate::random::ChaCha8Rng;
 use rand::RngExt;
 use std::f64::consts::TAU;
 
+/// What a case of the polygons target is (in the fuzz report).
 pub const DESCRIPTION: &str = "vertex lists of 3–12 vertices: stars at magnitudes 10^-300…10^300, stars offset far from the origin, near-collinear triangles, near-duplicate vertices, self-intersecting orders and random points, through Polygon::new and the part description (area, centroid, a, polar moment, stable states, contact model)";
 
 /// A generated vertex list.
