@@ -151,7 +151,7 @@ fn status_name<S: Serializer>(status: &ContactStatus, s: S) -> Result<S::Ok, S::
 /// One band B_j with its statistics (see [`bands`] for the definitions).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Band {
-    /// Lower and upper end of the final-angle arc (degrees; max < min when it straddles 0°).
+    /// Lower end of the final-angle arc (degrees; max < min when it straddles 0°).
     pub final_min_deg: f64,
     /// Upper end of the final-angle arc (degrees).
     pub final_max_deg: f64,
@@ -161,13 +161,13 @@ pub struct Band {
     pub mean_deg: f64,
     /// Standard deviation of the band's final angles (degrees).
     pub sd_deg: f64,
-    /// The thesis's adjusted band, mean ± sd (eq. 3-2), wrapped.
+    /// Lower end of the thesis's adjusted band, mean − sd (eq. 3-2; degrees, wrapped).
     pub adjusted_min_deg: f64,
-    /// Upper end of the adjusted band (degrees).
+    /// Upper end of the adjusted band, mean + sd (degrees, wrapped).
     pub adjusted_max_deg: f64,
     /// K_j: the θ0 runs feeding this band, [first, last] (degrees, on the grid).
     pub initial_ranges_deg: Vec<[f64; 2]>,
-    /// COM_j: range of the final centroid y (part units).
+    /// COM_j: smallest final centroid y (part units).
     pub com_y_min: f64,
     /// Largest final centroid y (part units).
     pub com_y_max: f64,

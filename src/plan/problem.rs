@@ -106,7 +106,7 @@ pub struct Problem {
     /// Branch and bound ([`super::bound`]): do not expand states that cannot beat the best
     /// effort within the pins left. Off, every state is expanded (same outcome, more work).
     pub bound: bool,
-    /// Search limits: most distinct states kept, and wall time (s).
+    /// Search limit: most distinct states kept.
     pub max_states: usize,
     /// Wall-time limit of the search (s).
     pub time_limit_s: f64,

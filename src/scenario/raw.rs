@@ -201,8 +201,7 @@ pub struct RawObstacle {
     pub mu_f: Option<f64>,
     /// `[obstacles.sensor]`: the sensor of a `sensor_pin` (or of a `moving_pin`).
     pub sensor: Option<RawSensor>,
-    /// A moving pin's lateral range [min, max] (m), speed (m/s) and acceleration (m/s²) limits,
-    /// settle time (s) and the pieces an acceleration phase is resolved into.
+    /// Moving pin: its lateral range [min, max] (m, over the belt, holding the home `y`).
     pub travel: Option<[f64; 2]>,
     /// Moving pin: speed limit (m/s, in [1e-6, 10³] and at most 1000 × belt speed).
     pub speed: Option<f64>,
@@ -212,7 +211,7 @@ pub struct RawObstacle {
     pub settle: Option<f64>,
     /// Moving pin: constant-speed pieces per acceleration phase for the contact model (1 to 64, default 8).
     pub pieces: Option<u32>,
-    /// A retractable pin's state before any command, and its switching times (s).
+    /// Retractable pin: its state before any command (default true: raised).
     pub raised: Option<bool>,
     /// Retractable pin: time to raise (s, in [0, 10⁴], default 0.1).
     pub raise_time: Option<f64>,

@@ -155,8 +155,8 @@ pub struct SensorPin {
     pub templates_per_hypothesis: usize,
     /// Decide "unknown" below this posterior (in [0, 1]; 0 never rejects).
     pub reject_below: f64,
-    /// The contact parameter d the templates were simulated at (the pin against the feed's
-    /// mean lateral offset), and the spread of d they were drawn with.
+    /// The contact parameter d the templates were simulated at (units of a: the pin against the
+    /// feed's mean lateral offset).
     pub template_d: f64,
     /// Standard deviation of d the templates were drawn with (units of a, from the feed's lateral spread).
     pub template_d_sd: f64,
