@@ -31,14 +31,14 @@ pub enum LineError {
 
 /// A scratch folder for a design's files while it is checked (a policy file must exist beside
 /// the scenario that names it); removed when dropped.
-pub struct Scratch {
+pub(crate) struct Scratch {
     /// The folder (under the system's temporary folder).
-    pub dir: PathBuf,
+    pub(crate) dir: PathBuf,
 }
 
 impl Scratch {
     /// Create a fresh folder `pinfeed-design-<process>-<n>` in the system's temporary folder; Err if it cannot be created.
-    pub fn new() -> Result<Scratch, LineError> {
+    pub(crate) fn new() -> Result<Scratch, LineError> {
         static NEXT: AtomicU64 = AtomicU64::new(0);
         let dir = std::env::temp_dir().join(format!(
             "pinfeed-design-{}-{}",
@@ -88,7 +88,7 @@ impl Runnable {
     }
 
     /// Run `parts` parts at headway `h` with `seed`, keeping per-part records if asked.
-    pub fn run(
+    pub(crate) fn run(
         &self,
         scratch: &Scratch,
         h: f64,
@@ -152,7 +152,7 @@ pub type HeadwayProbe = (f64, u64, u64, f64);
 /// the probes. (Short headways fail by collisions, and on lines with moving pins by pins that
 /// cannot reach the next part's position in time.)
 #[allow(clippy::too_many_arguments)]
-pub fn shortest_headway(
+pub(crate) fn shortest_headway(
     r: &Runnable,
     scratch: &Scratch,
     (lo, hi): (f64, f64),

@@ -15,7 +15,7 @@
 //!
 //! Then the candidates the screen holds at the target are taken in the order of the objective
 //! ([`Objective`]); for each, the line's own spacing of parts is found by simulation
-//! ([`line::shortest_headway`]: the shortest headway without collisions, with a reserve) and the
+//! (`line::shortest_headway`: the shortest headway without collisions, with a reserve) and the
 //! full line check (`check_parts` parts at that headway) decides: the first that holds the target
 //! is **confirmed** and chosen. If none is, the best the line measured is chosen and reported as
 //! **not confirmed**, with its number; with no plan at all the result is **no design**.
