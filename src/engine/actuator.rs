@@ -22,11 +22,15 @@ use std::collections::VecDeque;
 /// One trapezoidal move of a moving pin, from rest at `y0` (time `t0`) to rest at `y1`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Move {
+    /// Start time (s).
     pub t0: f64,
+    /// Start position (m).
     pub y0: f64,
+    /// End position (m).
     pub y1: f64,
-    /// Duration of the acceleration (= deceleration) phase and of the cruise (s).
+    /// Duration of the acceleration phase, and of the equal deceleration phase (s).
     pub ta: f64,
+    /// Cruise time at full speed (s, 0 for a triangular profile).
     pub tc: f64,
 }
 
@@ -42,10 +46,12 @@ impl Move {
         Move { t0, y0, y1, ta, tc }
     }
 
+    /// The move's length in time (s; 0 for a null move).
     pub fn duration(&self) -> f64 {
         2.0 * self.ta + self.tc
     }
 
+    /// When the move ends (s).
     pub fn t_end(&self) -> f64 {
         self.t0 + self.duration()
     }
@@ -101,28 +107,39 @@ impl Move {
 /// A retractable pin's switch: from `t0` to `t1` it is in transit, then raised (`up`) or withdrawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Switch {
+    /// Start time (s).
     pub t0: f64,
+    /// End time (s).
     pub t1: f64,
+    /// The state it switches to (true: raised).
     pub up: bool,
 }
 
 /// The timeline of one dynamic pin.
 #[derive(Debug, Clone)]
 pub enum Track {
+    /// A moving pin's planned moves.
     Moving {
+        /// The pin's limits.
         spec: MovingSpec,
         /// Where the pin rests before the first remembered move.
         base: f64,
+        /// Its moves, in time order.
         moves: VecDeque<Move>,
     },
+    /// A retractable pin's planned switches.
     Retractable {
+        /// The pin's switching times.
         spec: RetractSpec,
+        /// Its state before the first switch.
         base: bool,
+        /// Its switches, in time order.
         switches: VecDeque<Switch>,
     },
 }
 
 impl Track {
+    /// A moving pin with no move planned.
     pub fn moving(spec: MovingSpec) -> Track {
         Track::Moving {
             base: spec.home,
@@ -131,6 +148,7 @@ impl Track {
         }
     }
 
+    /// A retractable pin with no switch planned.
     pub fn retractable(spec: RetractSpec) -> Track {
         Track::Retractable {
             base: spec.raised,

@@ -1,7 +1,7 @@
 //! The online controller in the event engine (docs/physics.md#controller): a sensor pin's reading becomes a
 //! decision, the decision (after the controller's computation latency) becomes commands for the
 //! dynamic pins through the rules, and each command becomes an actuator motion with its real
-//! timing ([`super::actuator`]).
+//! timing (`super::actuator`).
 //!
 //! Each dynamic pin serves the parts in their order: a pin moves for part p only when every
 //! earlier part still within its reach (centroid short of x_pin + a + ρ) is known to clear it,
@@ -39,6 +39,7 @@ use std::sync::Arc;
 pub struct ControlRecord {
     /// Seconds.
     pub t: f64,
+    /// Index of the part in the stream (0-based).
     pub part: u64,
     /// The sensor (for a decision) or the dynamic pin (for an actuation).
     pub obstacle: String,
@@ -51,37 +52,50 @@ pub struct ControlRecord {
     pub motion: Option<MotionRecord>,
 }
 
+/// An actuation's motion.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct MotionRecord {
+    /// When the motion starts (s).
     pub t_start: f64,
+    /// When the pin is ready: motion and settle time over (s).
     pub t_ready: f64,
+    /// Where it starts: a moving pin's y (m), or a retractable pin's state (1 raised, 0 withdrawn).
     pub from: f64,
+    /// Where it ends, in the same terms as `from`.
     pub to: f64,
 }
 
 /// Per dynamic pin: commands and motion.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct ActuatorStats {
+    /// The pin's name.
     pub name: String,
+    /// Commands it was given.
     pub commands: u64,
     /// Commands carried out by a motion (a command for the state the pin is in needs none).
     pub moves: u64,
+    /// Commands that could not finish before their part could reach the pin.
     pub late: u64,
+    /// Commands dropped because their part was no longer on the line when the pin's turn came.
     pub dropped: u64,
     /// Lateral travel of a moving pin (m).
     pub travel_m: f64,
-    /// Time in motion (s), and as a share of the simulated time.
+    /// Time in motion (s).
     pub busy_s: f64,
+    /// `busy_s` as a share of the simulated time, in [0, 1].
     pub utilisation: f64,
 }
 
 /// Parts per decision and how many of them ended well.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct DecisionStats {
+    /// Parts that got this decision.
     pub parts: u64,
+    /// Of those, parts that ended in success.
     pub success: u64,
-    /// Decisions that differ from the part's true state, and of those the parts that failed.
+    /// Decisions that differ from the part's true state.
     pub wrong: u64,
+    /// Of the wrong decisions, the parts that failed.
     pub wrong_failed: u64,
 }
 
@@ -89,46 +103,56 @@ pub struct DecisionStats {
 /// [lo, hi), their mean prediction and the share that ended in the goal.
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct CalibrationBin {
+    /// Lower edge of the predicted-success bin, in [0, 1].
     pub lo: f64,
+    /// Upper edge (exclusive) of the bin.
     pub hi: f64,
+    /// Parts whose prediction fell in the bin.
     pub parts: u64,
+    /// Their mean predicted success.
     pub predicted_mean: f64,
+    /// The share of them that ended in the goal.
     pub observed: f64,
 }
 
 /// What the online controller did (docs/physics.md#belief-and-online-replanning).
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct OnlineSummary {
-    /// The model: hypotheses, joint actions, line runs its build took (a run through one
-    /// stretch of the line counts one) and the contact-model evaluations of its success runs.
+    /// Hypotheses of the model (states × offsets × μ values × support classes).
     pub hypotheses: usize,
+    /// Joint actions (commands of all dynamic pins together) the model chooses from.
     pub actions: usize,
+    /// Line runs the model's build took (a run through one stretch of the line counts one).
     pub model_runs: u64,
+    /// Contact-model evaluations of the model's success runs.
     pub model_evaluations: u64,
     /// Decisions taken (one per part once every sensor has spoken).
     pub decisions: u64,
-    /// Mean entropy of the belief before any observation and at the decision (bits).
+    /// Mean entropy of the belief before any observation (bits).
     pub entropy_prior_bits: f64,
+    /// Mean entropy of the belief at the decision (bits).
     pub entropy_posterior_bits: f64,
     /// Observations no hypothesis explained (the belief was left as it was).
     pub inconsistent: u64,
     /// Passes of a sensor without contact used as evidence.
     pub no_contact_passes: u64,
-    /// Mean predicted success of the decisions, and the observed success of those parts.
+    /// Mean predicted success of the decisions.
     pub predicted_mean: f64,
+    /// Observed success of the parts that got decisions.
     pub observed: f64,
     /// Predicted against observed, in ten bins of the prediction (empty bins left out).
     pub calibration: Vec<CalibrationBin>,
     /// How often each joint command was chosen (`pin=target, …`).
     pub chosen: BTreeMap<String, u64>,
-    /// Per sensor: the powers its two likelihoods are raised to, calibrated on held-out members
-    /// (0: not used): the matched filter over the hypotheses' templates, and the sensor
-    /// classifier's posterior over the states.
+    /// Per sensor: the power its matched-filter likelihood (over the hypotheses' templates) is
+    /// raised to, calibrated on held-out members (0: not used).
     pub temper: BTreeMap<String, f64>,
+    /// Per sensor: the power of the sensor classifier's posterior over the states (0: not used).
     pub classifier_power: BTreeMap<String, f64>,
     /// Decisions whose most probable stable state (the belief's marginal) is the part's true
-    /// state, over the decisions whose part has a known true state.
+    /// state (out of `state_known`).
     pub state_correct: u64,
+    /// Decisions whose part has a known true state.
     pub state_known: u64,
     /// What the model says this line can do, per support class the belief declares: the best
     /// single command with no information, and with a belief certain of the hypothesis.
@@ -138,8 +162,11 @@ pub struct OnlineSummary {
 /// The model's bounds for one support class (see [`crate::engine::online::OnlineModel::bounds`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Default)]
 pub struct ModelBound {
+    /// Support class (`uniform` or `tripod`).
     pub support: String,
+    /// Best success probability of a single command with no information.
     pub no_information: f64,
+    /// Best success probability with a belief certain of the hypothesis.
     pub certain_hypothesis: f64,
 }
 
@@ -148,13 +175,19 @@ pub struct ModelBound {
 pub struct ControllerSummary {
     /// "scenario" or the policy file.
     pub rules_from: String,
+    /// Decision latency (s).
     pub latency_s: f64,
+    /// `skip` or `move`: what a late command does.
     pub on_late: &'static str,
     /// Per sensor and decision (`<sensor>=<label>`, `unknown` for none).
     pub decisions: BTreeMap<String, DecisionStats>,
+    /// Decisions that differ from the part's true state, over all sensors.
     pub misclassified: u64,
+    /// Of those, the parts that failed.
     pub misclassified_failed: u64,
+    /// Late actuations, over all dynamic pins.
     pub late_actuations: u64,
+    /// Per dynamic pin, in obstacle order.
     pub actuators: Vec<ActuatorStats>,
     /// `policy` or `online`.
     pub mode: &'static str,

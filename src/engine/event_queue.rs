@@ -15,25 +15,54 @@ use std::collections::BinaryHeap;
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum EventKind {
     /// Part `part` enters the belt at x = 0.
-    Arrival { part: u64 },
+    Arrival {
+        /// Index of the part in the stream.
+        part: u64,
+    },
     /// Part `part` first touches obstacle `obstacle`.
-    ContactBegin { part: u64, obstacle: u32 },
+    ContactBegin {
+        /// Index of the part in the stream.
+        part: u64,
+        /// Index of the obstacle in `Scene::obstacles`.
+        obstacle: u32,
+    },
     /// The contact of `part` with `obstacle` ends (the pin has passed, or the contact model stopped).
-    ContactEnd { part: u64, obstacle: u32 },
+    ContactEnd {
+        /// Index of the part in the stream.
+        part: u64,
+        /// Index of the obstacle in `Scene::obstacles`.
+        obstacle: u32,
+    },
     /// Part `part`'s centroid reaches the end of the belt.
-    Exit { part: u64 },
+    Exit {
+        /// Index of the part in the stream.
+        part: u64,
+    },
     /// Parts `first` < `second` overlap.
-    Collision { first: u64, second: u64 },
+    Collision {
+        /// The lower part index.
+        first: u64,
+        /// The higher part index.
+        second: u64,
+    },
     /// Sensor pin `obstacle`'s decision on `part` reaches the controller (after its latency):
     /// hypothesis index, or `u32::MAX` for no decision.
     Decision {
+        /// Index of the part in the stream.
         part: u64,
+        /// Index of the sensor pin in `Scene::obstacles`.
         obstacle: u32,
+        /// Index into the sensor's hypotheses, or `u32::MAX` for no decision.
         hypothesis: u32,
     },
     /// The online controller asks whether part `part` has gone past sensor pin `obstacle`
     /// without touching it (evidence for the part's belief).
-    Unread { part: u64, obstacle: u32 },
+    Unread {
+        /// Index of the part in the stream.
+        part: u64,
+        /// Index of the sensor pin in `Scene::obstacles`.
+        obstacle: u32,
+    },
 }
 
 /// A scheduled event.
@@ -43,6 +72,7 @@ pub struct Event {
     pub time: f64,
     /// Order of scheduling; breaks ties in time.
     pub seq: u64,
+    /// What happens.
     pub kind: EventKind,
 }
 
@@ -79,6 +109,7 @@ pub struct EventQueue {
 }
 
 impl EventQueue {
+    /// An empty queue.
     pub fn new() -> EventQueue {
         EventQueue::default()
     }
@@ -118,10 +149,12 @@ impl EventQueue {
         self.heap.pop()
     }
 
+    /// Events waiting in the queue.
     pub fn len(&self) -> usize {
         self.heap.len()
     }
 
+    /// Is no event waiting?
     pub fn is_empty(&self) -> bool {
         self.heap.is_empty()
     }

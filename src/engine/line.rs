@@ -159,6 +159,7 @@ pub fn run_entry(
 /// online model runs the line this way hundreds of thousands of times.
 #[derive(Debug, Clone)]
 pub struct SingleRun {
+    /// How the part left the line.
     pub outcome: PartOutcome,
     /// The part's world pose when it left (at the belt's end when it exited).
     pub pose: Pose,

@@ -56,13 +56,16 @@ pub struct WorkCounters {
     pub signal_knots: u64,
     /// Readings classified.
     pub classifications: u64,
-    /// Decisions that reached the controller, commands they gave to dynamic pins, commands that
-    /// could not finish before their part arrived, free parts planned again after a pin's
-    /// timeline changed, and events dropped as stale (all 0 without dynamic pins).
+    /// Decisions that reached the controller (this and the next four counters stay 0 without
+    /// dynamic pins).
     pub decisions: u64,
+    /// Commands given to dynamic pins.
     pub actuator_commands: u64,
+    /// Commands that could not finish before their part arrived.
     pub late_actuations: u64,
+    /// Free parts planned again after a pin's timeline changed.
     pub replans: u64,
+    /// Events dropped as stale.
     pub stale_events: u64,
     /// Pushes answered by the map tier and pushes it handed to the exact model, by reason (only
     /// with `[model] fidelity = "map"`; absent from the summary otherwise).
@@ -153,7 +156,9 @@ impl MapTierCounters {
 /// Per-obstacle statistics.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct ObstacleStats {
+    /// The obstacle's name in the scene.
     pub name: String,
+    /// Pushes by this obstacle (each encounter counts once).
     pub contacts: u64,
     /// Seconds spent pushing parts.
     pub busy_s: f64,
@@ -162,18 +167,31 @@ pub struct ObstacleStats {
 /// Accumulators of a run.
 #[derive(Debug, Clone)]
 pub struct Metrics {
+    /// Parts that arrived.
     pub parts_in: u64,
+    /// Parts per final outcome.
     pub outcomes: OutcomeCounts,
+    /// Multi-contact failures by cause (e.g. `second_obstacle`, `pin_inside_part`).
     pub multi_contact_causes: BTreeMap<String, u64>,
+    /// Jams by cause (`travel_limit`, `fence_angle`).
     pub jam_causes: BTreeMap<String, u64>,
+    /// Solver failures by cause (e.g. `grazing_loop`).
     pub solver_causes: BTreeMap<String, u64>,
+    /// Time of the first arrival (s), None before any.
     pub first_arrival: Option<f64>,
+    /// Time of the latest arrival (s).
     pub last_arrival: f64,
+    /// Time of the first exit (s), None before any.
     pub first_exit: Option<f64>,
+    /// Time of the latest exit (s).
     pub last_exit: f64,
+    /// Exits at exactly `last_exit` (left out of the steady window's count, which is half-open).
     pub exits_at_last: u64,
+    /// Successes at exactly `last_exit`.
     pub successes_at_last: u64,
+    /// Parts that exited (success or wrong orientation).
     pub exits: u64,
+    /// Time of the latest event handled (s).
     pub last_event: f64,
     /// Entry → exit, microseconds.
     pub latency_us: Histogram<u64>,
@@ -181,11 +199,15 @@ pub struct Metrics {
     pub latency_max: f64,
     /// Smallest latency (s), exact (+∞ before the first exit).
     pub latency_min: f64,
+    /// Obstacle encounters (pushes) over all obstacles.
     pub contacts: u64,
+    /// Per obstacle, in scene order.
     pub obstacles: Vec<ObstacleStats>,
     /// Final orientations of exiting parts, counts per bin of `bin_deg`.
     pub orientation_bins: Vec<u64>,
+    /// Width of an orientation bin (degrees; divides 360).
     pub bin_deg: f64,
+    /// Work done by the engine, by kind.
     pub work: WorkCounters,
     /// Per sensor pin, in obstacle order.
     pub sensors: Vec<super::sensing::SensorStats>,
@@ -196,6 +218,7 @@ pub struct Metrics {
 const LATENCY_MAX_US: u64 = 1_000_000_000_000;
 
 impl Metrics {
+    /// Empty accumulators for the scene's obstacles (in order) and an orientation bin of `bin_deg` degrees (must divide 360).
     pub fn new(obstacle_names: Vec<String>, bin_deg: f64) -> Metrics {
         let bins = (360.0 / bin_deg).round() as usize;
         Metrics {
@@ -233,6 +256,7 @@ impl Metrics {
         }
     }
 
+    /// A part arrived at time `t` (s).
     pub fn arrival(&mut self, t: f64) {
         self.parts_in += 1;
         if self.first_arrival.is_none() {
@@ -274,6 +298,7 @@ impl Metrics {
         self.orientation_bins[bin] += 1;
     }
 
+    /// Record the cause of a failed part; ignored for outcomes other than multi-contact, jam and solver.
     pub fn cause(&mut self, outcome: PartOutcome, cause: &str) {
         let map = match outcome {
             PartOutcome::MultiContact => &mut self.multi_contact_causes,
@@ -289,23 +314,31 @@ impl Metrics {
 /// maximum exact).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct LatencySummary {
+    /// Median (s).
     pub p50: f64,
+    /// 90th percentile (s).
     pub p90: f64,
+    /// 99th percentile (s).
     pub p99: f64,
+    /// Largest latency (s, exact).
     pub max: f64,
 }
 
 /// Per-obstacle line of the summary.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ObstacleSummary {
+    /// The obstacle's name.
     pub name: String,
+    /// Pushes by this obstacle.
     pub contacts: u64,
+    /// Time it spent pushing parts / simulated time, in [0, 1] unless pushes overlap.
     pub busy_fraction: f64,
 }
 
 /// Final-orientation histogram of the exiting parts.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OrientationHistogram {
+    /// Bin width (degrees; divides 360).
     pub bin_deg: f64,
     /// `counts[k]` = parts with final θ in [k·bin, (k+1)·bin) degrees.
     pub counts: Vec<u64>,
@@ -314,35 +347,53 @@ pub struct OrientationHistogram {
 /// Causes behind the multi_contact, jam and solver classes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Causes {
+    /// Multi-contact failures by cause (e.g. `second_obstacle`, `pin_inside_part`).
     pub multi_contact: BTreeMap<String, u64>,
     /// `travel_limit` (a pin still pushing after `model.max_travel`) or `fence_angle` (stopped
     /// against a fence at α + atan μf ≥ 90°).
     pub jam: BTreeMap<String, u64>,
+    /// Solver failures by cause (e.g. `grazing_loop`).
     pub solver: BTreeMap<String, u64>,
 }
 
 /// The deterministic result of a run: a pure function of (scene, seed, parts).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Summary {
+    /// The scene's name.
     pub scenario: String,
+    /// The run's seed.
     pub seed: u64,
+    /// Contact-model fidelity used (`exact`, `ellipsoid`, `tip`, or `map`).
     pub fidelity: String,
+    /// Parts that arrived.
     pub parts_in: u64,
+    /// Parts per final outcome.
     pub outcomes: OutcomeCounts,
+    /// Successes / parts in (0 without parts).
     pub success_rate: f64,
+    /// 95% Wilson score interval of the success rate, [low, high].
     pub success_ci95: [f64; 2],
+    /// Arrival rate over first to last arrival (parts/min; None with fewer than two distinct arrival times).
     pub throughput_in_per_min: Option<f64>,
+    /// Exit rate over the steady window (parts/min; None without a window of positive length).
     pub throughput_out_per_min: Option<f64>,
+    /// Success rate over the steady window (parts/min; None without a window of positive length).
     pub throughput_ok_per_min: Option<f64>,
     /// [first exit, last exit] (s).
     pub steady_window_s: Option<[f64; 2]>,
+    /// Time on the belt of the exiting parts (None when no part exited).
     pub latency_s: Option<LatencySummary>,
+    /// Obstacle encounters per part in.
     pub contacts_per_part: f64,
+    /// Per obstacle, in scene order.
     pub obstacles: Vec<ObstacleSummary>,
+    /// Final orientations of the exiting parts.
     pub orientation_histogram: OrientationHistogram,
+    /// Why parts failed, by outcome class.
     pub causes: Causes,
     /// First arrival to last event (s).
     pub simulated_time_s: f64,
+    /// Work done by the engine, by kind (not wall-clock time).
     pub work: WorkCounters,
     /// Sensor pins: readings, confusion against the truth, parts that passed untouched (absent
     /// from the JSON when the scene has no sensor).

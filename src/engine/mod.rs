@@ -14,7 +14,7 @@
 //! * [`metrics`]: counts, rates, latency histogram, per-obstacle statistics, work counters and the
 //!   deterministic [`Summary`].
 
-pub mod actuator;
+pub(crate) mod actuator;
 pub mod contact;
 pub mod contact_map;
 pub mod controller;

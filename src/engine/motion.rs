@@ -26,8 +26,11 @@ pub enum Pusher {
     /// A pin of radius `radius` whose centre stands at `centre` at the anchor time and then
     /// follows `path` (a still pin: `PinPath::constant(0.0)`).
     Pin {
+        /// Pin centre at the anchor time (world, m).
         centre: Vec2,
+        /// Pin radius (m, ≥ 0).
         radius: f64,
+        /// The pin's lateral motion during the push, as a function of its travel.
         path: PinPath,
     },
     /// A fence.
@@ -59,20 +62,30 @@ impl Pusher {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Stop {
     /// Two obstacles at once; `cause` names how (`notch`, `second_obstacle`, `pin_inside_part`).
-    MultiContact { cause: &'static str },
+    MultiContact {
+        /// How: `notch`, `second_obstacle` or `pin_inside_part`.
+        cause: &'static str,
+    },
     /// The obstacle holds the part for good; `cause` is `travel_limit` (still pushed after
     /// `model.max_travel`) or `fence_angle` (stopped against a fence at α + atan μf ≥ 90°).
-    Jam { cause: &'static str },
+    Jam {
+        /// Why: `travel_limit` or `fence_angle`.
+        cause: &'static str,
+    },
     /// The part's centroid crossed the belt's edge while it was pushed along a fence.
     OffBelt,
     /// The contact model failed; `cause` is the contact status name (`evaluation_limit`,
     /// `event_limit`, `step_too_small`), or for a failed sub-problem `no_convergence` / `non_finite`.
-    Solver { cause: &'static str },
+    Solver {
+        /// The contact status or sub-problem failure name.
+        cause: &'static str,
+    },
 }
 
 /// A push in progress: its inputs (to re-run it with a recorder) and its outcome.
 #[derive(Debug, Clone)]
 pub struct ContactPlan {
+    /// Index of the pushing obstacle in `Scene::obstacles`.
     pub obstacle: usize,
     /// Anchor: the world and belt frames coincide at this time.
     pub t_ref: f64,
@@ -80,14 +93,19 @@ pub struct ContactPlan {
     pub pose_ref: Pose,
     /// The pushing obstacle.
     pub pusher: Pusher,
+    /// Contact-model settings of the push (the obstacle's friction, tolerance, fidelity).
     pub settings: ContactSettings,
+    /// What the contact model computed.
     pub outcome: ContactOutcome,
-    /// Pin travel at first touch and at the end of the last contact of the pass.
+    /// Pin travel at first touch (m, belt frame).
     pub s_touch: f64,
+    /// Pin travel at the end of the last contact of the pass (m, belt frame).
     pub s_end: f64,
-    /// World times of first touch and of the end of the push (or of an earlier stop).
+    /// World time of first touch (s).
     pub t_begin: f64,
+    /// World time of the end of the push, or of an earlier stop (s).
     pub t_end: f64,
+    /// Why the part leaves the line at the end of the push, if it does.
     pub stop: Option<Stop>,
     /// Recorded poses (pin travel, belt-frame pose), sorted by travel, once recorded.
     pub trace: Option<Vec<(f64, Pose)>>,
@@ -200,7 +218,14 @@ impl ContactPlan {
 #[derive(Debug, Clone)]
 pub enum Motion {
     /// Riding the belt from world pose `pose` at time `t0`, until its next event at `until`.
-    Free { t0: f64, pose: Pose, until: f64 },
+    Free {
+        /// Start time (s).
+        t0: f64,
+        /// World pose at `t0`.
+        pose: Pose,
+        /// Time of the part's next event (s).
+        until: f64,
+    },
     /// Being pushed by a pin.
     Held(Box<ContactPlan>),
 }

@@ -46,8 +46,9 @@ use rayon::prelude::*;
 const MEMBER_STREAMS: u64 = 3 << 61;
 /// First stream index of the held-out members' readings.
 const HELD_OUT_READINGS: u64 = 5 << 60;
-/// Largest joint action set and largest number of line runs a model may take to build.
+/// Largest joint action set a model may have (larger beliefs are refused).
 pub const MAX_ACTIONS: usize = 4096;
+/// Largest number of line runs the model's build may take (larger beliefs are refused).
 pub const MAX_RUNS: usize = 4_000_000;
 /// Predictions closer than this are a tie: they are shares of a few simulated members, and a
 /// belief that is all but certain leaves differences far below it.
@@ -58,12 +59,15 @@ const UNIFORM_SECTORS: usize = 12;
 /// One hypothesis about a part.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Hypothesis {
-    /// State index and its orientation (degrees).
+    /// State index (into the part's stable states, or a sector of a uniform feed).
     pub state: usize,
+    /// The state's orientation (degrees).
     pub state_deg: f64,
     /// The lateral-offset bin [lo, hi] (m).
     pub offset: [f64; 2],
+    /// Pin–part friction coefficient of the hypothesis.
     pub mu_c: f64,
+    /// Support class of the hypothesis.
     pub support: SupportKind,
 }
 
@@ -89,11 +93,15 @@ pub struct SensorModel {
 
 /// The online controller's model; see the module notes.
 pub struct OnlineModel {
+    /// The hypotheses, in the order of the belief's entries.
     pub hypotheses: Vec<Hypothesis>,
+    /// The belief before any observation.
     pub prior: Belief,
+    /// One per sensor pin, in obstacle order.
     pub sensors: Vec<SensorModel>,
-    /// The dynamic pins (obstacle indices) and the joint actions over them.
+    /// The dynamic pins (obstacle indices).
     pub pins: Vec<usize>,
+    /// The joint actions: one target per dynamic pin (in the order of `pins`).
     pub actions: Vec<Vec<Target>>,
     /// Number of options per pin (the actions are their product, the last pin fastest).
     options: Vec<usize>,
@@ -103,9 +111,9 @@ pub struct OnlineModel {
     success: Vec<f64>,
     /// Members per hypothesis.
     pub samples: usize,
-    /// Line runs the build took (a run through one stretch of the line counts one), and the
-    /// contact-model evaluations of the runs that predict success.
+    /// Line runs the build took (a run through one stretch of the line counts one).
     pub runs: u64,
+    /// Contact-model evaluations of the runs that predict success.
     pub evaluations: u64,
 }
 

@@ -16,16 +16,24 @@ use serde::Serialize;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PartOutcome {
+    /// Reached the end of the belt with its orientation in the goal.
     Success,
+    /// Reached the end of the belt with an orientation outside the goal.
     WrongOrientation,
+    /// Overlapped another part (both are taken off the line).
     Collision,
+    /// Touched two obstacles at once, or the pin met a concave notch.
     MultiContact,
+    /// Its centroid left the belt's width (it falls off).
     OffBelt,
+    /// Held for good by a pin (beyond `model.max_travel`) or a fence (α + atan μf ≥ 90°).
     Jam,
+    /// The contact model could not finish the push.
     Solver,
 }
 
 impl PartOutcome {
+    /// Every class, in the order of the summary.
     pub const ALL: [PartOutcome; 7] = [
         PartOutcome::Success,
         PartOutcome::WrongOrientation,
@@ -36,6 +44,7 @@ impl PartOutcome {
         PartOutcome::Solver,
     ];
 
+    /// The class's name in outputs (`success`, `wrong_orientation`, `collision`, `multi_contact`, `off_belt`, `jam`, `solver`).
     pub fn name(self) -> &'static str {
         match self {
             PartOutcome::Success => "success",
@@ -57,19 +66,28 @@ impl PartOutcome {
 /// Counts per class, serialised as an object with the classes in a fixed order.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct OutcomeCounts {
+    /// Parts that exited in the goal.
     pub success: u64,
+    /// Parts that exited outside the goal.
     pub wrong_orientation: u64,
+    /// Parts taken off by a part–part overlap.
     pub collision: u64,
+    /// Parts that touched two obstacles at once.
     pub multi_contact: u64,
+    /// Parts that fell off the belt's side.
     pub off_belt: u64,
+    /// Parts held for good by an obstacle.
     pub jam: u64,
+    /// Parts whose push the contact model could not finish.
     pub solver: u64,
 }
 
 impl OutcomeCounts {
+    /// Count one part of class `o`.
     pub fn add(&mut self, o: PartOutcome) {
         *self.get_mut(o) += 1;
     }
+    /// The count of class `o`.
     pub fn get(&self, o: PartOutcome) -> u64 {
         match o {
             PartOutcome::Success => self.success,
@@ -92,6 +110,7 @@ impl OutcomeCounts {
             PartOutcome::Solver => &mut self.solver,
         }
     }
+    /// All parts counted, over every class.
     pub fn total(&self) -> u64 {
         PartOutcome::ALL.iter().map(|&o| self.get(o)).sum()
     }

@@ -40,14 +40,23 @@ impl RunOptions {
 /// Why a run could not be carried out.
 #[derive(Debug, Error)]
 pub enum EngineError {
+    /// Part `index` could not be drawn from the feed (its random tripod support or the part model built on it failed).
     #[error("part {index}: {reason}")]
-    PartDraw { index: u64, reason: String },
+    PartDraw {
+        /// Index of the part in the stream.
+        index: u64,
+        /// Why it could not be drawn.
+        reason: String,
+    },
     /// An event time came out non-finite (NaN or ±∞): the scene's numbers leave f64. Validated
     /// scenarios never get here; the engine refuses instead of panicking.
     #[error("an event time is not finite ({kind:?} at {time} s; {refused} event(s) refused): the scene's numbers are out of range (see docs/scenario-format.md)")]
     NonFiniteTime {
+        /// The event's time (s): NaN or ±∞.
         time: f64,
+        /// The event that carried it.
         kind: EventKind,
+        /// Events refused this way in the run so far.
         refused: u64,
     },
 }
@@ -55,16 +64,25 @@ pub enum EngineError {
 /// One finished part.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PartRecord {
+    /// Index of the part in the stream (0-based).
     pub part: u64,
+    /// Arrival time (s).
     pub arrival_s: f64,
+    /// Time the part finished: exited, or failed (s).
     pub end_s: f64,
+    /// The outcome's name (`success`, `wrong_orientation`, …; see `PartOutcome::name`).
     pub outcome: &'static str,
     /// Cause behind multi_contact or solver, else empty.
     pub cause: &'static str,
+    /// Obstacle encounters (pushes) of the part.
     pub contacts: u32,
+    /// Orientation at entry (degrees, [0, 360)).
     pub theta_in_deg: f64,
+    /// Orientation at the end (degrees, [0, 360)).
     pub theta_out_deg: f64,
+    /// Lateral position of the centroid at entry (m).
     pub y_in_m: f64,
+    /// Lateral position of the centroid at the end (m).
     pub y_out_m: f64,
     /// Sensor decisions, `pin=decision (posterior)` separated by `; ` (empty without sensors).
     pub sensed: String,
@@ -73,8 +91,11 @@ pub struct PartRecord {
 /// The path of a sample part: world poses at successive instants (s, pose).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SamplePath {
+    /// Index of the part in the stream.
     pub part: u64,
+    /// How the part ended.
     pub outcome: PartOutcome,
+    /// World poses (x, y in m, θ in radians) at successive times (s), ascending.
     pub poses: Vec<(f64, Pose)>,
 }
 
@@ -85,22 +106,30 @@ pub struct SamplePath {
 pub struct CapturedPush {
     /// The obstacle's index in the scene.
     pub obstacle: usize,
+    /// The part's own contact model (a random tripod), None for the scene's model.
     pub model: Option<PartModel>,
+    /// The pin or fence that pushed.
     pub pusher: Pusher,
+    /// The part's world pose at the first touch.
     pub pose: Pose,
+    /// The contact-model settings of the push (the pin's μc, tolerance, fidelity).
     pub settings: ContactSettings,
+    /// Whether the line recorded the push's path as it computed it.
     pub recorded: bool,
 }
 
 /// Everything a run produces.
 #[derive(Debug, Clone)]
 pub struct RunResult {
+    /// The deterministic summary of the run.
     pub summary: Summary,
+    /// The raw accumulators the summary was built from.
     pub metrics: Metrics,
     /// Per-part records, if asked for.
     pub records: Vec<PartRecord>,
     /// Every event taken off the queue, if the scene's event log is on.
     pub events: Vec<Event>,
+    /// Paths of the first `RunOptions::sample_paths` parts.
     pub paths: Vec<SamplePath>,
     /// What the controller did (decisions, actuations, late ones), when the event log is on or
     /// sample paths are recorded; empty without dynamic pins.

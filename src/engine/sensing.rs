@@ -38,6 +38,7 @@ pub fn reading_stream(part: u64, obstacle: usize) -> u64 {
 pub struct SensedPass {
     /// The hypothesis the part really is (None: no hypothesis applies, e.g. no first feature).
     pub truth: Option<usize>,
+    /// What the sensor's classifier decided, with its posterior.
     pub classification: Classification,
     /// Knots the signal was built from.
     pub knots: usize,
@@ -95,6 +96,7 @@ pub fn nearest(degrees: &[f64], deg: f64) -> Option<usize> {
 pub struct SensorStats {
     /// The sensor pin's name.
     pub name: String,
+    /// Name of the sensor's classifier.
     pub classifier: String,
     /// Passes read.
     pub readings: u64,
@@ -107,6 +109,7 @@ pub struct SensorStats {
 }
 
 impl SensorStats {
+    /// Empty statistics for sensor pin `name`.
     pub fn new(name: &str, sensor: &SensorPin) -> SensorStats {
         SensorStats {
             name: name.to_string(),

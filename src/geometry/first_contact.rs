@@ -23,9 +23,17 @@ use serde::Serialize;
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Feature {
     /// Edge `index` (from vertex `index` to `index + 1`) at fraction `t` ∈ (0, 1) of its length.
-    Edge { index: usize, t: f64 },
+    Edge {
+        /// Index of the edge.
+        index: usize,
+        /// Fraction of the edge's length from its first vertex, in (0, 1).
+        t: f64,
+    },
     /// Vertex `index`.
-    Vertex { index: usize },
+    Vertex {
+        /// Index of the vertex.
+        index: usize,
+    },
 }
 
 /// Result of a first-contact query. Points and normals are in world coordinates.

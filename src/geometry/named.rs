@@ -18,12 +18,21 @@ use thiserror::Error;
 /// Why a part specification could not be turned into a polygon.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PartSpecError {
+    /// Not a known part name or form.
     #[error("unknown part '{0}'; expected one of tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], vertices:\"x1,y1 x2,y2 ...\"")]
     Unknown(String),
+    /// A known form with a parameter out of range or malformed (e.g. `ngon:2`).
     #[error("bad part '{spec}': {reason}")]
-    BadParameter { spec: String, reason: String },
+    BadParameter {
+        /// The specification as given.
+        spec: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// A `vertices:` list that does not parse as `x,y` pairs.
     #[error("bad vertex list: {0}")]
     BadVertexList(String),
+    /// The vertices do not make a valid polygon.
     #[error(transparent)]
     Polygon(#[from] PolygonError),
 }

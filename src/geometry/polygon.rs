@@ -29,33 +29,62 @@ use thiserror::Error;
 /// Why a vertex list is not a valid part.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PolygonError {
+    /// Fewer than 3 vertices.
     #[error("a polygon needs at least 3 vertices, got {count}")]
-    TooFewVertices { count: usize },
+    TooFewVertices {
+        /// Vertices given.
+        count: usize,
+    },
+    /// A coordinate is NaN or infinite.
     #[error("vertex {index} has a non-finite coordinate ({x}, {y}); every coordinate must be a finite number")]
-    NonFinite { index: usize, x: f64, y: f64 },
+    NonFinite {
+        /// Index of the vertex.
+        index: usize,
+        /// Its x.
+        x: f64,
+        /// Its y.
+        y: f64,
+    },
+    /// Two consecutive vertices coincide.
     #[error("vertex {index} repeats vertex {previous} (zero-length edge){hint}")]
     RepeatedVertex {
+        /// Index of the repeated vertex.
         index: usize,
+        /// Index of the vertex it repeats.
         previous: usize,
+        /// Advice appended to the message (e.g. when the last vertex repeats the first), or empty.
         hint: &'static str,
     },
+    /// All vertices are collinear, or the ring folds onto itself.
     #[error("the polygon has zero area (all vertices are collinear or it folds onto itself)")]
     ZeroArea,
+    /// A mass property over- or underflows f64 at the part's size.
     #[error("the part's {quantity} {direction} double precision at this size (a ≈ {a}): give the vertices in a unit where a lies between about 1e-70 and 1e70")]
     NotRepresentable {
+        /// Which quantity (e.g. `centroid`).
         quantity: &'static str,
+        /// `overflows` or `underflows`.
         direction: &'static str,
+        /// The part's size a, approximately, in decimal.
         a: String,
     },
+    /// A scale factor that is not positive and finite.
     #[error("scale factor must be a positive finite number, got {0}")]
     BadScale(f64),
+    /// Two non-adjacent edges intersect.
     #[error("the polygon is not simple: edge {edge_a} ({a0} -> {a1}) and edge {edge_b} ({b0} -> {b1}) intersect")]
     SelfIntersecting {
+        /// Index of the first edge.
         edge_a: usize,
+        /// Index of the second edge.
         edge_b: usize,
+        /// First vertex of `edge_a`.
         a0: usize,
+        /// Second vertex of `edge_a`.
         a1: usize,
+        /// First vertex of `edge_b`.
         b0: usize,
+        /// Second vertex of `edge_b`.
         b1: usize,
     },
 }
@@ -435,9 +464,11 @@ impl Polygon {
     pub fn vertices(&self) -> &[Vec2] {
         &self.vertices
     }
+    /// Number of vertices (at least 3).
     pub fn len(&self) -> usize {
         self.vertices.len()
     }
+    /// Always false: a valid polygon has at least 3 vertices.
     pub fn is_empty(&self) -> bool {
         self.vertices.is_empty()
     }
@@ -503,6 +534,7 @@ impl Polygon {
     pub fn radius(&self) -> f64 {
         self.radius
     }
+    /// Is the polygon convex?
     pub fn is_convex(&self) -> bool {
         self.convex
     }

@@ -11,13 +11,17 @@ use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 /// A vector (or point) in the plane.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Vec2 {
+    /// x coordinate (along the belt in the world frame).
     pub x: f64,
+    /// y coordinate (to the left of the belt's travel in the world frame).
     pub y: f64,
 }
 
 impl Vec2 {
+    /// The zero vector (the origin).
     pub const ZERO: Vec2 = Vec2 { x: 0.0, y: 0.0 };
 
+    /// The vector (x, y).
     #[inline]
     pub const fn new(x: f64, y: f64) -> Self {
         Vec2 { x, y }
@@ -28,6 +32,7 @@ impl Vec2 {
         let (s, c) = phi.sin_cos();
         Vec2 { x: c, y: s }
     }
+    /// Dot product.
     #[inline]
     pub fn dot(self, o: Vec2) -> f64 {
         self.x * o.x + self.y * o.y
@@ -51,6 +56,7 @@ impl Vec2 {
     pub fn norm(self) -> f64 {
         (self.x * self.x + self.y * self.y).sqrt()
     }
+    /// Squared length (no square root).
     #[inline]
     pub fn norm2(self) -> f64 {
         self.x * self.x + self.y * self.y
@@ -84,6 +90,7 @@ impl Vec2 {
     pub fn angle(self) -> f64 {
         self.y.atan2(self.x)
     }
+    /// Are both coordinates finite?
     #[inline]
     pub fn is_finite(self) -> bool {
         self.x.is_finite() && self.y.is_finite()
@@ -151,16 +158,21 @@ impl Neg for Vec2 {
 /// serialized as `theta`).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Pose {
+    /// x of the centroid (along the belt in the world frame).
     pub x: f64,
+    /// y of the centroid (to the left in the world frame).
     pub y: f64,
+    /// Rotation of the part frame (radians, counter-clockwise).
     #[serde(rename = "theta")]
     pub theta_rad: f64,
 }
 
 impl Pose {
+    /// The pose (x, y, θ in radians).
     pub const fn new(x: f64, y: f64, theta_rad: f64) -> Self {
         Pose { x, y, theta_rad }
     }
+    /// The centroid's position (x, y).
     #[inline]
     pub fn position(&self) -> Vec2 {
         Vec2::new(self.x, self.y)

@@ -123,7 +123,9 @@ pub fn coverage_share(arcs: &[Arc]) -> f64 {
 /// A predicted band: an arc and the share of the predicted angles that fall in it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct MassArc {
+    /// The arc of final angles.
     pub arc: Arc,
+    /// Share of the predicted angles in it, in [0, 1].
     pub mass: f64,
 }
 

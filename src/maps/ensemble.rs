@@ -41,12 +41,15 @@ pub struct EnsembleSpec {
     pub mu_c: Distribution,
     /// The non-uniform support model a member uses with probability `support_share`.
     pub support: SupportChoice,
+    /// Probability that a member uses `support` (in [0, 1]).
     pub support_share: f64,
     /// Pin radius of each member (the polygon's units).
     pub pin_radius: Distribution,
     /// Standard deviation of the θ0 error of each pass (degrees).
     pub jitter_deg: f64,
+    /// Contact-model fidelity of every pass.
     pub fidelity: Fidelity,
+    /// Integration tolerance of the contact model.
     pub tol: f64,
 }
 
@@ -183,9 +186,15 @@ fn parse_support(s: &str) -> Result<(SupportChoice, f64), String> {
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum InputState {
     /// Resting in stable state k (docs/physics.md#stable-states; the order of `pinfeed part`).
-    State { index: usize },
+    State {
+        /// Index of the stable state.
+        index: usize,
+    },
     /// θ0 uniform on an arc.
-    Theta { arc: Arc },
+    Theta {
+        /// The arc (degrees).
+        arc: Arc,
+    },
     /// θ0 uniform on the whole circle.
     All,
 }
@@ -221,9 +230,11 @@ pub fn stable_states_deg(poly: &Polygon) -> Vec<f64> {
 /// The values member i drew.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct MemberDraw {
+    /// Pin–part friction coefficient drawn.
     pub mu_c: f64,
     /// Does the member rest on the random support model (else uniform pressure)?
     pub random_support: bool,
+    /// Pin radius drawn (the polygon's units).
     pub pin_radius: f64,
     #[serde(skip)]
     support_seed: u64,
@@ -250,6 +261,7 @@ pub fn draw_member(spec: &EnsembleSpec, seed: u64, i: u64) -> Result<MemberDraw,
 
 /// One member: its draw and its compiled part.
 pub struct Member {
+    /// The values it drew.
     pub draw: MemberDraw,
     model: PartModel,
 }
@@ -324,8 +336,11 @@ pub fn members(
 /// An ensemble of maps: θf of every member at every (d, grid θ0).
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnsembleMaps {
+    /// Contact parameters mapped (units of a).
     pub ds: Vec<f64>,
+    /// The θ0 grid (degrees).
     pub grid: Vec<f64>,
+    /// The members' draws, in member order.
     pub members: Vec<MemberDraw>,
     /// θf (degrees), index (member · ds + d) · grid + θ0.
     pub theta_f: Vec<f64>,
@@ -383,7 +398,9 @@ pub fn ensemble_maps_observed(
 /// The predicted bands at one (d, input state).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PredictedBands {
+    /// The contact parameter (units of a).
     pub d: f64,
+    /// The input state's label (`state:K`, `theta:MIN:MAX` or `all`).
     pub input: String,
     /// Passes pooled.
     pub passes: usize,

@@ -16,16 +16,27 @@ pub const MAX_THREADS: usize = 1024;
 /// A map command out of its bounds.
 #[derive(Debug, thiserror::Error)]
 pub enum MapLimitError {
+    /// `--threads` above the limit (the value).
     #[error("--threads must lie in [0, {MAX_THREADS}] (0: one per core), got {0}")]
     Threads(usize),
+    /// More `--d` values than allowed (the count).
     #[error("--d takes at most {MAX_DS} contact parameters, got {0}")]
     Ds(usize),
+    /// `--theta-step` not a finite number of degrees in (0, 360] (the value).
     #[error("--theta-step: theta step must be a finite number of degrees in (0, 360] dividing 360, got {}", num(*.0))]
     ThetaStep(f64),
+    /// `--theta-step` does not make a valid θ0 grid.
     #[error("--theta-step: {0}")]
     Grid(MapError),
+    /// Too many contacts in one command.
     #[error("{maps} maps × {samples} θ0 samples = {} contacts; at most {MAX_CONTACTS} are allowed in one command (raise --theta-step or give fewer --d)", maps * samples)]
-    Contacts { maps: usize, samples: usize },
+    Contacts {
+        /// Maps asked for (one per d).
+        maps: usize,
+        /// θ0 samples per map.
+        samples: usize,
+    },
+    /// `--threshold` not a finite number of degrees in (0, 360] (the value).
     #[error("--threshold must be a finite number of degrees in (0, 360], got {}", num(*.0))]
     Threshold(f64),
 }

@@ -41,22 +41,36 @@ use serde::{Serialize, Serializer};
 /// Bad input to a map computation.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MapError {
+    /// Not a finite step in (0, 360] degrees (the value given).
     #[error("theta step must be a finite number of degrees in (0, 360], got {0}")]
     ThetaStep(f64),
+    /// The step (degrees) does not divide 360.
     #[error("theta step {0}° does not divide 360° into a whole number of samples")]
     ThetaStepNotDividing(f64),
+    /// The step gives more θ0 samples per map than allowed (the count).
     #[error("theta step gives {0} samples per map; at most {max} are allowed", max = sample::MAX_SAMPLES)]
     TooManySamples(usize),
+    /// Not a finite threshold in (0, 360] degrees (the value given).
     #[error("band threshold must be a finite number of degrees in (0, 360], got {0}")]
     Threshold(f64),
+    /// |d| is beyond the reach at which the pin can touch the part.
     #[error("contact parameter d = {d} is out of range: |d| must be at most {limit:.4} (beyond it the pin cannot touch the part)")]
-    ContactParameter { d: f64, limit: f64 },
+    ContactParameter {
+        /// The contact parameter given (units of a).
+        d: f64,
+        /// The largest |d| at which the pin touches (units of a).
+        limit: f64,
+    },
+    /// The list of contact parameters is empty.
     #[error("no contact parameter d given")]
     NoContactParameter,
+    /// The same contact parameter twice (the value).
     #[error("contact parameter d = {0} is given twice")]
     RepeatedContactParameter(f64),
+    /// A fence angle not strictly between −90 and 90 degrees (the value).
     #[error("fence angle must lie strictly between -90 and 90 degrees, got {0}")]
     FenceAngle(f64),
+    /// A fence length that is not positive (part units; the value).
     #[error("fence length must be a positive number (part units), got {0}")]
     FenceLength(f64),
 }
@@ -78,7 +92,9 @@ pub struct MapSettings {
     pub theta_step_deg: f64,
     /// Band threshold T (degrees): neighbouring final angles at least T apart start a new band.
     pub threshold_deg: f64,
+    /// The contact model's settings (fidelity, friction, tolerance).
     pub contact: ContactSettings,
+    /// The pin (its radius, in part units).
     pub pin: Pin,
     /// A fence instead of the pin (`pin` is then unused; `contact.mu_c` is the fence friction).
     pub fence: Option<MapFence>,
@@ -135,20 +151,25 @@ fn status_name<S: Serializer>(status: &ContactStatus, s: S) -> Result<S::Ok, S::
 /// One band B_j with its statistics (see [`bands`] for the definitions).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Band {
-    /// Lower and upper end of the final-angle arc (degrees; max < min when it straddles 0°).
+    /// Lower end of the final-angle arc (degrees; max < min when it straddles 0°).
     pub final_min_deg: f64,
+    /// Upper end of the final-angle arc (degrees).
     pub final_max_deg: f64,
     /// Arc length from min to max (degrees).
     pub width_deg: f64,
+    /// Mean final angle of the band (degrees, circular).
     pub mean_deg: f64,
+    /// Standard deviation of the band's final angles (degrees).
     pub sd_deg: f64,
-    /// The thesis's adjusted band, mean ± sd (eq. 3-2), wrapped.
+    /// Lower end of the thesis's adjusted band, mean − sd (eq. 3-2; degrees, wrapped).
     pub adjusted_min_deg: f64,
+    /// Upper end of the adjusted band, mean + sd (degrees, wrapped).
     pub adjusted_max_deg: f64,
     /// K_j: the θ0 runs feeding this band, [first, last] (degrees, on the grid).
     pub initial_ranges_deg: Vec<[f64; 2]>,
-    /// COM_j: range of the final centroid y (part units).
+    /// COM_j: smallest final centroid y (part units).
     pub com_y_min: f64,
+    /// Largest final centroid y (part units).
     pub com_y_max: f64,
     /// Number of samples in the band.
     pub samples: usize,
@@ -157,6 +178,7 @@ pub struct Band {
 /// The configuration map for one contact parameter d.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ConfigurationMap {
+    /// The contact parameter: the pin's lateral offset from the centroid's line (units of a).
     pub d: f64,
     /// One sample per grid θ0, in grid order.
     pub samples: Vec<MapSample>,

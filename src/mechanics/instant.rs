@@ -41,6 +41,7 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// The mode's name in outputs: `stick`, `slide_left`, `slide_right` or `slide`.
     pub fn name(self) -> &'static str {
         match self {
             Mode::Stick => "stick",
@@ -54,8 +55,11 @@ impl Mode {
 /// Contact geometry at one instant (part frame, normalised units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactGeom {
+    /// Contact point (part frame, normalised units).
     pub p: Vec2,
+    /// Unit contact normal into the part (part frame).
     pub n: Vec2,
+    /// The pin's velocity relative to the belt per unit of travel, rotated into the part frame.
     pub v_pin: Vec2,
     /// Where on the part the contact is, for the model's slide tables (`mechanics::slide_table`):
     /// an edge and ℓ, or a vertex and the normal's angle; `None` where no table applies (a
@@ -66,6 +70,7 @@ pub struct ContactGeom {
 /// The solved instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Instant {
+    /// Sticking or sliding (and to which side).
     pub mode: Mode,
     /// Part twist (part frame) scaled so that the normal velocity at the contact matches the pin's.
     pub twist: Twist,
@@ -80,10 +85,15 @@ pub struct Instant {
 /// converge for the contact's integration tolerance (`gap`, see [`final_gap`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Warm {
+    /// Warm start of the slide-left solve.
     pub left: Option<WarmTwist>,
+    /// Warm start of the slide-right solve.
     pub right: Option<WarmTwist>,
+    /// Warm start of the frictionless (normal) solve.
     pub normal: Option<WarmTwist>,
+    /// Warm start of the stick solve.
     pub stick: Option<WarmStick>,
+    /// How closely the exact solves must converge (from the integration tolerance; see `final_gap`).
     pub gap: f64,
 }
 
@@ -115,12 +125,14 @@ impl Warm {
 /// (precomputed: the cone edges are needed at every instant).
 #[derive(Debug, Clone, Copy)]
 pub struct Friction {
+    /// Pin–part friction coefficient μc (≥ 0).
     pub mu_c: f64,
     sin_phi: f64,
     cos_phi: f64,
 }
 
 impl Friction {
+    /// The friction of a contact with coefficient `mu_c` (≥ 0).
     pub fn new(mu_c: f64) -> Friction {
         let c = 1.0 / (1.0 + mu_c * mu_c).sqrt();
         Friction {

@@ -10,7 +10,9 @@ use serde::Serialize;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(tag = "kind", content = "index", rename_all = "snake_case")]
 pub enum ContactFeature {
+    /// Edge `k` of the polygon (from vertex k to k + 1).
     Edge(usize),
+    /// Vertex `k` of the polygon.
     Vertex(usize),
     /// A vertex of the part's convex hull sliding or sticking on a fence line (hull index).
     FenceVertex(usize),
@@ -42,14 +44,18 @@ impl ContactFeature {
 /// A stretch of contact with one feature in one mode.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Segment {
+    /// The feature in contact.
     pub feature: ContactFeature,
+    /// Sticking or sliding (and to which side).
     pub mode: Mode,
-    /// Pin travel (belt frame, caller's units) at the start and end of the segment.
+    /// Pin travel (belt frame, caller's units) at the start of the segment.
     pub s_begin: f64,
+    /// Pin travel at the end of the segment (belt frame, caller's units).
     pub s_end: f64,
-    /// Part orientation (radians, unwrapped) at the start and end.
+    /// Part orientation (radians, unwrapped) at the start.
     #[serde(rename = "theta_begin")]
     pub theta_begin_rad: f64,
+    /// Part orientation at the end (radians, unwrapped).
     #[serde(rename = "theta_end")]
     pub theta_end_rad: f64,
 }
@@ -62,34 +68,65 @@ pub enum ContactStatus {
     Ok,
     /// The pin touches the part at two places at once (a concave notch): the single-contact model
     /// stops here rather than mis-simulate; `pose_final` is the pose at that moment.
-    MultiContact { s: f64 },
+    MultiContact {
+        /// Pin travel where it stopped (caller's units).
+        s: f64,
+    },
     /// The pin started inside the part.
     PinInsidePart,
     /// The part was still being pushed after the travel limit (e.g. a metastable push through the
     /// centroid that never turns): the part rides on the pin.
-    TravelLimit { travel: f64 },
+    TravelLimit {
+        /// The travel limit reached (caller's units).
+        travel: f64,
+    },
     /// Too much work in one pass: limit-surface evaluations plus right-hand sides (the budget is
     /// a setting; a right-hand side served by a slide table costs no evaluation but counts here).
-    EvaluationLimit { evaluations: u64 },
+    EvaluationLimit {
+        /// Work done when the budget ran out.
+        evaluations: u64,
+    },
     /// Too many contact events (mode chattering).
-    EventLimit { events: u32 },
+    EventLimit {
+        /// Events handled when the limit was hit.
+        events: u32,
+    },
     /// The integrator's step fell below its floor (a non-smooth spot it cannot resolve).
-    StepTooSmall { s: f64 },
+    StepTooSmall {
+        /// Pin travel where it stopped (caller's units).
+        s: f64,
+    },
     /// A limit-surface sub-problem failed.
-    Solver { failure: SolveFailure, s: f64 },
+    Solver {
+        /// What failed.
+        failure: SolveFailure,
+        /// Pin travel where it failed (caller's units).
+        s: f64,
+    },
     /// The part jammed against a fence (α + atan μf ≥ 90°): it stops in the world while the belt
     /// slips under it, and would stay there for ever. `pose_final` is where it stopped.
-    Jam { s: f64 },
+    Jam {
+        /// Pin travel where the part stopped (caller's units).
+        s: f64,
+    },
     /// The contact model's own consistency check failed: the computed state contradicts the
     /// contact it was computed for (see [`SelfCheck`]). The result is not trustworthy; `pose_final`
     /// is the last state that passed the check.
-    SelfCheck { check: SelfCheck, s: f64 },
+    SelfCheck {
+        /// Which check failed.
+        check: SelfCheck,
+        /// Pin travel where it failed (caller's units).
+        s: f64,
+    },
     /// The push rode an unstable equilibrium (its force line through the centroid: a tie in
     /// Mason's vote) for `travel` of pin travel, turning slower than the tolerance resolves, and
     /// then the part fell off to one side. Which side is decided by rounding and the tolerance, not
     /// by the inputs, so `pose_final` is one of two possible outcomes. (Still riding at the travel
     /// limit is [`ContactStatus::TravelLimit`].)
-    Metastable { travel: f64 },
+    Metastable {
+        /// Pin travel spent on the equilibrium (caller's units).
+        travel: f64,
+    },
 }
 
 /// Which consistency check a contact failed (each is cheap and runs on every contact).
@@ -106,6 +143,7 @@ pub enum SelfCheck {
 }
 
 impl SelfCheck {
+    /// Short machine-readable name: `off_feature`, `penetration` or `non_finite`.
     pub fn name(self) -> &'static str {
         match self {
             SelfCheck::OffFeature => "off_feature",
@@ -116,6 +154,7 @@ impl SelfCheck {
 }
 
 impl ContactStatus {
+    /// Did the pass end as it should (`ContactStatus::Ok`)?
     pub fn is_ok(&self) -> bool {
         matches!(self, ContactStatus::Ok)
     }
@@ -155,11 +194,13 @@ pub struct ContactOutcome {
     pub contact_length: f64,
     /// Number of separate contacts during the pass (a concave part may be struck twice).
     pub contacts: u32,
+    /// The contact's segments, in order of travel.
     pub segments: Vec<Segment>,
     /// Limit-surface evaluations (exact model: dissipation evaluations; closed forms: solves).
     pub evaluations: u64,
     /// Accepted integration steps.
     pub steps: u32,
+    /// How the computation ended.
     pub status: ContactStatus,
 }
 
@@ -168,8 +209,11 @@ pub struct ContactOutcome {
 pub struct TraceSample {
     /// Pin travel relative to the belt.
     pub s: f64,
+    /// The part's pose (belt frame).
     pub pose: Pose,
+    /// The pin's centre (belt frame).
     pub pin_centre: Vec2,
+    /// The contact point (belt frame).
     pub contact_point: Vec2,
     /// Force the pin applies to the part (world axes), in units of the part's weight m g: the
     /// contact model's force (units of μs m g) times μs, so it scales with μs while the motion
@@ -179,12 +223,15 @@ pub struct TraceSample {
     pub normal: Vec2,
     /// Rotation rate dθ/ds (radians per unit of pin travel, caller's units).
     pub rotation_rate: f64,
+    /// Sticking or sliding (and to which side).
     pub mode: Mode,
+    /// The feature in contact.
     pub feature: ContactFeature,
 }
 
 /// Receives the trajectory of a contact. With no recorder attached nothing is collected.
 pub trait Recorder {
+    /// Receive one sample (called at every accepted step and at both sides of every event).
     fn record(&mut self, sample: &TraceSample);
 }
 

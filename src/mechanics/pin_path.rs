@@ -16,7 +16,9 @@ use serde::Serialize;
 /// speed is `w` (a fraction of the belt speed).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Turn {
+    /// Pin travel where the speed changes (caller's units, from the start of the pass).
     pub s: f64,
+    /// Lateral speed from `s` on (a fraction of the belt speed, signed: + is +y).
     pub w: f64,
 }
 
@@ -97,10 +99,12 @@ impl PinPath {
         PinPath::new(0.0, turns)
     }
 
+    /// Lateral speed before the first turn (a fraction of the belt speed).
     pub fn initial_speed(&self) -> f64 {
         self.w0
     }
 
+    /// The turns, in increasing travel.
     pub fn turns(&self) -> &[Turn] {
         &self.turns
     }

@@ -14,6 +14,7 @@ pub struct Pin {
 }
 
 impl Pin {
+    /// A fixed point pin (radius 0, no lateral speed): the thesis's pin.
     pub fn point() -> Pin {
         Pin {
             radius: 0.0,
@@ -25,6 +26,7 @@ impl Pin {
 /// Settings of the contact model.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ContactSettings {
+    /// Which model computes the push (exact, ellipsoid or tip).
     pub fidelity: Fidelity,
     /// Pin–part (contact) friction coefficient μc ≥ 0.
     pub mu_c: f64,

@@ -79,7 +79,9 @@ pub const EDGE_REACH: f64 = 0.25;
 /// (also the frictionless normal force when μc = 0) and on the clockwise one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Side {
+    /// Force on the counter-clockwise cone edge (also the frictionless normal force).
     Left = 0,
+    /// Force on the clockwise cone edge.
     Right = 1,
 }
 
@@ -95,7 +97,9 @@ pub enum SlideAt {
 /// A table's place on the part: an edge or a vertex (by index).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Place {
+    /// Edge k.
     Edge(usize),
+    /// Vertex k.
     Vertex(usize),
 }
 
@@ -125,8 +129,11 @@ struct Node {
 /// the Hessian of D at the nearer node (for warm-starting a later solve that is not served).
 #[derive(Debug, Clone, Copy)]
 pub struct TableTwist {
+    /// The normalised twist (w·ξ = 1).
     pub twist: Twist,
+    /// The multiplier λ: the force is λ f.
     pub lambda: f64,
+    /// The Hessian of D at the nearer node.
     pub hess: [[f64; 3]; 3],
 }
 

@@ -23,8 +23,9 @@ pub struct PinAction {
     pub y_q: i32,
     /// Lateral position of the pin's centre (m).
     pub y_m: f64,
-    /// The interval of positions (m) that act the same way qualitatively: [lo, hi].
+    /// Lower end of the interval of positions that act the same way qualitatively (m).
     pub lo_m: f64,
+    /// Upper end of that interval (m).
     pub hi_m: f64,
     /// Distance from `y_m` to the nearer edge of the interval (m).
     pub margin_m: f64,
@@ -34,7 +35,9 @@ pub struct PinAction {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Action {
+    /// A fixed pin.
     Pin(PinAction),
+    /// A fence.
     Fence(super::fences::FenceAction),
 }
 

@@ -8,8 +8,10 @@ use std::path::Path;
 /// Why a plan could not be checked.
 #[derive(Debug, thiserror::Error)]
 pub enum CheckError {
+    /// The emitted scenario does not compile.
     #[error("the emitted scenario does not compile: {0}")]
     Scenario(#[from] crate::scenario::ScenarioError),
+    /// The engine refused to run the plan.
     #[error("the line could not run the plan: {0}")]
     Engine(#[from] crate::engine::EngineError),
 }
@@ -101,8 +103,10 @@ pub fn check_uncertain(
 /// Why the plan could not be run under its uncertainty.
 #[derive(Debug, thiserror::Error)]
 pub enum UncertainCheckError {
+    /// The study file could not be written.
     #[error("writing the study: {0}")]
     Io(#[from] std::io::Error),
+    /// The Monte Carlo study failed.
     #[error("the plan's uncertainty study failed: {0}")]
     Study(#[from] crate::study::mc::StudyError),
 }

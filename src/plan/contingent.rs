@@ -44,22 +44,26 @@ use std::time::Instant;
 pub struct BranchPlan {
     /// The hypothesis label (`orientation_label` of the stable state).
     pub label: String,
+    /// The stable state's orientation (degrees).
     pub stable_deg: f64,
     /// The branch's pin actions, one per moving pin it uses (the rest are parked).
     pub pins: Vec<PinAction>,
     /// Lateral position (m) of every moving pin for this branch (parked ones included).
     pub targets_m: Vec<f64>,
-    /// Particles of the branch inside the goal window at the end, and the branch's total.
+    /// Particles of the branch inside the goal window at the end.
     pub inside: u32,
+    /// Particles of the branch.
     pub total: u32,
 }
 
 /// A contingent plan.
 #[derive(Debug, Clone, Serialize)]
 pub struct ContingentPlan {
+    /// The sensor pin that reads the stable state.
     pub sensor: PinAction,
     /// Moving pins.
     pub k: usize,
+    /// One branch per hypothesis of the sensor, in hypothesis order.
     pub branches: Vec<BranchPlan>,
     /// The goal window's centre (degrees).
     pub centre_deg: f64,
@@ -99,14 +103,18 @@ impl ContingentPlan {
 /// How the contingent search ended.
 #[derive(Debug, Clone)]
 pub enum ContingentOutcome {
+    /// A plan reaching the goal.
     Found(ContingentPlan),
     /// No sensor position and continuations of at most `depth` moving pins reach the goal.
     NoneUpTo {
+        /// Most moving pins tried.
         depth: usize,
     },
     /// A limit ended the search after `depth_completed` levels.
     LimitHit {
+        /// The limit that ended it, in words (e.g. `time limit 110 s`).
         limit: String,
+        /// Levels (moving pins) completed before it.
         depth_completed: usize,
     },
 }
@@ -114,11 +122,15 @@ pub enum ContingentOutcome {
 /// Statistics of the contingent search.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct ContingentStats {
+    /// Sensor positions tried.
     pub sensor_candidates: usize,
     /// States kept over every (sensor, branch) search, per level.
     pub states_per_depth: Vec<usize>,
+    /// Levels (moving pins) completed.
     pub depth_completed: usize,
+    /// Wall time of the search (s).
     pub elapsed_s: f64,
+    /// Peak resident memory of the process (bytes; None where it cannot be read).
     pub peak_rss_bytes: Option<u64>,
 }
 

@@ -27,9 +27,13 @@ fn num(x: f64, digits: usize) -> String {
 /// output folder), the seconds between parts, the belt width (m) and the feed's part count.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineSpec {
+    /// The scenario's `name` (names its output folder).
     pub name: String,
+    /// Seconds between parts.
     pub headway_s: f64,
+    /// Belt width (m).
     pub belt_width_m: f64,
+    /// Parts in the feed.
     pub parts: u64,
 }
 

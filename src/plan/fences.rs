@@ -31,15 +31,17 @@ use std::collections::HashMap;
 pub struct FenceAction {
     /// Angle from the belt direction (degrees; > 0 runs downstream to the left).
     pub angle_deg: f64,
-    /// Lateral position of the upstream end (m) and of the downstream end (m).
+    /// Lateral position of the upstream end (m).
     pub y0_m: f64,
+    /// Lateral position of the downstream end (m).
     pub y1_m: f64,
     /// Length along the fence (m).
     pub length_m: f64,
     /// Fence–part friction μf.
     pub mu_f: f64,
-    /// The upstream end's positions that act the same way qualitatively: [lo, hi] (m).
+    /// Lower end of the upstream end's positions that act the same way qualitatively (m).
     pub lo_m: f64,
+    /// Upper end of that interval (m).
     pub hi_m: f64,
     /// Distance from `y0_m` to the interval's edge at the parts (m).
     pub margin_m: f64,
@@ -105,12 +107,15 @@ type FenceOutcome = Option<(f64, f64, bool, f64)>;
 
 /// Fence transitions with their memo.
 pub struct FenceTransition {
+    /// The fence planner's settings.
     pub options: FenceOptions,
     memo: HashMap<FenceKey, FenceOutcome>,
+    /// Fence passes computed (memo misses).
     pub computed: u64,
 }
 
 impl FenceTransition {
+    /// A transition with an empty memo.
     pub fn new(options: FenceOptions) -> FenceTransition {
         FenceTransition {
             options,

@@ -72,13 +72,21 @@ pub enum PlanError {
     /// from, without its unit suffix: `tolerance`, `pin_radius`, `modes`, …).
     #[error("{field} {value}: {reason}")]
     Input {
+        /// The quantity at fault (without its unit suffix).
         field: &'static str,
+        /// The value given.
         value: String,
+        /// Why it is refused.
         reason: String,
     },
     /// The part could not be built or compiled.
     #[error("part '{part}': {reason}")]
-    Part { part: String, reason: String },
+    Part {
+        /// The part specification as given.
+        part: String,
+        /// Why it could not be built.
+        reason: String,
+    },
 }
 
 impl PlanError {

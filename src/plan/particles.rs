@@ -38,7 +38,9 @@ pub struct Particle {
 /// A search state: sorted, merged particles and the weight lost so far.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct State {
+    /// The particles, sorted and merged (equal ones add their weights).
     pub particles: Vec<Particle>,
+    /// Weight of the particles lost so far (a failed pass, or pushed off the belt).
     pub lost: u32,
 }
 

@@ -28,10 +28,17 @@ impl FeedKind {
 /// An uncertain-μc range that is not `LO:HI` with two numbers.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RangeSpecError {
+    /// The range is not two values separated by `:`.
     #[error("'{0}': expected LO:HI, e.g. 0.3:0.7")]
     Form(String),
+    /// A bound of the range is not a number.
     #[error("'{spec}': '{token}' is not a number")]
-    Number { spec: String, token: String },
+    Number {
+        /// The range as given.
+        spec: String,
+        /// The bound that is not a number.
+        token: String,
+    },
 }
 
 /// Parse an uncertain μc range `LO:HI` (its bounds are checked with the problem).
@@ -55,6 +62,7 @@ pub struct Problem {
     pub part: String,
     /// Metres per unit of the part's coordinates.
     pub scale: f64,
+    /// How parts arrive: in their stable states, or uniformly oriented.
     pub feed: FeedKind,
     /// Standard deviation of the orientation jitter of a stable feed (degrees).
     pub jitter_deg: f64,
@@ -62,6 +70,7 @@ pub struct Problem {
     pub lateral_m: f64,
     /// Particles per stable state: `jitter_samples` orientations × `offset_samples` offsets.
     pub jitter_samples: usize,
+    /// Lateral offsets per orientation (stratified over ±`lateral_m`).
     pub offset_samples: usize,
     /// Orientations of a uniform feed (each with `offset_samples` offsets).
     pub orientation_samples: usize,
@@ -97,11 +106,13 @@ pub struct Problem {
     /// Branch and bound ([`super::bound`]): do not expand states that cannot beat the best
     /// effort within the pins left. Off, every state is expanded (same outcome, more work).
     pub bound: bool,
-    /// Search limits: most distinct states kept, and wall time (s).
+    /// Search limit: most distinct states kept.
     pub max_states: usize,
+    /// Wall-time limit of the search (s).
     pub time_limit_s: f64,
     /// Integration tolerance of the contact model while planning.
     pub contact_tol: f64,
+    /// Seed of the planner's random draws (feed particles, physics samples) and of the emitted scenario; the same seed gives the same plan.
     pub seed: u64,
     /// Extra feed particles (θ degrees, y metres) after the stratified ones: parts the line
     /// check found failing, added where the abstraction missed them (see [`super::design`]).

@@ -36,7 +36,9 @@ use std::time::Instant;
 /// One pin of a plan and what the particles look like after it.
 #[derive(Debug, Clone, Serialize)]
 pub struct PlanStep {
+    /// The pin (or fence) placed at this step.
     pub action: Action,
+    /// The particles after it.
     #[serde(skip)]
     pub state: State,
     /// Best window after this pin.
@@ -50,16 +52,21 @@ pub struct PlanStep {
 /// A plan: the pins in belt order and the states they lead through.
 #[derive(Debug, Clone, Serialize)]
 pub struct Plan {
+    /// The feed's particles, before any pin.
     #[serde(skip)]
     pub initial: State,
+    /// Best window of the feed.
     pub initial_window: Window,
+    /// Orientation sets of the feed (`usize::MAX`, written null, when the lost particles alone miss the target).
     #[serde(serialize_with = "sets_or_null")]
     pub initial_sets: usize,
+    /// One step per pin, in belt order.
     pub steps: Vec<PlanStep>,
     /// The goal window (the final best window).
     pub window: Window,
     /// Predicted success: the share of the particles inside the goal window.
     pub predicted_success: f64,
+    /// Orientation sets at the end (`usize::MAX`, written null, when none reaches the target).
     #[serde(serialize_with = "sets_or_null")]
     pub sets: usize,
 }
@@ -80,15 +87,28 @@ pub enum Outcome {
     Found(Plan),
     /// Every plan of at most `depth` pins was tried; none reaches the goal. `best`: the shortest
     /// of the plans that bring the most particles into one window (a best effort, if any pin helps).
-    NoneUpTo { depth: usize, best: Option<Plan> },
+    NoneUpTo {
+        /// The deepest level tried (pins).
+        depth: usize,
+        /// The best effort, if any pin helps.
+        best: Option<Plan>,
+    },
     /// After `depth` pins no new state appeared: no plan exists at any depth in this action set
     /// (`best` as for `NoneUpTo`).
-    Exhausted { depth: usize, best: Option<Plan> },
+    Exhausted {
+        /// The level after which no new state appeared.
+        depth: usize,
+        /// The best effort, if any pin helps.
+        best: Option<Plan>,
+    },
     /// A limit ended the search after `depth_completed` full levels (`best`: with `fewest_sets`
     /// the fewest sets so far, otherwise the most particles in one window so far).
     LimitHit {
+        /// The limit that ended it, in words (e.g. `time limit 110 s`).
         limit: String,
+        /// Levels fully expanded before it.
         depth_completed: usize,
+        /// The best plan so far.
         best: Option<Plan>,
     },
 }
@@ -96,24 +116,31 @@ pub enum Outcome {
 /// Search statistics.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct SearchStats {
-    /// Particles of the initial state (before merging) and physics samples.
+    /// Particles of the initial state (before merging).
     pub particles: u32,
+    /// Physics samples (μc and support draws) each push is computed for.
     pub physics_samples: usize,
     /// New states per level kept open for expansion (level 0 = the feed); states the bound cut
     /// are counted in `pruned`.
     pub states_per_depth: Vec<usize>,
     /// Levels fully expanded.
     pub depth_completed: usize,
+    /// States expanded.
     pub expanded: u64,
-    /// Successors generated (before deduplication) and those already seen.
+    /// Successors generated (before deduplication).
     pub generated: u64,
+    /// Successors already seen (dropped).
     pub duplicates: u64,
     /// Actions not taken and new states not expanded because they cannot beat the best effort
     /// within the pins left (branch and bound, [`super::bound`]).
     pub pruned: u64,
+    /// Mean actions tried per expansion.
     pub actions_per_expansion: f64,
+    /// Contact passes computed, memo hits and the like.
     pub pushes: PushCounters,
+    /// Entries of the transition's memo.
     pub memo_entries: usize,
+    /// Wall time of the search (s).
     pub elapsed_s: f64,
     /// States' and memo's bytes (estimate).
     pub memory_estimate_bytes: usize,
@@ -131,9 +158,13 @@ pub fn peak_rss_bytes() -> Option<u64> {
 
 /// A planner: the checked problem, the transition with its memo, and the feed's state.
 pub struct Planner {
+    /// The problem, as given.
     pub problem: Problem,
+    /// Its derived data: the part in metres, its stable states and grids.
     pub compiled: Compiled,
+    /// The pin transition with its memo of pushes.
     pub transition: Transition,
+    /// The feed's particles.
     pub initial: State,
     /// With fences: the fence actions replace the pin actions (or, with `hybrid`, join them).
     pub fences: Option<super::fences::FenceTransition>,
@@ -148,6 +179,7 @@ struct Node {
 }
 
 impl Planner {
+    /// Check `problem` and build the part, its memo and the feed's particles; Err names the bad field or the part that cannot be built.
     pub fn new(problem: &Problem) -> Result<Planner, PlanError> {
         let compiled = problem.compile()?;
         let n = super::particles::feed_samples(problem, &compiled).len();

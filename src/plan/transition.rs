@@ -38,7 +38,9 @@ pub const FAILED: u32 = 1;
 /// The physics one particle carries.
 #[derive(Debug, Clone)]
 pub struct PhysicsSample {
+    /// The part's contact model under this sample's support.
     pub model: Arc<PartModel>,
+    /// Pin–part friction coefficient of this sample.
     pub mu_c: f64,
     /// The tripod's points (m, part frame) and weights, if any (for reports).
     pub support: Support,
@@ -47,6 +49,7 @@ pub struct PhysicsSample {
 /// The outcome of one pass, as the planner keeps it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PassOutcome {
+    /// Qualitative signature: `NO_CONTACT`, `FAILED`, or (≥ 2) a hash of the features touched and the sense of rotation.
     pub signature: u32,
     /// Final orientation (degrees, [0, 360)).
     pub theta_deg: f64,
@@ -81,9 +84,11 @@ pub struct Transition {
     coarse: usize,
     /// Largest |y_pin − y| (quanta) at which the pin can touch.
     pub reach_q: i32,
+    /// The physics samples the particles draw from (one without robustness options).
     pub samples: Vec<PhysicsSample>,
     memo: HashMap<PassKey, PassOutcome>,
     columns: HashMap<(u32, i32), Arc<Vec<u32>>>,
+    /// Work done so far.
     pub counters: PushCounters,
     /// Past this instant no pass is computed: [`Transition::expired`] turns true and the batch
     /// in progress is dropped (a search then stops with its time limit).

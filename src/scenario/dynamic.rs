@@ -10,8 +10,9 @@ pub struct MovingSpec {
     pub home: f64,
     /// The lateral range its centre may reach, [min, max] (m), over the belt.
     pub travel: [f64; 2],
-    /// Speed limit (m/s) and acceleration limit (m/s²), both > 0.
+    /// Speed limit (m/s, > 0).
     pub speed: f64,
+    /// Acceleration limit (m/s², > 0).
     pub accel: f64,
     /// Time after a move before the pin counts as ready (s).
     pub settle: f64,
@@ -24,15 +25,18 @@ pub struct MovingSpec {
 pub struct RetractSpec {
     /// Its state before any command.
     pub raised: bool,
-    /// Time to rise and to withdraw (s).
+    /// Time to rise (s).
     pub raise_time: f64,
+    /// Time to withdraw (s).
     pub lower_time: f64,
 }
 
 /// What moves a pin, if anything does.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Actuator {
+    /// A pin that translates across the belt.
     Moving(MovingSpec),
+    /// A pin that is raised or withdrawn per part.
     Retractable(RetractSpec),
 }
 
@@ -56,6 +60,7 @@ pub enum OnLate {
 }
 
 impl OnLate {
+    /// The setting's name in the file: `"skip"` or `"move"`.
     pub fn name(self) -> &'static str {
         match self {
             OnLate::Skip => "skip",
@@ -68,9 +73,13 @@ impl OnLate {
 /// `pin` to `target` for that part.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rule {
+    /// The sensor pin whose decision triggers the rule (index into `Scene::obstacles`).
     pub sensor: usize,
+    /// The decision that triggers it: an index into the sensor's hypotheses, `None` for "unknown".
     pub decides: Option<usize>,
+    /// The dynamic pin the rule commands (index into `Scene::obstacles`).
     pub pin: usize,
+    /// Where that pin is to be for the part.
     pub target: Target,
 }
 
@@ -109,7 +118,9 @@ pub struct Controller {
     pub latency: f64,
     /// A decision whose posterior is below this counts as no decision.
     pub min_posterior: f64,
+    /// What a command that cannot finish before its part arrives does.
     pub on_late: OnLate,
+    /// The rules, from `[[rules]]` and the policy file.
     pub rules: Vec<Rule>,
     /// Where the rules came from: "scenario" or the policy file's path.
     pub source: String,

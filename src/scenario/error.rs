@@ -14,7 +14,9 @@ pub enum ScenarioError {
     /// (The cause is in the message, not a `source`, so that it is printed once.)
     #[error("{}: cannot read the scenario: {error}", path.display())]
     Io {
+        /// The file that could not be read.
         path: PathBuf,
+        /// Why it could not be read.
         error: std::io::Error,
     },
     /// The file is not valid TOML, or a key or value is wrong.
@@ -25,9 +27,11 @@ pub enum ScenarioError {
 /// A located problem in a scenario file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InvalidScenario {
+    /// The scenario (or policy) file at fault, as given.
     pub file: PathBuf,
-    /// 1-based line and column of the key or value at fault.
+    /// 1-based line of the key or value at fault.
     pub line: usize,
+    /// 1-based column (in characters) of the key or value at fault.
     pub column: usize,
     /// The key path at fault, e.g. `belt.speed` or `obstacles[1].kind`.
     pub key: String,
@@ -67,14 +71,18 @@ impl ScenarioError {
 
 /// Builds located errors for one source file.
 pub struct Locator<'a> {
+    /// The file, as named in messages.
     pub file: &'a Path,
+    /// The file's whole text.
     pub source: &'a str,
+    /// The file's spanned TOML tree, to locate key paths.
     pub doc: SpannedDoc<'a>,
     /// What the file is, as a missing key's message names it ("the scenario", "a policy file").
     pub what: &'static str,
 }
 
 impl<'a> Locator<'a> {
+    /// A locator for a scenario file.
     pub fn new(file: &'a Path, source: &'a str) -> Locator<'a> {
         Locator {
             file,

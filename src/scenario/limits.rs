@@ -96,11 +96,14 @@ pub const ACTUATOR_ACCEL: (f64, f64) = (1e-6, 1e6);
 /// Actuator and controller times: settle, raise and lower times, decision latency (s).
 pub const ACTUATOR_TIME: (f64, f64) = (0.0, 1e4);
 
-/// `[controller.belief]`: lateral-offset bins, members per hypothesis, positions per moving pin
-/// on the online controller's action grid, friction values (bounded build time and memory).
+/// `[controller.belief] offsets`: lateral-offset bins over the feed's lateral range. The belief
+/// limits bound the online controller's build time and memory.
 pub const BELIEF_OFFSETS: (f64, f64) = (1.0, 41.0);
+/// `[controller.belief] samples`: simulated members per hypothesis.
 pub const BELIEF_SAMPLES: (f64, f64) = (1.0, 64.0);
+/// `[controller.belief] targets`: positions per moving pin on the action grid.
 pub const BELIEF_TARGETS: (f64, f64) = (2.0, 101.0);
+/// `[controller.belief] mu_c`: the most friction values.
 pub const BELIEF_MU_VALUES: usize = 16;
 
 #[cfg(test)]

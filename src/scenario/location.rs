@@ -12,7 +12,9 @@ use toml::Spanned;
 /// One step of a key path: a table key or an array index.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum PathStep {
+    /// A table key.
     Key(String),
+    /// An array index (0-based).
     Index(usize),
 }
 
@@ -21,6 +23,7 @@ pub enum PathStep {
 pub struct KeyPath(pub Vec<PathStep>);
 
 impl KeyPath {
+    /// The empty path (the document root).
     pub fn root() -> KeyPath {
         KeyPath(Vec::new())
     }
@@ -44,16 +47,19 @@ impl KeyPath {
         }
         KeyPath(steps)
     }
+    /// This path extended by table key `k`.
     pub fn key(&self, k: &str) -> KeyPath {
         let mut p = self.clone();
         p.0.push(PathStep::Key(k.to_string()));
         p
     }
+    /// This path extended by array index `i`.
     pub fn index(&self, i: usize) -> KeyPath {
         let mut p = self.clone();
         p.0.push(PathStep::Index(i));
         p
     }
+    /// Is this the empty path?
     pub fn is_root(&self) -> bool {
         self.0.is_empty()
     }
@@ -91,6 +97,7 @@ pub struct SpannedDoc<'a> {
 }
 
 impl<'a> SpannedDoc<'a> {
+    /// Parse `source` (a file that is not valid TOML gives a tree that locates nothing).
     pub fn parse(source: &'a str) -> SpannedDoc<'a> {
         SpannedDoc {
             root: DeTable::parse(source).ok(),

@@ -14,19 +14,29 @@ pub struct RawScenario {
     pub name: Option<String>,
     /// Seed of the run (default 1).
     pub seed: Option<u64>,
+    /// `[belt]` (required).
     pub belt: Option<RawBelt>,
+    /// `[part]` (required).
     pub part: Option<RawPart>,
+    /// `[feed]` (required).
     pub feed: Option<RawFeed>,
+    /// `[[obstacles]]`: pins and fences, in file order (their default names count in this order).
     #[serde(default)]
     pub obstacles: Vec<RawObstacle>,
+    /// `[goal]`: which final orientations count as correct (default: none are goals).
     pub goal: Option<RawGoal>,
+    /// `[model]`: contact-model fidelity and accuracy.
     #[serde(default)]
     pub model: RawModel,
+    /// `[effects]`: optional engine work (collisions, sweeps, event log).
     #[serde(default)]
     pub effects: RawEffects,
+    /// `[output]`: which files a run writes.
     #[serde(default)]
     pub output: RawOutput,
+    /// `[controller]`: how sensor decisions become actuator commands.
     pub controller: Option<RawController>,
+    /// `[[rules]]`: sensor decision → pin target rules for the policy controller.
     #[serde(default)]
     pub rules: Vec<RawRule>,
 }
@@ -36,8 +46,11 @@ pub struct RawScenario {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawBelt {
+    /// Belt speed (m/s, in [1e-4, 10]).
     pub speed: f64,
+    /// Belt width (m, in [1e-9, 1000], at least the part's 2a).
     pub width: f64,
+    /// Usable belt length (m, in [1e-9, 10⁴]).
     pub length: f64,
 }
 
@@ -56,7 +69,9 @@ pub enum SupportKind {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawPart {
+    /// A named part (`tripoly1`, `tripoly2`, `square`, `rect:W:H`, `ngon:N`, `lshape`); exactly one of `shape` and `vertices` is given.
     pub shape: Option<String>,
+    /// The part's vertices `[x, y]` in shape units (scaled by `scale`), instead of `shape`.
     pub vertices: Option<Vec<[f64; 2]>>,
     /// Metres per unit of the shape's coordinates.
     pub scale: Option<f64>,
@@ -66,6 +81,7 @@ pub struct RawPart {
     pub mu_s: Option<f64>,
     /// Part mass (kg, default 0.05): turns the contact model's forces into newtons for sensors.
     pub mass: Option<f64>,
+    /// How the weight rests on the belt (default uniform pressure).
     #[serde(default)]
     pub support: SupportKind,
 }
@@ -74,7 +90,9 @@ pub struct RawPart {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ArrivalKind {
+    /// Parts arrive every `headway` seconds, the first at t = 0.
     Periodic,
+    /// Arrivals form a Poisson process with mean spacing `headway`.
     Poisson,
 }
 
@@ -82,7 +100,9 @@ pub enum ArrivalKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum OrientationKind {
+    /// Uniform on [0°, 360°).
     Uniform,
+    /// One of the part's stable states, drawn by `weights`, plus `jitter`.
     Stable,
 }
 
@@ -90,8 +110,11 @@ pub enum OrientationKind {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LateralKind {
+    /// Always `value`.
     Fixed,
+    /// Uniform on [`min`, `max`].
     Uniform,
+    /// Normal with `mean` and `sd`, redrawn until the part lies on the belt.
     Normal,
 }
 
@@ -99,17 +122,21 @@ pub enum LateralKind {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawFeed {
+    /// Number of parts (1 to 10⁹).
     pub parts: u64,
+    /// Periodic or Poisson arrivals.
     pub arrival: ArrivalKind,
     /// Seconds between arrivals (the mean, for Poisson).
     pub headway: Option<f64>,
     /// Arrivals per second (alternative to headway).
     pub rate: Option<f64>,
+    /// How the entry orientation is drawn.
     pub orientation: OrientationKind,
     /// Relative weights of the stable states (orientation = "stable"), in the order `pinfeed part` lists them.
     pub weights: Option<Vec<f64>>,
     /// Standard deviation of a normal perturbation of the orientation (degrees).
     pub jitter: Option<f64>,
+    /// `[feed.lateral]`: the entry offset (default fixed at 0).
     pub lateral: Option<RawLateral>,
 }
 
@@ -117,11 +144,17 @@ pub struct RawFeed {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawLateral {
+    /// Which distribution the offset follows; it decides which of the keys below apply.
     pub distribution: LateralKind,
+    /// The offset for `fixed` (m).
     pub value: Option<f64>,
+    /// Lower bound for `uniform` (m).
     pub min: Option<f64>,
+    /// Upper bound for `uniform` (m).
     pub max: Option<f64>,
+    /// Mean for `normal` (m).
     pub mean: Option<f64>,
+    /// Standard deviation for `normal` (m, at most the belt width).
     pub sd: Option<f64>,
 }
 
@@ -129,10 +162,15 @@ pub struct RawLateral {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ObstacleKind {
+    /// A fixed pin.
     Pin,
+    /// A fixed pin carrying a force/torque or timing sensor (`[obstacles.sensor]`).
     SensorPin,
+    /// A pin that moves across the belt under the controller's commands.
     MovingPin,
+    /// A pin that the controller raises or withdraws per part.
     RetractablePin,
+    /// A straight fence (a segment with no thickness).
     Fence,
 }
 
@@ -142,10 +180,13 @@ pub enum ObstacleKind {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawObstacle {
+    /// What the obstacle is; decides which keys apply.
     pub kind: ObstacleKind,
+    /// A unique name (default `pinN` / `fenceN`, N the position in the list).
     pub name: Option<String>,
-    /// Position of the pin's centre, or of the fence's upstream end (m, world frame).
+    /// Position along the belt of the pin's centre, or of the fence's upstream end (m, world frame).
     pub x: Option<f64>,
+    /// Lateral position of the pin's centre, or of the fence's upstream end (m, |y| ≤ width/2).
     pub y: Option<f64>,
     /// Pin radius (m; 0 is a point pin).
     pub radius: Option<f64>,
@@ -160,16 +201,21 @@ pub struct RawObstacle {
     pub mu_f: Option<f64>,
     /// `[obstacles.sensor]`: the sensor of a `sensor_pin` (or of a `moving_pin`).
     pub sensor: Option<RawSensor>,
-    /// A moving pin's lateral range [min, max] (m), speed (m/s) and acceleration (m/s²) limits,
-    /// settle time (s) and the pieces an acceleration phase is resolved into.
+    /// Moving pin: its lateral range [min, max] (m, over the belt, holding the home `y`).
     pub travel: Option<[f64; 2]>,
+    /// Moving pin: speed limit (m/s, in [1e-6, 10³] and at most 1000 × belt speed).
     pub speed: Option<f64>,
+    /// Moving pin: acceleration limit (m/s², in [1e-6, 10⁶]).
     pub accel: Option<f64>,
+    /// Moving pin: settle time after each move (s, in [0, 10⁴], default 0).
     pub settle: Option<f64>,
+    /// Moving pin: constant-speed pieces per acceleration phase for the contact model (1 to 64, default 8).
     pub pieces: Option<u32>,
-    /// A retractable pin's state before any command, and its switching times (s).
+    /// Retractable pin: its state before any command (default true: raised).
     pub raised: Option<bool>,
+    /// Retractable pin: time to raise (s, in [0, 10⁴], default 0.1).
     pub raise_time: Option<f64>,
+    /// Retractable pin: time to withdraw (s, in [0, 10⁴], default 0.1).
     pub lower_time: Option<f64>,
 }
 
@@ -195,10 +241,15 @@ pub struct RawController {
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RawBelief {
+    /// Pin–part friction hypotheses (1 to 16 values in [0, 5]; default the part's mu_c).
     pub mu_c: Option<Vec<f64>>,
+    /// Support hypotheses (default: the part's support).
     pub support: Option<Vec<SupportKind>>,
+    /// Lateral-offset bins over the feed's lateral range (1 to 41, default 5).
     pub offsets: Option<usize>,
+    /// Simulated members per hypothesis (1 to 64, default 4).
     pub samples: Option<usize>,
+    /// Positions per moving pin over its travel in the action grid (2 to 101, default 25).
     pub targets: Option<usize>,
 }
 
@@ -207,10 +258,15 @@ pub struct RawBelief {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawRule {
+    /// Name of the sensor pin whose decision triggers the rule.
     pub sensor: String,
+    /// The decision that triggers it: a hypothesis label such as `"135°"`, or `"unknown"`.
     pub decides: String,
+    /// Name of the moving or retractable pin the rule commands.
     pub pin: String,
+    /// Target y of a moving pin (m, within its travel).
     pub y: Option<f64>,
+    /// Target state of a retractable pin (true: raised).
     pub raised: Option<bool>,
 }
 
@@ -218,7 +274,9 @@ pub struct RawRule {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawPolicy {
+    /// Name of the part the policy was planned for; must be the scenario's part.
     pub part: String,
+    /// The policy's rules, as `[[rules]]` in a scenario.
     #[serde(default)]
     pub rules: Vec<RawRule>,
 }
@@ -231,19 +289,33 @@ pub struct RawSensor {
     /// `ft` (force/torque, default) or `timing`.
     #[serde(rename = "type")]
     pub kind: Option<crate::sensing::SensorKind>,
+    /// Sample rate (Hz, in [1, 10⁵]).
     pub rate: Option<f64>,
+    /// Height of the sensor origin above the contact (m, in [0, 10]); torques are taken about it.
     pub height: Option<f64>,
+    /// White-noise standard deviation per force channel (N, in [0, 10⁶]).
     pub noise_force: Option<f64>,
+    /// White-noise standard deviation per torque channel (N·mm, in [0, 10⁹]).
     pub noise_torque: Option<f64>,
+    /// Constant force bias (N, within ±10⁶).
     pub bias_force: Option<f64>,
+    /// Constant torque bias (N·mm, within ±10⁹).
     pub bias_torque: Option<f64>,
+    /// Force drift (N/s, within ±10⁶).
     pub drift_force: Option<f64>,
+    /// Torque drift (N·mm/s, within ±10⁹).
     pub drift_torque: Option<f64>,
+    /// Quantisation step of Fx, Fy (N, in [0, 10³]; 0: none).
     pub resolution_force: Option<f64>,
+    /// Quantisation step of Fz (N, in [0, 10³]; 0: none).
     pub resolution_force_z: Option<f64>,
+    /// Quantisation step of the torques (N·mm, in [0, 10⁶]; 0: none).
     pub resolution_torque: Option<f64>,
+    /// Cut-off of a first-order low-pass filter before quantisation (Hz, in [10⁻³, 10⁶]; default none).
     pub lowpass: Option<f64>,
+    /// Timing sensor: the force magnitude that marks contact (N, in [10⁻⁹, 10⁶]).
     pub threshold: Option<f64>,
+    /// Timing sensor: standard deviation of each reported instant (s, in [0, 10]).
     pub jitter: Option<f64>,
     /// Classifier name (default `likelihood` for F/T, `timing` for a timing sensor).
     pub classifier: Option<String>,
@@ -259,7 +331,9 @@ pub struct RawSensor {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum RawHypotheses {
+    /// `"stable"` or `"vertex-edge"`.
     Named(String),
+    /// Explicit orientations (degrees).
     Degrees(Vec<f64>),
 }
 
@@ -270,6 +344,7 @@ pub struct RawGoal {
     /// Every exiting part counts as correctly oriented.
     #[serde(default)]
     pub any: bool,
+    /// Named sets of target orientations; a part is correct if it matches any of them.
     #[serde(default)]
     pub sets: Vec<RawGoalSet>,
 }
@@ -278,8 +353,11 @@ pub struct RawGoal {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawGoalSet {
+    /// Name of the set in reports (default: its position).
     pub name: Option<String>,
+    /// Target orientations (degrees, within ±360).
     pub orientations: Vec<f64>,
+    /// Tolerance around each target (degrees, in [0, 180], default 5).
     pub tolerance: Option<f64>,
 }
 
@@ -287,10 +365,12 @@ pub struct RawGoalSet {
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawModel {
+    /// Contact-model fidelity (default exact).
     pub fidelity: Option<RawFidelity>,
     /// The map tier's grid (`fidelity = "map"` only): [θ0 base cells, d base cells, refinement
     /// depth].
     pub map_grid: Option<[u32; 3]>,
+    /// Integration tolerance of the contact model (in [1e-10, 0.01], default 1e-6).
     pub tol: Option<f64>,
     /// Largest pin travel in contact, in units of a, before a part counts as jammed.
     pub max_travel: Option<f64>,
@@ -301,9 +381,13 @@ pub struct RawModel {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RawFidelity {
+    /// The tip model (docs/physics.md#fidelity-tiers).
     Tip,
+    /// The ellipsoidal limit-surface model.
     Ellipsoid,
+    /// The exact limit-surface model.
     Exact,
+    /// The certified map tier over the exact model.
     Map,
 }
 

@@ -32,11 +32,15 @@ pub struct PartSpec {
     pub radius: f64,
     /// Compiled once for uniform support; a tripod part gets its own model per part.
     pub model: PartModel,
+    /// Uniform pressure, or a random tripod per part.
     pub support: SupportKind,
+    /// Default pin–part friction coefficient (a pin's own `mu_c` overrides it).
     pub mu_c: f64,
+    /// Part–belt friction coefficient (scales the contact forces only, not the motion).
     pub mu_s: f64,
     /// Mass (kg): sensors turn forces into newtons with it.
     pub mass: f64,
+    /// The part's stable states (uniform support), in the order `pinfeed part` lists them.
     pub stable_states: Vec<StableState>,
 }
 
@@ -44,9 +48,15 @@ pub struct PartSpec {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Arrival {
     /// One part every `headway` seconds, the first at t = 0.
-    Periodic { headway: f64 },
+    Periodic {
+        /// Seconds between arrivals (> 0).
+        headway: f64,
+    },
     /// Exponential gaps with mean `headway` seconds, the first at t = 0.
-    Poisson { headway: f64 },
+    Poisson {
+        /// Mean seconds between arrivals (> 0).
+        headway: f64,
+    },
 }
 
 impl Arrival {
@@ -65,8 +75,11 @@ pub enum Orientation {
     Uniform,
     /// A stable state chosen with the given (normalised) weights, plus normal jitter (its sd).
     Stable {
+        /// The stable states' orientations (radians), in the order of `PartSpec::stable_states`.
         thetas_rad: Vec<f64>,
+        /// One weight per state, normalised to sum to 1.
         weights: Vec<f64>,
+        /// Standard deviation of the normal jitter added to the state (radians, ≥ 0).
         jitter_rad: f64,
     },
 }
@@ -74,16 +87,24 @@ pub enum Orientation {
 /// Distribution of the centroid's lateral position at entry (m).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Lateral {
+    /// Always this offset (m).
     Fixed(f64),
+    /// Uniform on [min, max] (m).
     Uniform {
+        /// Lower bound (m).
         min: f64,
+        /// Upper bound (m).
         max: f64,
     },
     /// Normal, redrawn until it falls within [lo, hi] (the belt minus the part's radius).
     Normal {
+        /// Mean (m).
         mean: f64,
+        /// Standard deviation (m).
         sd: f64,
+        /// Lowest accepted draw (m).
         lo: f64,
+        /// Highest accepted draw (m).
         hi: f64,
     },
 }
@@ -91,15 +112,20 @@ pub enum Lateral {
 /// The feed: number of parts and how each is drawn.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Feed {
+    /// Number of parts to run (≥ 1).
     pub parts: u64,
+    /// When parts arrive.
     pub arrival: Arrival,
+    /// How each part's entry orientation is drawn.
     pub orientation: Orientation,
+    /// How each part's entry lateral offset is drawn.
     pub lateral: Lateral,
 }
 
 /// A fixed pin over the belt, with an optional sensor (`kind = "sensor_pin"` in the file).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PinObstacle {
+    /// Unique obstacle name (from the file, or `pinN`).
     pub name: String,
     /// Centre, world frame (m).
     pub centre: Vec2,
@@ -117,17 +143,24 @@ pub struct PinObstacle {
 /// (compiled once with the scene; see [`super::sensors`]).
 #[derive(Clone)]
 pub struct SensorPin {
+    /// Sample rate, noise, bias, filtering and quantisation of the sensor.
     pub settings: SensorSettings,
     /// Classifier name (one of [`crate::sensing::classify::NAMES`]).
     pub classifier_name: String,
+    /// The states the classifier tells apart.
     pub hypotheses: Hypotheses,
+    /// One display label per hypothesis (e.g. `"135°"`), in the order of `hypotheses`.
     pub labels: Vec<String>,
+    /// Simulated templates per hypothesis the classifier was trained on.
     pub templates_per_hypothesis: usize,
+    /// Decide "unknown" below this posterior (in [0, 1]; 0 never rejects).
     pub reject_below: f64,
-    /// The contact parameter d the templates were simulated at (the pin against the feed's
-    /// mean lateral offset), and the spread of d they were drawn with.
+    /// The contact parameter d the templates were simulated at (units of a: the pin against the
+    /// feed's mean lateral offset).
     pub template_d: f64,
+    /// Standard deviation of d the templates were drawn with (units of a, from the feed's lateral spread).
     pub template_d_sd: f64,
+    /// The trained classifier, shared by every run of the scene.
     pub classifier: Arc<dyn Classifier>,
 }
 
@@ -166,6 +199,7 @@ impl PartialEq for SensorPin {
 /// only "side" a fence has.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FenceObstacle {
+    /// Unique obstacle name (from the file, or `fenceN`).
     pub name: String,
     /// Upstream end, world frame (m).
     pub start: Vec2,
@@ -197,11 +231,14 @@ impl FenceObstacle {
 /// format's `pin`, `sensor_pin`, `moving_pin` and `retractable_pin`) or a fence.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Obstacle {
+    /// A pin (fixed, sensing, moving or retractable).
     Pin(PinObstacle),
+    /// A straight fence.
     Fence(FenceObstacle),
 }
 
 impl Obstacle {
+    /// The obstacle's unique name.
     pub fn name(&self) -> &str {
         match self {
             Obstacle::Pin(p) => &p.name,
@@ -242,8 +279,11 @@ impl Obstacle {
 /// A named set of target orientations (radians) with a tolerance (radians).
 #[derive(Debug, Clone, PartialEq)]
 pub struct GoalSet {
+    /// Name of the set in reports.
     pub name: String,
+    /// Target orientations (radians).
     pub orientations_rad: Vec<f64>,
+    /// Tolerance around each target (radians, ≥ 0).
     pub tolerance_rad: f64,
 }
 
@@ -273,38 +313,54 @@ impl Goal {
 /// Optional work, switched per scene (effects are opt-in: a scene pays only for what it asks for).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Effects {
+    /// Detect part–part overlap while two or more parts share the belt.
     pub collisions: bool,
+    /// Check obstacles within reach of a pushing one for a second contact.
     pub obstacle_sweeps: bool,
+    /// Record every event (written to `events.json`).
     pub event_log: bool,
 }
 
 /// Output options.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputOptions {
+    /// Folder under which `<scene name>/` is written (relative to the working folder).
     pub dir: String,
+    /// Write one CSV row per part.
     pub parts_csv: bool,
+    /// Write the final-orientation histogram as SVG.
     pub histogram_svg: bool,
     /// Histogram bin width (degrees).
     pub histogram_bin_deg: f64,
+    /// How many sample parts `--draw` shows (1 to 20).
     pub draw_parts: u32,
 }
 
 /// A compiled, validated scenario.
 #[derive(Debug, Clone)]
 pub struct Scene {
+    /// Scene name (names the results folder).
     pub name: String,
+    /// Seed of the run; part i draws from its own stream (seed, i), so the same seed gives the same parts.
     pub seed: u64,
+    /// The belt's speed and extent.
     pub belt: Belt,
+    /// The part's geometry and contact model.
     pub part: PartSpec,
+    /// How many parts arrive, when and how posed.
     pub feed: Feed,
+    /// Pins and fences, in file order (indices used throughout the engine).
     pub obstacles: Vec<Obstacle>,
     /// For each obstacle, the other obstacles a part in contact with it could touch (their
     /// distance, between the pins' discs and the fences' segments, is at most 2a), ascending.
     pub neighbours: Vec<Vec<usize>>,
+    /// Which final orientations count as correct.
     pub goal: Goal,
     /// Contact-model settings; a pin's own μc replaces `mu_c` for its contacts.
     pub contact: ContactSettings,
+    /// Optional engine work switched on.
     pub effects: Effects,
+    /// Which files a run writes.
     pub output: OutputOptions,
     /// The controller driving the dynamic pins (`[controller]` and `[[rules]]`), if any.
     pub controller: Option<Controller>,

@@ -24,16 +24,28 @@ use thiserror::Error;
 pub enum FeedMismatch {
     /// Another part: the stream would differ.
     #[error("its part ({found}) is not the reference's ({reference}): the same part stream needs the same shape, scale and support")]
-    Part { reference: String, found: String },
+    Part {
+        /// The reference's part (label, a and support).
+        reference: String,
+        /// This scene's part, described the same way.
+        found: String,
+    },
     /// The reference feeds parts wider than this belt allows.
     #[error("the reference feed puts centroids up to {need:.6} m from the centre line, beyond this belt's {reach:.6} m (half its width minus the part's a)")]
-    Lateral { need: f64, reach: f64 },
+    Lateral {
+        /// The farthest centroid offset from the centre line the reference feeds (m).
+        need: f64,
+        /// The farthest this belt allows: half its width minus the part's a (m).
+        reach: f64,
+    },
 }
 
 /// The feed, seed and part of a reference scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeedSource {
+    /// The reference's feed, which replaces each scene's own.
     pub feed: Feed,
+    /// The reference's seed, which replaces each scene's own.
     pub seed: u64,
     polygon: Polygon,
     support: SupportKind,

@@ -23,19 +23,20 @@ struct Cell {
 
 /// The lattice geometry of a map.
 #[derive(Debug, Clone, Copy)]
-pub struct Lattice {
-    /// Lattice points per base cell and axis.
-    pub per_cell: u64,
-    pub theta_points: u64,
-    pub d_points: u64,
-    pub reach: f64,
+struct Lattice {
+    /// Lattice points along θ0 over the whole map.
+    theta_points: u64,
+    /// Lattice points along d over the whole map.
+    d_points: u64,
+    /// Half-width r of the d range (units of a).
+    reach: f64,
 }
 
 impl Lattice {
-    pub fn theta(&self, i: u64) -> f64 {
+    fn theta(&self, i: u64) -> f64 {
         std::f64::consts::TAU * i as f64 / self.theta_points as f64
     }
-    pub fn d(&self, j: u64) -> f64 {
+    fn d(&self, j: u64) -> f64 {
         -self.reach + 2.0 * self.reach * j as f64 / self.d_points as f64
     }
 }
@@ -253,7 +254,6 @@ fn build_cells(map: &mut TierMap, inputs: &TierInputs, todo: &[usize]) {
     let per_cell = 1u64 << (spec.max_depth + 2);
     let (nt, nd) = (u64::from(spec.theta_cells), u64::from(spec.d_cells));
     let lat = Lattice {
-        per_cell,
         theta_points: nt * per_cell,
         d_points: nd * per_cell,
         reach: map.reach,

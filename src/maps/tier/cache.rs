@@ -22,14 +22,23 @@ const MAGIC: &[u8; 16] = b"PINFEED-MAPTIER\n";
 /// Why a cache file was not used.
 #[derive(Debug, thiserror::Error)]
 pub enum CacheError {
+    /// The file exists but is corrupted, stale, or for another map; it is not used.
     #[error(
         "map cache file {path} is corrupted or stale ({reason}); it is refused and the map rebuilt"
     )]
-    Refused { path: PathBuf, reason: String },
+    Refused {
+        /// The cache file.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// The file could not be read or written.
     /// (The cause is in the message, not a `source`, so that it is printed once.)
     #[error("map cache file {path}: {error}")]
     Io {
+        /// The cache file.
         path: PathBuf,
+        /// Why it could not be read or written.
         error: std::io::Error,
     },
 }
@@ -42,16 +51,25 @@ pub enum Source {
     /// Read from a cache file.
     Disk(PathBuf),
     /// Built now (`cells` base cells, added to those a cache file held), in `seconds`.
-    Built { seconds: f64, cells: u64 },
+    Built {
+        /// Wall time of the build (s).
+        seconds: f64,
+        /// Base cells built now.
+        cells: u64,
+    },
 }
 
 /// A map ready for use, where it came from, and what went wrong on the way (a refused file, a
 /// file that could not be written): never fatal.
 #[derive(Debug, Clone)]
 pub struct Loaded {
+    /// The map.
     pub map: Arc<TierMap>,
+    /// Where it came from.
     pub source: Source,
+    /// Its cache file (None without a cache folder).
     pub file: Option<PathBuf>,
+    /// What went wrong on the way (a refused or unwritable file), in words; never fatal.
     pub warnings: Vec<String>,
 }
 

@@ -83,10 +83,15 @@ impl Default for TierSpec {
 /// and the grid.
 #[derive(Debug, Clone, Copy)]
 pub struct TierInputs<'a> {
+    /// The part's contact model (its normalised polygon and support).
     pub model: &'a PartModel,
+    /// The part's support.
     pub support: &'a Support,
+    /// Pin radius (the caller's units, as the model takes it).
     pub radius: f64,
+    /// Contact settings (μc, tolerance, budgets).
     pub settings: ContactSettings,
+    /// The map's grid.
     pub spec: TierSpec,
 }
 
@@ -99,8 +104,9 @@ pub struct Sample {
     pub feature: u32,
     /// Signed rotation (radians).
     pub rotation: f64,
-    /// Centroid displacement (units of a).
+    /// Centroid displacement along the belt (units of a).
     pub dx: f64,
+    /// Centroid displacement across the belt (units of a).
     pub dy: f64,
     /// Pin travel from first touch to separation (units of a).
     pub span: f64,
@@ -111,9 +117,15 @@ pub struct Sample {
 pub enum Node {
     /// Split in four: children at `first`..`first + 4` (θ-low d-low, θ-high d-low, θ-low d-high,
     /// θ-high d-high).
-    Split { first: u32 },
+    Split {
+        /// Index of the first child in `TierMap::nodes`.
+        first: u32,
+    },
     /// Certified: interpolate through these 3 × 3 node samples (θ-major within each d row).
-    Certified { points: [u32; 9] },
+    Certified {
+        /// Indices into `TierMap::samples`.
+        points: [u32; 9],
+    },
     /// Not certified at the finest level: the exact model answers here.
     Fallback,
     /// A base cell not built yet ([`build::extend`] builds base cells on demand: a single query
@@ -126,8 +138,9 @@ pub enum Node {
 pub struct BuildStats {
     /// Exact pushes computed.
     pub exact_samples: u64,
-    /// Certified and fallback leaves.
+    /// Certified leaves.
     pub certified_cells: u64,
+    /// Fallback leaves (uncertified at the finest level).
     pub fallback_cells: u64,
     /// Fraction of the (θ0, d) rectangle covered by certified cells.
     pub certified_area: f64,
@@ -138,12 +151,17 @@ pub struct BuildStats {
 /// A built map: the base grid, the quadtrees (roots first, θ-major), the corner samples.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TierMap {
+    /// Hash of everything the map depends on (names its cache file).
     pub key: TierKey,
+    /// The grid it was built on.
     pub spec: TierSpec,
     /// Half-width r of the d range (units of a).
     pub reach: f64,
+    /// The quadtree nodes, roots first (θ-major).
     pub nodes: Vec<Node>,
+    /// The exact samples the certified cells interpolate.
     pub samples: Vec<Sample>,
+    /// How it was built.
     pub stats: BuildStats,
 }
 

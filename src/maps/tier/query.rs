@@ -32,6 +32,7 @@ pub enum Fallback {
 }
 
 impl Fallback {
+    /// The reason's name in the summary's counters (`uncertified`, `pin_inside`, `trace`, …).
     pub fn name(self) -> &'static str {
         match self {
             Fallback::Uncertified => "uncertified",

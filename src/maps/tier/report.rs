@@ -62,10 +62,13 @@ pub fn served_line(
 /// A `--map-grid` that is not three whole numbers in range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GridError {
+    /// A value that is not a whole number (the text given).
     #[error("--map-grid '{0}': expected T,D,DEPTH (whole numbers)")]
     Numbers(String),
+    /// Not three values (the text given).
     #[error("--map-grid '{0}': expected three numbers T,D,DEPTH")]
     Count(String),
+    /// A value outside [4, 720] × [2, 200] × [0, 8] (θ0 cells, d cells, depth).
     #[error("--map-grid must lie in [4, 720] × [2, 200] × [0, 8], got {0},{1},{2}")]
     Range(u32, u32, u32),
 }

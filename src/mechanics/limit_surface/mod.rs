@@ -27,8 +27,11 @@ pub use uniform::UniformSurface;
 ///   all zeros when it was not requested.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dissipation {
+    /// D(ξ) (units: velocity).
     pub value: f64,
+    /// ∇D = [fx, fy, m] (see above).
     pub grad: [f64; 3],
+    /// The Hessian of D (zeros when not requested).
     pub hess: [[f64; 3]; 3],
 }
 

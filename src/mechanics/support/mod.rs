@@ -39,6 +39,7 @@ impl Default for SmoothParams {
 /// How the part's weight rests on the belt in a sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SupportChoice {
+    /// Uniform pressure over the footprint.
     Uniform,
     /// A random tripod per sample.
     Tripod,
@@ -47,6 +48,7 @@ pub enum SupportChoice {
 }
 
 impl SupportChoice {
+    /// The choice in words, as reports print it (e.g. `uniform pressure`).
     pub fn describe(&self) -> String {
         match self {
             SupportChoice::Uniform => "uniform pressure".into(),

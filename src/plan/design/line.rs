@@ -13,25 +13,32 @@ use std::time::Instant;
 /// Why a candidate could not be run on the line.
 #[derive(Debug, thiserror::Error)]
 pub enum LineError {
+    /// The emitted scenario does not compile.
     #[error("the emitted scenario does not compile: {0}")]
     Scenario(#[from] crate::scenario::ScenarioError),
+    /// The engine refused to run the design.
     #[error("the line could not run the design: {0}")]
     Engine(#[from] crate::engine::EngineError),
+    /// A design file could not be written.
     #[error("writing the design's files to {path}: {source}")]
     Io {
+        /// The file.
         path: PathBuf,
+        /// Why it could not be written.
         source: std::io::Error,
     },
 }
 
 /// A scratch folder for a design's files while it is checked (a policy file must exist beside
 /// the scenario that names it); removed when dropped.
-pub struct Scratch {
-    pub dir: PathBuf,
+pub(crate) struct Scratch {
+    /// The folder (under the system's temporary folder).
+    pub(crate) dir: PathBuf,
 }
 
 impl Scratch {
-    pub fn new() -> Result<Scratch, LineError> {
+    /// Create a fresh folder `pinfeed-design-<process>-<n>` in the system's temporary folder; Err if it cannot be created.
+    pub(crate) fn new() -> Result<Scratch, LineError> {
         static NEXT: AtomicU64 = AtomicU64::new(0);
         let dir = std::env::temp_dir().join(format!(
             "pinfeed-design-{}-{}",
@@ -52,11 +59,13 @@ impl Drop for Scratch {
     }
 }
 
-/// A scenario with the feed's headway as a parameter: its text is `before` + headway + `after`
-/// (the `headway = …` line of `[feed]`), with an optional policy file written beside it.
+/// A scenario with the feed's headway as a parameter (the `headway = …` line of `[feed]` is
+/// replaced per run), with an optional policy file written beside it.
 #[derive(Debug, Clone)]
 pub struct Runnable {
+    /// The scenario's text, whose `headway = …` line `with_headway` replaces.
     pub toml: String,
+    /// The policy file the scenario names, if any: (file name, text).
     pub policy: Option<(String, String)>,
 }
 
@@ -79,7 +88,7 @@ impl Runnable {
     }
 
     /// Run `parts` parts at headway `h` with `seed`, keeping per-part records if asked.
-    pub fn run(
+    pub(crate) fn run(
         &self,
         scratch: &Scratch,
         h: f64,
@@ -143,7 +152,7 @@ pub type HeadwayProbe = (f64, u64, u64, f64);
 /// the probes. (Short headways fail by collisions, and on lines with moving pins by pins that
 /// cannot reach the next part's position in time.)
 #[allow(clippy::too_many_arguments)]
-pub fn shortest_headway(
+pub(crate) fn shortest_headway(
     r: &Runnable,
     scratch: &Scratch,
     (lo, hi): (f64, f64),

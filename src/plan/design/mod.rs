@@ -15,7 +15,7 @@
 //!
 //! Then the candidates the screen holds at the target are taken in the order of the objective
 //! ([`Objective`]); for each, the line's own spacing of parts is found by simulation
-//! ([`line::shortest_headway`]: the shortest headway without collisions, with a reserve) and the
+//! (`line::shortest_headway`: the shortest headway without collisions, with a reserve) and the
 //! full line check (`check_parts` parts at that headway) decides: the first that holds the target
 //! is **confirmed** and chosen. If none is, the best the line measured is chosen and reported as
 //! **not confirmed**, with its number; with no plan at all the result is **no design**.
@@ -66,6 +66,7 @@ impl Mode {
         .collect()
     }
 
+    /// The mode's name in outputs and options: `pins`, `fences`, `hybrid` or `sensor`.
     pub fn name(self) -> &'static str {
         match self {
             Mode::Pins => "pins",
@@ -132,9 +133,11 @@ impl Default for FenceSettings {
 /// Everything a design needs. [`DesignOptions::new`] gives the defaults.
 #[derive(Debug, Clone)]
 pub struct DesignOptions {
+    /// The part, feed, goal and search settings the designs are planned for.
     pub problem: Problem,
     /// The modes tried, in this order.
     pub modes: Vec<Mode>,
+    /// What "best" means among the confirmed designs.
     pub objective: Objective,
     /// Parts of the full line check (0: no check; the design is then unchecked).
     pub check_parts: u64,
@@ -144,9 +147,11 @@ pub struct DesignOptions {
     pub refine: usize,
     /// Wall-time limit of the whole design (s).
     pub time_limit_s: f64,
+    /// Fence settings of the fence and hybrid modes.
     pub fences: FenceSettings,
-    /// Sensor mode: most moving pins, sensor positions tried.
+    /// Sensor mode: most moving pins.
     pub max_moving: usize,
+    /// Sensor mode: sensor positions tried.
     pub sensor_candidates: usize,
     /// Was the belt width given? If not, the fence and hybrid modes may use a wider belt.
     pub belt_width_given: bool,
@@ -219,6 +224,7 @@ pub enum Status {
 }
 
 impl Status {
+    /// The verdict in words: `confirmed`, `not confirmed`, `unchecked` or `no design`.
     pub fn word(self) -> &'static str {
         match self {
             Status::Confirmed => "confirmed",
@@ -232,14 +238,19 @@ impl Status {
 /// A run of the line.
 #[derive(Debug, Clone, Serialize)]
 pub struct LineCheck {
+    /// Parts run.
     pub parts: u64,
+    /// Parts that ended in success.
     pub success: u64,
+    /// `success` / `parts`.
     pub success_rate: f64,
     /// 95% Wilson interval of the success rate.
     pub ci95: [f64; 2],
+    /// Parts per final outcome.
     pub outcomes: OutcomeCounts,
     /// Seconds between parts.
     pub headway_s: f64,
+    /// Wall time the run took (s).
     pub elapsed_s: f64,
 }
 
@@ -248,13 +259,16 @@ pub struct LineCheck {
 pub struct ObstacleInfo {
     /// pin | fence | sensor_pin | moving_pin
     pub kind: &'static str,
+    /// The obstacle's name in the emitted scenario.
     pub name: String,
     /// Along the belt (m; a fence's upstream end).
     pub x_m: f64,
     /// Across the belt (m; a fence's upstream end, a moving pin's home).
     pub y_m: f64,
+    /// A fence's angle from the belt direction (degrees; None for pins).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub angle_deg: Option<f64>,
+    /// A fence's length (m; None for pins).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub length_m: Option<f64>,
     /// A moving pin's lateral targets, one per decision (m).
@@ -267,10 +281,13 @@ pub struct ObstacleInfo {
 pub struct SearchSummary {
     /// found | none_up_to_depth | exhausted | limit
     pub result: &'static str,
+    /// One sentence on how the search ended.
     pub message: String,
-    /// Particles searched over, and the levels completed.
+    /// Particles searched over.
     pub particles: u32,
+    /// Search levels (obstacles placed) completed.
     pub depth_completed: usize,
+    /// Wall time of the search (s).
     pub elapsed_s: f64,
 }
 
@@ -278,35 +295,42 @@ pub struct SearchSummary {
 #[derive(Debug, Clone, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Layout {
+    /// A fixed sequence of pins and fences.
     Sequence(Plan),
+    /// A sensor pin and per-decision moving pins.
     Contingent(ContingentPlan),
 }
 
 /// One design the workflow produced and ran on the line.
 #[derive(Debug, Clone, Serialize)]
 pub struct Candidate {
+    /// The kind of line.
     pub mode: Mode,
     /// Refinement round (0: the first search).
     pub round: usize,
+    /// How the search for it ended.
     pub search: SearchSummary,
     /// The particle abstraction's prediction.
     pub predicted_success: f64,
-    /// Sensor mode: the prediction with the classifier's confusion measured on the line, and its
-    /// accuracy there.
+    /// Sensor mode: the prediction with the classifier's confusion measured on the line.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub predicted_with_confusion: Option<f64>,
+    /// Sensor mode: the classifier's accuracy measured on the line.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sensor_accuracy: Option<f64>,
+    /// The obstacles as placed, upstream first.
     pub obstacles: Vec<ObstacleInfo>,
     /// Sensors and moving pins.
     pub actuators: usize,
+    /// Length of the emitted belt (m).
     pub belt_length_m: f64,
     /// The belt width the design uses (m): what its obstacles and parts reach, with a margin.
     pub belt_width_m: f64,
     /// The line with the parts far apart.
     pub screen: Option<LineCheck>,
-    /// The headway probes (s, parts, collisions, success) and the headway chosen.
+    /// The headway probes (s, parts, collisions, success).
     pub headway_probes: Vec<HeadwayProbe>,
+    /// The headway chosen on the line (s).
     pub headway_s: f64,
     /// The full check at `headway_s`.
     pub line_check: Option<LineCheck>,
@@ -317,10 +341,12 @@ pub struct Candidate {
     pub uncertain_check: Option<LineCheck>,
     /// Oriented parts per minute at `headway_s` (the full check's success, else the screen's).
     pub oriented_per_min: f64,
+    /// The plan, as searched.
     pub layout: Layout,
     /// The problem the candidate was searched with (its belt width and particles).
     #[serde(skip)]
     pub problem: Problem,
+    /// The emitted scenario with its headway as a parameter, and its policy file.
     #[serde(skip)]
     pub runnable: Runnable,
 }
@@ -353,10 +379,13 @@ impl Candidate {
 /// A finished design.
 #[derive(Debug, Clone, Serialize)]
 pub struct Design {
+    /// The verdict.
     pub status: Status,
     /// One sentence: what was found and what the line says.
     pub message: String,
+    /// Goal: share of the parts to end in the window, in [0, 1].
     pub target: f64,
+    /// Goal: half-width of the orientation window (degrees).
     pub tolerance_deg: f64,
     /// Every candidate, in the order produced.
     pub candidates: Vec<Candidate>,
@@ -364,15 +393,18 @@ pub struct Design {
     pub chosen: Option<usize>,
     /// A limit that cut the work short (the time limit), if any.
     pub limit: Option<String>,
+    /// Wall time of the whole design (s).
     pub elapsed_s: f64,
-    /// The chosen design's files' text: scenario (with its header) and policy.
+    /// The chosen design's scenario text (with its header).
     #[serde(skip)]
     pub scenario_toml: Option<String>,
+    /// The chosen design's policy file, if any: (file name, text).
     #[serde(skip)]
     pub policy_toml: Option<(String, String)>,
 }
 
 impl Design {
+    /// The chosen candidate, if any.
     pub fn chosen(&self) -> Option<&Candidate> {
         self.chosen.map(|i| &self.candidates[i])
     }
@@ -381,11 +413,15 @@ impl Design {
 /// Where a design stands, for a progress display.
 #[derive(Debug, Clone)]
 pub struct Progress {
+    /// The mode being worked on (None before the first).
     pub mode: Option<Mode>,
+    /// Refinement round (0: the first search).
     pub round: usize,
     /// What runs now ("searching 125 particles", "line check 3 (2000 parts)", …).
     pub stage: String,
+    /// Candidates produced so far.
     pub candidates: usize,
+    /// Line runs so far.
     pub line_runs: usize,
 }
 
@@ -411,15 +447,20 @@ impl std::fmt::Display for Progress {
 /// Why a design could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum DesignError {
+    /// The planner failed.
     #[error(transparent)]
     Plan(#[from] PlanError),
+    /// A candidate could not be run on the line.
     #[error(transparent)]
     Line(#[from] LineError),
     /// A design option out of range; `field` names it as [`PlanError::Input`] does.
     #[error("{field} {value}: {reason}")]
     Input {
+        /// The option's name (as on the command line).
         field: &'static str,
+        /// The value given.
         value: String,
+        /// Why it is refused.
         reason: String,
     },
 }

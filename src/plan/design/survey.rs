@@ -11,8 +11,11 @@ use std::fmt::Write as _;
 /// One part of a survey: its spec, metres per unit and a display name.
 #[derive(Debug, Clone, Serialize)]
 pub struct SurveyPart {
+    /// The part specification, as `pinfeed plan --part` takes it.
     pub spec: String,
+    /// Metres per unit of the part's coordinates (default 0.02).
     pub scale: f64,
+    /// Display name in the report (the spec as given).
     pub label: String,
 }
 
@@ -34,13 +37,17 @@ impl SurveyPart {
 /// A survey's settings.
 #[derive(Debug, Clone)]
 pub struct SurveySettings {
+    /// The parts surveyed, in report order.
     pub parts: Vec<SurveyPart>,
-    /// Each design's time limit (s) and line check (parts).
+    /// Each design's time limit (s).
     pub time_limit_s: f64,
+    /// Parts of each design's line check.
     pub check_parts: u64,
-    /// Robustness: plan and check against μc uniform in this range, and tripod supports.
+    /// Robustness: plan and check against μc uniform in this range.
     pub mu_c_range: Option<(f64, f64)>,
+    /// Robustness: plan and check against random tripod supports.
     pub tripod: bool,
+    /// Seed of every design's planning and line runs.
     pub seed: u64,
 }
 
@@ -49,17 +56,29 @@ pub struct SurveySettings {
 pub struct SurveyCell {
     /// The modes it was allowed ("pins", "fences", "sensor", or "all").
     pub modes: String,
+    /// The design's verdict.
     pub status: Status,
+    /// One sentence: what was found and what the line says.
     pub message: String,
+    /// The mode of the chosen design (None without one).
     pub mode: Option<Mode>,
+    /// The chosen design's obstacles, in one line (`–` without one).
     pub obstacles: String,
+    /// Success rate of the full line check (None without one).
     pub success_rate: Option<f64>,
+    /// Its 95% Wilson interval.
     pub ci95: Option<[f64; 2]>,
+    /// Parts in the full line check.
     pub parts: Option<u64>,
+    /// Length of the chosen design's belt (m).
     pub belt_length_m: Option<f64>,
+    /// Width of the chosen design's belt (m).
     pub belt_width_m: Option<f64>,
+    /// Headway chosen on the line (s).
     pub headway_s: Option<f64>,
+    /// Oriented parts per minute at that headway.
     pub oriented_per_min: Option<f64>,
+    /// Wall time of the design (s).
     pub elapsed_s: f64,
 }
 
@@ -106,7 +125,9 @@ impl SurveyCell {
 /// A part's row: one cell per mode set.
 #[derive(Debug, Clone, Serialize)]
 pub struct SurveyRow {
+    /// The part.
     pub part: SurveyPart,
+    /// One cell per mode set, in the order of `COLUMNS`.
     pub cells: Vec<SurveyCell>,
 }
 
