@@ -3,10 +3,10 @@
 //! & Tanie 1992) and c = a = 1 for Peshkin & Sanderson's COR-locus tip.
 
 use super::solve::{SolveFailure, Solved};
-use super::vec3::{dot3, norm3, scale3};
 use super::warm::{WarmStick, WarmTwist};
 use super::{wrench_of, Fidelity, PartModel, Twist, Wrench};
 use crate::geometry::Vec2;
+use nalgebra::Vector3;
 
 impl PartModel {
     /// The c of the closed-form normal map for a non-exact fidelity.
@@ -34,12 +34,13 @@ impl PartModel {
     ) -> Result<(Solved, WarmTwist), SolveFailure> {
         *evals += 1;
         let c2 = self.closed_form_c(fid).powi(2);
-        let xi = [c2 * w[0], c2 * w[1], w[2]];
-        let d = dot3(w, xi);
+        let wv = Vector3::from(w);
+        let xi = Vector3::new(c2 * w[0], c2 * w[1], w[2]);
+        let d = wv.dot(&xi);
         if d.is_nan() || d <= 0.0 || !d.is_finite() {
             return Err(SolveFailure::NonFinite);
         }
-        let xi = scale3(xi, 1.0 / d);
+        let xi: Twist = (xi * (1.0 / d)).into();
         let solved = Solved {
             twist: xi,
             wrench: self.wrench_for_twist(fid, xi, evals),
@@ -71,7 +72,7 @@ impl PartModel {
         let f = (v - q * (q.dot(v) / denom)) / c2;
         let w = wrench_of(f, p);
         let xi = [c2 * w[0], c2 * w[1], w[2]];
-        if !norm3(xi).is_finite() {
+        if !Vector3::from(xi).norm().is_finite() {
             return Err(SolveFailure::NonFinite);
         }
         let solved = Solved {
@@ -103,7 +104,7 @@ mod tests {
         let (s, _) = m
             .twist_for_wrench(Fidelity::Ellipsoid, w, None, 0.0, &mut ev)
             .unwrap();
-        assert!((dot3(w, s.twist) - 1.0).abs() < 1e-14);
+        assert!((Vector3::from(w).dot(&Vector3::from(s.twist)) - 1.0).abs() < 1e-14);
         let c2 = m.ellipsoid_c().powi(2);
         assert!((s.twist[0] / s.twist[2] - c2 * w[0] / w[2]).abs() < 1e-12);
         // The wrench returned lies on the ellipsoid.

@@ -24,7 +24,8 @@
 //!
 //! Files:
 //! * `mod.rs` (here): [`PartModel`] — compiling a part, its tables, and the front API that
-//!   dispatches each solve by fidelity; the twist and wrench conventions.
+//!   dispatches each solve by fidelity; the twist and wrench conventions; the quadratic form of
+//!   the Hessian the solves share.
 //! * `fidelity.rs`: [`Fidelity`], the three tiers and their names.
 //! * `support.rs`: [`Support`] (uniform pressure, weighted points, random tripods) and the compiled
 //!   limit-surface data.
@@ -33,13 +34,16 @@
 //!   [`final_gap`].
 //! * `stick.rs`: the exact stick solve (safeguarded Newton in ω).
 //! * `warm.rs`: the warm starts [`WarmTwist`], [`WarmStick`] and their first-order predictions.
+//!
+//! The solves' small vectors and matrices (twists, wrenches, directions, Hessians) are nalgebra's
+//! [`Vector3`] and [`Matrix3`]; the public [`Twist`] and [`Wrench`] stay plain `[f64; 3]` arrays,
+//! as the limit surfaces and the tables hold them.
 
 mod closed_form;
 mod fidelity;
 mod solve;
 mod stick;
 mod support;
-mod vec3;
 mod warm;
 
 pub use fidelity::Fidelity;
@@ -52,6 +56,7 @@ use super::limit_surface::Dissipation;
 use super::slide_table::{Place, Side, SlideTables, Table, TableStats};
 use super::stick_table::{StickStats, StickTables};
 use crate::geometry::{Polygon, Vec2};
+use nalgebra::{Matrix3, Vector3};
 use std::fmt;
 use std::sync::Arc;
 use support::SupportData;
@@ -71,6 +76,23 @@ pub fn wrench_of(f: Vec2, p: Vec2) -> Wrench {
 #[inline]
 pub fn point_velocity(xi: Twist, p: Vec2) -> Vec2 {
     Vec2::new(xi[0], xi[1]) + p.perp() * xi[2]
+}
+
+/// The Hessian `h` of D (row-major, as [`Dissipation::hess`] holds it) as a matrix.
+fn hessian(h: &[[f64; 3]; 3]) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| h[i][j])
+}
+
+/// The quadratic form aᵀ H b, summed term by term in row order (nalgebra's `a.dot(&(h * b))`
+/// would add in another order, and every solve's last bits depend on this one).
+fn quad_form(h: &Matrix3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let mut s = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            s += a[i] * h[(i, j)] * b[j];
+        }
+    }
+    s
 }
 
 /// The compiled part: normalised geometry and support data. Immutable; shared by all contacts.

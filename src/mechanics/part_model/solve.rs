@@ -4,10 +4,10 @@
 //! previous instant (`warm.rs`). Also what every solve returns ([`Solved`], [`SolveFailure`])
 //! and the stopping rules shared with the stick solve ([`final_gap`]).
 
-use super::vec3::{axpy3, dot3, norm3, quad3, scale3};
 use super::warm::{linearised, predict_twist, WarmTwist};
-use super::{PartModel, Twist, Wrench};
+use super::{hessian, quad_form, PartModel, Twist, Wrench};
 use crate::mechanics::limit_surface::Dissipation;
+use nalgebra::{Vector2, Vector3};
 use serde::Serialize;
 use std::fmt;
 
@@ -79,46 +79,55 @@ impl PartModel {
         gap: f64,
         evals: &mut u64,
     ) -> Result<(Solved, WarmTwist), SolveFailure> {
-        let wn = norm3(w);
+        let w = Vector3::from(w);
+        let wn = w.norm();
         if wn.is_nan() || wn <= 0.0 || !wn.is_finite() {
             return Err(SolveFailure::NonFinite);
         }
-        let wh = scale3(w, 1.0 / wn);
-        let (e1, e2) = orthonormal_complement(wh);
-        let xi0 = scale3(wh, 1.0 / wn);
-        let predicted = warm.and_then(|p| predict_twist(p, w));
+        let wh = w * (1.0 / wn);
+        let (e1, e2) = orthonormal_complement(&wh);
+        let xi0 = wh * (1.0 / wn);
+        let predicted = warm.and_then(|p| predict_twist(p, &w));
         let start = match (predicted, warm) {
             (Some(x), _) => x,
-            (None, Some(p)) if dot3(w, p.twist) > 0.0 => scale3(p.twist, 1.0 / dot3(w, p.twist)),
+            (None, Some(p)) if w.dot(&Vector3::from(p.twist)) > 0.0 => {
+                let t = Vector3::from(p.twist);
+                t * (1.0 / w.dot(&t))
+            }
             _ => {
-                let g = self.ellipsoid_guess(w);
-                scale3(g, 1.0 / dot3(w, g))
+                let g = Vector3::from(self.ellipsoid_guess(w.into()));
+                g * (1.0 / w.dot(&g))
             }
         };
-        let done = |xi: Twist, d: &Dissipation| {
+        let done = |xi: Vector3<f64>, d: &Dissipation| {
             let solved = Solved {
-                twist: xi,
+                twist: xi.into(),
                 wrench: d.grad,
             };
             let next = WarmTwist {
-                twist: xi,
-                wrench: w,
-                lambda: dot3(d.grad, w) / dot3(w, w),
+                twist: xi.into(),
+                wrench: w.into(),
+                lambda: Vector3::from(d.grad).dot(&w) / w.dot(&w),
                 hess: Some(d.hess),
             };
             (solved, next)
         };
-        let mut z = [dot3(e1, start), dot3(e2, start)];
-        let at = |z: [f64; 2]| axpy3(axpy3(xi0, z[0], e1), z[1], e2);
+        // Coordinates z on the plane w·ξ = 1: ξ = ξ0 + z₁ e1 + z₂ e2, and a gradient's part in it.
+        let at = |z: Vector2<f64>| xi0 + e1 * z.x + e2 * z.y;
+        let in_plane = |g: &[f64; 3]| {
+            let g = Vector3::from(*g);
+            Vector2::new(e1.dot(&g), e2.dot(&g))
+        };
+        let mut z = Vector2::new(e1.dot(&start), e2.dot(&start));
         let mut xi = at(z);
         *evals += 1;
-        let mut d = self.dissipation(xi, true);
+        let mut d = self.dissipation(xi.into(), true);
         let mut residual = f64::INFINITY;
         for it in 0..NEWTON_MAX {
             let prev_residual = residual;
-            let gr = [dot3(e1, d.grad), dot3(e2, d.grad)];
-            let gnorm = norm3(d.grad);
-            residual = (gr[0] * gr[0] + gr[1] * gr[1]).sqrt() / gnorm.max(1e-300);
+            let gr = in_plane(&d.grad);
+            let gnorm = Vector3::from(d.grad).norm();
+            residual = gr.norm() / gnorm.max(1e-300);
             if !residual.is_finite() {
                 return Err(SolveFailure::NonFinite);
             }
@@ -126,32 +135,33 @@ impl PartModel {
             if residual <= NEWTON_TOL || (residual <= 1e-9 && residual > 0.5 * prev_residual) {
                 return Ok(done(xi, &d));
             }
-            let h11 = quad3(&d.hess, e1, e1);
-            let h12 = quad3(&d.hess, e1, e2);
-            let h22 = quad3(&d.hess, e2, e2);
+            let h = hessian(&d.hess);
+            let h11 = quad_form(&h, &e1, &e1);
+            let h12 = quad_form(&h, &e1, &e2);
+            let h22 = quad_form(&h, &e2, &e2);
             let det = h11 * h22 - h12 * h12;
             let solvable = det > 0.0 && h11 > 0.0 && det.is_finite();
             let mut dz = if solvable {
-                [
-                    -(h22 * gr[0] - h12 * gr[1]) / det,
-                    -(-h12 * gr[0] + h11 * gr[1]) / det,
-                ]
+                Vector2::new(
+                    -(h22 * gr.x - h12 * gr.y) / det,
+                    -(-h12 * gr.x + h11 * gr.y) / det,
+                )
             } else {
-                [-gr[0], -gr[1]]
+                -gr
             };
-            let slope = gr[0] * dz[0] + gr[1] * dz[1];
+            let slope = gr.dot(&dz);
             if solvable && slope < 0.0 && residual <= gap {
-                let xin = at([z[0] + dz[0], z[1] + dz[1]]);
-                let dn = linearised(&d, xi, xin);
+                let xin = at(z + dz);
+                let dn = linearised(&d, &xi, &xin);
                 return Ok(done(xin, &dn));
             }
             if slope >= 0.0 {
-                dz = [-gr[0], -gr[1]];
+                dz = -gr;
             }
-            let slope0 = gr[0] * dz[0] + gr[1] * dz[1];
+            let slope0 = gr.dot(&dz);
             // Converged to rounding: the Newton step no longer moves the twist.
-            let step_len = (dz[0] * dz[0] + dz[1] * dz[1]).sqrt();
-            if step_len <= 1e-14 * norm3(xi) {
+            let step_len = dz.norm();
+            if step_len <= 1e-14 * xi.norm() {
                 return Ok(done(xi, &d));
             }
             // Line search on the directional derivative φ'(t) = ∇D(ξ(z + t dz))·dz, which is
@@ -160,11 +170,11 @@ impl PartModel {
             let mut t = 1.0;
             let mut accepted = false;
             for _ in 0..40 {
-                let zn = [z[0] + t * dz[0], z[1] + t * dz[1]];
+                let zn = z + dz * t;
                 let xin = at(zn);
                 *evals += 1;
-                let dn = self.dissipation(xin, true);
-                let slope_t = dot3(e1, dn.grad) * dz[0] + dot3(e2, dn.grad) * dz[1];
+                let dn = self.dissipation(xin.into(), true);
+                let slope_t = in_plane(&dn.grad).dot(&dz);
                 if !slope_t.is_finite() {
                     return Err(SolveFailure::NonFinite);
                 }
@@ -200,23 +210,18 @@ impl PartModel {
 }
 
 /// Two unit vectors orthogonal to the unit vector `w` and to each other.
-fn orthonormal_complement(w: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+fn orthonormal_complement(w: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     // Pick the coordinate axis least aligned with w.
-    let a = if w[0].abs() <= w[1].abs() && w[0].abs() <= w[2].abs() {
-        [1.0, 0.0, 0.0]
-    } else if w[1].abs() <= w[2].abs() {
-        [0.0, 1.0, 0.0]
+    let a = if w.x.abs() <= w.y.abs() && w.x.abs() <= w.z.abs() {
+        Vector3::x()
+    } else if w.y.abs() <= w.z.abs() {
+        Vector3::y()
     } else {
-        [0.0, 0.0, 1.0]
+        Vector3::z()
     };
-    let e1 = axpy3(a, -dot3(a, w), w);
-    let e1 = scale3(e1, 1.0 / norm3(e1));
-    let e2 = [
-        w[1] * e1[2] - w[2] * e1[1],
-        w[2] * e1[0] - w[0] * e1[2],
-        w[0] * e1[1] - w[1] * e1[0],
-    ];
-    (e1, e2)
+    let e1 = a - w * a.dot(w);
+    let e1 = e1 * (1.0 / e1.norm());
+    (e1, w.cross(&e1))
 }
 
 #[cfg(test)]
@@ -227,8 +232,8 @@ mod tests {
     use crate::geometry::{part_from_spec, Vec2};
 
     fn rel_diff(a: Twist, b: Twist) -> f64 {
-        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        norm3(d) / norm3(b)
+        let (a, b) = (Vector3::from(a), Vector3::from(b));
+        (a - b).norm() / b.norm()
     }
 
     /// A path of solves as an integration makes them: a wrench (or a stick velocity) turning in
@@ -274,11 +279,9 @@ mod tests {
 
     #[test]
     fn orthonormal_basis() {
-        let w = [0.2, -0.5, 0.84];
-        let n = norm3(w);
-        let w = scale3(w, 1.0 / n);
-        let (a, b) = orthonormal_complement(w);
-        assert!(dot3(a, w).abs() < 1e-15 && dot3(b, w).abs() < 1e-15 && dot3(a, b).abs() < 1e-15);
-        assert!((norm3(a) - 1.0).abs() < 1e-15 && (norm3(b) - 1.0).abs() < 1e-15);
+        let w = Vector3::new(0.2, -0.5, 0.84).normalize();
+        let (a, b) = orthonormal_complement(&w);
+        assert!(a.dot(&w).abs() < 1e-15 && b.dot(&w).abs() < 1e-15 && a.dot(&b).abs() < 1e-15);
+        assert!((a.norm() - 1.0).abs() < 1e-15 && (b.norm() - 1.0).abs() < 1e-15);
     }
 }

@@ -4,11 +4,11 @@
 //! Recipes' rtsafe), warm-started by a first-order prediction ([`WarmStick`]).
 
 use super::solve::{SolveFailure, Solved, NEWTON_TOL};
-use super::vec3::{dot3, norm3, quad3};
 use super::warm::{linearised, WarmStick};
-use super::{point_velocity, Fidelity, PartModel, Twist};
+use super::{hessian, point_velocity, quad_form, Fidelity, PartModel};
 use crate::geometry::Vec2;
 use crate::mechanics::limit_surface::Dissipation;
+use nalgebra::Vector3;
 
 impl PartModel {
     /// [`PartModel::stick_twist`] for the exact fidelity.
@@ -22,10 +22,10 @@ impl PartModel {
     ) -> Result<(Solved, WarmStick), SolveFailure> {
         // ξ(ω) = (v + ω q, ω), q = −ẑ×p, so that the velocity at p is v for every ω.
         let q = -p.perp();
-        let e = [q.x, q.y, 1.0];
-        let xi_of = |om: f64| [v.x + om * q.x, v.y + om * q.y, om];
+        let e = Vector3::new(q.x, q.y, 1.0);
+        let xi_of = |om: f64| Vector3::new(v.x + om * q.x, v.y + om * q.y, om);
         let mut om = match warm {
-            Some(w) if w.twist[2].is_finite() => w.predict(e, xi_of(w.twist[2])),
+            Some(w) if w.twist[2].is_finite() => w.predict(&e, &xi_of(w.twist[2])),
             _ => {
                 let mut dummy = 0;
                 self.stick_twist(Fidelity::Ellipsoid, p, v, None, 0.0, &mut dummy)
@@ -35,15 +35,15 @@ impl PartModel {
                     .unwrap_or(0.0)
             }
         };
-        let done = |xi: Twist, d: &Dissipation| {
+        let done = |xi: Vector3<f64>, d: &Dissipation| {
             let solved = Solved {
-                twist: xi,
+                twist: xi.into(),
                 wrench: d.grad,
             };
             (
                 solved,
                 WarmStick {
-                    twist: xi,
+                    twist: xi.into(),
                     wrench: d.grad,
                     hess: Some(d.hess),
                 },
@@ -56,19 +56,20 @@ impl PartModel {
         for it in 0..200u32 {
             let xi = xi_of(om);
             *evals += 1;
-            let d = self.dissipation(xi, true);
-            let g = dot3(e, d.grad);
-            let hss = quad3(&d.hess, e, e);
+            let d = self.dissipation(xi.into(), true);
+            let grad = Vector3::from(d.grad);
+            let g = e.dot(&grad);
+            let hss = quad_form(&hessian(&d.hess), &e, &e);
             if !g.is_finite() {
                 return Err(SolveFailure::NonFinite);
             }
-            residual = g.abs() / (norm3(d.grad) * norm3(e)).max(1e-300);
+            residual = g.abs() / (grad.norm() * e.norm()).max(1e-300);
             if residual <= NEWTON_TOL {
                 return Ok(done(xi, &d));
             }
             if residual <= gap && hss > 0.0 && hss.is_finite() {
                 let xin = xi_of(om - g / hss);
-                return Ok(done(xin, &linearised(&d, xi, xin)));
+                return Ok(done(xin, &linearised(&d, &xi, &xin)));
             }
             if g > 0.0 {
                 hi = hi.min(om);

@@ -3,9 +3,9 @@
 //! the optimality conditions ([`kkt_delta`]) and D linearised about a solution ([`linearised`]).
 
 use super::solve::{Solved, NEWTON_TOL};
-use super::vec3::{dot3, norm3, quad3, scale3};
-use super::{Twist, Wrench};
+use super::{hessian, quad_form, Twist, Wrench};
 use crate::mechanics::limit_surface::Dissipation;
+use nalgebra::{Matrix3, Vector3};
 
 /// What a twist solve leaves behind for the next one: the solution, the wrench it answered, the
 /// multiplier λ (∇D = λ w at the optimum) and the Hessian of D there. With these the next solve
@@ -51,17 +51,23 @@ impl WarmStick {
     /// is not defined, the previous ω; likewise when the previous ω already meets the solve's
     /// tolerance to first order (so that a state the solve holds exactly, e.g. the pure
     /// translation of a push through the centroid, is not moved by rounding).
-    pub(super) fn predict(&self, e: [f64; 3], xi: Twist) -> f64 {
+    pub(super) fn predict(&self, e: &Vector3<f64>, xi: &Vector3<f64>) -> f64 {
         let om = self.twist[2];
         let Some(h) = self.hess else {
             return om;
         };
-        let grad = linear_grad(self.wrench, &h, self.twist, xi);
-        let g = dot3(e, grad);
-        if g.abs() <= NEWTON_TOL * norm3(grad) * norm3(e) {
+        let h = hessian(&h);
+        let grad = linear_grad(
+            &Vector3::from(self.wrench),
+            &h,
+            &Vector3::from(self.twist),
+            xi,
+        );
+        let g = e.dot(&grad);
+        if g.abs() <= NEWTON_TOL * grad.norm() * e.norm() {
             return om;
         }
-        let hss = quad3(&h, e, e);
+        let hss = quad_form(&h, e, e);
         let next = om - g / hss;
         if hss > 0.0 && next.is_finite() {
             next
@@ -73,16 +79,12 @@ impl WarmStick {
 
 /// First-order prediction of the twist for wrench `w` from the previous solution (see
 /// [`WarmTwist`]), normalised to w·ξ = 1; `None` without a Hessian or if the system is singular.
-pub(super) fn predict_twist(p: &WarmTwist, w: Wrench) -> Option<Twist> {
-    let dw = [w[0] - p.wrench[0], w[1] - p.wrench[1], w[2] - p.wrench[2]];
-    let (dxi, _) = kkt_delta(p, dw)?;
-    let xi = [
-        p.twist[0] + dxi[0],
-        p.twist[1] + dxi[1],
-        p.twist[2] + dxi[2],
-    ];
-    let c = dot3(w, xi);
-    (c > 0.0 && c.is_finite()).then(|| scale3(xi, 1.0 / c))
+pub(super) fn predict_twist(p: &WarmTwist, w: &Vector3<f64>) -> Option<Vector3<f64>> {
+    let dw = w - Vector3::from(p.wrench);
+    let (dxi, _) = kkt_delta(p, dw.into())?;
+    let xi = Vector3::from(p.twist) + Vector3::from(dxi);
+    let c = w.dot(&xi);
+    (c > 0.0 && c.is_finite()).then(|| xi * (1.0 / c))
 }
 
 /// The first-order change (dξ, dλ) of a solution `p` of ∇D(ξ) = λ w, w·ξ = 1 when its wrench
@@ -96,7 +98,13 @@ pub(crate) fn kkt_delta(p: &WarmTwist, dw: [f64; 3]) -> Option<(Twist, f64)> {
         [h[0][0], h[0][1], h[0][2], -w0[0], p.lambda * dw[0]],
         [h[1][0], h[1][1], h[1][2], -w0[1], p.lambda * dw[1]],
         [h[2][0], h[2][1], h[2][2], -w0[2], p.lambda * dw[2]],
-        [w0[0], w0[1], w0[2], 0.0, -dot3(dw, p.twist)],
+        [
+            w0[0],
+            w0[1],
+            w0[2],
+            0.0,
+            -Vector3::from(dw).dot(&Vector3::from(p.twist)),
+        ],
     ];
     for col in 0..4 {
         let piv = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
@@ -120,23 +128,24 @@ pub(crate) fn kkt_delta(p: &WarmTwist, dw: [f64; 3]) -> Option<(Twist, f64)> {
 
 /// D, ∇D and H at `to`, to first order from their values `d` at `from`: ∇D(to) ≈ ∇D(from) +
 /// H (to − from); H is kept.
-pub(super) fn linearised(d: &Dissipation, from: Twist, to: Twist) -> Dissipation {
-    let dx = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
+pub(super) fn linearised(d: &Dissipation, from: &Vector3<f64>, to: &Vector3<f64>) -> Dissipation {
+    let grad = Vector3::from(d.grad);
     Dissipation {
-        value: d.value + dot3(d.grad, dx),
-        grad: linear_grad(d.grad, &d.hess, from, to),
+        value: d.value + grad.dot(&(to - from)),
+        grad: linear_grad(&grad, &hessian(&d.hess), from, to).into(),
         hess: d.hess,
     }
 }
 
-/// ∇D at `to` to first order from ∇D = `grad` and H = `hess` at `from`.
-fn linear_grad(grad: Wrench, hess: &[[f64; 3]; 3], from: Twist, to: Twist) -> Wrench {
-    let dx = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
-    [
-        grad[0] + dot3(hess[0], dx),
-        grad[1] + dot3(hess[1], dx),
-        grad[2] + dot3(hess[2], dx),
-    ]
+/// ∇D at `to` to first order from ∇D = `grad` and H = `hess` at `from`. (nalgebra's product
+/// H dx sums each row left to right, j = 0, 1, 2, as a dot product does.)
+fn linear_grad(
+    grad: &Vector3<f64>,
+    hess: &Matrix3<f64>,
+    from: &Vector3<f64>,
+    to: &Vector3<f64>,
+) -> Vector3<f64> {
+    grad + hess * (to - from)
 }
 
 #[cfg(test)]
@@ -166,12 +175,8 @@ mod tests {
                 .stick_twist(Fidelity::Exact, p, v, plain.as_ref(), 0.0, &mut ev_plain)
                 .unwrap();
             plain = Some(WarmStick { hess: None, ..next });
-            let d = [
-                a.twist[0] - b.twist[0],
-                a.twist[1] - b.twist[1],
-                a.twist[2] - b.twist[2],
-            ];
-            assert!(norm3(d) / norm3(b.twist) < 1e-10, "{k}");
+            let (a, b) = (Vector3::from(a.twist), Vector3::from(b.twist));
+            assert!((a - b).norm() / b.norm() < 1e-10, "{k}");
         }
         assert!(ev_pred < ev_plain, "{ev_pred} vs {ev_plain}");
     }
