@@ -70,6 +70,59 @@ pub fn final_gap(tol: f64) -> f64 {
     (1e-6 * tol).sqrt().clamp(1e-9, 1e-4)
 }
 
+/// The plane w·ξ = 1 of a slide solve in coordinates z: ξ = ξ0 + z₁ e1 + z₂ e2, with ξ0 = w/|w|²
+/// and e1, e2 an orthonormal basis of the directions orthogonal to w.
+struct Plane {
+    xi0: Vector3<f64>,
+    e1: Vector3<f64>,
+    e2: Vector3<f64>,
+}
+
+impl Plane {
+    /// The plane of the wrench `w`, whose length is `wn` (> 0).
+    fn new(w: &Vector3<f64>, wn: f64) -> Plane {
+        let wh = w * (1.0 / wn);
+        let (e1, e2) = orthonormal_complement(&wh);
+        let xi0 = wh * (1.0 / wn);
+        Plane { xi0, e1, e2 }
+    }
+
+    /// The twist at coordinates `z`.
+    fn at(&self, z: Vector2<f64>) -> Vector3<f64> {
+        self.xi0 + self.e1 * z.x + self.e2 * z.y
+    }
+
+    /// The components of `v` along e1 and e2: the coordinates of a twist on the plane, or the
+    /// gradient of D restricted to it.
+    fn in_plane(&self, v: &Vector3<f64>) -> Vector2<f64> {
+        Vector2::new(self.e1.dot(v), self.e2.dot(v))
+    }
+
+    /// The Newton step of D restricted to the plane at a point with gradient `gr` (in plane) and
+    /// Hessian `hess`; minus the gradient where the restricted Hessian is not positive definite.
+    /// Also whether the Newton step was defined.
+    fn newton_step(&self, hess: &[[f64; 3]; 3], gr: Vector2<f64>) -> (Vector2<f64>, bool) {
+        let h = hessian(hess);
+        let h11 = quad_form(&h, &self.e1, &self.e1);
+        let h12 = quad_form(&h, &self.e1, &self.e2);
+        let h22 = quad_form(&h, &self.e2, &self.e2);
+        let det = h11 * h22 - h12 * h12;
+        let solvable = det > 0.0 && h11 > 0.0 && det.is_finite();
+        let dz = if solvable {
+            Vector2::new(
+                -(h22 * gr.x - h12 * gr.y) / det,
+                -(-h12 * gr.x + h11 * gr.y) / det,
+            )
+        } else {
+            -gr
+        };
+        (dz, solvable)
+    }
+}
+
+/// Where a line search ended: the accepted coordinates, twist and its dissipation.
+type Accepted = (Vector2<f64>, Vector3<f64>, Dissipation);
+
 impl PartModel {
     /// [`PartModel::twist_for_wrench`] for the exact fidelity.
     pub(super) fn exact_twist_for_wrench(
@@ -84,21 +137,8 @@ impl PartModel {
         if wn.is_nan() || wn <= 0.0 || !wn.is_finite() {
             return Err(SolveFailure::NonFinite);
         }
-        let wh = w * (1.0 / wn);
-        let (e1, e2) = orthonormal_complement(&wh);
-        let xi0 = wh * (1.0 / wn);
-        let predicted = warm.and_then(|p| predict_twist(p, &w));
-        let start = match (predicted, warm) {
-            (Some(x), _) => x,
-            (None, Some(p)) if w.dot(&Vector3::from(p.twist)) > 0.0 => {
-                let t = Vector3::from(p.twist);
-                t * (1.0 / w.dot(&t))
-            }
-            _ => {
-                let g = Vector3::from(self.ellipsoid_guess(w.into()));
-                g * (1.0 / w.dot(&g))
-            }
-        };
+        let plane = Plane::new(&w, wn);
+        let start = self.slide_start(&w, warm);
         let done = |xi: Vector3<f64>, d: &Dissipation| {
             let solved = Solved {
                 twist: xi.into(),
@@ -112,20 +152,14 @@ impl PartModel {
             };
             (solved, next)
         };
-        // Coordinates z on the plane w·ξ = 1: ξ = ξ0 + z₁ e1 + z₂ e2, and a gradient's part in it.
-        let at = |z: Vector2<f64>| xi0 + e1 * z.x + e2 * z.y;
-        let in_plane = |g: &[f64; 3]| {
-            let g = Vector3::from(*g);
-            Vector2::new(e1.dot(&g), e2.dot(&g))
-        };
-        let mut z = Vector2::new(e1.dot(&start), e2.dot(&start));
-        let mut xi = at(z);
+        let mut z = plane.in_plane(&start);
+        let mut xi = plane.at(z);
         *evals += 1;
         let mut d = self.dissipation(xi.into(), true);
         let mut residual = f64::INFINITY;
         for it in 0..NEWTON_MAX {
             let prev_residual = residual;
-            let gr = in_plane(&d.grad);
+            let gr = plane.in_plane(&Vector3::from(d.grad));
             let gnorm = Vector3::from(d.grad).norm();
             residual = gr.norm() / gnorm.max(1e-300);
             if !residual.is_finite() {
@@ -135,23 +169,10 @@ impl PartModel {
             if residual <= NEWTON_TOL || (residual <= 1e-9 && residual > 0.5 * prev_residual) {
                 return Ok(done(xi, &d));
             }
-            let h = hessian(&d.hess);
-            let h11 = quad_form(&h, &e1, &e1);
-            let h12 = quad_form(&h, &e1, &e2);
-            let h22 = quad_form(&h, &e2, &e2);
-            let det = h11 * h22 - h12 * h12;
-            let solvable = det > 0.0 && h11 > 0.0 && det.is_finite();
-            let mut dz = if solvable {
-                Vector2::new(
-                    -(h22 * gr.x - h12 * gr.y) / det,
-                    -(-h12 * gr.x + h11 * gr.y) / det,
-                )
-            } else {
-                -gr
-            };
+            let (mut dz, solvable) = plane.newton_step(&d.hess, gr);
             let slope = gr.dot(&dz);
             if solvable && slope < 0.0 && residual <= gap {
-                let xin = at(z + dz);
+                let xin = plane.at(z + dz);
                 let dn = linearised(&d, &xi, &xin);
                 return Ok(done(xin, &dn));
             }
@@ -164,39 +185,15 @@ impl PartModel {
             if step_len <= 1e-14 * xi.norm() {
                 return Ok(done(xi, &d));
             }
-            // Line search on the directional derivative φ'(t) = ∇D(ξ(z + t dz))·dz, which is
-            // monotone for convex D. Unlike the value of D it stays informative near the optimum,
-            // where decreases fall below the rounding of D on ill-conditioned (needle-like) parts.
-            let mut t = 1.0;
-            let mut accepted = false;
-            for _ in 0..40 {
-                let zn = z + dz * t;
-                let xin = at(zn);
-                *evals += 1;
-                let dn = self.dissipation(xin.into(), true);
-                let slope_t = in_plane(&dn.grad).dot(&dz);
-                if !slope_t.is_finite() {
-                    return Err(SolveFailure::NonFinite);
+            match self.line_search(&plane, z, dz, slope0, evals)? {
+                Some((zn, xin, dn)) => (z, xi, d) = (zn, xin, dn),
+                None if residual <= 1e-9 => return Ok(done(xi, &d)),
+                None => {
+                    return Err(SolveFailure::NoConvergence {
+                        iterations: it + 1,
+                        residual,
+                    })
                 }
-                if slope_t <= 0.9 * slope0.abs() {
-                    z = zn;
-                    xi = xin;
-                    d = dn;
-                    accepted = true;
-                    break;
-                }
-                // Overshot: secant on φ' between 0 (slope0 < 0) and t (slope_t > 0), safeguarded.
-                let tn = t * (-slope0) / (slope_t - slope0);
-                t = tn.clamp(0.1 * t, 0.7 * t);
-            }
-            if !accepted {
-                if residual <= 1e-9 {
-                    return Ok(done(xi, &d));
-                }
-                return Err(SolveFailure::NoConvergence {
-                    iterations: it + 1,
-                    residual,
-                });
             }
         }
         if residual <= 1e-9 {
@@ -206,6 +203,55 @@ impl PartModel {
             iterations: NEWTON_MAX,
             residual,
         })
+    }
+
+    /// Where the slide solve for wrench `w` starts: the first-order prediction from `warm`, else
+    /// its twist, else the ellipsoid's normal, each scaled onto w·ξ = 1.
+    fn slide_start(&self, w: &Vector3<f64>, warm: Option<&WarmTwist>) -> Vector3<f64> {
+        let predicted = warm.and_then(|p| predict_twist(p, w));
+        match (predicted, warm) {
+            (Some(x), _) => x,
+            (None, Some(p)) if w.dot(&Vector3::from(p.twist)) > 0.0 => {
+                let t = Vector3::from(p.twist);
+                t * (1.0 / w.dot(&t))
+            }
+            _ => {
+                let g = Vector3::from(self.ellipsoid_guess((*w).into()));
+                g * (1.0 / w.dot(&g))
+            }
+        }
+    }
+
+    /// Line search from `z` along `dz` (slope `slope0` < 0 there) on the directional derivative
+    /// φ'(t) = ∇D(ξ(z + t dz))·dz, which is monotone for convex D. Unlike the value of D it stays
+    /// informative near the optimum, where decreases fall below the rounding of D on
+    /// ill-conditioned (needle-like) parts. `None` when 40 trials found no acceptable step.
+    fn line_search(
+        &self,
+        plane: &Plane,
+        z: Vector2<f64>,
+        dz: Vector2<f64>,
+        slope0: f64,
+        evals: &mut u64,
+    ) -> Result<Option<Accepted>, SolveFailure> {
+        let mut t = 1.0;
+        for _ in 0..40 {
+            let zn = z + dz * t;
+            let xin = plane.at(zn);
+            *evals += 1;
+            let dn = self.dissipation(xin.into(), true);
+            let slope_t = plane.in_plane(&Vector3::from(dn.grad)).dot(&dz);
+            if !slope_t.is_finite() {
+                return Err(SolveFailure::NonFinite);
+            }
+            if slope_t <= 0.9 * slope0.abs() {
+                return Ok(Some((zn, xin, dn)));
+            }
+            // Overshot: secant on φ' between 0 (slope0 < 0) and t (slope_t > 0), safeguarded.
+            let tn = t * (-slope0) / (slope_t - slope0);
+            t = tn.clamp(0.1 * t, 0.7 * t);
+        }
+        Ok(None)
     }
 }
 
