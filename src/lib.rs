@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # pinfeed
 //!
 //! A simulator and planner for orienting planar parts on a conveyor belt with overhead pins and
@@ -8,12 +9,26 @@
 //! the other end. Physics and conventions are described in `docs/physics.md` (quasi-static pushing with Coulomb
 //! friction; x along belt travel, y to the left, angles counter-clockwise, degrees at interfaces).
 //!
-//! Modules: [`geometry`] (polygons, stable states, first contact), [`mechanics`] (the contact
-//! model), [`maps`] (configuration maps and their bands), [`scenario`] (TOML scenarios compiled to
-//! an immutable scene), [`engine`] (the discrete-event feeder line and its metrics), [`report`]
-//! (tables, reports and figures), [`contact_case`] (one fully specified pin or fence pass, as
-//! `pinfeed contact` runs it); the `pinfeed` command itself (`cli`) only maps its arguments to
-//! these modules and prints, and is not part of the documented API.
+//! Modules, from the bottom layer up:
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | [`random`], [`statistics`], [`input`], [`progress`] | seeded streams, intervals, bounded file reads, progress callbacks |
+//! | [`geometry`] | polygons, named parts, stable states, first contact |
+//! | [`mechanics`] | the contact model: limit surfaces, one pin or fence pass |
+//! | [`maps`] | configuration maps θ0 → θf, their bands, ensembles, the map tier |
+//! | [`contact_case`] | one fully specified pass, as `pinfeed contact` runs it, and batches of them |
+//! | [`sensing`] | force/torque readings, classifiers, sense experiments |
+//! | [`scenario`] | TOML scenarios compiled to an immutable scene |
+//! | [`engine`] | the discrete-event feeder line, its controller and metrics |
+//! | [`validate`] | measured bands against the model; calibration |
+//! | [`plan`] | designing a line (pins, fences, a sensor with moving pins), checked on the line |
+//! | [`study`] | Monte Carlo studies, comparisons, cost and accuracy studies, the fuzzing driver |
+//! | [`report`] | tables, reports and figures |
+//!
+//! The `pinfeed` command itself (`cli`) only maps its arguments to these modules and prints, and
+//! is not part of the documented API. `examples/` holds one push, a line run, a plan and a sensing
+//! evaluation written against this API.
 
 // The `pinfeed` command's argument parsing and printing: public for `main.rs` and the tests, not
 // part of the documented library API (its workflows live in the modules below).

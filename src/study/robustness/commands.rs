@@ -138,8 +138,11 @@ pub fn plan_command(args: &[String]) -> String {
 /// A case: the CSV text and the command's arguments (after the file name).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CsvCase {
+    /// `pinfeed calibrate` (one case in four) rather than `pinfeed validate`.
     pub calibrate: bool,
+    /// The measured-bands file's text.
     pub text: String,
+    /// The command's arguments after the file name, each `--flag=value` or a switch.
     pub args: Vec<String>,
 }
 
@@ -148,6 +151,7 @@ fn pick<'a>(rng: &mut ChaCha8Rng, values: &[&'a str]) -> &'a str {
 }
 
 impl CsvCase {
+    /// A case drawn from `rng`: a mutated seed file and a random set of the command's flags.
     pub fn random(rng: &mut ChaCha8Rng) -> CsvCase {
         let text = random_text(rng);
         let calibrate = rng.random_range(0..4u32) == 0;
