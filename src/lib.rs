@@ -13,7 +13,7 @@
 //!
 //! | module | what it holds |
 //! |---|---|
-//! | [`random`], [`statistics`], [`input`], [`progress`] | seeded streams, intervals, bounded file reads, progress callbacks |
+//! | [`random`], [`statistics`], [`input`], [`output`], [`progress`] | seeded streams, intervals, bounded file reads, whole-or-nothing file writes, progress callbacks |
 //! | [`geometry`] | polygons, named parts, stable states, first contact |
 //! | [`mechanics`] | the contact model: limit surfaces, one pin or fence pass |
 //! | [`maps`] | configuration maps θ0 → θf, their bands, ensembles, the map tier |
@@ -40,6 +40,7 @@ pub mod geometry;
 pub mod input;
 pub mod maps;
 pub mod mechanics;
+pub mod output;
 pub mod plan;
 pub mod progress;
 pub mod random;

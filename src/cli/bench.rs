@@ -100,7 +100,8 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
             spin.set_message(format!(
                 "accuracy: {contacts} contacts against the reference"
             ));
-            let (table, files) = crate::study::accuracy::bench(*contacts, *seed, cmd, out)?;
+            let (table, files) =
+                crate::report::study_files::accuracy_bench(*contacts, *seed, cmd, out)?;
             print!("{table}");
             let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
             eprintln!("wrote {}", files.join(", "));

@@ -75,7 +75,7 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<
         ));
         rows.push(pool.install(|| survey_part(&s, p)));
         let m = page(cmd, &s, &rows);
-        crate::report::atomic::write_file(&a.out, m)?;
+        crate::output::write_file(&a.out, m)?;
     }
     eprintln!("wrote {}", a.out.display());
     Ok(())

@@ -51,7 +51,7 @@ pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()>
         rows.push(row);
     }
     let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, cmd), MARKERS.1);
-    crate::report::atomic::rewrite_file(&a.out, |old| splice_between(old, &marked, MARKERS))?;
+    crate::output::rewrite_file(&a.out, |old| splice_between(old, &marked, MARKERS))?;
     eprintln!("wrote {}", a.out.display());
     Ok(())
 }

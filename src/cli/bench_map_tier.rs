@@ -31,7 +31,7 @@ pub struct MapTierArgs {
 }
 
 fn write_section(path: &Path, section: &str) -> Result<()> {
-    crate::report::atomic::rewrite_file(path, |old| splice(old, &marked(section)))?;
+    crate::output::rewrite_file(path, |old| splice(old, &marked(section)))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }

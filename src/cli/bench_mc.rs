@@ -88,7 +88,7 @@ pub fn run(
             load_after,
         },
     );
-    crate::report::atomic::rewrite_file(out, |doc| precision::splice(doc, &section))?;
+    crate::output::rewrite_file(out, |doc| precision::splice(doc, &section))?;
     print!("{section}");
     eprintln!(
         "wrote the Monte Carlo precision section of {}",

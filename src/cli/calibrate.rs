@@ -108,7 +108,7 @@ pub fn run(args: &CalibrateArgs, recorded: &str) -> Result<()> {
         if let Some(dir) = args.measured.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         }
-        crate::report::atomic::write_atomic(&args.measured, text)
+        crate::output::write_atomic(&args.measured, text)
             .with_context(|| format!("writing {}", args.measured.display()))?;
         eprintln!("synthetic data set written to {}", args.measured.display());
         Some(SyntheticDesign::TRUTH)

@@ -125,11 +125,11 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
     if let Some(path) = &args.trace {
-        crate::report::atomic::write_atomic(path, trace_csv(&trace))
+        crate::output::write_atomic(path, trace_csv(&trace))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        crate::contact_case::plot::plot(&c, &poly, &out, &trace, path)
+        crate::report::plot_contact::plot_case(&c, &poly, &out, &trace, path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     let r = report(&c, &out).with_pin_positions(&c, poly.radius(), &out);

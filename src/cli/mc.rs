@@ -6,7 +6,7 @@
 //! `pinfeed merge`.
 
 use crate::study::mc::report::{self, McReport, StudyHeader};
-use crate::study::mc::shard::{self, ShardFile, ShardSpec};
+use crate::study::mc::shard::{ShardFile, ShardSpec};
 use crate::study::mc::{self, run};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -89,7 +89,8 @@ pub fn run(args: &McArgs) -> Result<()> {
         let path = dir.join(spec.file_name());
         let file = ShardFile::new(&header, spec, range.clone(), &tallies);
         let text = serde_json::to_string_pretty(&file)? + "\n";
-        shard::write_atomic(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        crate::output::write_atomic(&path, text)
+            .with_context(|| format!("writing {}", path.display()))?;
         if !args.quiet {
             eprintln!(
                 "shard {}/{}: samples [{}, {}) of {total}; {speed}; wrote {}",
@@ -114,10 +115,10 @@ pub fn run(args: &McArgs) -> Result<()> {
     Ok(())
 }
 
-/// Write a report's files to `dir` ([`report::write_files`]) and print the table or the JSON.
+/// Write a report's files to `dir` ([`crate::report::study_files::mc_report_files`]) and print the table or the JSON.
 /// `mc` and `merge` share it, so their outputs are the same bytes.
 pub fn publish(r: &McReport, dir: &Path, json: bool, quiet: bool) -> Result<()> {
-    let (json_text, md) = report::write_files(r, dir)?;
+    let (json_text, md) = crate::report::study_files::mc_report_files(r, dir)?;
     let text = if json {
         json_text
     } else if quiet {

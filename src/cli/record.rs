@@ -5,7 +5,7 @@
 //! they are. Arguments that change only how a result is shown or how fast it is computed
 //! ([`NOT_RECORDED`]) are left out, so the same result has the same recorded command.
 
-use crate::report::shell_word;
+use crate::output::shell_word;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Command};
 

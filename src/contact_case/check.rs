@@ -4,47 +4,7 @@
 
 use super::{Case, CaseError};
 use crate::geometry::Polygon;
-use crate::mechanics::limits;
-
-/// A number for a message: plain when moderate, in exponent notation when huge or tiny (so that
-/// 1e308 does not print as 309 digits).
-pub fn num(v: f64) -> String {
-    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
-    }
-}
-
-/// A value outside its closed range (or not finite).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{name} must be {}in [{}, {}] ({what}), got {}", if value.is_finite() { "" } else { "a finite number " }, num(*lo), num(*hi), num(*value))]
-pub struct OutOfRange {
-    /// The setting (a flag such as `--mu-c`, or `column mu_c`).
-    pub name: String,
-    /// The value given.
-    pub value: f64,
-    /// The lower end of the range.
-    pub lo: f64,
-    /// The upper end of the range.
-    pub hi: f64,
-    /// What the number is (its unit or meaning).
-    pub what: String,
-}
-
-/// `name must lie in [lo, hi] (what), got v` unless `lo ≤ v ≤ hi` (and v finite).
-pub fn in_range(name: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<(), OutOfRange> {
-    if !(v.is_finite() && v >= lo && v <= hi) {
-        return Err(OutOfRange {
-            name: name.to_string(),
-            value: v,
-            lo,
-            hi,
-            what: what.to_string(),
-        });
-    }
-    Ok(())
-}
+use crate::mechanics::limits::{self, in_range};
 
 /// The flag naming a setting (`mu_c` → `--mu-c`).
 pub fn flag(field: &str) -> String {

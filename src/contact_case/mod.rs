@@ -9,10 +9,10 @@
 
 pub mod batch;
 pub mod check;
-pub mod plot;
 pub mod report;
 
-pub use check::{check_geometry, check_inputs, in_range, num, reach, OutOfRange};
+use crate::mechanics::limits::{num, OutOfRange};
+pub use check::{check_geometry, check_inputs, reach};
 pub use report::ContactReport;
 
 use crate::geometry::{named, Polygon, Pose, Vec2};

@@ -3,7 +3,7 @@
 //! name the command's flags.
 
 use super::MapError;
-use crate::contact_case::num;
+use crate::mechanics::limits::num;
 
 /// Most contact parameters in one map command.
 pub const MAX_DS: usize = 1000;

@@ -90,9 +90,9 @@ pub fn check_uncertain(
     study_file: &str,
 ) -> Result<(crate::engine::OutcomeCounts, u64), UncertainCheckError> {
     std::fs::create_dir_all(dir)?;
-    crate::report::atomic::write_atomic(dir.join(scenario_file), scenario)?;
+    crate::output::write_atomic(dir.join(scenario_file), scenario)?;
     let path = dir.join(study_file);
-    crate::report::atomic::write_atomic(&path, study)?;
+    crate::output::write_atomic(&path, study)?;
     let study = crate::study::mc::load(&path, None)?;
     let n = study.total_samples();
     let tallies = crate::study::mc::run::run_range(&study, 0..n, &|| {})?;

@@ -119,10 +119,10 @@ pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>)
     }
     let json_path = out_dir.join("map.json");
     // Compact: the document holds every sample (README.md is the readable summary).
-    crate::report::atomic::write_atomic(&json_path, crate::report::versioned::compact(report)?)
+    crate::output::write_atomic(&json_path, crate::report::versioned::compact(report)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     let csv_path = out_dir.join("samples.csv");
-    crate::report::atomic::produce_atomic(&csv_path, |tmp| {
+    crate::output::produce_atomic(&csv_path, |tmp| {
         write_csv(
             std::io::BufWriter::new(std::fs::File::create(tmp)?),
             report.maps,
@@ -232,7 +232,7 @@ pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>)
         md += &format!("### {what}\n\n![{what}]({})\n\n", link(path));
     }
     let readme = out_dir.join("README.md");
-    crate::report::atomic::write_atomic(&readme, md)
+    crate::output::write_atomic(&readme, md)
         .with_context(|| format!("writing {}", readme.display()))?;
     // The folder holds this run's figures only: a figure of an earlier run for a d not asked
     // for now goes.

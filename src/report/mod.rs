@@ -2,7 +2,6 @@
 
 pub mod aligned;
 pub mod animate;
-pub mod atomic;
 pub mod calibrate_report;
 pub mod compare_table;
 pub mod ensemble_report;
@@ -28,20 +27,9 @@ pub(crate) mod plot_zoom;
 pub mod run_folder;
 pub mod sense;
 pub mod stale;
+pub mod study_files;
 pub mod validate_report;
 pub mod versioned;
-
-/// A word of a command line, quoted for a POSIX shell if it needs it (for the command lines that
-/// regenerate a report, written at its top): plain when it holds only letters, digits and
-/// `-_.,:/+=`, else in single quotes.
-pub fn shell_word(s: &str) -> String {
-    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
-    if !s.is_empty() && s.chars().all(plain) {
-        s.to_string()
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
-}
 
 /// `x` with `decimals` decimals (`plus`: with its sign always), never as a negative zero: a value
 /// that rounds to zero is printed as 0 (`-0.000` from a −0.0 or a −1e-17 says nothing).
@@ -61,15 +49,6 @@ pub fn fixed(x: f64, decimals: usize, plus: bool) -> String {
     } else {
         s
     }
-}
-
-/// Create the folder `path` goes into (if it has one), naming it on failure.
-pub fn create_parent(path: &std::path::Path) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
-    }
-    Ok(())
 }
 
 #[cfg(test)]

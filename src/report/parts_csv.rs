@@ -8,7 +8,7 @@ use std::path::Path;
 pub fn write_parts_csv(path: &Path, records: &[PartRecord]) -> anyhow::Result<()> {
     let mut sorted: Vec<&PartRecord> = records.iter().collect();
     sorted.sort_by_key(|r| r.part);
-    crate::report::atomic::produce_atomic(path, |tmp| {
+    crate::output::produce_atomic(path, |tmp| {
         let mut w = csv::Writer::from_path(tmp)?;
         for r in sorted {
             w.serialize(r)?;

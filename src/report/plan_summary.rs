@@ -178,7 +178,7 @@ fn write(path: &Path, text: &str) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    crate::report::atomic::write_atomic(path, text.as_bytes())
+    crate::output::write_atomic(path, text.as_bytes())
         .with_context(|| format!("writing {}", path.display()))
 }
 
@@ -210,7 +210,7 @@ pub fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) ->
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    // The plots write whole files or none (report::atomic).
+    // The plots write whole files or none (crate::output).
     match &c.layout {
         Layout::Sequence(plan) => crate::report::plot_plan::plot_plan(&c.problem, plan, &t, path),
         Layout::Contingent(plan) => {

@@ -1,7 +1,7 @@
 //! SVG of the accuracy-vs-time study: error against time per contact, one point per tier
 //! (log–log), mean error and 95th percentile.
 
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use crate::study::accuracy::AccuracyStudy;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

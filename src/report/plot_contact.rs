@@ -3,9 +3,10 @@
 //! contact; for a fence the fence segment at the start and end of contact (it travels along −x in
 //! the belt frame, as every fixed obstacle does).
 
+use crate::contact_case::{case_fence, case_geometry, Case};
 use crate::geometry::{Polygon, Pose, Vec2};
 use crate::mechanics::{ContactOutcome, TraceSample};
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -194,6 +195,62 @@ fn clip_segment(p: Vec2, q: Vec2, (lo, hi): (Vec2, Vec2)) -> Option<(Vec2, Vec2)
         }
     };
     (t0 <= t1).then(|| (at(t0), at(t1)))
+}
+
+/// Draw the pass of contact case `c` (`pinfeed contact --plot`) over `poly` (its outcome `out` and `trace`) into the SVG file `path`.
+pub fn plot_case(
+    c: &Case,
+    poly: &Polygon,
+    out: &ContactOutcome,
+    trace: &[TraceSample],
+    path: &Path,
+) -> anyhow::Result<()> {
+    let (pose, obstacle) = pass_obstacle(poly, c);
+    plot_contact(poly, pose, &obstacle, out, trace, &plot_title(c), path)
+}
+
+/// The initial pose of a case and its obstacle as the plot draws it: the pin (start, radius,
+/// lateral speed) or the fence segment.
+fn pass_obstacle(poly: &Polygon, c: &Case) -> (Pose, PassObstacle) {
+    let (pose, start) = case_geometry(poly, c);
+    let obstacle = match c.fence {
+        Some((angle, length)) => {
+            let fence = case_fence(poly, c, angle, length);
+            PassObstacle::Fence {
+                start: fence.start,
+                end: fence.start + Vec2::from_angle(fence.angle_rad) * fence.length,
+            }
+        }
+        None => PassObstacle::Pin {
+            start,
+            radius: c.pin_radius,
+            lateral_speed: c.pin_speed,
+        },
+    };
+    (pose, obstacle)
+}
+
+/// The plot's title: the part, θ0, d, the friction and the model (and the fence's angle).
+fn plot_title(c: &Case) -> String {
+    match c.fence {
+        Some((angle, _)) => format!(
+            "{} θ0={}° d={} fence α={}° μf={} ({})",
+            c.part,
+            c.theta0_deg,
+            c.d,
+            angle,
+            c.mu_c,
+            c.model.name()
+        ),
+        None => format!(
+            "{} θ0={}° d={} μc={} ({})",
+            c.part,
+            c.theta0_deg,
+            c.d,
+            c.mu_c,
+            c.model.name()
+        ),
+    }
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 
 use crate::engine::{PartOutcome, SamplePath};
 use crate::geometry::{wrap_deg, Pose};
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use crate::report::plot_labels::{text_width, LabelRows};
 use crate::scenario::{Obstacle, Scene};
 use plotters::prelude::*;

@@ -16,7 +16,7 @@ use super::plot_labels::text_width;
 use super::plot_zoom::{degree_view, DegreeView};
 use crate::geometry::wrap_deg;
 use crate::maps::{Band, ConfigurationMap};
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::ComposedElement;

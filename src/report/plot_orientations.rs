@@ -6,7 +6,7 @@
 use super::plot_zoom::{degree_view, DegreeView};
 use crate::engine::Summary;
 use crate::geometry::wrap_deg;
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use crate::scenario::{Goal, Scene};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

@@ -2,7 +2,7 @@
 //! `a`) beside its radius function ρ(φ) with the stable states marked.
 
 use crate::geometry::{Polygon, Vec2};
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use plotters::prelude::*;
 use std::path::Path;
 

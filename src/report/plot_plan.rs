@@ -8,8 +8,8 @@
 
 use super::plot_labels::{text_width, LabelRows};
 use crate::geometry::{Pose, Vec2};
+use crate::output::Staged;
 use crate::plan::{Action, Plan, Problem, State};
-use crate::report::atomic::Staged;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -6,7 +6,7 @@
 //!   chance;
 //! * [`plot_placement`]: mutual information against d per sensor kind, with the ceiling H(state).
 
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use crate::sensing::evaluate::Evaluation;
 use crate::sensing::placement::Placement;
 use crate::sensing::reading::Reading;

@@ -3,7 +3,7 @@
 //! parameter; without a sweep: the share of every outcome class that occurred, with whiskers.
 
 use crate::engine::PartOutcome;
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use crate::study::mc::report::McReport;
 use plotters::prelude::*;
 use std::path::Path;

@@ -73,6 +73,5 @@ pub fn plot_survey(rows: &[(String, [bool; 3])], path: &Path) -> Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    crate::report::atomic::write_atomic(path, s)
-        .with_context(|| format!("writing {}", path.display()))
+    crate::output::write_atomic(path, s).with_context(|| format!("writing {}", path.display()))
 }

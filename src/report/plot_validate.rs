@@ -10,7 +10,7 @@ use super::plot_map::{d_chart, header_with_legend, Swatch, PALETTE};
 use super::plot_zoom::{degree_view, DegreeView};
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::PredictedBands;
-use crate::report::atomic::Staged;
+use crate::output::Staged;
 use plotters::prelude::*;
 use std::path::Path;
 

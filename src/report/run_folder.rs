@@ -1,9 +1,9 @@
 //! The folder of a line run (`pinfeed run`): `summary.json` and, as the scenario's `[output]`
 //! asks, the per-part CSV, the orientation histogram, the event and control logs, and the drawing
-//! and animation asked for, written together ([`crate::report::atomic::Batch`]).
+//! and animation asked for, written together ([`crate::output::Batch`]).
 
 use crate::engine::RunResult;
-use crate::report::atomic::Batch;
+use crate::output::Batch;
 use crate::report::{animate, parts_csv, plot_line, plot_orientations};
 use crate::scenario::Scene;
 use anyhow::{bail, Context, Result};

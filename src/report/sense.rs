@@ -99,7 +99,7 @@ pub fn write_report(
 ) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let json_path = out.join("sense.json");
-    crate::report::atomic::write_atomic(&json_path, crate::report::versioned::pretty(r)?)
+    crate::output::write_atomic(&json_path, crate::report::versioned::pretty(r)?)
         .with_context(|| format!("writing {}", json_path.display()))?;
     let what = format!(
         "{} at d = {}, μc {}, {} sensor",
@@ -150,7 +150,7 @@ pub fn write_report(
         )
         .with_context(|| format!("writing {}", f.display()))?;
     }
-    crate::report::atomic::write_atomic(out.join("report.md"), report_markdown(r))
+    crate::output::write_atomic(out.join("report.md"), report_markdown(r))
         .with_context(|| format!("writing {}", out.join("report.md").display()))?;
     // A placement figure of an earlier run with --placement does not outlive this one.
     let written: Vec<String> = ["templates.svg", "accuracy_noise.svg"]

@@ -36,7 +36,7 @@ pub(crate) fn write_report_files<T: Serialize>(
 ) -> Result<()> {
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let json = out_dir.join(json_name);
-    crate::report::atomic::write_atomic(&json, crate::report::versioned::pretty(report)?)
+    crate::output::write_atomic(&json, crate::report::versioned::pretty(report)?)
         .with_context(|| format!("writing {}", json.display()))?;
     let mut md = format!(
         "# {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{}\n\n",
@@ -48,7 +48,7 @@ pub(crate) fn write_report_files<T: Serialize>(
     md.push('\n');
     md.push_str(&body(out_dir)?);
     let readme = out_dir.join("README.md");
-    crate::report::atomic::write_atomic(&readme, md)
+    crate::output::write_atomic(&readme, md)
         .with_context(|| format!("writing {}", readme.display()))?;
     Ok(())
 }

@@ -462,30 +462,3 @@ pub fn report_keeping(st: &AccuracyStudy, cmd: &str, old: &str) -> String {
     }
     md
 }
-
-/// `pinfeed bench accuracy`: the study over tripoly1, tripoly2, square and lshape with
-/// `contacts` contacts (4 to 10⁶), written to `out` with the extensions md (keeping the
-/// hand-written sections of an existing report; `cmd` heads it), csv and svg. Returns the
-/// Markdown table and the three files.
-pub fn bench(
-    contacts: usize,
-    seed: u64,
-    cmd: &str,
-    out: &std::path::Path,
-) -> anyhow::Result<(String, [std::path::PathBuf; 3])> {
-    if !(4..=1_000_000).contains(&contacts) {
-        anyhow::bail!("--contacts must be between 4 and 1000000, got {contacts}");
-    }
-    let st = run(
-        &["tripoly1", "tripoly2", "square", "lshape"],
-        contacts,
-        seed,
-    )?;
-    let [md, csv_path, svg] = ["md", "csv", "svg"].map(|e| out.with_extension(e));
-    let old = std::fs::read_to_string(&md).unwrap_or_default();
-    crate::report::atomic::write_file(&md, report_keeping(&st, cmd, &old))?;
-    crate::report::atomic::write_file(&csv_path, csv(&st))?;
-    crate::report::plot_accuracy::plot_accuracy(&st, &svg)
-        .map_err(|e| anyhow::anyhow!("writing {}: {e:#}", svg.display()))?;
-    Ok((markdown_table(&st), [md, csv_path, svg]))
-}

@@ -164,7 +164,7 @@ pub fn write(
         if !force && target.exists() {
             return Err(WriteError::Exists(target.clone()));
         }
-        crate::report::atomic::write_atomic(target, b.text.as_bytes()).map_err(io)?;
+        crate::output::write_atomic(target, b.text.as_bytes()).map_err(io)?;
     }
     Ok(targets)
 }

@@ -551,6 +551,6 @@ pub fn bench(
     stage("contact: cost against the vertex count");
     let scaling = vertex_scaling(&[3, 6, 12, 24, 48], (contacts / 4).max(1), tol, seed)?;
     let (table, doc) = report(&rows, &scaling, contacts, cmd);
-    crate::report::atomic::write_file(out, &doc)?;
+    crate::output::write_file(out, &doc)?;
     Ok(table)
 }

@@ -148,6 +148,6 @@ pub fn bench(
     let rows = measure(&["tripoly1", "tripoly2"], &fids, &threads, 1.0, repeats)?;
     let load_after = load();
     let (table, doc) = report(&rows, repeats, cores, (&load_before, &load_after), cmd);
-    crate::report::atomic::write_file(out, &doc)?;
+    crate::output::write_file(out, &doc)?;
     Ok(table)
 }

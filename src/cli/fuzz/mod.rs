@@ -165,7 +165,7 @@ pub fn run(args: &FuzzArgs, recorded: &str) -> Result<()> {
     if let Some(dir) = args.report.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    crate::report::atomic::write_atomic(&args.report, &text)
+    crate::output::write_atomic(&args.report, &text)
         .with_context(|| format!("writing {}", args.report.display()))?;
     print!("{text}");
     Ok(())

@@ -204,7 +204,7 @@ pub fn write(path: &Path, map: &TierMap) -> Result<(), CacheError> {
         std::fs::create_dir_all(dir).map_err(io)?;
     }
     // Whole or not at all; a failed write leaves no temporary file behind.
-    crate::report::atomic::write_atomic(path, encode(map)).map_err(io)
+    crate::output::write_atomic(path, encode(map)).map_err(io)
 }
 
 /// Read the map with key `key` from `path`, refusing anything that does not check out.

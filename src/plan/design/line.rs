@@ -99,7 +99,7 @@ impl Runnable {
         let path = scratch.dir.join("design.toml");
         if let Some((name, text)) = &self.policy {
             let p = scratch.dir.join(name);
-            crate::report::atomic::write_atomic(&p, text)
+            crate::output::write_atomic(&p, text)
                 .map_err(|source| LineError::Io { path: p, source })?;
         }
         let toml = self.with_headway(h);

@@ -9,9 +9,9 @@ mod run;
 
 pub use run::{Evaluated, Placeholder, SenseReport, Skipped, Sweep, UncertaintyReport, Untrained};
 
-use crate::contact_case::{in_range, num, parse_model, CaseError, OutOfRange};
 use crate::geometry::{named, Polygon};
-use crate::mechanics::{limits, PartModel, Support};
+use crate::mechanics::limits::{self, in_range, num, OutOfRange};
+use crate::mechanics::{Fidelity, PartModel, Support};
 use crate::random::distribution::Distribution;
 use crate::sensing::classify;
 use crate::sensing::evaluate::{applicable, TruthDraw, MAX_TEMPLATES, MAX_TRIALS};
@@ -144,8 +144,8 @@ pub enum SenseError {
         got: String,
     },
     /// An unknown contact model (`--model`).
-    #[error("--model: {0}")]
-    Model(CaseError),
+    #[error("--model: unknown model '{0}'; expected exact, ellipsoid or tip")]
+    Model(String),
     /// A sensor setting outside its range.
     #[error("--{}: {message}", field.replace('_', "-"))]
     Sensor {
@@ -406,7 +406,8 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
             })
         }
     };
-    let fidelity = parse_model(&a.model).map_err(SenseError::Model)?;
+    let fidelity =
+        Fidelity::parse(a.model.trim()).ok_or_else(|| SenseError::Model(a.model.clone()))?;
     let sensor = sensor_settings(a)?;
     for &f in &a.noise {
         sensor

@@ -24,9 +24,8 @@
 //! * [`sample`]: one perturbed line and its one part; [`run`]: many samples in parallel;
 //! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report; [`online`]:
 //!   what an online controller decided and predicted, against what happened;
-//! * [`atomic`]: files written by rename; [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
+//! * [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
 
-pub use crate::report::atomic;
 pub mod compile;
 pub use crate::random::distribution;
 pub mod error;

@@ -450,40 +450,6 @@ pub fn with_out(mut header: StudyHeader, dir: &std::path::Path) -> StudyHeader {
     header.command.push_str(" --out ");
     header
         .command
-        .push_str(&crate::report::shell_word(&dir.display().to_string()));
+        .push_str(&crate::output::shell_word(&dir.display().to_string()));
     header
-}
-
-/// Write a report's files into `dir`: `report.md`, `report.json` and `sensitivity.svg`, whole
-/// and together or not at all. Returns the JSON text and the Markdown file's path; `mc` and
-/// `merge` both write through it, so their files are the same bytes.
-pub fn write_files(
-    r: &McReport,
-    dir: &std::path::Path,
-) -> anyhow::Result<(String, std::path::PathBuf)> {
-    use anyhow::Context;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let figure = "sensitivity.svg";
-    let (md, js, svg) = (
-        dir.join("report.md"),
-        dir.join("report.json"),
-        dir.join(figure),
-    );
-    let json_text = json(r);
-    let mut batch = crate::report::atomic::Batch::new();
-    batch
-        .write(&md, markdown(r, figure))
-        .with_context(|| format!("writing {}", md.display()))?;
-    batch
-        .write(&js, &json_text)
-        .with_context(|| format!("writing {}", js.display()))?;
-    batch
-        .produce(&svg, |tmp| {
-            crate::report::plot_sensitivity::plot_sensitivity(r, tmp)
-        })
-        .with_context(|| format!("writing {}", svg.display()))?;
-    batch
-        .commit()
-        .with_context(|| format!("writing the report into {}", dir.display()))?;
-    Ok((json_text, md))
 }

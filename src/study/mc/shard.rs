@@ -8,7 +8,7 @@
 //!   and scenario hashes, seed, samples per point, sweep grid, pinfeed version), the shard's index
 //!   and sample range, and per touched point the integer counts and the latency histogram
 //!   serialised as HdrHistogram V2 (base64).
-//! * It is written atomically ([`super::atomic`]), so a killed job leaves either no shard file or a
+//! * It is written atomically ([`crate::output`]), so a killed job leaves either no shard file or a
 //!   complete one.
 //! * [`merge`] checks that the shards fit together (same format, pinfeed version, study hash, seed
 //!   and grid; sample ranges that cover [0, T) exactly once; counts that add up to each range) and
@@ -23,8 +23,6 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-
-pub use super::atomic::write_atomic;
 
 /// The format tag of a shard file.
 pub const FORMAT: &str = "pinfeed-mc-shard";

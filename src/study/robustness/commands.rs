@@ -3,8 +3,8 @@
 //! arguments ([`CsvCase`]). They are plain words and text; `pinfeed fuzz` runs them through the
 //! commands' own argument parsers (which is why running them lives with the command line).
 
+use crate::output::shell_word;
 use crate::random::ChaCha8Rng;
-use crate::report::shell_word;
 use crate::study::robustness::measured_csv::random_text;
 use rand::RngExt;
 use std::path::Path;

@@ -175,7 +175,7 @@ impl Batch {
 
 /// Write a report file whole (creating its folder), naming the file on failure.
 pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> anyhow::Result<()> {
-    super::create_parent(path)?;
+    create_parent(path)?;
     write_atomic(path, bytes).map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))
 }
 
@@ -184,6 +184,27 @@ pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> anyhow::Result<()> {
 pub fn rewrite_file(path: &Path, edit: impl FnOnce(&str) -> String) -> anyhow::Result<()> {
     let old = std::fs::read_to_string(path).unwrap_or_default();
     write_file(path, edit(&old))
+}
+
+/// A word of a command line, quoted for a POSIX shell if it needs it (for the command lines that
+/// regenerate a report, written at its top): plain when it holds only letters, digits and
+/// `-_.,:/+=`, else in single quotes.
+pub fn shell_word(s: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_.,:/+=".contains(c);
+    if !s.is_empty() && s.chars().all(plain) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// Create the folder `path` goes into (if it has one), naming it on failure.
+pub fn create_parent(path: &std::path::Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
