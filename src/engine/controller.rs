@@ -43,13 +43,48 @@ pub struct ControlRecord {
     pub part: u64,
     /// The sensor (for a decision) or the dynamic pin (for an actuation).
     pub obstacle: String,
-    /// `decision`, `actuation`, `late`, `dropped`.
-    pub kind: &'static str,
+    /// What the controller did.
+    pub kind: ControlKind,
     /// The decision's label, or the target (`y=0.012` / `raised` / `withdrawn`).
     pub what: String,
     /// An actuation's motion: start, ready (s), and a moving pin's lateral positions (m).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub motion: Option<MotionRecord>,
+}
+
+/// What a [`ControlRecord`] records (written as `decision`, `actuation`, `late`, `dropped`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ControlKind {
+    /// A sensor pin's decision about a part.
+    Decision,
+    /// A command to a dynamic pin, carried out in time.
+    Actuation,
+    /// A command that could not finish before its part arrived.
+    Late,
+    /// A decision dropped (a stale event, or a part that left first).
+    Dropped,
+}
+
+/// What the controller runs: the rule table or online replanning (written as `policy`, `online`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ControllerMode {
+    /// The rules of `[[rules]]` and the policy file.
+    #[default]
+    Policy,
+    /// Online replanning from a belief.
+    Online,
+}
+
+impl ControllerMode {
+    /// The mode's name in outputs: `policy` or `online`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ControllerMode::Policy => "policy",
+            ControllerMode::Online => "online",
+        }
+    }
 }
 
 /// An actuation's motion.
@@ -177,8 +212,8 @@ pub struct ControllerSummary {
     pub rules_from: String,
     /// Decision latency (s).
     pub latency_s: f64,
-    /// `skip` or `move`: what a late command does.
-    pub on_late: &'static str,
+    /// What a late command does (written as `skip` or `move`).
+    pub on_late: OnLate,
     /// Per sensor and decision (`<sensor>=<label>`, `unknown` for none).
     pub decisions: BTreeMap<String, DecisionStats>,
     /// Decisions that differ from the part's true state, over all sensors.
@@ -189,8 +224,8 @@ pub struct ControllerSummary {
     pub late_actuations: u64,
     /// Per dynamic pin, in obstacle order.
     pub actuators: Vec<ActuatorStats>,
-    /// `policy` or `online`.
-    pub mode: &'static str,
+    /// The rule table or online replanning.
+    pub mode: ControllerMode,
     /// The online controller's record (online mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub online: Option<OnlineSummary>,
@@ -265,7 +300,7 @@ impl Control {
         });
         summary.rules_from = spec.source.clone();
         summary.latency_s = spec.latency;
-        summary.on_late = spec.on_late.name();
+        summary.on_late = spec.on_late;
         let online = spec.online.as_ref().map(|h| OnlineRun {
             chosen: vec![0; h.0.actions.len()],
             pin_names: h
@@ -318,7 +353,11 @@ impl Control {
             },
             bins: [(0, 0.0, 0); 10],
         });
-        summary.mode = if online.is_some() { "online" } else { "policy" };
+        summary.mode = if online.is_some() {
+            ControllerMode::Online
+        } else {
+            ControllerMode::Policy
+        };
         Some(Control {
             online,
             queues: vec![BTreeMap::new(); tracks.len()],
@@ -532,7 +571,7 @@ impl Line<'_> {
             t,
             part: index,
             obstacle: name,
-            kind: "decision",
+            kind: ControlKind::Decision,
             what: label,
             motion: None,
         });
@@ -723,7 +762,7 @@ impl Line<'_> {
                 t,
                 part: index,
                 obstacle: "online".into(),
-                kind: "decision",
+                kind: ControlKind::Decision,
                 what: format!(
                     "{described} (P = {:.3}; entropy {h0:.2} → {h1:.2} bits)",
                     choice.predicted
@@ -803,7 +842,7 @@ impl Line<'_> {
                 t: now,
                 part,
                 obstacle: name,
-                kind: "dropped",
+                kind: ControlKind::Dropped,
                 what: describe_target(target),
                 motion: None,
             });
@@ -848,7 +887,11 @@ impl Line<'_> {
                 t: now,
                 part,
                 obstacle: name,
-                kind: if late { "late" } else { "actuation" },
+                kind: if late {
+                    ControlKind::Late
+                } else {
+                    ControlKind::Actuation
+                },
                 what: describe_target(target),
                 motion: Some(MotionRecord {
                     t_start,
@@ -863,7 +906,7 @@ impl Line<'_> {
                 t: now,
                 part,
                 obstacle: name,
-                kind: "late",
+                kind: ControlKind::Late,
                 what: format!("{} skipped", describe_target(target)),
                 motion: None,
             });

@@ -578,7 +578,7 @@ impl Line<'_> {
                 part: index,
                 arrival_s: part.arrival,
                 end_s: t,
-                outcome: outcome.name(),
+                outcome,
                 cause,
                 contacts: part.contacts,
                 theta_in_deg: wrap_deg(part.theta_in.to_degrees()),

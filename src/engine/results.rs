@@ -70,8 +70,8 @@ pub struct PartRecord {
     pub arrival_s: f64,
     /// Time the part finished: exited, or failed (s).
     pub end_s: f64,
-    /// The outcome's name (`success`, `wrong_orientation`, …; see `PartOutcome::name`).
-    pub outcome: &'static str,
+    /// How the part ended (written as its name: `success`, `wrong_orientation`, …).
+    pub outcome: crate::engine::PartOutcome,
     /// Cause behind multi_contact or solver, else empty.
     pub cause: &'static str,
     /// Obstacle encounters (pushes) of the part.

@@ -149,7 +149,9 @@ fn controller_table(o: &mut String, c: &crate::engine::controller::ControllerSum
             let _ = writeln!(
                 o,
                 "controller                rules from {}, latency {} s, late commands: {}",
-                c.rules_from, c.latency_s, c.on_late
+                c.rules_from,
+                c.latency_s,
+                c.on_late.name()
             );
         }
         Some(on) => online_block(o, c, on),
@@ -196,7 +198,7 @@ fn online_block(
     let _ = writeln!(
         o,
         "controller                online: {} hypotheses, {} joint commands ({} line runs, {} contact-model evaluations to build), latency {} s, late commands: {}",
-        on.hypotheses, on.actions, on.model_runs, on.model_evaluations, c.latency_s, c.on_late
+        on.hypotheses, on.actions, on.model_runs, on.model_evaluations, c.latency_s, c.on_late.name()
     );
     let temper: Vec<String> = on
         .temper

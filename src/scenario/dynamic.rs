@@ -49,10 +49,13 @@ pub enum Target {
     Raised(bool),
 }
 
-/// What the controller does with a command it cannot carry out before the part arrives.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What the controller does with a command it cannot carry out before the part arrives (written
+/// as its [`OnLate::name`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum OnLate {
     /// Leave the pin as it is for this part (counted as a late actuation).
+    #[default]
     Skip,
     /// Move anyway: the part may meet a pin in motion, simulated with its true velocity (moving
     /// pins only; counted too).

@@ -177,7 +177,11 @@ fn a_policy_equal_to_the_online_choices_reproduces_the_online_run() {
     let online = engine::run(&scene, &opts, &mut |_| {}).unwrap();
     // The decided state of each part (its record) and the online choice for it (the log).
     let mut choice_of = std::collections::BTreeMap::new();
-    for rec in online.control.iter().filter(|c| c.kind == "decision") {
+    for rec in online
+        .control
+        .iter()
+        .filter(|c| c.kind == pinfeed::engine::controller::ControlKind::Decision)
+    {
         let part = &online.records[rec.part as usize];
         assert_eq!(part.part, rec.part);
         let state = part.sensed.split(' ').next().unwrap().to_string();

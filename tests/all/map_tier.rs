@@ -408,8 +408,9 @@ fn the_quickstart_on_the_map_tier_ends_every_part_in_the_exact_class() {
     };
     let ex = engine::run(&exact_scene, &opts(&exact_scene), &mut |_| {}).unwrap();
     let mp = engine::run(&map_scene, &opts(&map_scene), &mut |_| {}).unwrap();
-    let classes =
-        |r: &engine::RunResult| -> Vec<&str> { r.records.iter().map(|p| p.outcome).collect() };
+    let classes = |r: &engine::RunResult| -> Vec<&str> {
+        r.records.iter().map(|p| p.outcome.name()).collect()
+    };
     assert_eq!(classes(&ex), classes(&mp));
     for (a, b) in ex.records.iter().zip(&mp.records) {
         assert!(

@@ -765,7 +765,11 @@ impl Work<'_> {
             }
             let base = (problem.jitter_samples * problem.offset_samples).max(25);
             let mut added = 0;
-            for r in res.records.iter().filter(|r| r.outcome != "success") {
+            for r in res
+                .records
+                .iter()
+                .filter(|r| r.outcome != crate::engine::PartOutcome::Success)
+            {
                 if added >= base * 2 {
                     break;
                 }

@@ -2,6 +2,7 @@
 //! readings, decisions and controller actions of the parts shown.
 
 use super::model::*;
+use crate::engine::controller::ControlKind;
 use crate::engine::controller::ControlRecord;
 use crate::engine::RunResult;
 use crate::geometry::{Pose, Vec2};
@@ -143,16 +144,18 @@ fn control_marks(scene: &Scene, control: &[ControlRecord], parts: &[AnimPart]) -
                 return None;
             };
             let (kind, text) = match r.kind {
-                "decision" => (MarkKind::Decision, format!("part {} → {}", r.part, r.what)),
-                "actuation" => (
+                ControlKind::Decision => {
+                    (MarkKind::Decision, format!("part {} → {}", r.part, r.what))
+                }
+                ControlKind::Actuation => (
                     MarkKind::Actuation,
                     format!("{} {} for part {}", r.obstacle, r.what, r.part),
                 ),
-                "late" => (
+                ControlKind::Late => (
                     MarkKind::Late,
                     format!("late: {} {} for part {}", r.obstacle, r.what, r.part),
                 ),
-                _ => return None,
+                ControlKind::Dropped => return None,
             };
             let at = match r.motion {
                 Some(m) if matches!(pin.actuator, Some(Actuator::Moving(_))) => {
