@@ -93,7 +93,7 @@ pub(crate) fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
         pin_radius_sd: args.pin_radius_sd,
         support,
         jitter_deg: args.jitter,
-        fidelity: crate::contact_case::parse_model(&c.model)?,
+        fidelity: c.model,
         tol: c.tol,
         score: c.score()?,
     })

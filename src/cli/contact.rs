@@ -7,7 +7,7 @@
 
 use crate::contact_case::batch::run_batch;
 use crate::contact_case::report::{report, trace_csv};
-use crate::contact_case::{parse_fence, parse_model, run_case, stop_travel, Case};
+use crate::contact_case::{parse_fence, run_case, stop_travel, Case};
 use crate::mechanics::Fidelity;
 use anyhow::{Context, Result};
 use clap::Args;
@@ -115,13 +115,16 @@ pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
 
 pub fn run(args: &ContactArgs) -> Result<()> {
     if let Some(path) = &args.cases {
-        let defaults = case_of(args, parse_model(&args.push.model)?)?;
+        let model = args
+            .push
+            .fidelity("the map tier does not run --cases batches")?;
+        let defaults = case_of(args, model)?;
         return Ok(run_batch(&defaults, path, std::io::stdout().lock())?);
     }
     if args.push.map_tier() {
         return super::contact_map::run(args);
     }
-    let c = case_of(args, parse_model(&args.push.model)?)?;
+    let c = case_of(args, args.push.fidelity("")?)?;
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
     if let Some(path) = &args.trace {

@@ -11,8 +11,7 @@
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
 
 use crate::contact_case::{
-    case_fence, check_geometry, check_inputs, compile_part, parse_fence, parse_model,
-    settings_and_pin, Case,
+    case_fence, check_geometry, check_inputs, compile_part, parse_fence, settings_and_pin, Case,
 };
 use crate::maps::{compute_maps_with, MapFence, MapSettings};
 use crate::report::map_report::{write_csv, write_report, MapReport};
@@ -117,7 +116,10 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     if use_tier && (args.fence.is_some() || args.uncertain.is_some()) {
         bail!("--model map: the map tier tabulates still pins with one support; use --model exact with --fence or --uncertain");
     }
-    let model = parse_model(if use_tier { "exact" } else { &args.push.model })?;
+    let model = match args.push.model {
+        crate::contact_case::ModelChoice::Model(f) => f,
+        crate::contact_case::ModelChoice::Map => crate::mechanics::Fidelity::Exact,
+    };
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;
     let template = Case {
         fence,

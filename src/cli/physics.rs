@@ -1,8 +1,9 @@
 //! The physics flags of one pin pass that `contact` and `map` share: one definition, so each has
 //! one meaning, one unit, one default and one help text in both commands.
 
-use crate::contact_case::Case;
+use crate::contact_case::{Case, ModelChoice};
 use crate::mechanics::{ContactSettings, Fidelity};
+use anyhow::{bail, Result};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -15,7 +16,7 @@ pub struct PushArgs {
     /// Fidelity: exact, ellipsoid or tip; or map (the certified map tier over exact, still pins
     /// only).
     #[arg(long, default_value = "exact")]
-    pub model: String,
+    pub model: ModelChoice,
     /// With --model map: the folder of the map cache files (default $XDG_CACHE_HOME/pinfeed/maps
     /// or ~/.cache/pinfeed/maps).
     #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
@@ -39,7 +40,16 @@ pub struct PushArgs {
 impl PushArgs {
     /// Whether `--model map` asks for the certified map tier.
     pub fn map_tier(&self) -> bool {
-        self.model.trim() == "map"
+        self.model == ModelChoice::Map
+    }
+
+    /// The fidelity of `--model` where the map tier does not apply (`what`: where, for the
+    /// message).
+    pub fn fidelity(&self, what: &str) -> Result<Fidelity> {
+        match self.model {
+            ModelChoice::Model(f) => Ok(f),
+            ModelChoice::Map => bail!("--model map: {what}; use exact, ellipsoid or tip"),
+        }
     }
 
     /// A still-pin case of `part` with these physics and fidelity `model`, at θ0 = 0 and d = 0,

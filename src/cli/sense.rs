@@ -54,8 +54,8 @@ pub struct SenseArgs {
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub mu_s: f64,
     /// Fidelity: exact, ellipsoid or tip.
-    #[arg(long, default_value = "exact")]
-    pub model: String,
+    #[arg(long, default_value = "exact", value_parser = crate::contact_case::parse_model)]
+    pub model: crate::mechanics::Fidelity,
     /// Integration tolerance per step.
     #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub tol: f64,
@@ -183,7 +183,7 @@ pub fn request(a: &SenseArgs) -> Request {
         pin_radius: a.pin_radius,
         mu_c: a.mu_c,
         mu_s: a.mu_s,
-        model: a.model.clone(),
+        model: a.model,
         tol: a.tol,
         hypotheses: a.hypotheses.clone(),
         sensor: SensorSettings {

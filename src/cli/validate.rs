@@ -7,11 +7,12 @@
 //! distributions and bands against d.
 
 use crate::maps::ensemble::EnsembleSpec;
+use crate::mechanics::limits::in_range;
 use crate::report::validate_report::{containment_text, rows_text, write_report, ValidateReport};
 use crate::validate::input::{self, check_members, load_measured};
 use crate::validate::measured::Measured;
 use crate::validate::score::ScoreSettings;
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -24,8 +25,8 @@ pub struct ModelArgs {
     #[arg(long, value_name = "PART", allow_hyphen_values = true)]
     pub part: Option<String>,
     /// Fidelity: exact, ellipsoid or tip.
-    #[arg(long, default_value = "exact")]
-    pub model: String,
+    #[arg(long, default_value = "exact", value_parser = crate::contact_case::parse_model)]
+    pub model: crate::mechanics::Fidelity,
     /// Integration tolerance.
     #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub tol: f64,
@@ -66,35 +67,23 @@ pub struct ModelArgs {
 }
 
 impl ModelArgs {
-    /// The score settings, checked.
+    /// The score settings and the model's, checked.
     pub fn score(&self) -> Result<ScoreSettings> {
-        let checks = [
-            ("--kernel", self.kernel, 0.01, 90.0),
-            ("--floor", self.floor, 1e-9, 1.0),
-            ("--window", self.window, 0.0, 180.0),
-            ("--tol", self.tol, 1e-12, 1e-2),
-            ("--contained-share", self.contained_share, 0.01, 1.0),
-        ];
-        for (flag, v, lo, hi) in checks {
-            if !(v.is_finite() && v >= lo && v <= hi) {
-                bail!("{flag} must lie in [{lo}, {hi}], got {v}");
-            }
-        }
-        if !(1..=100).contains(&self.passes) {
-            bail!("--passes must lie in [1, 100], got {}", self.passes);
-        }
-        if self.threads > crate::maps::limits::MAX_THREADS {
-            bail!(
-                "--threads must lie in [0, {}], got {}",
-                crate::maps::limits::MAX_THREADS,
-                self.threads
-            );
-        }
-        Ok(ScoreSettings {
-            kernel_deg: self.kernel,
-            floor: self.floor,
-            window_deg: self.window,
-            contained_share: self.contained_share,
+        let (lo, hi) = crate::mechanics::limits::TOL;
+        in_range("--tol", self.tol, lo, hi, "per step")?;
+        in_range("--passes", self.passes as f64, 1.0, 100.0, "passes")?;
+        let max = crate::maps::limits::MAX_THREADS as f64;
+        in_range(
+            "--threads",
+            self.threads as f64,
+            0.0,
+            max,
+            "0: one per core",
+        )?;
+        let (k, f, w, c) = (self.kernel, self.floor, self.window, self.contained_share);
+        ScoreSettings::checked(k, f, w, c).map_err(|mut e| {
+            e.name = format!("--{}", e.name.replace('_', "-"));
+            e.into()
         })
     }
 
@@ -148,7 +137,7 @@ pub fn ensemble_spec(
     uncertain: Option<&str>,
     common: &ModelArgs,
 ) -> Result<EnsembleSpec> {
-    let model = crate::contact_case::parse_model(&common.model)?;
+    let model = common.model;
     Ok(input::ensemble_spec(
         mu_c, pin_radius, model, common.tol, uncertain,
     )?)

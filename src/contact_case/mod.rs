@@ -165,6 +165,9 @@ pub enum CaseError {
     /// An unknown contact model name (not exact, ellipsoid or tip).
     #[error("unknown model '{0}'; expected exact, ellipsoid or tip")]
     Model(String),
+    /// An unknown `--model` of `contact` or `map` (where the map tier is a choice too).
+    #[error("unknown model '{0}'; expected exact, ellipsoid, tip or map")]
+    ModelChoice(String),
     /// A part spec that names no part.
     #[error("part '{part}'")]
     Part {
@@ -229,6 +232,30 @@ pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>), CaseError> {
 /// Parse a fidelity name: exact, ellipsoid or tip.
 pub fn parse_model(s: &str) -> Result<Fidelity, CaseError> {
     Fidelity::parse(s.trim()).ok_or_else(|| CaseError::Model(s.to_string()))
+}
+
+/// What a pass is answered by (`--model` of `pinfeed contact` and `pinfeed map`): the contact
+/// model at a fidelity, or the certified map tier over the exact model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelChoice {
+    /// The contact model at this fidelity (`exact`, `ellipsoid`, `tip`).
+    Model(Fidelity),
+    /// The map tier (`map`).
+    Map,
+}
+
+impl std::str::FromStr for ModelChoice {
+    type Err = CaseError;
+
+    /// `exact`, `ellipsoid`, `tip` or `map` (surrounding blanks ignored).
+    fn from_str(s: &str) -> Result<ModelChoice, CaseError> {
+        match s.trim() {
+            "map" => Ok(ModelChoice::Map),
+            m => Fidelity::parse(m)
+                .map(ModelChoice::Model)
+                .ok_or_else(|| CaseError::ModelChoice(m.to_string())),
+        }
+    }
 }
 
 /// The belt travel (units of a) after which a pin starting at lateral offset `d` and moving at

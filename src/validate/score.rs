@@ -60,6 +60,36 @@ pub const CONTAINED_SHARE: f64 = 0.8;
 /// Seed of the bootstrap resamples (fixed: the interval is a function of the ensemble).
 const RESAMPLE_SEED: u64 = 0xB007_57A9;
 
+impl ScoreSettings {
+    /// The settings, each checked against its range: the kernel's sd in [0.01, 90]°, the floor's
+    /// weight in [1e-9, 1], the window in [0, 180]° and the contained share in [0.01, 1]. The
+    /// error names the field (`kernel`, `floor`, `window`, `contained_share`).
+    pub fn checked(
+        kernel_deg: f64,
+        floor: f64,
+        window_deg: f64,
+        contained_share: f64,
+    ) -> Result<ScoreSettings, crate::mechanics::limits::OutOfRange> {
+        use crate::mechanics::limits::in_range;
+        in_range("kernel", kernel_deg, 0.01, 90.0, "degrees")?;
+        in_range("floor", floor, 1e-9, 1.0, "weight of the uniform floor")?;
+        in_range("window", window_deg, 0.0, 180.0, "degrees each side")?;
+        in_range(
+            "contained_share",
+            contained_share,
+            0.01,
+            1.0,
+            "share of the mass",
+        )?;
+        Ok(ScoreSettings {
+            kernel_deg,
+            floor,
+            window_deg,
+            contained_share,
+        })
+    }
+}
+
 impl Default for ScoreSettings {
     fn default() -> Self {
         ScoreSettings {

@@ -48,8 +48,8 @@ pub struct Request {
     pub mu_c: f64,
     /// Part–belt (support) friction coefficient μs.
     pub mu_s: f64,
-    /// Fidelity name.
-    pub model: String,
+    /// The contact model's fidelity.
+    pub model: Fidelity,
     /// Integration tolerance per step of the contact model.
     pub tol: f64,
     /// `stable`, `vertex-edge` or degrees.
@@ -143,9 +143,6 @@ pub enum SenseError {
         /// The word given.
         got: String,
     },
-    /// An unknown contact model (`--model`).
-    #[error("--model: unknown model '{0}'; expected exact, ellipsoid or tip")]
-    Model(String),
     /// A sensor setting outside its range.
     #[error("--{}: {message}", field.replace('_', "-"))]
     Sensor {
@@ -406,8 +403,7 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
             })
         }
     };
-    let fidelity =
-        Fidelity::parse(a.model.trim()).ok_or_else(|| SenseError::Model(a.model.clone()))?;
+    let fidelity = a.model;
     let sensor = sensor_settings(a)?;
     for &f in &a.noise {
         sensor
