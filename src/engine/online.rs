@@ -126,6 +126,103 @@ pub struct Choice {
     pub predicted: f64,
 }
 
+/// Per member of the online model: its signal at each sensor (None: no touch), its success per
+/// action, and its line runs and contact-model evaluations.
+type MemberOut = (Vec<Option<ContactSignal>>, Vec<bool>, [u64; 2]);
+
+/// success[a · H + h]: the share of hypothesis h's `s` members that end in the goal under joint
+/// action a (`order[a]`: the action's index in each member's successes).
+fn success_table(
+    outs: &[MemberOut],
+    order: &[usize],
+    n_actions: usize,
+    n_h: usize,
+    s: usize,
+) -> Vec<f64> {
+    let mut success = vec![0.0; n_actions * n_h];
+    for (k, (_, ok, _)) in outs.iter().enumerate() {
+        for (a, &p) in order.iter().enumerate() {
+            success[a * n_h + k / s] += f64::from(u8::from(ok[p])) / s as f64;
+        }
+    }
+    success
+}
+
+/// A sensor's held-out trials: each one's hypothesis and the evidence of its reading.
+type HeldTrials = Vec<(usize, Evidence)>;
+
+/// The model of sensor `i` (obstacle `j`) from the members' signals (`outs`, `s` per
+/// hypothesis), and its held-out trials (reading, hypothesis) for tempering; None when the
+/// obstacle is not a pin.
+fn sensor_model(
+    scene: &Scene,
+    hypotheses: &[Hypothesis],
+    i: usize,
+    j: usize,
+    outs: &[MemberOut],
+    s: usize,
+    held_out: &[(usize, Vec<Option<ContactSignal>>)],
+) -> Result<Option<(SensorModel, HeldTrials)>, String> {
+    let n_h = hypotheses.len();
+    let Obstacle::Pin(pin) = &scene.obstacles[j] else {
+        return Ok(None);
+    };
+    let sensor = pin.sensor.as_ref().expect("a sensor pin");
+    let mut p_touch = vec![0.0; n_h];
+    let mut set = TemplateSet {
+        labels: Vec::new(),
+        members: Vec::new(),
+    };
+    let mut rows = Vec::new();
+    for h in 0..n_h {
+        let sigs: Vec<ContactSignal> = (0..s)
+            .filter_map(|m| outs[h * s + m].0[i].clone())
+            .collect();
+        p_touch[h] = sigs.len() as f64 / s as f64;
+        if !sigs.is_empty() {
+            rows.push(h);
+            set.labels.push(format!("h{h}"));
+            set.members.push(sigs);
+        }
+    }
+    let likelihood = if rows.is_empty() {
+        None
+    } else {
+        Some(
+            Likelihood::new(&set, &sensor.settings, &ClassifierOptions::default())
+                .map_err(|e| format!("sensor \"{}\": {e}", pin.name))?,
+        )
+    };
+    let state_label = match &sensor.hypotheses {
+        Hypotheses::Orientations { degrees, .. } => hypotheses
+            .iter()
+            .map(|x| nearest(degrees, x.state_deg))
+            .collect::<Option<Vec<usize>>>(),
+        Hypotheses::VertexEdge { .. } => None,
+    };
+    let sm = SensorModel {
+        obstacle: j,
+        p_touch,
+        likelihood,
+        rows,
+        temper: 1.0,
+        state_label,
+        classifier_power: 1.0,
+    };
+    let trials: Vec<(usize, Evidence)> = held_out
+        .iter()
+        .enumerate()
+        .filter_map(|(k, (h, sigs))| {
+            let sig = sigs[i].as_ref()?;
+            let mut rng = stream(scene.seed, HELD_OUT_READINGS | ((k as u64) << 8) | i as u64);
+            let r = read(sig, &sensor.settings, &mut rng)?;
+            let post = sensor.classifier.classify(&r).posterior;
+            Some((*h, Evidence::of(&sm, Some(&r), post.as_deref(), true)))
+        })
+        .collect();
+    Ok(Some((sm, trials)))
+}
+
 impl OnlineModel {
     /// Build the model of `scene` (its nominal physics) for `spec`. Errors name the size that is
     /// too large or the hypothesis set that is empty.
@@ -186,7 +283,6 @@ impl OnlineModel {
             sensor_signals(scene, base, &sensor_obstacles, e)
         };
         // Per member: its signal at each sensor (None: no touch) and its success per action.
-        type MemberOut = (Vec<Option<ContactSignal>>, Vec<bool>, [u64; 2]);
         let outs: Vec<MemberOut> = members
             .par_iter()
             .map(|(h, e)| -> Result<MemberOut, String> {
@@ -210,73 +306,15 @@ impl OnlineModel {
             })
             .collect::<Result<_, String>>()?;
         let n_h = hypotheses.len();
-        let mut success = vec![0.0; actions.len() * n_h];
         let order = staging.prefix_of_actions(&options);
-        for (k, (_, ok, _)) in outs.iter().enumerate() {
-            for (a, &p) in order.iter().enumerate() {
-                success[a * n_h + k / s] += f64::from(u8::from(ok[p])) / s as f64;
-            }
-        }
+        let success = success_table(&outs, &order, actions.len(), n_h, s);
         let mut sensors = Vec::new();
         let mut held_trials = Vec::new();
         for (i, &j) in sensor_obstacles.iter().enumerate() {
-            let Obstacle::Pin(pin) = &scene.obstacles[j] else {
+            let Some((sm, trials)) = sensor_model(scene, &hypotheses, i, j, &outs, s, &held_out)?
+            else {
                 continue;
             };
-            let sensor = pin.sensor.as_ref().expect("a sensor pin");
-            let mut p_touch = vec![0.0; n_h];
-            let mut set = TemplateSet {
-                labels: Vec::new(),
-                members: Vec::new(),
-            };
-            let mut rows = Vec::new();
-            for h in 0..n_h {
-                let sigs: Vec<ContactSignal> = (0..s)
-                    .filter_map(|m| outs[h * s + m].0[i].clone())
-                    .collect();
-                p_touch[h] = sigs.len() as f64 / s as f64;
-                if !sigs.is_empty() {
-                    rows.push(h);
-                    set.labels.push(format!("h{h}"));
-                    set.members.push(sigs);
-                }
-            }
-            let likelihood = if rows.is_empty() {
-                None
-            } else {
-                Some(
-                    Likelihood::new(&set, &sensor.settings, &ClassifierOptions::default())
-                        .map_err(|e| format!("sensor \"{}\": {e}", pin.name))?,
-                )
-            };
-            let state_label = match &sensor.hypotheses {
-                Hypotheses::Orientations { degrees, .. } => hypotheses
-                    .iter()
-                    .map(|x| nearest(degrees, x.state_deg))
-                    .collect::<Option<Vec<usize>>>(),
-                Hypotheses::VertexEdge { .. } => None,
-            };
-            let sm = SensorModel {
-                obstacle: j,
-                p_touch,
-                likelihood,
-                rows,
-                temper: 1.0,
-                state_label,
-                classifier_power: 1.0,
-            };
-            let trials: Vec<(usize, Evidence)> = held_out
-                .iter()
-                .enumerate()
-                .filter_map(|(k, (h, sigs))| {
-                    let sig = sigs[i].as_ref()?;
-                    let mut rng =
-                        stream(scene.seed, HELD_OUT_READINGS | ((k as u64) << 8) | i as u64);
-                    let r = read(sig, &sensor.settings, &mut rng)?;
-                    let post = sensor.classifier.classify(&r).posterior;
-                    Some((*h, Evidence::of(&sm, Some(&r), post.as_deref(), true)))
-                })
-                .collect();
             held_trials.push(trials);
             sensors.push(sm);
         }

@@ -183,18 +183,7 @@ impl Problem {
 
     /// Check every value and build the part in metres. Errors name the field.
     pub fn compile(&self) -> Result<Compiled, PlanError> {
-        let finite_pos = |field: &'static str, v: f64| -> Result<(), PlanError> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(PlanError::input(
-                    field,
-                    v,
-                    "must be a positive finite number",
-                ))
-            }
-        };
-        finite_pos("scale", self.scale)?;
+        check_finite_pos("scale", self.scale)?;
         let unit = part_from_spec(&self.part).map_err(|err| PlanError::Part {
             part: self.part.clone(),
             reason: err.to_string(),
@@ -211,6 +200,47 @@ impl Problem {
                 format!("gives a part of size a = {a} m; it must lie in [0.1 mm, 1 m]"),
             ));
         }
+        self.check_feed()?;
+        self.check_line(a)?;
+        self.check_goal_and_search(a)?;
+        let q = self.theta_quantum_deg;
+        let n = (360.0 / q).round();
+        // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform
+        // support only: a tripod is fixed in the part frame and breaks the symmetry).
+        let mut symmetry = if self.tripod {
+            1
+        } else {
+            rotational_symmetry(&polygon)
+        };
+        let mut period_steps = 360.0 / symmetry as f64 / q;
+        if (period_steps - period_steps.round()).abs() > 1e-9 {
+            symmetry = 1;
+            period_steps = n;
+        }
+        let stable: Vec<f64> = unit
+            .stable_states()
+            .iter()
+            .map(|s| s.theta_rad.to_degrees())
+            .collect();
+        if self.feed == FeedKind::Stable && stable.is_empty() {
+            return Err(PlanError::input(
+                "feed",
+                "stable",
+                "the part has no stable state",
+            ));
+        }
+        Ok(Compiled {
+            polygon,
+            radius: a,
+            stable_deg: stable,
+            theta_steps: period_steps.round() as i32,
+            symmetry,
+        })
+    }
+
+    /// Check the feed's settings and the friction: jitter, lateral offset, particle counts, μc
+    /// and its range.
+    fn check_feed(&self) -> Result<(), PlanError> {
         if !(self.jitter_deg.is_finite() && (0.0..=45.0).contains(&self.jitter_deg)) {
             return Err(PlanError::input(
                 "jitter",
@@ -252,6 +282,12 @@ impl Problem {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// Check the line's settings against the part's size `a` (m): pin radius, belt width (and
+    /// the lateral offset on it), spacing and the most pins.
+    fn check_line(&self, a: f64) -> Result<(), PlanError> {
         if !(self.pin_radius_m.is_finite() && self.pin_radius_m >= 0.0 && self.pin_radius_m <= a) {
             return Err(PlanError::input(
                 "pin_radius",
@@ -259,7 +295,7 @@ impl Problem {
                 format!("must lie in [0, a = {a:.4} m] (m)"),
             ));
         }
-        finite_pos("belt_width", self.belt_width_m)?;
+        check_finite_pos("belt_width", self.belt_width_m)?;
         if self.belt_width_m > 10.0 {
             return Err(PlanError::input(
                 "belt_width",
@@ -289,7 +325,7 @@ impl Problem {
                 ),
             ));
         }
-        finite_pos("spacing", self.spacing_m)?;
+        check_finite_pos("spacing", self.spacing_m)?;
         if self.spacing_m > 10.0 {
             return Err(PlanError::input(
                 "spacing",
@@ -321,6 +357,12 @@ impl Problem {
                 "at most 64 pins",
             ));
         }
+        Ok(())
+    }
+
+    /// Check the goal and the search settings (`a`: the part's size, m): tolerance, target,
+    /// margin, quanta, coarse sampling, states, time limit and contact tolerance.
+    fn check_goal_and_search(&self, a: f64) -> Result<(), PlanError> {
         if !(self.tolerance_deg.is_finite()
             && self.tolerance_deg > 0.0
             && self.tolerance_deg < 180.0)
@@ -390,37 +432,7 @@ impl Problem {
                 format!("must lie in {range}"),
             ));
         }
-        // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform
-        // support only: a tripod is fixed in the part frame and breaks the symmetry).
-        let mut symmetry = if self.tripod {
-            1
-        } else {
-            rotational_symmetry(&polygon)
-        };
-        let mut period_steps = 360.0 / symmetry as f64 / q;
-        if (period_steps - period_steps.round()).abs() > 1e-9 {
-            symmetry = 1;
-            period_steps = n;
-        }
-        let stable: Vec<f64> = unit
-            .stable_states()
-            .iter()
-            .map(|s| s.theta_rad.to_degrees())
-            .collect();
-        if self.feed == FeedKind::Stable && stable.is_empty() {
-            return Err(PlanError::input(
-                "feed",
-                "stable",
-                "the part has no stable state",
-            ));
-        }
-        Ok(Compiled {
-            polygon,
-            radius: a,
-            stable_deg: stable,
-            theta_steps: period_steps.round() as i32,
-            symmetry,
-        })
+        Ok(())
     }
 }
 
@@ -468,6 +480,19 @@ pub fn rotational_symmetry(poly: &Polygon) -> u32 {
         }
     }
     1
+}
+
+/// Check that `v` (the setting `field`) is a positive finite number.
+fn check_finite_pos(field: &'static str, v: f64) -> Result<(), PlanError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(PlanError::input(
+            field,
+            v,
+            "must be a positive finite number",
+        ))
+    }
 }
 
 #[cfg(test)]

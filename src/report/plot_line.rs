@@ -98,17 +98,21 @@ fn display_poses(path: &SamplePath, gap: f64) -> Vec<Pose> {
     out
 }
 
-/// Draw the sample paths over the line.
-pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow::Result<()> {
-    let belt = scene.belt;
-    let a = scene.part.radius;
-    let margin = 2.0 * a;
-    let (x0, x1) = (-margin, belt.length + margin);
-    let plot_w = 1500.0;
-    let px_per_m = plot_w / (x1 - x0);
-    // Every obstacle named in a row beyond the belt edge on its side, no two overlapping.
+/// The chart of one panel: metres on both axes.
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// An obstacle's label: text, x (m), beyond the upper belt edge or the lower, row, colour.
+type Label = (String, f64, bool, usize, RGBColor);
+
+/// Every obstacle named in a row beyond the belt edge on its side, no two overlapping; with the
+/// rows they take (x0: the plot's left edge in metres).
+fn obstacle_labels(scene: &Scene, x0: f64, px_per_m: f64) -> (Vec<Label>, LabelRows) {
     let mut rows = LabelRows::new();
-    let labels: Vec<(String, f64, bool, usize, RGBColor)> = scene
+    let labels: Vec<Label> = scene
         .obstacles
         .iter()
         .map(|ob| {
@@ -132,6 +136,123 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
             (text, x, above, row, colour)
         })
         .collect();
+    (labels, rows)
+}
+
+/// A panel's caption: the sample part, its outcome and its first and last orientation.
+fn caption(scene: &Scene, sample: Option<&&SamplePath>) -> String {
+    match sample {
+        Some(s) => {
+            let first = s.poses.first().map(|p| p.1.theta_rad).unwrap_or(0.0);
+            let last = s.poses.last().map(|p| p.1.theta_rad).unwrap_or(0.0);
+            format!(
+                "{} — part {}: {} (θ {:.1}° → {:.1}°)",
+                scene.name,
+                s.part,
+                s.outcome.name(),
+                wrap_deg(first.to_degrees()),
+                wrap_deg(last.to_degrees())
+            )
+        }
+        None => format!("{} — no sample part", scene.name),
+    }
+}
+
+/// Draw the line itself into a panel: belt edges, entry and exit, the obstacles and their labels.
+fn draw_line(ch: &mut Chart, scene: &Scene, labels: &[Label], px_per_m: f64) -> anyhow::Result<()> {
+    let belt = scene.belt;
+    // Belt edges, entry and exit.
+    for y in [-belt.width / 2.0, belt.width / 2.0] {
+        ch.draw_series(LineSeries::new(
+            vec![(0.0, y), (belt.length, y)],
+            BLACK.stroke_width(2),
+        ))?;
+    }
+    for x in [0.0, belt.length] {
+        ch.draw_series(DashedLineSeries::new(
+            vec![(x, -belt.width / 2.0), (x, belt.width / 2.0)],
+            5,
+            4,
+            BLACK.mix(0.5).stroke_width(1),
+        ))?;
+    }
+    for ob in &scene.obstacles {
+        match ob {
+            Obstacle::Pin(pin) => {
+                let r = ((pin.radius * px_per_m).round() as i32).max(2);
+                let fill = if pin.sensor.is_some() {
+                    SENSOR_COLOUR
+                } else {
+                    OBSTACLE_COLOUR
+                };
+                ch.draw_series(std::iter::once(Circle::new(
+                    (pin.centre.x, pin.centre.y),
+                    r,
+                    fill.filled(),
+                )))?;
+            }
+            Obstacle::Fence(fence) => {
+                let (p, q) = (fence.start, fence.end());
+                ch.draw_series(LineSeries::new(
+                    vec![(p.x, p.y), (q.x, q.y)],
+                    OBSTACLE_COLOUR.stroke_width(3),
+                ))?;
+            }
+        }
+    }
+    for (text, x, above, row, colour) in labels {
+        let gap = (6.0 + LABEL_ROW_PX * *row as f64) / px_per_m;
+        let (y, v) = if *above {
+            (belt.width / 2.0 + gap, VPos::Bottom)
+        } else {
+            (-belt.width / 2.0 - gap + 2.0 / px_per_m, VPos::Top)
+        };
+        ch.draw_series(std::iter::once(Text::new(
+            text.clone(),
+            (*x, y),
+            ("sans-serif", LABEL_FONT)
+                .into_font()
+                .color(colour)
+                .pos(Pos::new(HPos::Center, v)),
+        )))?;
+    }
+    Ok(())
+}
+
+/// Draw a sample part into a panel: its outline at the display poses and its centroid's track,
+/// in its outcome's colour.
+fn draw_sample(ch: &mut Chart, scene: &Scene, sample: &SamplePath) -> anyhow::Result<()> {
+    let a = scene.part.radius;
+    let colour = outcome_colour(sample.outcome);
+    let poses = display_poses(sample, 2.5 * a);
+    let m = poses.len();
+    for (i, p) in poses.iter().enumerate() {
+        let mut ring: Vec<(f64, f64)> = scene
+            .part
+            .polygon
+            .world_vertices(p)
+            .iter()
+            .map(|v| (v.x, v.y))
+            .collect();
+        ring.push(ring[0]);
+        let strength = if i == 0 || i + 1 == m { 1.0 } else { 0.55 };
+        ch.draw_series(LineSeries::new(ring, colour.mix(strength).stroke_width(1)))?;
+    }
+    let track: Vec<(f64, f64)> = sample.poses.iter().map(|(_, p)| (p.x, p.y)).collect();
+    ch.draw_series(LineSeries::new(track, colour.mix(0.35)))?;
+    Ok(())
+}
+
+/// Draw the sample paths over the line.
+pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow::Result<()> {
+    let belt = scene.belt;
+    let a = scene.part.radius;
+    let margin = 2.0 * a;
+    let (x0, x1) = (-margin, belt.length + margin);
+    let plot_w = 1500.0;
+    let px_per_m = plot_w / (x1 - x0);
+    // Every obstacle named in a row beyond the belt edge on its side, no two overlapping.
+    let (labels, rows) = obstacle_labels(scene, x0, px_per_m);
     let room = |above: bool| (10.0 + LABEL_ROW_PX * rows.rows(above) as f64) / px_per_m;
     let (y0, y1) = (
         -belt.width / 2.0 - margin.max(room(false)),
@@ -149,23 +270,8 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
     let panels = root.split_evenly((n, 1));
     for (k, panel) in panels.iter().enumerate() {
         let sample = samples.get(k);
-        let caption = match sample {
-            Some(s) => {
-                let first = s.poses.first().map(|p| p.1.theta_rad).unwrap_or(0.0);
-                let last = s.poses.last().map(|p| p.1.theta_rad).unwrap_or(0.0);
-                format!(
-                    "{} — part {}: {} (θ {:.1}° → {:.1}°)",
-                    scene.name,
-                    s.part,
-                    s.outcome.name(),
-                    wrap_deg(first.to_degrees()),
-                    wrap_deg(last.to_degrees())
-                )
-            }
-            None => format!("{} — no sample part", scene.name),
-        };
         let mut ch = ChartBuilder::on(panel)
-            .caption(caption, ("sans-serif", 16))
+            .caption(caption(scene, sample), ("sans-serif", 16))
             .margin(5)
             .x_label_area_size(bottom)
             .y_label_area_size(left)
@@ -176,79 +282,9 @@ pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow:
             .y_desc("y (m)")
             .y_label_formatter(&|v| crate::report::fixed(*v, 2, false))
             .draw()?;
-        // Belt edges, entry and exit.
-        for y in [-belt.width / 2.0, belt.width / 2.0] {
-            ch.draw_series(LineSeries::new(
-                vec![(0.0, y), (belt.length, y)],
-                BLACK.stroke_width(2),
-            ))?;
-        }
-        for x in [0.0, belt.length] {
-            ch.draw_series(DashedLineSeries::new(
-                vec![(x, -belt.width / 2.0), (x, belt.width / 2.0)],
-                5,
-                4,
-                BLACK.mix(0.5).stroke_width(1),
-            ))?;
-        }
-        for ob in &scene.obstacles {
-            match ob {
-                Obstacle::Pin(pin) => {
-                    let r = ((pin.radius * px_per_m).round() as i32).max(2);
-                    let fill = if pin.sensor.is_some() {
-                        SENSOR_COLOUR
-                    } else {
-                        OBSTACLE_COLOUR
-                    };
-                    ch.draw_series(std::iter::once(Circle::new(
-                        (pin.centre.x, pin.centre.y),
-                        r,
-                        fill.filled(),
-                    )))?;
-                }
-                Obstacle::Fence(fence) => {
-                    let (p, q) = (fence.start, fence.end());
-                    ch.draw_series(LineSeries::new(
-                        vec![(p.x, p.y), (q.x, q.y)],
-                        OBSTACLE_COLOUR.stroke_width(3),
-                    ))?;
-                }
-            }
-        }
-        for (text, x, above, row, colour) in &labels {
-            let gap = (6.0 + LABEL_ROW_PX * *row as f64) / px_per_m;
-            let (y, v) = if *above {
-                (belt.width / 2.0 + gap, VPos::Bottom)
-            } else {
-                (-belt.width / 2.0 - gap + 2.0 / px_per_m, VPos::Top)
-            };
-            ch.draw_series(std::iter::once(Text::new(
-                text.clone(),
-                (*x, y),
-                ("sans-serif", LABEL_FONT)
-                    .into_font()
-                    .color(colour)
-                    .pos(Pos::new(HPos::Center, v)),
-            )))?;
-        }
+        draw_line(&mut ch, scene, &labels, px_per_m)?;
         let Some(sample) = sample else { continue };
-        let colour = outcome_colour(sample.outcome);
-        let poses = display_poses(sample, 2.5 * a);
-        let m = poses.len();
-        for (i, p) in poses.iter().enumerate() {
-            let mut ring: Vec<(f64, f64)> = scene
-                .part
-                .polygon
-                .world_vertices(p)
-                .iter()
-                .map(|v| (v.x, v.y))
-                .collect();
-            ring.push(ring[0]);
-            let strength = if i == 0 || i + 1 == m { 1.0 } else { 0.55 };
-            ch.draw_series(LineSeries::new(ring, colour.mix(strength).stroke_width(1)))?;
-        }
-        let track: Vec<(f64, f64)> = sample.poses.iter().map(|(_, p)| (p.x, p.y)).collect();
-        ch.draw_series(LineSeries::new(track, colour.mix(0.35)))?;
+        draw_sample(&mut ch, scene, sample)?;
     }
     root.present()?;
     staged.commit()?;

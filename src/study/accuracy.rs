@@ -89,59 +89,13 @@ fn ang_err(a_deg: f64, b_deg: f64) -> f64 {
 
 /// Run the study.
 pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy> {
-    let polys: Vec<_> = parts
-        .iter()
-        .map(|p| part_from_spec(p))
-        .collect::<Result<_, _>>()?;
-    let models: Vec<PartModel> = polys
-        .iter()
-        .map(|p| PartModel::new(p, &Support::Uniform).map_err(anyhow::Error::msg))
-        .collect::<Result<_, _>>()?;
-    let per = n.div_ceil(parts.len());
-    let mut cases = Vec::new();
-    for pi in 0..parts.len() {
-        let mut rng = crate::random::stream(seed, pi as u64);
-        for _ in 0..per {
-            cases.push(Case {
-                part: pi,
-                theta0: rng.random::<f64>() * 360.0,
-                d: -0.9 + 1.8 * rng.random::<f64>(),
-            });
-        }
-    }
-    // The exact model with its slide tables (built here, before any timing).
-    let mu_c = ContactSettings::default().mu_c;
-    let tabled: Vec<PartModel> = models
-        .iter()
-        .map(|m| m.clone().with_slide_tables(&[mu_c]))
-        .collect();
-    tabled.iter().for_each(PartModel::build_all_tables);
-    let run_with = |c: &Case, fid: Fidelity, tol: f64, tables: bool| {
-        let a = polys[c.part].radius();
-        let s = ContactSettings {
-            fidelity: fid,
-            tol,
-            ..ContactSettings::default()
-        };
-        push(
-            if tables {
-                &tabled[c.part]
-            } else {
-                &models[c.part]
-            },
-            Pose::new(0.0, 0.0, c.theta0.to_radians()),
-            Vec2::new(1.01 * a, c.d * a),
-            &Pin::point(),
-            &s,
-            None,
-        )
-    };
-    let run_one = |c: &Case, fid: Fidelity, tol: f64| run_with(c, fid, tol, false);
+    let bench = Bench::new(parts)?;
+    let cases = draw_cases(parts.len(), n.div_ceil(parts.len()), seed);
     // Reference.
     let reference: Vec<Option<f64>> = cases
         .iter()
         .map(|c| {
-            let o = run_one(c, Fidelity::Exact, 1e-10);
+            let o = bench.push(c, Fidelity::Exact, 1e-10, false);
             o.status
                 .is_ok()
                 .then(|| o.pose_final.theta_rad.to_degrees())
@@ -152,6 +106,40 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
         .collect();
     let excluded = cases.len() - kept.len();
 
+    let mut rows = Vec::new();
+    for tier in &tiers() {
+        rows.push(bench.time_tier(&cases, &kept, &reference, tier));
+    }
+    let (map_row, map_build, d_count) = bench.map_tier(&cases, &kept, &reference);
+    rows.push(map_row);
+    Ok(AccuracyStudy {
+        parts: parts.iter().map(|s| s.to_string()).collect(),
+        contacts: kept.len(),
+        reference_excluded: excluded,
+        map_build_seconds: map_build,
+        map_grid: format!("{} parts × {} d × 360 θ0", parts.len(), d_count),
+        rows,
+    })
+}
+
+/// `per` random contacts per part (θ0 and d), each part's from the stream (seed, part index).
+fn draw_cases(n_parts: usize, per: usize, seed: u64) -> Vec<Case> {
+    let mut cases = Vec::new();
+    for pi in 0..n_parts {
+        let mut rng = crate::random::stream(seed, pi as u64);
+        for _ in 0..per {
+            cases.push(Case {
+                part: pi,
+                theta0: rng.random::<f64>() * 360.0,
+                d: -0.9 + 1.8 * rng.random::<f64>(),
+            });
+        }
+    }
+    cases
+}
+
+/// The timed tiers: name, fidelity, tolerance and whether the exact model uses its slide tables.
+fn tiers() -> Vec<(String, Fidelity, f64, bool)> {
     let mut tiers: Vec<(String, Fidelity, f64, bool)> = vec![
         ("tip".into(), Fidelity::Tip, 1e-6, false),
         ("ellipsoid".into(), Fidelity::Ellipsoid, 1e-6, false),
@@ -167,18 +155,89 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
             true,
         ));
     }
-    let mut rows = Vec::new();
-    for (name, fid, tol, tables) in &tiers {
+    tiers
+}
+
+/// The parts of a study with their models, plain and with slide tables.
+struct Bench {
+    polys: Vec<crate::geometry::Polygon>,
+    models: Vec<PartModel>,
+    /// The exact model with its slide tables (built before any timing).
+    tabled: Vec<PartModel>,
+}
+
+impl Bench {
+    /// Build the parts' models and their slide tables.
+    fn new(parts: &[&str]) -> anyhow::Result<Bench> {
+        let polys: Vec<_> = parts
+            .iter()
+            .map(|p| part_from_spec(p))
+            .collect::<Result<_, _>>()?;
+        let models: Vec<PartModel> = polys
+            .iter()
+            .map(|p| PartModel::new(p, &Support::Uniform).map_err(anyhow::Error::msg))
+            .collect::<Result<_, _>>()?;
+        // The exact model with its slide tables (built here, before any timing).
+        let mu_c = ContactSettings::default().mu_c;
+        let tabled: Vec<PartModel> = models
+            .iter()
+            .map(|m| m.clone().with_slide_tables(&[mu_c]))
+            .collect();
+        tabled.iter().for_each(PartModel::build_all_tables);
+        Ok(Bench {
+            polys,
+            models,
+            tabled,
+        })
+    }
+
+    /// One case's push at this fidelity and tolerance, with or without slide tables.
+    fn push(
+        &self,
+        c: &Case,
+        fid: Fidelity,
+        tol: f64,
+        tables: bool,
+    ) -> crate::mechanics::ContactOutcome {
+        let a = self.polys[c.part].radius();
+        let s = ContactSettings {
+            fidelity: fid,
+            tol,
+            ..ContactSettings::default()
+        };
+        push(
+            if tables {
+                &self.tabled[c.part]
+            } else {
+                &self.models[c.part]
+            },
+            Pose::new(0.0, 0.0, c.theta0.to_radians()),
+            Vec2::new(1.01 * a, c.d * a),
+            &Pin::point(),
+            &s,
+            None,
+        )
+    }
+
+    /// Time one tier (see [`tiers`]) over the kept cases (after a warm-up) against the reference.
+    fn time_tier(
+        &self,
+        cases: &[Case],
+        kept: &[usize],
+        reference: &[Option<f64>],
+        tier: &(String, Fidelity, f64, bool),
+    ) -> TierRow {
+        let (name, fid, tol, tables) = (tier.0.as_str(), tier.1, tier.2, tier.3);
         // Warm-up.
         for &i in kept.iter().take(20) {
-            std::hint::black_box(run_with(&cases[i], *fid, *tol, *tables));
+            std::hint::black_box(self.push(&cases[i], fid, tol, tables));
         }
         let mut errors = Vec::with_capacity(kept.len());
         let mut times = Vec::with_capacity(kept.len());
         let mut evals = 0u64;
-        for &i in &kept {
+        for &i in kept {
             let t0 = Instant::now();
-            let o = std::hint::black_box(run_with(&cases[i], *fid, *tol, *tables));
+            let o = std::hint::black_box(self.push(&cases[i], fid, tol, tables));
             times.push(t0.elapsed().as_secs_f64() * 1e6);
             evals += o.evaluations;
             errors.push(ang_err(
@@ -186,61 +245,57 @@ pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy>
                 reference[i].expect("kept cases have a reference"),
             ));
         }
-        rows.push(summarise(name, fid.name(), *tol, errors, times, evals));
+        summarise(name, fid.name(), tol, errors, times, evals)
     }
-    // The map tier: exact configuration maps on a 1° × 0.05 grid, looked up by nearest point.
-    let t_build = Instant::now();
-    let d_steps: Vec<f64> = (0..=36).map(|k| -0.9 + 0.05 * k as f64).collect();
-    let mut maps: Vec<Vec<f64>> = Vec::new(); // [part][d_index * 360 + theta]
-    for pi in 0..parts.len() {
-        let mut grid = vec![0.0; d_steps.len() * 360];
-        for (di, &d) in d_steps.iter().enumerate() {
-            for th in 0..360 {
-                let c = Case {
-                    part: pi,
-                    theta0: th as f64,
-                    d,
-                };
-                grid[di * 360 + th] = run_one(&c, Fidelity::Exact, 1e-6)
-                    .pose_final
-                    .theta_rad
-                    .to_degrees();
+
+    /// The map tier: exact configuration maps on a 1° × 0.05 grid, looked up by nearest point.
+    /// Its row, the maps' build time (s) and the number of d values.
+    fn map_tier(
+        &self,
+        cases: &[Case],
+        kept: &[usize],
+        reference: &[Option<f64>],
+    ) -> (TierRow, f64, usize) {
+        let t_build = Instant::now();
+        let d_steps: Vec<f64> = (0..=36).map(|k| -0.9 + 0.05 * k as f64).collect();
+        let mut maps: Vec<Vec<f64>> = Vec::new(); // [part][d_index * 360 + theta]
+        for pi in 0..self.polys.len() {
+            let mut grid = vec![0.0; d_steps.len() * 360];
+            for (di, &d) in d_steps.iter().enumerate() {
+                for th in 0..360 {
+                    let c = Case {
+                        part: pi,
+                        theta0: th as f64,
+                        d,
+                    };
+                    grid[di * 360 + th] = self
+                        .push(&c, Fidelity::Exact, 1e-6, false)
+                        .pose_final
+                        .theta_rad
+                        .to_degrees();
+                }
             }
+            maps.push(grid);
         }
-        maps.push(grid);
+        let map_build = t_build.elapsed().as_secs_f64();
+        let lookup = |c: &Case| {
+            let di = (((c.d + 0.9) / 0.05).round() as usize).min(d_steps.len() - 1);
+            let ti = (c.theta0.round() as usize) % 360;
+            let stored = maps[c.part][di * 360 + ti];
+            // The map stores the final angle for θ0 = ti; apply the same turn to the actual θ0.
+            stored - ti as f64 + c.theta0
+        };
+        let mut errors = Vec::new();
+        let mut times = Vec::new();
+        for &i in kept {
+            let t0 = Instant::now();
+            let th = std::hint::black_box(lookup(&cases[i]));
+            times.push(t0.elapsed().as_secs_f64() * 1e6);
+            errors.push(ang_err(th, reference[i].expect("kept")));
+        }
+        let row = summarise("map (1° × 0.05, nearest)", "exact", 1e-6, errors, times, 0);
+        (row, map_build, d_steps.len())
     }
-    let map_build = t_build.elapsed().as_secs_f64();
-    let lookup = |c: &Case| {
-        let di = (((c.d + 0.9) / 0.05).round() as usize).min(d_steps.len() - 1);
-        let ti = (c.theta0.round() as usize) % 360;
-        let stored = maps[c.part][di * 360 + ti];
-        // The map stores the final angle for θ0 = ti; apply the same turn to the actual θ0.
-        stored - ti as f64 + c.theta0
-    };
-    let mut errors = Vec::new();
-    let mut times = Vec::new();
-    for &i in &kept {
-        let t0 = Instant::now();
-        let th = std::hint::black_box(lookup(&cases[i]));
-        times.push(t0.elapsed().as_secs_f64() * 1e6);
-        errors.push(ang_err(th, reference[i].expect("kept")));
-    }
-    rows.push(summarise(
-        "map (1° × 0.05, nearest)",
-        "exact",
-        1e-6,
-        errors,
-        times,
-        0,
-    ));
-    Ok(AccuracyStudy {
-        parts: parts.iter().map(|s| s.to_string()).collect(),
-        contacts: kept.len(),
-        reference_excluded: excluded,
-        map_build_seconds: map_build,
-        map_grid: format!("{} parts × {} d × 360 θ0", parts.len(), d_steps.len()),
-        rows,
-    })
 }
 
 fn summarise(

@@ -796,7 +796,6 @@ impl Work<'_> {
         planner: &mut Planner,
     ) -> Result<Option<Candidate>, DesignError> {
         let o = self.o;
-        let compiled = planner.compiled.clone();
         let line = LineSpec {
             name: o.name.clone(),
             headway_s: 4.0,
@@ -804,109 +803,112 @@ impl Work<'_> {
             parts: o.check_parts.max(1),
         };
         if mode == Mode::Sensor {
-            let res = contingent::search(planner, o.max_moving, o.sensor_candidates);
-            let (outcome, stats) = match res {
-                Ok(x) => x,
-                // A part the sensor cannot tell apart (one stable state, no position) is not an
-                // error of the design: the mode has no plan.
-                Err(e) => {
-                    if o.modes == [Mode::Sensor] {
-                        return Err(e.into());
-                    }
-                    self.tell(Some(mode), round, format!("no sensing plan: {e}"));
-                    return Ok(None);
-                }
-            };
-            let (result, message, plan) = match outcome {
-                ContingentOutcome::Found(p) => (
-                    "found",
-                    format!(
-                        "a contingent plan: a sensor pin and {} moving pin(s), the fewest for its action set",
-                        p.k
-                    ),
-                    p,
-                ),
-                ContingentOutcome::NoneUpTo { depth } => {
-                    self.tell(
-                        Some(mode),
-                        round,
-                        format!("no contingent plan up to {depth} moving pins"),
-                    );
-                    return Ok(None);
-                }
-                ContingentOutcome::LimitHit { limit, .. } => {
-                    self.limit.get_or_insert(self.command_limit(&limit));
-                    return Ok(None);
-                }
-            };
-            let policy_name = format!("{}.policy.toml", o.name);
-            let (body, policy) = emit::contingent_toml(
-                problem,
-                &plan,
-                compiled.stable_deg.len(),
-                compiled.symmetry,
-                &line,
-                &policy_name,
-            );
-            let mut obstacles = vec![ObstacleInfo {
-                kind: "sensor_pin",
-                name: "probe".into(),
-                x_m: problem.spacing_m,
-                y_m: plan.sensor.y_m,
-                angle_deg: None,
-                length_m: None,
-                targets_m: Vec::new(),
-            }];
-            for j in 0..plan.k {
-                let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j]).collect();
-                let fixed = ys.iter().all(|&y| (y - ys[0]).abs() < 1e-12);
-                obstacles.push(ObstacleInfo {
-                    kind: if fixed { "pin" } else { "moving_pin" },
-                    name: if fixed {
-                        format!("pin{}", j + 2)
-                    } else {
-                        format!("mover{}", j + 1)
-                    },
-                    x_m: problem.spacing_m * (j as f64 + 2.0),
-                    y_m: ys[0],
-                    angle_deg: None,
-                    length_m: None,
-                    targets_m: if fixed { Vec::new() } else { ys },
-                });
-            }
-            let actuators = obstacles.iter().filter(|x| x.kind != "pin").count();
-            let belt_length_m = problem.spacing_m * (plan.k as f64 + 2.0);
-            return Ok(Some(Candidate {
-                mode,
-                round,
-                search: SearchSummary {
-                    result,
-                    message,
-                    particles: planner.initial.total(),
-                    depth_completed: stats.depth_completed,
-                    elapsed_s: stats.elapsed_s,
-                },
-                predicted_success: plan.predicted_success,
-                predicted_with_confusion: None,
-                sensor_accuracy: None,
-                obstacles,
-                actuators,
-                belt_length_m,
-                belt_width_m: problem.belt_width_m,
-                screen: None,
-                headway_probes: Vec::new(),
-                headway_s: 0.0,
-                line_check: None,
-                uncertain_check: None,
-                oriented_per_min: 0.0,
-                layout: Layout::Contingent(plan),
-                problem: problem.clone(),
-                runnable: Runnable {
-                    toml: body,
-                    policy: Some((policy_name, policy)),
-                },
-            }));
+            return self.search_sensor(mode, round, problem, planner, line);
         }
+        self.search_sequence(mode, round, problem, planner, line)
+    }
+
+    /// The sensor mode of [`Self::search`]: a contingent plan (a sensor pin and moving pins).
+    fn search_sensor(
+        &mut self,
+        mode: Mode,
+        round: usize,
+        problem: &Problem,
+        planner: &mut Planner,
+        line: LineSpec,
+    ) -> Result<Option<Candidate>, DesignError> {
+        let o = self.o;
+        let compiled = planner.compiled.clone();
+        let res = contingent::search(planner, o.max_moving, o.sensor_candidates);
+        let (outcome, stats) = match res {
+            Ok(x) => x,
+            // A part the sensor cannot tell apart (one stable state, no position) is not an
+            // error of the design: the mode has no plan.
+            Err(e) => {
+                if o.modes == [Mode::Sensor] {
+                    return Err(e.into());
+                }
+                self.tell(Some(mode), round, format!("no sensing plan: {e}"));
+                return Ok(None);
+            }
+        };
+        let (result, message, plan) = match outcome {
+            ContingentOutcome::Found(p) => (
+                "found",
+                format!(
+                    "a contingent plan: a sensor pin and {} moving pin(s), the fewest for its action set",
+                    p.k
+                ),
+                p,
+            ),
+            ContingentOutcome::NoneUpTo { depth } => {
+                self.tell(
+                    Some(mode),
+                    round,
+                    format!("no contingent plan up to {depth} moving pins"),
+                );
+                return Ok(None);
+            }
+            ContingentOutcome::LimitHit { limit, .. } => {
+                self.limit.get_or_insert(self.command_limit(&limit));
+                return Ok(None);
+            }
+        };
+        let policy_name = format!("{}.policy.toml", o.name);
+        let (body, policy) = emit::contingent_toml(
+            problem,
+            &plan,
+            compiled.stable_deg.len(),
+            compiled.symmetry,
+            &line,
+            &policy_name,
+        );
+        let obstacles = contingent_obstacles(problem, &plan);
+        let actuators = obstacles.iter().filter(|x| x.kind != "pin").count();
+        let belt_length_m = problem.spacing_m * (plan.k as f64 + 2.0);
+        Ok(Some(Candidate {
+            mode,
+            round,
+            search: SearchSummary {
+                result,
+                message,
+                particles: planner.initial.total(),
+                depth_completed: stats.depth_completed,
+                elapsed_s: stats.elapsed_s,
+            },
+            predicted_success: plan.predicted_success,
+            predicted_with_confusion: None,
+            sensor_accuracy: None,
+            obstacles,
+            actuators,
+            belt_length_m,
+            belt_width_m: problem.belt_width_m,
+            screen: None,
+            headway_probes: Vec::new(),
+            headway_s: 0.0,
+            line_check: None,
+            uncertain_check: None,
+            oriented_per_min: 0.0,
+            layout: Layout::Contingent(plan),
+            problem: problem.clone(),
+            runnable: Runnable {
+                toml: body,
+                policy: Some((policy_name, policy)),
+            },
+        }))
+    }
+
+    /// The pins, fences and hybrid modes of [`Self::search`]: a sequence of obstacles.
+    fn search_sequence(
+        &mut self,
+        mode: Mode,
+        round: usize,
+        problem: &Problem,
+        planner: &mut Planner,
+        line: LineSpec,
+    ) -> Result<Option<Candidate>, DesignError> {
+        let o = self.o;
+        let compiled = planner.compiled.clone();
         if matches!(mode, Mode::Fences | Mode::Hybrid) {
             planner.fences = Some(FenceTransition::new(fence_options(o, problem.mu_c)?));
             planner.hybrid = mode == Mode::Hybrid;
@@ -948,25 +950,8 @@ impl Work<'_> {
             self.tell(Some(mode), round, "no obstacle improves on the feed".into());
             return Ok(None);
         };
-        // The width the design needs (within the searched one): its obstacles, and the parts'
-        // centroids with a margin of a/2, rounded up to 5 mm.
         let a = compiled.radius;
-        let mut reach: f64 = problem.lateral_m + a / 2.0;
-        for s in std::iter::once(&plan.initial).chain(plan.steps.iter().map(|s| &s.state)) {
-            for q in &s.particles {
-                reach = reach.max((q.y_q as f64 * problem.y_quantum_m).abs() + a / 2.0);
-            }
-        }
-        for s in &plan.steps {
-            match s.action {
-                Action::Pin(p) => reach = reach.max(p.y_m.abs() + problem.pin_radius_m),
-                Action::Fence(f) => reach = reach.max(f.y0_m.abs()).max(f.y1_m.abs()),
-            }
-        }
-        // At least 2(a + lateral): the scenario parser refuses a belt on which the fed part
-        // does not fit.
-        let fits = a + problem.lateral_m;
-        let width = ((2.0 * reach.max(fits) / 0.005).ceil() * 0.005).min(problem.belt_width_m);
+        let width = sequence_width(problem, &plan, a);
         let line = LineSpec {
             belt_width_m: width,
             ..line
@@ -979,38 +964,7 @@ impl Work<'_> {
             &line,
         );
         let (xs, belt_length_m) = emit::layout(problem, &plan, a);
-        let (mut pins, mut fences) = (0, 0);
-        let obstacles = plan
-            .steps
-            .iter()
-            .zip(&xs)
-            .map(|(s, &x)| match s.action {
-                Action::Pin(p) => {
-                    pins += 1;
-                    ObstacleInfo {
-                        kind: "pin",
-                        name: format!("pin{pins}"),
-                        x_m: x,
-                        y_m: p.y_m,
-                        angle_deg: None,
-                        length_m: None,
-                        targets_m: Vec::new(),
-                    }
-                }
-                Action::Fence(f) => {
-                    fences += 1;
-                    ObstacleInfo {
-                        kind: "fence",
-                        name: format!("fence{fences}"),
-                        x_m: x,
-                        y_m: f.y0_m,
-                        angle_deg: Some(f.angle_deg),
-                        length_m: Some(f.length_m),
-                        targets_m: Vec::new(),
-                    }
-                }
-            })
-            .collect();
+        let obstacles = sequence_obstacles(&plan, &xs);
         let mut problem = problem.clone();
         problem.belt_width_m = width;
         Ok(Some(Candidate {
@@ -1402,4 +1356,93 @@ fn confusion_prediction(
         })
         .collect();
     (acc, Some(plan.with_confusion(&counts)))
+}
+
+/// The belt width a sequence plan needs (m; `a`: the part's size).
+fn sequence_width(problem: &Problem, plan: &Plan, a: f64) -> f64 {
+    // The width the design needs (within the searched one): its obstacles, and the parts'
+    // centroids with a margin of a/2, rounded up to 5 mm.
+    let mut reach: f64 = problem.lateral_m + a / 2.0;
+    for s in std::iter::once(&plan.initial).chain(plan.steps.iter().map(|s| &s.state)) {
+        for q in &s.particles {
+            reach = reach.max((q.y_q as f64 * problem.y_quantum_m).abs() + a / 2.0);
+        }
+    }
+    for s in &plan.steps {
+        match s.action {
+            Action::Pin(p) => reach = reach.max(p.y_m.abs() + problem.pin_radius_m),
+            Action::Fence(f) => reach = reach.max(f.y0_m.abs()).max(f.y1_m.abs()),
+        }
+    }
+    // At least 2(a + lateral): the scenario parser refuses a belt on which the fed part
+    // does not fit.
+    let fits = a + problem.lateral_m;
+    ((2.0 * reach.max(fits) / 0.005).ceil() * 0.005).min(problem.belt_width_m)
+}
+
+/// The obstacles of a sequence plan at their positions `xs` along the belt, named in order.
+fn sequence_obstacles(plan: &Plan, xs: &[f64]) -> Vec<ObstacleInfo> {
+    let (mut pins, mut fences) = (0, 0);
+    plan.steps
+        .iter()
+        .zip(xs)
+        .map(|(s, &x)| match s.action {
+            Action::Pin(p) => {
+                pins += 1;
+                ObstacleInfo {
+                    kind: "pin",
+                    name: format!("pin{pins}"),
+                    x_m: x,
+                    y_m: p.y_m,
+                    angle_deg: None,
+                    length_m: None,
+                    targets_m: Vec::new(),
+                }
+            }
+            Action::Fence(f) => {
+                fences += 1;
+                ObstacleInfo {
+                    kind: "fence",
+                    name: format!("fence{fences}"),
+                    x_m: x,
+                    y_m: f.y0_m,
+                    angle_deg: Some(f.angle_deg),
+                    length_m: Some(f.length_m),
+                    targets_m: Vec::new(),
+                }
+            }
+        })
+        .collect()
+}
+
+/// The obstacles of a contingent plan: the sensor pin, then a pin per step (moving where the
+/// branches' targets differ).
+fn contingent_obstacles(problem: &Problem, plan: &ContingentPlan) -> Vec<ObstacleInfo> {
+    let mut obstacles = vec![ObstacleInfo {
+        kind: "sensor_pin",
+        name: "probe".into(),
+        x_m: problem.spacing_m,
+        y_m: plan.sensor.y_m,
+        angle_deg: None,
+        length_m: None,
+        targets_m: Vec::new(),
+    }];
+    for j in 0..plan.k {
+        let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j]).collect();
+        let fixed = ys.iter().all(|&y| (y - ys[0]).abs() < 1e-12);
+        obstacles.push(ObstacleInfo {
+            kind: if fixed { "pin" } else { "moving_pin" },
+            name: if fixed {
+                format!("pin{}", j + 2)
+            } else {
+                format!("mover{}", j + 1)
+            },
+            x_m: problem.spacing_m * (j as f64 + 2.0),
+            y_m: ys[0],
+            angle_deg: None,
+            length_m: None,
+            targets_m: if fixed { Vec::new() } else { ys },
+        });
+    }
+    obstacles
 }

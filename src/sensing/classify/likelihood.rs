@@ -84,17 +84,25 @@ pub struct Likelihood {
     options: ClassifierOptions,
 }
 
-impl Likelihood {
-    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
-    pub fn new(
+/// Pass 1 of training: what the templates span and how the detector sees them.
+struct Survey {
+    /// The detector's delays (samples) from each member's true contact begin, over the phases.
+    delays: Vec<f64>,
+    /// The longest member's contact span (s).
+    longest: f64,
+    /// Per channel, the largest magnitude of the clean samples.
+    scale: [f64; CHANNELS],
+}
+
+impl Survey {
+    /// Sample every member cleanly at every phase: spans, the detector's delays, channel scales.
+    fn new(
         templates: &TemplateSet,
         sensor: &SensorSettings,
-        options: &ClassifierOptions,
-    ) -> Result<Likelihood, String> {
-        let dt = 1.0 / sensor.rate;
-        let detector = common::Detector::new(sensor);
+        detector: &common::Detector,
+        dt: f64,
+    ) -> Survey {
         let p = PHASES as f64;
-        // Pass 1: spans, the detector's delays, channel scales.
         let mut delays: Vec<f64> = Vec::new();
         let mut longest: f64 = 0.0;
         let mut scale = [0.0f64; CHANNELS];
@@ -118,22 +126,42 @@ impl Likelihood {
                 }
             }
         }
-        if delays.is_empty() {
-            // The detector sees none of the templates' contacts at this noise level: no reading
-            // of these pushes will be detected either, so every answer is Unknown.
-            return Ok(Likelihood {
-                base: Vec::new(),
-                members: Vec::new(),
-                ranges: Vec::new(),
-                pre: 0,
-                block: 1,
-                blocks: 0,
-                lags: 0,
-                detector,
-                sensor: *sensor,
-                options: *options,
-            });
+        Survey {
+            delays,
+            longest,
+            scale,
         }
+    }
+}
+
+/// The frame, its blocks, the lag grid and the channel weights that pass 2 of training fills.
+struct Frame {
+    /// Lag grid (in steps of dt/[`PHASES`]): first, last and base lag.
+    o_lo: i64,
+    o_hi: i64,
+    o_base: i64,
+    /// Whole-sample lags of the first and last lag.
+    l_lo: i64,
+    l_hi: i64,
+    /// Number of lags.
+    lags: usize,
+    /// Samples before k_b in the frame, frame length, block length, blocks per channel.
+    pre: usize,
+    frame: usize,
+    block: usize,
+    blocks: usize,
+    /// Entries per member vector (used channels × blocks).
+    dims: usize,
+    /// Per used channel, the weight 1/σ² of the noise model.
+    w: Vec<f64>,
+}
+
+impl Frame {
+    /// Lay out the lag grid from the detector's delays, the frame and its blocks from the longest
+    /// span, and the channel weights from the sensor's noise floored by the channel scales.
+    fn new(survey: &Survey, sensor: &SensorSettings, dt: f64) -> Frame {
+        let p = PHASES as f64;
+        let delays = &survey.delays;
         let dmin = delays.iter().copied().fold(f64::INFINITY, f64::min);
         let dmax = delays.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let mut o_lo = ((dmin - LAG_SAMPLES as f64) * p).floor() as i64;
@@ -151,7 +179,7 @@ impl Likelihood {
         let l_hi = o_hi.div_euclid(PHASES as i64);
         // Frame: from k_b − pre; the template at lag o sits at (i − pre)·dt + o·dt/P from its begin.
         let pre = (l_hi.max(0) + 2) as usize;
-        let frame = pre + (longest / dt).ceil() as usize + (-l_lo).max(0) as usize + 4;
+        let frame = pre + (survey.longest / dt).ceil() as usize + (-l_lo).max(0) as usize + 4;
         let block = frame.div_ceil(MAX_BLOCKS).max(1);
         let blocks = frame.div_ceil(block);
         let frame = blocks * block;
@@ -159,83 +187,156 @@ impl Likelihood {
         let w: Vec<f64> = USED
             .iter()
             .map(|&c| {
-                let floor = (1e-3 * scale[c]).max(1e-12);
+                let floor = (1e-3 * survey.scale[c]).max(1e-12);
                 1.0 / common::noise_var(sensor, c).max(floor * floor)
             })
             .collect();
+        Frame {
+            o_lo,
+            o_hi,
+            o_base,
+            l_lo,
+            l_hi,
+            lags,
+            pre,
+            frame,
+            block,
+            blocks,
+            dims,
+            w,
+        }
+    }
+
+    /// Block sums of member `s` (contact begin `b`) per lag, with the sensor's low-pass.
+    fn lag_sums(
+        &self,
+        s: &crate::sensing::ContactSignal,
+        b: f64,
+        sensor: &SensorSettings,
+        dt: f64,
+    ) -> Vec<Vec<f64>> {
+        let p = PHASES as f64;
+        let (pre, frame, l_lo) = (self.pre, self.frame, self.l_lo);
+        let (blocks, block, dims) = (self.blocks, self.block, self.dims);
+        let span_l = (self.l_hi - l_lo) as usize;
+        // fine[φ][j] = s(b + (j − pre + l_lo + φ/P)·dt)
+        let fine: Vec<Vec<[f64; CHANNELS]>> = (0..PHASES)
+            .map(|ph| {
+                (0..frame + span_l + 1)
+                    .map(|j| {
+                        let tau = (j as f64 - pre as f64 + l_lo as f64 + ph as f64 / p) * dt;
+                        s.at(b + tau)
+                    })
+                    .collect()
+            })
+            .collect();
+        (self.o_lo..=self.o_hi)
+            .map(|o| {
+                let l = o.div_euclid(PHASES as i64);
+                let ph = o.rem_euclid(PHASES as i64) as usize;
+                let off = (l - l_lo) as usize;
+                let mut v: Vec<[f64; CHANNELS]> = fine[ph][off..off + frame].to_vec();
+                reading::lowpass(&mut v, sensor);
+                let mut out = vec![0.0; dims];
+                for (ci, &c) in USED.iter().enumerate() {
+                    for (i, x) in v.iter().enumerate() {
+                        out[ci * blocks + i / block] += x[c];
+                    }
+                }
+                out
+            })
+            .collect()
+    }
+
+    /// Train one member `s` (contact begin `b`): push its base vector onto `base` and return its
+    /// constant terms and lag-dependent entries.
+    fn member(
+        &self,
+        s: &crate::sensing::ContactSignal,
+        b: f64,
+        sensor: &SensorSettings,
+        dt: f64,
+        base: &mut Vec<f64>,
+    ) -> Member {
+        let (dims, blocks, block, lags) = (self.dims, self.blocks, self.block, self.lags);
+        let w = &self.w;
+        let sums = self.lag_sums(s, b, sensor, dt);
+        let sb = &sums[(self.o_base - self.o_lo) as usize];
+        let wb = |d: usize| w[d / blocks] / block as f64;
+        let cst0: f64 = (0..dims).map(|d| -0.5 * wb(d) * sb[d] * sb[d]).sum();
+        base.extend((0..dims).map(|d| wb(d) * sb[d]));
+        // Lag-dependent entries, most important first.
+        let mut imp: Vec<(f64, usize)> = (0..dims)
+            .map(|d| {
+                let m = sums
+                    .iter()
+                    .map(|so| (so[d] - sb[d]).abs())
+                    .fold(0.0, f64::max);
+                (m * wb(d).sqrt(), d)
+            })
+            .filter(|&(m, _)| m > 1e-6)
+            .collect();
+        imp.sort_by(|a, b| b.0.total_cmp(&a.0));
+        imp.truncate(MAX_VARYING);
+        let vidx: Vec<u32> = imp.iter().map(|&(_, d)| d as u32).collect();
+        let mut dlin = Vec::with_capacity(vidx.len() * lags);
+        let mut cst = vec![cst0; lags];
+        for &d in &vidx {
+            let d = d as usize;
+            for (o, so) in sums.iter().enumerate() {
+                dlin.push(wb(d) * (so[d] - sb[d]));
+                cst[o] -= 0.5 * wb(d) * (so[d] * so[d] - sb[d] * sb[d]);
+            }
+        }
+        let row = &base[base.len() - dims..];
+        let chunks = nonzero_chunks(row);
+        Member {
+            cst,
+            vidx,
+            dlin,
+            chunks,
+        }
+    }
+}
+
+impl Likelihood {
+    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
+    pub fn new(
+        templates: &TemplateSet,
+        sensor: &SensorSettings,
+        options: &ClassifierOptions,
+    ) -> Result<Likelihood, String> {
+        let dt = 1.0 / sensor.rate;
+        let detector = common::Detector::new(sensor);
+        // Pass 1: spans, the detector's delays, channel scales.
+        let survey = Survey::new(templates, sensor, &detector, dt);
+        if survey.delays.is_empty() {
+            // The detector sees none of the templates' contacts at this noise level: no reading
+            // of these pushes will be detected either, so every answer is Unknown.
+            return Ok(Likelihood {
+                base: Vec::new(),
+                members: Vec::new(),
+                ranges: Vec::new(),
+                pre: 0,
+                block: 1,
+                blocks: 0,
+                lags: 0,
+                detector,
+                sensor: *sensor,
+                options: *options,
+            });
+        }
+        let f = Frame::new(&survey, sensor, dt);
 
         // Pass 2: block sums per member and lag.
         let mut base = Vec::new();
         let mut members = Vec::new();
         let mut ranges = Vec::new();
-        let span_l = (l_hi - l_lo) as usize;
         for ms in &templates.members {
             let start = members.len();
             for s in ms {
                 let Some((b, _)) = s.span() else { continue };
-                // fine[φ][j] = s(b + (j − pre + l_lo + φ/P)·dt)
-                let fine: Vec<Vec<[f64; CHANNELS]>> = (0..PHASES)
-                    .map(|ph| {
-                        (0..frame + span_l + 1)
-                            .map(|j| {
-                                let tau =
-                                    (j as f64 - pre as f64 + l_lo as f64 + ph as f64 / p) * dt;
-                                s.at(b + tau)
-                            })
-                            .collect()
-                    })
-                    .collect();
-                let sums: Vec<Vec<f64>> = (o_lo..=o_hi)
-                    .map(|o| {
-                        let l = o.div_euclid(PHASES as i64);
-                        let ph = o.rem_euclid(PHASES as i64) as usize;
-                        let off = (l - l_lo) as usize;
-                        let mut v: Vec<[f64; CHANNELS]> = fine[ph][off..off + frame].to_vec();
-                        reading::lowpass(&mut v, sensor);
-                        let mut out = vec![0.0; dims];
-                        for (ci, &c) in USED.iter().enumerate() {
-                            for (i, x) in v.iter().enumerate() {
-                                out[ci * blocks + i / block] += x[c];
-                            }
-                        }
-                        out
-                    })
-                    .collect();
-                let sb = &sums[(o_base - o_lo) as usize];
-                let wb = |d: usize| w[d / blocks] / block as f64;
-                let cst0: f64 = (0..dims).map(|d| -0.5 * wb(d) * sb[d] * sb[d]).sum();
-                base.extend((0..dims).map(|d| wb(d) * sb[d]));
-                // Lag-dependent entries, most important first.
-                let mut imp: Vec<(f64, usize)> = (0..dims)
-                    .map(|d| {
-                        let m = sums
-                            .iter()
-                            .map(|so| (so[d] - sb[d]).abs())
-                            .fold(0.0, f64::max);
-                        (m * wb(d).sqrt(), d)
-                    })
-                    .filter(|&(m, _)| m > 1e-6)
-                    .collect();
-                imp.sort_by(|a, b| b.0.total_cmp(&a.0));
-                imp.truncate(MAX_VARYING);
-                let vidx: Vec<u32> = imp.iter().map(|&(_, d)| d as u32).collect();
-                let mut dlin = Vec::with_capacity(vidx.len() * lags);
-                let mut cst = vec![cst0; lags];
-                for &d in &vidx {
-                    let d = d as usize;
-                    for (o, so) in sums.iter().enumerate() {
-                        dlin.push(wb(d) * (so[d] - sb[d]));
-                        cst[o] -= 0.5 * wb(d) * (so[d] * so[d] - sb[d] * sb[d]);
-                    }
-                }
-                let row = &base[base.len() - dims..];
-                let chunks = nonzero_chunks(row);
-                members.push(Member {
-                    cst,
-                    vidx,
-                    dlin,
-                    chunks,
-                });
+                members.push(f.member(s, b, sensor, dt, &mut base));
             }
             ranges.push(start..members.len());
         }
@@ -243,10 +344,10 @@ impl Likelihood {
             base,
             members,
             ranges,
-            pre,
-            block,
-            blocks,
-            lags,
+            pre: f.pre,
+            block: f.block,
+            blocks: f.blocks,
+            lags: f.lags,
             detector,
             sensor: *sensor,
             options: *options,

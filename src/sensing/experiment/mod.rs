@@ -323,6 +323,58 @@ pub fn sensor_settings(r: &Request) -> Result<SensorSettings, SenseError> {
 
 /// Check every setting of a request and build what it fixes.
 pub fn check(a: &Request) -> Result<Checked, SenseError> {
+    check_settings(a)?;
+    let truth = truth_draw(&a.truth)?;
+    let fidelity = a.model;
+    let sensor = sensor_settings(a)?;
+    check_noise_factors(&sensor, &a.noise)?;
+    let part = named::part_from_spec(&a.part).map_err(|error| SenseError::Part {
+        spec: a.part.clone(),
+        error,
+    })?;
+    let poly = part.scaled(a.scale);
+    check_offsets(a, part.radius())?;
+    let hyps = parse_hypotheses(&a.hypotheses, &part)?;
+    let mu_c = match &a.mu_c_range {
+        Some(r) => parse_range(r)?,
+        None => Distribution::Fixed(a.mu_c),
+    };
+    let unc = Uncertainty {
+        mu_c,
+        tripod: a.tripod,
+        theta_sd_deg: a.theta_jitter,
+        d_sd: a.d_jitter,
+    };
+    let (classifiers, explicit) = classifier_list(a, sensor.kind, &hyps)?;
+    let model = PartModel::new(&poly, &Support::Uniform).map_err(SenseError::PartModel)?;
+    let setup = PushSetup {
+        polygon: poly,
+        d: a.d,
+        pin_radius: a.pin_radius * a.scale,
+        mu_c: a.mu_c,
+        mu_s: a.mu_s,
+        fidelity,
+        tol: a.tol,
+        mass: a.mass,
+        belt_speed: a.belt_speed,
+        height: sensor.height,
+    };
+    Ok(Checked {
+        part_name: a.part.clone(),
+        setup,
+        model,
+        hyps,
+        unc,
+        sensor,
+        classifiers,
+        explicit,
+        truth,
+    })
+}
+
+/// Check the request's numbers, counts and list lengths, each against its range (the first
+/// step of [`check`], in the order of its error messages).
+fn check_settings(a: &Request) -> Result<(), SenseError> {
     positive("--scale", a.scale, 100.0, "metres per part unit")?;
     positive("--mass", a.mass, 1e3, "kg")?;
     positive("--belt-speed", a.belt_speed, 100.0, "m/s")?;
@@ -392,7 +444,12 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
             value: a.placement_d.len(),
         });
     }
-    let truth = match a.truth.trim() {
+    Ok(())
+}
+
+/// How the true hypothesis of each trial is drawn (`--truth`).
+fn truth_draw(spec: &str) -> Result<TruthDraw, SenseError> {
+    Ok(match spec.trim() {
         "cycle" => TruthDraw::Cycle,
         "uniform" => TruthDraw::Uniform,
         other => {
@@ -402,10 +459,12 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
                 got: other.to_string(),
             })
         }
-    };
-    let fidelity = a.model;
-    let sensor = sensor_settings(a)?;
-    for &f in &a.noise {
+    })
+}
+
+/// Check that the sensor is valid at every noise factor of the sweep.
+fn check_noise_factors(sensor: &SensorSettings, noise: &[f64]) -> Result<(), SenseError> {
+    for &f in noise {
         sensor
             .with_noise_factor(f)
             .validate()
@@ -415,12 +474,12 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
                 message: e.message,
             })?;
     }
-    let part = named::part_from_spec(&a.part).map_err(|error| SenseError::Part {
-        spec: a.part.clone(),
-        error,
-    })?;
-    let poly = part.scaled(a.scale);
-    let radius_units = part.radius();
+    Ok(())
+}
+
+/// Check the pin radius, the offset d and the placement offsets against the part's radius
+/// (`radius_units`, in part units).
+fn check_offsets(a: &Request, radius_units: f64) -> Result<(), SenseError> {
     in_range(
         "--pin-radius",
         a.pin_radius,
@@ -440,17 +499,16 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
             in_range("--placement-d", d, -reach, reach, beyond)?;
         }
     }
-    let hyps = parse_hypotheses(&a.hypotheses, &part)?;
-    let mu_c = match &a.mu_c_range {
-        Some(r) => parse_range(r)?,
-        None => Distribution::Fixed(a.mu_c),
-    };
-    let unc = Uncertainty {
-        mu_c,
-        tripod: a.tripod,
-        theta_sd_deg: a.theta_jitter,
-        d_sd: a.d_jitter,
-    };
+    Ok(())
+}
+
+/// The classifiers to evaluate, and whether they were given explicitly (each known and named
+/// once) rather than the defaults for the sensor and hypotheses.
+fn classifier_list(
+    a: &Request,
+    kind: SensorKind,
+    hyps: &Hypotheses,
+) -> Result<(Vec<String>, bool), SenseError> {
     let explicit = !a.classifiers.is_empty();
     let classifiers: Vec<String> = if explicit {
         let mut v: Vec<String> = Vec::new();
@@ -466,30 +524,7 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
         }
         v
     } else {
-        applicable(sensor.kind, &hyps)
+        applicable(kind, hyps)
     };
-    let model = PartModel::new(&poly, &Support::Uniform).map_err(SenseError::PartModel)?;
-    let setup = PushSetup {
-        polygon: poly,
-        d: a.d,
-        pin_radius: a.pin_radius * a.scale,
-        mu_c: a.mu_c,
-        mu_s: a.mu_s,
-        fidelity,
-        tol: a.tol,
-        mass: a.mass,
-        belt_speed: a.belt_speed,
-        height: sensor.height,
-    };
-    Ok(Checked {
-        part_name: a.part.clone(),
-        setup,
-        model,
-        hyps,
-        unc,
-        sensor,
-        classifiers,
-        explicit,
-        truth,
-    })
+    Ok((classifiers, explicit))
 }

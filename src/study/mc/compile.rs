@@ -219,7 +219,6 @@ pub fn in_domain(name: &str, v: f64) -> bool {
 
 fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Distribution> {
     let base = format!("uncertain.{name}");
-    let key = |k: &str| format!("{base}.{k}");
     let Some(kind) = d.distribution else {
         return Err(err(
             loc,
@@ -227,6 +226,21 @@ fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Dis
             "give distribution = \"fixed\" (value), \"uniform\" (min, max), \"normal\" (mean, sd) or \"triangular\" (min, mode, max)",
         ));
     };
+    let vals = distribution_fields(loc, name, kind, d)?;
+    check_fields_in_domain(loc, name, &vals)?;
+    build_distribution(loc, name, kind, d, &vals)
+}
+
+/// The values a distribution table gives, each finite, by field name: an error for a field the
+/// kind does not take (the first in the order value, min, max, mean, sd, mode) or one it needs.
+fn distribution_fields(
+    loc: &Locator,
+    name: &str,
+    kind: DistributionKind,
+    d: &RawDistribution,
+) -> R<std::collections::BTreeMap<&'static str, f64>> {
+    let base = format!("uncertain.{name}");
+    let key = |k: &str| format!("{base}.{k}");
     let given = [
         ("value", d.value),
         ("min", d.min),
@@ -272,24 +286,36 @@ fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Dis
             ));
         }
     }
-    let g = |k: &str| vals.get(k).copied();
+    Ok(vals)
+}
+
+/// Check a field's value `v` against the parameter's domain (see [`domain`]).
+fn check_in_domain(loc: &Locator, name: &str, k: &str, v: f64) -> R<()> {
     let ((lo_dom, hi_dom), dom_text) = domain(name);
-    let check_in_domain = |k: &str, v: f64| -> R<()> {
-        if !in_domain(name, v) {
-            return Err(err(
-                loc,
-                &key(k),
-                format!(
-                    "{name} must be at least {} and at most {} ({dom_text}), got {}",
-                    num(lo_dom),
-                    num(hi_dom),
-                    num(v)
-                ),
-            ));
-        }
-        Ok(())
-    };
-    for (k, v) in &vals {
+    if !in_domain(name, v) {
+        return Err(err(
+            loc,
+            &format!("uncertain.{name}.{k}"),
+            format!(
+                "{name} must be at least {} and at most {} ({dom_text}), got {}",
+                num(lo_dom),
+                num(hi_dom),
+                num(v)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Check every field in key order: sd within the domain's width, the others within the domain.
+fn check_fields_in_domain(
+    loc: &Locator,
+    name: &str,
+    vals: &std::collections::BTreeMap<&'static str, f64>,
+) -> R<()> {
+    let key = |k: &str| format!("uncertain.{name}.{k}");
+    let ((lo_dom, hi_dom), dom_text) = domain(name);
+    for (k, v) in vals {
         if *k == "sd" {
             let widest = hi_dom - lo_dom;
             if !(0.0..=widest).contains(v) {
@@ -306,13 +332,27 @@ fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Dis
                 ));
             }
         } else {
-            check_in_domain(k, *v)?;
+            check_in_domain(loc, name, k, *v)?;
         }
     }
+    Ok(())
+}
+
+/// The distribution of a checked table: its own constraints (min ≤ max, min ≤ mode ≤ max,
+/// sd ≥ 0, the mean within the truncation) and its location within the domain.
+fn build_distribution(
+    loc: &Locator,
+    name: &str,
+    kind: DistributionKind,
+    d: &RawDistribution,
+    vals: &std::collections::BTreeMap<&'static str, f64>,
+) -> R<Distribution> {
+    let key = |k: &str| format!("uncertain.{name}.{k}");
+    let g = |k: &str| vals.get(k).copied();
     let dist = match kind {
         DistributionKind::Fixed => {
             let v = g("value").expect("checked");
-            check_in_domain("value", v)?;
+            check_in_domain(loc, name, "value", v)?;
             Distribution::Fixed(v)
         }
         DistributionKind::Uniform => {
@@ -324,7 +364,7 @@ fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Dis
                     format!("must be at least min ({min}), got {max}"),
                 ));
             }
-            check_in_domain("min", min)?;
+            check_in_domain(loc, name, "min", min)?;
             Distribution::Uniform { min, max }
         }
         DistributionKind::Triangular => {
@@ -340,7 +380,7 @@ fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Dis
                     format!("needs min ≤ mode ≤ max, got {min}, {mode}, {max}"),
                 ));
             }
-            check_in_domain("min", min)?;
+            check_in_domain(loc, name, "min", min)?;
             Distribution::Triangular { min, mode, max }
         }
         DistributionKind::Normal => {
@@ -370,7 +410,7 @@ fn compile_distribution(loc: &Locator, name: &str, d: &RawDistribution) -> R<Dis
                 ));
             }
             let where_ = if d.mean.is_some() { "mean" } else { "sd" };
-            check_in_domain(where_, mean)?;
+            check_in_domain(loc, name, where_, mean)?;
             Distribution::Normal { mean, sd, lo, hi }
         }
     };

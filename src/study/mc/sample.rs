@@ -689,59 +689,10 @@ pub fn draw_scene(
     )?
     .unwrap_or(base.belt.speed);
     let belt = crate::scenario::Belt { speed, ..base.belt };
-    // A perturbed polygon that cannot carry the support (a sliver with no tripod around its
-    // centroid) is redrawn like an invalid one.
-    let mut attempts = 0;
-    let (polygon, model) = loop {
-        let polygon = draw_polygon(base, &p.shape, &mut st.shape, &mut shape_redraws)?;
-        let model = draw_support(&polygon, &p.support, &mut st.support, &mut other)
-            .and_then(|support| PartModel::new(&polygon, &support));
-        match model {
-            Ok(m) => break (polygon, m),
-            Err(_) if p.shape.is_some_and(|d| !d.is_fixed()) && attempts < MAX_SHAPE_REDRAWS => {
-                attempts += 1;
-                shape_redraws += 1;
-            }
-            Err(e) => return Err(format!("support: {e}")),
-        }
-    };
+    let (polygon, model) = draw_part_model(base, p, &mut st, &mut shape_redraws, &mut other)?;
     let radius = polygon.radius();
     let sensor_values = draw_sensor_values(base, p, &mut st, &mut other)?;
-    let (mu_f, latency) = match st.obstacles.as_mut() {
-        Some(ost) => (
-            draw_value(
-                &p.fence_mu_f,
-                &mut ost.fence_mu_f,
-                "fence_mu_f",
-                |v| super::compile::in_domain("fence_mu_f", v),
-                &mut other,
-            )?,
-            match &base.controller {
-                Some(c) => draw_value(
-                    &p.controller_latency,
-                    &mut ost.controller_latency,
-                    "controller_latency",
-                    |e| {
-                        crate::scenario::limits::contains(
-                            crate::scenario::limits::ACTUATOR_TIME,
-                            c.latency + e,
-                        )
-                    },
-                    &mut other,
-                )
-                .map_err(|e| {
-                    format!(
-                        "{e}: the controller's latency ({} s) plus the error must lie in {} s",
-                        c.latency,
-                        crate::scenario::limits::show(crate::scenario::limits::ACTUATOR_TIME)
-                    )
-                })?
-                .map(|e| c.latency + e),
-                None => None,
-            },
-        ),
-        None => (None, None),
-    };
+    let (mu_f, latency) = draw_fence_friction_and_latency(base, p, &mut st, &mut other)?;
 
     let mut obstacles = Vec::with_capacity(base.obstacles.len());
     for ob in &base.obstacles {
@@ -794,32 +745,7 @@ pub fn draw_scene(
         // One map per sample would cost far more than the sample's few exact contacts.
         map_tier: base.map_tier.filter(|_| p.varies_map_inputs().is_none()),
     };
-    // The scenario's feed draws the entry pose (its support is uniform here, so it draws no tripod).
-    let entry = draw_part(&scene, st.feed_seed, 0)?;
-    let any = |_: f64| true;
-    let d_theta = draw_value(
-        &p.pose_theta,
-        &mut st.pose_theta,
-        "pose_theta",
-        any,
-        &mut other,
-    )?;
-    let d_y = draw_value(&p.pose_y, &mut st.pose_y, "pose_y", any, &mut other)?;
-    let theta = entry.theta_rad + d_theta.unwrap_or(0.0).to_radians();
-    let reach = (scene.belt.width / 2.0 - radius).max(0.0);
-    let y = (entry.y + d_y.unwrap_or(0.0)).clamp(-reach, reach);
-    scene.feed = Feed {
-        parts: 1,
-        arrival: Arrival::Periodic {
-            headway: base.feed.arrival.headway(),
-        },
-        orientation: Orientation::Stable {
-            thetas_rad: vec![crate::geometry::wrap_2pi(theta)],
-            weights: vec![1.0],
-            jitter_rad: 0.0,
-        },
-        lateral: Lateral::Fixed(y),
-    };
+    scene.feed = draw_entry(&scene, base, p, &mut st, &mut other)?;
     let run_seed = if sensors(base).is_empty() {
         0
     } else {
@@ -831,6 +757,108 @@ pub fn draw_scene(
         other_redraws: other,
         run_seed,
         streams: st.seeded(),
+    })
+}
+
+/// The sample's polygon and its part model: a perturbed polygon that cannot carry the drawn
+/// support is redrawn (counted in `shape_redraws`) like an invalid one.
+fn draw_part_model(
+    base: &Scene,
+    p: &Perturbations,
+    st: &mut Streams,
+    shape_redraws: &mut u32,
+    other: &mut u32,
+) -> Result<(Polygon, PartModel), String> {
+    // A perturbed polygon that cannot carry the support (a sliver with no tripod around its
+    // centroid) is redrawn like an invalid one.
+    let mut attempts = 0;
+    Ok(loop {
+        let polygon = draw_polygon(base, &p.shape, &mut st.shape, shape_redraws)?;
+        let model = draw_support(&polygon, &p.support, &mut st.support, other)
+            .and_then(|support| PartModel::new(&polygon, &support));
+        match model {
+            Ok(m) => break (polygon, m),
+            Err(_) if p.shape.is_some_and(|d| !d.is_fixed()) && attempts < MAX_SHAPE_REDRAWS => {
+                attempts += 1;
+                *shape_redraws += 1;
+            }
+            Err(e) => return Err(format!("support: {e}")),
+        }
+    })
+}
+
+/// The fences' friction and the controller's latency of a sample (None: the scenario's).
+fn draw_fence_friction_and_latency(
+    base: &Scene,
+    p: &Perturbations,
+    st: &mut Streams,
+    other: &mut u32,
+) -> Result<(Option<f64>, Option<f64>), String> {
+    Ok(match st.obstacles.as_mut() {
+        Some(ost) => (
+            draw_value(
+                &p.fence_mu_f,
+                &mut ost.fence_mu_f,
+                "fence_mu_f",
+                |v| super::compile::in_domain("fence_mu_f", v),
+                other,
+            )?,
+            match &base.controller {
+                Some(c) => draw_value(
+                    &p.controller_latency,
+                    &mut ost.controller_latency,
+                    "controller_latency",
+                    |e| {
+                        crate::scenario::limits::contains(
+                            crate::scenario::limits::ACTUATOR_TIME,
+                            c.latency + e,
+                        )
+                    },
+                    other,
+                )
+                .map_err(|e| {
+                    format!(
+                        "{e}: the controller's latency ({} s) plus the error must lie in {} s",
+                        c.latency,
+                        crate::scenario::limits::show(crate::scenario::limits::ACTUATOR_TIME)
+                    )
+                })?
+                .map(|e| c.latency + e),
+                None => None,
+            },
+        ),
+        None => (None, None),
+    })
+}
+
+/// The sample's feed: one part whose entry pose the scenario's feed draws, perturbed by the
+/// pose errors and kept on the belt.
+fn draw_entry(
+    scene: &Scene,
+    base: &Scene,
+    p: &Perturbations,
+    st: &mut Streams,
+    other: &mut u32,
+) -> Result<Feed, String> {
+    // The scenario's feed draws the entry pose (its support is uniform here, so it draws no tripod).
+    let entry = draw_part(scene, st.feed_seed, 0)?;
+    let any = |_: f64| true;
+    let d_theta = draw_value(&p.pose_theta, &mut st.pose_theta, "pose_theta", any, other)?;
+    let d_y = draw_value(&p.pose_y, &mut st.pose_y, "pose_y", any, other)?;
+    let theta = entry.theta_rad + d_theta.unwrap_or(0.0).to_radians();
+    let reach = (scene.belt.width / 2.0 - scene.part.radius).max(0.0);
+    let y = (entry.y + d_y.unwrap_or(0.0)).clamp(-reach, reach);
+    Ok(Feed {
+        parts: 1,
+        arrival: Arrival::Periodic {
+            headway: base.feed.arrival.headway(),
+        },
+        orientation: Orientation::Stable {
+            thetas_rad: vec![crate::geometry::wrap_2pi(theta)],
+            weights: vec![1.0],
+            jitter_rad: 0.0,
+        },
+        lateral: Lateral::Fixed(y),
     })
 }
 
