@@ -16,7 +16,8 @@
 //! counted and bounded (< 1% of the cases; the geometric skips < 2%). Every other case must agree:
 //! final orientation (signed total rotation) within max(3·(reference's error estimate), 0.05°),
 //! final centroid within max(3·estimate, 1e-3·a + 2e-4·(contact travel)) — except the centroid of
-//! the cases in [`KNOWN`], production defects this comparison found.
+//! the cases in [`KNOWN`] (none now: [`FIXED`] lists the defects this comparison found and that
+//! were fixed).
 //!
 //! A control test runs the same comparison against the ellipsoid fidelity and requires most pushes
 //! to disagree, so the comparison is shown to be able to fail.
@@ -387,15 +388,16 @@ struct Compared {
     reproducer: String,
 }
 
-/// Disagreements this comparison found that are defects of the production model, reported to
-/// the lead and excused here for the centroid only (the orientation must still agree): after the
-/// pin stops pushing in stick (n·v_pin → 0, the pin's path tangent to the edge), `run_passes`
-/// strikes the same edge again several times (`contacts` 5–16 on a convex part) and every re-touch
-/// shifts the centroid along x, with status `ok`. Seed 37 is in the CI run; the others turn up in
-/// `many_cases` (7 in seeds 0..23000). With `SLOW_REF_MU_MAX=2`, seeds 100000..104000 show four
-/// more (100490, 101369, 101536, 102298; up to 0.19·a), not listed here because those seeds mean
-/// other cases without that setting.
-const KNOWN: &[(u64, &str)] = &[
+/// Centroid excuses for known production defects: none. The defect once listed here (after the
+/// pin stopped pushing in stick, `run_passes` struck the same edge again and every re-touch
+/// shifted the centroid) is fixed; [`FIXED`] keeps its seeds and
+/// [`former_defects_stay_fixed`] checks them in every run.
+const KNOWN: &[(u64, &str)] = &[];
+
+/// Cases this comparison once found wrong and that agree now, with what was wrong: re-touches
+/// after a tangential separation (several contacts on a convex part struck by a point pin), and
+/// orientation errors at the default tolerance.
+const FIXED: &[(u64, &str)] = &[
     (37, "re-touch after tangential separation"),
     (4344, "re-touch after tangential separation"),
     (4794, "re-touch after tangential separation"),
@@ -403,25 +405,23 @@ const KNOWN: &[(u64, &str)] = &[
     (6803, "re-touch after tangential separation"),
     (18469, "re-touch after tangential separation"),
     (20404, "re-touch after tangential separation"),
+    (
+        12739,
+        "rotation −73.466° at default tol, −74.194° in the reference (μc 0.033, 3 edges)",
+    ),
+    (
+        17539,
+        "rotation 38.034° at default tol, 38.099° in the reference (μc 1.24)",
+    ),
 ];
 
 /// Open disagreements found by `many_cases` (seeds 0..23000), not excused anywhere: the
 /// production model at its default tolerance (1e-6) is off, and agrees with the reference at
-/// tol 1e-8 and 1e-10. They are not in the CI run; [`known_defects_are_fixed`] checks them.
-const OPEN: &[(u64, &str)] = &[
-    (
-        12739,
-        "rotation −73.466° at default tol, −74.194° at 1e-8 and in the reference (μc 0.033, 3 edges)",
-    ),
-    (
-        7956,
-        "centroid off by 4.3e-3·a after 6·a of stick at default tol (rotation agrees)",
-    ),
-    (
-        17539,
-        "rotation 38.034° at default tol, 38.099° at 1e-8 and in the reference (μc 1.24)",
-    ),
-];
+/// tol 1e-8 and 1e-10. It is not in the CI run; [`known_defects_are_fixed`] checks it.
+const OPEN: &[(u64, &str)] = &[(
+    7956,
+    "centroid off by 4.3e-3·a after 6·a of stick at default tol (rotation agrees)",
+)];
 
 impl Compared {
     fn agrees(&self) -> bool {
@@ -641,7 +641,7 @@ fn assert_agreement(s: &Summary) {
 ///
 /// Measured (seeds 0..1000, 2026-11-23, step H = 0.04·a): 994 compared, skipped 5 near-central
 /// and 1 near-vertex, none for a non-ok status or a reference failure; all 994 agree in
-/// orientation and all but seed 37 (in [`KNOWN`]) in centroid. (With the geometric skips off,
+/// orientation and all but seed 37 (then a known defect, now in [`FIXED`]) in centroid. (With the geometric skips off,
 /// all 1000 agree as well.) |Δθ| median 1.6e-4°, 90% 8.2e-4°,
 /// 99% 2.8e-3°, max 7.3e-3° (seed 932, allowed 0.05°); the reference's own error estimate median
 /// 4.5e-4°, 90% 3.5e-3°, max 3.5e-2°; |Δc|/a median 3.1e-6, 99% 4.4e-5, max 2.2e-2 (seed 37).
@@ -726,13 +726,12 @@ fn many_cases() {
     assert_agreement(&s);
 }
 
-/// The production defects in [`KNOWN`] and [`OPEN`] as a regression test: a convex part struck by
-/// a point pin is touched once, and its final pose agrees with the reference. Fails until the
-/// re-touch after a tangential separation is fixed in `src/mechanics/integrate.rs` (`run_passes` /
-/// `next_touch`) and the default tolerance holds on the open cases; then drop the `ignore` and
-/// empty the lists.
+/// The open defect in [`OPEN`] as a regression test: the final pose at the default tolerance
+/// agrees with the reference. Fails until the default tolerance holds on that case (seed 7956:
+/// 4.3e-3·a of centroid after 6·a of stick, allowed 2.3e-3·a); then drop the `ignore` and move
+/// the seed to [`FIXED`].
 #[test]
-#[ignore = "production defects found by the reference (re-touch after tangential separation; default-tolerance error)"]
+#[ignore = "open production defect found by the reference (centroid error at the default tolerance after a long stick)"]
 fn known_defects_are_fixed() {
     for &(seed, why) in OPEN {
         match compare_case(seed, Fidelity::Exact, true) {
@@ -740,13 +739,23 @@ fn known_defects_are_fixed() {
             Verdict::Skip(w) => panic!("seed {seed} skipped: {w}"),
         }
     }
-    for &(seed, why) in KNOWN {
+}
+
+/// The cases in [`FIXED`] stay fixed: their final pose agrees with the reference in orientation
+/// and centroid, and a former re-touch is a single contact again.
+#[test]
+fn former_defects_stay_fixed() {
+    for &(seed, why) in FIXED {
         let c = random_case(seed);
         let poly = library_polygon(&c.verts);
         let o = run_production(&c, &poly, &common::settings(Fidelity::Exact, c.mu));
-        assert_eq!(o.contacts, 1, "seed {seed} ({why}): contacts");
+        if why.starts_with("re-touch") {
+            assert_eq!(o.contacts, 1, "seed {seed} ({why}): contacts");
+        }
         match compare_case(seed, Fidelity::Exact, true) {
-            Verdict::Compared(cmp) => assert!(cmp.dc <= cmp.tol_c, "{}", cmp.line()),
+            Verdict::Compared(cmp) => {
+                assert!(cmp.agrees() && cmp.dc <= cmp.tol_c, "{why}: {}", cmp.line())
+            }
             Verdict::Skip(w) => panic!("seed {seed} skipped: {w}"),
         }
     }
