@@ -1,4 +1,4 @@
-//! A small XML reader (elements, attributes, text; enough for pinfeed's own SVG output), and
+//! pinfeed's SVG output as a tree of elements, attributes and text (read with roxmltree), and
 //! estimated boxes of an SVG's texts for the figure tests (`animate`, `figures`).
 
 #[derive(Debug, Clone)]
@@ -40,116 +40,41 @@ impl Element {
     }
 }
 
-fn unescape(s: &str) -> String {
-    let mut out = String::new();
-    let mut rest = s;
-    while let Some(i) = rest.find('&') {
-        out.push_str(&rest[..i]);
-        let j = rest[i..].find(';').expect("entity ends with ;") + i;
-        out.push_str(match &rest[i..=j] {
-            "&amp;" => "&",
-            "&lt;" => "<",
-            "&gt;" => ">",
-            "&quot;" => "\"",
-            "&apos;" => "'",
-            e => panic!("unknown entity {e}"),
-        });
-        rest = &rest[j + 1..];
-    }
-    out.push_str(rest);
-    out
+/// Parse a document with one root element (with roxmltree); panics on anything ill-formed
+/// (mismatched or duplicate names, unquoted values, unknown entities, text outside the root).
+pub fn parse_xml(doc: &str) -> Element {
+    let d = roxmltree::Document::parse(doc).expect("well-formed XML");
+    element(d.root_element())
 }
 
-/// Parse a document with one root element; panics on anything ill-formed.
-pub fn parse_xml(doc: &str) -> Element {
-    let mut stack: Vec<Element> = vec![Element {
-        name: "#document".into(),
-        attrs: vec![],
-        children: vec![],
-        text: String::new(),
-    }];
-    let mut rest = doc;
-    while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix("</") {
-            let end = after.find('>').expect("closing tag ends");
-            let name = after[..end].trim();
-            let el = stack.pop().expect("open element");
-            assert_eq!(el.name, name, "mismatched closing tag");
-            stack.last_mut().expect("parent").children.push(el);
-            rest = &after[end + 1..];
-        } else if let Some(after) = rest.strip_prefix('<') {
-            assert!(
-                !after.starts_with('!') && !after.starts_with('?'),
-                "no DTD/PI"
-            );
-            // Find the tag's end outside quotes.
-            let mut in_quote = None;
-            let mut end = None;
-            for (i, c) in after.char_indices() {
-                match (in_quote, c) {
-                    (None, '"') | (None, '\'') => in_quote = Some(c),
-                    (Some(q), c) if c == q => in_quote = None,
-                    (None, '>') => {
-                        end = Some(i);
-                        break;
-                    }
-                    (None, '<') => panic!("'<' inside a tag"),
-                    _ => {}
-                }
-            }
-            let end = end.expect("tag ends");
-            let mut body = &after[..end];
-            let self_closing = body.ends_with('/');
-            if self_closing {
-                body = &body[..body.len() - 1];
-            }
-            let name_end = body.find(|c: char| c.is_whitespace()).unwrap_or(body.len());
-            let name = body[..name_end].to_string();
-            assert!(!name.is_empty(), "tag has a name");
-            let mut attrs = Vec::new();
-            let mut a = body[name_end..].trim_start();
-            while !a.is_empty() {
-                let eq = a.find('=').expect("attribute has =");
-                let key = a[..eq].trim().to_string();
-                let q = a[eq + 1..].chars().next().expect("quoted value");
-                assert!(q == '"' || q == '\'', "attribute {key} is quoted");
-                let close = a[eq + 2..].find(q).expect("value ends") + eq + 2;
-                let value = unescape(&a[eq + 2..close]);
-                assert!(
-                    !attrs.iter().any(|(k, _): &(String, String)| *k == key),
-                    "duplicate attribute {key} on <{name}>"
-                );
-                attrs.push((key, value));
-                a = a[close + 1..].trim_start();
-            }
-            let el = Element {
-                name,
-                attrs,
-                children: vec![],
-                text: String::new(),
+/// The tree below `node`, attribute names with their usual prefix (`xlink:href`, `xml:space`).
+fn element(node: roxmltree::Node) -> Element {
+    let attrs = node
+        .attributes()
+        .map(|a| {
+            let prefix = match a.namespace() {
+                Some("http://www.w3.org/1999/xlink") => "xlink:",
+                Some("http://www.w3.org/XML/1998/namespace") => "xml:",
+                _ => "",
             };
-            if self_closing {
-                stack.last_mut().expect("parent").children.push(el);
-            } else {
-                stack.push(el);
-            }
-            rest = &after[end + 1..];
-        } else {
-            let end = rest.find('<').unwrap_or(rest.len());
-            let text = unescape(&rest[..end]);
-            let top = stack.last_mut().expect("element");
-            assert!(
-                top.name != "#document" || text.trim().is_empty(),
-                "text outside the root"
-            );
-            top.text.push_str(&text);
-            rest = &rest[end..];
-        }
+            (format!("{prefix}{}", a.name()), a.value().to_string())
+        })
+        .collect();
+    let text = node
+        .children()
+        .filter(|c| c.is_text())
+        .filter_map(|c| c.text())
+        .collect();
+    Element {
+        name: node.tag_name().name().to_string(),
+        attrs,
+        children: node
+            .children()
+            .filter(|c| c.is_element())
+            .map(element)
+            .collect(),
+        text,
     }
-    assert_eq!(stack.len(), 1, "unclosed elements");
-    let mut doc = stack.pop().unwrap();
-    assert_eq!(doc.children.len(), 1, "one root element");
-    doc.children.pop().unwrap()
 }
 
 /// A text's estimated box (px, y down) and its content.
