@@ -641,3 +641,43 @@ pub fn search(problem: &Problem) -> Result<(Planner, Outcome, SearchStats), Plan
     let (outcome, stats) = planner.search();
     Ok((planner, outcome, stats))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The plan found for a small problem reaches the target, and no plan one pin shorter does:
+    /// the search is breadth first, so what it finds is a shortest plan.
+    #[test]
+    fn a_found_plan_reaches_the_target_and_is_shortest() {
+        let p = Problem::new("square");
+        let (_, outcome, _) = search(&p).unwrap();
+        let Outcome::Found(plan) = outcome else {
+            panic!("no plan for the square: {outcome:?}");
+        };
+        // The feed alone (jittered stable states) misses the target: the plan needs pins.
+        assert!(plan.initial_window.share < p.target);
+        assert!(!plan.steps.is_empty());
+        let last = plan.steps.last().unwrap();
+        assert_eq!(last.window.share, plan.predicted_success);
+        assert!(
+            plan.predicted_success >= p.target,
+            "{}",
+            plan.predicted_success
+        );
+        assert!(plan.steps.len() <= p.max_pins);
+        let mut shorter = p.clone();
+        shorter.max_pins = plan.steps.len() - 1;
+        let (_, again, _) = search(&shorter).unwrap();
+        assert!(!matches!(again, Outcome::Found(_)), "{again:?}");
+    }
+
+    /// A problem the planner cannot take is refused before any search, naming its field.
+    #[test]
+    fn a_bad_problem_is_refused_with_its_field() {
+        let mut p = Problem::new("square");
+        p.target = 1.5;
+        let e = search(&p).err().expect("target 1.5 refused");
+        assert_eq!(e.field(), Some("target"), "{e}");
+    }
+}
