@@ -647,3 +647,51 @@ impl Line<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quickstart() -> Scene {
+        crate::scenario::load(std::path::Path::new("scenarios/quickstart.toml")).unwrap()
+    }
+
+    fn entry(theta_rad: f64) -> Entry {
+        Entry {
+            theta_rad,
+            y: 0.0,
+            x: 0.0,
+            model: None,
+        }
+    }
+
+    /// A line without obstacles only carries the part: it leaves at the belt's end with the
+    /// orientation and offset it entered with, and the contact model is never called.
+    #[test]
+    fn an_empty_line_carries_the_part_unchanged_and_calls_no_model() {
+        let mut scene = quickstart();
+        scene.obstacles.clear();
+        for theta in [0.0, 1.0, 4.0] {
+            let r = run_single(&scene, entry(theta)).unwrap();
+            assert!(r.outcome.exited(), "{:?}", r.outcome);
+            assert_eq!(r.pose.theta_rad.rem_euclid(std::f64::consts::TAU), theta);
+            assert_eq!(r.pose.y, 0.0);
+            assert_eq!(r.model_evaluations, 0);
+        }
+    }
+
+    /// The same entry through the same line ends the same way to the bit, and a part that meets
+    /// the quickstart's pins is pushed: the model is called and the orientation changes.
+    #[test]
+    fn a_pushed_part_ends_the_same_way_every_time() {
+        let scene = quickstart();
+        let a = run_single(&scene, entry(1.0)).unwrap();
+        let b = run_single(&scene, entry(1.0)).unwrap();
+        assert_eq!(
+            (a.outcome, a.pose, a.model_evaluations),
+            (b.outcome, b.pose, b.model_evaluations)
+        );
+        assert!(a.model_evaluations > 0);
+        assert_ne!(a.pose.theta_rad.rem_euclid(std::f64::consts::TAU), 1.0);
+    }
+}
