@@ -962,3 +962,39 @@ impl Line<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(name: &str) -> Scene {
+        let path = format!("scenarios/{name}.toml");
+        crate::scenario::load(std::path::Path::new(&path)).unwrap()
+    }
+
+    /// A line without dynamic pins runs no controller (it pays nothing for it); a line with
+    /// dynamic pins gets one timeline and one actuator record per dynamic pin, with its mode.
+    #[test]
+    fn only_lines_with_dynamic_pins_get_a_controller() {
+        for name in ["quickstart", "tripoly1", "tripoly1_fences", "crowded_belt"] {
+            assert!(Control::new(&scene(name), false).is_none(), "{name}");
+        }
+        for (name, mode) in [
+            ("tripoly1_sensing", ControllerMode::Policy),
+            ("tripoly1_online", ControllerMode::Online),
+        ] {
+            let s = scene(name);
+            let c = Control::new(&s, true).expect("dynamic pins");
+            let dynamic = s
+                .obstacles
+                .iter()
+                .filter(|o| matches!(o, Obstacle::Pin(p) if p.actuator.is_some()))
+                .count();
+            assert!(dynamic > 0);
+            assert_eq!(c.tracks.iter().filter(|t| t.is_some()).count(), dynamic);
+            assert_eq!(c.summary.actuators.len(), dynamic);
+            assert_eq!(c.summary.mode, mode, "{name}");
+            assert!(c.log.as_ref().is_some_and(|l| l.is_empty()));
+        }
+    }
+}
