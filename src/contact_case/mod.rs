@@ -287,7 +287,7 @@ pub fn compile_part(part: &str, support: &str) -> Result<(Polygon, PartModel), C
         part: part.to_string(),
         source,
     })?;
-    let support = Support::parse(support, &poly).map_err(CaseError::Compile)?;
+    let support = Support::parse(support, &poly).map_err(|e| CaseError::Compile(e.to_string()))?;
     let model = PartModel::new(&poly, &support).map_err(CaseError::Compile)?;
     Ok((poly, model))
 }

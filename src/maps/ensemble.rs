@@ -70,11 +70,13 @@ impl EnsembleSpec {
     /// Apply a comma-separated list of `key=value` settings to `self`:
     /// `mu_c=DIST`, `pin_radius=DIST` (DIST: a number, `uniform:MIN:MAX`, `normal:MEAN:SD`,
     /// `triangular:MIN:MODE:MAX`), `support=uniform|tripod:SHARE|smooth:SHARE`, `jitter=SD_DEG`.
-    pub fn with_settings(mut self, text: &str) -> Result<EnsembleSpec, String> {
+    pub fn with_settings(mut self, text: &str) -> Result<EnsembleSpec, SettingsError> {
         for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             let (key, value) = item
                 .split_once('=')
-                .ok_or_else(|| format!("'{item}': expected KEY=VALUE"))?;
+                .ok_or_else(|| SettingsError::NotKeyValue {
+                    item: item.to_string(),
+                })?;
             let (key, value) = (key.trim(), value.trim());
             match key {
                 "mu_c" => self.mu_c = parse_distribution(value, "mu_c", 0.0, 10.0)?,
@@ -84,9 +86,9 @@ impl EnsembleSpec {
                 "support" => (self.support, self.support_share) = parse_support(value)?,
                 "jitter" => self.jitter_deg = parse_number(value, "jitter", 0.0, 90.0)?,
                 _ => {
-                    return Err(format!(
-                        "unknown uncertain parameter '{key}'; expected mu_c, support, pin_radius or jitter"
-                    ))
+                    return Err(SettingsError::UnknownKey {
+                        key: key.to_string(),
+                    })
                 }
             }
         }
@@ -119,18 +121,121 @@ impl EnsembleSpec {
     }
 }
 
-fn parse_number(s: &str, what: &str, lo: f64, hi: f64) -> Result<f64, String> {
-    let v: f64 = s
-        .parse()
-        .map_err(|_| format!("{what}: '{s}' is not a number"))?;
+/// Why an `--uncertain` list is refused ([`EnsembleSpec::with_settings`]). `what` names the
+/// parameter (`mu_c`, `pin_radius`, `jitter`, `support share`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SettingsError {
+    /// An item without `=`.
+    #[error("'{item}': expected KEY=VALUE")]
+    NotKeyValue {
+        /// The item.
+        item: String,
+    },
+    /// A key that is none of the uncertain parameters.
+    #[error("unknown uncertain parameter '{key}'; expected mu_c, support, pin_radius or jitter")]
+    UnknownKey {
+        /// The key.
+        key: String,
+    },
+    /// A value that should be a number.
+    #[error("{what}: '{value}' is not a number")]
+    NotANumber {
+        /// The parameter.
+        what: String,
+        /// The text given.
+        value: String,
+    },
+    /// A number outside the parameter's range.
+    #[error("{what}: {value} must lie in [{lo}, {hi}]")]
+    OutOfRange {
+        /// The parameter.
+        what: String,
+        /// The number given.
+        value: f64,
+        /// Smallest allowed value.
+        lo: f64,
+        /// Largest allowed value.
+        hi: f64,
+    },
+    /// A distribution written in none of the accepted forms.
+    #[error("{what}: '{value}' is not a number, uniform:MIN:MAX, normal:MEAN:SD or triangular:MIN:MODE:MAX")]
+    Distribution {
+        /// The parameter.
+        what: String,
+        /// The text given.
+        value: String,
+    },
+    /// A distribution with no values in the parameter's range, or whose minimum exceeds its maximum.
+    #[error(
+        "{what}: '{value}' has no values in [{lo}, {hi}] (or its minimum exceeds its maximum)"
+    )]
+    EmptyRange {
+        /// The parameter.
+        what: String,
+        /// The text given.
+        value: String,
+        /// Smallest allowed value.
+        lo: f64,
+        /// Largest allowed value.
+        hi: f64,
+    },
+    /// A support that is none of `uniform`, `tripod:SHARE`, `smooth:SHARE`.
+    #[error("support: '{value}' must be uniform, tripod:SHARE or smooth:SHARE")]
+    Support {
+        /// The text given.
+        value: String,
+    },
+}
+
+/// Why an ensemble member could not be drawn or compiled ([`draw_member`], [`Member::new`]).
+/// Each variant holds the message of the step that failed, printed as it is.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MemberError {
+    /// A parameter's distribution gave no value in its domain
+    /// ([`crate::random::distribution::Distribution::draw`]).
+    #[error("{0}")]
+    Draw(String),
+    /// The member's support could not be drawn ([`draw_support`]).
+    #[error("{0}")]
+    Support(String),
+    /// The member's part model could not be compiled ([`PartModel::new`]).
+    #[error("{0}")]
+    Model(String),
+}
+
+/// Why an ensemble could not be compiled ([`members`], [`ensemble_maps`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("ensemble member {index}: {cause}")]
+pub struct EnsembleError {
+    /// Index of the member that failed.
+    pub index: u64,
+    /// Why it failed. (In the message, not a `source`, so that it is printed once.)
+    pub cause: MemberError,
+}
+
+fn parse_number(s: &str, what: &str, lo: f64, hi: f64) -> Result<f64, SettingsError> {
+    let v: f64 = s.parse().map_err(|_| SettingsError::NotANumber {
+        what: what.to_string(),
+        value: s.to_string(),
+    })?;
     if !(v.is_finite() && (lo..=hi).contains(&v)) {
-        return Err(format!("{what}: {v} must lie in [{lo}, {hi}]"));
+        return Err(SettingsError::OutOfRange {
+            what: what.to_string(),
+            value: v,
+            lo,
+            hi,
+        });
     }
     Ok(v)
 }
 
 /// A distribution written `V`, `uniform:MIN:MAX`, `normal:MEAN:SD` or `triangular:MIN:MODE:MAX`.
-fn parse_distribution(s: &str, what: &str, lo: f64, hi: f64) -> Result<Distribution, String> {
+fn parse_distribution(
+    s: &str,
+    what: &str,
+    lo: f64,
+    hi: f64,
+) -> Result<Distribution, SettingsError> {
     let parts: Vec<&str> = s.split(':').collect();
     let n = |k: usize| parse_number(parts[k], what, -hi, hi);
     let d = match (parts[0], parts.len()) {
@@ -151,22 +256,26 @@ fn parse_distribution(s: &str, what: &str, lo: f64, hi: f64) -> Result<Distribut
             max: n(3)?,
         },
         _ => {
-            return Err(format!(
-                "{what}: '{s}' is not a number, uniform:MIN:MAX, normal:MEAN:SD or triangular:MIN:MODE:MAX"
-            ))
+            return Err(SettingsError::Distribution {
+                what: what.to_string(),
+                value: s.to_string(),
+            })
         }
     };
     let (a, b) = d.range();
     if a > b || b < lo || a > hi {
-        return Err(format!(
-            "{what}: '{s}' has no values in [{lo}, {hi}] (or its minimum exceeds its maximum)"
-        ));
+        return Err(SettingsError::EmptyRange {
+            what: what.to_string(),
+            value: s.to_string(),
+            lo,
+            hi,
+        });
     }
     Ok(d)
 }
 
 /// `uniform`, `tripod:SHARE` or `smooth:SHARE` (default smooth-density parameters).
-fn parse_support(s: &str) -> Result<(SupportChoice, f64), String> {
+fn parse_support(s: &str) -> Result<(SupportChoice, f64), SettingsError> {
     let (kind, share) = match s.split_once(':') {
         Some((k, v)) => (k, parse_number(v, "support share", 0.0, 1.0)?),
         None => (s, 1.0),
@@ -175,9 +284,9 @@ fn parse_support(s: &str) -> Result<(SupportChoice, f64), String> {
         "uniform" => Ok((SupportChoice::Uniform, 0.0)),
         "tripod" => Ok((SupportChoice::Tripod, share)),
         "smooth" => Ok((SupportChoice::Smooth(SmoothParams::default()), share)),
-        _ => Err(format!(
-            "support: '{s}' must be uniform, tripod:SHARE or smooth:SHARE"
-        )),
+        _ => Err(SettingsError::Support {
+            value: s.to_string(),
+        }),
     }
 }
 
@@ -243,13 +352,19 @@ pub struct MemberDraw {
 }
 
 /// Draw member `i` of an ensemble seeded with `seed`.
-pub fn draw_member(spec: &EnsembleSpec, seed: u64, i: u64) -> Result<MemberDraw, String> {
+pub fn draw_member(spec: &EnsembleSpec, seed: u64, i: u64) -> Result<MemberDraw, MemberError> {
     let mut master = stream(seed, i);
     let mut next = || ChaCha8Rng::seed_from_u64(master.random::<u64>());
     let (mut mu, mut share, mut shape, mut radius, mut jitter) =
         (next(), next(), next(), next(), next());
-    let (mu_c, _) = spec.mu_c.draw(&mut mu, |v| v >= 0.0)?;
-    let (pin_radius, _) = spec.pin_radius.draw(&mut radius, |v| v >= 0.0)?;
+    let (mu_c, _) = spec
+        .mu_c
+        .draw(&mut mu, |v| v >= 0.0)
+        .map_err(MemberError::Draw)?;
+    let (pin_radius, _) = spec
+        .pin_radius
+        .draw(&mut radius, |v| v >= 0.0)
+        .map_err(MemberError::Draw)?;
     Ok(MemberDraw {
         mu_c,
         random_support: share.random::<f64>() < spec.support_share,
@@ -268,7 +383,12 @@ pub struct Member {
 
 impl Member {
     /// Compile member `i` (its support drawn on `poly`).
-    pub fn new(poly: &Polygon, spec: &EnsembleSpec, seed: u64, i: u64) -> Result<Member, String> {
+    pub fn new(
+        poly: &Polygon,
+        spec: &EnsembleSpec,
+        seed: u64,
+        i: u64,
+    ) -> Result<Member, MemberError> {
         let draw = draw_member(spec, seed, i)?;
         let choice = if draw.random_support {
             spec.support
@@ -276,8 +396,9 @@ impl Member {
             SupportChoice::Uniform
         };
         let mut rng = ChaCha8Rng::seed_from_u64(draw.support_seed);
-        let support = draw_support(poly, &choice, &mut rng, &mut 0)?;
-        let model = PartModel::new(poly, &support)?;
+        let support =
+            draw_support(poly, &choice, &mut rng, &mut 0).map_err(MemberError::Support)?;
+        let model = PartModel::new(poly, &support).map_err(MemberError::Model)?;
         Ok(Member { draw, model })
     }
 
@@ -326,10 +447,12 @@ pub fn members(
     spec: &EnsembleSpec,
     seed: u64,
     n: usize,
-) -> Result<Vec<Member>, String> {
+) -> Result<Vec<Member>, EnsembleError> {
     (0..n as u64)
         .into_par_iter()
-        .map(|i| Member::new(poly, spec, seed, i).map_err(|e| format!("ensemble member {i}: {e}")))
+        .map(|i| {
+            Member::new(poly, spec, seed, i).map_err(|cause| EnsembleError { index: i, cause })
+        })
         .collect()
 }
 
@@ -355,7 +478,7 @@ pub fn ensemble_maps(
     grid: &[f64],
     seed: u64,
     n: usize,
-) -> Result<EnsembleMaps, String> {
+) -> Result<EnsembleMaps, EnsembleError> {
     ensemble_maps_observed(poly, spec, ds, grid, seed, n, &|| {})
 }
 
@@ -368,7 +491,7 @@ pub fn ensemble_maps_observed(
     seed: u64,
     n: usize,
     on_pass: &(dyn Fn() + Sync),
-) -> Result<EnsembleMaps, String> {
+) -> Result<EnsembleMaps, EnsembleError> {
     let members = members(poly, spec, seed, n)?;
     let (nd, nk) = (ds.len(), grid.len());
     let states = stable_states_deg(poly);

@@ -293,7 +293,7 @@ pub fn stop_after_touch(
             "the travel after first touch must be a finite number >= 0, got {after}"
         ));
     }
-    let moving = PinPath::new(w, Vec::new())?;
+    let moving = PinPath::new(w, Vec::new()).map_err(|e| e.to_string())?;
     match pin_first_touch(model, pose, pin_start, radius, &moving) {
         Some(s) if s.is_finite() => PinPath::new(
             w,
@@ -301,7 +301,8 @@ pub fn stop_after_touch(
                 s: s.max(0.0) + after.max(f64::MIN_POSITIVE),
                 w: 0.0,
             }],
-        ),
+        )
+        .map_err(|e| e.to_string()),
         _ => Ok(moving),
     }
 }

@@ -32,6 +32,45 @@ pub struct PinPath {
     turns: Vec<Turn>,
 }
 
+/// Why a pin path is refused ([`PinPath::new`], [`PinPath::move_to`], [`PinPath::ramp`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PinPathError {
+    /// The initial lateral speed is not finite or exceeds ±[`MAX_LATERAL_SPEED`].
+    #[error("lateral pin speed {w0} is not within ±{MAX_LATERAL_SPEED} belt speeds")]
+    InitialSpeed {
+        /// The initial lateral speed.
+        w0: f64,
+    },
+    /// A turn's travel is not finite or does not exceed the previous turn's.
+    #[error("turn {index}: travel {s} must be finite and greater than {previous}")]
+    Travel {
+        /// Index of the turn.
+        index: usize,
+        /// Its travel.
+        s: f64,
+        /// The previous turn's travel (0 for the first).
+        previous: f64,
+    },
+    /// A turn's lateral speed is not finite or exceeds ±[`MAX_LATERAL_SPEED`].
+    #[error("turn {index}: lateral pin speed {w} is not within ±{MAX_LATERAL_SPEED} belt speeds")]
+    TurnSpeed {
+        /// Index of the turn.
+        index: usize,
+        /// Its lateral speed.
+        w: f64,
+    },
+    /// A pin moving away from its stop position.
+    #[error("a pin moving at lateral speed {w} from y = {y0} never reaches y = {y_stop}")]
+    NeverReaches {
+        /// The lateral speed.
+        w: f64,
+        /// The starting lateral position.
+        y0: f64,
+        /// The stop position.
+        y_stop: f64,
+    },
+}
+
 impl PinPath {
     /// A pin moving at constant lateral speed `w` (0: a still pin).
     pub fn constant(w: f64) -> PinPath {
@@ -43,26 +82,22 @@ impl PinPath {
 
     /// A profile starting at `w0` with `turns`; travels must be finite, positive and increasing,
     /// speeds finite and within ±[`MAX_LATERAL_SPEED`].
-    pub fn new(w0: f64, turns: Vec<Turn>) -> Result<PinPath, String> {
+    pub fn new(w0: f64, turns: Vec<Turn>) -> Result<PinPath, PinPathError> {
         let speed_ok = |w: f64| w.is_finite() && w.abs() <= MAX_LATERAL_SPEED;
         if !speed_ok(w0) {
-            return Err(format!(
-                "lateral pin speed {w0} is not within ±{MAX_LATERAL_SPEED} belt speeds"
-            ));
+            return Err(PinPathError::InitialSpeed { w0 });
         }
         let mut last = 0.0;
         for (i, t) in turns.iter().enumerate() {
             if !(t.s.is_finite() && t.s > last) {
-                return Err(format!(
-                    "turn {i}: travel {} must be finite and greater than {last}",
-                    t.s
-                ));
+                return Err(PinPathError::Travel {
+                    index: i,
+                    s: t.s,
+                    previous: last,
+                });
             }
             if !speed_ok(t.w) {
-                return Err(format!(
-                    "turn {i}: lateral pin speed {} is not within ±{MAX_LATERAL_SPEED} belt speeds",
-                    t.w
-                ));
+                return Err(PinPathError::TurnSpeed { index: i, w: t.w });
             }
             last = t.s;
         }
@@ -71,14 +106,12 @@ impl PinPath {
 
     /// The thesis's app. E set-up: the pin moves across the belt at lateral speed `w` from lateral
     /// position `y0` until it stands at `y_stop` (then still). Positions in the caller's units.
-    pub fn move_to(w: f64, y0: f64, y_stop: f64) -> Result<PinPath, String> {
+    pub fn move_to(w: f64, y0: f64, y_stop: f64) -> Result<PinPath, PinPathError> {
         if y_stop == y0 || w == 0.0 {
             return PinPath::new(0.0, Vec::new());
         }
         if (y_stop - y0) * w < 0.0 {
-            return Err(format!(
-                "a pin moving at lateral speed {w} from y = {y0} never reaches y = {y_stop}"
-            ));
+            return Err(PinPathError::NeverReaches { w, y0, y_stop });
         }
         let s = (y_stop - y0) / w;
         PinPath::new(w, vec![Turn { s, w: 0.0 }])
@@ -87,7 +120,7 @@ impl PinPath {
     /// A pin still until travel `s0`, then changing its lateral speed linearly from 0 to `w` over
     /// a travel `len`, resolved into `pieces` constant-speed pieces (each at its mean speed, so
     /// positions agree with the linear ramp at the piece ends), then moving at `w`.
-    pub fn ramp(s0: f64, len: f64, w: f64, pieces: usize) -> Result<PinPath, String> {
+    pub fn ramp(s0: f64, len: f64, w: f64, pieces: usize) -> Result<PinPath, PinPathError> {
         let n = pieces.max(1);
         let turns = (0..n)
             .map(|i| Turn {

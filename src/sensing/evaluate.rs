@@ -236,7 +236,8 @@ pub fn trial_pass(
         degrees[j],
         config.seed,
         TRIAL_STREAMS + i as u64,
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     let truth = if vertex_edge {
         pass.signal.first_feature.map(vertex_edge_class)
     } else {
@@ -285,7 +286,8 @@ pub fn evaluate_observed(
         problem.uncertainty,
         config.templates_per_hypothesis,
         config.seed,
-    )?;
+    )
+    .map_err(|e| e.to_string())?;
     let labels = templates.labels.clone();
     let k = labels.len();
     // Trained classifiers, per point.

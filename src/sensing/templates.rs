@@ -265,6 +265,22 @@ pub fn simulate(setup: &PushSetup, model: &PartModel, theta0_deg: f64, d: f64, m
     }
 }
 
+/// Why a template or trial pass could not be drawn ([`draw_pass`], [`build_templates`]). Each
+/// variant holds the message of the step that failed, printed as it is.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PassError {
+    /// μc's distribution gave no value in its domain
+    /// ([`crate::random::distribution::Distribution::draw`]).
+    #[error("{0}")]
+    MuC(String),
+    /// No tripod could be drawn ([`Support::random_tripod`]).
+    #[error("{0}")]
+    Tripod(String),
+    /// The tripod's part model could not be compiled ([`PartModel::new`]).
+    #[error("{0}")]
+    Model(String),
+}
+
 /// Draws one pass for orientation `theta_deg` under `unc` from stream `(seed, index)`. Draw order:
 /// μc, tripod (if any), θ jitter, d jitter.
 pub fn draw_pass(
@@ -274,16 +290,20 @@ pub fn draw_pass(
     theta_deg: f64,
     seed: u64,
     index: u64,
-) -> Result<Pass, String> {
+) -> Result<Pass, PassError> {
     let mut rng = stream(seed, index);
-    let (mu_c, _) = unc.mu_c.draw(&mut rng, |v| {
-        let (lo, hi) = crate::mechanics::limits::MU_C;
-        (lo..=hi).contains(&v)
-    })?;
+    let (mu_c, _) = unc
+        .mu_c
+        .draw(&mut rng, |v| {
+            let (lo, hi) = crate::mechanics::limits::MU_C;
+            (lo..=hi).contains(&v)
+        })
+        .map_err(PassError::MuC)?;
     let tripod;
     let model = if unc.tripod {
-        let support = Support::random_tripod(&setup.polygon, &mut rng)?;
-        tripod = PartModel::new(&setup.polygon, &support)?;
+        let support =
+            Support::random_tripod(&setup.polygon, &mut rng).map_err(PassError::Tripod)?;
+        tripod = PartModel::new(&setup.polygon, &support).map_err(PassError::Model)?;
         &tripod
     } else {
         uniform
@@ -323,7 +343,7 @@ pub fn build_templates(
     unc: &Uncertainty,
     per_hypothesis: usize,
     seed: u64,
-) -> Result<TemplateSet, String> {
+) -> Result<TemplateSet, PassError> {
     let labels = hyps.labels();
     let mut members: Vec<Vec<ContactSignal>> = vec![Vec::new(); labels.len()];
     match hyps {

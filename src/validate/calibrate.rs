@@ -300,8 +300,22 @@ fn profile_interval(x: &[f64], p: &[f64], best: f64) -> (f64, f64, bool, bool) {
     (lo, hi, first == 0, last + 1 == x.len())
 }
 
+/// Why a calibration failed ([`calibrate`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CalibrateError {
+    /// The proposal ensemble's predictions could not be made (their message, as it is).
+    #[error("{0}")]
+    Predict(String),
+    /// No point of the parameter grid has a finite log-likelihood.
+    #[error("the log-likelihood is not finite anywhere on the grid")]
+    NotFinite,
+}
+
 /// Calibrate the parameters to `measured`.
-pub fn calibrate(measured: &Measured, s: &CalibrationSettings) -> Result<Calibration, String> {
+pub fn calibrate(
+    measured: &Measured,
+    s: &CalibrationSettings,
+) -> Result<Calibration, CalibrateError> {
     calibrate_observed(measured, s, &crate::progress::silent)
 }
 
@@ -311,7 +325,7 @@ pub fn calibrate_observed(
     measured: &Measured,
     s: &CalibrationSettings,
     progress: crate::progress::Report,
-) -> Result<Calibration, String> {
+) -> Result<Calibration, CalibrateError> {
     let pred = predict_observed(
         measured,
         &s.proposal(),
@@ -319,7 +333,8 @@ pub fn calibrate_observed(
         s.members,
         s.passes,
         progress,
-    )?;
+    )
+    .map_err(CalibrateError::Predict)?;
     let kernels: Vec<RowKernel> = measured
         .rows
         .iter()
@@ -360,7 +375,7 @@ pub fn calibrate_observed(
         }
     }
     if !best.0.is_finite() {
-        return Err("the log-likelihood is not finite anywhere on the grid".into());
+        return Err(CalibrateError::NotFinite);
     }
     let parameters = (0..4)
         .map(|q| {

@@ -30,7 +30,7 @@ pub enum InputError {
     PinRadius(f64),
     /// The uncertain parameters (`KEY=VALUE,...`) are refused.
     #[error("--uncertain: {0}")]
-    Uncertain(String),
+    Uncertain(crate::maps::ensemble::SettingsError),
     /// The measured-bands file is refused.
     #[error(transparent)]
     Measured(#[from] MeasuredError),

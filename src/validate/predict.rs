@@ -55,7 +55,7 @@ pub fn predict_observed(
         .parts
         .iter()
         .map(|(name, poly)| {
-            let m = members(poly, spec, seed, n)?;
+            let m = members(poly, spec, seed, n).map_err(|e| e.to_string())?;
             Ok((name.clone(), m, stable_states_deg(poly)))
         })
         .collect::<Result<_, String>>()?;

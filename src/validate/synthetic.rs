@@ -108,13 +108,25 @@ pub fn smallest_arc(angles: &[f64]) -> Arc {
     }
 }
 
+/// Why a synthetic measured-bands file could not be made ([`synthesize`]).
+#[derive(Debug, thiserror::Error)]
+pub enum SynthesizeError {
+    /// The design's part spec is refused.
+    #[error("{0}")]
+    Part(crate::geometry::PartSpecError),
+    /// An ensemble member of the hidden truth could not be compiled.
+    #[error("{0}")]
+    Ensemble(crate::maps::ensemble::EnsembleError),
+}
+
 /// The design's measured-bands file (CSV text, with a comment header naming seed and design).
-pub fn synthesize(design: &SyntheticDesign) -> Result<String, String> {
-    let poly = part_from_spec(&design.part).map_err(|e| e.to_string())?;
+pub fn synthesize(design: &SyntheticDesign) -> Result<String, SynthesizeError> {
+    let poly = part_from_spec(&design.part).map_err(SynthesizeError::Part)?;
     let states = stable_states_deg(&poly);
     let n_rows = design.ds.len() * design.inputs.len();
     let trials = design.trials as usize;
-    let ms = members(&poly, &design.truth, design.seed, n_rows * trials)?;
+    let ms = members(&poly, &design.truth, design.seed, n_rows * trials)
+        .map_err(SynthesizeError::Ensemble)?;
     let finals: Vec<f64> = (0..n_rows * trials)
         .into_par_iter()
         .map(|x| {

@@ -101,7 +101,7 @@ fn run_calibrate(c: &CsvCase, path: &Path) -> CaseReport {
     };
     let cal = match crate::validate::calibrate::calibrate(&m, &s) {
         Ok(cal) => cal,
-        Err(e) => return refused(&e),
+        Err(e) => return refused(&e.to_string()),
     };
     let fitted = s.spec_at(cal.estimate());
     let scored =

@@ -30,7 +30,7 @@ pub enum CacheError {
         /// The cache file.
         path: PathBuf,
         /// What is wrong with it.
-        reason: String,
+        reason: DecodeError,
     },
     /// The file could not be read or written.
     /// (The cause is in the message, not a `source`, so that it is printed once.)
@@ -41,6 +41,46 @@ pub enum CacheError {
         /// Why it could not be read or written.
         error: std::io::Error,
     },
+}
+
+/// Why a cache file's bytes are refused ([`decode`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DecodeError {
+    /// Too short, or the magic bytes are not ours.
+    #[error("not a pinfeed map file")]
+    NotAMapFile,
+    /// The stored checksum is not that of the bytes before it.
+    #[error("checksum mismatch")]
+    Checksum,
+    /// Written by another format version.
+    #[error("format version {found}, expected {expected}")]
+    Version {
+        /// The version in the file.
+        found: u32,
+        /// The version this build reads and writes.
+        expected: u32,
+    },
+    /// The key in the file is not that of the inputs.
+    #[error("its key does not match its inputs")]
+    KeyMismatch,
+    /// The stated payload length is not the number of bytes that follow.
+    #[error("payload length mismatch")]
+    PayloadLength,
+    /// Bytes after the payload.
+    #[error("trailing bytes")]
+    TrailingBytes,
+    /// The file ends before what it announces.
+    #[error("truncated")]
+    Truncated,
+    /// A node tag that is none of split, certified, fallback, unbuilt.
+    #[error("unknown node tag {0}")]
+    NodeTag(u8),
+    /// The grid is empty, has fewer nodes than base cells, or its reach is not positive.
+    #[error("inconsistent grid")]
+    Grid,
+    /// A node or corner index points outside the map.
+    #[error("a node points outside the map")]
+    Link,
 }
 
 /// Where a map came from.
@@ -268,36 +308,37 @@ pub fn encode(map: &TierMap) -> Vec<u8> {
 }
 
 /// Parse a file's bytes (the reason it is refused, if it is).
-pub fn decode(bytes: &[u8], key: &TierKey) -> Result<TierMap, String> {
+pub fn decode(bytes: &[u8], key: &TierKey) -> Result<TierMap, DecodeError> {
     if bytes.len() < 16 + 4 + 16 + 8 + 8 || &bytes[..16] != MAGIC {
-        return Err("not a pinfeed map file".into());
+        return Err(DecodeError::NotAMapFile);
     }
     let (body, sum) = bytes.split_at(bytes.len() - 8);
     if fnv1a64(body, BASIS).to_le_bytes() != sum {
-        return Err("checksum mismatch".into());
+        return Err(DecodeError::Checksum);
     }
     let mut r = Reader(&body[16..]);
     let version = r.u32()?;
     if version != FORMAT_VERSION {
-        return Err(format!(
-            "format version {version}, expected {FORMAT_VERSION}"
-        ));
+        return Err(DecodeError::Version {
+            found: version,
+            expected: FORMAT_VERSION,
+        });
     }
     if r.take(16)? != key.0 {
-        return Err("its key does not match its inputs".into());
+        return Err(DecodeError::KeyMismatch);
     }
     let len = r.u64()? as usize;
     if len != r.0.len() {
-        return Err("payload length mismatch".into());
+        return Err(DecodeError::PayloadLength);
     }
     let map = payload(&mut r, *key)?;
     if !r.0.is_empty() {
-        return Err("trailing bytes".into());
+        return Err(DecodeError::TrailingBytes);
     }
     Ok(map)
 }
 
-fn payload(r: &mut Reader, key: TierKey) -> Result<TierMap, String> {
+fn payload(r: &mut Reader, key: TierKey) -> Result<TierMap, DecodeError> {
     let spec = TierSpec {
         theta_cells: r.u32()?,
         d_cells: r.u32()?,
@@ -326,7 +367,7 @@ fn payload(r: &mut Reader, key: TierKey) -> Result<TierMap, String> {
             1 => Node::Certified { points: v },
             2 => Node::Fallback,
             3 => Node::Unbuilt,
-            t => return Err(format!("unknown node tag {t}")),
+            t => return Err(DecodeError::NodeTag(t)),
         });
     }
     let n_samples = r.count(37)?;
@@ -357,10 +398,10 @@ fn payload(r: &mut Reader, key: TierKey) -> Result<TierMap, String> {
 }
 
 /// Every node and corner index points inside the map, and the base grid is there.
-fn check_links(map: &TierMap) -> Result<(), String> {
+fn check_links(map: &TierMap) -> Result<(), DecodeError> {
     let roots = map.spec.theta_cells as usize * map.spec.d_cells as usize;
     if roots == 0 || map.nodes.len() < roots || !(map.reach > 0.0 && map.reach.is_finite()) {
-        return Err("inconsistent grid".into());
+        return Err(DecodeError::Grid);
     }
     let ok = map.nodes.iter().enumerate().all(|(i, n)| match *n {
         Node::Split { first } => (first as usize) > i && first as usize + 4 <= map.nodes.len(),
@@ -371,7 +412,7 @@ fn check_links(map: &TierMap) -> Result<(), String> {
     if ok {
         Ok(())
     } else {
-        Err("a node points outside the map".into())
+        Err(DecodeError::Link)
     }
 }
 
@@ -392,32 +433,32 @@ impl Writer {
 struct Reader<'a>(&'a [u8]);
 
 impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], DecodeError> {
         if self.0.len() < n {
-            return Err("truncated".into());
+            return Err(DecodeError::Truncated);
         }
         let (head, rest) = self.0.split_at(n);
         self.0 = rest;
         Ok(head)
     }
-    fn u32(&mut self) -> Result<u32, String> {
+    fn u32(&mut self) -> Result<u32, DecodeError> {
         Ok(u32::from_le_bytes(
             self.take(4)?.try_into().expect("4 bytes"),
         ))
     }
-    fn u64(&mut self) -> Result<u64, String> {
+    fn u64(&mut self) -> Result<u64, DecodeError> {
         Ok(u64::from_le_bytes(
             self.take(8)?.try_into().expect("8 bytes"),
         ))
     }
-    fn f64(&mut self) -> Result<f64, String> {
+    fn f64(&mut self) -> Result<f64, DecodeError> {
         Ok(f64::from_bits(self.u64()?))
     }
     /// A count of items of `size` bytes each that must fit in what is left.
-    fn count(&mut self, size: usize) -> Result<usize, String> {
+    fn count(&mut self, size: usize) -> Result<usize, DecodeError> {
         let n = self.u64()? as usize;
         if n.checked_mul(size).is_none_or(|b| b > self.0.len()) {
-            return Err("truncated".into());
+            return Err(DecodeError::Truncated);
         }
         Ok(n)
     }

@@ -31,6 +31,46 @@ pub struct PointSupport {
     pub spin_radius: f64,
 }
 
+/// Why a point support is refused ([`PointSupport::new`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PointSupportError {
+    /// No points.
+    #[error("a point support needs at least one point")]
+    Empty,
+    /// Not one weight per point.
+    #[error("{points} support points but {weights} weights")]
+    Lengths {
+        /// Number of points.
+        points: usize,
+        /// Number of weights.
+        weights: usize,
+    },
+    /// A point with a non-finite coordinate.
+    #[error("support point {index} ({x}, {y}) is not finite")]
+    Point {
+        /// Index of the point.
+        index: usize,
+        /// Its x coordinate.
+        x: f64,
+        /// Its y coordinate.
+        y: f64,
+    },
+    /// A negative or non-finite weight.
+    #[error("support weight {index} is {weight}; weights must be finite and non-negative")]
+    Weight {
+        /// Index of the weight.
+        index: usize,
+        /// Its value.
+        weight: f64,
+    },
+    /// The weights sum to zero (or to a non-finite total).
+    #[error("support weights sum to {total}; at least one must be positive (and the sum finite)")]
+    Total {
+        /// The sum of the weights.
+        total: f64,
+    },
+}
+
 /// Patch radius as a fraction of the largest support-point radius.
 pub const PATCH_FRACTION: f64 = 1e-3;
 
@@ -38,34 +78,32 @@ impl PointSupport {
     /// Build from points and non-negative loads (any positive total; they are normalised to sum 1).
     /// Rejects an empty set, mismatched lengths, non-finite points, and negative, non-finite or
     /// all-zero weights.
-    pub fn new(points: Vec<Vec2>, weights: Vec<f64>) -> Result<Self, String> {
+    pub fn new(points: Vec<Vec2>, weights: Vec<f64>) -> Result<Self, PointSupportError> {
         if points.is_empty() {
-            return Err("a point support needs at least one point".to_string());
+            return Err(PointSupportError::Empty);
         }
         if points.len() != weights.len() {
-            return Err(format!(
-                "{} support points but {} weights",
-                points.len(),
-                weights.len()
-            ));
+            return Err(PointSupportError::Lengths {
+                points: points.len(),
+                weights: weights.len(),
+            });
         }
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
-            return Err(format!(
-                "support point {i} ({}, {}) is not finite",
-                points[i].x, points[i].y
-            ));
+            return Err(PointSupportError::Point {
+                index: i,
+                x: points[i].x,
+                y: points[i].y,
+            });
         }
         if let Some(i) = weights.iter().position(|w| !w.is_finite() || *w < 0.0) {
-            return Err(format!(
-                "support weight {i} is {}; weights must be finite and non-negative",
-                weights[i]
-            ));
+            return Err(PointSupportError::Weight {
+                index: i,
+                weight: weights[i],
+            });
         }
         let total: f64 = weights.iter().sum();
         if total <= 0.0 || !total.is_finite() {
-            return Err(format!(
-                "support weights sum to {total}; at least one must be positive (and the sum finite)"
-            ));
+            return Err(PointSupportError::Total { total });
         }
         let weights = weights.into_iter().map(|w| w / total).collect();
         let reach = points.iter().map(|p| p.norm()).fold(0.0, f64::max);

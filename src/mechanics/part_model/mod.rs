@@ -48,7 +48,7 @@ mod warm;
 
 pub use fidelity::Fidelity;
 pub use solve::{final_gap, SolveFailure, Solved};
-pub use support::Support;
+pub use support::{Support, SupportSpecError};
 pub(crate) use warm::kkt_delta;
 pub use warm::{WarmStick, WarmTwist};
 
@@ -127,7 +127,7 @@ impl PartModel {
     pub fn new(poly: &Polygon, support: &Support) -> Result<PartModel, String> {
         let scale = poly.radius();
         let unit = poly.scaled(1.0 / scale);
-        let data = SupportData::new(&unit, scale, support)?;
+        let data = SupportData::new(&unit, scale, support).map_err(|e| e.to_string())?;
         let c = data.ellipsoid_c();
         let hull = Polygon::new(unit.hull()).map_err(|e| e.to_string())?;
         Ok(PartModel {

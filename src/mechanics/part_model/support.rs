@@ -71,23 +71,42 @@ impl Support {
     }
 
     /// Parse a support specification: `uniform` or `tripod:SEED`.
-    pub fn parse(spec: &str, poly: &Polygon) -> Result<Support, String> {
+    pub fn parse(spec: &str, poly: &Polygon) -> Result<Support, SupportSpecError> {
         let s = spec.trim();
         if s == "uniform" {
             return Ok(Support::Uniform);
         }
         if let Some(seed) = s.strip_prefix("tripod:") {
-            let seed: u64 = seed
-                .trim()
-                .parse()
-                .map_err(|_| format!("support '{s}': the tripod seed must be a whole number"))?;
+            let seed: u64 = seed.trim().parse().map_err(|_| SupportSpecError::Seed {
+                spec: s.to_string(),
+            })?;
             let mut rng = crate::random::stream(seed, 0);
-            return Support::random_tripod(poly, &mut rng);
+            return Support::random_tripod(poly, &mut rng).map_err(SupportSpecError::Tripod);
         }
-        Err(format!(
-            "unknown support '{s}'; expected 'uniform' or 'tripod:SEED'"
-        ))
+        Err(SupportSpecError::Unknown {
+            spec: s.to_string(),
+        })
     }
+}
+
+/// Why a support specification is refused ([`Support::parse`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SupportSpecError {
+    /// `tripod:SEED` whose seed is not a whole number.
+    #[error("support '{spec}': the tripod seed must be a whole number")]
+    Seed {
+        /// The specification (trimmed).
+        spec: String,
+    },
+    /// Neither `uniform` nor `tripod:SEED`.
+    #[error("unknown support '{spec}'; expected 'uniform' or 'tripod:SEED'")]
+    Unknown {
+        /// The specification (trimmed).
+        spec: String,
+    },
+    /// No tripod could be drawn ([`Support::random_tripod`]'s message).
+    #[error("{0}")]
+    Tripod(String),
 }
 
 /// A support compiled for the normalised part (a = 1): the data its dissipation is evaluated from.
@@ -103,7 +122,7 @@ impl SupportData {
         unit: &Polygon,
         scale: f64,
         support: &Support,
-    ) -> Result<SupportData, String> {
+    ) -> Result<SupportData, crate::mechanics::limit_surface::points::PointSupportError> {
         Ok(match support {
             Support::Uniform => SupportData::Uniform(UniformSurface::new(unit)),
             Support::Points { points, weights } => {

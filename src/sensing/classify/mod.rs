@@ -126,9 +126,9 @@ pub fn build(
         ));
     }
     if name == "zero-crossings" {
-        return Ok(Box::new(zero_crossings::ZeroCrossings::new(
-            templates, sensor,
-        )?));
+        return Ok(Box::new(
+            zero_crossings::ZeroCrossings::new(templates, sensor).map_err(|e| e.to_string())?,
+        ));
     }
     if templates.labels.is_empty() {
         return Err(format!("{name}: no hypotheses"));
@@ -140,7 +140,7 @@ pub fn build(
         ));
     }
     Ok(match name {
-        "sign-matrix" => Box::new(sign_matrix::SignMatrixClassifier::new(templates, sensor)?),
+        "sign-matrix" => Box::new(sign_matrix::SignMatrixClassifier::new(templates, sensor)),
         "timing" => Box::new(timing::Timing::new(templates, sensor, options)?),
         _ => Box::new(likelihood::Likelihood::new(templates, sensor, options)?),
     })

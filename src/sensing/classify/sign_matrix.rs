@@ -110,8 +110,9 @@ pub fn score(a: &SignMatrix, b: &SignMatrix) -> usize {
 }
 
 impl SignMatrixClassifier {
-    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
-    pub fn new(templates: &TemplateSet, sensor: &SensorSettings) -> Result<Self, String> {
+    /// Train on `templates` for `sensor` (a template whose contact the detector does not see is
+    /// left out; a hypothesis left without templates scores −∞, see [`Self::scores`]).
+    pub fn new(templates: &TemplateSet, sensor: &SensorSettings) -> Self {
         let thr = common::Detector::new(sensor);
         let mut matrices = Vec::new();
         for members in &templates.members {
@@ -126,10 +127,10 @@ impl SignMatrixClassifier {
             }
             matrices.push(mh);
         }
-        Ok(SignMatrixClassifier {
+        SignMatrixClassifier {
             matrices,
             sensor: *sensor,
-        })
+        }
     }
 
     /// The mean /40 score of `m` against each hypothesis (−∞ for a hypothesis none of whose

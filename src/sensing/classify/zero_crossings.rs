@@ -66,10 +66,27 @@ fn profile(values: &[[f64; CHANNELS]], sensor: &SensorSettings) -> Option<Vec<f6
     Some(values[b..=e].iter().map(|v| v[0]).collect())
 }
 
+/// Why zero-crossings cannot be trained on a template set ([`ZeroCrossings::new`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ZeroCrossingsError {
+    /// The hypotheses are not exactly `vertex` and `edge`.
+    #[error(
+        "zero-crossings tells vertex from edge contact: it needs the hypotheses \
+         [\"vertex\", \"edge\"], got {labels:?}"
+    )]
+    Labels {
+        /// The template set's hypothesis labels.
+        labels: Vec<String>,
+    },
+}
+
 impl ZeroCrossings {
     /// Train on `templates` for `sensor`; Err (the reason) when the labels are not `vertex` and
     /// `edge` or the templates cannot be used.
-    pub fn new(templates: &TemplateSet, sensor: &SensorSettings) -> Result<Self, String> {
+    pub fn new(
+        templates: &TemplateSet,
+        sensor: &SensorSettings,
+    ) -> Result<Self, ZeroCrossingsError> {
         let find = |l: &str| templates.labels.iter().position(|x| x == l);
         match (find("vertex"), find("edge"), templates.labels.len()) {
             (Some(vertex), Some(edge), 2) => Ok(ZeroCrossings {
@@ -77,11 +94,9 @@ impl ZeroCrossings {
                 edge,
                 sensor: *sensor,
             }),
-            _ => Err(format!(
-                "zero-crossings tells vertex from edge contact: it needs the hypotheses \
-                 [\"vertex\", \"edge\"], got {:?}",
-                templates.labels
-            )),
+            _ => Err(ZeroCrossingsError::Labels {
+                labels: templates.labels.clone(),
+            }),
         }
     }
 }
