@@ -73,7 +73,7 @@ pub fn write_design(o: &DesignOptions, d: &Design, paths: &DesignPaths) -> Resul
             let study_file = study_path
                 .file_name()
                 .map_or(String::new(), |f| f.to_string_lossy().to_string());
-            let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind).collect();
+            let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
             if let Some(study) = crate::plan::check::uncertainty_study(
                 &c.problem,
                 &kinds,
@@ -259,7 +259,7 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
             c.mode.name(),
             c.round,
             c.search.particles,
-            format!("{} {:.1} s", c.search.result, c.search.elapsed_s),
+            format!("{} {:.1} s", c.search.result.name(), c.search.elapsed_s),
             describe_obstacles(c),
             c.belt_length_m,
             c.belt_width_m,
@@ -308,7 +308,7 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
         for ob in &c.obstacles {
             t += &format!(
                 "  {:<10} {:<8} x {:.3} m  y {:+7.2} mm{}{}\n",
-                ob.kind,
+                ob.kind.name(),
                 ob.name,
                 ob.x_m,
                 ob.y_m * 1e3,

@@ -254,11 +254,75 @@ pub struct LineCheck {
     pub elapsed_s: f64,
 }
 
+/// What an obstacle of a design is (written as `pin`, `fence`, `sensor_pin`, `moving_pin`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObstacleKind {
+    /// A fixed pin.
+    Pin,
+    /// A fence.
+    Fence,
+    /// A sensorised pin.
+    SensorPin,
+    /// A pin that moves to a target per decision.
+    MovingPin,
+}
+
+impl ObstacleKind {
+    /// The kind's name in outputs: `pin`, `fence`, `sensor_pin` or `moving_pin`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ObstacleKind::Pin => "pin",
+            ObstacleKind::Fence => "fence",
+            ObstacleKind::SensorPin => "sensor_pin",
+            ObstacleKind::MovingPin => "moving_pin",
+        }
+    }
+}
+
+impl std::fmt::Display for ObstacleKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
+    }
+}
+
+/// How a search ended (written as `found`, `none_up_to_depth`, `exhausted`, `limit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SearchResult {
+    /// A plan was found.
+    Found,
+    /// No plan up to the depth limit.
+    NoneUpToDepth,
+    /// No plan at any depth (no new state appeared).
+    Exhausted,
+    /// A limit (time, states) stopped the search.
+    Limit,
+}
+
+impl SearchResult {
+    /// The result's name in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchResult::Found => "found",
+            SearchResult::NoneUpToDepth => "none_up_to_depth",
+            SearchResult::Exhausted => "exhausted",
+            SearchResult::Limit => "limit",
+        }
+    }
+}
+
+impl std::fmt::Display for SearchResult {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
+    }
+}
+
 /// One obstacle of a design, as placed on the belt.
 #[derive(Debug, Clone, Serialize)]
 pub struct ObstacleInfo {
-    /// pin | fence | sensor_pin | moving_pin
-    pub kind: &'static str,
+    /// What the obstacle is.
+    pub kind: ObstacleKind,
     /// The obstacle's name in the emitted scenario.
     pub name: String,
     /// Along the belt (m; a fence's upstream end).
@@ -279,8 +343,8 @@ pub struct ObstacleInfo {
 /// What a search ended with.
 #[derive(Debug, Clone, Serialize)]
 pub struct SearchSummary {
-    /// found | none_up_to_depth | exhausted | limit
-    pub result: &'static str,
+    /// How the search ended.
+    pub result: SearchResult,
     /// One sentence on how the search ended.
     pub message: String,
     /// Particles searched over.
@@ -834,7 +898,7 @@ impl Work<'_> {
         };
         let (result, message, plan) = match outcome {
             ContingentOutcome::Found(p) => (
-                "found",
+                SearchResult::Found,
                 format!(
                     "a contingent plan: a sensor pin and {} moving pin(s), the fewest for its action set",
                     p.k
@@ -864,7 +928,10 @@ impl Work<'_> {
             &policy_name,
         );
         let obstacles = contingent_obstacles(problem, &plan);
-        let actuators = obstacles.iter().filter(|x| x.kind != "pin").count();
+        let actuators = obstacles
+            .iter()
+            .filter(|x| x.kind != ObstacleKind::Pin)
+            .count();
         let belt_length_m = problem.spacing_m * (plan.k as f64 + 2.0);
         Ok(Some(Candidate {
             mode,
@@ -916,17 +983,17 @@ impl Work<'_> {
         let (outcome, stats) = planner.search();
         let (result, message, plan) = match outcome {
             Outcome::Found(p) => (
-                "found",
+                SearchResult::Found,
                 "a shortest plan for its action set".into(),
                 Some(p),
             ),
             Outcome::NoneUpTo { depth, best } => (
-                "none_up_to_depth",
+                SearchResult::NoneUpToDepth,
                 format!("no plan up to depth {depth} reaches the goal; the best effort is kept"),
                 best,
             ),
             Outcome::Exhausted { depth, best } => (
-                "exhausted",
+                SearchResult::Exhausted,
                 format!(
                     "no plan at any depth (no new state after {depth}); the best effort is kept"
                 ),
@@ -940,7 +1007,7 @@ impl Work<'_> {
                 let l = self.command_limit(&limit);
                 self.limit.get_or_insert(l);
                 (
-                    "limit",
+                    SearchResult::Limit,
                     format!("stopped by its {limit} after depth {depth_completed}; the best so far is kept"),
                     best,
                 )
@@ -1059,7 +1126,7 @@ impl Work<'_> {
         c.headway_s = h;
         c.oriented_per_min = check.success_rate * 60.0 / h;
         c.line_check = Some(check);
-        let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind).collect();
+        let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
         let study = super::check::uncertainty_study(
             &c.problem,
             &kinds,
@@ -1229,7 +1296,7 @@ impl Work<'_> {
 
 /// "3 pin(s)", "2 fence(s) and 1 pin(s)", "a sensor pin and 2 moving pin(s)".
 pub fn describe_obstacles(c: &Candidate) -> String {
-    let count = |k: &str| c.obstacles.iter().filter(|o| o.kind == k).count();
+    let count = |k: &str| c.obstacles.iter().filter(|o| o.kind.name() == k).count();
     let (pins, fences, sensors, movers) = (
         count("pin"),
         count("fence"),
@@ -1390,7 +1457,7 @@ fn sequence_obstacles(plan: &Plan, xs: &[f64]) -> Vec<ObstacleInfo> {
             Action::Pin(p) => {
                 pins += 1;
                 ObstacleInfo {
-                    kind: "pin",
+                    kind: ObstacleKind::Pin,
                     name: format!("pin{pins}"),
                     x_m: x,
                     y_m: p.y_m,
@@ -1402,7 +1469,7 @@ fn sequence_obstacles(plan: &Plan, xs: &[f64]) -> Vec<ObstacleInfo> {
             Action::Fence(f) => {
                 fences += 1;
                 ObstacleInfo {
-                    kind: "fence",
+                    kind: ObstacleKind::Fence,
                     name: format!("fence{fences}"),
                     x_m: x,
                     y_m: f.y0_m,
@@ -1419,7 +1486,7 @@ fn sequence_obstacles(plan: &Plan, xs: &[f64]) -> Vec<ObstacleInfo> {
 /// branches' targets differ).
 fn contingent_obstacles(problem: &Problem, plan: &ContingentPlan) -> Vec<ObstacleInfo> {
     let mut obstacles = vec![ObstacleInfo {
-        kind: "sensor_pin",
+        kind: ObstacleKind::SensorPin,
         name: "probe".into(),
         x_m: problem.spacing_m,
         y_m: plan.sensor.y_m,
@@ -1431,7 +1498,11 @@ fn contingent_obstacles(problem: &Problem, plan: &ContingentPlan) -> Vec<Obstacl
         let ys: Vec<f64> = plan.branches.iter().map(|b| b.targets_m[j]).collect();
         let fixed = ys.iter().all(|&y| (y - ys[0]).abs() < 1e-12);
         obstacles.push(ObstacleInfo {
-            kind: if fixed { "pin" } else { "moving_pin" },
+            kind: if fixed {
+                ObstacleKind::Pin
+            } else {
+                ObstacleKind::MovingPin
+            },
             name: if fixed {
                 format!("pin{}", j + 2)
             } else {
