@@ -39,6 +39,7 @@ mod hardening;
 mod input_regressions;
 mod invariant_properties;
 mod json_versions;
+mod layering;
 mod limit_surface;
 mod line;
 mod line_cost;

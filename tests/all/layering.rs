@@ -1,0 +1,131 @@
+//! The library's layering, read from its source: which top-level module names which
+//! (`crate::X` outside test modules and comments). The command line (`cli`) is named by no
+//! library module, the modules below the studies import nothing from `study`, and the modules
+//! form no import circle except the one listed in [`KNOWN_CIRCLE`].
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+/// The one circle left: parsing a scenario builds the online controller's model, which runs the
+/// engine (`scenario::compile` → `engine::online`), and the engine runs scenes.
+const KNOWN_CIRCLE: [&str; 2] = ["engine", "scenario"];
+
+/// The source files below `dir`.
+fn files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The top-level modules each top-level module names (`crate::X`), without test modules and
+/// comments.
+fn graph() -> BTreeMap<String, BTreeSet<String>> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut modules = BTreeMap::new();
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_stem().unwrap().to_string_lossy().to_string();
+        if name != "lib" && name != "main" {
+            let mut fs = Vec::new();
+            if p.is_dir() {
+                files(&p, &mut fs);
+            } else {
+                fs.push(p);
+            }
+            modules.insert(name, fs);
+        }
+    }
+    let names: BTreeSet<String> = modules.keys().cloned().collect();
+    let mut g = BTreeMap::new();
+    for (m, fs) in &modules {
+        let mut uses = BTreeSet::new();
+        for f in fs {
+            let text = std::fs::read_to_string(f).unwrap();
+            let code = text.split("#[cfg(test)]").next().unwrap();
+            for line in code.lines() {
+                let line = line.split("//").next().unwrap();
+                for (i, _) in line.match_indices("crate::") {
+                    let rest = &line[i + 7..];
+                    let word: String = rest
+                        .chars()
+                        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                        .collect();
+                    if names.contains(&word) && &word != m {
+                        uses.insert(word);
+                    }
+                }
+            }
+        }
+        g.insert(m.clone(), uses);
+    }
+    g
+}
+
+/// The modules reachable from `from`.
+fn reach(g: &BTreeMap<String, BTreeSet<String>>, from: &str) -> BTreeSet<String> {
+    let mut seen = BTreeSet::new();
+    let mut todo = vec![from.to_string()];
+    while let Some(m) = todo.pop() {
+        for n in &g[&m] {
+            if seen.insert(n.clone()) {
+                todo.push(n.clone());
+            }
+        }
+    }
+    seen
+}
+
+#[test]
+fn the_library_never_names_the_command_line() {
+    let g = graph();
+    assert!(
+        g["cli"].contains("plan"),
+        "the scan sees cli's imports: {:?}",
+        g["cli"]
+    );
+    for (m, uses) in &g {
+        assert!(m == "cli" || !uses.contains("cli"), "{m} imports cli");
+    }
+}
+
+#[test]
+fn the_modules_below_the_studies_import_nothing_from_study() {
+    let g = graph();
+    for m in [
+        "maps",
+        "validate",
+        "mechanics",
+        "geometry",
+        "scenario",
+        "engine",
+    ] {
+        assert!(!g[m].contains("study"), "{m} imports study: {:?}", g[m]);
+    }
+}
+
+#[test]
+fn no_import_circle_but_the_known_one() {
+    let g = graph();
+    let mut circles = BTreeSet::new();
+    for m in g.keys() {
+        if reach(&g, m).contains(m) {
+            circles.insert(m.clone());
+        }
+    }
+    let known: BTreeSet<String> = KNOWN_CIRCLE.iter().map(|s| s.to_string()).collect();
+    assert_eq!(circles, known, "modules on an import circle");
+    // The known circle is only the two of them: neither reaches the other through a third.
+    for (a, b) in [("engine", "scenario"), ("scenario", "engine")] {
+        let mut without = g.clone();
+        without.get_mut(a).unwrap().remove(b);
+        assert!(
+            !reach(&without, a).contains(a),
+            "{a} reaches itself without {a} → {b}"
+        );
+    }
+}
