@@ -121,10 +121,10 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         let defaults = case_of(args, model)?;
         return Ok(run_batch(&defaults, path, std::io::stdout().lock())?);
     }
-    if args.push.map_tier() {
+    let crate::contact_case::ModelChoice::Model(model) = args.push.model else {
         return super::contact_map::run(args);
-    }
-    let c = case_of(args, args.push.fidelity("")?)?;
+    };
+    let c = case_of(args, model)?;
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
     if let Some(path) = &args.trace {
