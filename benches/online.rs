@@ -31,7 +31,10 @@ fn decision(c: &mut Criterion) {
         ("tripoly2_", "scenarios/tripoly2_online.toml", 0.3),
     ] {
         let scene = load(path);
-        let model = scene.online_model().expect("an online model").clone();
+        let model = pinfeed::engine::prepare::online_model(&scene)
+            .unwrap()
+            .expect("an online model")
+            .0;
         let sm = &model.sensors[0];
         let Obstacle::Pin(pin) = &scene.obstacles[sm.obstacle] else {
             panic!("the sensor is a pin")

@@ -46,8 +46,11 @@ pub struct CompareArgs {
 pub fn run(args: &CompareArgs) -> Result<()> {
     let mut scenes = Vec::new();
     let mut files = Vec::new();
+    let mut online = Vec::new();
     for path in &args.scenarios {
-        scenes.push(crate::scenario::load(path)?);
+        let scene = crate::scenario::load(path)?;
+        online.push(crate::engine::prepare::online_model(&scene)?);
+        scenes.push(scene);
         files.push(path.display().to_string());
     }
     let mut source = FeedSource::from_scene(&scenes[0]);
@@ -69,7 +72,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     let bar = super::progress::bar(0, "parts", args.quiet || args.json);
     let tell = super::progress::counter(&bar);
-    let rows = compare_observed(&scenes, &files, parts, &tell).context("running the comparison")?;
+    let rows = compare_observed(&scenes, &files, &online, parts, &tell)
+        .context("running the comparison")?;
     bar.finish_and_clear();
     let text = if args.json {
         // One document: the version fields and the rows, one per design.

@@ -54,6 +54,7 @@ pub struct RunArgs {
 pub fn run(args: &RunArgs) -> Result<()> {
     let scene = crate::study::bundled::load_scenario(&args.scenario)?;
     let mut opts = RunOptions::from_scene(&scene);
+    opts.online = crate::engine::prepare::online_model(&scene)?;
     if let Some(n) = args.parts {
         if !(1..=1_000_000_000).contains(&n) {
             bail!("--parts must lie in [1, 1000000000], got {n}");

@@ -94,7 +94,7 @@ impl Line<'_> {
         if let Some(sensor) = sensor {
             let (decision, sensed) =
                 self.sense(index, j, sensor, &out, &knots.samples, pose.theta_rad);
-            part.sensed.push((j, decision));
+            part.sensed.push(decision);
             reading = Some(sensed);
         }
         let mut plan = plan_of(j, (t0, pose), pusher, settings, out, t, v);

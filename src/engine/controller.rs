@@ -261,7 +261,11 @@ pub(super) struct Control {
 impl Control {
     /// The controller of a scene with dynamic pins (None without: a passive or sensing-only
     /// scene runs none of this).
-    pub(super) fn new(scene: &Scene, keep_log: bool) -> Option<Control> {
+    pub(super) fn new(
+        scene: &Scene,
+        keep_log: bool,
+        online: Option<super::prepare::OnlineHandle>,
+    ) -> Option<Control> {
         let mut tracks = Vec::new();
         let mut stats_of = Vec::new();
         let mut summary = ControllerSummary::default();
@@ -296,12 +300,12 @@ impl Control {
             rules: Vec::new(),
             source: "none".into(),
             mode: ControlMode::Policy,
-            online: None,
+            belief_at: None,
         });
         summary.rules_from = spec.source.clone();
         summary.latency_s = spec.latency;
         summary.on_late = spec.on_late;
-        let online = spec.online.as_ref().map(|h| OnlineRun {
+        let online = online.as_ref().map(|h| OnlineRun {
             chosen: vec![0; h.0.actions.len()],
             pin_names: h
                 .0
@@ -677,7 +681,7 @@ impl Line<'_> {
         let Some(mut part) = self.active.remove(&index) else {
             return;
         };
-        if part.sensed.iter().any(|(o, _)| *o == j) {
+        if part.sensed.iter().any(|d| d.obstacle == j) {
             self.active.insert(index, part);
             return;
         }
@@ -977,14 +981,15 @@ mod tests {
     #[test]
     fn only_lines_with_dynamic_pins_get_a_controller() {
         for name in ["quickstart", "tripoly1", "tripoly1_fences", "crowded_belt"] {
-            assert!(Control::new(&scene(name), false).is_none(), "{name}");
+            assert!(Control::new(&scene(name), false, None).is_none(), "{name}");
         }
         for (name, mode) in [
             ("tripoly1_sensing", ControllerMode::Policy),
             ("tripoly1_online", ControllerMode::Online),
         ] {
             let s = scene(name);
-            let c = Control::new(&s, true).expect("dynamic pins");
+            let online = crate::engine::prepare::online_model(&s).unwrap();
+            let c = Control::new(&s, true, online).expect("dynamic pins");
             let dynamic = s
                 .obstacles
                 .iter()

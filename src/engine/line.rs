@@ -48,7 +48,7 @@ use super::motion::{Motion, Stop};
 use super::outcome::PartOutcome;
 use super::part_stream::{arrival_gap, draw_part};
 use super::results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};
-use super::sensing::{describe, sense_pass, SensedPass, SensorStats};
+use super::sensing::{sense_pass, SensedDecision, SensedPass, SensorStats};
 use crate::geometry::{wrap_deg, Pose};
 use crate::mechanics::{
     fence_first_touch, pin_first_touch, ContactOutcome, PartModel, TraceSample,
@@ -75,7 +75,7 @@ pub(super) struct ActivePart {
     pub(super) model: Option<PartModel>,
     pub(super) path: Option<Vec<(f64, Pose)>>,
     /// Sensor pins that have read this part (obstacle index) and their decisions.
-    pub(super) sensed: Vec<(usize, String)>,
+    pub(super) sensed: Vec<super::sensing::SensedDecision>,
     /// Decisions taken on this part for the controller: (sensor, decision, true state).
     pub(super) decided: Vec<(usize, Option<usize>, Option<usize>)>,
     /// The part's events are valid from this sequence number on: a part planned again after an
@@ -143,6 +143,7 @@ pub fn run_entry(
         seed: scene.seed,
         sample_paths: 0,
         keep_records: true,
+        online: None,
     };
     let (mut r, captured) = run_inner(
         scene,
@@ -175,6 +176,7 @@ pub fn run_single(scene: &Scene, entry: Entry) -> Result<SingleRun, EngineError>
         seed: scene.seed,
         sample_paths: 0,
         keep_records: false,
+        online: None,
     };
     let line = simulate(scene, &opts, &mut |_| {}, None, Some(entry))?;
     let (outcome, pose) = line.last_end.expect("one part, one end");
@@ -263,6 +265,10 @@ fn simulate<'a>(
     captured: Option<Vec<CapturedPush>>,
     entry: Option<Entry>,
 ) -> Result<Line<'a>, EngineError> {
+    let online = match &opts.online {
+        Some(m) => Some(m.clone()),
+        None => super::prepare::online_model(scene).map_err(EngineError::OnlineModel)?,
+    };
     let names = scene
         .obstacles
         .iter()
@@ -292,7 +298,11 @@ fn simulate<'a>(
         paths: Vec::new(),
         finished: 0,
         sensor_pins,
-        control: Control::new(scene, scene.effects.event_log || opts.sample_paths > 0),
+        control: Control::new(
+            scene,
+            scene.effects.event_log || opts.sample_paths > 0,
+            online,
+        ),
         maps: LineMaps::for_scene(scene),
         captured,
         entry,
@@ -558,7 +568,7 @@ impl Line<'_> {
 
     /// Take part `index` off the line at time `t` with `outcome`.
     pub(super) fn finish(&mut self, index: u64, t: f64, outcome: PartOutcome, cause: &'static str) {
-        let Some(part) = self.active.remove(&index) else {
+        let Some(mut part) = self.active.remove(&index) else {
             return;
         };
         let pose = part.motion.world_pose(t, self.speed());
@@ -585,12 +595,7 @@ impl Line<'_> {
                 theta_out_deg: theta_deg,
                 y_in_m: part.y_in,
                 y_out_m: pose.y,
-                sensed: part
-                    .sensed
-                    .iter()
-                    .map(|(j, d)| format!("{}={d}", self.scene.obstacles[*j].name()))
-                    .collect::<Vec<_>>()
-                    .join("; "),
+                sensed: std::mem::take(&mut part.sensed),
             });
         }
         if let Some(mut poses) = part.path {
@@ -616,7 +621,7 @@ impl Line<'_> {
         out: &ContactOutcome,
         knots: &[TraceSample],
         theta: f64,
-    ) -> (String, SensedPass) {
+    ) -> (super::sensing::SensedDecision, SensedPass) {
         let scale = SignalScale {
             mass: self.scene.part.mass,
             belt_speed: self.speed(),
@@ -630,7 +635,9 @@ impl Line<'_> {
         if let Some(&(_, k)) = self.sensor_pins.iter().find(|(o, _)| *o == j) {
             self.metrics.sensors[k].add(&sensed);
         }
-        (describe(&sensor.labels, &sensed.classification), sensed)
+        let name = self.scene.obstacles[j].name();
+        let decision = SensedDecision::of(j, name, &sensor.labels, &sensed.classification);
+        (decision, sensed)
     }
 
     /// A part leaving the line at world x `x` has gone past every sensor pin upstream of it:
@@ -641,7 +648,7 @@ impl Line<'_> {
                 Obstacle::Pin(p) => p.centre.x < x,
                 Obstacle::Fence(_) => false,
             };
-            if passed && !part.sensed.iter().any(|(o, _)| *o == j) {
+            if passed && !part.sensed.iter().any(|d| d.obstacle == j) {
                 self.metrics.sensors[k].untouched += 1;
             }
         }

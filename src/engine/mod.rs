@@ -10,6 +10,7 @@
 //! * [`contact`]: contact begin: the push, its stop, neighbouring obstacles and the belt's edges;
 //! * [`pairs`]: part–part overlap checks (broad and narrow phase);
 //! * [`results`]: what a run takes ([`RunOptions`]) and gives ([`RunResult`]);
+//! * [`prepare`]: what a scene needs built before it runs (the online controller's model);
 //! * [`outcome`]: the classes a part can end in;
 //! * [`metrics`]: counts, rates, latency histogram, per-obstacle statistics, work counters and the
 //!   deterministic [`Summary`].
@@ -27,6 +28,7 @@ pub mod outcome;
 pub mod overlap;
 pub mod pairs;
 pub mod part_stream;
+pub mod prepare;
 pub mod results;
 pub mod sensing;
 

@@ -23,6 +23,11 @@ pub struct RunOptions {
     pub sample_paths: usize,
     /// Keep one record per part (for the per-part CSV).
     pub keep_records: bool,
+    /// The online controller's model (`[controller] mode = "online"`). None: the run builds it
+    /// from the scene it is given ([`super::prepare::online_model`], kept per process). A caller
+    /// that changes a scene before running it (its physics, feed or seed) passes the model of the
+    /// scene as written, which the controller was designed with.
+    pub online: Option<super::prepare::OnlineHandle>,
 }
 
 impl RunOptions {
@@ -33,6 +38,7 @@ impl RunOptions {
             seed: scene.seed,
             sample_paths: 0,
             keep_records: false,
+            online: None,
         }
     }
 }
@@ -48,6 +54,10 @@ pub enum EngineError {
         /// Why it could not be drawn.
         reason: String,
     },
+    /// The online controller's model cannot be built for the scene (located at its
+    /// `[controller.belief]`).
+    #[error("{0}")]
+    OnlineModel(crate::scenario::ScenarioError),
     /// An event time came out non-finite (NaN or ±∞): the scene's numbers leave f64. Validated
     /// scenarios never get here; the engine refuses instead of panicking.
     #[error("an event time is not finite ({kind:?} at {time} s; {refused} event(s) refused): the scene's numbers are out of range (see docs/scenario-format.md)")]
@@ -84,8 +94,10 @@ pub struct PartRecord {
     pub y_in_m: f64,
     /// Lateral position of the centroid at the end (m).
     pub y_out_m: f64,
-    /// Sensor decisions, `pin=decision (posterior)` separated by `; ` (empty without sensors).
-    pub sensed: String,
+    /// The sensor pins' decisions on the part, in the order they read it (none without
+    /// sensors); written as one field, `pin=decision (posterior)` separated by `; `.
+    #[serde(serialize_with = "super::sensing::serialize_sensed")]
+    pub sensed: Vec<super::sensing::SensedDecision>,
 }
 
 /// The path of a sample part: world poses at successive instants (s, pose).

@@ -131,21 +131,96 @@ impl SensorStats {
     }
 }
 
-/// A decision as text for the per-part record: `label` (with its posterior when the method gives
-/// one, e.g. `135 (0.97)`) or `unknown`.
-pub fn describe(labels: &[String], c: &Classification) -> String {
-    match c.decision {
-        Decision::Hypothesis(h) => match &c.posterior {
-            Some(p) => format!("{} ({:.3})", labels[h], p[h]),
-            None => labels[h].clone(),
-        },
-        Decision::Unknown => "unknown".into(),
+/// One sensor pin's decision on a part, as the part's record keeps it (written `pin=label
+/// (posterior)`, `pin=label` or `pin=unknown`; records join several with `; `).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensedDecision {
+    /// The sensor pin's index among the scene's obstacles.
+    pub obstacle: usize,
+    /// The sensor pin's name.
+    pub sensor: String,
+    /// The decided hypothesis's label; None: no decision (`unknown`).
+    pub label: Option<String>,
+    /// The classifier's posterior of the decided hypothesis, when it gives one.
+    pub posterior: Option<f64>,
+}
+
+impl SensedDecision {
+    /// Sensor pin `obstacle` (named `sensor`, with hypothesis `labels`) decided `c`.
+    pub fn of(obstacle: usize, sensor: &str, labels: &[String], c: &Classification) -> Self {
+        let (label, posterior) = match c.decision {
+            Decision::Hypothesis(h) => {
+                (Some(labels[h].clone()), c.posterior.as_ref().map(|p| p[h]))
+            }
+            Decision::Unknown => (None, None),
+        };
+        SensedDecision {
+            obstacle,
+            sensor: sensor.to_string(),
+            label,
+            posterior,
+        }
     }
+
+    /// The decision alone: `0° (0.998)`, `0°` without a posterior, `unknown` without a decision.
+    pub fn decision_text(&self) -> String {
+        match (&self.label, self.posterior) {
+            (Some(l), Some(p)) => format!("{l} ({p:.3})"),
+            (Some(l), None) => l.clone(),
+            (None, _) => "unknown".into(),
+        }
+    }
+}
+
+impl std::fmt::Display for SensedDecision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}={}", self.sensor, self.decision_text())
+    }
+}
+
+/// A part record's decisions as one text field (`probe=0° (0.998); b=unknown`), as the per-part
+/// CSV and JSON write them.
+pub fn serialize_sensed<S: serde::Serializer>(
+    decisions: &[SensedDecision],
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    let text = decisions
+        .iter()
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join("; ");
+    s.serialize_str(&text)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_decision_is_written_with_its_posterior_or_as_unknown() {
+        let labels = vec!["0°".to_string(), "135°".to_string()];
+        let decided = Classification {
+            decision: Decision::Hypothesis(1),
+            posterior: Some(vec![0.0025, 0.9975]),
+        };
+        let d = SensedDecision::of(3, "probe", &labels, &decided);
+        assert_eq!(d.to_string(), "probe=135° (0.998)");
+        let bare = Classification {
+            decision: Decision::Hypothesis(0),
+            posterior: None,
+        };
+        assert_eq!(
+            SensedDecision::of(3, "probe", &labels, &bare).to_string(),
+            "probe=0°"
+        );
+        let none = Classification {
+            decision: Decision::Unknown,
+            posterior: Some(vec![0.5, 0.5]),
+        };
+        let u = SensedDecision::of(3, "b", &labels, &none);
+        assert_eq!((u.label.as_deref(), u.posterior), (None, None));
+        assert_eq!(u.to_string(), "b=unknown");
+    }
 
     #[test]
     fn nearest_wraps_round_the_circle() {

@@ -24,6 +24,7 @@ pub fn check(toml: &str, path: &Path, parts: u64, seed: u64) -> Result<Summary, 
         seed,
         sample_paths: 0,
         keep_records: false,
+        online: None,
     };
     let res = run(&scene, &opts, &mut |_| {})?;
     Ok(res.summary)

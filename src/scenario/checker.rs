@@ -18,14 +18,6 @@ impl<'a, 'b> Checker<'a, 'b> {
         Checker { loc }
     }
 
-    /// The file being checked and its text.
-    pub(super) fn file(&self) -> &'a std::path::Path {
-        self.loc.file
-    }
-    pub(super) fn source(&self) -> &'a str {
-        self.loc.source
-    }
-
     /// An error at key path `path` (e.g. `belt.speed`, `obstacles[1].x`).
     pub(super) fn err(&self, path: &str, msg: impl Into<String>) -> ScenarioError {
         self.loc.at_key(&KeyPath::parse(path), msg)

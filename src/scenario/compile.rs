@@ -77,68 +77,25 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         controller,
         map_tier,
     };
-    attach_online_model(&c, raw, &mut scene)?;
+    locate_belief(&c, raw, &mut scene);
     Ok(scene)
 }
 
-/// `[controller] mode = "online"`: build the controller's model from the scene's nominal physics
-/// (docs/physics.md#belief-and-online-replanning). Its errors are located at the belief (or the
-/// mode when the belief is not written).
-fn attach_online_model(c: &Checker, raw: &RawScenario, scene: &mut Scene) -> R<()> {
-    let Some(ctl) = scene.controller.as_ref() else {
-        return Ok(());
+/// `[controller] mode = "online"`: where the belief is declared (or the mode, when the belief is
+/// not written), to locate an error in building the controller's model, which happens after
+/// parsing (`engine::prepare`; docs/physics.md#belief-and-online-replanning).
+fn locate_belief(c: &Checker, raw: &RawScenario, scene: &mut Scene) {
+    let Some(ctl) = scene.controller.as_mut() else {
+        return;
     };
-    let super::dynamic::ControlMode::Online(spec) = &ctl.mode else {
-        return Ok(());
-    };
-    // The model is a pure function of the file (its text, its path, which resolves a policy
-    // file, and that policy's rules): a process that reads the same file again (a study's
-    // shards, a fuzzer's unchanged scenario) shares the model built the first time.
-    let key = (
-        std::fs::canonicalize(c.file()).unwrap_or_else(|_| c.file().to_path_buf()),
-        c.source().to_string(),
-        format!("{:?}", ctl.rules),
-    );
-    let cached = model_cache().lock().ok().and_then(|m| m.get(&key).cloned());
-    let model = match cached {
-        Some(m) => m,
-        None => {
-            let m = crate::engine::online::OnlineModel::build(scene, spec).map_err(|e| {
-                let at = match raw.controller.as_ref().and_then(|r| r.belief.as_ref()) {
-                    Some(_) => "controller.belief",
-                    None => "controller.mode",
-                };
-                c.err(
-                    at,
-                    format!("the online controller's model cannot be built: {e}"),
-                )
-            })?;
-            let m = std::sync::Arc::new(m);
-            if let Ok(mut cache) = model_cache().lock() {
-                if cache.len() >= MODEL_CACHE {
-                    cache.clear();
-                }
-                cache.insert(key, m.clone());
-            }
-            m
-        }
-    };
-    if let Some(ctl) = scene.controller.as_mut() {
-        ctl.online = Some(super::dynamic::OnlineHandle(model));
+    if !matches!(ctl.mode, super::dynamic::ControlMode::Online(_)) {
+        return;
     }
-    Ok(())
-}
-
-/// Online models kept per process (cleared when full: a bounded memory).
-const MODEL_CACHE: usize = 8;
-
-type ModelKey = (std::path::PathBuf, String, String);
-type ModelMap =
-    std::collections::HashMap<ModelKey, std::sync::Arc<crate::engine::online::OnlineModel>>;
-
-fn model_cache() -> &'static std::sync::Mutex<ModelMap> {
-    static CACHE: std::sync::OnceLock<std::sync::Mutex<ModelMap>> = std::sync::OnceLock::new();
-    CACHE.get_or_init(Default::default)
+    let at = match raw.controller.as_ref().and_then(|r| r.belief.as_ref()) {
+        Some(_) => "controller.belief",
+        None => "controller.mode",
+    };
+    ctl.belief_at = super::error::KeyLocation::of(c.err(at, ""));
 }
 
 /// The μc values the scene's pins push with: the shared part model tabulates its exact slides

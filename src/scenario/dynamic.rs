@@ -129,24 +129,8 @@ pub struct Controller {
     pub source: String,
     /// Rules or online replanning.
     pub mode: ControlMode,
-    /// The online controller's model (built with the scene from its nominal physics; shared by
-    /// the scenes a study draws from it, so that the controller never sees a sample's physics).
-    pub online: Option<OnlineHandle>,
-}
-
-/// The online model behind an `Arc`; two handles are equal when they share the model (a model
-/// is a function of the scene and the belief spec, which the controller's equality covers).
-#[derive(Clone)]
-pub struct OnlineHandle(pub std::sync::Arc<crate::engine::online::OnlineModel>);
-
-impl PartialEq for OnlineHandle {
-    fn eq(&self, _: &Self) -> bool {
-        true
-    }
-}
-
-impl std::fmt::Debug for OnlineHandle {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "OnlineModel({} hypotheses)", self.0.hypotheses.len())
-    }
+    /// Where `[controller.belief]` (or, without it, `controller.mode`) is written, online mode
+    /// only: the online controller's model is built after parsing (it runs the line; see
+    /// `engine::prepare`), and an error in building it is located here.
+    pub belief_at: Option<super::error::KeyLocation>,
 }

@@ -182,7 +182,7 @@ pub(super) fn controller(
         rules: compiled.into_iter().map(|(_, r)| r).collect(),
         source,
         mode,
-        online: None,
+        belief_at: None,
     }))
 }
 

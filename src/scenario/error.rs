@@ -22,6 +22,10 @@ pub enum ScenarioError {
     /// The file is not valid TOML, or a key or value is wrong.
     #[error("{0}")]
     Invalid(Box<InvalidScenario>),
+    /// A scene built in code (with no file to point at) is refused after parsing: its online
+    /// controller's model cannot be built.
+    #[error("{0}")]
+    Unlocated(String),
 }
 
 /// A located problem in a scenario file.
@@ -64,8 +68,31 @@ impl ScenarioError {
     pub fn invalid(&self) -> Option<&InvalidScenario> {
         match self {
             ScenarioError::Invalid(i) => Some(i),
-            ScenarioError::Io { .. } => None,
+            ScenarioError::Io { .. } | ScenarioError::Unlocated(_) => None,
         }
+    }
+}
+
+/// Where a key is written in a file: locates an error found after parsing (the online
+/// controller's model is built from the parsed scene, then refused at the key that declared it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeyLocation(Box<InvalidScenario>);
+
+impl KeyLocation {
+    /// The location of `error` (its message is replaced by each [`KeyLocation::error`]); None
+    /// for an I/O error, which has no location.
+    pub fn of(error: ScenarioError) -> Option<KeyLocation> {
+        match error {
+            ScenarioError::Invalid(i) => Some(KeyLocation(i)),
+            ScenarioError::Io { .. } | ScenarioError::Unlocated(_) => None,
+        }
+    }
+
+    /// The error `message`, located here.
+    pub fn error(&self, message: impl Into<String>) -> ScenarioError {
+        let mut i = self.0.clone();
+        i.message = message.into();
+        ScenarioError::Invalid(i)
     }
 }
 

@@ -26,10 +26,9 @@ pub mod sensors;
 pub mod shared_feed;
 
 pub use dynamic::{
-    Actuator, BeliefSpec, ControlMode, Controller, MovingSpec, OnLate, OnlineHandle, RetractSpec,
-    Rule, Target,
+    Actuator, BeliefSpec, ControlMode, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target,
 };
-pub use error::{InvalidScenario, ScenarioError};
+pub use error::{InvalidScenario, KeyLocation, ScenarioError};
 pub use scene::*;
 pub use shared_feed::{FeedMismatch, FeedSource};
 

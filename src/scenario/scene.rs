@@ -368,10 +368,3 @@ pub struct Scene {
     /// push).
     pub map_tier: Option<crate::maps::tier::TierSpec>,
 }
-
-impl Scene {
-    /// The online controller's model, when `[controller] mode = "online"`.
-    pub fn online_model(&self) -> Option<&std::sync::Arc<crate::engine::online::OnlineModel>> {
-        self.controller.as_ref()?.online.as_ref().map(|h| &h.0)
-    }
-}

@@ -18,6 +18,7 @@
 //!   run's HDR histogram (3 significant digits);
 //! * **contacts per part** and the number of **jams**, with every outcome count beside them.
 
+use crate::engine::prepare::OnlineHandle;
 use crate::engine::{self, EngineError, OutcomeCounts, RunOptions};
 use crate::geometry::Polygon;
 use crate::scenario::{Goal, Obstacle, Scene};
@@ -126,19 +127,23 @@ fn span(scene: &Scene, range: fn(&Obstacle) -> [f64; 2]) -> Option<[f64; 2]> {
 }
 
 /// Run every scene (already on one part stream) with `parts` parts; one row per scene, in order.
-/// `files` names where each scene came from.
+/// `files` names where each scene came from; `online` holds, per scene, the online controller's
+/// model of the scene as written, before it was given the shared part stream
+/// ([`crate::engine::prepare::online_model`]; None: built from the scene run).
 pub fn compare(
     scenes: &[Scene],
     files: &[String],
+    online: &[Option<OnlineHandle>],
     parts: u64,
 ) -> Result<Vec<ComparisonRow>, EngineError> {
-    compare_observed(scenes, files, parts, &crate::progress::silent)
+    compare_observed(scenes, files, online, parts, &crate::progress::silent)
 }
 
 /// [`compare`], telling `progress` the parts finished over all scenes of all.
 pub fn compare_observed(
     scenes: &[Scene],
     files: &[String],
+    online: &[Option<OnlineHandle>],
     parts: u64,
     progress: crate::progress::Report,
 ) -> Result<Vec<ComparisonRow>, EngineError> {
@@ -146,9 +151,11 @@ pub fn compare_observed(
     scenes
         .par_iter()
         .zip(files.par_iter())
-        .map(|(scene, file)| {
+        .enumerate()
+        .map(|(k, (scene, file))| {
             let opts = RunOptions {
                 parts,
+                online: online.get(k).cloned().flatten(),
                 ..RunOptions::from_scene(scene)
             };
             let mut reported = 0;

@@ -184,7 +184,7 @@ fn a_policy_equal_to_the_online_choices_reproduces_the_online_run() {
     {
         let part = &online.records[rec.part as usize];
         assert_eq!(part.part, rec.part);
-        let state = part.sensed.split(' ').next().unwrap().to_string();
+        let state = part.sensed[0].label.clone().unwrap_or_default();
         let y = rec.what.split(['=', ' ']).nth(2).unwrap().to_string();
         let prev = choice_of.insert(state.clone(), y.clone());
         assert!(
@@ -230,7 +230,10 @@ fn a_sensor_that_some_states_miss_gives_evidence_by_its_silence() {
         .replace("weights = [1, 1, 1]  # 0°, 135°, 225°", "")
         .replace("y = -0.007           # d = −0.22", "y = -0.0096");
     let scene = parse(&text);
-    let model = scene.online_model().expect("an online model").clone();
+    let model = pinfeed::engine::prepare::online_model(&scene)
+        .unwrap()
+        .expect("an online model")
+        .0;
     let never: Vec<usize> = (0..model.hypotheses.len())
         .filter(|&h| model.sensors[0].p_touch[h] == 0.0)
         .collect();
@@ -375,6 +378,48 @@ fn online_mode_errors_are_located() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("bad.toml") && err.contains("controller.belief.targets"),
+        "{err}"
+    );
+}
+
+/// Parsing a scenario never runs the line: a belief whose model is too large to build parses,
+/// and the build (`engine::prepare`, or the run that needs it) refuses it, located at
+/// `[controller.belief]` in the file, with the numbers that make it too large.
+#[test]
+fn a_model_too_large_to_build_is_refused_at_the_belief_not_at_parse() {
+    let text =
+        online_text("offsets = 41\nsamples = 64\ntargets = 101\nmu_c = [0.3, 0.4, 0.5, 0.6, 0.7]");
+    let scene = parse(&text);
+    let located = |e: &pinfeed::scenario::ScenarioError| {
+        let i = e.invalid().expect("a located error");
+        assert_eq!(i.key, "controller.belief", "{e}");
+        assert!(i.message.contains("would run the line"), "{e}");
+        i.line
+    };
+    let e = engine::prepare::online_model(&scene).unwrap_err();
+    let line = located(&e);
+    assert_eq!(
+        text.lines().nth(line - 1),
+        Some("[controller.belief]"),
+        "{e}"
+    );
+    // A run that is not given the model builds it, and refuses the same way.
+    let opts = RunOptions::from_scene(&scene);
+    match engine::run(&scene, &opts, &mut |_| {}) {
+        Err(engine::EngineError::OnlineModel(e)) => assert_eq!(located(&e), line),
+        other => panic!(
+            "expected the model's error, got {:?}",
+            other.map(|r| r.summary)
+        ),
+    }
+    let dir = TempDir::new();
+    let f = dir.path().join("huge.toml");
+    std::fs::write(&f, &text).unwrap();
+    let out = pinfeed(&["run", f.to_str().unwrap(), "--parts", "1"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(&format!("huge.toml:{line}:")) && err.contains("would run the line"),
         "{err}"
     );
 }

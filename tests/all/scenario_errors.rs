@@ -391,6 +391,7 @@ fn mc_sample_with_a_non_finite_event_time_is_an_error() {
     let mut p = study.points[0].clone();
     p.belt_speed = Some(mc::distribution::Distribution::Fixed(1e-320));
     // draw_scene redraws a speed outside the domain: it gives up with a named error.
-    let err = mc::sample::run_sample(&study.scene, &p, 0, study.seed, 0).unwrap_err();
+    let err = mc::sample::run_sample(&study.scene, study.online.as_ref(), &p, 0, study.seed, 0)
+        .unwrap_err();
     assert!(err.to_string().contains("belt_speed"), "{err}");
 }

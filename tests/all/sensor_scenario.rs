@@ -205,7 +205,9 @@ fn a_sensor_pin_pushes_like_a_plain_pin() {
         assert_eq!(x.theta_out_deg, y.theta_out_deg);
         assert_eq!(x.y_out_m, y.y_out_m);
         assert_eq!(x.outcome, y.outcome);
-        assert!(x.sensed.starts_with("probe="), "{}", x.sensed);
+        assert_eq!(x.sensed.len(), 1, "{:?}", x.sensed);
+        assert_eq!(x.sensed[0].sensor, "probe");
+        assert!(x.sensed[0].to_string().starts_with("probe="));
         assert!(y.sensed.is_empty());
     }
     assert_eq!(a.summary.outcomes, b.summary.outcomes);

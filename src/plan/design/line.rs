@@ -109,6 +109,7 @@ impl Runnable {
             seed,
             sample_paths: 0,
             keep_records: records,
+            online: None,
         };
         let started = Instant::now();
         let res = run(&scene, &opts, &mut |_| {})?;

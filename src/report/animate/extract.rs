@@ -66,7 +66,8 @@ pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation 
         let Some(part) = parts.iter().find(|p| p.part == rec.part) else {
             continue;
         };
-        for (name, decision) in parse_sensed(&rec.sensed) {
+        for sensed in &rec.sensed {
+            let (name, decision) = (sensed.sensor.as_str(), sensed.decision_text());
             let Some(Obstacle::Pin(pin)) = scene.obstacles.iter().find(|o| o.name() == name) else {
                 continue;
             };
@@ -173,15 +174,6 @@ fn control_marks(scene: &Scene, control: &[ControlRecord], parts: &[AnimPart]) -
         .collect()
 }
 
-/// `pin=decision; pin2=decision` (a part record's `sensed`) as (pin, decision) pairs.
-fn parse_sensed(sensed: &str) -> Vec<(&str, &str)> {
-    sensed
-        .split("; ")
-        .filter_map(|item| item.split_once('='))
-        .map(|(a, b)| (a.trim(), b.trim()))
-        .collect()
-}
-
 /// The first run of recorded poses whose centroid lies within `reach` (part radius + pin
 /// radius) of a pin: its first and last times — contact begin and end, since a path records the
 /// pose at both and the pins stand beyond reach of the entry.
@@ -193,18 +185,4 @@ fn contact_interval(poses: &[(f64, Pose)], pin: Vec2, reach: f64) -> Option<(f64
         j += 1;
     }
     Some((poses[i].0, poses[j].0))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sensed_text_parses() {
-        assert_eq!(
-            parse_sensed("probe=0° (0.998); b=unknown"),
-            vec![("probe", "0° (0.998)"), ("b", "unknown")]
-        );
-        assert!(parse_sensed("").is_empty());
-    }
 }

@@ -82,6 +82,9 @@ pub struct Study {
     pub study_hash: u64,
     /// Content hash of the scenario file.
     pub scenario_hash: u64,
+    /// The online controller's model of the nominal line (`[controller] mode = "online"`),
+    /// built once when the study is read and shared by every sample.
+    pub online: Option<crate::engine::prepare::OnlineHandle>,
 }
 
 impl Study {
@@ -225,6 +228,7 @@ pub fn parse_with(
         parts.push(policy_text.as_bytes());
         scenario_parts.push(policy_text.as_bytes());
     }
+    let online = crate::engine::prepare::online_model(&scene).map_err(StudyError::Scenario)?;
     let study_hash = hash::fnv1a(&parts);
     let scenario_hash = hash::fnv1a(&scenario_parts);
     Ok(Study {
@@ -240,6 +244,7 @@ pub fn parse_with(
         declared,
         study_hash,
         scenario_hash,
+        online,
     })
 }
 

@@ -22,7 +22,14 @@ pub fn locate(study: &Study, g: u64) -> (usize, u64) {
 /// Run one sample by its global index.
 pub fn run_global(study: &Study, g: u64) -> Result<SampleResult, StudyError> {
     let (point, i) = locate(study, g);
-    run_sample(&study.scene, &study.points[point], point, study.seed, i)
+    run_sample(
+        &study.scene,
+        study.online.as_ref(),
+        &study.points[point],
+        point,
+        study.seed,
+        i,
+    )
 }
 
 /// Run the samples in `range` (global indices) on the current rayon pool; `tick` is called once

@@ -863,8 +863,13 @@ fn draw_entry(
 }
 
 /// Run sample `sample` at sweep point number `point` (perturbations `p`): draw the scene and send its one part down the line.
+///
+/// `online` is the online controller's model of `base` (the study's [`super::Study::online`]):
+/// every sample's controller is the one designed for the nominal line, whatever physics the
+/// sample draws.
 pub fn run_sample(
     base: &Scene,
+    online: Option<&crate::engine::prepare::OnlineHandle>,
     p: &Perturbations,
     point: usize,
     seed: u64,
@@ -882,6 +887,7 @@ pub fn run_sample(
         seed: drawn.run_seed,
         sample_paths: 0,
         keep_records: true,
+        online: online.cloned(),
     };
     let run = engine::run(&drawn.scene, &opts, &mut |_| {}).map_err(|source| {
         super::StudyError::Engine {

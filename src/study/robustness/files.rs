@@ -608,6 +608,7 @@ fn classify_scenario_error(e: &ScenarioError) -> CaseReport {
 fn engine_error(e: &EngineError) -> CaseReport {
     match e {
         EngineError::NonFiniteTime { .. } => CaseReport::with(Class::NonFinite, e.to_string()),
+        EngineError::OnlineModel(se) => classify_scenario_error(se),
         _ => CaseReport::new(Class::Named),
     }
 }
@@ -664,6 +665,7 @@ pub fn run_scene(scene: &Scene) -> CaseReport {
         seed: scene.seed,
         sample_paths: 1,
         keep_records: true,
+        online: None,
     };
     match engine::run(scene, &opts, &mut |_| {}) {
         Err(e) => engine_error(&e),
@@ -711,6 +713,7 @@ pub fn check_study(path: &Path, text: &str) -> CaseReport {
         for sample in 0..SAMPLES_PER_CASE.min(study.samples) {
             let r = mc::sample::run_sample(
                 &study.scene,
+                study.online.as_ref(),
                 &study.points[point],
                 point,
                 study.seed,
