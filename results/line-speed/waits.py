@@ -82,6 +82,7 @@ def main():
             ["map", "--part", "tripoly1", "--d=-0.9,-0.5,-0.1,0.1,0.5,0.9", "--uncertain",
              "mu_c=normal:0.5:0.1,support=tripod:0.5,pin_radius=uniform:0:0.1,jitter=2",
              "--members", "200", "--out-dir", "{out}"], env, ["out"], "≤ 5 s", None))
+    load_before = os.getloadavg()[0]
     rows = []
     for what, args, e, fresh, target, count in items:
         best = {}
@@ -96,6 +97,7 @@ def main():
             best[name] = min(runs)
             print(f"{name:4} {best[name]} {what}", file=sys.stderr)
         rows.append((what, best["base"], best["new"], target, count))
+    load_after = os.getloadavg()[0]
     shutil.rmtree(work, ignore_errors=True)
     lines = [
         "<!-- waits:begin -->",
@@ -108,7 +110,9 @@ def main():
         f"python3 results/line-speed/waits.py --base BASE_BINARY --reps {a.reps}",
         "```",
         "",
-        f"Base: the binary of commit `{a.base_name}`. Machine: {os.cpu_count()} cores.",
+        f"Base: the binary of commit `{a.base_name}`. Machine: {os.cpu_count()} cores, shared with other work.",
+        f"Load average (1 min): {load_before:.1f} at the start of the run, {load_after:.1f} at its end; "
+        f"above {os.cpu_count()}, the wall times include waiting for a core and the CPU times do not.",
         "",
         f"| command | {a.base_name}: wall / CPU / peak | now: wall / CPU / peak | speed-up (wall) | target |",
         "|---|---|---|---|---|",

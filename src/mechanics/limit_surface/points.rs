@@ -144,12 +144,19 @@ impl PointSupport {
                     at([0.0, 1.0, 0.0]),
                     at([0.0, 0.0, 1.0]),
                 ];
+                // The upper triangle, mirrored: each product's factors swap, so the lower
+                // triangle's terms are the same numbers.
+                let s2 = speed * speed;
                 for i in 0..3 {
-                    for j in 0..3 {
+                    for j in i..3 {
                         let ata = cols[0][i] * cols[0][j]
                             + cols[1][i] * cols[1][j]
                             + cols[2][i] * cols[2][j];
-                        out.hess[i][j] += ws * (ata - grad[i] * grad[j] / (speed * speed));
+                        let term = ws * (ata - grad[i] * grad[j] / s2);
+                        out.hess[i][j] += term;
+                        if j != i {
+                            out.hess[j][i] += term;
+                        }
                     }
                 }
             }

@@ -106,24 +106,44 @@ pub(crate) fn kkt_delta(p: &WarmTwist, dw: [f64; 3]) -> Option<(Twist, f64)> {
             -Vector3::from(dw).dot(&Vector3::from(p.twist)),
         ],
     ];
-    for col in 0..4 {
-        let piv = (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[piv][col].abs() < 1e-300 {
-            return None;
+    eliminate::<0>(&mut a)?;
+    eliminate::<1>(&mut a)?;
+    eliminate::<2>(&mut a)?;
+    eliminate::<3>(&mut a)?;
+    let dxi = [a[0][4] / a[0][0], a[1][4] / a[1][1], a[2][4] / a[2][2]];
+    Some((dxi, a[3][4] / a[3][3]))
+}
+
+/// Column `COL` of [`kkt_delta`]'s Gauss–Jordan elimination with partial pivoting (a constant
+/// column, so that every loop has fixed bounds and unrolls); `None` at a zero pivot.
+#[inline(always)]
+fn eliminate<const COL: usize>(a: &mut [[f64; 5]; 4]) -> Option<()> {
+    // The row of the largest |a[i][COL]|, the last of equals (as `Iterator::max_by` with
+    // `total_cmp` picks it): on non-negative floats the bit patterns order as the values.
+    let mut piv = COL;
+    let mut best = a[COL][COL].abs().to_bits();
+    for (i, row) in a.iter().enumerate().skip(COL + 1) {
+        let b = row[COL].abs().to_bits();
+        if b >= best {
+            (piv, best) = (i, b);
         }
-        a.swap(col, piv);
-        let pivot_row = a[col];
-        for (r, row) in a.iter_mut().enumerate() {
-            if r != col {
-                let f = row[col] / pivot_row[col];
-                for (x, p) in row.iter_mut().zip(pivot_row).skip(col) {
-                    *x -= f * p;
-                }
+    }
+    if a[piv][COL].abs() < 1e-300 {
+        return None;
+    }
+    if piv != COL {
+        a.swap(COL, piv);
+    }
+    let pivot_row = a[COL];
+    for (r, row) in a.iter_mut().enumerate() {
+        if r != COL {
+            let f = row[COL] / pivot_row[COL];
+            for (x, p) in row[COL..].iter_mut().zip(&pivot_row[COL..]) {
+                *x -= f * p;
             }
         }
     }
-    let dxi = [a[0][4] / a[0][0], a[1][4] / a[1][1], a[2][4] / a[2][2]];
-    Some((dxi, a[3][4] / a[3][3]))
+    Some(())
 }
 
 /// D, ∇D and H at `to`, to first order from their values `d` at `from`: ∇D(to) ≈ ∇D(from) +
