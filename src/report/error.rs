@@ -1,7 +1,7 @@
 //! Why a report could not be written: [`ReportError`], the error of the library's report writers
 //! (files, figures, report folders).
 //!
-//! Each message reads as it did when the writers returned `anyhow` errors: a wrapping variant
+//! Each message reads as it did when the writers returned untyped errors: a wrapping variant
 //! (`writing PATH`, `creating DIR`) names what failed and keeps the cause as its source, so a
 //! chain printed in full (`{:#}`) reads `writing PATH: CAUSE`.
 
