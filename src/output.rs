@@ -270,6 +270,19 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// A failed write names the file (or the folder it could not create) with the I/O error in
+    /// the message, and no source (a chain printed in full names the error once).
+    #[test]
+    fn write_errors_name_the_path_and_the_error() {
+        let e = write_file(Path::new("/proc/pinfeed-no/such.md"), "x").unwrap_err();
+        assert!(matches!(e, WriteError::Creating { .. }), "{e:?}");
+        assert!(
+            e.to_string().starts_with("creating /proc/pinfeed-no: "),
+            "{e}"
+        );
+        assert!(std::error::Error::source(&e).is_none());
+    }
+
     /// A batch whose second file fails changes no target and leaves no temporary file; a
     /// committed batch replaces every target.
     #[test]

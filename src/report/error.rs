@@ -159,3 +159,23 @@ pub fn create_dir(dir: &Path) -> ReportResult<()> {
 pub fn write_whole(path: &Path, bytes: impl AsRef<[u8]>) -> ReportResult<()> {
     crate::output::write_atomic(path, bytes).map_err(ReportError::writing(path))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// A wrapper names what failed and keeps the cause as its only source (printed in full:
+    /// `writing PATH: CAUSE`, the cause once).
+    #[test]
+    fn a_wrapper_names_the_file_and_keeps_the_cause_as_its_source() {
+        let cause = std::io::Error::other("disk full");
+        let e = ReportError::writing(Path::new("out/a.svg"))(cause);
+        assert_eq!(e.to_string(), "writing out/a.svg");
+        let source = e.source().expect("the cause");
+        assert_eq!(source.to_string(), "disk full");
+        assert!(source.source().is_none());
+        let e = ReportError::removing("figures", Path::new("out"))(std::io::Error::other("busy"));
+        assert_eq!(e.to_string(), "removing earlier figures from out");
+    }
+}
