@@ -173,15 +173,42 @@ impl Batch {
     }
 }
 
+/// Why a report file could not be written: the path and the I/O error, both in the message.
+///
+/// The I/O error is part of the message rather than a `source`, so a chain printed in full
+/// (`{:#}`) names it once.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// The file could not be written.
+    #[error("writing {}: {error}", path.display())]
+    Writing {
+        /// The file.
+        path: PathBuf,
+        /// Why it could not be written.
+        error: std::io::Error,
+    },
+    /// The folder the file goes into could not be created.
+    #[error("creating {}: {error}", dir.display())]
+    Creating {
+        /// The folder.
+        dir: PathBuf,
+        /// Why it could not be created.
+        error: std::io::Error,
+    },
+}
+
 /// Write a report file whole (creating its folder), naming the file on failure.
-pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> anyhow::Result<()> {
+pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<(), WriteError> {
     create_parent(path)?;
-    write_atomic(path, bytes).map_err(|e| anyhow::anyhow!("writing {}: {e}", path.display()))
+    write_atomic(path, bytes).map_err(|error| WriteError::Writing {
+        path: path.to_path_buf(),
+        error,
+    })
 }
 
 /// Rewrite a report file from its current text (empty when it does not exist yet), whole: for
 /// the benchmarks that replace their own marked section of a shared report.
-pub fn rewrite_file(path: &Path, edit: impl FnOnce(&str) -> String) -> anyhow::Result<()> {
+pub fn rewrite_file(path: &Path, edit: impl FnOnce(&str) -> String) -> Result<(), WriteError> {
     let old = std::fs::read_to_string(path).unwrap_or_default();
     write_file(path, edit(&old))
 }
@@ -199,10 +226,12 @@ pub fn shell_word(s: &str) -> String {
 }
 
 /// Create the folder `path` goes into (if it has one), naming it on failure.
-pub fn create_parent(path: &std::path::Path) -> anyhow::Result<()> {
+pub fn create_parent(path: &std::path::Path) -> Result<(), WriteError> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| anyhow::anyhow!("creating {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|error| WriteError::Creating {
+            dir: dir.to_path_buf(),
+            error,
+        })?;
     }
     Ok(())
 }
@@ -239,6 +268,19 @@ mod tests {
             .collect();
         assert!(leftovers.is_empty());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A failed write names the file (or the folder it could not create) with the I/O error in
+    /// the message, and no source (a chain printed in full names the error once).
+    #[test]
+    fn write_errors_name_the_path_and_the_error() {
+        let e = write_file(Path::new("/proc/pinfeed-no/such.md"), "x").unwrap_err();
+        assert!(matches!(e, WriteError::Creating { .. }), "{e:?}");
+        assert!(
+            e.to_string().starts_with("creating /proc/pinfeed-no: "),
+            "{e}"
+        );
+        assert!(std::error::Error::source(&e).is_none());
     }
 
     /// A batch whose second file fails changes no target and leaves no temporary file; a

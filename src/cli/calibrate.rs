@@ -158,6 +158,6 @@ pub fn run(args: &CalibrateArgs, recorded: &str) -> Result<()> {
         hidden,
     };
     emit(&report, &text, c, "calibrate", &args.measured, |dir| {
-        write_report(&report, &text, dir)
+        Ok(write_report(&report, &text, dir)?)
     })
 }

@@ -207,6 +207,6 @@ pub fn run(args: &ValidateArgs, recorded: &str) -> Result<()> {
     };
     let text = rows_text(&rows, &summary);
     emit(&report, &text, c, "validate", &args.measured, |dir| {
-        write_report(&report, &text, dir)
+        Ok(write_report(&report, &text, dir)?)
     })
 }

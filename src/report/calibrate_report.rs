@@ -2,9 +2,9 @@
 //! parameter table with the scores, and the report folder.
 
 use crate::report::validate_report::{summary_text, write_report_files, ReportHead};
+use crate::report::ReportResult;
 use crate::validate::calibrate::Calibration;
 use crate::validate::score::Summary;
-use anyhow::Result;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -86,7 +86,7 @@ pub fn calibration_text(
 }
 
 /// Write `calibration.json` and README.md (with `text`) into `out_dir`.
-pub fn write_report(report: &CalibrateReport, text: &str, out_dir: &Path) -> Result<()> {
+pub fn write_report(report: &CalibrateReport, text: &str, out_dir: &Path) -> ReportResult<()> {
     let head = ReportHead {
         title: format!("Calibration: {}", report.measured),
         command: &report.command,

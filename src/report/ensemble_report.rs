@@ -5,7 +5,7 @@ use crate::maps::ensemble::{InputState, MemberDraw, PredictedBands};
 use crate::report::map_table::predicted_bands_text;
 use crate::report::plot_validate::plot_band_distributions;
 use crate::report::validate_report::{write_report_files, ReportHead};
-use anyhow::{Context, Result};
+use crate::report::ReportResult;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -57,7 +57,7 @@ pub fn write_report(
     table: &str,
     out_dir: &Path,
     plot_dir: Option<&Path>,
-) -> Result<()> {
+) -> ReportResult<()> {
     let head = ReportHead {
         title: format!("Ensemble map: {}", report.part),
         command: &report.command,
@@ -69,8 +69,7 @@ pub fn write_report(
     };
     write_report_files(out_dir, "ensemble.json", report, head, |out_dir| {
         let plot_dir = plot_dir.unwrap_or(out_dir);
-        std::fs::create_dir_all(plot_dir)
-            .with_context(|| format!("creating {}", plot_dir.display()))?;
+        crate::report::error::create_dir(plot_dir)?;
         let mut md = format!("Predicted bands: the smallest arcs (1° resolution, gaps under 5° closed, ends at the extreme passes they hold) that hold 90% of the passes pooled over the members and the input's θ0 (a stable state: the grid θ0 nearest it).\n\n{table}\n");
         for input in inputs {
             let label = input.label();

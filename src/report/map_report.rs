@@ -4,7 +4,7 @@
 
 use crate::maps::ConfigurationMap;
 use crate::report::{map_table, plot_map};
-use anyhow::{Context, Result};
+use crate::report::{ReportError, ReportResult};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -90,7 +90,7 @@ fn figure_name(m: &ConfigurationMap) -> String {
 }
 
 /// One CSV row per sample of every map (`pinfeed map --csv`, `samples.csv`).
-pub fn write_csv<W: std::io::Write>(w: W, maps: &[ConfigurationMap]) -> Result<()> {
+pub fn write_csv<W: std::io::Write>(w: W, maps: &[ConfigurationMap]) -> ReportResult<()> {
     let mut wtr = csv::Writer::from_writer(w);
     for m in maps {
         for s in &m.samples {
@@ -112,15 +112,19 @@ pub fn write_csv<W: std::io::Write>(w: W, maps: &[ConfigurationMap]) -> Result<(
 }
 
 /// Write README.md, map.json, samples.csv and the figures.
-pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>) -> Result<()> {
+pub fn write_report(
+    report: &MapReport,
+    out_dir: &Path,
+    plot_dir: Option<&Path>,
+) -> ReportResult<()> {
     let plot_dir = plot_dir.unwrap_or(out_dir);
     for dir in [out_dir, plot_dir] {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        crate::report::error::create_dir(dir)?;
     }
     let json_path = out_dir.join("map.json");
     // Compact: the document holds every sample (README.md is the readable summary).
     crate::output::write_atomic(&json_path, crate::report::versioned::compact(report)?)
-        .with_context(|| format!("writing {}", json_path.display()))?;
+        .map_err(ReportError::writing(&json_path))?;
     let csv_path = out_dir.join("samples.csv");
     crate::output::produce_atomic(&csv_path, |tmp| {
         write_csv(
@@ -128,7 +132,7 @@ pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>)
             report.maps,
         )
     })
-    .with_context(|| format!("writing {}", csv_path.display()))?;
+    .map_err(ReportError::writing(&csv_path))?;
 
     let describe = match &report.fence {
         Some(f) => format!(
@@ -158,7 +162,7 @@ pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>)
     for &(adjusted, file, what) in against_d {
         let path = plot_dir.join(file);
         plot_map::plot_band_intervals(report.maps, adjusted, &format!("{what}: {describe}"), &path)
-            .with_context(|| format!("writing {}", path.display()))?;
+            .map_err(ReportError::writing(&path))?;
         figures.push((what.to_string(), path));
     }
     for m in report.maps {
@@ -171,7 +175,7 @@ pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>)
             ),
         };
         plot_map::plot_map(m, &title, report.theta_step_deg, &path)
-            .with_context(|| format!("writing {}", path.display()))?;
+            .map_err(ReportError::writing(&path))?;
         figures.push((what, path));
     }
 
@@ -232,8 +236,7 @@ pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>)
         md += &format!("### {what}\n\n![{what}]({})\n\n", link(path));
     }
     let readme = out_dir.join("README.md");
-    crate::output::write_atomic(&readme, md)
-        .with_context(|| format!("writing {}", readme.display()))?;
+    crate::output::write_atomic(&readme, md).map_err(ReportError::writing(&readme))?;
     // The folder holds this run's figures only: a figure of an earlier run for a d not asked
     // for now goes.
     let written: Vec<String> = figures
@@ -241,7 +244,7 @@ pub fn write_report(report: &MapReport, out_dir: &Path, plot_dir: Option<&Path>)
         .filter_map(|(_, p)| p.file_name().map(|f| f.to_string_lossy().into_owned()))
         .collect();
     crate::report::stale::remove_stale(plot_dir, &written, is_map_figure)
-        .with_context(|| format!("removing earlier figures from {}", plot_dir.display()))?;
+        .map_err(ReportError::removing("figures", plot_dir))?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@ pub mod animate;
 pub mod calibrate_report;
 pub mod compare_table;
 pub mod ensemble_report;
+pub mod error;
 pub mod line_table;
 pub mod map_report;
 pub mod map_table;
@@ -30,6 +31,8 @@ pub mod stale;
 pub mod study_files;
 pub mod validate_report;
 pub mod versioned;
+
+pub use error::{ReportError, ReportResult};
 
 /// `x` with `decimals` decimals (`plus`: with its sign always), never as a negative zero: a value
 /// that rounds to zero is printed as 0 (`-0.000` from a −0.0 or a −1e-17 says nothing).

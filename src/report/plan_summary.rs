@@ -6,7 +6,7 @@ use crate::plan::design::{
     self, describe_obstacles, Candidate, Design, DesignOptions, Layout, Mode, Objective, Status,
 };
 use crate::plan::Problem;
-use anyhow::{Context, Result};
+use crate::report::{ReportError, ReportResult};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -49,7 +49,11 @@ impl DesignPaths {
 }
 
 /// Write the chosen design's files (nothing when there is none) and return their names.
-pub fn write_design(o: &DesignOptions, d: &Design, paths: &DesignPaths) -> Result<Vec<String>> {
+pub fn write_design(
+    o: &DesignOptions,
+    d: &Design,
+    paths: &DesignPaths,
+) -> ReportResult<Vec<String>> {
     let mut files = Vec::new();
     let DesignPaths {
         scenario,
@@ -143,7 +147,7 @@ pub struct PlanJson<'a> {
 }
 
 /// The JSON document of a design, `files` being the ones written.
-pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> Result<String> {
+pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> ReportResult<String> {
     let c = d.chosen();
     let doc = PlanJson {
         schema_version: crate::SCHEMA_VERSION,
@@ -174,12 +178,11 @@ pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> Result<String>
 }
 
 /// Write `text` to `path` (creating its folder), whole or not at all.
-fn write(path: &Path, text: &str) -> Result<()> {
+fn write(path: &Path, text: &str) -> ReportResult<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        crate::report::error::create_dir(dir)?;
     }
-    crate::output::write_atomic(path, text.as_bytes())
-        .with_context(|| format!("writing {}", path.display()))
+    crate::report::error::write_whole(path, text.as_bytes())
 }
 
 /// The drawing's title: the verdict with the line's number beside the prediction.
@@ -205,10 +208,10 @@ fn title(o: &DesignOptions, c: &Candidate, d: &Design) -> String {
 }
 
 /// Draw the chosen candidate of a design into `path`.
-pub fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) -> Result<()> {
+pub fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) -> ReportResult<()> {
     let t = title(o, c, d);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        crate::report::error::create_dir(dir)?;
     }
     // The plots write whole files or none (crate::output).
     match &c.layout {
@@ -219,7 +222,7 @@ pub fn draw_design(o: &DesignOptions, c: &Candidate, d: &Design, path: &Path) ->
             crate::report::plot_plan::plot_contingent(&c.problem, plan, &stages, &t, path)
         }
     }
-    .with_context(|| format!("drawing {}", path.display()))
+    .map_err(ReportError::drawing(path))
 }
 
 /// The printed result: the command, the candidates, the verdict, the chosen layout and the files.

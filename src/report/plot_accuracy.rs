@@ -2,13 +2,14 @@
 //! (log–log), mean error and 95th percentile.
 
 use crate::output::Staged;
+use crate::report::ReportResult;
 use crate::study::accuracy::AccuracyStudy;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// Draw the accuracy-vs-time study to the SVG file `path` (written whole or not at all).
-pub fn plot_accuracy(st: &AccuracyStudy, path: &Path) -> anyhow::Result<()> {
+pub fn plot_accuracy(st: &AccuracyStudy, path: &Path) -> ReportResult<()> {
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
     let root = SVGBackend::new(&tmp, (900, 600)).into_drawing_area();

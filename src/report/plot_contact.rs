@@ -7,6 +7,7 @@ use crate::contact_case::{case_fence, case_geometry, Case};
 use crate::geometry::{Polygon, Pose, Vec2};
 use crate::mechanics::{ContactOutcome, TraceSample};
 use crate::output::Staged;
+use crate::report::ReportResult;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -45,7 +46,7 @@ pub fn plot_contact(
     trace: &[TraceSample],
     title: &str,
     path: &Path,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let a = poly.radius();
     // Poses to draw: the start, ~10 evenly spaced trace samples, and the end.
     let mut poses = vec![pose0];
@@ -204,7 +205,7 @@ pub fn plot_case(
     out: &ContactOutcome,
     trace: &[TraceSample],
     path: &Path,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let (pose, obstacle) = pass_obstacle(poly, c);
     plot_contact(poly, pose, &obstacle, out, trace, &plot_title(c), path)
 }

@@ -8,6 +8,7 @@ use crate::engine::{PartOutcome, SamplePath};
 use crate::geometry::{wrap_deg, Pose};
 use crate::output::Staged;
 use crate::report::plot_labels::{text_width, LabelRows};
+use crate::report::ReportResult;
 use crate::scenario::{Obstacle, Scene};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -159,7 +160,7 @@ fn caption(scene: &Scene, sample: Option<&&SamplePath>) -> String {
 }
 
 /// Draw the line itself into a panel: belt edges, entry and exit, the obstacles and their labels.
-fn draw_line(ch: &mut Chart, scene: &Scene, labels: &[Label], px_per_m: f64) -> anyhow::Result<()> {
+fn draw_line(ch: &mut Chart, scene: &Scene, labels: &[Label], px_per_m: f64) -> ReportResult<()> {
     let belt = scene.belt;
     // Belt edges, entry and exit.
     for y in [-belt.width / 2.0, belt.width / 2.0] {
@@ -221,7 +222,7 @@ fn draw_line(ch: &mut Chart, scene: &Scene, labels: &[Label], px_per_m: f64) -> 
 
 /// Draw a sample part into a panel: its outline at the display poses and its centroid's track,
 /// in its outcome's colour.
-fn draw_sample(ch: &mut Chart, scene: &Scene, sample: &SamplePath) -> anyhow::Result<()> {
+fn draw_sample(ch: &mut Chart, scene: &Scene, sample: &SamplePath) -> ReportResult<()> {
     let a = scene.part.radius;
     let colour = outcome_colour(sample.outcome);
     let poses = display_poses(sample, 2.5 * a);
@@ -244,7 +245,7 @@ fn draw_sample(ch: &mut Chart, scene: &Scene, sample: &SamplePath) -> anyhow::Re
 }
 
 /// Draw the sample paths over the line.
-pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> anyhow::Result<()> {
+pub fn plot_line(scene: &Scene, samples: &[&SamplePath], path: &Path) -> ReportResult<()> {
     let belt = scene.belt;
     let a = scene.part.radius;
     let margin = 2.0 * a;

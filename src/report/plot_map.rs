@@ -17,6 +17,7 @@ use super::plot_zoom::{degree_view, DegreeView};
 use crate::geometry::wrap_deg;
 use crate::maps::{Band, ConfigurationMap};
 use crate::output::Staged;
+use crate::report::ReportResult;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::ComposedElement;
@@ -68,7 +69,7 @@ pub(crate) fn degree_chart<'a, 'b>(
     title: &str,
     x: std::ops::Range<f64>,
     y_top: f64,
-) -> anyhow::Result<Chart<'a, 'b>> {
+) -> ReportResult<Chart<'a, 'b>> {
     root.fill(&WHITE)?;
     Ok(ChartBuilder::on(root)
         .caption(title, ("sans-serif", 18))
@@ -98,7 +99,7 @@ pub(crate) fn header_with_legend<'a>(
     title: &str,
     entries: &[(&str, Swatch)],
     height: u32,
-) -> anyhow::Result<DrawingArea<SVGBackend<'a>, Shift>> {
+) -> ReportResult<DrawingArea<SVGBackend<'a>, Shift>> {
     root.fill(&WHITE)?;
     let (head, body) = root.split_vertically(height.max(62));
     let centre = root.dim_in_pixel().0 as i32 / 2;
@@ -139,7 +140,7 @@ pub(crate) fn header_with_legend<'a>(
 pub(crate) fn draw_legend<'a, 'b: 'a>(
     ch: &mut Chart<'a, 'b>,
     position: SeriesLabelPosition,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     ch.configure_series_labels()
         .position(position)
         .border_style(BLACK)
@@ -155,7 +156,7 @@ pub fn plot_map(
     title: &str,
     step_deg: f64,
     path: &Path,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
     let root = SVGBackend::new(&tmp, (760, 680)).into_drawing_area();
@@ -296,7 +297,7 @@ pub(crate) fn d_chart<'a, 'b>(
     view: DegreeView,
     x_desc: &str,
     y_desc: &str,
-) -> anyhow::Result<Chart<'a, 'b>> {
+) -> ReportResult<Chart<'a, 'b>> {
     let mut ch = ChartBuilder::on(body)
         .margin(14)
         .margin_top(4)
@@ -320,7 +321,7 @@ pub fn plot_band_intervals(
     adjusted: bool,
     title: &str,
     path: &Path,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let (mut dmin, mut dmax) = maps
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), m| {

@@ -7,6 +7,7 @@ use super::plot_zoom::{degree_view, DegreeView};
 use crate::engine::Summary;
 use crate::geometry::wrap_deg;
 use crate::output::Staged;
+use crate::report::ReportResult;
 use crate::scenario::{Goal, Scene};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -24,7 +25,7 @@ fn deg(x: f64) -> String {
 
 /// Draw the histogram of a line run's final part orientations, the scenario's goal windows
 /// marked, to the SVG file `path` (written whole or not at all).
-pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> anyhow::Result<()> {
+pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> ReportResult<()> {
     let h = &s.orientation_histogram;
     let top = h.counts.iter().copied().max().unwrap_or(0).max(1);
     let ymax = (top as f64 * 1.18).max(top as f64 + 1.0);

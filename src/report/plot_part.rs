@@ -3,11 +3,12 @@
 
 use crate::geometry::{Polygon, Vec2};
 use crate::output::Staged;
+use crate::report::ReportResult;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Draw the part and its radius function into an SVG file.
-pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> anyhow::Result<()> {
+pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> ReportResult<()> {
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
     let root = SVGBackend::new(&tmp, (1000, 460)).into_drawing_area();

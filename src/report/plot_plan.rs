@@ -10,6 +10,7 @@ use super::plot_labels::{text_width, LabelRows};
 use crate::geometry::{Pose, Vec2};
 use crate::output::Staged;
 use crate::plan::{Action, Plan, Problem, State};
+use crate::report::ReportResult;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -108,7 +109,7 @@ impl BeltView {
     fn chart<'a, 'b>(
         &self,
         area: &'a DrawingArea<SVGBackend<'b>, Shift>,
-    ) -> anyhow::Result<Chart<'a, 'b>> {
+    ) -> ReportResult<Chart<'a, 'b>> {
         let mut ch = ChartBuilder::on(area)
             .margin(MARGIN)
             .x_label_area_size(X_LABELS)
@@ -147,7 +148,7 @@ impl BeltView {
     }
 
     /// Draw the labels in their rows.
-    fn labels(&self, ch: &mut Chart<'_, '_>) -> anyhow::Result<()> {
+    fn labels(&self, ch: &mut Chart<'_, '_>) -> ReportResult<()> {
         for (l, row) in &self.placed {
             let (y, v) = if l.above {
                 (
@@ -198,7 +199,7 @@ fn draw_pin(
     x: f64,
     p: &crate::plan::PinAction,
     pin_px: i32,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let w = 3.0 / view.k;
     ch.draw_series(std::iter::once(Rectangle::new(
         [(x - w, p.lo_m * 1e3), (x + w, p.hi_m * 1e3)],
@@ -217,7 +218,7 @@ fn head(
     area: &DrawingArea<SVGBackend<'_>, Shift>,
     title: &str,
     notes: &[(String, RGBColor)],
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     area.draw(&Text::new(
         title.to_string(),
         ((PAGE_W / 2) as i32, 8),
@@ -250,7 +251,7 @@ fn sets_view<'a, 'b>(
     label: &dyn Fn(usize) -> String,
     centre: f64,
     tol: f64,
-) -> anyhow::Result<Chart<'a, 'b>> {
+) -> ReportResult<Chart<'a, 'b>> {
     let mut ch = ChartBuilder::on(area)
         .margin(MARGIN)
         .x_label_area_size(X_LABELS)
@@ -289,7 +290,7 @@ fn draw_part(
     polygon: &crate::geometry::Polygon,
     theta_deg: f64,
     cx: f64,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let pose = Pose::new(0.0, 0.0, theta_deg.to_radians());
     let verts: Vec<Vec2> = polygon.world_vertices(&pose);
     let outline: Vec<(f64, f64)> = verts.iter().map(|v| (cx + v.x * 1e3, v.y * 1e3)).collect();
@@ -302,7 +303,7 @@ fn draw_part(
 
 /// Draw a plan to `path` under `title` (the design's verdict: its line check beside the
 /// prediction).
-pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> anyhow::Result<()> {
+pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> ReportResult<()> {
     let compiled = problem.compile()?;
     let period = compiled.period_deg();
     let stages = plan.steps.len() + 1;
@@ -436,7 +437,7 @@ pub fn plot_contingent(
     stages: &[Vec<State>],
     title: &str,
     path: &Path,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let compiled = problem.compile()?;
     let period = compiled.period_deg();
     let k = plan.k;

@@ -7,6 +7,7 @@
 //! * [`plot_placement`]: mutual information against d per sensor kind, with the ceiling H(state).
 
 use crate::output::Staged;
+use crate::report::ReportResult;
 use crate::sensing::evaluate::Evaluation;
 use crate::sensing::placement::Placement;
 use crate::sensing::reading::Reading;
@@ -47,7 +48,7 @@ pub fn plot_templates(
     overlay: Option<&Overlay>,
     title: &str,
     path: &Path,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     // Time axis (ms since contact begin): the longest template, padded.
     let mut tmax: f64 = 0.0;
     for m in templates.members.iter().flatten() {
@@ -184,7 +185,7 @@ pub fn plot_templates(
 }
 
 /// Accuracy against noise factor per classifier (one point per factor, evenly spaced).
-pub fn plot_accuracy_noise(ev: &Evaluation, title: &str, path: &Path) -> anyhow::Result<()> {
+pub fn plot_accuracy_noise(ev: &Evaluation, title: &str, path: &Path) -> ReportResult<()> {
     let mut factors: Vec<f64> = Vec::new();
     let mut names: Vec<String> = Vec::new();
     for c in &ev.cells {
@@ -270,7 +271,7 @@ pub fn plot_accuracy_noise(ev: &Evaluation, title: &str, path: &Path) -> anyhow:
 }
 
 /// Mutual information of the best classifier against d, one line per sensor kind.
-pub fn plot_placement(p: &Placement, title: &str, path: &Path) -> anyhow::Result<()> {
+pub fn plot_placement(p: &Placement, title: &str, path: &Path) -> ReportResult<()> {
     let mut kinds: Vec<&str> = Vec::new();
     for r in &p.rows {
         if !kinds.contains(&r.sensor) {

@@ -4,12 +4,13 @@
 
 use crate::engine::PartOutcome;
 use crate::output::Staged;
+use crate::report::ReportResult;
 use crate::study::mc::report::McReport;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Draw the figure for `r` into `path`.
-pub fn plot_sensitivity(r: &McReport, path: &Path) -> anyhow::Result<()> {
+pub fn plot_sensitivity(r: &McReport, path: &Path) -> ReportResult<()> {
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
     let root = SVGBackend::new(&tmp, (900, 560)).into_drawing_area();
@@ -37,7 +38,7 @@ fn success_lines(
     r: &McReport,
     root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
     title: &str,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let axis0 = &r.header.sweep[0];
     let (mut x0, mut x1) = axis0
         .values
@@ -131,7 +132,7 @@ fn outcome_bars(
     r: &McReport,
     root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
     title: &str,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let p = &r.results[0];
     let classes: Vec<&str> = PartOutcome::ALL
         .iter()

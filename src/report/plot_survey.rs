@@ -3,7 +3,7 @@
 //! orient it only with a sensor), **F** (fences orient it) — filled when true, hollow when not.
 
 use crate::geometry::named::part_from_spec;
-use anyhow::{Context, Result};
+use crate::report::ReportResult;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -11,7 +11,7 @@ const CELL: f64 = 150.0;
 const COLS: usize = 5;
 
 /// Draw `rows` (part spec, [pins, sensing only, fences]) to `path`.
-pub fn plot_survey(rows: &[(String, [bool; 3])], path: &Path) -> Result<()> {
+pub fn plot_survey(rows: &[(String, [bool; 3])], path: &Path) -> ReportResult<()> {
     let n_rows = rows.len().div_ceil(COLS).max(1);
     let (w, h) = (CELL * COLS as f64, CELL * n_rows as f64 + 40.0);
     let mut s = String::new();
@@ -71,7 +71,7 @@ pub fn plot_survey(rows: &[(String, [bool; 3])], path: &Path) -> Result<()> {
     }
     writeln!(s, "</svg>")?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        crate::report::error::create_dir(dir)?;
     }
-    crate::output::write_atomic(path, s).with_context(|| format!("writing {}", path.display()))
+    crate::report::error::write_whole(path, s)
 }

@@ -11,6 +11,7 @@ use super::plot_zoom::{degree_view, DegreeView};
 use crate::maps::arcs::Arc;
 use crate::maps::ensemble::PredictedBands;
 use crate::output::Staged;
+use crate::report::ReportResult;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -57,7 +58,7 @@ pub fn plot_band_distributions(
     measured: &[(f64, Arc)],
     title: &str,
     path: &Path,
-) -> anyhow::Result<()> {
+) -> ReportResult<()> {
     let ds: Vec<f64> = predicted
         .iter()
         .map(|p| p.d)

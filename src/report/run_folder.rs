@@ -5,8 +5,8 @@
 use crate::engine::RunResult;
 use crate::output::Batch;
 use crate::report::{animate, parts_csv, plot_line, plot_orientations};
+use crate::report::{ReportError, ReportResult};
 use crate::scenario::Scene;
-use anyhow::{bail, Context, Result};
 use std::path::Path;
 
 /// The pictures a run asks for besides the scenario's files.
@@ -59,9 +59,9 @@ pub fn write_run(
     result: &RunResult,
     dir: &Path,
     files: &RunFiles,
-) -> Result<String> {
+) -> ReportResult<String> {
     let summary = &result.summary;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    crate::report::error::create_dir(dir)?;
     // The run's files appear whole and together, or not at all (a full disk leaves the previous
     // run's files as they were, never a new summary beside a truncated figure).
     let mut batch = Batch::new();
@@ -69,12 +69,12 @@ pub fn write_run(
     let summary_path = dir.join("summary.json");
     batch
         .write(&summary_path, &json)
-        .with_context(|| format!("writing {}", summary_path.display()))?;
+        .map_err(ReportError::writing(&summary_path))?;
     if scene.output.parts_csv {
         let p = dir.join("parts.csv");
         batch
             .produce(&p, |tmp| parts_csv::write_parts_csv(tmp, &result.records))
-            .with_context(|| format!("writing {}", p.display()))?;
+            .map_err(ReportError::writing(&p))?;
     }
     if scene.output.histogram_svg {
         let p = dir.join("orientation_histogram.svg");
@@ -82,25 +82,25 @@ pub fn write_run(
             .produce(&p, |tmp| {
                 plot_orientations::plot_orientation_histogram(scene, summary, tmp)
             })
-            .with_context(|| format!("writing {}", p.display()))?;
+            .map_err(ReportError::writing(&p))?;
     }
     if scene.effects.event_log {
         let p = dir.join("events.json");
         batch
             .write(&p, event_log("events", &result.events)?)
-            .with_context(|| format!("writing {}", p.display()))?;
+            .map_err(ReportError::writing(&p))?;
         if !result.control.is_empty() {
             let p = dir.join("control.json");
             batch
                 .write(&p, event_log("control", &result.control)?)
-                .with_context(|| format!("writing {}", p.display()))?;
+                .map_err(ReportError::writing(&p))?;
         }
     }
     if let Some(p) = files.draw {
         let samples = plot_line::choose_samples(&result.paths, scene.output.draw_parts as usize);
         batch
             .produce(p, |tmp| plot_line::plot_line(scene, &samples, tmp))
-            .with_context(|| format!("writing {}", p.display()))?;
+            .map_err(ReportError::writing(p))?;
     }
     if let Some(p) = files.animate {
         let anim = animate::from_run(scene, result, animate::DEFAULT_PARTS);
@@ -109,19 +109,19 @@ pub fn write_run(
         };
         let dur = (anim.t_end - anim.t_start) / aopts.speedup.unwrap_or(1.0);
         if files.animate_speed.is_some() && dur > animate::MAX_DURATION_S {
-            bail!(
-                "--animate-speed {} would make the animation last {dur:.0} s; at most {} s (choose a larger speed-up)",
-                aopts.speedup.unwrap_or(1.0),
-                animate::MAX_DURATION_S
-            );
+            return Err(ReportError::AnimationTooLong {
+                speedup: aopts.speedup.unwrap_or(1.0),
+                duration_s: dur,
+                max_s: animate::MAX_DURATION_S,
+            });
         }
         batch
             .write(p, animate::render(&anim, &aopts))
-            .with_context(|| format!("writing {}", p.display()))?;
+            .map_err(ReportError::writing(p))?;
     }
     batch
         .commit()
-        .with_context(|| format!("writing the results into {}", dir.display()))?;
+        .map_err(ReportError::writing_into("results", dir))?;
     // The folder holds this run's files only (a parts.csv or events.json of an earlier run whose
     // scenario asked for it does not outlive it).
     let written: Vec<String> = [
@@ -139,7 +139,7 @@ pub fn write_run(
     .map(String::from)
     .collect();
     crate::report::stale::remove_stale(dir, &written, |n| RUN_FILES.contains(&n))
-        .with_context(|| format!("removing earlier files from {}", dir.display()))?;
+        .map_err(ReportError::removing("files", dir))?;
     Ok(json)
 }
 

@@ -2,11 +2,11 @@
 //! terminal summary, `report.md` and the report directory with `sense.json` and the figures.
 
 use crate::report::plot_sensing;
+use crate::report::{ReportError, ReportResult};
 use crate::sensing::evaluate::{trial_pass, Cell, Config, Problem, READING_STREAMS};
 use crate::sensing::experiment::SenseReport;
 use crate::sensing::read;
 use crate::sensing::templates::TemplateSet;
-use anyhow::{anyhow, Context, Result};
 use std::path::Path;
 
 fn matrix_line(c: &Cell) -> String {
@@ -96,11 +96,11 @@ pub fn write_report(
     config: &Config,
     templates: &TemplateSet,
     out: &Path,
-) -> Result<()> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+) -> ReportResult<()> {
+    crate::report::error::create_dir(out)?;
     let json_path = out.join("sense.json");
     crate::output::write_atomic(&json_path, crate::report::versioned::pretty(r)?)
-        .with_context(|| format!("writing {}", json_path.display()))?;
+        .map_err(ReportError::writing(&json_path))?;
     let what = format!(
         "{} at d = {}, μc {}, {} sensor",
         r.part,
@@ -109,7 +109,7 @@ pub fn write_report(
         r.sensor.kind.name()
     );
     // (a) templates with trial 0's reading at noise factor 1.
-    let (truth, pass) = trial_pass(problem, config, 0).map_err(|e| anyhow!(e))?;
+    let (truth, pass) = trial_pass(problem, config, 0).map_err(ReportError::Trial)?;
     let mut rng = crate::random::stream(config.seed, READING_STREAMS);
     let reading = read(&pass.signal, &r.sensor, &mut rng);
     let overlay = match (&reading, pass.signal.span()) {
@@ -130,14 +130,14 @@ pub fn write_report(
         &format!("Templates per hypothesis: {what}"),
         &f_templates,
     )
-    .with_context(|| format!("writing {}", f_templates.display()))?;
+    .map_err(ReportError::writing(&f_templates))?;
     let f_acc = out.join("accuracy_noise.svg");
     plot_sensing::plot_accuracy_noise(
         &r.evaluation,
         &format!("Accuracy against noise: {what}, {} trials", r.trials),
         &f_acc,
     )
-    .with_context(|| format!("writing {}", f_acc.display()))?;
+    .map_err(ReportError::writing(&f_acc))?;
     if let Some(pl) = &r.placement {
         let f = out.join("placement.svg");
         plot_sensing::plot_placement(
@@ -148,10 +148,10 @@ pub fn write_report(
             ),
             &f,
         )
-        .with_context(|| format!("writing {}", f.display()))?;
+        .map_err(ReportError::writing(&f))?;
     }
-    crate::output::write_atomic(out.join("report.md"), report_markdown(r))
-        .with_context(|| format!("writing {}", out.join("report.md").display()))?;
+    let readme = out.join("report.md");
+    crate::report::error::write_whole(&readme, report_markdown(r))?;
     // A placement figure of an earlier run with --placement does not outlive this one.
     let written: Vec<String> = ["templates.svg", "accuracy_noise.svg"]
         .into_iter()
@@ -159,7 +159,7 @@ pub fn write_report(
         .map(String::from)
         .collect();
     crate::report::stale::remove_stale(out, &written, |n| n.ends_with(".svg"))
-        .with_context(|| format!("removing earlier figures from {}", out.display()))?;
+        .map_err(ReportError::removing("figures", out))?;
     Ok(())
 }
 

@@ -2,8 +2,10 @@
 //! `pinfeed mc` and `pinfeed merge` write it) and the accuracy benchmark's report
 //! ([`accuracy_bench`]).
 
-use crate::output::{write_file, Batch};
+use crate::output::{write_file, Batch, WriteError};
+use crate::report::{ReportError, ReportResult};
 use crate::study::accuracy;
+use crate::study::bench_error::BenchError;
 use crate::study::mc::report::{self, McReport};
 
 /// Write a report's files into `dir`: `report.md`, `report.json` and `sensitivity.svg`, whole
@@ -12,9 +14,8 @@ use crate::study::mc::report::{self, McReport};
 pub fn mc_report_files(
     r: &McReport,
     dir: &std::path::Path,
-) -> anyhow::Result<(String, std::path::PathBuf)> {
-    use anyhow::Context;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+) -> ReportResult<(String, std::path::PathBuf)> {
+    crate::report::error::create_dir(dir)?;
     let figure = "sensitivity.svg";
     let (md, js, svg) = (
         dir.join("report.md"),
@@ -25,19 +26,49 @@ pub fn mc_report_files(
     let mut batch = Batch::new();
     batch
         .write(&md, report::markdown(r, figure))
-        .with_context(|| format!("writing {}", md.display()))?;
+        .map_err(ReportError::writing(&md))?;
     batch
         .write(&js, &json_text)
-        .with_context(|| format!("writing {}", js.display()))?;
+        .map_err(ReportError::writing(&js))?;
     batch
         .produce(&svg, |tmp| {
             super::plot_sensitivity::plot_sensitivity(r, tmp)
         })
-        .with_context(|| format!("writing {}", svg.display()))?;
+        .map_err(ReportError::writing(&svg))?;
     batch
         .commit()
-        .with_context(|| format!("writing the report into {}", dir.display()))?;
+        .map_err(ReportError::writing_into("report", dir))?;
     Ok((json_text, md))
+}
+
+/// Why `pinfeed bench accuracy` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum AccuracyBenchError {
+    /// The study could not run (or `--contacts` is out of range).
+    #[error(transparent)]
+    Bench(#[from] BenchError),
+    /// The report or its table could not be written.
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    /// The figure could not be written (the cause in full in the message, not as a source).
+    #[error("writing {}: {}", path.display(), chain(error))]
+    Figure {
+        /// The figure's file.
+        path: std::path::PathBuf,
+        /// Why it could not be written.
+        error: ReportError,
+    },
+}
+
+/// `e` and its sources, joined by ": " (as the command line prints a chain with `{:#}`).
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(&format!(": {s}"));
+        source = s.source();
+    }
+    text
 }
 
 /// `pinfeed bench accuracy`: the study over tripoly1, tripoly2, square and lshape with
@@ -49,9 +80,9 @@ pub fn accuracy_bench(
     seed: u64,
     cmd: &str,
     out: &std::path::Path,
-) -> anyhow::Result<(String, [std::path::PathBuf; 3])> {
+) -> Result<(String, [std::path::PathBuf; 3]), AccuracyBenchError> {
     if !(4..=1_000_000).contains(&contacts) {
-        anyhow::bail!("--contacts must be between 4 and 1000000, got {contacts}");
+        return Err(BenchError::argument("--contacts", "between 4 and 1000000", contacts).into());
     }
     let st = accuracy::run(
         &["tripoly1", "tripoly2", "square", "lshape"],
@@ -62,7 +93,11 @@ pub fn accuracy_bench(
     let old = std::fs::read_to_string(&md).unwrap_or_default();
     write_file(&md, accuracy::report_keeping(&st, cmd, &old))?;
     write_file(&csv_path, accuracy::csv(&st))?;
-    crate::report::plot_accuracy::plot_accuracy(&st, &svg)
-        .map_err(|e| anyhow::anyhow!("writing {}: {e:#}", svg.display()))?;
+    crate::report::plot_accuracy::plot_accuracy(&st, &svg).map_err(|error| {
+        AccuracyBenchError::Figure {
+            path: svg.clone(),
+            error,
+        }
+    })?;
     Ok((accuracy::markdown_table(&st), [md, csv_path, svg]))
 }

@@ -7,8 +7,8 @@ use crate::maps::ensemble::PredictedBands;
 use crate::report::fixed;
 use crate::report::map_table::predicted_bands_text as bands_text;
 use crate::report::plot_validate::plot_band_distributions;
+use crate::report::{ReportError, ReportResult};
 use crate::validate::score::{RowScore, ScoreSettings, Summary};
-use anyhow::{Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -32,12 +32,12 @@ pub(crate) fn write_report_files<T: Serialize>(
     json_name: &str,
     report: &T,
     head: ReportHead,
-    body: impl FnOnce(&Path) -> Result<String>,
-) -> Result<()> {
-    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    body: impl FnOnce(&Path) -> ReportResult<String>,
+) -> ReportResult<()> {
+    crate::report::error::create_dir(out_dir)?;
     let json = out_dir.join(json_name);
     crate::output::write_atomic(&json, crate::report::versioned::pretty(report)?)
-        .with_context(|| format!("writing {}", json.display()))?;
+        .map_err(ReportError::writing(&json))?;
     let mut md = format!(
         "# {}\n\nRegenerate with:\n\n```\n{}\n```\n\n{}\n\n",
         head.title, head.command, head.intro
@@ -48,8 +48,7 @@ pub(crate) fn write_report_files<T: Serialize>(
     md.push('\n');
     md.push_str(&body(out_dir)?);
     let readme = out_dir.join("README.md");
-    crate::output::write_atomic(&readme, md)
-        .with_context(|| format!("writing {}", readme.display()))?;
+    crate::output::write_atomic(&readme, md).map_err(ReportError::writing(&readme))?;
     Ok(())
 }
 
@@ -139,7 +138,7 @@ pub fn summary_text(s: &Summary) -> String {
 }
 
 /// Figures of measured bands over predictions, one per (part, input): (file name, title) written.
-pub fn write_figures(rows: &[RowScore], dir: &Path) -> Result<Vec<String>> {
+pub fn write_figures(rows: &[RowScore], dir: &Path) -> ReportResult<Vec<String>> {
     let mut groups: Vec<(String, String)> = Vec::new();
     for r in rows {
         let key = (r.part.clone(), r.input.clone());
@@ -173,7 +172,7 @@ pub fn write_figures(rows: &[RowScore], dir: &Path) -> Result<Vec<String>> {
 }
 
 /// Write `validate.json`, README.md (with `text`) and the figures into `out_dir`.
-pub fn write_report(report: &ValidateReport, text: &str, out_dir: &Path) -> Result<()> {
+pub fn write_report(report: &ValidateReport, text: &str, out_dir: &Path) -> ReportResult<()> {
     let head = ReportHead {
         title: format!("Validation: {}", report.measured),
         command: &report.command,

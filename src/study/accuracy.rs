@@ -19,6 +19,7 @@
 
 use crate::geometry::{part_from_spec, wrap_deg, Pose, Vec2};
 use crate::mechanics::{push, ContactSettings, Fidelity, PartModel, Pin, Support};
+use crate::study::bench_error::{uniform_model, BenchError};
 use rand::RngExt;
 use serde::Serialize;
 use std::time::Instant;
@@ -88,7 +89,7 @@ fn ang_err(a_deg: f64, b_deg: f64) -> f64 {
 }
 
 /// Run the study.
-pub fn run(parts: &[&str], n: usize, seed: u64) -> anyhow::Result<AccuracyStudy> {
+pub fn run(parts: &[&str], n: usize, seed: u64) -> Result<AccuracyStudy, BenchError> {
     let bench = Bench::new(parts)?;
     let cases = draw_cases(parts.len(), n.div_ceil(parts.len()), seed);
     // Reference.
@@ -168,15 +169,12 @@ struct Bench {
 
 impl Bench {
     /// Build the parts' models and their slide tables.
-    fn new(parts: &[&str]) -> anyhow::Result<Bench> {
+    fn new(parts: &[&str]) -> Result<Bench, BenchError> {
         let polys: Vec<_> = parts
             .iter()
             .map(|p| part_from_spec(p))
             .collect::<Result<_, _>>()?;
-        let models: Vec<PartModel> = polys
-            .iter()
-            .map(|p| PartModel::new(p, &Support::Uniform).map_err(anyhow::Error::msg))
-            .collect::<Result<_, _>>()?;
+        let models: Vec<PartModel> = polys.iter().map(uniform_model).collect::<Result<_, _>>()?;
         // The exact model with its slide tables (built here, before any timing).
         let mu_c = ContactSettings::default().mu_c;
         let tabled: Vec<PartModel> = models

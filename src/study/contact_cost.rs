@@ -9,7 +9,8 @@
 //! reported as median and 90th percentile.
 
 use crate::geometry::{part_from_spec, wrap_deg, Pose, Vec2};
-use crate::mechanics::{push, ContactOutcome, ContactSettings, Fidelity, PartModel, Pin, Support};
+use crate::mechanics::{push, ContactOutcome, ContactSettings, Fidelity, PartModel, Pin};
+use crate::study::bench_error::{uniform_model, BenchError};
 use rand::RngExt;
 use serde::Serialize;
 use std::time::Instant;
@@ -90,11 +91,11 @@ pub fn measure(
     tol: f64,
     seed: u64,
     tables: bool,
-) -> anyhow::Result<Vec<ContactCostRow>> {
+) -> Result<Vec<ContactCostRow>, BenchError> {
     let mut rows = Vec::new();
     for (pi, part) in parts.iter().enumerate() {
         let poly = part_from_spec(part)?;
-        let model = PartModel::new(&poly, &Support::Uniform).map_err(anyhow::Error::msg)?;
+        let model = uniform_model(&poly)?;
         let mut rng = crate::random::stream(seed, pi as u64);
         let cases: Vec<(f64, f64)> = (0..n)
             .map(|_| {
@@ -361,12 +362,11 @@ pub fn vertex_scaling(
     n: usize,
     tol: f64,
     seed: u64,
-) -> anyhow::Result<Vec<ScalingRow>> {
+) -> Result<Vec<ScalingRow>, BenchError> {
     let mut rows = Vec::new();
     for &m in vertices {
         let name = format!("ngon:{m}");
-        let model = PartModel::new(&part_from_spec(&name)?, &Support::Uniform)
-            .map_err(anyhow::Error::msg)?;
+        let model = uniform_model(&part_from_spec(&name)?)?;
         let near_ns = eval_ns(&model, 2.0, 20_000);
         let far_ns = eval_ns(&model, 8.0, 20_000);
         let contact = measure(&[name.as_str()], &[Fidelity::Exact], n, tol, seed, false)?
@@ -537,12 +537,16 @@ pub fn bench(
     cmd: &str,
     out: &std::path::Path,
     stage: &dyn Fn(&str),
-) -> anyhow::Result<String> {
+) -> Result<String, BenchError> {
     if contacts == 0 || contacts > 1_000_000 {
-        anyhow::bail!("--contacts must be between 1 and 1000000, got {contacts}");
+        return Err(BenchError::argument(
+            "--contacts",
+            "between 1 and 1000000",
+            contacts,
+        ));
     }
     if !(tol > 0.0 && tol <= 1e-2) {
-        anyhow::bail!("--tol must be in (0, 0.01], got {tol}");
+        return Err(BenchError::argument("--tol", "in (0, 0.01]", tol));
     }
     let parts = ["tripoly1", "tripoly2", "square", "lshape"];
     let fids = [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact];

@@ -16,7 +16,7 @@ use crate::engine::{self, CapturedPush, RunOptions};
 use crate::mechanics::{ContactOutcome, PartModel, Recorder};
 use crate::scenario::Scene;
 use crate::sensing::signal::KnotRecorder;
-use anyhow::{bail, Result};
+use crate::study::bench_error::BenchError;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -75,12 +75,9 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 }
 
 /// Measure `scene` over `parts` parts, `reps` alternating repeats.
-pub fn measure(scene: &Scene, parts: u64, reps: usize) -> Result<LineCost> {
+pub fn measure(scene: &Scene, parts: u64, reps: usize) -> Result<LineCost, BenchError> {
     if scene.map_tier.is_some() {
-        bail!(
-            "scenario '{}' runs on the map tier: its pushes are answered by a map that a bare batch would not use (see `pinfeed bench map-tier`)",
-            scene.name
-        );
+        return Err(BenchError::MapTier(scene.name.clone()));
     }
     let opts = RunOptions {
         parts,
@@ -89,10 +86,10 @@ pub fn measure(scene: &Scene, parts: u64, reps: usize) -> Result<LineCost> {
     let (first, pushes) = engine::run_capturing(scene, &opts)?;
     let evaluations = batch(scene, &pushes, false);
     if evaluations != first.summary.work.model_evaluations {
-        bail!(
-            "the batch of captured pushes made {evaluations} evaluations where the line made {}: the capture is incomplete",
-            first.summary.work.model_evaluations
-        );
+        return Err(BenchError::IncompleteCapture {
+            batch: evaluations,
+            line: first.summary.work.model_evaluations,
+        });
     }
     let (mut line_s, mut bare_s, mut rec_s) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     for _ in 0..reps.max(1) {

@@ -5,7 +5,8 @@
 
 use crate::geometry::part_from_spec;
 use crate::maps::{compute_maps, MapSettings};
-use crate::mechanics::{Fidelity, PartModel, Support};
+use crate::mechanics::Fidelity;
+use crate::study::bench_error::{uniform_model, BenchError};
 use std::time::Instant;
 
 /// The thesis's contact parameters: ±0.1 … ±0.9.
@@ -41,11 +42,11 @@ pub fn measure(
     thread_counts: &[usize],
     theta_step_deg: f64,
     repeats: usize,
-) -> anyhow::Result<Vec<MapCostRow>> {
+) -> Result<Vec<MapCostRow>, BenchError> {
     let mut rows = Vec::new();
     for part in parts {
         let poly = part_from_spec(part)?;
-        let model = PartModel::new(&poly, &Support::Uniform).map_err(anyhow::Error::msg)?;
+        let model = uniform_model(&poly)?;
         for &fidelity in fidelities {
             let settings = MapSettings::point_pin(fidelity, 0.5, theta_step_deg, 5.0);
             for &threads in thread_counts {
@@ -135,9 +136,13 @@ pub fn bench(
     cmd: &str,
     out: &std::path::Path,
     load: &dyn Fn() -> String,
-) -> anyhow::Result<String> {
+) -> Result<String, BenchError> {
     if repeats == 0 || repeats > 1000 {
-        anyhow::bail!("--repeats must be between 1 and 1000, got {repeats}");
+        return Err(BenchError::argument(
+            "--repeats",
+            "between 1 and 1000",
+            repeats,
+        ));
     }
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut threads = vec![1, 2, cores];

@@ -12,9 +12,9 @@ use crate::engine::{self, contact_map, RunOptions, RunResult};
 use crate::geometry::{part_from_spec, Pose, Vec2};
 use crate::maps::pass_start;
 use crate::maps::tier::{self, push_with_map, Source, TierInputs, TierSpec};
-use crate::mechanics::{push, ContactSettings, PartModel, Pin, Support};
+use crate::mechanics::{push, ContactSettings, Pin, Support};
 use crate::random::stream;
-use anyhow::{Context, Result};
+use crate::study::bench_error::{uniform_model, BenchError};
 use rand::RngExt;
 use std::path::Path;
 use std::time::Instant;
@@ -62,9 +62,12 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 }
 
 /// Measure one part.
-pub fn contact_row(part: &str, contacts: usize, seed: u64) -> Result<ContactRow> {
-    let poly = part_from_spec(part).with_context(|| format!("part '{part}'"))?;
-    let model = PartModel::new(&poly, &Support::Uniform).map_err(anyhow::Error::msg)?;
+pub fn contact_row(part: &str, contacts: usize, seed: u64) -> Result<ContactRow, BenchError> {
+    let poly = part_from_spec(part).map_err(|source| BenchError::Part {
+        part: part.to_string(),
+        source,
+    })?;
+    let model = uniform_model(&poly)?;
     let settings = ContactSettings::default();
     let inputs = TierInputs {
         model: &model,
@@ -224,7 +227,7 @@ pub struct LineRow {
     pub map: RunResult,
 }
 
-fn run_timed(scene: &crate::scenario::Scene, parts: u64) -> Result<(RunResult, f64)> {
+fn run_timed(scene: &crate::scenario::Scene, parts: u64) -> Result<(RunResult, f64), BenchError> {
     let opts = RunOptions {
         parts,
         keep_records: true,
@@ -236,7 +239,7 @@ fn run_timed(scene: &crate::scenario::Scene, parts: u64) -> Result<(RunResult, f
 }
 
 /// Run `scenario` exact (its own fidelity) and on the map tier (default grid, built fresh).
-pub fn line_row(scenario: &Path, parts: u64) -> Result<LineRow> {
+pub fn line_row(scenario: &Path, parts: u64) -> Result<LineRow, BenchError> {
     let exact_scene = crate::scenario::load(scenario)?;
     let mut map_scene = crate::scenario::load(scenario)?;
     map_scene.map_tier = Some(TierSpec::default());

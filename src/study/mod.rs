@@ -4,6 +4,7 @@
 //! designs side by side on one part stream (`compare`), and fuzzing of every input (`robustness`).
 
 pub mod accuracy;
+pub mod bench_error;
 pub mod bundled;
 pub mod compare;
 pub mod contact_cost;
