@@ -11,9 +11,8 @@
 //! [0°, 360°) instead of the first file's distribution. Nothing is written to disk.
 
 use crate::report::compare_table;
-use crate::scenario::FeedSource;
-use crate::study::compare::compare_observed;
-use anyhow::{bail, Context, Result};
+use crate::study::compare::{compare_observed, designs};
+use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -44,35 +43,16 @@ pub struct CompareArgs {
 }
 
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let mut scenes = Vec::new();
-    let mut files = Vec::new();
-    let mut online = Vec::new();
-    for path in &args.scenarios {
-        let scene = crate::scenario::load(path)?;
-        online.push(crate::engine::prepare::online_model(&scene)?);
-        scenes.push(scene);
-        files.push(path.display().to_string());
-    }
-    let mut source = FeedSource::from_scene(&scenes[0]);
-    if let Some(s) = args.seed {
-        source.seed = s;
-    }
-    if args.uniform_orientation {
-        source = source.with_uniform_orientation();
-    }
-    let parts = args.parts.unwrap_or(source.feed.parts);
-    if !(1..=1_000_000_000).contains(&parts) {
-        bail!("--parts must lie in [1, 1000000000], got {parts}");
-    }
-    source.feed.parts = parts;
-    for (scene, file) in scenes.iter_mut().zip(&files) {
-        source
-            .apply(scene)
-            .with_context(|| format!("{file} cannot run on the part stream of {}", files[0]))?;
-    }
+    let d = designs(
+        &args.scenarios,
+        args.seed,
+        args.parts,
+        args.uniform_orientation,
+    )?;
+    let (files, source, parts) = (&d.files, &d.source, d.source.feed.parts);
     let bar = super::progress::bar(0, "parts", args.quiet || args.json);
     let tell = super::progress::counter(&bar);
-    let rows = compare_observed(&scenes, &files, &online, parts, &tell)
+    let rows = compare_observed(&d.scenes, files, &d.online, parts, &tell)
         .context("running the comparison")?;
     bar.finish_and_clear();
     let text = if args.json {
@@ -83,7 +63,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         }
         crate::report::versioned::pretty(&Designs { designs: &rows })?
     } else {
-        let feed = compare_table::feed_line(&files[0], &source, parts);
+        let feed = compare_table::feed_line(&files[0], source, parts);
         if args.markdown {
             format!("{feed}\n\n{}", compare_table::markdown(&rows))
         } else {

@@ -24,6 +24,7 @@ use crate::geometry::Polygon;
 use crate::scenario::{Goal, Obstacle, Scene};
 use rayon::prelude::*;
 use serde::Serialize;
+use thiserror::Error;
 
 /// One scene's line of the comparison.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -124,6 +125,85 @@ fn span(scene: &Scene, range: fn(&Obstacle) -> [f64; 2]) -> Option<[f64; 2]> {
         .iter()
         .map(range)
         .reduce(|a, b| [a[0].min(b[0]), a[1].max(b[1])])
+}
+
+/// The designs of a comparison, on one part stream: what [`designs`] returns.
+#[derive(Debug)]
+pub struct Designs {
+    /// The scenes, in the order given, each with the first one's feed and seed.
+    pub scenes: Vec<Scene>,
+    /// Where each scene came from (as given).
+    pub files: Vec<String>,
+    /// Each scene's online controller's model, built from the file as written (None without one).
+    pub online: Vec<Option<OnlineHandle>>,
+    /// The part stream every scene runs.
+    pub source: crate::scenario::FeedSource,
+}
+
+/// Why the designs of a comparison cannot be set up.
+#[derive(Debug, Error)]
+pub enum DesignsError {
+    /// A scenario file is refused (or its online model cannot be built).
+    #[error(transparent)]
+    Scenario(#[from] crate::scenario::ScenarioError),
+    /// No scenario file was given.
+    #[error("compare needs at least one scenario file")]
+    Empty,
+    /// `--parts` out of range.
+    #[error("--parts must lie in [1, 1000000000], got {0}")]
+    Parts(u64),
+    /// A design cannot take the first one's part stream.
+    #[error("{file} cannot run on the part stream of {first}: {reason}")]
+    Stream {
+        /// The design refused.
+        file: String,
+        /// The first design's file, whose stream is imposed.
+        first: String,
+        /// Why (a different part, or offsets the belt cannot hold).
+        reason: crate::scenario::FeedMismatch,
+    },
+}
+
+/// Read the scenario files `paths` and put them on one part stream: the first file's feed and
+/// seed (`seed` and `parts` override its own; `uniform_orientation` feeds orientations uniform on
+/// [0°, 360°) instead). Each online controller's model is built from its file as written, before
+/// the stream is imposed: the controller was designed for its own feed.
+pub fn designs(
+    paths: &[std::path::PathBuf],
+    seed: Option<u64>,
+    parts: Option<u64>,
+    uniform_orientation: bool,
+) -> Result<Designs, DesignsError> {
+    let (mut scenes, mut files, mut online) = (Vec::new(), Vec::new(), Vec::new());
+    for path in paths {
+        let scene = crate::scenario::load(path)?;
+        online.push(crate::engine::prepare::online_model(&scene)?);
+        scenes.push(scene);
+        files.push(path.display().to_string());
+    }
+    let mut source =
+        crate::scenario::FeedSource::from_scene(scenes.first().ok_or(DesignsError::Empty)?);
+    source.seed = seed.unwrap_or(source.seed);
+    if uniform_orientation {
+        source = source.with_uniform_orientation();
+    }
+    source.feed.parts = parts.unwrap_or(source.feed.parts);
+    if !(1..=1_000_000_000).contains(&source.feed.parts) {
+        return Err(DesignsError::Parts(source.feed.parts));
+    }
+    for (scene, file) in scenes.iter_mut().zip(&files) {
+        source.apply(scene).map_err(|reason| DesignsError::Stream {
+            file: file.clone(),
+            first: files[0].clone(),
+            reason,
+        })?;
+    }
+    Ok(Designs {
+        scenes,
+        files,
+        online,
+        source,
+    })
 }
 
 /// Run every scene (already on one part stream) with `parts` parts; one row per scene, in order.
