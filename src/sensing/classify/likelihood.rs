@@ -54,7 +54,10 @@ pub const MAX_VARYING: usize = 8;
 /// Largest number of lags searched.
 pub const MAX_LAGS: usize = 24;
 
+/// One member of an ensemble as training leaves it (packed into [`Likelihood::data`] after).
 struct Member {
+    /// The base vector w/B · S_base (used channels × blocks).
+    base: Vec<f64>,
     /// Σ −½ w/B S_base² plus, per lag, the lag's correction of that term.
     cst: Vec<f64>,
     /// Flat indices (channel·blocks + block) of the lag-dependent entries.
@@ -66,19 +69,189 @@ struct Member {
     chunks: Vec<std::ops::Range<u32>>,
 }
 
+/// Where one member's numbers sit in [`Packed::data`].
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    /// Offset of the member's numbers in `data`.
+    at: u32,
+    /// Number of its base vector's packed entries (eight per non-zero chunk).
+    packed: u32,
+    /// Its runs of non-zero chunks: a range into `runs`.
+    runs: [u32; 2],
+    /// Its lag-dependent entries: a range into `vidx`.
+    vars: [u32; 2],
+}
+
+/// The trained members laid out for scoring: one sequential stream of numbers per reading, with
+/// nothing of a base vector's all-zero chunks (a template is quiet outside its contact).
+struct Packed {
+    /// Per member, one after the other: its base vector w/B · S_base without the chunks of eight
+    /// that are all zero (the non-zero chunks, then the entries after the last whole chunk), its
+    /// constant per lag, then per lag-dependent entry its row of corrections over the lags.
+    data: Vec<f64>,
+    /// Per member, its place in `data`, `runs` and `vidx`.
+    slots: Vec<Slot>,
+    /// The runs of non-zero chunks of every member's base vector (chunk indices).
+    runs: Vec<std::ops::Range<u32>>,
+    /// The flat indices (channel·blocks + block) of every member's lag-dependent entries.
+    vidx: Vec<u32>,
+    /// Entries per base vector (used channels × blocks) and lags.
+    dims: usize,
+    lags: usize,
+}
+
+impl Packed {
+    /// Lay out `members` (base vectors of `dims` entries, `lags` lags).
+    fn new(members: &[Member], dims: usize, lags: usize) -> Packed {
+        let whole = dims / 8 * 8;
+        let mut p = Packed {
+            data: Vec::new(),
+            slots: Vec::with_capacity(members.len()),
+            runs: Vec::new(),
+            vidx: Vec::new(),
+            dims,
+            lags,
+        };
+        for m in members {
+            let at = p.data.len() as u32;
+            let runs0 = p.runs.len() as u32;
+            for r in &m.chunks {
+                p.data
+                    .extend_from_slice(&m.base[r.start as usize * 8..r.end as usize * 8]);
+                p.runs.push(r.clone());
+            }
+            let packed = p.data.len() as u32 - at;
+            p.data.extend_from_slice(&m.base[whole..]);
+            p.data.extend_from_slice(&m.cst);
+            p.data.extend_from_slice(&m.dlin);
+            let vars0 = p.vidx.len() as u32;
+            p.vidx.extend_from_slice(&m.vidx);
+            p.slots.push(Slot {
+                at,
+                packed,
+                runs: [runs0, p.runs.len() as u32],
+                vars: [vars0, p.vidx.len() as u32],
+            });
+        }
+        p
+    }
+
+    /// Each member's profile log-likelihood of the block sums `y`: the base dot product plus the
+    /// best lag's correction. The same arithmetic in the same order on every CPU; where the CPU
+    /// has AVX2 the loops are compiled for its wider registers (four sums at once instead of two).
+    fn scores(&self, y: &[f64]) -> Vec<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.scores_avx2(y) };
+        }
+        self.scores_plain(y)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn scores_avx2(&self, y: &[f64]) -> Vec<f64> {
+        self.scores_plain(y)
+    }
+
+    /// The loop of [`Packed::scores`], written as plain loops so that all of it is compiled
+    /// into the caller (an iterator adapter's fold would be a separate function, without the
+    /// caller's AVX2).
+    #[inline(always)]
+    fn scores_plain(&self, y: &[f64]) -> Vec<f64> {
+        let (dims, lags) = (self.dims, self.lags);
+        let tail = dims - dims / 8 * 8;
+        let mut out = Vec::with_capacity(self.slots.len());
+        for s in &self.slots {
+            let runs = &self.runs[s.runs[0] as usize..s.runs[1] as usize];
+            let vidx = &self.vidx[s.vars[0] as usize..s.vars[1] as usize];
+            let at = s.at as usize;
+            let packed = s.packed as usize;
+            let n = packed + tail + lags * (1 + vidx.len());
+            let (a, rest) = self.data[at..at + n].split_at(packed);
+            let (a_tail, rest) = rest.split_at(tail);
+            let (cst, dlin) = rest.split_at(lags);
+            out.push(dot_packed(a, a_tail, y, runs) + best_lag(cst, dlin, vidx, y));
+        }
+        out
+    }
+}
+
+/// The dot product of a base vector packed as [`Packed`] keeps it (`a`: its non-zero chunks of
+/// eight, listed by `runs`; `tail`: its entries after the last whole chunk) with the full vector
+/// `y`: eight independent accumulators over the chunks, summed, plus the tail's sequential sum —
+/// [`dot`] bit for bit (each product of an all-zero chunk is ±0, which leaves every accumulator
+/// as it was).
+#[inline(always)]
+fn dot_packed(a: &[f64], tail: &[f64], y: &[f64], runs: &[std::ops::Range<u32>]) -> f64 {
+    let mut acc = [0.0; 8];
+    let whole = y.len() / 8 * 8;
+    let mut t = -0.0;
+    for (x, y) in tail.iter().zip(&y[whole..]) {
+        t += x * y;
+    }
+    let mut k = 0;
+    for r in runs {
+        for c in r.start as usize..r.end as usize {
+            let (xc, yc) = (&a[k..k + 8], &y[c * 8..c * 8 + 8]);
+            for i in 0..8 {
+                acc[i] += xc[i] * yc[i];
+            }
+            k += 8;
+        }
+    }
+    let mut sum = -0.0;
+    for v in acc {
+        sum += v;
+    }
+    sum + t
+}
+
+/// The best lag's correction: max over the lags o of `cst[o]` + Σ_e y[vidx[e]] · dlin[e][o]
+/// (each lag's sum in the order of the entries), four lags at a time.
+#[inline(always)]
+fn best_lag(cst: &[f64], dlin: &[f64], vidx: &[u32], y: &[f64]) -> f64 {
+    let lags = cst.len();
+    let at = |o: usize| {
+        let mut v = cst[o];
+        for (e, &d) in vidx.iter().enumerate() {
+            v += y[d as usize] * dlin[e * lags + o];
+        }
+        v
+    };
+    let mut best = [f64::NEG_INFINITY; 4];
+    let four = lags / 4 * 4;
+    for o in (0..four).step_by(4) {
+        let mut v = [cst[o], cst[o + 1], cst[o + 2], cst[o + 3]];
+        for (e, &d) in vidx.iter().enumerate() {
+            let yd = y[d as usize];
+            let row = &dlin[e * lags + o..e * lags + o + 4];
+            for i in 0..4 {
+                v[i] += yd * row[i];
+            }
+        }
+        for i in 0..4 {
+            best[i] = best[i].max(v[i]);
+        }
+    }
+    let mut rest = f64::NEG_INFINITY;
+    for o in four..lags {
+        rest = rest.max(at(o));
+    }
+    best[0].max(best[1]).max(best[2].max(best[3])).max(rest)
+}
+
 /// The `likelihood` classifier: a matched filter of the reading against the hypotheses' template
 /// ensembles under the sensor's noise model.
 pub struct Likelihood {
-    /// Members' base vectors w/B · S_base, flat (member × dims).
-    base: Vec<f64>,
-    members: Vec<Member>,
-    /// Members of each hypothesis: a range into `members`.
+    /// The members' numbers, packed for the scoring of a reading.
+    packed: Packed,
+    /// Members of each hypothesis: a range into the packed members.
     ranges: Vec<std::ops::Range<usize>>,
     /// Samples before k_b in the frame, frame length, block length, blocks per channel.
     pre: usize,
     block: usize,
     blocks: usize,
-    lags: usize,
     detector: common::Detector,
     sensor: SensorSettings,
     options: ClassifierOptions,
@@ -248,15 +421,14 @@ impl Frame {
             .collect()
     }
 
-    /// Train one member `s` (contact begin `b`): push its base vector onto `base` and return its
-    /// constant terms and lag-dependent entries.
+    /// Train one member `s` (contact begin `b`): its base vector, constant terms and
+    /// lag-dependent entries.
     fn member(
         &self,
         s: &crate::sensing::ContactSignal,
         b: f64,
         sensor: &SensorSettings,
         dt: f64,
-        base: &mut Vec<f64>,
     ) -> Member {
         let (dims, blocks, block, lags) = (self.dims, self.blocks, self.block, self.lags);
         let w = &self.w;
@@ -264,7 +436,7 @@ impl Frame {
         let sb = &sums[(self.o_base - self.o_lo) as usize];
         let wb = |d: usize| w[d / blocks] / block as f64;
         let cst0: f64 = (0..dims).map(|d| -0.5 * wb(d) * sb[d] * sb[d]).sum();
-        base.extend((0..dims).map(|d| wb(d) * sb[d]));
+        let base: Vec<f64> = (0..dims).map(|d| wb(d) * sb[d]).collect();
         // Lag-dependent entries, most important first.
         let mut imp: Vec<(f64, usize)> = (0..dims)
             .map(|d| {
@@ -288,9 +460,9 @@ impl Frame {
                 cst[o] -= 0.5 * wb(d) * (so[d] * so[d] - sb[d] * sb[d]);
             }
         }
-        let row = &base[base.len() - dims..];
-        let chunks = nonzero_chunks(row);
+        let chunks = nonzero_chunks(&base);
         Member {
+            base,
             cst,
             vidx,
             dlin,
@@ -314,13 +486,11 @@ impl Likelihood {
             // The detector sees none of the templates' contacts at this noise level: no reading
             // of these pushes will be detected either, so every answer is Unknown.
             return Ok(Likelihood {
-                base: Vec::new(),
-                members: Vec::new(),
+                packed: Packed::new(&[], 0, 0),
                 ranges: Vec::new(),
                 pre: 0,
                 block: 1,
                 blocks: 0,
-                lags: 0,
                 detector,
                 sensor: *sensor,
                 options: *options,
@@ -329,25 +499,22 @@ impl Likelihood {
         let f = Frame::new(&survey, sensor, dt);
 
         // Pass 2: block sums per member and lag.
-        let mut base = Vec::new();
         let mut members = Vec::new();
         let mut ranges = Vec::new();
         for ms in &templates.members {
             let start = members.len();
             for s in ms {
                 let Some((b, _)) = s.span() else { continue };
-                members.push(f.member(s, b, sensor, dt, &mut base));
+                members.push(f.member(s, b, sensor, dt));
             }
             ranges.push(start..members.len());
         }
         Ok(Likelihood {
-            base,
-            members,
+            packed: Packed::new(&members, f.dims, f.lags),
             ranges,
             pre: f.pre,
             block: f.block,
             blocks: f.blocks,
-            lags: f.lags,
             detector,
             sensor: *sensor,
             options: *options,
@@ -383,54 +550,14 @@ impl Likelihood {
         Some(y)
     }
 
-    /// Each member's profile log-likelihood of the block sums `y`: the base dot product plus the
-    /// best lag's correction. The same arithmetic in the same order on every CPU; where the CPU
-    /// has AVX2 the loops are compiled for its wider registers (four sums at once instead of two).
-    fn member_scores(&self, y: &[f64]) -> Vec<f64> {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.member_scores_avx2(y) };
-        }
-        self.member_scores_plain(y)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn member_scores_avx2(&self, y: &[f64]) -> Vec<f64> {
-        self.member_scores_plain(y)
-    }
-
-    #[inline(always)]
-    fn member_scores_plain(&self, y: &[f64]) -> Vec<f64> {
-        let dims = y.len();
-        let mut acc = vec![0.0; self.lags];
-        let mut per_member = Vec::with_capacity(self.members.len());
-        for (m, mem) in self.members.iter().enumerate() {
-            let a = &self.base[m * dims..(m + 1) * dims];
-            let lin = dot_chunks(a, y, &mem.chunks);
-            acc.copy_from_slice(&mem.cst);
-            for (e, &d) in mem.vidx.iter().enumerate() {
-                let yd = y[d as usize];
-                let row = &mem.dlin[e * self.lags..(e + 1) * self.lags];
-                for (a, r) in acc.iter_mut().zip(row) {
-                    *a += yd * r;
-                }
-            }
-            let best = acc.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            per_member.push(lin + best);
-        }
-        per_member
-    }
-
     /// log p(reading | h) per hypothesis (up to a common constant); `None` when no contact is
     /// detected.
     pub fn log_likelihoods(&self, r: &Reading) -> Option<Vec<f64>> {
-        if self.members.is_empty() {
+        if self.packed.slots.is_empty() {
             return None;
         }
         let y = self.block_sums(r)?;
-        let per_member = self.member_scores(&y);
+        let per_member = self.packed.scores(&y);
         Some(
             self.ranges
                 .iter()
@@ -463,25 +590,6 @@ fn nonzero_chunks(a: &[f64]) -> Vec<std::ops::Range<u32>> {
         }
     }
     out
-}
-
-/// [`dot`] over the chunks of eight entries listed in `chunks` (and the tail after the last
-/// whole chunk): the same sums in the same order, without the chunks of `a` that are all zero
-/// (each of their products is ±0, which leaves every accumulator as it was).
-#[inline(always)]
-fn dot_chunks(a: &[f64], b: &[f64], chunks: &[std::ops::Range<u32>]) -> f64 {
-    let mut acc = [0.0; 8];
-    let whole = a.len() / 8 * 8;
-    let tail: f64 = a[whole..].iter().zip(&b[whole..]).map(|(x, y)| x * y).sum();
-    for r in chunks {
-        let (lo, hi) = (r.start as usize * 8, r.end as usize * 8);
-        for (x, y) in a[lo..hi].chunks_exact(8).zip(b[lo..hi].chunks_exact(8)) {
-            for i in 0..8 {
-                acc[i] += x[i] * y[i];
-            }
-        }
-    }
-    acc.iter().sum::<f64>() + tail
 }
 
 /// A dot product with eight independent accumulators (a plain sequential sum cannot vectorise).
@@ -544,10 +652,71 @@ mod tests {
                 let b: Vec<f64> = (0..n).map(|_| rng.random_range(-1e3..1e3)).collect();
                 let chunks = nonzero_chunks(&a);
                 assert!(chunks.iter().all(|r| r.start < r.end));
-                assert_eq!(dot_chunks(&a, &b, &chunks).to_bits(), dot(&a, &b).to_bits());
+                let whole = n / 8 * 8;
+                let packed: Vec<f64> = chunks
+                    .iter()
+                    .flat_map(|r| a[r.start as usize * 8..r.end as usize * 8].iter().copied())
+                    .collect();
+                let fast = dot_packed(&packed, &a[whole..], &b, &chunks);
+                assert_eq!(fast.to_bits(), dot(&a, &b).to_bits());
             }
             let zero = vec![0.0; n];
             assert!(nonzero_chunks(&zero).is_empty());
+        }
+    }
+
+    /// A member's score as the plain formula gives it: the full dot product of its base vector,
+    /// then each lag's corrections in entry order, then the largest over the lags.
+    fn naive_score(m: &Member, y: &[f64], lags: usize) -> f64 {
+        let mut acc = m.cst.clone();
+        for (e, &d) in m.vidx.iter().enumerate() {
+            for (o, a) in acc.iter_mut().enumerate() {
+                *a += y[d as usize] * m.dlin[e * lags + o];
+            }
+        }
+        dot(&m.base, y) + acc.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The packed layout (base vectors without their all-zero chunks, constants and lag rows in
+    /// one stream, four lags at a time) scores hand-made members exactly as the plain formula.
+    #[test]
+    fn packed_scores_are_the_plain_formula_bit_for_bit() {
+        let mut rng = crate::random::stream(11, 0);
+        for (dims, lags) in [(5usize, 1usize), (21, 5), (40, 8), (240, 24), (235, 23)] {
+            let members: Vec<Member> = (0..6)
+                .map(|_| {
+                    let base: Vec<f64> = (0..dims)
+                        .map(|i| {
+                            if (i / 7 + rng.random_range(0..3)) % 3 == 0 {
+                                rng.random_range(-1e3..1e3)
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect();
+                    let n_var = rng.random_range(0..=MAX_VARYING.min(dims));
+                    let vidx: Vec<u32> = (0..n_var)
+                        .map(|_| rng.random_range(0..dims) as u32)
+                        .collect();
+                    Member {
+                        chunks: nonzero_chunks(&base),
+                        base,
+                        cst: (0..lags).map(|_| rng.random_range(-1e4..0.0)).collect(),
+                        dlin: (0..n_var * lags)
+                            .map(|_| rng.random_range(-1e2..1e2))
+                            .collect(),
+                        vidx,
+                    }
+                })
+                .collect();
+            let packed = Packed::new(&members, dims, lags);
+            for _ in 0..20 {
+                let y: Vec<f64> = (0..dims).map(|_| rng.random_range(-10.0..10.0)).collect();
+                let fast = packed.scores(&y);
+                for (m, f) in members.iter().zip(&fast) {
+                    assert_eq!(f.to_bits(), naive_score(m, &y, lags).to_bits());
+                }
+            }
         }
     }
 
@@ -583,8 +752,8 @@ mod tests {
             let Some(y) = lik.block_sums(&r) else {
                 continue;
             };
-            let plain = lik.member_scores_plain(&y);
-            let used = lik.member_scores(&y);
+            let plain = lik.packed.scores_plain(&y);
+            let used = lik.packed.scores(&y);
             assert_eq!(plain.len(), 9);
             assert!(plain.iter().all(|x| x.is_finite()));
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
