@@ -64,39 +64,51 @@ struct Member {
     vidx: Vec<u32>,
     /// Per entry and lag: w/B · (S_lag − S_base).
     dlin: Vec<f64>,
-    /// The chunks of eight entries of the member's base vector that hold a non-zero value (a
-    /// template is quiet outside its contact, so the rest of its frame adds nothing).
-    chunks: Vec<std::ops::Range<u32>>,
 }
 
-/// Where one member's numbers sit in [`Packed::data`].
+/// Members scored together: their base vectors' dot products run side by side, which hides
+/// the latency of each one's fixed order of additions.
+const GROUP: usize = 4;
+
+/// Where a group of up to [`GROUP`] consecutive members sits in [`Packed::data`].
 #[derive(Debug, Clone, Copy)]
-struct Slot {
-    /// Offset of the member's numbers in `data`.
+struct Group {
+    /// Offset of the group's base vectors in `data`.
     at: u32,
-    /// Number of its base vector's packed entries (eight per non-zero chunk).
-    packed: u32,
-    /// Its runs of non-zero chunks: a range into `runs`.
+    /// Number of members.
+    len: u32,
+    /// The runs of chunks where one of them is non-zero: a range into `runs`.
     runs: [u32; 2],
+    /// Its first member (index into `lagged`).
+    first: u32,
+}
+
+/// Where one member's lag terms sit in [`Packed::data`].
+#[derive(Debug, Clone, Copy)]
+struct Lagged {
+    /// Offset of its constants per lag (its rows of corrections follow).
+    at: u32,
     /// Its lag-dependent entries: a range into `vidx`.
     vars: [u32; 2],
 }
 
 /// The trained members laid out for scoring: one sequential stream of numbers per reading, with
-/// nothing of a base vector's all-zero chunks (a template is quiet outside its contact).
+/// nothing of the chunks of eight where a group's base vectors are all zero (a template is quiet
+/// outside its contact).
 struct Packed {
-    /// Per member, one after the other: its base vector w/B · S_base without the chunks of eight
-    /// that are all zero (the non-zero chunks, then the entries after the last whole chunk), its
-    /// constant per lag, then per lag-dependent entry its row of corrections over the lags.
+    /// Per group of members: per chunk of eight where one of them is non-zero, the chunk of each
+    /// member in turn; then each member's entries after the last whole chunk; then per member its
+    /// constant per lag and per lag-dependent entry its row of corrections over the lags.
     data: Vec<f64>,
-    /// Per member, its place in `data`, `runs` and `vidx`.
-    slots: Vec<Slot>,
-    /// The runs of non-zero chunks of every member's base vector (chunk indices).
+    /// The groups, in member order.
+    groups: Vec<Group>,
+    /// Per member, its lag terms.
+    lagged: Vec<Lagged>,
+    /// The runs of chunks of every group (chunk indices).
     runs: Vec<std::ops::Range<u32>>,
     /// The flat indices (channel·blocks + block) of every member's lag-dependent entries.
     vidx: Vec<u32>,
-    /// Entries per base vector (used channels × blocks) and lags.
-    dims: usize,
+    /// Lags per member.
     lags: usize,
 }
 
@@ -106,32 +118,48 @@ impl Packed {
         let whole = dims / 8 * 8;
         let mut p = Packed {
             data: Vec::new(),
-            slots: Vec::with_capacity(members.len()),
+            groups: Vec::new(),
+            lagged: Vec::with_capacity(members.len()),
             runs: Vec::new(),
             vidx: Vec::new(),
-            dims,
             lags,
         };
-        for m in members {
+        for (g, ms) in members.chunks(GROUP).enumerate() {
             let at = p.data.len() as u32;
             let runs0 = p.runs.len() as u32;
-            for r in &m.chunks {
-                p.data
-                    .extend_from_slice(&m.base[r.start as usize * 8..r.end as usize * 8]);
-                p.runs.push(r.clone());
+            let mut union = vec![0.0; dims];
+            for m in ms {
+                for (u, x) in union.iter_mut().zip(&m.base) {
+                    *u = if *x == 0.0 { *u } else { 1.0 };
+                }
             }
-            let packed = p.data.len() as u32 - at;
-            p.data.extend_from_slice(&m.base[whole..]);
-            p.data.extend_from_slice(&m.cst);
-            p.data.extend_from_slice(&m.dlin);
-            let vars0 = p.vidx.len() as u32;
-            p.vidx.extend_from_slice(&m.vidx);
-            p.slots.push(Slot {
+            for r in nonzero_chunks(&union) {
+                for c in r.start as usize..r.end as usize {
+                    for m in ms {
+                        p.data.extend_from_slice(&m.base[c * 8..c * 8 + 8]);
+                    }
+                }
+                p.runs.push(r);
+            }
+            for m in ms {
+                p.data.extend_from_slice(&m.base[whole..]);
+            }
+            p.groups.push(Group {
                 at,
-                packed,
+                len: ms.len() as u32,
                 runs: [runs0, p.runs.len() as u32],
-                vars: [vars0, p.vidx.len() as u32],
+                first: (g * GROUP) as u32,
             });
+            for m in ms {
+                let vars0 = p.vidx.len() as u32;
+                p.vidx.extend_from_slice(&m.vidx);
+                p.lagged.push(Lagged {
+                    at: p.data.len() as u32,
+                    vars: [vars0, p.vidx.len() as u32],
+                });
+                p.data.extend_from_slice(&m.cst);
+                p.data.extend_from_slice(&m.dlin);
+            }
         }
         p
     }
@@ -159,52 +187,69 @@ impl Packed {
     /// caller's AVX2).
     #[inline(always)]
     fn scores_plain(&self, y: &[f64]) -> Vec<f64> {
-        let (dims, lags) = (self.dims, self.lags);
-        let tail = dims - dims / 8 * 8;
-        let mut out = Vec::with_capacity(self.slots.len());
-        for s in &self.slots {
-            let runs = &self.runs[s.runs[0] as usize..s.runs[1] as usize];
-            let vidx = &self.vidx[s.vars[0] as usize..s.vars[1] as usize];
-            let at = s.at as usize;
-            let packed = s.packed as usize;
-            let n = packed + tail + lags * (1 + vidx.len());
-            let (a, rest) = self.data[at..at + n].split_at(packed);
-            let (a_tail, rest) = rest.split_at(tail);
-            let (cst, dlin) = rest.split_at(lags);
-            out.push(dot_packed(a, a_tail, y, runs) + best_lag(cst, dlin, vidx, y));
+        let lags = self.lags;
+        let mut out = Vec::with_capacity(self.lagged.len());
+        let mut lin = [0.0; GROUP];
+        for g in &self.groups {
+            let runs = &self.runs[g.runs[0] as usize..g.runs[1] as usize];
+            let a = &self.data[g.at as usize..];
+            match g.len {
+                4 => lin = dot_group::<4>(a, y, runs),
+                3 => lin[..3].copy_from_slice(&dot_group::<3>(a, y, runs)),
+                2 => lin[..2].copy_from_slice(&dot_group::<2>(a, y, runs)),
+                _ => lin[..1].copy_from_slice(&dot_group::<1>(a, y, runs)),
+            }
+            let first = g.first as usize;
+            for (j, l) in self.lagged[first..first + g.len as usize]
+                .iter()
+                .enumerate()
+            {
+                let vidx = &self.vidx[l.vars[0] as usize..l.vars[1] as usize];
+                let at = l.at as usize;
+                let (cst, dlin) = self.data[at..at + lags * (1 + vidx.len())].split_at(lags);
+                out.push(lin[j] + best_lag(cst, dlin, vidx, y));
+            }
         }
         out
     }
 }
 
-/// The dot product of a base vector packed as [`Packed`] keeps it (`a`: its non-zero chunks of
-/// eight, listed by `runs`; `tail`: its entries after the last whole chunk) with the full vector
-/// `y`: eight independent accumulators over the chunks, summed, plus the tail's sequential sum —
-/// [`dot`] bit for bit (each product of an all-zero chunk is ±0, which leaves every accumulator
-/// as it was).
+/// The dot products of `G` base vectors packed as [`Packed`] keeps a group (`a`: per chunk of
+/// eight listed by `runs`, each vector's chunk in turn, then each vector's entries after the last
+/// whole chunk) with the full vector `y`. Per vector: eight independent accumulators over the
+/// chunks, summed, plus the tail's sequential sum — [`dot`] bit for bit (a product with an
+/// all-zero chunk is ±0, which leaves an accumulator as it was).
 #[inline(always)]
-fn dot_packed(a: &[f64], tail: &[f64], y: &[f64], runs: &[std::ops::Range<u32>]) -> f64 {
-    let mut acc = [0.0; 8];
+fn dot_group<const G: usize>(a: &[f64], y: &[f64], runs: &[std::ops::Range<u32>]) -> [f64; G] {
+    let mut acc = [[0.0; 8]; G];
     let whole = y.len() / 8 * 8;
-    let mut t = -0.0;
-    for (x, y) in tail.iter().zip(&y[whole..]) {
-        t += x * y;
-    }
     let mut k = 0;
     for r in runs {
         for c in r.start as usize..r.end as usize {
-            let (xc, yc) = (&a[k..k + 8], &y[c * 8..c * 8 + 8]);
-            for i in 0..8 {
-                acc[i] += xc[i] * yc[i];
+            let yc: &[f64; 8] = y[c * 8..c * 8 + 8].try_into().expect("a chunk");
+            for (j, acc) in acc.iter_mut().enumerate() {
+                let xc: &[f64; 8] = a[k + j * 8..k + j * 8 + 8].try_into().expect("a chunk");
+                for i in 0..8 {
+                    acc[i] += xc[i] * yc[i];
+                }
             }
-            k += 8;
+            k += 8 * G;
         }
     }
-    let mut sum = -0.0;
-    for v in acc {
-        sum += v;
+    let tail = y.len() - whole;
+    let mut out = [0.0; G];
+    for (j, o) in out.iter_mut().enumerate() {
+        let mut t = -0.0;
+        for i in 0..tail {
+            t += a[k + j * tail + i] * y[whole + i];
+        }
+        let mut sum = -0.0;
+        for v in acc[j] {
+            sum += v;
+        }
+        *o = sum + t;
     }
-    sum + t
+    out
 }
 
 /// The best lag's correction: max over the lags o of `cst[o]` + Σ_e y[vidx[e]] · dlin[e][o]
@@ -212,20 +257,19 @@ fn dot_packed(a: &[f64], tail: &[f64], y: &[f64], runs: &[std::ops::Range<u32>])
 #[inline(always)]
 fn best_lag(cst: &[f64], dlin: &[f64], vidx: &[u32], y: &[f64]) -> f64 {
     let lags = cst.len();
-    let at = |o: usize| {
-        let mut v = cst[o];
-        for (e, &d) in vidx.iter().enumerate() {
-            v += y[d as usize] * dlin[e * lags + o];
-        }
-        v
-    };
+    let mut ys = [0.0; MAX_VARYING];
+    for (v, &d) in ys.iter_mut().zip(vidx) {
+        *v = y[d as usize];
+    }
+    let ys = &ys[..vidx.len()];
     let mut best = [f64::NEG_INFINITY; 4];
     let four = lags / 4 * 4;
     for o in (0..four).step_by(4) {
-        let mut v = [cst[o], cst[o + 1], cst[o + 2], cst[o + 3]];
-        for (e, &d) in vidx.iter().enumerate() {
-            let yd = y[d as usize];
-            let row = &dlin[e * lags + o..e * lags + o + 4];
+        let mut v: [f64; 4] = cst[o..o + 4].try_into().expect("four lags");
+        for (e, &yd) in ys.iter().enumerate() {
+            let row: &[f64; 4] = dlin[e * lags + o..e * lags + o + 4]
+                .try_into()
+                .expect("four lags");
             for i in 0..4 {
                 v[i] += yd * row[i];
             }
@@ -236,7 +280,11 @@ fn best_lag(cst: &[f64], dlin: &[f64], vidx: &[u32], y: &[f64]) -> f64 {
     }
     let mut rest = f64::NEG_INFINITY;
     for o in four..lags {
-        rest = rest.max(at(o));
+        let mut v = cst[o];
+        for (e, &yd) in ys.iter().enumerate() {
+            v += yd * dlin[e * lags + o];
+        }
+        rest = rest.max(v);
     }
     best[0].max(best[1]).max(best[2].max(best[3])).max(rest)
 }
@@ -460,13 +508,11 @@ impl Frame {
                 cst[o] -= 0.5 * wb(d) * (so[d] * so[d] - sb[d] * sb[d]);
             }
         }
-        let chunks = nonzero_chunks(&base);
         Member {
             base,
             cst,
             vidx,
             dlin,
-            chunks,
         }
     }
 }
@@ -553,7 +599,7 @@ impl Likelihood {
     /// log p(reading | h) per hypothesis (up to a common constant); `None` when no contact is
     /// detected.
     pub fn log_likelihoods(&self, r: &Reading) -> Option<Vec<f64>> {
-        if self.packed.slots.is_empty() {
+        if self.packed.lagged.is_empty() {
             return None;
         }
         let y = self.block_sums(r)?;
@@ -576,7 +622,7 @@ impl Likelihood {
 }
 
 /// The runs of whole chunks of eight entries of `a` that hold a non-zero value, as chunk index
-/// ranges; the entries after the last whole chunk are always summed (see [`dot_chunks`]).
+/// ranges; the entries after the last whole chunk are always summed (see [`dot_group`]).
 fn nonzero_chunks(a: &[f64]) -> Vec<std::ops::Range<u32>> {
     let mut out: Vec<std::ops::Range<u32>> = Vec::new();
     for (k, c) in a.chunks_exact(8).enumerate() {
@@ -632,6 +678,25 @@ mod tests {
     use super::*;
     use rand::RngExt;
 
+    /// `n` values in (−`scale`, `scale`) broken by quiet runs (zeros) of random length about
+    /// `run`, as a template's base vector outside its contact.
+    fn quiet_runs(
+        rng: &mut crate::random::ChaCha8Rng,
+        n: usize,
+        run: usize,
+        scale: f64,
+    ) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                if (i / run + rng.random_range(0..3)) % 3 == 0 {
+                    rng.random_range(-scale..scale)
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+
     /// Skipping the all-zero chunks of a template's base vector gives the full dot product bit
     /// for bit, for every pattern of quiet runs and lengths that are not a multiple of eight.
     #[test]
@@ -639,16 +704,7 @@ mod tests {
         let mut rng = crate::random::stream(7, 0);
         for n in [1usize, 7, 8, 9, 40, 235, 240] {
             for _ in 0..200 {
-                let a: Vec<f64> = (0..n)
-                    .map(|i| {
-                        // Quiet runs of random length, as a template outside its contact.
-                        if (i / 5 + rng.random_range(0..3)) % 3 == 0 {
-                            rng.random_range(-1e6..1e6)
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect();
+                let a = quiet_runs(&mut rng, n, 5, 1e6);
                 let b: Vec<f64> = (0..n).map(|_| rng.random_range(-1e3..1e3)).collect();
                 let chunks = nonzero_chunks(&a);
                 assert!(chunks.iter().all(|r| r.start < r.end));
@@ -657,7 +713,8 @@ mod tests {
                     .iter()
                     .flat_map(|r| a[r.start as usize * 8..r.end as usize * 8].iter().copied())
                     .collect();
-                let fast = dot_packed(&packed, &a[whole..], &b, &chunks);
+                let packed = [packed, a[whole..].to_vec()].concat();
+                let [fast] = dot_group::<1>(&packed, &b, &chunks);
                 assert_eq!(fast.to_bits(), dot(&a, &b).to_bits());
             }
             let zero = vec![0.0; n];
@@ -685,21 +742,12 @@ mod tests {
         for (dims, lags) in [(5usize, 1usize), (21, 5), (40, 8), (240, 24), (235, 23)] {
             let members: Vec<Member> = (0..6)
                 .map(|_| {
-                    let base: Vec<f64> = (0..dims)
-                        .map(|i| {
-                            if (i / 7 + rng.random_range(0..3)) % 3 == 0 {
-                                rng.random_range(-1e3..1e3)
-                            } else {
-                                0.0
-                            }
-                        })
-                        .collect();
+                    let base = quiet_runs(&mut rng, dims, 7, 1e3);
                     let n_var = rng.random_range(0..=MAX_VARYING.min(dims));
                     let vidx: Vec<u32> = (0..n_var)
                         .map(|_| rng.random_range(0..dims) as u32)
                         .collect();
                     Member {
-                        chunks: nonzero_chunks(&base),
                         base,
                         cst: (0..lags).map(|_| rng.random_range(-1e4..0.0)).collect(),
                         dlin: (0..n_var * lags)
