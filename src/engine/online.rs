@@ -109,6 +109,8 @@ pub struct OnlineModel {
     homes: Vec<Target>,
     /// success[a · H + h].
     success: Vec<f64>,
+    /// The same table hypothesis by hypothesis: success[h · A + a] (what a decision reads).
+    by_hypothesis: Vec<f64>,
     /// Members per hypothesis.
     pub samples: usize,
     /// Line runs the build took (a run through one stretch of the line counts one).
@@ -146,6 +148,13 @@ fn success_table(
         }
     }
     success
+}
+
+/// `table` (rows × cols, row-major) column by column: out[c · rows + r] = table[r · cols + c].
+fn transpose(table: &[f64], rows: usize, cols: usize) -> Vec<f64> {
+    (0..cols * rows)
+        .map(|k| table[(k % rows) * cols + k / rows])
+        .collect()
 }
 
 /// A sensor's held-out trials: each one's hypothesis and the evidence of its reading.
@@ -308,6 +317,7 @@ impl OnlineModel {
         let n_h = hypotheses.len();
         let order = staging.prefix_of_actions(&options);
         let success = success_table(&outs, &order, actions.len(), n_h, s);
+        let actions_len = actions.len();
         let mut sensors = Vec::new();
         let mut held_trials = Vec::new();
         for (i, &j) in sensor_obstacles.iter().enumerate() {
@@ -326,6 +336,7 @@ impl OnlineModel {
             actions,
             options,
             homes,
+            by_hypothesis: transpose(&success, actions_len, n_h),
             success,
             samples: s,
             runs: runs_taken + held_out.len() as u64,
@@ -389,14 +400,7 @@ impl OnlineModel {
     /// happen to stand), so a rule table can reproduce it.
     pub fn choose(&self, belief: &Belief) -> Choice {
         let current = &self.homes;
-        let n_h = self.hypotheses.len();
-        let w = belief.probabilities();
-        let p: Vec<f64> = (0..self.actions.len())
-            .map(|a| {
-                let row = &self.success[a * n_h..(a + 1) * n_h];
-                w.iter().zip(row).map(|(w, s)| w * s).sum()
-            })
-            .collect();
+        let p = self.predictions(belief);
         // The tie-breakers are computed only for actions within TIE of the best so far: the
         // same sequential comparison, without the neighbours of every action.
         let around = |a: usize| {
@@ -426,6 +430,25 @@ impl OnlineModel {
             action: best,
             predicted: p[best].clamp(0.0, 1.0),
         }
+    }
+
+    /// P(goal | a) = Σ_h p(h) · success[a][h] for every action a, each sum in the order of the
+    /// hypotheses, all actions at once (hypothesis by hypothesis over the transposed table). A
+    /// hypothesis of probability 0 is skipped: its products are +0, which leave every sum as it
+    /// was (each is +0 or positive).
+    fn predictions(&self, belief: &Belief) -> Vec<f64> {
+        let n_a = self.actions.len();
+        let mut p = vec![0.0; n_a];
+        for (h, w) in belief.probabilities().into_iter().enumerate() {
+            if w == 0.0 {
+                continue;
+            }
+            let row = &self.by_hypothesis[h * n_a..(h + 1) * n_a];
+            for (pa, s) in p.iter_mut().zip(row) {
+                *pa += w * s;
+            }
+        }
+        p
     }
 
     /// The actions one grid step of one pin away from action `a`.

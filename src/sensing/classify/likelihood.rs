@@ -54,31 +54,252 @@ pub const MAX_VARYING: usize = 8;
 /// Largest number of lags searched.
 pub const MAX_LAGS: usize = 24;
 
+/// One member of an ensemble as training leaves it (packed into [`Likelihood::data`] after).
 struct Member {
+    /// The base vector w/B · S_base (used channels × blocks).
+    base: Vec<f64>,
     /// Σ −½ w/B S_base² plus, per lag, the lag's correction of that term.
     cst: Vec<f64>,
     /// Flat indices (channel·blocks + block) of the lag-dependent entries.
     vidx: Vec<u32>,
     /// Per entry and lag: w/B · (S_lag − S_base).
     dlin: Vec<f64>,
-    /// The chunks of eight entries of the member's base vector that hold a non-zero value (a
-    /// template is quiet outside its contact, so the rest of its frame adds nothing).
-    chunks: Vec<std::ops::Range<u32>>,
+}
+
+/// Members scored together: their base vectors' dot products run side by side, which hides
+/// the latency of each one's fixed order of additions.
+const GROUP: usize = 4;
+
+/// Where a group of up to [`GROUP`] consecutive members sits in [`Packed::data`].
+#[derive(Debug, Clone, Copy)]
+struct Group {
+    /// Offset of the group's base vectors in `data`.
+    at: u32,
+    /// Number of members.
+    len: u32,
+    /// The runs of chunks where one of them is non-zero: a range into `runs`.
+    runs: [u32; 2],
+    /// Its first member (index into `lagged`).
+    first: u32,
+}
+
+/// Where one member's lag terms sit in [`Packed::data`].
+#[derive(Debug, Clone, Copy)]
+struct Lagged {
+    /// Offset of its constants per lag (its rows of corrections follow).
+    at: u32,
+    /// Its lag-dependent entries: a range into `vidx`.
+    vars: [u32; 2],
+}
+
+/// The trained members laid out for scoring: one sequential stream of numbers per reading, with
+/// nothing of the chunks of eight where a group's base vectors are all zero (a template is quiet
+/// outside its contact).
+struct Packed {
+    /// Per group of members: per chunk of eight where one of them is non-zero, the chunk of each
+    /// member in turn; then each member's entries after the last whole chunk; then per member its
+    /// constant per lag and per lag-dependent entry its row of corrections over the lags.
+    data: Vec<f64>,
+    /// The groups, in member order.
+    groups: Vec<Group>,
+    /// Per member, its lag terms.
+    lagged: Vec<Lagged>,
+    /// The runs of chunks of every group (chunk indices).
+    runs: Vec<std::ops::Range<u32>>,
+    /// The flat indices (channel·blocks + block) of every member's lag-dependent entries.
+    vidx: Vec<u32>,
+    /// Lags per member.
+    lags: usize,
+}
+
+impl Packed {
+    /// Lay out `members` (base vectors of `dims` entries, `lags` lags).
+    fn new(members: &[Member], dims: usize, lags: usize) -> Packed {
+        let whole = dims / 8 * 8;
+        let mut p = Packed {
+            data: Vec::new(),
+            groups: Vec::new(),
+            lagged: Vec::with_capacity(members.len()),
+            runs: Vec::new(),
+            vidx: Vec::new(),
+            lags,
+        };
+        for (g, ms) in members.chunks(GROUP).enumerate() {
+            let at = p.data.len() as u32;
+            let runs0 = p.runs.len() as u32;
+            let mut union = vec![0.0; dims];
+            for m in ms {
+                for (u, x) in union.iter_mut().zip(&m.base) {
+                    *u = if *x == 0.0 { *u } else { 1.0 };
+                }
+            }
+            for r in nonzero_chunks(&union) {
+                for c in r.start as usize..r.end as usize {
+                    for m in ms {
+                        p.data.extend_from_slice(&m.base[c * 8..c * 8 + 8]);
+                    }
+                }
+                p.runs.push(r);
+            }
+            for m in ms {
+                p.data.extend_from_slice(&m.base[whole..]);
+            }
+            p.groups.push(Group {
+                at,
+                len: ms.len() as u32,
+                runs: [runs0, p.runs.len() as u32],
+                first: (g * GROUP) as u32,
+            });
+            for m in ms {
+                let vars0 = p.vidx.len() as u32;
+                p.vidx.extend_from_slice(&m.vidx);
+                p.lagged.push(Lagged {
+                    at: p.data.len() as u32,
+                    vars: [vars0, p.vidx.len() as u32],
+                });
+                p.data.extend_from_slice(&m.cst);
+                p.data.extend_from_slice(&m.dlin);
+            }
+        }
+        p
+    }
+
+    /// Each member's profile log-likelihood of the block sums `y`: the base dot product plus the
+    /// best lag's correction. The same arithmetic in the same order on every CPU; where the CPU
+    /// has AVX2 the loops are compiled for its wider registers (four sums at once instead of two).
+    fn scores(&self, y: &[f64]) -> Vec<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.scores_avx2(y) };
+        }
+        self.scores_plain(y)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn scores_avx2(&self, y: &[f64]) -> Vec<f64> {
+        self.scores_plain(y)
+    }
+
+    /// The loop of [`Packed::scores`], written as plain loops so that all of it is compiled
+    /// into the caller (an iterator adapter's fold would be a separate function, without the
+    /// caller's AVX2).
+    #[inline(always)]
+    fn scores_plain(&self, y: &[f64]) -> Vec<f64> {
+        let lags = self.lags;
+        let mut out = Vec::with_capacity(self.lagged.len());
+        let mut lin = [0.0; GROUP];
+        for g in &self.groups {
+            let runs = &self.runs[g.runs[0] as usize..g.runs[1] as usize];
+            let a = &self.data[g.at as usize..];
+            match g.len {
+                4 => lin = dot_group::<4>(a, y, runs),
+                3 => lin[..3].copy_from_slice(&dot_group::<3>(a, y, runs)),
+                2 => lin[..2].copy_from_slice(&dot_group::<2>(a, y, runs)),
+                _ => lin[..1].copy_from_slice(&dot_group::<1>(a, y, runs)),
+            }
+            let first = g.first as usize;
+            for (j, l) in self.lagged[first..first + g.len as usize]
+                .iter()
+                .enumerate()
+            {
+                let vidx = &self.vidx[l.vars[0] as usize..l.vars[1] as usize];
+                let at = l.at as usize;
+                let (cst, dlin) = self.data[at..at + lags * (1 + vidx.len())].split_at(lags);
+                out.push(lin[j] + best_lag(cst, dlin, vidx, y));
+            }
+        }
+        out
+    }
+}
+
+/// The dot products of `G` base vectors packed as [`Packed`] keeps a group (`a`: per chunk of
+/// eight listed by `runs`, each vector's chunk in turn, then each vector's entries after the last
+/// whole chunk) with the full vector `y`. Per vector: eight independent accumulators over the
+/// chunks, summed, plus the tail's sequential sum — [`dot`] bit for bit (a product with an
+/// all-zero chunk is ±0, which leaves an accumulator as it was).
+#[inline(always)]
+fn dot_group<const G: usize>(a: &[f64], y: &[f64], runs: &[std::ops::Range<u32>]) -> [f64; G] {
+    let mut acc = [[0.0; 8]; G];
+    let whole = y.len() / 8 * 8;
+    let mut k = 0;
+    for r in runs {
+        for c in r.start as usize..r.end as usize {
+            let yc: &[f64; 8] = y[c * 8..c * 8 + 8].try_into().expect("a chunk");
+            for (j, acc) in acc.iter_mut().enumerate() {
+                let xc: &[f64; 8] = a[k + j * 8..k + j * 8 + 8].try_into().expect("a chunk");
+                for i in 0..8 {
+                    acc[i] += xc[i] * yc[i];
+                }
+            }
+            k += 8 * G;
+        }
+    }
+    let tail = y.len() - whole;
+    let mut out = [0.0; G];
+    for (j, o) in out.iter_mut().enumerate() {
+        let mut t = -0.0;
+        for i in 0..tail {
+            t += a[k + j * tail + i] * y[whole + i];
+        }
+        let mut sum = -0.0;
+        for v in acc[j] {
+            sum += v;
+        }
+        *o = sum + t;
+    }
+    out
+}
+
+/// The best lag's correction: max over the lags o of `cst[o]` + Σ_e y[vidx[e]] · dlin[e][o]
+/// (each lag's sum in the order of the entries), four lags at a time.
+#[inline(always)]
+fn best_lag(cst: &[f64], dlin: &[f64], vidx: &[u32], y: &[f64]) -> f64 {
+    let lags = cst.len();
+    let mut ys = [0.0; MAX_VARYING];
+    for (v, &d) in ys.iter_mut().zip(vidx) {
+        *v = y[d as usize];
+    }
+    let ys = &ys[..vidx.len()];
+    let mut best = [f64::NEG_INFINITY; 4];
+    let four = lags / 4 * 4;
+    for o in (0..four).step_by(4) {
+        let mut v: [f64; 4] = cst[o..o + 4].try_into().expect("four lags");
+        for (e, &yd) in ys.iter().enumerate() {
+            let row: &[f64; 4] = dlin[e * lags + o..e * lags + o + 4]
+                .try_into()
+                .expect("four lags");
+            for i in 0..4 {
+                v[i] += yd * row[i];
+            }
+        }
+        for i in 0..4 {
+            best[i] = best[i].max(v[i]);
+        }
+    }
+    let mut rest = f64::NEG_INFINITY;
+    for o in four..lags {
+        let mut v = cst[o];
+        for (e, &yd) in ys.iter().enumerate() {
+            v += yd * dlin[e * lags + o];
+        }
+        rest = rest.max(v);
+    }
+    best[0].max(best[1]).max(best[2].max(best[3])).max(rest)
 }
 
 /// The `likelihood` classifier: a matched filter of the reading against the hypotheses' template
 /// ensembles under the sensor's noise model.
 pub struct Likelihood {
-    /// Members' base vectors w/B · S_base, flat (member × dims).
-    base: Vec<f64>,
-    members: Vec<Member>,
-    /// Members of each hypothesis: a range into `members`.
+    /// The members' numbers, packed for the scoring of a reading.
+    packed: Packed,
+    /// Members of each hypothesis: a range into the packed members.
     ranges: Vec<std::ops::Range<usize>>,
     /// Samples before k_b in the frame, frame length, block length, blocks per channel.
     pre: usize,
     block: usize,
     blocks: usize,
-    lags: usize,
     detector: common::Detector,
     sensor: SensorSettings,
     options: ClassifierOptions,
@@ -248,15 +469,14 @@ impl Frame {
             .collect()
     }
 
-    /// Train one member `s` (contact begin `b`): push its base vector onto `base` and return its
-    /// constant terms and lag-dependent entries.
+    /// Train one member `s` (contact begin `b`): its base vector, constant terms and
+    /// lag-dependent entries.
     fn member(
         &self,
         s: &crate::sensing::ContactSignal,
         b: f64,
         sensor: &SensorSettings,
         dt: f64,
-        base: &mut Vec<f64>,
     ) -> Member {
         let (dims, blocks, block, lags) = (self.dims, self.blocks, self.block, self.lags);
         let w = &self.w;
@@ -264,7 +484,7 @@ impl Frame {
         let sb = &sums[(self.o_base - self.o_lo) as usize];
         let wb = |d: usize| w[d / blocks] / block as f64;
         let cst0: f64 = (0..dims).map(|d| -0.5 * wb(d) * sb[d] * sb[d]).sum();
-        base.extend((0..dims).map(|d| wb(d) * sb[d]));
+        let base: Vec<f64> = (0..dims).map(|d| wb(d) * sb[d]).collect();
         // Lag-dependent entries, most important first.
         let mut imp: Vec<(f64, usize)> = (0..dims)
             .map(|d| {
@@ -288,13 +508,11 @@ impl Frame {
                 cst[o] -= 0.5 * wb(d) * (so[d] * so[d] - sb[d] * sb[d]);
             }
         }
-        let row = &base[base.len() - dims..];
-        let chunks = nonzero_chunks(row);
         Member {
+            base,
             cst,
             vidx,
             dlin,
-            chunks,
         }
     }
 }
@@ -314,13 +532,11 @@ impl Likelihood {
             // The detector sees none of the templates' contacts at this noise level: no reading
             // of these pushes will be detected either, so every answer is Unknown.
             return Ok(Likelihood {
-                base: Vec::new(),
-                members: Vec::new(),
+                packed: Packed::new(&[], 0, 0),
                 ranges: Vec::new(),
                 pre: 0,
                 block: 1,
                 blocks: 0,
-                lags: 0,
                 detector,
                 sensor: *sensor,
                 options: *options,
@@ -329,25 +545,22 @@ impl Likelihood {
         let f = Frame::new(&survey, sensor, dt);
 
         // Pass 2: block sums per member and lag.
-        let mut base = Vec::new();
         let mut members = Vec::new();
         let mut ranges = Vec::new();
         for ms in &templates.members {
             let start = members.len();
             for s in ms {
                 let Some((b, _)) = s.span() else { continue };
-                members.push(f.member(s, b, sensor, dt, &mut base));
+                members.push(f.member(s, b, sensor, dt));
             }
             ranges.push(start..members.len());
         }
         Ok(Likelihood {
-            base,
-            members,
+            packed: Packed::new(&members, f.dims, f.lags),
             ranges,
             pre: f.pre,
             block: f.block,
             blocks: f.blocks,
-            lags: f.lags,
             detector,
             sensor: *sensor,
             options: *options,
@@ -383,54 +596,14 @@ impl Likelihood {
         Some(y)
     }
 
-    /// Each member's profile log-likelihood of the block sums `y`: the base dot product plus the
-    /// best lag's correction. The same arithmetic in the same order on every CPU; where the CPU
-    /// has AVX2 the loops are compiled for its wider registers (four sums at once instead of two).
-    fn member_scores(&self, y: &[f64]) -> Vec<f64> {
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.member_scores_avx2(y) };
-        }
-        self.member_scores_plain(y)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn member_scores_avx2(&self, y: &[f64]) -> Vec<f64> {
-        self.member_scores_plain(y)
-    }
-
-    #[inline(always)]
-    fn member_scores_plain(&self, y: &[f64]) -> Vec<f64> {
-        let dims = y.len();
-        let mut acc = vec![0.0; self.lags];
-        let mut per_member = Vec::with_capacity(self.members.len());
-        for (m, mem) in self.members.iter().enumerate() {
-            let a = &self.base[m * dims..(m + 1) * dims];
-            let lin = dot_chunks(a, y, &mem.chunks);
-            acc.copy_from_slice(&mem.cst);
-            for (e, &d) in mem.vidx.iter().enumerate() {
-                let yd = y[d as usize];
-                let row = &mem.dlin[e * self.lags..(e + 1) * self.lags];
-                for (a, r) in acc.iter_mut().zip(row) {
-                    *a += yd * r;
-                }
-            }
-            let best = acc.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            per_member.push(lin + best);
-        }
-        per_member
-    }
-
     /// log p(reading | h) per hypothesis (up to a common constant); `None` when no contact is
     /// detected.
     pub fn log_likelihoods(&self, r: &Reading) -> Option<Vec<f64>> {
-        if self.members.is_empty() {
+        if self.packed.lagged.is_empty() {
             return None;
         }
         let y = self.block_sums(r)?;
-        let per_member = self.member_scores(&y);
+        let per_member = self.packed.scores(&y);
         Some(
             self.ranges
                 .iter()
@@ -449,7 +622,7 @@ impl Likelihood {
 }
 
 /// The runs of whole chunks of eight entries of `a` that hold a non-zero value, as chunk index
-/// ranges; the entries after the last whole chunk are always summed (see [`dot_chunks`]).
+/// ranges; the entries after the last whole chunk are always summed (see [`dot_group`]).
 fn nonzero_chunks(a: &[f64]) -> Vec<std::ops::Range<u32>> {
     let mut out: Vec<std::ops::Range<u32>> = Vec::new();
     for (k, c) in a.chunks_exact(8).enumerate() {
@@ -463,25 +636,6 @@ fn nonzero_chunks(a: &[f64]) -> Vec<std::ops::Range<u32>> {
         }
     }
     out
-}
-
-/// [`dot`] over the chunks of eight entries listed in `chunks` (and the tail after the last
-/// whole chunk): the same sums in the same order, without the chunks of `a` that are all zero
-/// (each of their products is ±0, which leaves every accumulator as it was).
-#[inline(always)]
-fn dot_chunks(a: &[f64], b: &[f64], chunks: &[std::ops::Range<u32>]) -> f64 {
-    let mut acc = [0.0; 8];
-    let whole = a.len() / 8 * 8;
-    let tail: f64 = a[whole..].iter().zip(&b[whole..]).map(|(x, y)| x * y).sum();
-    for r in chunks {
-        let (lo, hi) = (r.start as usize * 8, r.end as usize * 8);
-        for (x, y) in a[lo..hi].chunks_exact(8).zip(b[lo..hi].chunks_exact(8)) {
-            for i in 0..8 {
-                acc[i] += x[i] * y[i];
-            }
-        }
-    }
-    acc.iter().sum::<f64>() + tail
 }
 
 /// A dot product with eight independent accumulators (a plain sequential sum cannot vectorise).
@@ -524,6 +678,25 @@ mod tests {
     use super::*;
     use rand::RngExt;
 
+    /// `n` values in (−`scale`, `scale`) broken by quiet runs (zeros) of random length about
+    /// `run`, as a template's base vector outside its contact.
+    fn quiet_runs(
+        rng: &mut crate::random::ChaCha8Rng,
+        n: usize,
+        run: usize,
+        scale: f64,
+    ) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                if (i / run + rng.random_range(0..3)) % 3 == 0 {
+                    rng.random_range(-scale..scale)
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+
     /// Skipping the all-zero chunks of a template's base vector gives the full dot product bit
     /// for bit, for every pattern of quiet runs and lengths that are not a multiple of eight.
     #[test]
@@ -531,23 +704,67 @@ mod tests {
         let mut rng = crate::random::stream(7, 0);
         for n in [1usize, 7, 8, 9, 40, 235, 240] {
             for _ in 0..200 {
-                let a: Vec<f64> = (0..n)
-                    .map(|i| {
-                        // Quiet runs of random length, as a template outside its contact.
-                        if (i / 5 + rng.random_range(0..3)) % 3 == 0 {
-                            rng.random_range(-1e6..1e6)
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect();
+                let a = quiet_runs(&mut rng, n, 5, 1e6);
                 let b: Vec<f64> = (0..n).map(|_| rng.random_range(-1e3..1e3)).collect();
                 let chunks = nonzero_chunks(&a);
                 assert!(chunks.iter().all(|r| r.start < r.end));
-                assert_eq!(dot_chunks(&a, &b, &chunks).to_bits(), dot(&a, &b).to_bits());
+                let whole = n / 8 * 8;
+                let packed: Vec<f64> = chunks
+                    .iter()
+                    .flat_map(|r| a[r.start as usize * 8..r.end as usize * 8].iter().copied())
+                    .collect();
+                let packed = [packed, a[whole..].to_vec()].concat();
+                let [fast] = dot_group::<1>(&packed, &b, &chunks);
+                assert_eq!(fast.to_bits(), dot(&a, &b).to_bits());
             }
             let zero = vec![0.0; n];
             assert!(nonzero_chunks(&zero).is_empty());
+        }
+    }
+
+    /// A member's score as the plain formula gives it: the full dot product of its base vector,
+    /// then each lag's corrections in entry order, then the largest over the lags.
+    fn naive_score(m: &Member, y: &[f64], lags: usize) -> f64 {
+        let mut acc = m.cst.clone();
+        for (e, &d) in m.vidx.iter().enumerate() {
+            for (o, a) in acc.iter_mut().enumerate() {
+                *a += y[d as usize] * m.dlin[e * lags + o];
+            }
+        }
+        dot(&m.base, y) + acc.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The packed layout (base vectors without their all-zero chunks, constants and lag rows in
+    /// one stream, four lags at a time) scores hand-made members exactly as the plain formula.
+    #[test]
+    fn packed_scores_are_the_plain_formula_bit_for_bit() {
+        let mut rng = crate::random::stream(11, 0);
+        for (dims, lags) in [(5usize, 1usize), (21, 5), (40, 8), (240, 24), (235, 23)] {
+            let members: Vec<Member> = (0..6)
+                .map(|_| {
+                    let base = quiet_runs(&mut rng, dims, 7, 1e3);
+                    let n_var = rng.random_range(0..=MAX_VARYING.min(dims));
+                    let vidx: Vec<u32> = (0..n_var)
+                        .map(|_| rng.random_range(0..dims) as u32)
+                        .collect();
+                    Member {
+                        base,
+                        cst: (0..lags).map(|_| rng.random_range(-1e4..0.0)).collect(),
+                        dlin: (0..n_var * lags)
+                            .map(|_| rng.random_range(-1e2..1e2))
+                            .collect(),
+                        vidx,
+                    }
+                })
+                .collect();
+            let packed = Packed::new(&members, dims, lags);
+            for _ in 0..20 {
+                let y: Vec<f64> = (0..dims).map(|_| rng.random_range(-10.0..10.0)).collect();
+                let fast = packed.scores(&y);
+                for (m, f) in members.iter().zip(&fast) {
+                    assert_eq!(f.to_bits(), naive_score(m, &y, lags).to_bits());
+                }
+            }
         }
     }
 
@@ -583,8 +800,8 @@ mod tests {
             let Some(y) = lik.block_sums(&r) else {
                 continue;
             };
-            let plain = lik.member_scores_plain(&y);
-            let used = lik.member_scores(&y);
+            let plain = lik.packed.scores_plain(&y);
+            let used = lik.packed.scores(&y);
             assert_eq!(plain.len(), 9);
             assert!(plain.iter().all(|x| x.is_finite()));
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
