@@ -177,9 +177,12 @@ pub enum CaseError {
         #[source]
         source: named::PartSpecError,
     },
-    /// The support or the part's contact model could not be built.
-    #[error("{0}")]
-    Compile(String),
+    /// The support specification is refused.
+    #[error(transparent)]
+    Support(#[from] crate::mechanics::part_model::SupportSpecError),
+    /// The part's contact model could not be built.
+    #[error(transparent)]
+    Compile(#[from] crate::mechanics::PartModelError),
     /// A `--pin-stop-at` the moving pin never reaches, or reaches too late.
     #[error("--pin-stop-at {}: a pin starting at d = {} and moving {} per unit of travel reaches it after {} units of a; that must lie in [1e-9, 1000] (Y on the side the pin moves to, within 1000·|w| of d)", num(*y), num(*d), num(*w), num(*travel))]
     StopAt {
@@ -287,8 +290,8 @@ pub fn compile_part(part: &str, support: &str) -> Result<(Polygon, PartModel), C
         part: part.to_string(),
         source,
     })?;
-    let support = Support::parse(support, &poly).map_err(|e| CaseError::Compile(e.to_string()))?;
-    let model = PartModel::new(&poly, &support).map_err(CaseError::Compile)?;
+    let support = Support::parse(support, &poly)?;
+    let model = PartModel::new(&poly, &support)?;
     Ok((poly, model))
 }
 

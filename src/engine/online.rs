@@ -755,8 +755,9 @@ fn member(scene: &Scene, hyp: &Hypothesis, h: usize, m: usize) -> Result<Entry, 
     let model = match hyp.support {
         SupportKind::Uniform => None,
         SupportKind::Tripod => {
-            let support = Support::random_tripod(&scene.part.polygon, &mut rng)?;
-            Some(PartModel::new(&scene.part.polygon, &support)?)
+            let support =
+                Support::random_tripod(&scene.part.polygon, &mut rng).map_err(|e| e.to_string())?;
+            Some(PartModel::new(&scene.part.polygon, &support).map_err(|e| e.to_string())?)
         }
     };
     Ok(Entry {

@@ -42,7 +42,11 @@ fn draw_gap(scene: &Scene, rng: &mut ChaCha8Rng) -> f64 {
 }
 
 /// Draw part `index` of a run seeded with `seed`.
-pub fn draw_part(scene: &Scene, seed: u64, index: u64) -> Result<PartDraw, String> {
+pub fn draw_part(
+    scene: &Scene,
+    seed: u64,
+    index: u64,
+) -> Result<PartDraw, crate::mechanics::PartModelError> {
     let mut rng = stream(seed, index);
     let gap = draw_gap(scene, &mut rng);
     let theta = match &scene.feed.orientation {

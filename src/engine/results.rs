@@ -52,7 +52,7 @@ pub enum EngineError {
         /// Index of the part in the stream.
         index: u64,
         /// Why it could not be drawn.
-        reason: String,
+        reason: crate::mechanics::PartModelError,
     },
     /// The online controller's model cannot be built for the scene (located at its
     /// `[controller.belief]`).

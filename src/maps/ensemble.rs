@@ -200,7 +200,7 @@ pub enum MemberError {
     Support(String),
     /// The member's part model could not be compiled ([`PartModel::new`]).
     #[error("{0}")]
-    Model(String),
+    Model(crate::mechanics::PartModelError),
 }
 
 /// Why an ensemble could not be compiled ([`members`], [`ensemble_maps`]).

@@ -52,7 +52,7 @@ pub use instant::Mode;
 pub use outcome::{
     ContactFeature, ContactOutcome, ContactStatus, Recorder, Segment, SelfCheck, TraceSample,
 };
-pub use part_model::{Fidelity, PartModel, SolveFailure, Support};
+pub use part_model::{Fidelity, PartModel, PartModelError, SolveFailure, Support, TripodError};
 pub(crate) use pass::untouched;
 pub use pass::{
     fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path,

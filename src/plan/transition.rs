@@ -103,9 +103,9 @@ impl Transition {
     /// The physics samples: one (nominal) for all particles, or one per feed sample (`n`) drawn
     /// from the seed when the problem asks for robustness.
     pub fn new(problem: &Problem, compiled: &Compiled, n: usize) -> Result<Transition, PlanError> {
-        let part_err = |reason: String| PlanError::Part {
+        let part_err = |reason: crate::mechanics::PartModelError| PlanError::Part {
             part: problem.part.clone(),
-            reason,
+            reason: reason.to_string(),
         };
         // Every pass at the nominal μc shares this model: its exact slides come from tables,
         // built per edge on first use. A table costs ~10³ limit-surface evaluations, each linear
@@ -134,8 +134,8 @@ impl Transition {
                     None => problem.mu_c,
                 };
                 let (model, support) = if problem.tripod {
-                    let s =
-                        Support::random_tripod(&compiled.polygon, &mut rng).map_err(part_err)?;
+                    let s = Support::random_tripod(&compiled.polygon, &mut rng)
+                        .map_err(|e| part_err(e.into()))?;
                     (
                         Arc::new(PartModel::new(&compiled.polygon, &s).map_err(part_err)?),
                         s,

@@ -275,10 +275,10 @@ pub enum PassError {
     MuC(String),
     /// No tripod could be drawn ([`Support::random_tripod`]).
     #[error("{0}")]
-    Tripod(String),
+    Tripod(crate::mechanics::TripodError),
     /// The tripod's part model could not be compiled ([`PartModel::new`]).
     #[error("{0}")]
-    Model(String),
+    Model(crate::mechanics::PartModelError),
 }
 
 /// Draws one pass for orientation `theta_deg` under `unc` from stream `(seed, index)`. Draw order:

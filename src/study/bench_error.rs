@@ -30,7 +30,7 @@ pub enum BenchError {
     },
     /// A part's contact model could not be built.
     #[error("{0}")]
-    Model(String),
+    Model(crate::mechanics::PartModelError),
     /// The thread pool of a timing could not be built.
     #[error(transparent)]
     Threads(#[from] rayon::ThreadPoolBuildError),

@@ -48,7 +48,7 @@ mod warm;
 
 pub use fidelity::Fidelity;
 pub use solve::{final_gap, SolveFailure, Solved};
-pub use support::{Support, SupportSpecError};
+pub use support::{Support, SupportSpecError, TripodError};
 pub(crate) use warm::kkt_delta;
 pub use warm::{WarmStick, WarmTwist};
 
@@ -122,14 +122,29 @@ impl fmt::Debug for PartModel {
     }
 }
 
+/// Why a part's contact model cannot be built ([`PartModel::new`]), or a part with a random
+/// tripod cannot be drawn.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PartModelError {
+    /// The support's points or weights are refused.
+    #[error(transparent)]
+    Support(#[from] super::limit_surface::points::PointSupportError),
+    /// The part's convex hull is not a valid polygon.
+    #[error(transparent)]
+    Hull(#[from] crate::geometry::PolygonError),
+    /// No random tripod could be drawn for the part.
+    #[error(transparent)]
+    Tripod(#[from] TripodError),
+}
+
 impl PartModel {
     /// Compile a part: normalise to a = 1 and precompute the support's limit-surface data.
-    pub fn new(poly: &Polygon, support: &Support) -> Result<PartModel, String> {
+    pub fn new(poly: &Polygon, support: &Support) -> Result<PartModel, PartModelError> {
         let scale = poly.radius();
         let unit = poly.scaled(1.0 / scale);
-        let data = SupportData::new(&unit, scale, support).map_err(|e| e.to_string())?;
+        let data = SupportData::new(&unit, scale, support)?;
         let c = data.ellipsoid_c();
-        let hull = Polygon::new(unit.hull()).map_err(|e| e.to_string())?;
+        let hull = Polygon::new(unit.hull())?;
         Ok(PartModel {
             hull,
             poly: unit,

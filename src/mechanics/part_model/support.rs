@@ -28,7 +28,7 @@ impl Support {
     /// contains the centroid; each carries the centroid's barycentric weight (static equilibrium).
     /// Points are in the polygon's part frame (centroid origin). Each weight is at least 2%, so the
     /// tripod is never degenerate.
-    pub fn random_tripod(poly: &Polygon, rng: &mut impl rand::Rng) -> Result<Support, String> {
+    pub fn random_tripod(poly: &Polygon, rng: &mut impl rand::Rng) -> Result<Support, TripodError> {
         use rand::RngExt;
         let v = poly.vertices();
         let (mut lo, mut hi) = (v[0], v[0]);
@@ -67,7 +67,7 @@ impl Support {
                 });
             }
         }
-        Err("could not draw a tripod inside the part that carries its centroid".into())
+        Err(TripodError)
     }
 
     /// Parse a support specification: `uniform` or `tripod:SEED`.
@@ -104,10 +104,17 @@ pub enum SupportSpecError {
         /// The specification (trimmed).
         spec: String,
     },
-    /// No tripod could be drawn ([`Support::random_tripod`]'s message).
-    #[error("{0}")]
-    Tripod(String),
+    /// No tripod could be drawn ([`Support::random_tripod`]).
+    #[error(transparent)]
+    Tripod(#[from] TripodError),
 }
+
+/// [`Support::random_tripod`] found no tripod: the part is too thin (or its centroid too close
+/// to its outline) for three points inside it whose triangle carries the centroid with every
+/// weight at least 2%.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("could not draw a tripod inside the part that carries its centroid")]
+pub struct TripodError;
 
 /// A support compiled for the normalised part (a = 1): the data its dissipation is evaluated from.
 #[derive(Clone)]

@@ -71,7 +71,7 @@ pub fn draw_support(
 ) -> Result<Support, String> {
     Ok(match choice {
         SupportChoice::Uniform => Support::Uniform,
-        SupportChoice::Tripod => Support::random_tripod(polygon, rng)?,
+        SupportChoice::Tripod => Support::random_tripod(polygon, rng).map_err(|e| e.to_string())?,
         SupportChoice::Smooth(params) => {
             let (s, n) = random_smooth_support(polygon, params, rng)?;
             *redraws += n;

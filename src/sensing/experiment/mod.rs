@@ -171,7 +171,7 @@ pub enum SenseError {
     },
     /// A part whose model cannot be built (the reason).
     #[error("--part: {0}")]
-    PartModel(String),
+    PartModel(crate::mechanics::PartModelError),
     /// A hypothesis that is neither `stable`, `vertex-edge` nor a number of degrees.
     #[error("--hypotheses: '{0}' is not a number of degrees (or give stable or vertex-edge)")]
     HypothesisDegrees(String),

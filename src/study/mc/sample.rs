@@ -775,7 +775,7 @@ fn draw_part_model(
     Ok(loop {
         let polygon = draw_polygon(base, &p.shape, &mut st.shape, shape_redraws)?;
         let model = draw_support(&polygon, &p.support, &mut st.support, other)
-            .and_then(|support| PartModel::new(&polygon, &support));
+            .and_then(|support| PartModel::new(&polygon, &support).map_err(|e| e.to_string()));
         match model {
             Ok(m) => break (polygon, m),
             Err(_) if p.shape.is_some_and(|d| !d.is_fixed()) && attempts < MAX_SHAPE_REDRAWS => {
@@ -841,7 +841,7 @@ fn draw_entry(
     other: &mut u32,
 ) -> Result<Feed, String> {
     // The scenario's feed draws the entry pose (its support is uniform here, so it draws no tripod).
-    let entry = draw_part(scene, st.feed_seed, 0)?;
+    let entry = draw_part(scene, st.feed_seed, 0).map_err(|e| e.to_string())?;
     let any = |_: f64| true;
     let d_theta = draw_value(&p.pose_theta, &mut st.pose_theta, "pose_theta", any, other)?;
     let d_y = draw_value(&p.pose_y, &mut st.pose_y, "pose_y", any, other)?;

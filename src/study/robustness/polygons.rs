@@ -116,7 +116,7 @@ pub fn run(v: &[Vec2]) -> CaseReport {
     }
     match PartModel::new(&poly, &Support::Uniform) {
         Ok(_) => CaseReport::new(Class::Success),
-        Err(e) if e.trim().is_empty() => CaseReport::with(Class::Unlocated, command(v)),
+        Err(e) if e.to_string().trim().is_empty() => CaseReport::with(Class::Unlocated, command(v)),
         Err(_) => CaseReport::new(Class::Named),
     }
 }
