@@ -88,7 +88,8 @@ pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<SensorDraft>
             ))
         }
         Some(RawHypotheses::Degrees(list)) => {
-            Hypotheses::orientations(list.clone()).map_err(|e| c.err(&path("hypotheses"), e))?;
+            Hypotheses::orientations(list.clone())
+                .map_err(|e| c.err(&path("hypotheses"), e.to_string()))?;
             (Some(list.clone()), false)
         }
     };
@@ -160,7 +161,9 @@ pub(super) fn train(
         } => jitter.to_degrees(),
         Orientation::Uniform => 0.0,
     };
-    let at_hypotheses = |e: String| c.err(&format!("obstacles[{i}].sensor.hypotheses"), e);
+    let at_hypotheses = |e: crate::sensing::templates::HypothesesError| {
+        c.err(&format!("obstacles[{i}].sensor.hypotheses"), e.to_string())
+    };
     let hypotheses = if draft.vertex_edge {
         match &feed.orientation {
             // Parts fed in their stable states meet the pin in those states.

@@ -141,6 +141,26 @@ impl Hypotheses {
     }
 }
 
+/// Why a list of hypotheses is refused ([`Hypotheses::stable_states`],
+/// [`Hypotheses::orientations`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum HypothesesError {
+    /// The part has fewer than two stable states to tell apart.
+    #[error(
+        "the part has {0} stable state(s): list at least two orientations (degrees) to tell apart"
+    )]
+    FewStates(usize),
+    /// Fewer than 2 or more than [`MAX_HYPOTHESES`] orientations.
+    #[error("give between 2 and {MAX_HYPOTHESES} orientations (degrees), got {0}")]
+    Count(usize),
+    /// An orientation that is not finite or lies outside ±360°.
+    #[error("orientation {0} is out of range: each must lie in [-360, 360] degrees")]
+    OutOfRange(f64),
+    /// Two orientations that are the same angle (modulo 360°).
+    #[error("orientations {0} and {1} are the same angle: list each hypothesis once")]
+    Same(f64, f64),
+}
+
 /// Most hypotheses a sensor is asked to tell apart.
 pub const MAX_HYPOTHESES: usize = 64;
 /// Orientation step (degrees) of the pushes drawn for vertex/edge hypotheses over any orientation.
@@ -148,42 +168,32 @@ pub const VERTEX_EDGE_STEP_DEG: f64 = 5.0;
 
 impl Hypotheses {
     /// The part's stable states (docs/physics.md#stable-states), labelled by their orientation; at least two are needed.
-    pub fn stable_states(poly: &Polygon) -> Result<Hypotheses, String> {
+    pub fn stable_states(poly: &Polygon) -> Result<Hypotheses, HypothesesError> {
         let degrees: Vec<f64> = poly
             .stable_states()
             .iter()
             .map(|s| s.theta_rad.to_degrees())
             .collect();
         if degrees.len() < 2 {
-            return Err(format!(
-                "the part has {} stable state(s): list at least two orientations (degrees) to tell apart",
-                degrees.len()
-            ));
+            return Err(HypothesesError::FewStates(degrees.len()));
         }
         Hypotheses::orientations(degrees)
     }
 
     /// Listed orientations (degrees): each finite and within ±360, between 2 and
     /// [`MAX_HYPOTHESES`] of them, no two the same angle (modulo 360°).
-    pub fn orientations(degrees: Vec<f64>) -> Result<Hypotheses, String> {
+    pub fn orientations(degrees: Vec<f64>) -> Result<Hypotheses, HypothesesError> {
         if degrees.len() < 2 || degrees.len() > MAX_HYPOTHESES {
-            return Err(format!(
-                "give between 2 and {MAX_HYPOTHESES} orientations (degrees), got {}",
-                degrees.len()
-            ));
+            return Err(HypothesesError::Count(degrees.len()));
         }
         for (i, &x) in degrees.iter().enumerate() {
             if !(x.is_finite() && (-360.0..=360.0).contains(&x)) {
-                return Err(format!(
-                    "orientation {x} is out of range: each must lie in [-360, 360] degrees"
-                ));
+                return Err(HypothesesError::OutOfRange(x));
             }
             for &y in &degrees[..i] {
                 let diff = (x - y).rem_euclid(360.0);
                 if diff.min(360.0 - diff) < 1e-9 {
-                    return Err(format!(
-                        "orientations {y} and {x} are the same angle: list each hypothesis once"
-                    ));
+                    return Err(HypothesesError::Same(y, x));
                 }
             }
         }

@@ -181,7 +181,7 @@ pub enum SenseError {
         /// The `--hypotheses` value given.
         spec: String,
         /// Why it is refused.
-        message: String,
+        message: crate::sensing::templates::HypothesesError,
     },
     /// `--mu-c-range` without a colon.
     #[error("--mu-c-range must be LO:HI (e.g. 0.3:0.7), got '{0}'")]
