@@ -62,9 +62,7 @@ pub fn run(args: &McArgs) -> Result<()> {
     let header = StudyHeader::of(&study);
     let total = study.total_samples();
     let shard = match &args.shard {
-        Some(text) => {
-            Some(ShardSpec::parse(text, &|k| std::env::var(k).ok()).map_err(anyhow::Error::msg)?)
-        }
+        Some(text) => Some(ShardSpec::parse(text, &|k| std::env::var(k).ok())?),
         None => None,
     };
     let range = shard.map_or(0..total, |s| s.range(total));

@@ -41,30 +41,27 @@ pub struct ShardSpec {
 impl ShardSpec {
     /// Parse `k/n`, `/n` or `auto/n`; a missing k is read with `env` (the process environment in
     /// the CLI) from SLURM_ARRAY_TASK_ID (− SLURM_ARRAY_TASK_MIN) or JOB_COMPLETION_INDEX.
-    pub fn parse(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<ShardSpec, String> {
-        let usage = "write --shard K/N with 0 ≤ K < N (K 0-based), or --shard /N to take K from SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX";
-        let (k, n) = text
-            .split_once('/')
-            .ok_or_else(|| format!("--shard '{text}': {usage}"))?;
-        let count: u64 = n
-            .trim()
-            .parse()
-            .map_err(|_| format!("--shard '{text}': N must be a whole number; {usage}"))?;
+    pub fn parse(
+        text: &str,
+        env: &dyn Fn(&str) -> Option<String>,
+    ) -> Result<ShardSpec, ShardSpecError> {
+        let fail = |why: ShardWhy| ShardSpecError {
+            text: text.to_string(),
+            why,
+        };
+        let (k, n) = text.split_once('/').ok_or_else(|| fail(ShardWhy::Form))?;
+        let count: u64 = n.trim().parse().map_err(|_| fail(ShardWhy::N))?;
         if count == 0 {
-            return Err(format!("--shard '{text}': N must be at least 1"));
+            return Err(fail(ShardWhy::NoShards));
         }
         let k = k.trim();
         let index = if k.is_empty() || k == "auto" {
-            from_scheduler(env).map_err(|e| format!("--shard '{text}': {e}"))?
+            from_scheduler(env).map_err(fail)?
         } else {
-            k.parse()
-                .map_err(|_| format!("--shard '{text}': K must be a whole number; {usage}"))?
+            k.parse().map_err(|_| fail(ShardWhy::K))?
         };
         if index >= count {
-            return Err(format!(
-                "--shard '{text}': shard index {index} is out of range for {count} shards (K is 0-based: 0 to {})",
-                count - 1
-            ));
+            return Err(fail(ShardWhy::Index { index, count }));
         }
         Ok(ShardSpec { index, count })
     }
@@ -81,8 +78,8 @@ impl ShardSpec {
     }
 }
 
-fn from_scheduler(env: &dyn Fn(&str) -> Option<String>) -> Result<u64, String> {
-    let num = |var: &str| -> Result<Option<u64>, String> {
+fn from_scheduler(env: &dyn Fn(&str) -> Option<String>) -> Result<u64, ShardWhy> {
+    let num = |var: &'static str| -> Result<Option<u64>, ShardWhy> {
         match env(var) {
             None => Ok(None),
             Some(v) if v.trim().is_empty() => Ok(None),
@@ -90,22 +87,75 @@ fn from_scheduler(env: &dyn Fn(&str) -> Option<String>) -> Result<u64, String> {
                 .trim()
                 .parse()
                 .map(Some)
-                .map_err(|_| format!("{var}='{v}' is not a whole number")),
+                .map_err(|_| ShardWhy::Variable { var, value: v }),
         }
     };
     if let Some(id) = num("SLURM_ARRAY_TASK_ID")? {
         let min = num("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
-        return id.checked_sub(min).ok_or_else(|| {
-            format!("SLURM_ARRAY_TASK_ID ({id}) is below SLURM_ARRAY_TASK_MIN ({min})")
-        });
+        return id.checked_sub(min).ok_or(ShardWhy::BelowMin { id, min });
     }
     if let Some(k) = num("JOB_COMPLETION_INDEX")? {
         return Ok(k);
     }
-    Err(
+    Err(ShardWhy::NoIndex)
+}
+
+const SHARD_USAGE: &str = "write --shard K/N with 0 ≤ K < N (K 0-based), or --shard /N to take K from SLURM_ARRAY_TASK_ID or JOB_COMPLETION_INDEX";
+
+/// A `--shard` value that is refused ([`ShardSpec::parse`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("--shard '{text}': {why}")]
+pub struct ShardSpecError {
+    /// The value given.
+    pub text: String,
+    /// What is wrong with it.
+    pub why: ShardWhy,
+}
+
+/// What is wrong with a `--shard` value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ShardWhy {
+    /// No `/`.
+    #[error("{SHARD_USAGE}")]
+    Form,
+    /// N is not a whole number.
+    #[error("N must be a whole number; {SHARD_USAGE}")]
+    N,
+    /// N = 0.
+    #[error("N must be at least 1")]
+    NoShards,
+    /// K is not a whole number.
+    #[error("K must be a whole number; {SHARD_USAGE}")]
+    K,
+    /// K ≥ N.
+    #[error("shard index {index} is out of range for {count} shards (K is 0-based: 0 to {})", count - 1)]
+    Index {
+        /// K.
+        index: u64,
+        /// N.
+        count: u64,
+    },
+    /// A scheduler's variable that is not a whole number.
+    #[error("{var}='{value}' is not a whole number")]
+    Variable {
+        /// The variable.
+        var: &'static str,
+        /// Its value.
+        value: String,
+    },
+    /// SLURM_ARRAY_TASK_ID below SLURM_ARRAY_TASK_MIN.
+    #[error("SLURM_ARRAY_TASK_ID ({id}) is below SLURM_ARRAY_TASK_MIN ({min})")]
+    BelowMin {
+        /// SLURM_ARRAY_TASK_ID.
+        id: u64,
+        /// SLURM_ARRAY_TASK_MIN.
+        min: u64,
+    },
+    /// K left out and no scheduler's index set.
+    #[error(
         "no shard index given and neither SLURM_ARRAY_TASK_ID nor JOB_COMPLETION_INDEX is set"
-            .into(),
-    )
+    )]
+    NoIndex,
 }
 
 /// One point's counts in a shard file.
@@ -545,20 +595,27 @@ mod tests {
         );
         assert!(ShardSpec::parse("4/4", &none)
             .unwrap_err()
+            .to_string()
             .contains("0-based"));
         assert!(ShardSpec::parse("1/0", &none).is_err());
         assert!(ShardSpec::parse("3", &none).is_err());
         assert!(ShardSpec::parse("/4", &none)
             .unwrap_err()
+            .to_string()
             .contains("SLURM_ARRAY_TASK_ID"));
         let slurm = env_of(&[("SLURM_ARRAY_TASK_ID", "5"), ("SLURM_ARRAY_TASK_MIN", "1")]);
         assert_eq!(ShardSpec::parse("/8", &slurm).unwrap().index, 4);
         let k8s = env_of(&[("JOB_COMPLETION_INDEX", "3")]);
         assert_eq!(ShardSpec::parse("auto/8", &k8s).unwrap().index, 3);
         let junk = env_of(&[("JOB_COMPLETION_INDEX", "x")]);
-        assert!(ShardSpec::parse("/8", &junk)
-            .unwrap_err()
-            .contains("not a whole number"));
+        assert_eq!(
+            ShardSpec::parse("/8", &junk).unwrap_err().to_string(),
+            "--shard '/8': JOB_COMPLETION_INDEX='x' is not a whole number"
+        );
+        assert_eq!(
+            ShardSpec::parse("3", &none).unwrap_err().to_string(),
+            format!("--shard '3': {SHARD_USAGE}")
+        );
     }
 
     #[test]
