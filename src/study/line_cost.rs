@@ -79,8 +79,10 @@ pub fn measure(scene: &Scene, parts: u64, reps: usize) -> Result<LineCost, Bench
     if scene.map_tier.is_some() {
         return Err(BenchError::MapTier(scene.name.clone()));
     }
+    // An online controller's model is built once, here, not inside the timed runs.
     let opts = RunOptions {
         parts,
+        online: crate::engine::prepare::online_model(scene)?,
         ..RunOptions::from_scene(scene)
     };
     let (first, pushes) = engine::run_capturing(scene, &opts)?;
