@@ -2,7 +2,7 @@
 //! tests/fixtures/validate/synthetic.csv --jitter 3` runs it (2 000 proposal members, the
 //! likelihood grid reweighting their predictions): the whole calibration, and its two parts —
 //! the proposal's predictions (every member's pushes) and the grid (reweighting only).
-//! Run: `cargo bench --bench calibrate`.
+//! Run: `cargo bench --features bench --bench calibrate`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::validate::calibrate::{calibrate, CalibrationSettings};

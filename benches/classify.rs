@@ -1,5 +1,5 @@
 //! Time per classification (one likelihood classification of 3 hypotheses × 64
-//! templates ≤ 50 µs). Run: `cargo bench --bench classify`.
+//! templates ≤ 50 µs). Run: `cargo bench --features bench --bench classify`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::geometry::named;

@@ -2,7 +2,7 @@
 //! triangle contact at 0.01° self-accuracy; ellipsoid and tip ≤ 5 µs), and a batch of contacts as
 //! `pinfeed contact --cases` runs it (1 200 exact contacts over 4 parts × 3 μc, from reading the
 //! file to the last row: ≤ 15 µs per contact), beside the same contacts run one by one without
-//! shared tables. Run: `cargo bench --bench contact`.
+//! shared tables. Run: `cargo bench --features bench --bench contact`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use pinfeed::contact_case::batch::run_batch;

@@ -6,7 +6,7 @@
 //!   `no_controller` and the difference is the controller's own work;
 //! * `controller_rules`: the bundled rules (the pin moves; different pushes).
 //!
-//! `cargo bench --bench controller`; figures in `results/line-speed.md`.
+//! `cargo bench --features bench --bench controller`; figures in `results/line-speed.md`.
 //!
 //! Also `ramp_pieces/N`: one push by a pin that accelerates across the belt during the contact,
 //! the acceleration phase resolved into N constant-speed pieces (the accuracy of each N against

@@ -6,7 +6,7 @@
 //! `push_with_map` (the exact model where the map is not certified), `exact_all` — every push
 //! exact. And the build (no cache): `build/query cell` — the one base cell a single query needs
 //! (`contact --model map`: θ0 100°, d 0.3), `build/whole map 36x12x2` — every base cell of a
-//! coarser grid than the default. Run: `cargo bench --bench map_tier`.
+//! coarser grid than the default. Run: `cargo bench --features bench --bench map_tier`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::geometry::{part_from_spec, Pose, Vec2};

@@ -9,7 +9,7 @@
 //!   model is built once, outside the timing); `tripoly2_line_150_parts/*` the same for
 //!   tripoly2's line, whose model also uses the matched filter.
 //!
-//! `cargo bench --bench online`; figures in `results/online.md`.
+//! `cargo bench --features bench --bench online`; figures in `results/online.md`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pinfeed::engine::{self, RunOptions};

@@ -1,7 +1,7 @@
 //! What the sensor signal costs (issue "Sensor pins": the signal adds ≤ 10% to the push that makes
 //! it). Three variants of the same 24 pushes per part, exact model: the bare push; the push with a
 //! knot recorder and its `ContactSignal` built; and that plus one noisy 1 kHz F/T reading sampled
-//! from it. Run: `cargo bench --bench signal`; figures in results/sensing.md.
+//! from it. Run: `cargo bench --features bench --bench signal`; figures in results/sensing.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use pinfeed::geometry::{part_from_spec, Pose, Vec2};

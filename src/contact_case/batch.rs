@@ -143,7 +143,7 @@ pub fn run_batch<W: std::io::Write>(
 
 /// Rows of one part and μc that pay for that μc's slide tables: building a part's tables costs
 /// about as much as 300–1 000 of its untabled contacts save (tripoly2, L-shape; `cargo bench
-/// --bench contact`, `contact_batch`), so smaller groups solve untabled.
+/// --features bench --bench contact`, `contact_batch`), so smaller groups solve untabled.
 pub const TABLED_ROWS: usize = 500;
 
 /// The μc values of one part's rows that have at least [`TABLED_ROWS`] rows.

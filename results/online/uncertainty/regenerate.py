@@ -10,7 +10,7 @@ the uncertainty (pin-part friction uniform in [0.3, 0.7], random tripod supports
 has a ±3 mm lateral offset), and `pinfeed run --json` on the online lines for the controller's own
 record (belief, calibration, model bounds, run time). Every number in the report comes from the
 JSON files this script writes under results/online/uncertainty/out/ (ignored by git).
-`--report-only` rewrites the report from those files; `--bench-only` runs `cargo bench --bench
+`--report-only` rewrites the report from those files; `--bench-only` runs `cargo bench --features bench --bench
 online` again and rewrites the report with its medians and the other measurements from those files.
 """
 
@@ -195,8 +195,8 @@ BENCHES = ["decision/reading_update_choose", "decision/likelihood", "decision/ch
 
 
 def run_bench():
-    """`cargo bench --bench online`, then the median of each benchmark (s)."""
-    sh(["cargo", "bench", "--bench", "online", "--quiet"])
+    """`cargo bench --features bench --bench online`, then the median of each benchmark (s)."""
+    sh(["cargo", "bench", "--features", "bench", "--bench", "online", "--quiet"])
     bench = {}
     for name in BENCHES:
         est = os.path.join(ROOT, "target", "criterion", *name.split("/"), "new", "estimates.json")
@@ -277,7 +277,7 @@ def write_report(rows, details, bench):
             "not met on tripoly2: its online parts do about as much contact work as with its rules (the work table), so the "
             "difference is the controller, chiefly the matched filter, which only tripoly2's model keeps (tripoly1's, without it, "
             "costs nothing measurable)")
-    w(f"Criterion (`cargo bench --bench online`, medians; each line's two variants in one run): a decision on tripoly1's online line — the sensor's classification, the reading's likelihood over the 54 hypotheses (the channels the model uses), the belief's update and the choice among the joint commands — takes **{decision * 1e6:.0f} µs** (the likelihood {bench['decision/likelihood'] * 1e6:.1f} µs, the choice {bench['decision/choose'] * 1e6:.1f} µs); on tripoly2's line **{bench['decision/tripoly2_reading_update_choose'] * 1e6:.0f} µs**, of which the likelihood — the matched filter over the model's 324 simulated members (54 hypotheses × 6) — takes {bench['decision/tripoly2_likelihood'] * 1e6:.0f} µs and the choice {bench['decision/tripoly2_choose'] * 1e6:.1f} µs. The lines themselves, 150 parts: tripoly1 {bench['line_150_parts/rules'] * 1e3:.1f} ms with its rules, {bench['line_150_parts/online'] * 1e3:.1f} ms online, **{100 * extra:+.0f}%**; tripoly2 (whose model also uses the matched filter) {bench['tripoly2_line_150_parts/rules'] * 1e3:.1f} ms with its rules, {bench['tripoly2_line_150_parts/online'] * 1e3:.1f} ms online, **{100 * extra2:+.0f}%** (the online parts also meet the movers at other positions, so part of each difference is other pushes; the work table above gives them). Targets: a median decision ≤ 1 ms ({'met' if decision <= 1e-3 else 'not met'}); a controller that adds ≤ 20% to the line's run time ({verdict}).\n")
+    w(f"Criterion (`cargo bench --features bench --bench online`, medians; each line's two variants in one run): a decision on tripoly1's online line — the sensor's classification, the reading's likelihood over the 54 hypotheses (the channels the model uses), the belief's update and the choice among the joint commands — takes **{decision * 1e6:.0f} µs** (the likelihood {bench['decision/likelihood'] * 1e6:.1f} µs, the choice {bench['decision/choose'] * 1e6:.1f} µs); on tripoly2's line **{bench['decision/tripoly2_reading_update_choose'] * 1e6:.0f} µs**, of which the likelihood — the matched filter over the model's 324 simulated members (54 hypotheses × 6) — takes {bench['decision/tripoly2_likelihood'] * 1e6:.0f} µs and the choice {bench['decision/tripoly2_choose'] * 1e6:.1f} µs. The lines themselves, 150 parts: tripoly1 {bench['line_150_parts/rules'] * 1e3:.1f} ms with its rules, {bench['line_150_parts/online'] * 1e3:.1f} ms online, **{100 * extra:+.0f}%**; tripoly2 (whose model also uses the matched filter) {bench['tripoly2_line_150_parts/rules'] * 1e3:.1f} ms with its rules, {bench['tripoly2_line_150_parts/online'] * 1e3:.1f} ms online, **{100 * extra2:+.0f}%** (the online parts also meet the movers at other positions, so part of each difference is other pushes; the work table above gives them). Targets: a median decision ≤ 1 ms ({'met' if decision <= 1e-3 else 'not met'}); a controller that adds ≤ 20% to the line's run time ({verdict}).\n")
     open(os.path.join(ROOT, "results", "online.md"), "w").write("\n".join(o) + "\n")
 
 
