@@ -62,7 +62,7 @@ fn assert_clean(class: Class, detail: &str, text: &str) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 6000, rng_seed: proptest::test_runner::RngSeed::Fixed(20261134), .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: crate::support::cases(1500, 6000), rng_seed: proptest::test_runner::RngSeed::Fixed(20261134), .. ProptestConfig::default() })]
 
     #[test]
     fn mutated_scenarios_are_refused_cleanly_or_run_finitely(
@@ -76,7 +76,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 3000, rng_seed: proptest::test_runner::RngSeed::Fixed(20261135), .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: crate::support::cases(600, 3000), rng_seed: proptest::test_runner::RngSeed::Fixed(20261135), .. ProptestConfig::default() })]
 
     #[test]
     fn mutated_studies_are_refused_cleanly_or_run_finitely(
@@ -150,13 +150,14 @@ fn options(seed: u64, threads: usize) -> Options {
 fn fuzz_driver_is_deterministic_across_threads() {
     let corpus = Arc::new(Corpus::load(root()).unwrap());
     let opts = |threads| options(7, threads);
+    let n = u64::from(crate::support::cases(50, 150));
     for target in [Target::Scenarios, Target::Studies, Target::Polygons] {
-        let mut one = robustness::run_target(target, 150, &corpus, &opts(1), &|_| {});
-        let mut two = robustness::run_target(target, 150, &corpus, &opts(3), &|_| {});
+        let mut one = robustness::run_target(target, n, &corpus, &opts(1), &|_| {});
+        let mut two = robustness::run_target(target, n, &corpus, &opts(3), &|_| {});
         one.seconds = 0.0;
         two.seconds = 0.0;
         assert_eq!(one, two, "{}", target.name());
-        assert_eq!(one.generated, 150);
+        assert_eq!(one.generated, n);
         assert_eq!(
             one.count(Class::Panic) + one.count(Class::Hang),
             0,

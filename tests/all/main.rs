@@ -7,6 +7,9 @@
 //!
 //! Tests in different modules run in parallel threads of one process: scratch files go under
 //! names that no other test uses (every module's folders carry its own name and the process id).
+//! The long randomized tests (the file fuzzers, the fuzz driver's determinism across threads, the
+//! slow reference) run a bounded number of cases; `PINFEED_DEEP_TESTS=1 cargo test --release`
+//! runs their deep form (`support::cases`): the same assertions over more cases of the same seeds.
 //! proptest keeps each module's failure seeds in `tests/proptest-regressions/<module>.txt` (its
 //! default, `SourceParallel`, for a source file beside a `main.rs`).
 

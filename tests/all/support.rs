@@ -98,3 +98,14 @@ pub fn fresh_dir(tag: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).expect("creating a temporary folder");
     d
 }
+
+/// The number of cases of a long randomized test: `bounded` in a plain `cargo test`, `deep` when
+/// the environment variable `PINFEED_DEEP_TESTS` is set to anything but `0` (the deep form; see
+/// docs/commands.md, "Tests"). Both forms make the same assertions over the same seeds; the deep
+/// one draws more cases from each seed's stream.
+pub fn cases(bounded: u32, deep: u32) -> u32 {
+    match std::env::var("PINFEED_DEEP_TESTS") {
+        Ok(v) if v != "0" => deep,
+        _ => bounded,
+    }
+}
