@@ -1,5 +1,5 @@
 #!/bin/sh
-# Before/after two commits of the contact model, both measured in one run:
+# Two commits of the contact model, measured in one run:
 #   sh results/line-speed/compare-commits.sh BEFORE AFTER
 # Builds BEFORE and AFTER in temporary worktrees, compares their outcomes and work counters on the
 # quickstart and crowded_belt lines (20 000 parts), times each alternately (three times each, one

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Before/after "record a push once" (issue 15, item 2), both measured in one run:
+# "Record a push once": the build without it and the build with it, measured in one run:
 #   sh results/line-speed/record-once.sh
 # Builds the commit before the change (c6fcdf2) and the change (30818a6) in temporary
 # worktrees, checks that their summaries agree apart from the work counters, and times each on

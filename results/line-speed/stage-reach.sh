@@ -1,6 +1,6 @@
 #!/bin/sh
-# Before/after the slide tables' reach past an edge's ends and round a vertex's whole turn
-# (issue 15 item 1), both measured in one run:
+# The slide tables' reach past an edge's ends and round a vertex's whole turn: the build without
+# it and the build with it, measured in one run:
 #   sh results/line-speed/stage-reach.sh
 # f2b485c (before: tables on the edges and vertices' cones only) against 6700b62 (after); see
 # compare-commits.sh.

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Regenerates results/validation.md's numbers and figures (issue 16). Run from the repository root.
+# Regenerates results/validation.md's numbers and figures. Run from the repository root.
 set -e
 P="cargo run --release --quiet --"
 TRUTH=mu_c=normal:0.45:0.08,support=tripod:0.6,pin_radius=normal:0.12:0.03,jitter=3

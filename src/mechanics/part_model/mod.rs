@@ -173,7 +173,7 @@ impl PartModel {
     /// (`mechanics::stick_table`): for a batch of contacts large enough to pay for the cells it
     /// visits (a map tier's build). A stick cell costs ~10³ evaluations to build and saves ~1.7 per
     /// stick it serves, so a line of a few thousand parts, or of a part with many edges, runs
-    /// slower with them (`results/line-speed.md`, "Stick tables"); scenes and the planner do not
+    /// slower with them (`results/line-speed.md`, "Stick tables and where they pay"); scenes and the planner do not
     /// use them. Only uniform pressure is tabulated, as for [`PartModel::with_slide_tables`].
     pub fn with_stick_tables(mut self) -> PartModel {
         if matches!(self.support, SupportData::Uniform(_)) {
