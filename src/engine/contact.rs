@@ -15,7 +15,7 @@ use super::event_queue::EventKind;
 use super::line::{ActivePart, Line};
 use super::metrics::WorkCounters;
 use super::motion::{ContactPlan, Motion, Pusher, Stop};
-use super::outcome::PartOutcome;
+use super::outcome::{Cause, PartOutcome};
 use super::overlap::{capsule_clearance, first_touch};
 use super::results::CapturedPush;
 use super::sensing::SensedPass;
@@ -82,7 +82,7 @@ impl Line<'_> {
         self.metrics.work.model_evaluations += out.evaluations;
         if matches!(out.status, ContactStatus::PinInsidePart) {
             self.active.insert(index, part);
-            self.finish(index, t, PartOutcome::MultiContact, "pin_inside_part");
+            self.finish(index, t, PartOutcome::MultiContact, Cause::PinInsidePart);
             return;
         }
         if !out.contact {
@@ -109,7 +109,7 @@ impl Line<'_> {
         if let Some(tm) = sweep_neighbours(scene, &mut plan, model, &capsules, work) {
             plan.t_end = tm.max(t);
             plan.stop = Some(Stop::MultiContact {
-                cause: "second_obstacle",
+                cause: Cause::SecondObstacle,
             });
         }
         if let Some(tm) = fence_off_belt(scene, &mut plan, model, work) {
@@ -196,7 +196,7 @@ impl Line<'_> {
         part.grazes += 1;
         if part.grazes > MAX_GRAZES {
             self.active.insert(index, part);
-            self.finish(index, t, PartOutcome::Solver, "grazing_loop");
+            self.finish(index, t, PartOutcome::Solver, Cause::GrazingLoop);
             return;
         }
         part.last_obstacle = Some(j);
@@ -263,21 +263,38 @@ fn sensor_of(obstacle: &Obstacle) -> Option<&SensorPin> {
 pub fn stop_of(status: &ContactStatus) -> Option<Stop> {
     match status {
         ContactStatus::Ok => None,
-        ContactStatus::MultiContact { .. } => Some(Stop::MultiContact { cause: "notch" }),
+        ContactStatus::MultiContact { .. } => Some(Stop::MultiContact {
+            cause: Cause::Notch,
+        }),
         ContactStatus::TravelLimit { .. } => Some(Stop::Jam {
-            cause: "travel_limit",
+            cause: Cause::TravelLimit,
         }),
         ContactStatus::Jam { .. } => Some(Stop::Jam {
-            cause: "fence_angle",
+            cause: Cause::FenceAngle,
         }),
         ContactStatus::Solver { failure, .. } => Some(Stop::Solver {
             cause: match failure {
-                SolveFailure::NoConvergence { .. } => "no_convergence",
-                SolveFailure::NonFinite => "non_finite",
+                SolveFailure::NoConvergence { .. } => Cause::NoConvergence,
+                SolveFailure::NonFinite => Cause::NonFinite,
             },
         }),
-        other => Some(Stop::Solver {
-            cause: other.name(),
+        ContactStatus::PinInsidePart => Some(Stop::Solver {
+            cause: Cause::PinInsidePart,
+        }),
+        ContactStatus::EvaluationLimit { .. } => Some(Stop::Solver {
+            cause: Cause::EvaluationLimit,
+        }),
+        ContactStatus::EventLimit { .. } => Some(Stop::Solver {
+            cause: Cause::EventLimit,
+        }),
+        ContactStatus::StepTooSmall { .. } => Some(Stop::Solver {
+            cause: Cause::StepTooSmall,
+        }),
+        ContactStatus::SelfCheck { .. } => Some(Stop::Solver {
+            cause: Cause::SelfCheck,
+        }),
+        ContactStatus::Metastable { .. } => Some(Stop::Solver {
+            cause: Cause::Metastable,
         }),
     }
 }

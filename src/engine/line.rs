@@ -45,7 +45,7 @@ use super::controller::Control;
 use super::event_queue::{Event, EventKind, EventQueue};
 use super::metrics::Metrics;
 use super::motion::{Motion, Stop};
-use super::outcome::PartOutcome;
+use super::outcome::{Cause, PartOutcome};
 use super::part_stream::{arrival_gap, draw_part};
 use super::results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};
 use super::sensing::{sense_pass, SensedDecision, SensedPass, SensorStats};
@@ -366,8 +366,8 @@ impl Line<'_> {
             EventKind::Exit { part } => self.exit(t, part),
             EventKind::Collision { first, second } => {
                 if self.active.contains_key(&first) && self.active.contains_key(&second) {
-                    self.finish(first, t, PartOutcome::Collision, "");
-                    self.finish(second, t, PartOutcome::Collision, "");
+                    self.finish(first, t, PartOutcome::Collision, Cause::None);
+                    self.finish(second, t, PartOutcome::Collision, Cause::None);
                 }
             }
             EventKind::Decision {
@@ -526,7 +526,7 @@ impl Line<'_> {
             let (outcome, cause) = match stop {
                 Stop::MultiContact { cause } => (PartOutcome::MultiContact, cause),
                 Stop::Jam { cause } => (PartOutcome::Jam, cause),
-                Stop::OffBelt => (PartOutcome::OffBelt, ""),
+                Stop::OffBelt => (PartOutcome::OffBelt, Cause::None),
                 Stop::Solver { cause } => (PartOutcome::Solver, cause),
             };
             self.finish(index, t, outcome, cause);
@@ -545,7 +545,7 @@ impl Line<'_> {
         part.last_obstacle = Some(j);
         if pose.y.abs() > self.scene.belt.width / 2.0 {
             self.active.insert(index, part);
-            self.finish(index, t, PartOutcome::OffBelt, "");
+            self.finish(index, t, PartOutcome::OffBelt, Cause::None);
             return;
         }
         self.plan_next(index, &mut part, t);
@@ -563,11 +563,11 @@ impl Line<'_> {
         } else {
             PartOutcome::WrongOrientation
         };
-        self.finish(index, t, outcome, "");
+        self.finish(index, t, outcome, Cause::None);
     }
 
     /// Take part `index` off the line at time `t` with `outcome`.
-    pub(super) fn finish(&mut self, index: u64, t: f64, outcome: PartOutcome, cause: &'static str) {
+    pub(super) fn finish(&mut self, index: u64, t: f64, outcome: PartOutcome, cause: Cause) {
         let Some(mut part) = self.active.remove(&index) else {
             return;
         };

@@ -299,14 +299,14 @@ impl Metrics {
     }
 
     /// Record the cause of a failed part; ignored for outcomes other than multi-contact, jam and solver.
-    pub fn cause(&mut self, outcome: PartOutcome, cause: &str) {
+    pub fn cause(&mut self, outcome: PartOutcome, cause: super::Cause) {
         let map = match outcome {
             PartOutcome::MultiContact => &mut self.multi_contact_causes,
             PartOutcome::Jam => &mut self.jam_causes,
             PartOutcome::Solver => &mut self.solver_causes,
             _ => return,
         };
-        *map.entry(cause.to_string()).or_insert(0) += 1;
+        *map.entry(cause.name().to_string()).or_insert(0) += 1;
     }
 }
 

@@ -34,5 +34,5 @@ pub mod sensing;
 
 pub use line::{run, run_capturing, run_entry, run_single, Entry, SingleRun};
 pub use metrics::Summary;
-pub use outcome::{OutcomeCounts, PartOutcome};
+pub use outcome::{Cause, OutcomeCounts, PartOutcome};
 pub use results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};

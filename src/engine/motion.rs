@@ -14,6 +14,7 @@
 //! recorder (it is a pure function, so the outcome is the same) and the trace is kept; between
 //! recorded steps the pose is interpolated linearly in (centroid, θ).
 
+use super::outcome::Cause;
 use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
     push_fence, push_path, ContactOutcome, ContactSettings, FenceSpec, PartModel, PinPath,
@@ -61,24 +62,26 @@ impl Pusher {
 /// Why a part leaves the line at the end of a push instead of riding on.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Stop {
-    /// Two obstacles at once; `cause` names how (`notch`, `second_obstacle`, `pin_inside_part`).
+    /// Two obstacles at once; `cause` names how ([`Cause::Notch`], [`Cause::SecondObstacle`]).
     MultiContact {
-        /// How: `notch`, `second_obstacle` or `pin_inside_part`.
-        cause: &'static str,
+        /// How.
+        cause: Cause,
     },
-    /// The obstacle holds the part for good; `cause` is `travel_limit` (still pushed after
-    /// `model.max_travel`) or `fence_angle` (stopped against a fence at α + atan μf ≥ 90°).
+    /// The obstacle holds the part for good; `cause` is [`Cause::TravelLimit`] (still pushed
+    /// after `model.max_travel`) or [`Cause::FenceAngle`] (stopped against a fence at
+    /// α + atan μf ≥ 90°).
     Jam {
-        /// Why: `travel_limit` or `fence_angle`.
-        cause: &'static str,
+        /// Why.
+        cause: Cause,
     },
     /// The part's centroid crossed the belt's edge while it was pushed along a fence.
     OffBelt,
-    /// The contact model failed; `cause` is the contact status name (`evaluation_limit`,
-    /// `event_limit`, `step_too_small`), or for a failed sub-problem `no_convergence` / `non_finite`.
+    /// The contact model failed; `cause` is the contact status ([`Cause::EvaluationLimit`],
+    /// [`Cause::EventLimit`], [`Cause::StepTooSmall`], …), or for a failed sub-problem
+    /// [`Cause::NoConvergence`] / [`Cause::NonFinite`].
     Solver {
-        /// The contact status or sub-problem failure name.
-        cause: &'static str,
+        /// The contact status or sub-problem failure.
+        cause: Cause,
     },
 }
 

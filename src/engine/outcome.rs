@@ -115,3 +115,114 @@ impl OutcomeCounts {
         PartOutcome::ALL.iter().map(|&o| self.get(o)).sum()
     }
 }
+
+/// Why a part ended as `multi_contact`, `jam` or `solver`: the cause counted in the summary
+/// (`causes`) and written in its record. Written as its name (`second_obstacle`, …; the empty
+/// string for [`Cause::None`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Cause {
+    /// No cause: the part exited, collided or fell off the belt.
+    None,
+    /// `multi_contact`: the pin met a concave notch (two contact points at once).
+    Notch,
+    /// `multi_contact`: a neighbouring obstacle touched the part during a push.
+    SecondObstacle,
+    /// The pin started inside the part: `multi_contact` at a contact's begin (a solver cause if
+    /// a push reports it otherwise).
+    PinInsidePart,
+    /// `jam`: a pin still pushed the part after `model.max_travel`.
+    TravelLimit,
+    /// `jam`: the part stopped against a fence at α + atan μf ≥ 90°.
+    FenceAngle,
+    /// `solver`: touches in a row that pushed nothing, beyond the bound on grazes.
+    GrazingLoop,
+    /// `solver`: a limit-surface sub-problem did not converge.
+    NoConvergence,
+    /// `solver`: a sub-problem produced a non-finite number.
+    NonFinite,
+    /// `solver`: the push exceeded its budget of limit-surface evaluations.
+    EvaluationLimit,
+    /// `solver`: the push exceeded its budget of events.
+    EventLimit,
+    /// `solver`: the integration step fell below its floor.
+    StepTooSmall,
+    /// `solver`: the contact model's consistency check failed.
+    SelfCheck,
+    /// `solver`: the push rode an unstable equilibrium and fell off to a side rounding decided.
+    Metastable,
+}
+
+impl Cause {
+    /// The cause's name in outputs (the empty string for [`Cause::None`]).
+    pub fn name(self) -> &'static str {
+        match self {
+            Cause::None => "",
+            Cause::Notch => "notch",
+            Cause::SecondObstacle => "second_obstacle",
+            Cause::PinInsidePart => "pin_inside_part",
+            Cause::TravelLimit => "travel_limit",
+            Cause::FenceAngle => "fence_angle",
+            Cause::GrazingLoop => "grazing_loop",
+            Cause::NoConvergence => "no_convergence",
+            Cause::NonFinite => "non_finite",
+            Cause::EvaluationLimit => "evaluation_limit",
+            Cause::EventLimit => "event_limit",
+            Cause::StepTooSmall => "step_too_small",
+            Cause::SelfCheck => "self_check",
+            Cause::Metastable => "metastable",
+        }
+    }
+}
+
+impl std::fmt::Display for Cause {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for Cause {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cause;
+
+    const ALL: [Cause; 14] = [
+        Cause::None,
+        Cause::Notch,
+        Cause::SecondObstacle,
+        Cause::PinInsidePart,
+        Cause::TravelLimit,
+        Cause::FenceAngle,
+        Cause::GrazingLoop,
+        Cause::NoConvergence,
+        Cause::NonFinite,
+        Cause::EvaluationLimit,
+        Cause::EventLimit,
+        Cause::StepTooSmall,
+        Cause::SelfCheck,
+        Cause::Metastable,
+    ];
+
+    /// A cause is written as its name, the empty string for none, and no two share a name.
+    #[test]
+    fn causes_are_written_by_distinct_names() {
+        let names: std::collections::BTreeSet<&str> = ALL.iter().map(|c| c.name()).collect();
+        assert_eq!(names.len(), ALL.len());
+        assert_eq!(serde_json::to_string(&Cause::None).unwrap(), "\"\"");
+        for c in ALL {
+            assert_eq!(
+                serde_json::to_string(&c).unwrap(),
+                format!("\"{}\"", c.name())
+            );
+            assert_eq!(c.to_string(), c.name());
+            assert!(c
+                .name()
+                .chars()
+                .all(|ch| ch.is_ascii_lowercase() || ch == '_'));
+        }
+    }
+}

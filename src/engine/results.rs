@@ -82,8 +82,9 @@ pub struct PartRecord {
     pub end_s: f64,
     /// How the part ended (written as its name: `success`, `wrong_orientation`, …).
     pub outcome: crate::engine::PartOutcome,
-    /// Cause behind multi_contact or solver, else empty.
-    pub cause: &'static str,
+    /// Cause behind multi_contact, jam or solver (written as its name), else [`Cause::None`]
+    /// (written empty).
+    pub cause: crate::engine::Cause,
     /// Obstacle encounters (pushes) of the part.
     pub contacts: u32,
     /// Orientation at entry (degrees, [0, 360)).
