@@ -261,6 +261,7 @@ fn sensor_of(obstacle: &Obstacle) -> Option<&SensorPin> {
 /// Why the line stops a part at the end of a push with contact status `status` (None: it rides
 /// on).
 pub fn stop_of(status: &ContactStatus) -> Option<Stop> {
+    let solver = |cause| Some(Stop::Solver { cause });
     match status {
         ContactStatus::Ok => None,
         ContactStatus::MultiContact { .. } => Some(Stop::MultiContact {
@@ -272,30 +273,16 @@ pub fn stop_of(status: &ContactStatus) -> Option<Stop> {
         ContactStatus::Jam { .. } => Some(Stop::Jam {
             cause: Cause::FenceAngle,
         }),
-        ContactStatus::Solver { failure, .. } => Some(Stop::Solver {
-            cause: match failure {
-                SolveFailure::NoConvergence { .. } => Cause::NoConvergence,
-                SolveFailure::NonFinite => Cause::NonFinite,
-            },
+        ContactStatus::Solver { failure, .. } => solver(match failure {
+            SolveFailure::NoConvergence { .. } => Cause::NoConvergence,
+            SolveFailure::NonFinite => Cause::NonFinite,
         }),
-        ContactStatus::PinInsidePart => Some(Stop::Solver {
-            cause: Cause::PinInsidePart,
-        }),
-        ContactStatus::EvaluationLimit { .. } => Some(Stop::Solver {
-            cause: Cause::EvaluationLimit,
-        }),
-        ContactStatus::EventLimit { .. } => Some(Stop::Solver {
-            cause: Cause::EventLimit,
-        }),
-        ContactStatus::StepTooSmall { .. } => Some(Stop::Solver {
-            cause: Cause::StepTooSmall,
-        }),
-        ContactStatus::SelfCheck { .. } => Some(Stop::Solver {
-            cause: Cause::SelfCheck,
-        }),
-        ContactStatus::Metastable { .. } => Some(Stop::Solver {
-            cause: Cause::Metastable,
-        }),
+        ContactStatus::PinInsidePart => solver(Cause::PinInsidePart),
+        ContactStatus::EvaluationLimit { .. } => solver(Cause::EvaluationLimit),
+        ContactStatus::EventLimit { .. } => solver(Cause::EventLimit),
+        ContactStatus::StepTooSmall { .. } => solver(Cause::StepTooSmall),
+        ContactStatus::SelfCheck { .. } => solver(Cause::SelfCheck),
+        ContactStatus::Metastable { .. } => solver(Cause::Metastable),
     }
 }
 
