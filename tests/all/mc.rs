@@ -293,6 +293,95 @@ fn merge_refuses_shards_that_do_not_fit() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+/// A shard rewritten with `edit` and its checksum recomputed: it reads, but its counts are what
+/// `edit` made them.
+fn resealed(from: &Path, to: &Path, edit: impl FnOnce(&mut mc::shard::ShardFile)) -> PathBuf {
+    let mut f = mc::shard::read(from).unwrap();
+    edit(&mut f);
+    f.checksum = f.content_checksum();
+    std::fs::write(to, serde_json::to_string_pretty(&f).unwrap() + "\n").unwrap();
+    to.to_path_buf()
+}
+
+#[test]
+fn merge_refuses_resealed_shards_whose_counts_do_not_hang_together() {
+    use mc::shard::ShardPointError;
+    use mc::StudyError;
+    let d = tmp("resealed");
+    let study = write_study(&d, "samples = 4\n");
+    let shards = d.join("shards");
+    for k in 0..2 {
+        let spec = format!("{k}/2");
+        pinfeed_ok(&[
+            "mc",
+            s(&study),
+            "--shard",
+            &spec,
+            "--quiet",
+            "--out",
+            s(&shards),
+        ]);
+    }
+    let a0 = shards.join("shard-0000-of-0002.json");
+    let a1 = shards.join("shard-0001-of-0002.json");
+    let merge = |second: &Path| {
+        let files: Vec<_> = [&a0, second]
+            .iter()
+            .map(|p| (p.to_path_buf(), mc::shard::read(p).unwrap()))
+            .collect();
+        let e = mc::shard::merge(&files).unwrap_err();
+        let cli = refused(&["merge", "--out", s(&d.join("merged")), s(&a0), s(second)]);
+        assert_eq!(cli, format!("error: {e}\n"));
+        e
+    };
+    // An outcome count one short of the point's samples.
+    let short = resealed(&a1, &d.join("short.json"), |f| {
+        *f.points[0].outcomes.values_mut().find(|n| **n > 0).unwrap() -= 1;
+    });
+    let e = merge(&short);
+    assert!(
+        matches!(
+            &e,
+            StudyError::ShardPoint {
+                path,
+                error: ShardPointError::OutcomeTotal { point: 0, total: 1, samples: 2 },
+            } if *path == short
+        ),
+        "{e:?}"
+    );
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: point 0: the outcome counts add up to 1, not to its 2 samples",
+            short.display()
+        )
+    );
+    // Online counts without their calibration bins.
+    let online = resealed(&a1, &d.join("online.json"), |f| {
+        f.points[0].online.decisions = 1;
+    });
+    let e = merge(&online);
+    assert!(
+        matches!(
+            &e,
+            StudyError::ShardPoint {
+                error: ShardPointError::Online { point: 0, .. },
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: point 0: online: 0 calibration bins, not 10",
+            online.display()
+        )
+    );
+    assert!(!d.join("merged").exists(), "a refused merge wrote a report");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
 /// File names in `dir` (none if it does not exist).
 fn names_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)

@@ -312,6 +312,35 @@ fn impossible_constraints_are_refused_with_the_flag_named() {
 }
 
 #[test]
+fn an_unknown_objective_is_refused_with_the_names_it_takes() {
+    use pinfeed::plan::design::{Objective, ObjectiveError};
+    assert_eq!(
+        " throughput ".parse::<Objective>(),
+        Ok(Objective::Throughput)
+    );
+    let e = "fastest".parse::<Objective>().unwrap_err();
+    assert_eq!(e, ObjectiveError("fastest".into()));
+    assert_eq!(
+        e.to_string(),
+        "'fastest': expected belt-length, obstacles, actuators or throughput"
+    );
+    let out = pinfeed(&[
+        "plan",
+        "--part",
+        "tripoly2",
+        "--no-write",
+        "--objective",
+        "fastest",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty(), "refused before any search");
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "error: --objective 'fastest': expected belt-length, obstacles, actuators or throughput\n"
+    );
+}
+
+#[test]
 fn robust_plan_carries_its_uncertainty() {
     // Each particle has its own μc and tripod: the plan is searched against them and says so.
     let out = tmp("robust.toml");

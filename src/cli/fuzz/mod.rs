@@ -13,6 +13,7 @@ pub mod csvs;
 pub mod plans;
 
 use crate::study::robustness::counts::MAX_CASES;
+use crate::study::robustness::files::SeedsError;
 use crate::study::robustness::{self, Class, Corpus, Options, Target};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
@@ -74,7 +75,7 @@ pub struct FuzzArgs {
 }
 
 /// The fuzzing corpus of the project at `root`, with the command-line targets' cases.
-pub fn corpus(root: &std::path::Path) -> Result<Corpus, String> {
+pub fn corpus(root: &std::path::Path) -> Result<Corpus, SeedsError> {
     Ok(Corpus::load(root)?
         .with_commands(Target::Plans, plans::CASES)
         .with_commands(Target::Csvs, csvs::CASES))

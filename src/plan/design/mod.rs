@@ -92,19 +92,23 @@ pub enum Objective {
 }
 
 impl std::str::FromStr for Objective {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = ObjectiveError;
+    fn from_str(s: &str) -> Result<Self, ObjectiveError> {
         match s.trim() {
             "belt-length" | "belt_length" | "length" => Ok(Objective::BeltLength),
             "obstacles" => Ok(Objective::Obstacles),
             "actuators" => Ok(Objective::Actuators),
             "throughput" => Ok(Objective::Throughput),
-            o => Err(format!(
-                "'{o}': expected belt-length, obstacles, actuators or throughput"
-            )),
+            o => Err(ObjectiveError(o.to_string())),
         }
     }
 }
+
+/// An objective name that is none of the known ones (the [`Objective`] parser); holds the name
+/// as given, trimmed.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("'{0}': expected belt-length, obstacles, actuators or throughput")]
+pub struct ObjectiveError(pub String);
 
 /// Fence settings of the fence and hybrid modes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -415,7 +419,80 @@ pub struct Candidate {
     pub runnable: Runnable,
 }
 
+/// A mode's plan as its search emitted it: the line, before the line has run it.
+#[derive(Debug)]
+struct Emitted {
+    /// How the search ended.
+    search: SearchSummary,
+    /// The plan.
+    layout: Layout,
+    /// The problem the plan was searched with, its belt width the line's.
+    problem: Problem,
+    /// The emitted scenario and its policy file.
+    runnable: Runnable,
+    /// The obstacles as placed, upstream first.
+    obstacles: Vec<ObstacleInfo>,
+    /// Length of the emitted belt (m).
+    belt_length_m: f64,
+}
+
+impl SearchSummary {
+    /// How a search over `planner`'s particles ended, after `depth_completed` levels in
+    /// `elapsed_s` seconds.
+    fn new(
+        result: SearchResult,
+        message: String,
+        planner: &Planner,
+        depth_completed: usize,
+        elapsed_s: f64,
+    ) -> SearchSummary {
+        SearchSummary {
+            result,
+            message,
+            particles: planner.initial.total(),
+            depth_completed,
+            elapsed_s,
+        }
+    }
+}
+
 impl Candidate {
+    /// The candidate of mode `mode` that refinement round `round` emitted, before the line
+    /// has run it (no screen, headway or check yet): its prediction is the plan's, its belt width
+    /// the problem's and its actuators the sensor and moving pins among its obstacles.
+    fn emitted(mode: Mode, round: usize, e: Emitted) -> Candidate {
+        let predicted_success = match &e.layout {
+            Layout::Sequence(p) => p.predicted_success,
+            Layout::Contingent(p) => p.predicted_success,
+        };
+        let actuators = e
+            .obstacles
+            .iter()
+            .filter(|o| matches!(o.kind, ObstacleKind::SensorPin | ObstacleKind::MovingPin))
+            .count();
+        Candidate {
+            mode,
+            round,
+            search: e.search,
+            predicted_success,
+            predicted_with_confusion: None,
+            sensor_accuracy: None,
+            obstacles: e.obstacles,
+            actuators,
+            belt_length_m: e.belt_length_m,
+            belt_width_m: e.problem.belt_width_m,
+            screen: None,
+            headway_probes: Vec::new(),
+            headway_s: 0.0,
+            line_check: None,
+            uncertain_check: None,
+            oriented_per_min: 0.0,
+            layout: e.layout,
+            problem: e.problem,
+            runnable: e.runnable,
+        }
+    }
+
     /// The line's best word on it: the check under uncertainty, else the full check, else the
     /// screen.
     pub fn measured(&self) -> Option<&LineCheck> {
@@ -866,10 +943,12 @@ impl Work<'_> {
             belt_width_m: problem.belt_width_m,
             parts: o.check_parts.max(1),
         };
-        if mode == Mode::Sensor {
-            return self.search_sensor(mode, round, problem, planner, line);
-        }
-        self.search_sequence(mode, round, problem, planner, line)
+        let emitted = if mode == Mode::Sensor {
+            self.search_sensor(mode, round, problem, planner, line)?
+        } else {
+            self.search_sequence(mode, round, problem, planner, line)?
+        };
+        Ok(emitted.map(|e| Candidate::emitted(mode, round, e)))
     }
 
     /// The sensor mode of [`Self::search`]: a contingent plan (a sensor pin and moving pins).
@@ -880,7 +959,7 @@ impl Work<'_> {
         problem: &Problem,
         planner: &mut Planner,
         line: LineSpec,
-    ) -> Result<Option<Candidate>, DesignError> {
+    ) -> Result<Option<Emitted>, DesignError> {
         let o = self.o;
         let compiled = planner.compiled.clone();
         let res = contingent::search(planner, o.max_moving, o.sensor_candidates);
@@ -928,40 +1007,23 @@ impl Work<'_> {
             &policy_name,
         );
         let obstacles = contingent_obstacles(problem, &plan);
-        let actuators = obstacles
-            .iter()
-            .filter(|x| x.kind != ObstacleKind::Pin)
-            .count();
         let belt_length_m = problem.spacing_m * (plan.k as f64 + 2.0);
-        Ok(Some(Candidate {
-            mode,
-            round,
-            search: SearchSummary {
+        Ok(Some(Emitted {
+            search: SearchSummary::new(
                 result,
                 message,
-                particles: planner.initial.total(),
-                depth_completed: stats.depth_completed,
-                elapsed_s: stats.elapsed_s,
-            },
-            predicted_success: plan.predicted_success,
-            predicted_with_confusion: None,
-            sensor_accuracy: None,
-            obstacles,
-            actuators,
-            belt_length_m,
-            belt_width_m: problem.belt_width_m,
-            screen: None,
-            headway_probes: Vec::new(),
-            headway_s: 0.0,
-            line_check: None,
-            uncertain_check: None,
-            oriented_per_min: 0.0,
+                planner,
+                stats.depth_completed,
+                stats.elapsed_s,
+            ),
             layout: Layout::Contingent(plan),
             problem: problem.clone(),
             runnable: Runnable {
                 toml: body,
                 policy: Some((policy_name, policy)),
             },
+            obstacles,
+            belt_length_m,
         }))
     }
 
@@ -973,7 +1035,7 @@ impl Work<'_> {
         problem: &Problem,
         planner: &mut Planner,
         line: LineSpec,
-    ) -> Result<Option<Candidate>, DesignError> {
+    ) -> Result<Option<Emitted>, DesignError> {
         let o = self.o;
         let compiled = planner.compiled.clone();
         if matches!(mode, Mode::Fences | Mode::Hybrid) {
@@ -1034,35 +1096,22 @@ impl Work<'_> {
         let obstacles = sequence_obstacles(&plan, &xs);
         let mut problem = problem.clone();
         problem.belt_width_m = width;
-        Ok(Some(Candidate {
-            mode,
-            round,
-            search: SearchSummary {
+        Ok(Some(Emitted {
+            search: SearchSummary::new(
                 result,
                 message,
-                particles: planner.initial.total(),
-                depth_completed: stats.depth_completed,
-                elapsed_s: stats.elapsed_s,
-            },
-            predicted_success: plan.predicted_success,
-            predicted_with_confusion: None,
-            sensor_accuracy: None,
-            obstacles,
-            actuators: 0,
-            belt_length_m,
-            belt_width_m: width,
-            screen: None,
-            headway_probes: Vec::new(),
-            headway_s: 0.0,
-            line_check: None,
-            uncertain_check: None,
-            oriented_per_min: 0.0,
+                planner,
+                stats.depth_completed,
+                stats.elapsed_s,
+            ),
             layout: Layout::Sequence(plan),
             problem,
             runnable: Runnable {
                 toml: body,
                 policy: None,
             },
+            obstacles,
+            belt_length_m,
         }))
     }
 

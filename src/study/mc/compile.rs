@@ -595,35 +595,49 @@ pub fn reach_text(name: &str) -> &'static str {
     }
 }
 
+/// A sweep that names no field of the declared uncertainty ([`apply_sweep`]); the study's
+/// error locates it at the sweep's `parameter`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+enum SweepError {
+    /// A field of the support swept without an `[uncertain.support]` table.
+    #[error("[uncertain.support] is not declared; declare model = \"smooth\" to sweep its fields")]
+    NoSupport,
+    /// A field the support does not have (holds the parameter as given).
+    #[error("`{0}`: the support can be swept only through support.bumps, support.width, support.contrast or support.points")]
+    SupportField(String),
+    /// A parameter that is no distribution parameter (holds its name before any `.`).
+    #[error("unknown parameter `{0}`; expected one of {known}, support", known = DISTRIBUTION_PARAMETERS.join(", "))]
+    UnknownParameter(String),
+    /// A field of a distribution the study does not declare (holds the parameter's name).
+    #[error("[uncertain.{0}] is not declared; declare its distribution, or sweep `{0}` itself to fix it at each value")]
+    Undeclared(String),
+    /// A field no distribution has (holds the field).
+    #[error("`{0}` is not a distribution field; expected value, min, max, mean, sd or mode")]
+    Field(String),
+}
+
 /// Set the field a sweep names to `value` (see the module docs).
-fn apply_sweep(u: &mut RawUncertain, parameter: &str, value: f64) -> Result<(), String> {
+fn apply_sweep(u: &mut RawUncertain, parameter: &str, value: f64) -> Result<(), SweepError> {
     let (name, field) = match parameter.split_once('.') {
         Some((n, f)) => (n, Some(f)),
         None => (parameter, None),
     };
     if name == "support" {
         let Some(s) = u.support.as_mut() else {
-            return Err("[uncertain.support] is not declared; declare model = \"smooth\" to sweep its fields".into());
+            return Err(SweepError::NoSupport);
         };
         let target = match field {
             Some("bumps") => &mut s.bumps,
             Some("width") => &mut s.width,
             Some("contrast") => &mut s.contrast,
             Some("points") => &mut s.points,
-            _ => {
-                return Err(format!(
-                    "`{parameter}`: the support can be swept only through support.bumps, support.width, support.contrast or support.points"
-                ))
-            }
+            _ => return Err(SweepError::SupportField(parameter.to_string())),
         };
         *target = Some(value);
         return Ok(());
     }
     if !DISTRIBUTION_PARAMETERS.contains(&name) {
-        return Err(format!(
-            "unknown parameter `{name}`; expected one of {}, support",
-            DISTRIBUTION_PARAMETERS.join(", ")
-        ));
+        return Err(SweepError::UnknownParameter(name.to_string()));
     }
     let d = slot_mut(u, name);
     match field {
@@ -640,9 +654,7 @@ fn apply_sweep(u: &mut RawUncertain, parameter: &str, value: f64) -> Result<(), 
         }
         Some(f) => {
             let Some(raw) = d.as_mut() else {
-                return Err(format!(
-                    "[uncertain.{name}] is not declared; declare its distribution, or sweep `{name}` itself to fix it at each value"
-                ));
+                return Err(SweepError::Undeclared(name.to_string()));
             };
             let target = match f {
                 "value" => &mut raw.value,
@@ -651,11 +663,7 @@ fn apply_sweep(u: &mut RawUncertain, parameter: &str, value: f64) -> Result<(), 
                 "mean" => &mut raw.mean,
                 "sd" => &mut raw.sd,
                 "mode" => &mut raw.mode,
-                other => {
-                    return Err(format!(
-                        "`{other}` is not a distribution field; expected value, min, max, mean, sd or mode"
-                    ))
-                }
+                other => return Err(SweepError::Field(other.to_string())),
             };
             *target = Some(value);
         }
@@ -766,7 +774,7 @@ pub fn compile_points(
         let mut raw = u.clone();
         for (k, (axis, &v)) in axes.iter().zip(&values).enumerate() {
             apply_sweep(&mut raw, &axis.parameter, v)
-                .map_err(|m| err(loc, &format!("sweep[{k}].parameter"), m))?;
+                .map_err(|e| err(loc, &format!("sweep[{k}].parameter"), e.to_string()))?;
         }
         let p = compile_uncertain(loc, &raw, scenario_support).map_err(|e| {
             let inner = e
@@ -943,4 +951,38 @@ pub fn check_reach(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sweep that names no declared field is refused with the message the study file's error
+    /// shows at the sweep.
+    #[test]
+    fn sweeps_of_undeclared_or_unknown_fields_are_refused() {
+        let mut u = RawUncertain::default();
+        let e = apply_sweep(&mut u, "shape.sd", 0.1).unwrap_err();
+        assert_eq!(e, SweepError::Undeclared("shape".into()));
+        assert_eq!(
+            e.to_string(),
+            "[uncertain.shape] is not declared; declare its distribution, or sweep `shape` itself to fix it at each value"
+        );
+        assert_eq!(
+            apply_sweep(&mut u, "support.width", 0.1),
+            Err(SweepError::NoSupport)
+        );
+        let e = apply_sweep(&mut u, "mu_cc", 0.1).unwrap_err();
+        assert_eq!(e, SweepError::UnknownParameter("mu_cc".into()));
+        assert!(e
+            .to_string()
+            .starts_with("unknown parameter `mu_cc`; expected one of mu_c, belt_speed, "));
+        assert!(e.to_string().ends_with(", controller_latency, support"));
+        apply_sweep(&mut u, "mu_c", 0.5).unwrap();
+        let e = apply_sweep(&mut u, "mu_c.median", 0.5).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "`median` is not a distribution field; expected value, min, max, mean, sd or mode"
+        );
+    }
 }

@@ -1,5 +1,7 @@
 //! Why a Monte Carlo study could not be loaded, run, sharded or merged.
 
+use super::shard::ShardPointError;
+use super::tally::TallyMergeError;
 use crate::engine::EngineError;
 use crate::scenario::{InvalidScenario, ScenarioError};
 use std::path::PathBuf;
@@ -55,6 +57,24 @@ pub enum StudyError {
     /// A shard file or a set of shard files that cannot be used.
     #[error("{0}")]
     Shard(String),
+    /// A point of a shard file whose counts do not hang together.
+    /// (The cause is in the message, not a `source`, so that it is printed once.)
+    #[error("{}: {error}", path.display())]
+    ShardPoint {
+        /// The shard file.
+        path: PathBuf,
+        /// What is wrong with the point.
+        error: ShardPointError,
+    },
+    /// A shard file whose tally of a point cannot be added to the other shards'.
+    /// (The cause is in the message, not a `source`, so that it is printed once.)
+    #[error("{}: {error}", path.display())]
+    ShardMerge {
+        /// The shard file.
+        path: PathBuf,
+        /// Why the tallies do not add.
+        error: TallyMergeError,
+    },
 }
 
 impl StudyError {

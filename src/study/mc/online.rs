@@ -131,23 +131,22 @@ impl OnlineTally {
 
     /// Whether the counts hang together (a shard's check): every part in one bin, no more
     /// successes or correct states than their totals.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), OnlineTallyError> {
         if self.decisions == 0 {
             return Ok(());
         }
         if self.bins.len() != BINS {
-            return Err(format!(
-                "online: {} calibration bins, not {BINS}",
-                self.bins.len()
-            ));
+            return Err(OnlineTallyError::Bins(self.bins.len()));
         }
         let parts: u64 = self.bins.iter().map(|b| b.parts).sum();
         let ok: u64 = self.bins.iter().map(|b| b.successes).sum();
         if parts != self.decisions || ok != self.successes {
-            return Err(format!(
-                "online: the calibration bins hold {parts} decisions and {ok} successes, not {} and {}",
-                self.decisions, self.successes
-            ));
+            return Err(OnlineTallyError::BinTotals {
+                parts,
+                successes: ok,
+                decisions: self.decisions,
+                total_successes: self.successes,
+            });
         }
         if self.successes > self.decisions
             || self.state_correct > self.state_known
@@ -155,7 +154,7 @@ impl OnlineTally {
             || self.bins.iter().any(|b| b.successes > b.parts)
             || self.predicted_micro > self.decisions * SCALE as u64
         {
-            return Err("online: a count exceeds its total".into());
+            return Err(OnlineTallyError::Exceeds);
         }
         Ok(())
     }
@@ -190,6 +189,31 @@ impl OnlineTally {
             }
         })
     }
+}
+
+/// Counts of an online controller that do not hang together ([`OnlineTally::check`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum OnlineTallyError {
+    /// Not [`BINS`] calibration bins (holds how many there are).
+    #[error("online: {0} calibration bins, not {BINS}")]
+    Bins(usize),
+    /// The bins' decisions or successes are not the tally's.
+    #[error(
+        "online: the calibration bins hold {parts} decisions and {successes} successes, not {decisions} and {total_successes}"
+    )]
+    BinTotals {
+        /// Decisions, summed over the bins.
+        parts: u64,
+        /// Successes, summed over the bins.
+        successes: u64,
+        /// The tally's decisions.
+        decisions: u64,
+        /// The tally's successes.
+        total_successes: u64,
+    },
+    /// More successes or correct states than their totals, or a mean prediction above 1.
+    #[error("online: a count exceeds its total")]
+    Exceeds,
 }
 
 /// What the online controller did at one sweep point, in the report.
@@ -347,10 +371,28 @@ mod tests {
         t.check().unwrap();
         let mut bad = t.clone();
         bad.successes += 1;
-        assert!(bad.check().is_err());
+        let e = bad.check().unwrap_err();
+        assert_eq!(
+            e,
+            OnlineTallyError::BinTotals {
+                parts: 2,
+                successes: 1,
+                decisions: 2,
+                total_successes: 2
+            }
+        );
+        assert_eq!(
+            e.to_string(),
+            "online: the calibration bins hold 2 decisions and 1 successes, not 2 and 2"
+        );
         let mut bad = t.clone();
         bad.bins.pop();
-        assert!(bad.check().is_err());
+        let e = bad.check().unwrap_err();
+        assert_eq!(e, OnlineTallyError::Bins(BINS - 1));
+        assert_eq!(e.to_string(), "online: 9 calibration bins, not 10");
+        let mut bad = t.clone();
+        bad.state_correct = 3;
+        assert_eq!(bad.check(), Err(OnlineTallyError::Exceeds));
         assert!(OnlineTally::default().report().is_none());
     }
 }

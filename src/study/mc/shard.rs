@@ -300,55 +300,49 @@ impl ShardFile {
 
 impl ShardPoint {
     /// The exact tally this point carries.
-    fn tally(&self) -> Result<PointTally, String> {
+    fn tally(&self) -> Result<PointTally, ShardPointError> {
+        let point = self.point;
         let mut outcomes = OutcomeCounts::default();
         for (name, &n) in &self.outcomes {
             let c = PartOutcome::ALL
                 .into_iter()
                 .find(|c| c.name() == name)
-                .ok_or_else(|| format!("unknown outcome class `{name}`"))?;
+                .ok_or_else(|| ShardPointError::UnknownOutcome(name.clone()))?;
             add_count(&mut outcomes, c, n);
         }
         if outcomes.total() != self.samples {
-            return Err(format!(
-                "point {}: the outcome counts add up to {}, not to its {} samples",
-                self.point,
-                outcomes.total(),
-                self.samples
-            ));
+            return Err(ShardPointError::OutcomeTotal {
+                point,
+                total: outcomes.total(),
+                samples: self.samples,
+            });
         }
         let bytes = base64::engine::general_purpose::STANDARD
             .decode(&self.latency_us_hdr_v2)
-            .map_err(|e| format!("point {}: latency histogram is not base64: {e}", self.point))?;
+            .map_err(|error| ShardPointError::NotBase64 { point, error })?;
         let h: hdrhistogram::Histogram<u64> = Deserializer::new()
             .deserialize(&mut bytes.as_slice())
-            .map_err(|e| {
-                format!(
-                    "point {}: latency histogram is not HdrHistogram V2: {e:?}",
-                    self.point
-                )
-            })?;
+            .map_err(|error| ShardPointError::NotHdrHistogram { point, error })?;
         let mut latency_us = latency_histogram();
-        latency_us.add(&h).map_err(|e| {
-            format!(
-                "point {}: latency histogram out of range: {e:?}",
-                self.point
-            )
-        })?;
+        latency_us
+            .add(&h)
+            .map_err(|error| ShardPointError::LatencyRange { point, error })?;
         if self.sensor_correct > self.sensor_readings {
-            return Err(format!(
-                "point {}: {} correct sensor decisions out of {} readings",
-                self.point, self.sensor_correct, self.sensor_readings
-            ));
+            return Err(ShardPointError::SensorCorrect {
+                point,
+                correct: self.sensor_correct,
+                readings: self.sensor_readings,
+            });
         }
         self.online
             .check()
-            .map_err(|e| format!("point {}: {e}", self.point))?;
+            .map_err(|error| ShardPointError::Online { point, error })?;
         if self.online.decisions > self.samples {
-            return Err(format!(
-                "point {}: {} online decisions out of {} samples",
-                self.point, self.online.decisions, self.samples
-            ));
+            return Err(ShardPointError::OnlineDecisions {
+                point,
+                decisions: self.online.decisions,
+                samples: self.samples,
+            });
         }
         Ok(PointTally {
             samples: self.samples,
@@ -362,6 +356,78 @@ impl ShardPoint {
             online: self.online.clone(),
         })
     }
+}
+
+/// Why a point of a shard file gives no tally: its counts do not hang together. Every message
+/// but the unknown class's starts with `point N: `; the causes are in the messages, not sources,
+/// so that they are printed once.
+#[derive(Debug, thiserror::Error)]
+pub enum ShardPointError {
+    /// An outcome class no pinfeed outcome is named (holds the name).
+    #[error("unknown outcome class `{0}`")]
+    UnknownOutcome(String),
+    /// The outcome counts do not add up to the point's samples.
+    #[error("point {point}: the outcome counts add up to {total}, not to its {samples} samples")]
+    OutcomeTotal {
+        /// Index of the sweep point.
+        point: usize,
+        /// The sum of the outcome counts.
+        total: u64,
+        /// The point's samples.
+        samples: u64,
+    },
+    /// The latency histogram is not base64.
+    #[error("point {point}: latency histogram is not base64: {error}")]
+    NotBase64 {
+        /// Index of the sweep point.
+        point: usize,
+        /// The decoder's error.
+        error: base64::DecodeError,
+    },
+    /// The latency histogram is not an HdrHistogram V2 serialisation.
+    #[error("point {point}: latency histogram is not HdrHistogram V2: {error:?}")]
+    NotHdrHistogram {
+        /// Index of the sweep point.
+        point: usize,
+        /// The deserialiser's error.
+        error: hdrhistogram::serialization::DeserializeError,
+    },
+    /// The latency histogram holds values outside the study's latency range.
+    #[error("point {point}: latency histogram out of range: {error:?}")]
+    LatencyRange {
+        /// Index of the sweep point.
+        point: usize,
+        /// The histogram's error.
+        error: hdrhistogram::errors::AdditionError,
+    },
+    /// More correct sensor decisions than readings.
+    #[error("point {point}: {correct} correct sensor decisions out of {readings} readings")]
+    SensorCorrect {
+        /// Index of the sweep point.
+        point: usize,
+        /// Correct sensor decisions.
+        correct: u64,
+        /// Sensor readings.
+        readings: u64,
+    },
+    /// The online controller's counts do not hang together.
+    #[error("point {point}: {error}")]
+    Online {
+        /// Index of the sweep point.
+        point: usize,
+        /// What is wrong with them.
+        error: super::online::OnlineTallyError,
+    },
+    /// More online decisions than samples.
+    #[error("point {point}: {decisions} online decisions out of {samples} samples")]
+    OnlineDecisions {
+        /// Index of the sweep point.
+        point: usize,
+        /// The online controller's decisions.
+        decisions: u64,
+        /// The point's samples.
+        samples: u64,
+    },
 }
 
 /// Read a shard file.
@@ -544,9 +610,10 @@ pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTa
     for (path, f) in &order {
         let [a, b] = f.samples;
         for sp in &f.points {
-            let t = sp
-                .tally()
-                .map_err(|e| StudyError::Shard(format!("{}: {e}", path.display())))?;
+            let t = sp.tally().map_err(|error| StudyError::ShardPoint {
+                path: path.clone(),
+                error,
+            })?;
             // The samples of this point inside the shard's range.
             let (lo, hi) = (sp.point as u64 * n, (sp.point as u64 + 1) * n);
             let expected = b.min(hi).saturating_sub(a.max(lo));
@@ -560,7 +627,10 @@ pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTa
             }
             tallies[sp.point]
                 .merge(&t)
-                .map_err(|e| StudyError::Shard(format!("{}: {e}", path.display())))?;
+                .map_err(|error| StudyError::ShardMerge {
+                    path: path.clone(),
+                    error,
+                })?;
         }
     }
     for (j, t) in tallies.iter().enumerate() {

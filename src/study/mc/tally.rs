@@ -5,6 +5,7 @@
 use super::online::OnlineTally;
 use super::sample::SampleResult;
 use crate::engine::{OutcomeCounts, PartOutcome};
+use hdrhistogram::errors::AdditionError;
 use hdrhistogram::Histogram;
 
 /// Counts of one sweep point.
@@ -72,7 +73,7 @@ impl PointTally {
     }
 
     /// Add another tally of the same point.
-    pub fn merge(&mut self, o: &PointTally) -> Result<(), String> {
+    pub fn merge(&mut self, o: &PointTally) -> Result<(), TallyMergeError> {
         self.samples += o.samples;
         for c in PartOutcome::ALL {
             add_count(&mut self.outcomes, c, o.outcomes.get(c));
@@ -83,11 +84,15 @@ impl PointTally {
         self.sensor_readings += o.sensor_readings;
         self.sensor_correct += o.sensor_correct;
         self.online.merge(&o.online);
-        self.latency_us
-            .add(&o.latency_us)
-            .map_err(|e| format!("latency histograms do not add up: {e:?}"))
+        self.latency_us.add(&o.latency_us).map_err(TallyMergeError)
     }
 }
+
+/// Two tallies whose latency histograms cannot be added ([`PointTally::merge`]): the other's
+/// values exceed this one's range (holds the histogram's error).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("latency histograms do not add up: {0:?}")]
+pub struct TallyMergeError(pub AdditionError);
 
 /// Add `n` to the count of class `c`.
 pub fn add_count(counts: &mut OutcomeCounts, c: PartOutcome, n: u64) {

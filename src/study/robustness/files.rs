@@ -500,13 +500,43 @@ pub struct Seeds {
     pub studies: Vec<(PathBuf, String)>,
 }
 
-fn read_dir_toml(dir: &Path) -> Result<Vec<(PathBuf, String)>, String> {
+/// Why the seed files could not be read ([`Seeds::load`]).
+#[derive(Debug, thiserror::Error)]
+pub enum SeedsError {
+    /// A folder or a file that could not be read.
+    /// (The cause is in the message, not a `source`, so that it is printed once.)
+    #[error("{}: {error}", path.display())]
+    Read {
+        /// The folder or file.
+        path: PathBuf,
+        /// Why it could not be read.
+        error: std::io::Error,
+    },
+    /// An entry of a folder that could not be listed.
+    #[error(transparent)]
+    Entry(std::io::Error),
+    /// No seed scenarios or no seed studies under the root.
+    #[error(
+        "no scenario or study files under {} (run from the project root, or give --root)",
+        root.display()
+    )]
+    Empty {
+        /// The project root given.
+        root: PathBuf,
+    },
+}
+
+fn read_dir_toml(dir: &Path) -> Result<Vec<(PathBuf, String)>, SeedsError> {
+    let read = |path: &Path| {
+        let path = path.to_path_buf();
+        move |error| SeedsError::Read { path, error }
+    };
     let mut out = Vec::new();
-    let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let entries = std::fs::read_dir(dir).map_err(read(dir))?;
     for e in entries {
-        let p = e.map_err(|e| e.to_string())?.path();
+        let p = e.map_err(SeedsError::Entry)?.path();
         if p.extension().is_some_and(|x| x == "toml") {
-            let text = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+            let text = std::fs::read_to_string(&p).map_err(read(&p))?;
             out.push((p, text));
         }
     }
@@ -541,7 +571,7 @@ fn smallest_belief(text: &str) -> String {
 
 impl Seeds {
     /// The bundled scenarios and studies and the test fixtures under `root`.
-    pub fn load(root: &Path) -> Result<Seeds, String> {
+    pub fn load(root: &Path) -> Result<Seeds, SeedsError> {
         let mut scenarios = read_dir_toml(&root.join("scenarios"))?;
         for (_, text) in &mut scenarios {
             *text = smallest_belief(text);
@@ -550,10 +580,9 @@ impl Seeds {
         let mut studies = read_dir_toml(&root.join("studies"))?;
         studies.extend(read_dir_toml(&root.join("tests/fixtures/studies"))?);
         if scenarios.is_empty() || studies.is_empty() {
-            return Err(format!(
-                "no scenario or study files under {} (run from the project root, or give --root)",
-                root.display()
-            ));
+            return Err(SeedsError::Empty {
+                root: root.to_path_buf(),
+            });
         }
         Ok(Seeds { scenarios, studies })
     }

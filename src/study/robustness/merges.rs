@@ -21,10 +21,21 @@ pub const DESCRIPTION: &str = "the three shards of studies/quickstart_mu_tripod.
 /// Shards of the study.
 pub const SHARDS: u64 = 3;
 
+/// Why the study's shards could not be made ([`make_shards`]).
+#[derive(Debug, thiserror::Error)]
+pub enum ShardsError {
+    /// The study could not be loaded or run.
+    #[error(transparent)]
+    Study(#[from] mc::StudyError),
+    /// A shard could not be written as JSON.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
 /// The shards of the study: (file name, JSON text).
-pub fn make_shards(root: &Path) -> Result<Vec<(String, String)>, String> {
+pub fn make_shards(root: &Path) -> Result<Vec<(String, String)>, ShardsError> {
     let path = root.join("studies/quickstart_mu_tripod.toml");
-    let study = mc::load(&path, Some(3)).map_err(|e| e.to_string())?;
+    let study = mc::load(&path, Some(3))?;
     let header = mc::report::StudyHeader::of(&study);
     let total = study.total_samples();
     (0..SHARDS)
@@ -34,10 +45,9 @@ pub fn make_shards(root: &Path) -> Result<Vec<(String, String)>, String> {
                 count: SHARDS,
             };
             let range = spec.range(total);
-            let tallies = mc::run::run_range_with_threads(&study, range.clone(), Some(1), &|| {})
-                .map_err(|e| e.to_string())?;
+            let tallies = mc::run::run_range_with_threads(&study, range.clone(), Some(1), &|| {})?;
             let file = shard::ShardFile::new(&header, spec, range, &tallies);
-            let text = serde_json::to_string_pretty(&file).map_err(|e| e.to_string())? + "\n";
+            let text = serde_json::to_string_pretty(&file)? + "\n";
             Ok((spec.file_name(), text))
         })
         .collect()

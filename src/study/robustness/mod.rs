@@ -315,7 +315,7 @@ pub struct Corpus {
     pub pair_seeds: Vec<(PathBuf, String)>,
     root: PathBuf,
     /// The merges target's shards, made on first use.
-    shards: std::sync::OnceLock<Result<Vec<(String, String)>, String>>,
+    shards: std::sync::OnceLock<Result<Vec<(String, String)>, merges::ShardsError>>,
     /// The command-line targets' cases ([`Corpus::with_commands`]).
     commands: Vec<(Target, CommandCases)>,
 }
@@ -323,7 +323,7 @@ pub struct Corpus {
 impl Corpus {
     /// Read the seed files under the project root `root`; Err names the file or folder that could
     /// not be read.
-    pub fn load(root: &Path) -> Result<Corpus, String> {
+    pub fn load(root: &Path) -> Result<Corpus, files::SeedsError> {
         let files = files::Seeds::load(root)?;
         Ok(Corpus {
             pair_seeds: pairs::seeds(&files),
@@ -350,13 +350,12 @@ impl Corpus {
             .map(|(_, c)| c)
     }
 
-    /// The shards of the merges target (run once).
-    pub fn shards(&self) -> Result<&[(String, String)], String> {
+    /// The shards of the merges target (run once; a failure is kept and given to every case).
+    pub fn shards(&self) -> Result<&[(String, String)], &merges::ShardsError> {
         self.shards
             .get_or_init(|| merges::make_shards(&self.root))
             .as_ref()
             .map(|v| v.as_slice())
-            .map_err(|e| e.clone())
     }
 }
 
