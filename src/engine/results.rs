@@ -82,7 +82,7 @@ pub struct PartRecord {
     pub end_s: f64,
     /// How the part ended (written as its name: `success`, `wrong_orientation`, …).
     pub outcome: crate::engine::PartOutcome,
-    /// Cause behind multi_contact, jam or solver (written as its name), else [`Cause::None`]
+    /// Cause behind multi_contact, jam or solver (written as its name), else [`Cause::None`](crate::engine::Cause::None)
     /// (written empty).
     pub cause: crate::engine::Cause,
     /// Obstacle encounters (pushes) of the part.
