@@ -441,19 +441,21 @@ impl Member {
     }
 }
 
-/// Compile members 0 … n − 1 in parallel (in index order).
+/// Compile members 0 … n − 1 in parallel (in index order). When members fail, the error is the
+/// first failing member's by index, whatever the thread count and timing.
 pub fn members(
     poly: &Polygon,
     spec: &EnsembleSpec,
     seed: u64,
     n: usize,
 ) -> Result<Vec<Member>, EnsembleError> {
-    (0..n as u64)
+    let built: Vec<Result<Member, EnsembleError>> = (0..n as u64)
         .into_par_iter()
         .map(|i| {
             Member::new(poly, spec, seed, i).map_err(|cause| EnsembleError { index: i, cause })
         })
-        .collect()
+        .collect();
+    built.into_iter().collect()
 }
 
 /// An ensemble of maps: θf of every member at every (d, grid θ0).
@@ -626,6 +628,28 @@ mod tests {
             "mu_c=normal:1",
         ] {
             assert!(base.clone().with_settings(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// Every member fails (μc drawn far below 0): the error names member 0 on any number of
+    /// threads, every time (the first failure by index, not the first to finish).
+    #[test]
+    fn a_failing_ensemble_reports_its_first_member() {
+        let poly = crate::geometry::part_from_spec("tripoly1").unwrap();
+        let spec = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
+            .with_settings("mu_c=normal:-5:0.01")
+            .unwrap();
+        for threads in [1, 2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for _ in 0..10 {
+                match pool.install(|| members(&poly, &spec, 1, 64)) {
+                    Err(e) => assert_eq!(e.index, 0, "{threads} threads: {e}"),
+                    Ok(_) => panic!("a negative μc was accepted"),
+                }
+            }
         }
     }
 
