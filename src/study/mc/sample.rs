@@ -407,8 +407,8 @@ fn draw_polygon(
     for _ in 0..MAX_SHAPE_REDRAWS {
         let mut pts = Vec::with_capacity(base.part.polygon.len());
         for v in base.part.polygon.vertices() {
-            let (ex, _) = d.draw(rng, |_| true)?;
-            let (ey, _) = d.draw(rng, |_| true)?;
+            let (ex, _) = d.draw(rng, |_| true).map_err(|e| e.to_string())?;
+            let (ey, _) = d.draw(rng, |_| true).map_err(|e| e.to_string())?;
             pts.push(Vec2::new(v.x + ex, v.y + ey));
         }
         match Polygon::new(&pts) {
@@ -775,6 +775,7 @@ fn draw_part_model(
     Ok(loop {
         let polygon = draw_polygon(base, &p.shape, &mut st.shape, shape_redraws)?;
         let model = draw_support(&polygon, &p.support, &mut st.support, other)
+            .map_err(|e| e.to_string())
             .and_then(|support| PartModel::new(&polygon, &support).map_err(|e| e.to_string()));
         match model {
             Ok(m) => break (polygon, m),
