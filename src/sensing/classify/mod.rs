@@ -160,23 +160,23 @@ pub fn build(
     sensor: &SensorSettings,
     options: &ClassifierOptions,
 ) -> Result<Box<dyn Classifier>, BuildError> {
-    let name_ = || name.to_string();
+    let owned = || name.to_string();
     if !NAMES.contains(&name) {
-        return Err(BuildError::Unknown { name: name_() });
+        return Err(BuildError::Unknown { name: owned() });
     }
     sensor.validate().map_err(|error| BuildError::Sensor {
-        name: name_(),
+        name: owned(),
         error,
     })?;
     if !(0.0..=1.0).contains(&options.reject_below) {
         return Err(BuildError::RejectBelow {
-            name: name_(),
+            name: owned(),
             value: options.reject_below,
         });
     }
     if templates.labels.len() != templates.members.len() {
         return Err(BuildError::Ensembles {
-            name: name_(),
+            name: owned(),
             labels: templates.labels.len(),
             ensembles: templates.members.len(),
         });
@@ -190,7 +190,7 @@ pub fn build(
         .sum();
     if samples > super::reading::MAX_TEMPLATE_SAMPLES {
         return Err(BuildError::Samples {
-            name: name_(),
+            name: owned(),
             samples,
             rate: sensor.rate,
         });
@@ -202,11 +202,11 @@ pub fn build(
         ));
     }
     if templates.labels.is_empty() {
-        return Err(BuildError::NoHypotheses { name: name_() });
+        return Err(BuildError::NoHypotheses { name: owned() });
     }
     if let Some(h) = templates.members.iter().position(|m| m.is_empty()) {
         return Err(BuildError::EmptyEnsemble {
-            name: name_(),
+            name: owned(),
             label: templates.labels[h].clone(),
         });
     }
