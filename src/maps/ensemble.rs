@@ -18,9 +18,10 @@ use super::arcs::{Arc, MassArc};
 use super::sample::sample_one;
 use super::MapSettings;
 use crate::geometry::{wrap_deg, Polygon};
-use crate::mechanics::support::{draw_support, SmoothParams, SupportChoice};
+use crate::mechanics::support::{draw_support, SmoothParams, SupportChoice, SupportDrawError};
 use crate::mechanics::{ContactSettings, Fidelity, PartModel, Pin};
 use crate::random::distribution::Distribution;
+use crate::random::distribution::DrawError;
 use crate::random::{stream, ChaCha8Rng};
 use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution as _, StandardNormal};
@@ -188,16 +189,16 @@ pub enum SettingsError {
 }
 
 /// Why an ensemble member could not be drawn or compiled ([`draw_member`], [`Member::new`]).
-/// Each variant holds the message of the step that failed, printed as it is.
+/// Each variant holds the error of the step that failed, printed as it is.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MemberError {
     /// A parameter's distribution gave no value in its domain
     /// ([`crate::random::distribution::Distribution::draw`]).
     #[error("{0}")]
-    Draw(String),
+    Draw(DrawError),
     /// The member's support could not be drawn ([`draw_support`]).
     #[error("{0}")]
-    Support(String),
+    Support(SupportDrawError),
     /// The member's part model could not be compiled ([`PartModel::new`]).
     #[error("{0}")]
     Model(crate::mechanics::PartModelError),

@@ -56,7 +56,7 @@ pub use part_model::{Fidelity, PartModel, PartModelError, SolveFailure, Support,
 pub(crate) use pass::untouched;
 pub use pass::{
     fence_first_touch, first_instant, pin_first_touch, push, push_fence, push_path,
-    stop_after_touch,
+    stop_after_touch, StopAfterTouchError,
 };
 pub use pin_path::{PinPath, Turn, MAX_LATERAL_SPEED};
 pub use settings::{ContactSettings, Pin};

@@ -13,7 +13,7 @@ use super::instant::{classify, ContactGeom, Instant};
 use super::integrate::{integrate_contact, End, Tally};
 use super::outcome::{ContactOutcome, ContactStatus, Recorder, SelfCheck};
 use super::part_model::PartModel;
-use super::pin_path::PinPath;
+use super::pin_path::{PinPath, PinPathError};
 use super::settings::{ContactSettings, Pin};
 use crate::geometry::{first_contact, Feature, Pose, Vec2};
 
@@ -276,6 +276,20 @@ pub fn pin_first_touch(
     }
 }
 
+/// Why a stopping pin path could not be built ([`stop_after_touch`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StopAfterTouchError {
+    /// The travel after the first touch is negative or not finite.
+    #[error("the travel after first touch must be a finite number >= 0, got {after}")]
+    After {
+        /// The travel given.
+        after: f64,
+    },
+    /// The pin path itself is invalid (e.g. the speed); its message is printed as it is.
+    #[error("{0}")]
+    Path(PinPathError),
+}
+
 /// The path of a pin moving at lateral speed `w` from `pin_start` that stops `after` (belt travel,
 /// caller's units) after it first touches the part resting at `pose` ([`pin_first_touch`] on the
 /// constant path, which the stopping path follows up to the stop), then stands still. A pin that
@@ -287,13 +301,11 @@ pub fn stop_after_touch(
     radius: f64,
     w: f64,
     after: f64,
-) -> Result<PinPath, String> {
+) -> Result<PinPath, StopAfterTouchError> {
     if !(after.is_finite() && after >= 0.0) {
-        return Err(format!(
-            "the travel after first touch must be a finite number >= 0, got {after}"
-        ));
+        return Err(StopAfterTouchError::After { after });
     }
-    let moving = PinPath::new(w, Vec::new()).map_err(|e| e.to_string())?;
+    let moving = PinPath::new(w, Vec::new()).map_err(StopAfterTouchError::Path)?;
     match pin_first_touch(model, pose, pin_start, radius, &moving) {
         Some(s) if s.is_finite() => PinPath::new(
             w,
@@ -302,7 +314,7 @@ pub fn stop_after_touch(
                 w: 0.0,
             }],
         )
-        .map_err(|e| e.to_string()),
+        .map_err(StopAfterTouchError::Path),
         _ => Ok(moving),
     }
 }

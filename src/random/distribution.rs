@@ -16,6 +16,19 @@ use rand_distr::{Distribution as _, StandardNormal};
 /// Redraws before a draw is declared impossible.
 pub const MAX_REDRAWS: u32 = 1000;
 
+/// Why no value could be drawn ([`Distribution::draw`]): [`MAX_REDRAWS`] redraws in a row fell
+/// outside the allowed range.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error(
+    "{} draws in a row from {} fell outside the allowed range",
+    MAX_REDRAWS + 1,
+    .distribution.describe()
+)]
+pub struct DrawError {
+    /// The distribution drawn from.
+    pub distribution: Distribution,
+}
+
 /// A compiled distribution.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Distribution {
@@ -80,7 +93,7 @@ impl Distribution {
         &self,
         rng: &mut impl rand::Rng,
         ok: impl Fn(f64) -> bool,
-    ) -> Result<(f64, u32), String> {
+    ) -> Result<(f64, u32), DrawError> {
         for redraws in 0..=MAX_REDRAWS {
             let v = self.raw_draw(rng);
             let truncated = match *self {
@@ -91,11 +104,9 @@ impl Distribution {
                 return Ok((v, redraws));
             }
         }
-        Err(format!(
-            "{} draws in a row from {} fell outside the allowed range",
-            MAX_REDRAWS + 1,
-            self.describe()
-        ))
+        Err(DrawError {
+            distribution: *self,
+        })
     }
 
     /// Smallest and largest value the distribution can produce.
@@ -184,7 +195,11 @@ mod tests {
             max: -1.0,
         };
         let e = d.draw(&mut stream(1, 1), |v| v >= 0.0).unwrap_err();
-        assert!(e.contains("outside the allowed range"), "{e}");
+        assert_eq!(e, DrawError { distribution: d });
+        assert_eq!(
+            e.to_string(),
+            "1001 draws in a row from uniform [-2, -1] fell outside the allowed range"
+        );
         let n = Distribution::Normal {
             mean: 0.0,
             sd: 1.0,

@@ -41,7 +41,7 @@ pub enum ReportError {
     Plan(#[from] crate::plan::PlanError),
     /// A sensing trial of a figure could not be simulated.
     #[error("{0}")]
-    Trial(String),
+    Trial(crate::sensing::evaluate::EvaluateError),
     /// An animation would last longer than allowed at the speed-up asked for.
     #[error(
         "--animate-speed {speedup} would make the animation last {duration_s:.0} s; at most {max_s} s (choose a larger speed-up)"

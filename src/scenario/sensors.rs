@@ -228,7 +228,7 @@ pub(super) fn train(
         reject_below: draft.reject_below,
     };
     let classifier = classify::build(&draft.classifier, &set, &draft.settings, &options)
-        .map_err(|e| c.err(&format!("obstacles[{i}].sensor.classifier"), e))?;
+        .map_err(|e| c.err(&format!("obstacles[{i}].sensor.classifier"), e.to_string()))?;
     Ok(SensorPin {
         settings: draft.settings,
         classifier_name: draft.classifier.clone(),

@@ -170,9 +170,37 @@ impl Evaluation {
     }
 }
 
+/// Why an evaluation could not be run ([`evaluate_with`], [`trial_pass`]); a failed step's
+/// message is printed as it is.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EvaluateError {
+    /// No hypotheses to draw a trial for.
+    #[error("no hypotheses")]
+    NoHypotheses,
+    /// A trial count out of range.
+    #[error("trials must lie in [1, {MAX_TRIALS}], got {trials}")]
+    Trials {
+        /// The count given.
+        trials: usize,
+    },
+    /// A template count out of range.
+    #[error("templates per hypothesis must lie in [1, {MAX_TEMPLATES}], got {templates}")]
+    Templates {
+        /// The count given.
+        templates: usize,
+    },
+    /// A template or trial pass could not be drawn.
+    #[error("{0}")]
+    Pass(super::templates::PassError),
+    /// A classifier could not be built by the factory.
+    #[error("{0}")]
+    Classifier(classify::BuildError),
+}
+
 /// A classifier factory: [`classify::build`] or a test double.
-pub type Factory<'f> =
-    dyn Fn(&str, &TemplateSet, &SensorSettings) -> Result<Box<dyn Classifier>, String> + Sync + 'f;
+pub type Factory<'f> = dyn Fn(&str, &TemplateSet, &SensorSettings) -> Result<Box<dyn Classifier>, classify::BuildError>
+    + Sync
+    + 'f;
 
 /// The classifiers that apply to a sensor kind and hypotheses (the default list): an F/T sensor
 /// feeds the thesis's method, the matched filter and the contact duration it shows; a timing sensor
@@ -220,13 +248,13 @@ pub fn trial_pass(
     problem: &Problem,
     config: &Config,
     i: usize,
-) -> Result<(Option<usize>, super::templates::Pass), String> {
+) -> Result<(Option<usize>, super::templates::Pass), EvaluateError> {
     let (degrees, vertex_edge) = match problem.hypotheses {
         Hypotheses::Orientations { degrees, .. } => (degrees, false),
         Hypotheses::VertexEdge { degrees } => (degrees, true),
     };
     if degrees.is_empty() {
-        return Err("no hypotheses".into());
+        return Err(EvaluateError::NoHypotheses);
     }
     let j = trial_choice(i, degrees.len(), config.truth, config.seed);
     let pass = draw_pass(
@@ -237,7 +265,7 @@ pub fn trial_pass(
         config.seed,
         TRIAL_STREAMS + i as u64,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(EvaluateError::Pass)?;
     let truth = if vertex_edge {
         pass.signal.first_feature.map(vertex_edge_class)
     } else {
@@ -253,7 +281,7 @@ pub fn evaluate_with(
     points: &[SensorPoint],
     config: &Config,
     factory: &Factory,
-) -> Result<(TemplateSet, Evaluation), String> {
+) -> Result<(TemplateSet, Evaluation), EvaluateError> {
     evaluate_observed(problem, points, config, factory, &crate::progress::silent)
 }
 
@@ -265,18 +293,16 @@ pub fn evaluate_observed(
     config: &Config,
     factory: &Factory,
     progress: crate::progress::Report,
-) -> Result<(TemplateSet, Evaluation), String> {
+) -> Result<(TemplateSet, Evaluation), EvaluateError> {
     if config.trials == 0 || config.trials > MAX_TRIALS {
-        return Err(format!(
-            "trials must lie in [1, {MAX_TRIALS}], got {}",
-            config.trials
-        ));
+        return Err(EvaluateError::Trials {
+            trials: config.trials,
+        });
     }
     if config.templates_per_hypothesis == 0 || config.templates_per_hypothesis > MAX_TEMPLATES {
-        return Err(format!(
-            "templates per hypothesis must lie in [1, {MAX_TEMPLATES}], got {}",
-            config.templates_per_hypothesis
-        ));
+        return Err(EvaluateError::Templates {
+            templates: config.templates_per_hypothesis,
+        });
     }
     let tally = crate::progress::Tally::new(config.trials as u64, progress);
     let templates = build_templates(
@@ -287,7 +313,7 @@ pub fn evaluate_observed(
         config.templates_per_hypothesis,
         config.seed,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(EvaluateError::Pass)?;
     let labels = templates.labels.clone();
     let k = labels.len();
     // Trained classifiers, per point.
@@ -295,7 +321,7 @@ pub fn evaluate_observed(
     for p in points {
         let mut v = Vec::with_capacity(p.classifiers.len());
         for name in &p.classifiers {
-            v.push(factory(name, &templates, &p.sensor)?);
+            v.push(factory(name, &templates, &p.sensor).map_err(EvaluateError::Classifier)?);
         }
         trained.push(v);
     }
@@ -320,7 +346,7 @@ pub fn evaluate_observed(
     };
     let (matrices, unscored) = (0..config.trials)
         .into_par_iter()
-        .map(|i| -> Result<Acc, String> {
+        .map(|i| -> Result<Acc, EvaluateError> {
             let mut acc = empty();
             let (truth, pass) = trial_pass(problem, config, i)?;
             tally.add(1);
@@ -379,7 +405,7 @@ pub fn evaluate(
     problem: &Problem,
     points: &[SensorPoint],
     config: &Config,
-) -> Result<(TemplateSet, Evaluation), String> {
+) -> Result<(TemplateSet, Evaluation), EvaluateError> {
     let options = config.options;
     let factory = move |name: &str, t: &TemplateSet, s: &SensorSettings| {
         classify::build(name, t, s, &options)

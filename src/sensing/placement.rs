@@ -7,7 +7,9 @@
 //! placement is the one with the most information (ties: the higher accuracy, then the first
 //! listed); the best placement likewise over the grid, per kind and overall.
 
-use super::evaluate::{evaluate_with, Config, Evaluation, Factory, Problem, SensorPoint};
+use super::evaluate::{
+    evaluate_with, Config, EvaluateError, Evaluation, Factory, Problem, SensorPoint,
+};
 use super::templates::PushSetup;
 use serde::Serialize;
 
@@ -106,7 +108,7 @@ pub fn search_with(
     config: &Config,
     factory: &Factory,
     progress: &mut dyn FnMut(f64, &[Row]),
-) -> Result<Placement, String> {
+) -> Result<Placement, EvaluateError> {
     let mut rows = Vec::new();
     for &d in grid {
         let setup = PushSetup {

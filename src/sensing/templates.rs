@@ -276,13 +276,13 @@ pub fn simulate(setup: &PushSetup, model: &PartModel, theta0_deg: f64, d: f64, m
 }
 
 /// Why a template or trial pass could not be drawn ([`draw_pass`], [`build_templates`]). Each
-/// variant holds the message of the step that failed, printed as it is.
+/// variant holds the error of the step that failed, printed as it is.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PassError {
     /// μc's distribution gave no value in its domain
     /// ([`crate::random::distribution::Distribution::draw`]).
     #[error("{0}")]
-    MuC(String),
+    MuC(crate::random::distribution::DrawError),
     /// No tripod could be drawn ([`Support::random_tripod`]).
     #[error("{0}")]
     Tripod(crate::mechanics::TripodError),

@@ -305,7 +305,7 @@ fn profile_interval(x: &[f64], p: &[f64], best: f64) -> (f64, f64, bool, bool) {
 pub enum CalibrateError {
     /// The proposal ensemble's predictions could not be made (their message, as it is).
     #[error("{0}")]
-    Predict(String),
+    Predict(crate::maps::ensemble::EnsembleError),
     /// No point of the parameter grid has a finite log-likelihood.
     #[error("the log-likelihood is not finite anywhere on the grid")]
     NotFinite,

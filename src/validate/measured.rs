@@ -124,9 +124,20 @@ pub fn parse(file: &Path, text: &str, max_pin_radius: f64) -> Result<Measured, M
     parse_for(file, text, max_pin_radius, None)
 }
 
+/// Why a CSV line could not be split into fields ([`split_fields`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum FieldsError {
+    /// A quoted field runs to the end of the line.
+    #[error("a quoted field is not closed (a `\"` is missing)")]
+    Unclosed,
+    /// Something other than a comma follows a closing quote.
+    #[error("'{0}' after a closing quote (expected ',')")]
+    AfterQuote(char),
+}
+
 /// The fields of one CSV line, trimmed: a field in double quotes may hold commas, and `""` in it
 /// is one quote (RFC 4180).
-pub fn split_fields(line: &str) -> Result<Vec<String>, String> {
+pub fn split_fields(line: &str) -> Result<Vec<String>, FieldsError> {
     let mut fields = Vec::new();
     let mut chars = line.chars().peekable();
     loop {
@@ -145,7 +156,7 @@ pub fn split_fields(line: &str) -> Result<Vec<String>, String> {
                     }
                     Some('"') => break,
                     Some(c) => field.push(c),
-                    None => return Err("a quoted field is not closed (a `\"` is missing)".into()),
+                    None => return Err(FieldsError::Unclosed),
                 }
             }
             while chars.peek().is_some_and(|c| *c == ' ' || *c == '\t') {
@@ -157,7 +168,7 @@ pub fn split_fields(line: &str) -> Result<Vec<String>, String> {
                     return Ok(fields);
                 }
                 Some(',') => fields.push(field),
-                Some(c) => return Err(format!("'{c}' after a closing quote (expected ',')")),
+                Some(c) => return Err(FieldsError::AfterQuote(c)),
             }
         } else {
             loop {
@@ -196,7 +207,7 @@ pub fn parse_for(
     let (hline, header) = lines
         .next()
         .ok_or_else(|| err(1, None, "empty file: expected the header `part,d,input,min_deg,max_deg,trials` and at least one row".into()))?;
-    let names: Vec<String> = split_fields(header).map_err(|m| err(hline, None, m))?;
+    let names: Vec<String> = split_fields(header).map_err(|m| err(hline, None, m.to_string()))?;
     let has_part = names.first().is_some_and(|n| n == "part");
     let without_part: Vec<&str> = names[usize::from(has_part)..]
         .iter()
@@ -225,7 +236,8 @@ pub fn parse_for(
         parts: Vec::new(),
     };
     for (line, text) in lines {
-        let mut fields: Vec<String> = split_fields(text).map_err(|m| err(line, None, m))?;
+        let mut fields: Vec<String> =
+            split_fields(text).map_err(|m| err(line, None, m.to_string()))?;
         let full = names.len() + usize::from(!has_part);
         if fields.len() != names.len() && !(full == 6 && fields.len() + 1 == names.len()) {
             return Err(err(

@@ -15,7 +15,7 @@ pub mod predict;
 pub mod score;
 pub mod synthetic;
 
-use crate::maps::ensemble::EnsembleSpec;
+use crate::maps::ensemble::{EnsembleError, EnsembleSpec};
 use measured::Measured;
 use predict::Predictions;
 use score::{RowScore, ScoreSettings, Summary};
@@ -31,7 +31,7 @@ pub fn validate(
     members: usize,
     passes: usize,
     score: &ScoreSettings,
-) -> Result<(Vec<RowScore>, Summary, Predictions), String> {
+) -> Result<(Vec<RowScore>, Summary, Predictions), EnsembleError> {
     let draw = (seed, members, passes);
     validate_observed(measured, spec, draw, score, &crate::progress::silent)
 }
@@ -44,7 +44,7 @@ pub fn validate_observed(
     (seed, members, passes): (u64, usize, usize),
     score: &ScoreSettings,
     progress: crate::progress::Report,
-) -> Result<(Vec<RowScore>, Summary, Predictions), String> {
+) -> Result<(Vec<RowScore>, Summary, Predictions), EnsembleError> {
     let pred = predict::predict_observed(measured, spec, seed, members, passes, progress)?;
     let weights = vec![1.0; pred.members.len() * passes];
     let (rows, count) = score::score_rows(measured, &pred.rows, &weights, passes, score);

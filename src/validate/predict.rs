@@ -7,7 +7,9 @@
 //! draw (μc, support choice, pin radius) is the same for every part.
 
 use super::measured::Measured;
-use crate::maps::ensemble::{members, stable_states_deg, EnsembleSpec, Member, MemberDraw};
+use crate::maps::ensemble::{
+    members, stable_states_deg, EnsembleError, EnsembleSpec, Member, MemberDraw,
+};
 use rayon::prelude::*;
 
 /// The predicted final orientations of every row.
@@ -38,7 +40,7 @@ pub fn predict(
     seed: u64,
     n: usize,
     passes: usize,
-) -> Result<Predictions, String> {
+) -> Result<Predictions, EnsembleError> {
     predict_observed(measured, spec, seed, n, passes, &crate::progress::silent)
 }
 
@@ -50,15 +52,15 @@ pub fn predict_observed(
     n: usize,
     passes: usize,
     progress: crate::progress::Report,
-) -> Result<Predictions, String> {
+) -> Result<Predictions, EnsembleError> {
     let compiled: Vec<(String, Vec<Member>, Vec<f64>)> = measured
         .parts
         .iter()
         .map(|(name, poly)| {
-            let m = members(poly, spec, seed, n).map_err(|e| e.to_string())?;
+            let m = members(poly, spec, seed, n)?;
             Ok((name.clone(), m, stable_states_deg(poly)))
         })
-        .collect::<Result<_, String>>()?;
+        .collect::<Result<_, EnsembleError>>()?;
     // The distinct (part, d, input) in order of first appearance, and each row's among them.
     let mut groups: Vec<(&str, u64, String)> = Vec::new();
     let group_of: Vec<usize> = measured

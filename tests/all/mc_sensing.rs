@@ -311,7 +311,17 @@ fn a_negative_jitter_is_redrawn_and_an_impossible_one_reported() {
     let e = sample::draw_scene(&st.scene, &st.points[0], st.seed, 0)
         .err()
         .expect("refused");
-    assert!(e.contains("sensor_jitter"), "{e}");
+    assert!(
+        matches!(
+            e,
+            sample::SampleError::Value {
+                name: "sensor_jitter",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("sensor_jitter"), "{e}");
     std::fs::remove_dir_all(&d).unwrap();
 }
 

@@ -6,7 +6,9 @@ use pinfeed::geometry::named;
 use pinfeed::mechanics::*;
 use pinfeed::random::stream;
 use pinfeed::sensing::classify::zero_crossings::derivative_zero_crossings;
-use pinfeed::sensing::classify::{build, Classifier, ClassifierOptions, Decision, NAMES};
+use pinfeed::sensing::classify::{
+    build, BuildError, Classifier, ClassifierOptions, Decision, NAMES,
+};
 use pinfeed::sensing::reading::{read, Reading, Sampled};
 use pinfeed::sensing::settings::{SensorKind, SensorSettings, CHANNELS};
 use pinfeed::sensing::templates::*;
@@ -425,11 +427,20 @@ fn bad_names_and_templates_are_refused() {
     let sensor = SensorSettings::default();
     let o = ClassifierOptions::default();
     let err = build("bayes", &t, &sensor, &o).err().unwrap();
+    assert_eq!(
+        err,
+        BuildError::Unknown {
+            name: "bayes".into()
+        }
+    );
+    let err = err.to_string();
     for n in NAMES {
         assert!(err.contains(n), "{err}");
     }
     assert!(err.contains("bayes"));
     let err = build("zero-crossings", &t, &sensor, &o).err().unwrap();
+    assert!(matches!(err, BuildError::ZeroCrossings(_)), "{err:?}");
+    let err = err.to_string();
     assert!(err.contains("vertex"), "{err}");
     let empty = TemplateSet {
         labels: vec!["a".into(), "b".into()],
@@ -437,6 +448,11 @@ fn bad_names_and_templates_are_refused() {
     };
     for name in ["sign-matrix", "timing", "likelihood"] {
         let err = build(name, &empty, &sensor, &o).err().unwrap();
+        assert!(
+            matches!(&err, BuildError::EmptyEnsemble { label, .. } if label == "b"),
+            "{err:?}"
+        );
+        let err = err.to_string();
         assert!(err.contains("'b'"), "{err}");
     }
     let err = build(
@@ -447,6 +463,11 @@ fn bad_names_and_templates_are_refused() {
     )
     .err()
     .unwrap();
+    assert!(
+        matches!(err, BuildError::RejectBelow { value: 2.0, .. }),
+        "{err:?}"
+    );
+    let err = err.to_string();
     assert!(err.contains("reject_below"), "{err}");
     for name in NAMES {
         assert!(build(name, &t, &sensor, &o).is_ok() || name == "zero-crossings");

@@ -5,7 +5,7 @@
 use pinfeed::geometry::named;
 use pinfeed::mechanics::{PartModel, Support};
 use pinfeed::random::distribution::Distribution;
-use pinfeed::sensing::classify::{Classification, Classifier, Decision};
+use pinfeed::sensing::classify::{BuildError, Classification, Classifier, Decision};
 use pinfeed::sensing::evaluate::{
     evaluate_with, noise_sweep, Config, Confusion, Evaluation, Problem, TruthDraw,
 };
@@ -79,14 +79,18 @@ impl Classifier for Constant {
     }
 }
 
-fn factory(name: &str, t: &TemplateSet, s: &SensorSettings) -> Result<Box<dyn Classifier>, String> {
+fn factory(
+    name: &str,
+    t: &TemplateSet,
+    s: &SensorSettings,
+) -> Result<Box<dyn Classifier>, BuildError> {
     match name {
         "nearest" => Ok(Box::new(Nearest {
             templates: t.members.clone(),
             threshold: s.threshold,
         })),
         "constant" => Ok(Box::new(Constant)),
-        other => Err(format!("unknown classifier '{other}'")),
+        other => Err(BuildError::Unknown { name: other.into() }),
     }
 }
 

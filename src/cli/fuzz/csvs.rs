@@ -74,7 +74,7 @@ fn run_validate(c: &CsvCase, path: &Path) -> CaseReport {
         Err(e) => return refused(&format!("{e:#}")),
     };
     match crate::validate::validate(&m, &spec, a.common.seed, a.members, a.common.passes, &score) {
-        Err(e) => refused(&e),
+        Err(e) => refused(&e.to_string()),
         Ok((rows, summary, _)) => {
             if shows_non_finite(&format!("{rows:?} {summary:?}")) {
                 CaseReport::with(Class::NonFinite, "a row or the summary holds NaN or inf")
@@ -107,7 +107,7 @@ fn run_calibrate(c: &CsvCase, path: &Path) -> CaseReport {
     let scored =
         crate::validate::validate(&m, &fitted, s.seed, a.score_members, s.passes, &s.score);
     match scored {
-        Err(e) => refused(&e),
+        Err(e) => refused(&e.to_string()),
         Ok((rows, summary, _)) => {
             if shows_non_finite(&format!("{cal:?} {rows:?} {summary:?}")) {
                 CaseReport::with(

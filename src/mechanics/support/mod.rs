@@ -8,9 +8,10 @@
 pub mod smooth;
 
 use super::Support;
+use super::TripodError;
 use crate::geometry::Polygon;
 use crate::random::ChaCha8Rng;
-use smooth::random_smooth_support;
+use smooth::{random_smooth_support, SmoothSupportError};
 
 /// Parameters of the random smooth pressure density (see [`smooth`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,6 +62,29 @@ impl SupportChoice {
     }
 }
 
+/// Why a support could not be drawn ([`draw_support`]); prints the failed draw's message as it is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum SupportDrawError {
+    /// No random tripod carrying the centroid was found.
+    #[error("{0}")]
+    Tripod(TripodError),
+    /// No random smooth density was found.
+    #[error("{0}")]
+    Smooth(SmoothSupportError),
+}
+
+impl From<TripodError> for SupportDrawError {
+    fn from(e: TripodError) -> Self {
+        SupportDrawError::Tripod(e)
+    }
+}
+
+impl From<SmoothSupportError> for SupportDrawError {
+    fn from(e: SmoothSupportError) -> Self {
+        SupportDrawError::Smooth(e)
+    }
+}
+
 /// The support of one sample on its (perturbed) polygon; smooth densities redrawn because their
 /// tilt made the pressure negative are counted in `redraws`.
 pub fn draw_support(
@@ -68,10 +92,10 @@ pub fn draw_support(
     choice: &SupportChoice,
     rng: &mut ChaCha8Rng,
     redraws: &mut u32,
-) -> Result<Support, String> {
+) -> Result<Support, SupportDrawError> {
     Ok(match choice {
         SupportChoice::Uniform => Support::Uniform,
-        SupportChoice::Tripod => Support::random_tripod(polygon, rng).map_err(|e| e.to_string())?,
+        SupportChoice::Tripod => Support::random_tripod(polygon, rng)?,
         SupportChoice::Smooth(params) => {
             let (s, n) = random_smooth_support(polygon, params, rng)?;
             *redraws += n;

@@ -70,22 +70,38 @@ fn point_inside(poly: &Polygon, rng: &mut impl rand::Rng) -> Option<Vec2> {
     None
 }
 
+/// Why no smooth random support could be drawn ([`random_smooth_support`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum SmoothSupportError {
+    /// Fewer than three lattice points fit inside the part.
+    #[error("the part is too thin for a lattice of support points")]
+    TooThin,
+    /// No point inside the part was found for a bump's centre.
+    #[error("could not place a pressure bump inside the part")]
+    Bump,
+    /// The support points lie on a line, so no tilt centres the pressure.
+    #[error("the support points are collinear")]
+    Collinear,
+    /// Every density drawn needed a tilt that made the pressure negative somewhere.
+    #[error("100 smooth densities in a row needed a tilt that made the pressure negative; lower support.contrast or widen support.width")]
+    Negative,
+}
+
 /// Draw a smooth random support. Returns the support and the number of redraws.
 pub fn random_smooth_support(
     poly: &Polygon,
     params: &SmoothParams,
     rng: &mut impl rand::Rng,
-) -> Result<(Support, u32), String> {
+) -> Result<(Support, u32), SmoothSupportError> {
     let points = lattice_points(poly, params.points);
     if points.len() < 3 {
-        return Err("the part is too thin for a lattice of support points".into());
+        return Err(SmoothSupportError::TooThin);
     }
     let s = params.width * poly.radius();
     for redraws in 0..100u32 {
         let mut bumps = Vec::with_capacity(params.bumps);
         for _ in 0..params.bumps {
-            let c =
-                point_inside(poly, rng).ok_or("could not place a pressure bump inside the part")?;
+            let c = point_inside(poly, rng).ok_or(SmoothSupportError::Bump)?;
             bumps.push((c, params.contrast * rng.random::<f64>()));
         }
         let field: Vec<f64> = points
@@ -108,7 +124,7 @@ pub fn random_smooth_support(
         }
         let det = sxx * syy - sxy * sxy;
         if det.abs() <= 1e-300 {
-            return Err("the support points are collinear".into());
+            return Err(SmoothSupportError::Collinear);
         }
         let gx = -(syy * mx - sxy * my) / det;
         let gy = -(-sxy * mx + sxx * my) / det;
@@ -128,7 +144,7 @@ pub fn random_smooth_support(
             ));
         }
     }
-    Err("100 smooth densities in a row needed a tilt that made the pressure negative; lower support.contrast or widen support.width".into())
+    Err(SmoothSupportError::Negative)
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@ pub mod timing;
 pub mod zero_crossings;
 
 use super::reading::Reading;
-use super::settings::SensorSettings;
+use super::settings::{SensorSettings, SettingError};
 use super::templates::TemplateSet;
 use serde::Serialize;
 
@@ -76,6 +76,77 @@ pub trait Classifier: Send + Sync {
 /// The names [`build`] accepts.
 pub const NAMES: [&str; 4] = ["sign-matrix", "timing", "likelihood", "zero-crossings"];
 
+/// Why a classifier could not be built ([`build`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BuildError {
+    /// A name that is no classifier.
+    #[error("unknown classifier '{name}'; known: {}", NAMES.join(", "))]
+    Unknown {
+        /// The name given.
+        name: String,
+    },
+    /// Invalid sensor settings.
+    #[error("{name}: sensor settings: {error}")]
+    Sensor {
+        /// The classifier.
+        name: String,
+        /// The invalid setting.
+        error: SettingError,
+    },
+    /// A rejection threshold out of [0, 1].
+    #[error("{name}: reject_below must lie in [0, 1], got {value}")]
+    RejectBelow {
+        /// The classifier.
+        name: String,
+        /// The threshold given.
+        value: f64,
+    },
+    /// Labels and template ensembles that do not match one to one.
+    #[error("{name}: {labels} labels but {ensembles} template ensembles")]
+    Ensembles {
+        /// The classifier.
+        name: String,
+        /// Number of labels.
+        labels: usize,
+        /// Number of template ensembles.
+        ensembles: usize,
+    },
+    /// Templates that would hold too many samples at the sensor's rate.
+    #[error(
+        "{name}: the templates would hold {samples} samples at {rate} Hz (at most {}): lower the rate or the number of templates",
+        super::reading::MAX_TEMPLATE_SAMPLES
+    )]
+    Samples {
+        /// The classifier.
+        name: String,
+        /// The samples the templates would hold.
+        samples: usize,
+        /// The sensor's rate (Hz).
+        rate: f64,
+    },
+    /// Zero-crossings cannot be trained on these templates.
+    #[error("{0}")]
+    ZeroCrossings(zero_crossings::ZeroCrossingsError),
+    /// No hypotheses.
+    #[error("{name}: no hypotheses")]
+    NoHypotheses {
+        /// The classifier.
+        name: String,
+    },
+    /// A hypothesis without templates.
+    #[error("{name}: hypothesis '{label}' has no templates (an empty ensemble cannot be matched)")]
+    EmptyEnsemble {
+        /// The classifier.
+        name: String,
+        /// The hypothesis's label.
+        label: String,
+    },
+    /// The likelihood classifier could not be trained ([`likelihood::Likelihood::new`]; its
+    /// message as it is).
+    #[error("{0}")]
+    Likelihood(String),
+}
+
 /// Trains the classifier `name` (one of [`NAMES`]) on `templates` for readings of `sensor`.
 ///
 /// Errors: an unknown name (the message lists the known ones), invalid sensor settings or
@@ -88,28 +159,27 @@ pub fn build(
     templates: &TemplateSet,
     sensor: &SensorSettings,
     options: &ClassifierOptions,
-) -> Result<Box<dyn Classifier>, String> {
+) -> Result<Box<dyn Classifier>, BuildError> {
+    let owned = || name.to_string();
     if !NAMES.contains(&name) {
-        return Err(format!(
-            "unknown classifier '{name}'; known: {}",
-            NAMES.join(", ")
-        ));
+        return Err(BuildError::Unknown { name: owned() });
     }
-    sensor
-        .validate()
-        .map_err(|e| format!("{name}: sensor settings: {e}"))?;
+    sensor.validate().map_err(|error| BuildError::Sensor {
+        name: owned(),
+        error,
+    })?;
     if !(0.0..=1.0).contains(&options.reject_below) {
-        return Err(format!(
-            "{name}: reject_below must lie in [0, 1], got {}",
-            options.reject_below
-        ));
+        return Err(BuildError::RejectBelow {
+            name: owned(),
+            value: options.reject_below,
+        });
     }
     if templates.labels.len() != templates.members.len() {
-        return Err(format!(
-            "{name}: {} labels but {} template ensembles",
-            templates.labels.len(),
-            templates.members.len()
-        ));
+        return Err(BuildError::Ensembles {
+            name: owned(),
+            labels: templates.labels.len(),
+            ensembles: templates.members.len(),
+        });
     }
     // Training samples every template at the sensor's rate: bound the work and the memory.
     let samples: usize = templates
@@ -119,29 +189,33 @@ pub fn build(
         .map(|s| super::reading::samples_needed(s, sensor.rate))
         .sum();
     if samples > super::reading::MAX_TEMPLATE_SAMPLES {
-        return Err(format!(
-            "{name}: the templates would hold {samples} samples at {} Hz (at most {}): lower the rate or the number of templates",
-            sensor.rate,
-            super::reading::MAX_TEMPLATE_SAMPLES
-        ));
+        return Err(BuildError::Samples {
+            name: owned(),
+            samples,
+            rate: sensor.rate,
+        });
     }
     if name == "zero-crossings" {
         return Ok(Box::new(
-            zero_crossings::ZeroCrossings::new(templates, sensor).map_err(|e| e.to_string())?,
+            zero_crossings::ZeroCrossings::new(templates, sensor)
+                .map_err(BuildError::ZeroCrossings)?,
         ));
     }
     if templates.labels.is_empty() {
-        return Err(format!("{name}: no hypotheses"));
+        return Err(BuildError::NoHypotheses { name: owned() });
     }
     if let Some(h) = templates.members.iter().position(|m| m.is_empty()) {
-        return Err(format!(
-            "{name}: hypothesis '{}' has no templates (an empty ensemble cannot be matched)",
-            templates.labels[h]
-        ));
+        return Err(BuildError::EmptyEnsemble {
+            name: owned(),
+            label: templates.labels[h].clone(),
+        });
     }
     Ok(match name {
         "sign-matrix" => Box::new(sign_matrix::SignMatrixClassifier::new(templates, sensor)),
-        "timing" => Box::new(timing::Timing::new(templates, sensor, options)?),
-        _ => Box::new(likelihood::Likelihood::new(templates, sensor, options)?),
+        "timing" => Box::new(timing::Timing::new(templates, sensor, options)),
+        _ => Box::new(
+            likelihood::Likelihood::new(templates, sensor, options)
+                .map_err(BuildError::Likelihood)?,
+        ),
     })
 }

@@ -57,12 +57,12 @@ fn silverman_sq(v: &[f64]) -> f64 {
 }
 
 impl Timing {
-    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
+    /// Train on `templates` for `sensor` (any template set can be used).
     pub fn new(
         templates: &TemplateSet,
         sensor: &SensorSettings,
         options: &ClassifierOptions,
-    ) -> Result<Timing, String> {
+    ) -> Timing {
         let exact = SensorSettings {
             jitter: 0.0,
             ..*sensor
@@ -100,14 +100,14 @@ impl Timing {
             timing.push(th);
             ft.push(fh);
         }
-        Ok(Timing {
+        Timing {
             timing,
             ft,
             var_timing,
             var_ft,
             sensor: *sensor,
             options: *options,
-        })
+        }
     }
 
     /// log p(durations | h) per hypothesis.

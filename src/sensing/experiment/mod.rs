@@ -214,7 +214,7 @@ pub enum SenseError {
     NoClassifier,
     /// The evaluation or the placement search failed.
     #[error("{0}")]
-    Evaluate(String),
+    Evaluate(crate::sensing::evaluate::EvaluateError),
 }
 
 /// A request checked: the push, its part model, hypotheses, uncertainty, sensor and classifiers.

@@ -240,7 +240,7 @@ impl Checked {
                 failures
                     .lock()
                     .expect("lock")
-                    .push((name.to_string(), *s, e));
+                    .push((name.to_string(), *s, e.to_string()));
                 Ok(Box::new(Placeholder) as Box<dyn Classifier>)
             }
         };

@@ -1,5 +1,6 @@
 //! Why a Monte Carlo study could not be loaded, run, sharded or merged.
 
+use super::sample::SampleError;
 use super::shard::ShardPointError;
 use super::tally::TallyMergeError;
 use crate::engine::EngineError;
@@ -33,7 +34,7 @@ pub enum StudyError {
         /// Index of the sample within its sweep point (0-based).
         sample: u64,
         /// Why no valid sample came out.
-        reason: String,
+        reason: Box<SampleError>,
     },
     /// The line engine refused a sample.
     #[error("sample {sample} of sweep point {point}: {source}")]

@@ -57,18 +57,20 @@
 //! kind of obstacle cannot slip through this step unnoticed. Fence and actuator parameters reach
 //! only the obstacles their `fences`/`pins` selector names, if it names any.
 
-use super::distribution::Distribution;
+use super::distribution::{Distribution, DrawError, MAX_REDRAWS};
 use super::perturbations::Perturbations;
 use crate::engine::part_stream::draw_part;
 use crate::engine::{self, PartOutcome, RunOptions};
-use crate::geometry::{Polygon, Vec2};
-use crate::mechanics::support::draw_support;
-use crate::mechanics::PartModel;
+use crate::geometry::{Polygon, PolygonError, Vec2};
+use crate::mechanics::support::{draw_support, SupportDrawError};
+use crate::mechanics::{PartModel, PartModelError};
 use crate::random::{stream, ChaCha8Rng};
+use crate::scenario::limits::{show, ACTUATOR_TIME};
 use crate::scenario::{
     Actuator, Arrival, Controller, Feed, FenceObstacle, Lateral, MovingSpec, Obstacle, Orientation,
     PartSpec, PinObstacle, RetractSpec, Scene, SensorPin, SupportKind,
 };
+use crate::sensing::settings::SettingError;
 use crate::sensing::SensorSettings;
 use rand::{RngExt, SeedableRng};
 use std::sync::Arc;
@@ -265,6 +267,149 @@ fn sensors(scene: &Scene) -> Vec<&SensorPin> {
         .collect()
 }
 
+/// Why a sample could not be drawn ([`draw_scene`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SampleError {
+    /// A parameter's distribution gave no value in its domain; `range`, when known, says which
+    /// range the values left.
+    #[error(
+        "{name}: {error}{}",
+        .range.as_ref().map(|r| format!(": {r}")).unwrap_or_default()
+    )]
+    Value {
+        /// The parameter (`mu_c`, `pin_x`, …).
+        name: &'static str,
+        /// The failed draw.
+        error: DrawError,
+        /// The range the values left, when known.
+        range: Option<RangeLeft>,
+    },
+    /// A vertex error of the perturbed polygon could not be drawn.
+    #[error("{0}")]
+    ShapeDraw(DrawError),
+    /// Every perturbed polygon drawn was invalid.
+    #[error(
+        "shape: {MAX_SHAPE_REDRAWS} perturbed polygons in a row were invalid (last: {}); the shape tolerance is too large for this part",
+        .last.as_ref().map(ToString::to_string).unwrap_or_default()
+    )]
+    Shape {
+        /// Why the last one was rejected.
+        last: Option<ShapeRejection>,
+    },
+    /// The part's support could not be drawn.
+    #[error("support: {0}")]
+    Support(SupportDrawError),
+    /// The part's model could not be compiled on its drawn support.
+    #[error("support: {0}")]
+    Model(PartModelError),
+    /// A pin's sensor settings are invalid once perturbed.
+    #[error("sensor pin `{pin}`: the perturbed sensor settings are invalid ({error})")]
+    SensorSettings {
+        /// The pin's name.
+        pin: String,
+        /// The invalid setting.
+        error: SettingError,
+    },
+    /// Every perturbed position of a pin was invalid.
+    #[error(
+        "pin `{pin}`: {} perturbed positions in a row left the belt, touched the entry or had a negative radius",
+        MAX_REDRAWS + 1
+    )]
+    Pin {
+        /// The pin's name.
+        pin: String,
+    },
+    /// Every perturbed fence was invalid.
+    #[error(
+        "fence `{fence}`: {} perturbed fences in a row were invalid (an angle not strictly between -90° and 90°, an end off the belt or within a of the entry, or a length out of [1e-6 a, 1e6 a])",
+        MAX_REDRAWS + 1
+    )]
+    Fence {
+        /// The fence's name.
+        fence: String,
+    },
+    /// Every perturbed actuator of a pin was invalid.
+    #[error(
+        "pin `{pin}`: {} perturbed actuators in a row were invalid (a speed above the belt's limit of {max_speed} m/s, or a time or acceleration out of range)",
+        MAX_REDRAWS + 1
+    )]
+    Actuator {
+        /// The pin's name.
+        pin: String,
+        /// The largest pin speed the sample's belt allows (m/s).
+        max_speed: f64,
+    },
+    /// The scenario's feed could not draw the part's entry.
+    #[error("{0}")]
+    Entry(PartModelError),
+}
+
+impl SampleError {
+    /// A failed value draw with the range its values left (other errors as they are).
+    fn left(self, left: Option<RangeLeft>) -> SampleError {
+        match self {
+            SampleError::Value { name, error, .. } => SampleError::Value {
+                name,
+                error,
+                range: left,
+            },
+            other => other,
+        }
+    }
+}
+
+/// Which range a parameter's values left ([`SampleError::Value`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RangeLeft {
+    /// The study's domain of the parameter.
+    #[error("{name} must lie in {} ({unit}), it reaches {value}", show(*.domain))]
+    Domain {
+        /// The parameter.
+        name: &'static str,
+        /// Its domain.
+        domain: (f64, f64),
+        /// What it is, in words.
+        unit: &'static str,
+        /// The end of the distribution outside the domain.
+        value: f64,
+    },
+    /// A sensor's own setting.
+    #[error("at {name} = {value} the sensor's {error}")]
+    Setting {
+        /// The parameter.
+        name: &'static str,
+        /// The end of the distribution that makes the setting invalid.
+        value: f64,
+        /// The invalid setting.
+        error: SettingError,
+    },
+    /// The controller's latency plus the error.
+    #[error(
+        "the controller's latency ({latency} s) plus the error must lie in {} s",
+        show(ACTUATOR_TIME)
+    )]
+    Latency {
+        /// The scenario's controller latency (s).
+        latency: f64,
+    },
+}
+
+/// Why a perturbed polygon was rejected ([`SampleError::Shape`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ShapeRejection {
+    /// The part no longer fits the belt.
+    #[error("the part (2a = {width_2a:.6} m) no longer fits the belt ({belt} m)")]
+    Belt {
+        /// The part's width 2a (m).
+        width_2a: f64,
+        /// The belt's width (m).
+        belt: f64,
+    },
+    /// The vertices do not make a valid part.
+    #[error("{0}")]
+    Polygon(PolygonError),
+}
+
 /// Draw the sample's sensor parameters; a value that would make any sensor's settings invalid is
 /// redrawn (counted in `redraws`).
 fn draw_sensor_values(
@@ -272,16 +417,16 @@ fn draw_sensor_values(
     p: &Perturbations,
     st: &mut Streams,
     redraws: &mut u32,
-) -> Result<SensorDraw, String> {
+) -> Result<SensorDraw, SampleError> {
     if !p.perturbs_sensors() {
         return Ok(SensorDraw::default());
     }
     let sensors = sensors(base);
     let mut pick = |d: &Option<Distribution>,
                     rng: &mut ChaCha8Rng,
-                    name: &str,
+                    name: &'static str,
                     set: fn(f64) -> SensorDraw|
-     -> Result<Option<f64>, String> {
+     -> Result<Option<f64>, SampleError> {
         let ok = |v: f64| {
             super::compile::in_domain(name, v)
                 && sensors
@@ -293,23 +438,22 @@ fn draw_sensor_values(
             let (domain, unit) = super::compile::domain(name);
             let why = d.as_ref().and_then(|d| {
                 let (lo, hi) = d.range();
-                [lo, hi].into_iter().find_map(|v| {
-                    if !super::compile::in_domain(name, v) {
-                        return Some(format!(
-                            "{name} must lie in {} ({unit}), it reaches {v}",
-                            crate::scenario::limits::show(domain)
-                        ));
+                [lo, hi].into_iter().find_map(|value| {
+                    if !super::compile::in_domain(name, value) {
+                        return Some(RangeLeft::Domain {
+                            name,
+                            domain,
+                            unit,
+                            value,
+                        });
                     }
                     sensors.iter().find_map(|s| {
-                        let err = set(v).apply(&s.settings).validate().err()?;
-                        Some(format!("at {name} = {v} the sensor's {err}"))
+                        let error = set(value).apply(&s.settings).validate().err()?;
+                        Some(RangeLeft::Setting { name, value, error })
                     })
                 })
             });
-            match why {
-                Some(w) => format!("{e}: {w}"),
-                None => e,
-            }
+            e.left(why)
         })
     };
     Ok(SensorDraw {
@@ -351,7 +495,7 @@ fn draw_sensor_values(
 fn perturb_sensor(
     pin: &PinObstacle,
     values: &SensorDraw,
-) -> Result<Option<Arc<SensorPin>>, String> {
+) -> Result<Option<Arc<SensorPin>>, SampleError> {
     let Some(sensor) = &pin.sensor else {
         return Ok(None);
     };
@@ -359,12 +503,12 @@ fn perturb_sensor(
         return Ok(Some(Arc::clone(sensor)));
     }
     let settings = values.apply(&sensor.settings);
-    settings.validate().map_err(|e| {
-        format!(
-            "sensor pin `{}`: the perturbed sensor settings are invalid ({e})",
-            pin.name
-        )
-    })?;
+    settings
+        .validate()
+        .map_err(|error| SampleError::SensorSettings {
+            pin: pin.name.clone(),
+            error,
+        })?;
     Ok(Some(Arc::new(SensorPin {
         settings,
         ..SensorPin::clone(sensor)
@@ -374,14 +518,18 @@ fn perturb_sensor(
 fn draw_value(
     d: &Option<Distribution>,
     rng: &mut ChaCha8Rng,
-    name: &str,
+    name: &'static str,
     ok: impl Fn(f64) -> bool,
     redraws: &mut u32,
-) -> Result<Option<f64>, String> {
+) -> Result<Option<f64>, SampleError> {
     match d {
         None => Ok(None),
         Some(d) => {
-            let (v, n) = d.draw(rng, ok).map_err(|e| format!("{name}: {e}"))?;
+            let (v, n) = d.draw(rng, ok).map_err(|error| SampleError::Value {
+                name,
+                error,
+                range: None,
+            })?;
             *redraws += n;
             Ok(Some(v))
         }
@@ -399,34 +547,31 @@ fn draw_polygon(
     d: &Option<Distribution>,
     rng: &mut ChaCha8Rng,
     redraws: &mut u32,
-) -> Result<Polygon, String> {
+) -> Result<Polygon, SampleError> {
     let Some(d) = d else {
         return Ok(base.part.polygon.clone());
     };
-    let mut last = String::new();
+    let mut last = None;
     for _ in 0..MAX_SHAPE_REDRAWS {
         let mut pts = Vec::with_capacity(base.part.polygon.len());
         for v in base.part.polygon.vertices() {
-            let (ex, _) = d.draw(rng, |_| true)?;
-            let (ey, _) = d.draw(rng, |_| true)?;
+            let (ex, _) = d.draw(rng, |_| true).map_err(SampleError::ShapeDraw)?;
+            let (ey, _) = d.draw(rng, |_| true).map_err(SampleError::ShapeDraw)?;
             pts.push(Vec2::new(v.x + ex, v.y + ey));
         }
         match Polygon::new(&pts) {
             Ok(p) if 2.0 * p.radius() <= base.belt.width => return Ok(p),
             Ok(p) => {
-                last = format!(
-                    "the part (2a = {:.6} m) no longer fits the belt ({} m)",
-                    2.0 * p.radius(),
-                    base.belt.width
-                )
+                last = Some(ShapeRejection::Belt {
+                    width_2a: 2.0 * p.radius(),
+                    belt: base.belt.width,
+                })
             }
-            Err(e) => last = e.to_string(),
+            Err(e) => last = Some(ShapeRejection::Polygon(e)),
         }
         *redraws += 1;
     }
-    Err(format!(
-        "shape: {MAX_SHAPE_REDRAWS} perturbed polygons in a row were invalid (last: {last}); the shape tolerance is too large for this part"
-    ))
+    Err(SampleError::Shape { last })
 }
 
 /// One obstacle of the perturbed line: a pin (with or without a sensor) with its position and
@@ -445,7 +590,7 @@ fn draw_obstacle(
     mu_f: Option<f64>,
     sensor_values: &SensorDraw,
     other: &mut u32,
-) -> Result<Obstacle, String> {
+) -> Result<Obstacle, SampleError> {
     let pin = match ob {
         Obstacle::Pin(pin) => pin,
         Obstacle::Fence(fence) => {
@@ -490,11 +635,9 @@ fn draw_obstacle(
         }
         *other += 1;
     }
-    Err(format!(
-        "pin `{}`: {} perturbed positions in a row left the belt, touched the entry or had a negative radius",
-        pin.name,
-        super::distribution::MAX_REDRAWS + 1
-    ))
+    Err(SampleError::Pin {
+        pin: pin.name.clone(),
+    })
 }
 
 /// A fence of the perturbed line: the sample's μf if `fence_mu_f` reaches it, and its angle,
@@ -510,7 +653,7 @@ fn draw_fence(
     radius: f64,
     mu_f: Option<f64>,
     other: &mut u32,
-) -> Result<FenceObstacle, String> {
+) -> Result<FenceObstacle, SampleError> {
     let mu_f = match mu_f.filter(|_| p.reaches("fence_mu_f", &fence.name)) {
         Some(m) => m,
         None => fence.mu_f,
@@ -566,11 +709,9 @@ fn draw_fence(
         }
         *other += 1;
     }
-    Err(format!(
-        "fence `{}`: {} perturbed fences in a row were invalid (an angle not strictly between -90° and 90°, an end off the belt or within a of the entry, or a length out of [1e-6 a, 1e6 a])",
-        fence.name,
-        super::distribution::MAX_REDRAWS + 1
-    ))
+    Err(SampleError::Fence {
+        fence: fence.name.clone(),
+    })
 }
 
 /// A dynamic pin's actuator under the sample's actuator parameters (drawn per pin, each only if
@@ -584,7 +725,7 @@ fn draw_actuator(
     st: &mut ObstacleStreams,
     belt: &crate::scenario::Belt,
     other: &mut u32,
-) -> Result<Actuator, String> {
+) -> Result<Actuator, SampleError> {
     use crate::scenario::limits::{contains, max_pin_speed, ACTUATOR_ACCEL, ACTUATOR_TIME};
     let reached = |d: &Option<Distribution>, key: &str| -> Option<Distribution> {
         d.filter(|_| p.reaches(key, name))
@@ -655,11 +796,10 @@ fn draw_actuator(
         }
         *other += 1;
     }
-    Err(format!(
-        "pin `{name}`: {} perturbed actuators in a row were invalid (a speed above the belt's limit of {} m/s, or a time or acceleration out of range)",
-        super::distribution::MAX_REDRAWS + 1,
-        crate::scenario::limits::max_pin_speed(belt.speed)
-    ))
+    Err(SampleError::Actuator {
+        pin: name.to_string(),
+        max_speed: max_pin_speed(belt.speed),
+    })
 }
 
 /// Draw sample `sample` of a study seeded with `seed` at the sweep point `p`: the perturbed scene.
@@ -669,7 +809,7 @@ pub fn draw_scene(
     p: &Perturbations,
     seed: u64,
     sample: u64,
-) -> Result<DrawnScene, String> {
+) -> Result<DrawnScene, SampleError> {
     let mut st = Streams::new(seed, sample, p.perturbs_obstacles());
     let mut other = 0u32;
     let mut shape_redraws = 0u32;
@@ -768,21 +908,22 @@ fn draw_part_model(
     st: &mut Streams,
     shape_redraws: &mut u32,
     other: &mut u32,
-) -> Result<(Polygon, PartModel), String> {
+) -> Result<(Polygon, PartModel), SampleError> {
     // A perturbed polygon that cannot carry the support (a sliver with no tripod around its
     // centroid) is redrawn like an invalid one.
     let mut attempts = 0;
     Ok(loop {
         let polygon = draw_polygon(base, &p.shape, &mut st.shape, shape_redraws)?;
         let model = draw_support(&polygon, &p.support, &mut st.support, other)
-            .and_then(|support| PartModel::new(&polygon, &support).map_err(|e| e.to_string()));
+            .map_err(SampleError::Support)
+            .and_then(|support| PartModel::new(&polygon, &support).map_err(SampleError::Model));
         match model {
             Ok(m) => break (polygon, m),
             Err(_) if p.shape.is_some_and(|d| !d.is_fixed()) && attempts < MAX_SHAPE_REDRAWS => {
                 attempts += 1;
                 *shape_redraws += 1;
             }
-            Err(e) => return Err(format!("support: {e}")),
+            Err(e) => return Err(e),
         }
     })
 }
@@ -793,7 +934,7 @@ fn draw_fence_friction_and_latency(
     p: &Perturbations,
     st: &mut Streams,
     other: &mut u32,
-) -> Result<(Option<f64>, Option<f64>), String> {
+) -> Result<(Option<f64>, Option<f64>), SampleError> {
     Ok(match st.obstacles.as_mut() {
         Some(ost) => (
             draw_value(
@@ -816,13 +957,7 @@ fn draw_fence_friction_and_latency(
                     },
                     other,
                 )
-                .map_err(|e| {
-                    format!(
-                        "{e}: the controller's latency ({} s) plus the error must lie in {} s",
-                        c.latency,
-                        crate::scenario::limits::show(crate::scenario::limits::ACTUATOR_TIME)
-                    )
-                })?
+                .map_err(|e| e.left(Some(RangeLeft::Latency { latency: c.latency })))?
                 .map(|e| c.latency + e),
                 None => None,
             },
@@ -839,9 +974,9 @@ fn draw_entry(
     p: &Perturbations,
     st: &mut Streams,
     other: &mut u32,
-) -> Result<Feed, String> {
+) -> Result<Feed, SampleError> {
     // The scenario's feed draws the entry pose (its support is uniform here, so it draws no tripod).
-    let entry = draw_part(scene, st.feed_seed, 0).map_err(|e| e.to_string())?;
+    let entry = draw_part(scene, st.feed_seed, 0).map_err(SampleError::Entry)?;
     let any = |_: f64| true;
     let d_theta = draw_value(&p.pose_theta, &mut st.pose_theta, "pose_theta", any, other)?;
     let d_y = draw_value(&p.pose_y, &mut st.pose_y, "pose_y", any, other)?;
@@ -875,12 +1010,12 @@ pub fn run_sample(
     seed: u64,
     sample: u64,
 ) -> Result<SampleResult, super::StudyError> {
-    let fail = |reason: String| super::StudyError::Sample {
+    let fail = |reason: Box<SampleError>| super::StudyError::Sample {
         point,
         sample,
         reason,
     };
-    let drawn = draw_scene(base, p, seed, sample).map_err(fail)?;
+    let drawn = draw_scene(base, p, seed, sample).map_err(|e| fail(Box::new(e)))?;
     let opts = RunOptions {
         parts: 1,
         // The part's pose is fixed in the drawn feed, so the seed draws only sensor readings.

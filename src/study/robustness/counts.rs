@@ -6,35 +6,54 @@ use super::{case_input, run_case, Corpus, Target};
 /// Most cases of one target in a run.
 pub const MAX_CASES: u64 = 100_000_000;
 
+/// Why a `--counts` list could not be read ([`parse_counts`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CountsError {
+    /// A word without `=`.
+    #[error("--counts: `{0}` is not TARGET=N")]
+    NotPair(String),
+    /// A name that is no fuzz target.
+    #[error(
+        "--counts: unknown target `{name}` (expected one of {})",
+        Target::ALL.map(|t| t.name()).join(", ")
+    )]
+    Target {
+        /// The name given.
+        name: String,
+    },
+    /// A count that is not a whole number in [0, [`MAX_CASES`]].
+    #[error("--counts: {} must be a count in [0, {MAX_CASES}], got `{value}`", .target.name())]
+    Count {
+        /// The target the count is for.
+        target: Target,
+        /// The text given as its count.
+        value: String,
+    },
+}
+
 /// `TARGET=N,...`: the targets' own case counts, each in [0, [`MAX_CASES`]]; an error names the
 /// word it could not read and what was expected.
-pub fn parse_counts(text: &str) -> Result<Vec<(Target, u64)>, String> {
+pub fn parse_counts(text: &str) -> Result<Vec<(Target, u64)>, CountsError> {
     text.split(',')
         .filter(|w| !w.trim().is_empty())
         .map(|w| {
             let (name, n) = w
                 .split_once('=')
-                .ok_or_else(|| format!("--counts: `{w}` is not TARGET=N"))?;
+                .ok_or_else(|| CountsError::NotPair(w.to_string()))?;
             let t = Target::ALL
                 .into_iter()
                 .find(|t| t.name() == name.trim())
-                .ok_or_else(|| {
-                    format!(
-                        "--counts: unknown target `{}` (expected one of {})",
-                        name.trim(),
-                        Target::ALL.map(|t| t.name()).join(", ")
-                    )
+                .ok_or_else(|| CountsError::Target {
+                    name: name.trim().to_string(),
                 })?;
             let n: u64 = n
                 .trim()
                 .parse()
                 .ok()
                 .filter(|&n| n <= MAX_CASES)
-                .ok_or_else(|| {
-                    format!(
-                        "--counts: {} must be a count in [0, {MAX_CASES}], got `{n}`",
-                        t.name()
-                    )
+                .ok_or_else(|| CountsError::Count {
+                    target: t,
+                    value: n.to_string(),
                 })?;
             Ok((t, n))
         })
@@ -72,13 +91,36 @@ mod tests {
             parse_counts("plans=5, pairs=20000,").unwrap(),
             [(Target::Plans, 5), (Target::Pairs, 20000)]
         );
+        assert_eq!(
+            parse_counts("plans").unwrap_err(),
+            CountsError::NotPair("plans".into())
+        );
         assert!(parse_counts("plans")
             .unwrap_err()
+            .to_string()
             .contains("`plans` is not TARGET=N"));
+        assert_eq!(
+            parse_counts("bogus=1").unwrap_err(),
+            CountsError::Target {
+                name: "bogus".into()
+            }
+        );
         assert!(parse_counts("bogus=1")
             .unwrap_err()
+            .to_string()
             .contains("unknown target `bogus`"));
         let e = parse_counts("csvs=100000001").unwrap_err();
+        assert!(
+            matches!(
+                e,
+                CountsError::Count {
+                    target: Target::Csvs,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        let e = e.to_string();
         assert!(e.contains("[0, 100000000]") && e.contains("csvs"), "{e}");
     }
 }
