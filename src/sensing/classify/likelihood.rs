@@ -81,9 +81,9 @@ const SKIP_GAP: f64 = 800.0;
 /// 10⁻¹³ of the magnitudes involved).
 const ROUNDING: f64 = 1e-9;
 /// Numbers per member in [`Bounds::rec`] besides its basis coefficients: ρ, κ, ‖b̂‖, max cst,
-/// max |cst|, then per lag-dependent entry (padded to [`MAX_VARYING`]) the largest and the
+/// max |cst|, Σ |dlin|, then per lag-dependent entry (padded to [`MAX_VARYING`]) the largest and the
 /// smallest correction over the lags.
-const REC_FIXED: usize = 5 + 2 * MAX_VARYING;
+const REC_FIXED: usize = 6 + 2 * MAX_VARYING;
 
 /// Where one member sits in [`Packed::data`].
 #[derive(Debug, Clone, Copy)]
@@ -114,12 +114,14 @@ struct Bounds {
     rec: Vec<f64>,
 }
 
-/// A reading's numbers for the bounds: z = V ŷ, ‖z‖, ‖ŷ − Vᵀz‖, ‖ŷ‖.
+/// A reading's numbers for the bounds: z = V ŷ, ‖z‖, ‖ŷ − Vᵀz‖, ‖ŷ‖, max |y|.
 struct Projected {
     z: Vec<f64>,
     z_norm: f64,
     perp: f64,
     y_norm: f64,
+    /// max_d |y_d| (not whitened).
+    y_max: f64,
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -169,6 +171,7 @@ impl Bounds {
             rec.push(norm(bh));
             rec.push(m.cst.iter().copied().fold(f64::NEG_INFINITY, f64::max));
             rec.push(m.cst.iter().fold(0.0, |a: f64, c| a.max(c.abs())));
+            rec.push(m.dlin.iter().map(|x| x.abs()).sum());
             let rows: Vec<&[f64]> = m.dlin.chunks_exact(lags.max(1)).collect();
             for e in 0..MAX_VARYING {
                 rec.push(
@@ -219,6 +222,7 @@ impl Bounds {
             z_norm: norm(&z),
             perp: norm(&perp),
             y_norm: norm(&yh),
+            y_max: y.iter().fold(0.0, |a: f64, x| a.max(x.abs())),
             z,
         }
     }
@@ -230,21 +234,28 @@ impl Bounds {
         let k = self.k;
         let r = &self.rec[m * (k + REC_FIXED)..(m + 1) * (k + REC_FIXED)];
         let (alpha, r) = r.split_at(k);
-        let mut az = 0.0;
-        for (a, z) in alpha.iter().zip(&p.z) {
+        let mut acc = [0.0; 4];
+        let whole = k / 4 * 4;
+        for (a, z) in alpha[..whole].chunks_exact(4).zip(p.z.chunks_exact(4)) {
+            for i in 0..4 {
+                acc[i] += a[i] * z[i];
+            }
+        }
+        let mut az = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+        for (a, z) in alpha[whole..].iter().zip(&p.z[whole..]) {
             az += a * z;
         }
-        let (rho, kappa, bnorm, cmax, cabs) = (r[0], r[1], r[2], r[3], r[4]);
-        let (hi, lo) = r[5..].split_at(MAX_VARYING);
-        let mut lag = cmax;
-        let mut mag = cabs;
-        for ((&y, &h), &l) in ys.iter().zip(hi).zip(lo) {
+        let (rho, kappa, bnorm, cmax, cabs, dsum) = (r[0], r[1], r[2], r[3], r[4], r[5]);
+        let (hi, lo) = r[6..].split_at(MAX_VARYING);
+        let mut lag = [cmax, 0.0];
+        for (e, ((&y, &h), &l)) in ys.iter().zip(hi).zip(lo).enumerate() {
             let (a, b) = (y * h, y * l);
-            lag += if a > b { a } else { b };
-            mag += y.abs() * (h.abs() + l.abs());
+            lag[e % 2] += if a > b { a } else { b };
         }
+        // |y_e| ≤ max |y|, so Σ_e |y_e| Σ_o |dlin[e][o]| bounds the corrections' magnitudes.
+        let mag = cabs + p.y_max * dsum;
         let base = az + kappa * p.z_norm + rho * p.perp + ROUNDING * (bnorm * p.y_norm + mag);
-        (base, lag)
+        (base, lag[0] + lag[1])
     }
 }
 
