@@ -403,10 +403,7 @@ impl OnlineModel {
         let p = self.predictions(belief);
         // The tie-breakers are computed only for actions within TIE of the best so far: the
         // same sequential comparison, without the neighbours of every action.
-        let around = |a: usize| {
-            let nb = self.neighbours(a);
-            nb.iter().map(|&b| p[b]).sum::<f64>() / nb.len().max(1) as f64
-        };
+        let around = |a: usize| self.around(&p, a);
         let mut best = 0;
         let mut best_around: Option<f64> = None;
         for a in 1..self.actions.len() {
@@ -437,9 +434,29 @@ impl OnlineModel {
     /// hypothesis of probability 0 is skipped: its products are +0, which leave every sum as it
     /// was (each is +0 or positive).
     fn predictions(&self, belief: &Belief) -> Vec<f64> {
+        let w = belief.probabilities();
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { self.predictions_avx2(&w) };
+        }
+        self.predictions_plain(&w)
+    }
+
+    /// [`OnlineModel::predictions`] compiled for AVX2's wider registers: the same products and
+    /// sums in the same order, four actions at a time instead of two.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn predictions_avx2(&self, probabilities: &[f64]) -> Vec<f64> {
+        self.predictions_plain(probabilities)
+    }
+
+    /// The loop of [`OnlineModel::predictions`] over the belief's `probabilities`.
+    #[inline(always)]
+    fn predictions_plain(&self, probabilities: &[f64]) -> Vec<f64> {
         let n_a = self.actions.len();
         let mut p = vec![0.0; n_a];
-        for (h, w) in belief.probabilities().into_iter().enumerate() {
+        for (h, &w) in probabilities.iter().enumerate() {
             if w == 0.0 {
                 continue;
             }
@@ -451,21 +468,24 @@ impl OnlineModel {
         p
     }
 
-    /// The actions one grid step of one pin away from action `a`.
-    fn neighbours(&self, a: usize) -> Vec<usize> {
-        let mut out = Vec::new();
+    /// The mean of the predictions `p` over the actions one grid step of one pin away from
+    /// action `a` (summed pin by pin, the last pin first, the step down before the step up).
+    fn around(&self, p: &[f64], a: usize) -> f64 {
+        let (mut sum, mut n) = (-0.0, 0usize);
         let mut stride = 1;
         for size in self.options.iter().rev() {
             let digit = (a / stride) % size;
             if digit > 0 {
-                out.push(a - stride);
+                sum += p[a - stride];
+                n += 1;
             }
             if digit + 1 < *size {
-                out.push(a + stride);
+                sum += p[a + stride];
+                n += 1;
             }
             stride *= size;
         }
-        out
+        sum / n.max(1) as f64
     }
 
     /// `success[a][h]` for every hypothesis.
@@ -518,12 +538,14 @@ impl Evidence {
                 out
             });
         let classifier = match (&sm.state_label, posterior) {
-            (Some(labels), Some(p)) => Some(
-                labels
-                    .iter()
-                    .map(|&l| p.get(l).copied().unwrap_or(0.0).max(1e-300).ln())
-                    .collect(),
-            ),
+            (Some(labels), Some(p)) => {
+                // The log of each label's posterior once (a few labels, many hypotheses).
+                let n = labels.iter().copied().max().map_or(0, |m| m + 1);
+                let logs: Vec<f64> = (0..n)
+                    .map(|l| p.get(l).copied().unwrap_or(0.0).max(1e-300).ln())
+                    .collect();
+                Some(labels.iter().map(|&l| logs[l]).collect())
+            }
             _ => None,
         };
         Evidence { filter, classifier }
