@@ -55,6 +55,13 @@ impl Detector {
     pub fn detect(&self, values: &[[f64; CHANNELS]]) -> Option<(usize, usize)> {
         detect(values, self.threshold, self.window)
     }
+
+    /// The first sample of the detected contact, as [`Detector::detect`] finds it, reading no
+    /// further into `values` than that sample's window; `None` when the threshold is never
+    /// reached.
+    pub fn first(&self, values: &[[f64; CHANNELS]]) -> Option<usize> {
+        detect_first(values, self.threshold, self.window)
+    }
 }
 
 /// Effective (white + quantisation) noise variance of channel `c`.
@@ -123,6 +130,40 @@ pub fn detect(values: &[[f64; CHANNELS]], threshold: f64, window: usize) -> Opti
     let first = (0..n).find(|&k| above(k))?;
     let last = (first..n).rev().find(|&k| above(k))?;
     Some((first, last))
+}
+
+/// The first index of [`detect`]'s contact: the same prefix sums and comparisons, each prefix
+/// sum computed only once a window needs it, so the scan stops at the first sample above the
+/// threshold.
+pub fn detect_first(values: &[[f64; CHANNELS]], threshold: f64, window: usize) -> Option<usize> {
+    let n = values.len();
+    if n == 0 {
+        return None;
+    }
+    let h = window / 2;
+    let mut px = Vec::with_capacity(n + 1);
+    let mut py = Vec::with_capacity(n + 1);
+    let (mut sx, mut sy) = (0.0, 0.0);
+    px.push(0.0);
+    py.push(0.0);
+    for k in 0..n {
+        let lo = k.saturating_sub(h);
+        let hi = (k + h).min(n - 1);
+        while px.len() < hi + 2 {
+            let v = values[px.len() - 1];
+            sx += v[0];
+            sy += v[1];
+            px.push(sx);
+            py.push(sy);
+        }
+        let m = (hi - lo + 1) as f64;
+        let fx = px[hi + 1] - px[lo];
+        let fy = py[hi + 1] - py[lo];
+        if fx * fx + fy * fy >= (threshold * m).powi(2) {
+            return Some(k);
+        }
+    }
+    None
 }
 
 /// A least-squares polynomial fit (thesis app. D2: the normal equations' minimiser, computed here by
@@ -206,13 +247,24 @@ pub fn posterior(ll: &[f64]) -> Option<Vec<f64>> {
     (b.observe_log_likelihood(&finite) == Update::Updated).then(|| b.probabilities())
 }
 
-/// log Σ exp(v), −∞ for an empty or all −∞ slice.
+/// Below this, exp(x) is exactly +0 in floating point (e^x < the smallest subnormal's half, at
+/// x ≈ −745.13).
+pub const EXP_UNDERFLOW: f64 = -750.0;
+
+/// log Σ exp(v), −∞ for an empty or all −∞ slice. A term more than −[`EXP_UNDERFLOW`] below the
+/// largest is left out: its exponential is +0, which leaves the sum as it was (the largest term
+/// itself is 1), so the result is that of the full sum bit for bit.
 pub fn log_sum_exp(v: &[f64]) -> f64 {
     let m = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if !m.is_finite() {
         return m;
     }
-    m + v.iter().map(|x| (x - m).exp()).sum::<f64>().ln()
+    m + v
+        .iter()
+        .filter(|&&x| x - m >= EXP_UNDERFLOW || x.is_nan())
+        .map(|x| (x - m).exp())
+        .sum::<f64>()
+        .ln()
 }
 
 /// A decision from a posterior with the reject option: the arg-max when it reaches `reject_below`
@@ -256,6 +308,55 @@ mod tests {
         assert_eq!(detect(&v, 0.05, 5), Some((29, 70)));
         assert_eq!(detect(&vec![[0.0; CHANNELS]; 10], 0.05, 5), None);
         assert_eq!(detect(&[], 0.05, 5), None);
+    }
+
+    /// The early-stopping scan finds [`detect`]'s first sample on pulses, noise and edges.
+    #[test]
+    fn first_detection_is_the_full_scans_first() {
+        use rand::RngExt;
+        let mut rng = crate::random::stream(5, 2);
+        for n in [1usize, 2, 5, 17, 300] {
+            for _ in 0..50 {
+                let v: Vec<[f64; CHANNELS]> = (0..n)
+                    .map(|k| {
+                        let pulse = if k > n / 3 && k < n / 2 { 0.3 } else { 0.0 };
+                        std::array::from_fn(|_| pulse + rng.random_range(-0.08..0.08))
+                    })
+                    .collect();
+                for w in [1, 5, 9] {
+                    assert_eq!(
+                        detect_first(&v, 0.05, w),
+                        detect(&v, 0.05, w).map(|d| d.0),
+                        "n {n}, w {w}"
+                    );
+                }
+            }
+        }
+        let mut v = vec![[0.0; CHANNELS]; 100];
+        v[99][1] = 1.0;
+        assert_eq!(detect_first(&v, 0.05, 5), Some(97));
+        assert_eq!(detect_first(&v[..99], 0.05, 5), None);
+    }
+
+    /// Terms far below the largest add exactly nothing: the sum over them is the full sum's bits.
+    #[test]
+    fn log_sum_exp_leaves_out_only_vanishing_terms() {
+        let full = |v: &[f64]| {
+            let m = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            m + v.iter().map(|x| (x - m).exp()).sum::<f64>().ln()
+        };
+        for v in [
+            vec![0.0, -749.0, -751.0, -1e6, 3.0],
+            vec![-2000.0, -1.5, -760.5, -745.0, -1.5 - 744.9],
+            vec![1e5, 1e5 - 700.0, 1e5 - 800.0, f64::NEG_INFINITY],
+            vec![-3.0],
+        ] {
+            assert_eq!(log_sum_exp(&v).to_bits(), full(&v).to_bits(), "{v:?}");
+        }
+        assert!((-800.0f64).exp() == 0.0 && (EXP_UNDERFLOW).exp() == 0.0);
+        assert!((-745.0f64).exp() > 0.0);
+        assert_eq!(log_sum_exp(&[]), f64::NEG_INFINITY);
+        assert!(log_sum_exp(&[0.0, f64::NAN]).is_nan());
     }
 
     #[test]

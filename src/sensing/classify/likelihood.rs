@@ -26,7 +26,12 @@
 //!   few (block, channel) entries that change with the lag (the contact's jumps), per-lag
 //!   corrections — at most [`MAX_VARYING`] of them per member, the ones that matter most.
 //! * **Mixture and posterior.** log p(y | h) = log-sum-exp over members − ln n_h (the ensemble
-//!   stands for the declared uncertainty); the posterior normalises over hypotheses with equal
+//!   stands for the declared uncertainty). A member whose score is certainly more than 800 below
+//!   the best of its hypothesis adds exactly +0 to the sum (e^−800 underflows), so it is not
+//!   scored: cheap upper bounds of the scores (the whitened base vectors' first principal
+//!   components plus the rest's norm, and the lag corrections' extremes) order and prune each
+//!   hypothesis's members, and the result is that of scoring every member, bit for bit. The
+//!   posterior normalises over hypotheses with equal
 //!   priors; the reject option answers Unknown when the largest posterior is below
 //!   `reject_below`. No contact detected, empty or non-finite reading → Unknown; when the detector
 //!   cannot see even the noise-free templates' contacts (noise far above the signal) every
@@ -66,157 +71,365 @@ struct Member {
     dlin: Vec<f64>,
 }
 
-/// Members scored together: their base vectors' dot products run side by side, which hides
-/// the latency of each one's fixed order of additions.
-const GROUP: usize = 4;
+/// Principal directions of the members' (whitened) base vectors kept for their bounds.
+pub const BASIS: usize = 16;
+/// A member whose score is certainly more than this below the best score of its hypothesis is
+/// not scored: its term of the hypothesis's log-sum-exp, exp(score − best), is exactly +0 (see
+/// [`common::EXP_UNDERFLOW`]), so leaving it out changes no bit of the result.
+const SKIP_GAP: f64 = 800.0;
+/// Relative allowance for rounding in a member's bound (rounding errors of these sums are below
+/// 10⁻¹³ of the magnitudes involved).
+const ROUNDING: f64 = 1e-9;
+/// Numbers per member in [`Bounds::rec`] besides its basis coefficients: ρ, κ, ‖b̂‖, max cst,
+/// max |cst|, Σ |dlin|, then per lag-dependent entry (padded to [`MAX_VARYING`]) the largest and the
+/// smallest correction over the lags.
+const REC_FIXED: usize = 6 + 2 * MAX_VARYING;
 
-/// Where a group of up to [`GROUP`] consecutive members sits in [`Packed::data`].
+/// Where one member sits in [`Packed::data`].
 #[derive(Debug, Clone, Copy)]
-struct Group {
-    /// Offset of the group's base vectors in `data`.
-    at: u32,
-    /// Number of members.
-    len: u32,
-    /// The runs of chunks where one of them is non-zero: a range into `runs`.
-    runs: [u32; 2],
-    /// Its first member (index into `lagged`).
-    first: u32,
-}
-
-/// Where one member's lag terms sit in [`Packed::data`].
-#[derive(Debug, Clone, Copy)]
-struct Lagged {
-    /// Offset of its constants per lag (its rows of corrections follow).
+struct Slot {
+    /// Offset of its constants per lag (its rows of corrections, then its base vector follow).
     at: u32,
     /// Its lag-dependent entries: a range into `vidx`.
     vars: [u32; 2],
+    /// The runs of chunks of eight where its base vector is non-zero: a range into `runs`.
+    runs: [u32; 2],
 }
 
-/// The trained members laid out for scoring: one sequential stream of numbers per reading, with
-/// nothing of the chunks of eight where a group's base vectors are all zero (a template is quiet
-/// outside its contact).
+/// Upper bounds of the members' scores, far cheaper than the scores. In whitened coordinates
+/// (entry d scaled by s_d = √(w/B)), a member's base product is b·y = b̂·ŷ with b̂ = b/s and
+/// ŷ = s·y; with V the first [`BASIS`] principal directions of the members' b̂, α = V b̂ and
+/// r = b̂ − Vᵀα, b̂·ŷ = α·z + (V r)·z + r·(ŷ − Vᵀz) for z = V ŷ, so
+/// b̂·ŷ ≤ α·z + κ‖z‖ + ρ‖ŷ − Vᵀz‖ (κ = ‖V r‖, ρ = ‖r‖). The best lag's correction is at most
+/// max cst + Σ_e max(y_e · max_o dlin[e][o], y_e · min_o dlin[e][o]). A reading resembles some
+/// templates, so ŷ − Vᵀz is small, and the bound separates a hypothesis's members whose scores
+/// lie thousands apart.
+struct Bounds {
+    /// s_d per entry.
+    scale: Vec<f64>,
+    /// The directions, `k` rows of `dims`.
+    basis: Vec<f64>,
+    k: usize,
+    /// Per member, `k` + [`REC_FIXED`] numbers: α, then as [`REC_FIXED`] lists.
+    rec: Vec<f64>,
+}
+
+/// A reading's numbers for the bounds: z = V ŷ, ‖z‖, ‖ŷ − Vᵀz‖, ‖ŷ‖, max |y|.
+struct Projected {
+    z: Vec<f64>,
+    z_norm: f64,
+    perp: f64,
+    y_norm: f64,
+    /// max_d |y_d| (not whitened).
+    y_max: f64,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+impl Bounds {
+    /// The basis and each member's record; `scale` is s_d per entry.
+    fn new(members: &[Member], dims: usize, lags: usize, scale: &[f64]) -> Bounds {
+        let whitened: Vec<Vec<f64>> = members
+            .iter()
+            .map(|m| m.base.iter().zip(scale).map(|(b, s)| b / s).collect())
+            .collect();
+        let mut basis = Vec::new();
+        if !members.is_empty() && dims > 0 {
+            let a = nalgebra::DMatrix::from_fn(members.len(), dims, |i, d| whitened[i][d]);
+            let svd = a.svd(false, true);
+            if let Some(v_t) = svd.v_t {
+                let sv = &svd.singular_values;
+                let mut order: Vec<usize> = (0..sv.len()).filter(|&i| sv[i] > 0.0).collect();
+                order.sort_by(|&i, &j| sv[j].total_cmp(&sv[i]));
+                for &i in order.iter().take(BASIS) {
+                    basis.extend(v_t.row(i).iter().copied());
+                }
+            }
+        }
+        let k = basis.len().checked_div(dims).unwrap_or(0);
+        let mut rec = Vec::with_capacity(members.len() * (k + REC_FIXED));
+        for (m, bh) in members.iter().zip(&whitened) {
+            let alpha: Vec<f64> = basis
+                .chunks_exact(dims)
+                .map(|v| v.iter().zip(bh).map(|(a, b)| a * b).sum())
+                .collect();
+            let mut r = bh.clone();
+            for (v, a) in basis.chunks_exact(dims).zip(&alpha) {
+                for (x, b) in r.iter_mut().zip(v) {
+                    *x -= a * b;
+                }
+            }
+            let vr: Vec<f64> = basis
+                .chunks_exact(dims)
+                .map(|v| v.iter().zip(&r).map(|(a, b)| a * b).sum())
+                .collect();
+            rec.extend_from_slice(&alpha);
+            rec.push(norm(&r));
+            rec.push(norm(&vr));
+            rec.push(norm(bh));
+            rec.push(m.cst.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+            rec.push(m.cst.iter().fold(0.0, |a: f64, c| a.max(c.abs())));
+            rec.push(m.dlin.iter().map(|x| x.abs()).sum());
+            let rows: Vec<&[f64]> = m.dlin.chunks_exact(lags.max(1)).collect();
+            for e in 0..MAX_VARYING {
+                rec.push(
+                    rows.get(e)
+                        .map_or(0.0, |r| r.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
+                );
+            }
+            for e in 0..MAX_VARYING {
+                rec.push(
+                    rows.get(e)
+                        .map_or(0.0, |r| r.iter().copied().fold(f64::INFINITY, f64::min)),
+                );
+            }
+        }
+        Bounds {
+            scale: scale.to_vec(),
+            basis,
+            k,
+            rec,
+        }
+    }
+
+    #[inline(always)]
+    fn project(&self, y: &[f64]) -> Projected {
+        let dims = y.len();
+        let yh: Vec<f64> = y.iter().zip(&self.scale).map(|(a, s)| a * s).collect();
+        let mut z = vec![0.0; self.k];
+        let mut perp = yh.clone();
+        for (v, zj) in self.basis.chunks_exact(dims.max(1)).zip(z.iter_mut()) {
+            let mut acc = [0.0; 4];
+            let (whole, rest) = v.split_at(dims / 4 * 4);
+            for (a, b) in whole.chunks_exact(4).zip(yh.chunks_exact(4)) {
+                for i in 0..4 {
+                    acc[i] += a[i] * b[i];
+                }
+            }
+            let t: f64 = rest
+                .iter()
+                .zip(&yh[dims / 4 * 4..])
+                .map(|(a, b)| a * b)
+                .sum();
+            *zj = acc[0] + acc[1] + acc[2] + acc[3] + t;
+            for (p, b) in perp.iter_mut().zip(v) {
+                *p -= *zj * b;
+            }
+        }
+        Projected {
+            z_norm: norm(&z),
+            perp: norm(&perp),
+            y_norm: norm(&yh),
+            y_max: y.iter().fold(0.0, |a: f64, x| a.max(x.abs())),
+            z,
+        }
+    }
+
+    /// Member `m`'s bound without its lag term, plus its allowance for rounding; and the bound of
+    /// its lag term (`ys`: the reading at its lag-dependent entries).
+    #[inline(always)]
+    fn of(&self, m: usize, p: &Projected, ys: &[f64]) -> (f64, f64) {
+        let k = self.k;
+        let r = &self.rec[m * (k + REC_FIXED)..(m + 1) * (k + REC_FIXED)];
+        let (alpha, r) = r.split_at(k);
+        let mut acc = [0.0; 4];
+        let whole = k / 4 * 4;
+        for (a, z) in alpha[..whole].chunks_exact(4).zip(p.z.chunks_exact(4)) {
+            for i in 0..4 {
+                acc[i] += a[i] * z[i];
+            }
+        }
+        let mut az = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+        for (a, z) in alpha[whole..].iter().zip(&p.z[whole..]) {
+            az += a * z;
+        }
+        let (rho, kappa, bnorm, cmax, cabs, dsum) = (r[0], r[1], r[2], r[3], r[4], r[5]);
+        let (hi, lo) = r[6..].split_at(MAX_VARYING);
+        let mut lag = [cmax, 0.0];
+        for (e, ((&y, &h), &l)) in ys.iter().zip(hi).zip(lo).enumerate() {
+            let (a, b) = (y * h, y * l);
+            lag[e % 2] += if a > b { a } else { b };
+        }
+        // |y_e| ≤ max |y|, so Σ_e |y_e| Σ_o |dlin[e][o]| bounds the corrections' magnitudes.
+        let mag = cabs + p.y_max * dsum;
+        let base = az + kappa * p.z_norm + rho * p.perp + ROUNDING * (bnorm * p.y_norm + mag);
+        (base, lag[0] + lag[1])
+    }
+}
+
+/// The trained members laid out for scoring: per member one sequential run of numbers.
 struct Packed {
-    /// Per group of members: per chunk of eight where one of them is non-zero, the chunk of each
-    /// member in turn; then each member's entries after the last whole chunk; then per member its
-    /// constant per lag and per lag-dependent entry its row of corrections over the lags.
+    /// Per member: its constant per lag, per lag-dependent entry its row of corrections over the
+    /// lags, then its base vector's chunks of eight that hold a non-zero value and its entries
+    /// after the last whole chunk.
     data: Vec<f64>,
-    /// The groups, in member order.
-    groups: Vec<Group>,
-    /// Per member, its lag terms.
-    lagged: Vec<Lagged>,
-    /// The runs of chunks of every group (chunk indices).
+    /// The members, in order.
+    slots: Vec<Slot>,
+    /// The runs of chunks of every member (chunk indices).
     runs: Vec<std::ops::Range<u32>>,
     /// The flat indices (channel·blocks + block) of every member's lag-dependent entries.
     vidx: Vec<u32>,
     /// Lags per member.
     lags: usize,
+    bounds: Bounds,
 }
 
 impl Packed {
-    /// Lay out `members` (base vectors of `dims` entries, `lags` lags).
-    fn new(members: &[Member], dims: usize, lags: usize) -> Packed {
+    /// Lay out `members` (base vectors of `dims` entries, `lags` lags; `scale`: s_d per entry,
+    /// see [`Bounds`]).
+    fn new(members: &[Member], dims: usize, lags: usize, scale: &[f64]) -> Packed {
         let whole = dims / 8 * 8;
         let mut p = Packed {
             data: Vec::new(),
-            groups: Vec::new(),
-            lagged: Vec::with_capacity(members.len()),
+            slots: Vec::with_capacity(members.len()),
             runs: Vec::new(),
             vidx: Vec::new(),
             lags,
+            bounds: Bounds::new(members, dims, lags, scale),
         };
-        for (g, ms) in members.chunks(GROUP).enumerate() {
+        for m in members {
             let at = p.data.len() as u32;
+            let vars0 = p.vidx.len() as u32;
+            p.vidx.extend_from_slice(&m.vidx);
+            p.data.extend_from_slice(&m.cst);
+            p.data.extend_from_slice(&m.dlin);
             let runs0 = p.runs.len() as u32;
-            let mut union = vec![0.0; dims];
-            for m in ms {
-                for (u, x) in union.iter_mut().zip(&m.base) {
-                    *u = if *x == 0.0 { *u } else { 1.0 };
-                }
-            }
-            for r in nonzero_chunks(&union) {
-                for c in r.start as usize..r.end as usize {
-                    for m in ms {
-                        p.data.extend_from_slice(&m.base[c * 8..c * 8 + 8]);
-                    }
-                }
+            for r in nonzero_chunks(&m.base) {
+                p.data
+                    .extend_from_slice(&m.base[r.start as usize * 8..r.end as usize * 8]);
                 p.runs.push(r);
             }
-            for m in ms {
-                p.data.extend_from_slice(&m.base[whole..]);
-            }
-            p.groups.push(Group {
+            p.data.extend_from_slice(&m.base[whole..]);
+            p.slots.push(Slot {
                 at,
-                len: ms.len() as u32,
+                vars: [vars0, p.vidx.len() as u32],
                 runs: [runs0, p.runs.len() as u32],
-                first: (g * GROUP) as u32,
             });
-            for m in ms {
-                let vars0 = p.vidx.len() as u32;
-                p.vidx.extend_from_slice(&m.vidx);
-                p.lagged.push(Lagged {
-                    at: p.data.len() as u32,
-                    vars: [vars0, p.vidx.len() as u32],
-                });
-                p.data.extend_from_slice(&m.cst);
-                p.data.extend_from_slice(&m.dlin);
-            }
         }
         p
     }
 
-    /// Each member's profile log-likelihood of the block sums `y`: the base dot product plus the
-    /// best lag's correction. The same arithmetic in the same order on every CPU; where the CPU
-    /// has AVX2 the loops are compiled for its wider registers (four sums at once instead of two).
+    /// Member `m`'s lag-dependent entries and where its numbers start.
+    #[inline(always)]
+    fn parts(&self, m: usize) -> (&[u32], &[f64], &[f64], &[f64]) {
+        let s = self.slots[m];
+        let vidx = &self.vidx[s.vars[0] as usize..s.vars[1] as usize];
+        let at = s.at as usize;
+        let n = self.lags * (1 + vidx.len());
+        let (cst, dlin) = self.data[at..at + n].split_at(self.lags);
+        (vidx, cst, dlin, &self.data[at + n..])
+    }
+
+    /// Member `m`'s profile log-likelihood of the block sums `y` from its best lag's correction
+    /// `lag`: the base dot product plus `lag`.
+    #[inline(always)]
+    fn score_with(&self, m: usize, y: &[f64], lag: f64) -> f64 {
+        let s = self.slots[m];
+        let runs = &self.runs[s.runs[0] as usize..s.runs[1] as usize];
+        let [lin] = dot_group::<1>(self.parts(m).3, y, runs);
+        lin + lag
+    }
+
+    /// Member `m`'s best lag's correction.
+    #[inline(always)]
+    fn lag_of(&self, m: usize, y: &[f64]) -> f64 {
+        let (vidx, cst, dlin, _) = self.parts(m);
+        best_lag(cst, dlin, vidx, y)
+    }
+
+    /// Every member's score (what [`Packed::log_likelihoods`] computes for the members it does
+    /// not leave out).
+    #[cfg(test)]
     fn scores(&self, y: &[f64]) -> Vec<f64> {
+        (0..self.slots.len())
+            .map(|m| self.score_with(m, y, self.lag_of(m, y)))
+            .collect()
+    }
+
+    /// Per range of members (a hypothesis), the log-sum-exp of their scores minus ln n (−∞ for an
+    /// empty range), and the number of members scored. Within a range the members are scored in
+    /// decreasing order of their bound ([`Bounds`]); one whose bound (first without, then with
+    /// its exact lag correction) lies more than [`SKIP_GAP`] below the best score so far is left
+    /// out, since its term of the log-sum-exp would be +0. The result is that of every member
+    /// scored, bit for bit. The same arithmetic in the same order on every CPU; where the CPU has
+    /// AVX2 the loops are compiled for its wider registers.
+    fn log_likelihoods(&self, y: &[f64], ranges: &[std::ops::Range<usize>]) -> (Vec<f64>, usize) {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.scores_avx2(y) };
+            return unsafe { self.log_likelihoods_avx2(y, ranges) };
         }
-        self.scores_plain(y)
+        self.log_likelihoods_plain(y, ranges)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn scores_avx2(&self, y: &[f64]) -> Vec<f64> {
-        self.scores_plain(y)
+    fn log_likelihoods_avx2(
+        &self,
+        y: &[f64],
+        ranges: &[std::ops::Range<usize>],
+    ) -> (Vec<f64>, usize) {
+        self.log_likelihoods_plain(y, ranges)
     }
 
-    /// The loop of [`Packed::scores`], written as plain loops so that all of it is compiled
-    /// into the caller (an iterator adapter's fold would be a separate function, without the
-    /// caller's AVX2).
+    /// The loop of [`Packed::log_likelihoods`], as plain loops so that all of it is compiled
+    /// into the caller.
     #[inline(always)]
-    fn scores_plain(&self, y: &[f64]) -> Vec<f64> {
-        let lags = self.lags;
-        let mut out = Vec::with_capacity(self.lagged.len());
-        let mut lin = [0.0; GROUP];
-        for g in &self.groups {
-            let runs = &self.runs[g.runs[0] as usize..g.runs[1] as usize];
-            let a = &self.data[g.at as usize..];
-            match g.len {
-                4 => lin = dot_group::<4>(a, y, runs),
-                3 => lin[..3].copy_from_slice(&dot_group::<3>(a, y, runs)),
-                2 => lin[..2].copy_from_slice(&dot_group::<2>(a, y, runs)),
-                _ => lin[..1].copy_from_slice(&dot_group::<1>(a, y, runs)),
+    fn log_likelihoods_plain(
+        &self,
+        y: &[f64],
+        ranges: &[std::ops::Range<usize>],
+    ) -> (Vec<f64>, usize) {
+        let p = self.bounds.project(y);
+        let mut out = Vec::with_capacity(ranges.len());
+        let mut scored = 0;
+        let mut order: Vec<(f64, f64, usize)> = Vec::new();
+        let mut scores: Vec<f64> = Vec::new();
+        let mut ys = [0.0; MAX_VARYING];
+        for r in ranges {
+            if r.is_empty() {
+                out.push(f64::NEG_INFINITY);
+                continue;
             }
-            let first = g.first as usize;
-            for (j, l) in self.lagged[first..first + g.len as usize]
-                .iter()
-                .enumerate()
-            {
-                let vidx = &self.vidx[l.vars[0] as usize..l.vars[1] as usize];
-                let at = l.at as usize;
-                let (cst, dlin) = self.data[at..at + lags * (1 + vidx.len())].split_at(lags);
-                out.push(lin[j] + best_lag(cst, dlin, vidx, y));
+            order.clear();
+            for m in r.clone() {
+                let vidx = self.parts(m).0;
+                for (v, &d) in ys.iter_mut().zip(vidx) {
+                    *v = y[d as usize];
+                }
+                let (base, lag) = self.bounds.of(m, &p, &ys[..vidx.len()]);
+                // A bound that is not a number (a reading beyond any scale) leaves out nothing.
+                let bound = base + lag;
+                order.push((if bound.is_nan() { f64::INFINITY } else { bound }, base, m));
             }
+            order.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.2.cmp(&b.2)));
+            scores.clear();
+            scores.resize(r.len(), f64::NEG_INFINITY);
+            let mut best = f64::NEG_INFINITY;
+            for &(bound, base, m) in &order {
+                if bound < best - SKIP_GAP {
+                    break;
+                }
+                let lag = self.lag_of(m, y);
+                if base + lag < best - SKIP_GAP {
+                    continue;
+                }
+                let s = self.score_with(m, y, lag);
+                scored += 1;
+                scores[m - r.start] = s;
+                best = best.max(s);
+            }
+            out.push(log_sum_exp(&scores) - (r.len() as f64).ln());
         }
-        out
+        (out, scored)
     }
 }
 
-/// The dot products of `G` base vectors packed as [`Packed`] keeps a group (`a`: per chunk of
-/// eight listed by `runs`, each vector's chunk in turn, then each vector's entries after the last
-/// whole chunk) with the full vector `y`. Per vector: eight independent accumulators over the
+/// The dot products of `G` base vectors packed side by side (`a`: per chunk of eight listed by
+/// `runs`, each vector's chunk in turn, then each vector's entries after the last whole chunk)
+/// with the full vector `y`; [`Packed`] keeps one vector per member (`G` = 1). Per vector: eight independent accumulators over the
 /// chunks, summed, plus the tail's sequential sum — [`dot`] bit for bit (a product with an
 /// all-zero chunk is ±0, which leaves an accumulator as it was).
 #[inline(always)]
@@ -532,7 +745,7 @@ impl Likelihood {
             // The detector sees none of the templates' contacts at this noise level: no reading
             // of these pushes will be detected either, so every answer is Unknown.
             return Ok(Likelihood {
-                packed: Packed::new(&[], 0, 0),
+                packed: Packed::new(&[], 0, 0, &[]),
                 ranges: Vec::new(),
                 pre: 0,
                 block: 1,
@@ -555,8 +768,11 @@ impl Likelihood {
             }
             ranges.push(start..members.len());
         }
+        let scale: Vec<f64> = (0..f.dims)
+            .map(|d| (f.w[d / f.blocks] / f.block as f64).sqrt())
+            .collect();
         Ok(Likelihood {
-            packed: Packed::new(&members, f.dims, f.lags),
+            packed: Packed::new(&members, f.dims, f.lags, &scale),
             ranges,
             pre: f.pre,
             block: f.block,
@@ -572,7 +788,7 @@ impl Likelihood {
     fn block_sums(&self, r: &Reading) -> Option<Vec<f64>> {
         let Reading::Ft(s) = r else { return None };
         let v = common::clean_values(s, &self.sensor)?;
-        let (kb, _) = self.detector.detect(&v)?;
+        let kb = self.detector.first(&v)?;
         let mut y = vec![0.0; USED.len() * self.blocks];
         let first = kb as i64 - self.pre as i64;
         let lo = (-first).max(0) as usize;
@@ -599,25 +815,13 @@ impl Likelihood {
     /// log p(reading | h) per hypothesis (up to a common constant); `None` when no contact is
     /// detected.
     pub fn log_likelihoods(&self, r: &Reading) -> Option<Vec<f64>> {
-        if self.packed.lagged.is_empty() {
+        if self.packed.slots.is_empty() {
             return None;
         }
         let y = self.block_sums(r)?;
-        let per_member = self.packed.scores(&y);
-        Some(
-            self.ranges
-                .iter()
-                .map(|r| {
-                    if r.is_empty() {
-                        // No template of this hypothesis makes a detectable contact: a reading
-                        // with a contact cannot come from it.
-                        f64::NEG_INFINITY
-                    } else {
-                        log_sum_exp(&per_member[r.clone()]) - (r.len() as f64).ln()
-                    }
-                })
-                .collect(),
-        )
+        // A hypothesis without a template that makes a detectable contact gets −∞: a reading with
+        // a contact cannot come from it.
+        Some(self.packed.log_likelihoods(&y, &self.ranges).0)
     }
 }
 
@@ -757,7 +961,8 @@ mod tests {
                     }
                 })
                 .collect();
-            let packed = Packed::new(&members, dims, lags);
+            let scale = vec![1.0; dims];
+            let packed = Packed::new(&members, dims, lags, &scale);
             for _ in 0..20 {
                 let y: Vec<f64> = (0..dims).map(|_| rng.random_range(-10.0..10.0)).collect();
                 let fast = packed.scores(&y);
@@ -768,8 +973,120 @@ mod tests {
         }
     }
 
-    /// The scores compiled for AVX2 (where the CPU has it) are those of the plain loops, bit for
-    /// bit: the dispatch changes the registers, not the arithmetic.
+    /// log-sum-exp over every member's score, without leaving any term out.
+    fn full_log_likelihoods(
+        packed: &Packed,
+        y: &[f64],
+        ranges: &[std::ops::Range<usize>],
+    ) -> Vec<f64> {
+        let s = packed.scores(y);
+        ranges
+            .iter()
+            .map(|r| {
+                let v = &s[r.clone()];
+                let m = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                if !m.is_finite() {
+                    return m;
+                }
+                m + v.iter().map(|x| (x - m).exp()).sum::<f64>().ln() - (r.len() as f64).ln()
+            })
+            .collect()
+    }
+
+    /// The members' bounds are upper bounds of their scores (without and with the exact lag
+    /// correction), and the hypotheses' log-likelihoods with the members the bounds leave out
+    /// are those of every member scored, bit for bit — on hand-made members whose scores lie
+    /// far apart, so that members are left out, and on members alike, so that few are.
+    #[test]
+    fn leaving_out_members_by_their_bounds_changes_no_bit() {
+        let mut rng = crate::random::stream(13, 0);
+        let (mut scored, mut total) = (0, 0);
+        let (mut scored_far, mut total_far) = (0, 0);
+        for (dims, lags, spread, near) in [
+            (40usize, 5usize, 1e3, true),
+            (240, 17, 1e3, true),
+            (235, 24, 3e2, true),
+            (240, 17, 1e3, false),
+        ] {
+            // Six hypotheses of six members: a hypothesis's members vary about a common shape.
+            let mut members = Vec::new();
+            for _ in 0..6 {
+                let shape = quiet_runs(&mut rng, dims, 7, spread);
+                for _ in 0..6 {
+                    let base: Vec<f64> = shape
+                        .iter()
+                        .map(|&x| x * rng.random_range(0.7..1.3) + rng.random_range(-1.0..1.0))
+                        .collect();
+                    let n_var = rng.random_range(0..=MAX_VARYING.min(dims));
+                    let vidx: Vec<u32> = (0..n_var)
+                        .map(|_| rng.random_range(0..dims) as u32)
+                        .collect();
+                    members.push(Member {
+                        cst: (0..lags).map(|_| rng.random_range(-1e4..0.0)).collect(),
+                        dlin: (0..n_var * lags)
+                            .map(|_| rng.random_range(-1e2..1e2))
+                            .collect(),
+                        vidx,
+                        base,
+                    });
+                }
+            }
+            let ranges: Vec<std::ops::Range<usize>> = (0..6).map(|h| h * 6..h * 6 + 6).collect();
+            let scale: Vec<f64> = (0..dims).map(|_| rng.random_range(0.5..2.0)).collect();
+            let packed = Packed::new(&members, dims, lags, &scale);
+            for _ in 0..20 {
+                // A reading near a member (its block sums base/s², plus noise), or anywhere.
+                let like = rng.random_range(0..members.len());
+                let y: Vec<f64> = (0..dims)
+                    .map(|d| {
+                        let noise = rng.random_range(-1.0..1.0);
+                        if near {
+                            members[like].base[d] / (scale[d] * scale[d]) + noise
+                        } else {
+                            10.0 * noise
+                        }
+                    })
+                    .collect();
+                let p = packed.bounds.project(&y);
+                for (m, s) in packed.scores(&y).iter().enumerate() {
+                    let ys: Vec<f64> = members[m].vidx.iter().map(|&d| y[d as usize]).collect();
+                    let (base, lag) = packed.bounds.of(m, &p, &ys);
+                    assert!(base + lag >= *s, "member {m}: {} < {s}", base + lag);
+                    assert!(base + packed.lag_of(m, &y) >= *s, "member {m}");
+                }
+                let (fast, n) = packed.log_likelihoods(&y, &ranges);
+                let (plain, n_plain) = packed.log_likelihoods_plain(&y, &ranges);
+                let full = full_log_likelihoods(&packed, &y, &ranges);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&full));
+                assert_eq!(bits(&plain), bits(&full));
+                assert_eq!(n, n_plain);
+                assert!((6..=36).contains(&n));
+                if near {
+                    scored += n;
+                    total += 36;
+                } else {
+                    scored_far += n;
+                    total_far += 36;
+                }
+            }
+        }
+        assert!(scored < total / 2, "{scored} of {total} members scored");
+        assert!(
+            scored_far > scored,
+            "{scored_far} of {total_far} members scored"
+        );
+        // An empty hypothesis is −∞ and scores nothing.
+        let packed = Packed::new(&[], 0, 0, &[]);
+        assert_eq!(
+            packed.log_likelihoods(&[], std::slice::from_ref(&(0..0))),
+            (vec![f64::NEG_INFINITY], 0)
+        );
+    }
+
+    /// The log-likelihoods compiled for AVX2 (where the CPU has it) are those of the plain loops
+    /// and of every member scored, bit for bit: the dispatch changes the registers, not the
+    /// arithmetic.
     #[test]
     fn member_scores_are_the_same_on_every_code_path() {
         use crate::mechanics::{PartModel, Support};
@@ -800,12 +1117,14 @@ mod tests {
             let Some(y) = lik.block_sums(&r) else {
                 continue;
             };
-            let plain = lik.packed.scores_plain(&y);
-            let used = lik.packed.scores(&y);
-            assert_eq!(plain.len(), 9);
+            let (plain, _) = lik.packed.log_likelihoods_plain(&y, &lik.ranges);
+            let (used, _) = lik.packed.log_likelihoods(&y, &lik.ranges);
+            let full = full_log_likelihoods(&lik.packed, &y, &lik.ranges);
+            assert_eq!(plain.len(), 3);
             assert!(plain.iter().all(|x| x.is_finite()));
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&plain), bits(&used));
+            assert_eq!(bits(&plain), bits(&full));
             compared += 1;
         }
         assert!(
