@@ -140,14 +140,6 @@ pub enum OnlineModelError {
         /// Joint commands.
         actions: usize,
     },
-    /// A sensor's likelihood cannot be trained on its templates.
-    #[error("sensor \"{sensor}\": {reason}")]
-    Sensor {
-        /// The sensor pin's name.
-        sensor: String,
-        /// Why its likelihood cannot be trained.
-        reason: String,
-    },
     /// A member's part or run could not be simulated (the simulator's message).
     #[error("{0}")]
     Simulation(String),
@@ -231,14 +223,11 @@ fn sensor_model(
     let likelihood = if rows.is_empty() {
         None
     } else {
-        Some(
-            Likelihood::new(&set, &sensor.settings, &ClassifierOptions::default()).map_err(
-                |reason| OnlineModelError::Sensor {
-                    sensor: pin.name.clone(),
-                    reason,
-                },
-            )?,
-        )
+        Some(Likelihood::new(
+            &set,
+            &sensor.settings,
+            &ClassifierOptions::default(),
+        ))
     };
     let state_label = match &sensor.hypotheses {
         Hypotheses::Orientations { degrees, .. } => hypotheses
@@ -1217,11 +1206,6 @@ mod tests {
             OnlineModelError::TooManyActions(5000).to_string(),
             format!("the dynamic pins have 5000 joint commands on the action grid (at most {MAX_ACTIONS}): lower controller.belief.targets")
         );
-        let e = OnlineModelError::Sensor {
-            sensor: "probe".into(),
-            reason: "no templates".into(),
-        };
-        assert_eq!(e.to_string(), "sensor \"probe\": no templates");
         assert_eq!(
             OnlineModelError::NoPrior.to_string(),
             "the belief's prior has no positive weight"

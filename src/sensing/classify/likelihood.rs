@@ -731,12 +731,13 @@ impl Frame {
 }
 
 impl Likelihood {
-    /// Train on `templates` for `sensor`; Err when the templates cannot be used (the reason).
+    /// Train on `templates` for `sensor`. Templates whose contacts the detector never sees give a
+    /// classifier that answers Unknown to every reading.
     pub fn new(
         templates: &TemplateSet,
         sensor: &SensorSettings,
         options: &ClassifierOptions,
-    ) -> Result<Likelihood, String> {
+    ) -> Likelihood {
         let dt = 1.0 / sensor.rate;
         let detector = common::Detector::new(sensor);
         // Pass 1: spans, the detector's delays, channel scales.
@@ -744,7 +745,7 @@ impl Likelihood {
         if survey.delays.is_empty() {
             // The detector sees none of the templates' contacts at this noise level: no reading
             // of these pushes will be detected either, so every answer is Unknown.
-            return Ok(Likelihood {
+            return Likelihood {
                 packed: Packed::new(&[], 0, 0, &[]),
                 ranges: Vec::new(),
                 pre: 0,
@@ -753,7 +754,7 @@ impl Likelihood {
                 detector,
                 sensor: *sensor,
                 options: *options,
-            });
+            };
         }
         let f = Frame::new(&survey, sensor, dt);
 
@@ -771,7 +772,7 @@ impl Likelihood {
         let scale: Vec<f64> = (0..f.dims)
             .map(|d| (f.w[d / f.blocks] / f.block as f64).sqrt())
             .collect();
-        Ok(Likelihood {
+        Likelihood {
             packed: Packed::new(&members, f.dims, f.lags, &scale),
             ranges,
             pre: f.pre,
@@ -780,7 +781,7 @@ impl Likelihood {
             detector,
             sensor: *sensor,
             options: *options,
-        })
+        }
     }
 
     /// The reading's block sums on the frame anchored at its detected begin; `None` without a
@@ -1108,7 +1109,7 @@ mod tests {
             members,
         };
         let sensor = SensorSettings::default();
-        let lik = Likelihood::new(&templates, &sensor, &ClassifierOptions::default()).unwrap();
+        let lik = Likelihood::new(&templates, &sensor, &ClassifierOptions::default());
         let mut rng = crate::random::stream(3, 1);
         let mut compared = 0;
         for deg in [50.0, 140.0, 250.0] {

@@ -141,10 +141,6 @@ pub enum BuildError {
         /// The hypothesis's label.
         label: String,
     },
-    /// The likelihood classifier could not be trained ([`likelihood::Likelihood::new`]; its
-    /// message as it is).
-    #[error("{0}")]
-    Likelihood(String),
 }
 
 /// Trains the classifier `name` (one of [`NAMES`]) on `templates` for readings of `sensor`.
@@ -213,9 +209,6 @@ pub fn build(
     Ok(match name {
         "sign-matrix" => Box::new(sign_matrix::SignMatrixClassifier::new(templates, sensor)),
         "timing" => Box::new(timing::Timing::new(templates, sensor, options)),
-        _ => Box::new(
-            likelihood::Likelihood::new(templates, sensor, options)
-                .map_err(BuildError::Likelihood)?,
-        ),
+        _ => Box::new(likelihood::Likelihood::new(templates, sensor, options)),
     })
 }
