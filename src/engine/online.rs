@@ -324,7 +324,9 @@ impl OnlineModel {
                 let base = &sensing[mu_index(hypotheses[h].mu_c)];
                 sensor_signals(scene, base, &sensor_obstacles, e)
             };
-        // Per member: its signal at each sensor (None: no touch) and its success per action.
+        // Per member: its signal at each sensor (None: no touch) and its success per action. The
+        // parallel results are gathered in member order before the first error is taken, so a
+        // failing model names the same member on any number of threads.
         let outs: Vec<MemberOut> = members
             .par_iter()
             .map(|(h, e)| -> Result<MemberOut, OnlineModelError> {
@@ -333,6 +335,8 @@ impl OnlineModel {
                 let (ok, member_runs) = staging.success(mi, e)?;
                 Ok((signals, ok, member_runs))
             })
+            .collect::<Vec<_>>()
+            .into_iter()
             .collect::<Result<_, OnlineModelError>>()?;
         let runs_taken: u64 = outs.iter().map(|o| o.2[0] + 1).sum();
         let evaluations: u64 = outs.iter().map(|o| o.2[1]).sum();
@@ -346,6 +350,8 @@ impl OnlineModel {
                 let e = member(scene, &hypotheses[h], h, m)?;
                 Ok((h, signals_of(h, &e)?))
             })
+            .collect::<Vec<_>>()
+            .into_iter()
             .collect::<Result<_, OnlineModelError>>()?;
         let n_h = hypotheses.len();
         let order = staging.prefix_of_actions(&options);
