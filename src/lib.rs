@@ -26,14 +26,10 @@
 //! | [`study`] | Monte Carlo studies, comparisons, cost and accuracy studies, the fuzzing driver |
 //! | [`report`] | tables, reports and figures |
 //!
-//! The `pinfeed` command itself (`cli`) only maps its arguments to these modules and prints, and
-//! is not part of the documented API. `examples/` holds one push, a line run, a plan and a sensing
+//! The `pinfeed` command is the crate's binary (`src/main.rs` and its `cli` module, not part of
+//! this library): it only maps its arguments to these modules and prints. `examples/` holds one push, a line run, a plan and a sensing
 //! evaluation written against this API.
 
-// The `pinfeed` command's argument parsing and printing: public for `main.rs` and the tests, not
-// part of the documented library API (its workflows live in the modules below).
-#[doc(hidden)]
-pub mod cli;
 pub mod contact_case;
 pub mod engine;
 pub mod geometry;

@@ -1,8 +1,8 @@
 //! `pinfeed bench`: measurements that produce the reports in `results/`.
 
-use crate::study::{contact_cost, map_cost};
 use anyhow::Result;
 use clap::{Args, Subcommand};
+use pinfeed::study::{contact_cost, map_cost};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -101,7 +101,7 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
                 "accuracy: {contacts} contacts against the reference"
             ));
             let (table, files) =
-                crate::report::study_files::accuracy_bench(*contacts, *seed, cmd, out)?;
+                pinfeed::report::study_files::accuracy_bench(*contacts, *seed, cmd, out)?;
             print!("{table}");
             let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
             eprintln!("wrote {}", files.join(", "));

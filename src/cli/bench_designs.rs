@@ -1,9 +1,9 @@
-//! `pinfeed bench designs`: maps its arguments to [`crate::plan::design::survey`] and writes the
+//! `pinfeed bench designs`: maps its arguments to [`pinfeed::plan::design::survey`] and writes the
 //! Markdown report (rewritten after every part, so a long survey shows its progress).
 
-use crate::plan::design::survey::{page, survey_part, SurveyPart, SurveySettings};
-use crate::plan::problem::parse_mu_c_range;
 use anyhow::{anyhow, bail, Context, Result};
+use pinfeed::plan::design::survey::{page, survey_part, SurveyPart, SurveySettings};
+use pinfeed::plan::problem::parse_mu_c_range;
 use std::path::PathBuf;
 
 /// The arguments of `bench designs`.
@@ -75,7 +75,7 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<
         ));
         rows.push(pool.install(|| survey_part(&s, p)));
         let m = page(cmd, &s, &rows);
-        crate::output::write_file(&a.out, m)?;
+        pinfeed::output::write_file(&a.out, m)?;
     }
     eprintln!("wrote {}", a.out.display());
     Ok(())

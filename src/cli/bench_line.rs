@@ -1,10 +1,10 @@
 //! `pinfeed bench line`: a scenario's line against its own pushes run as a bare batch; writes the
-//! marked section of results/line-speed.md ([`crate::study::line_cost`]).
+//! marked section of results/line-speed.md ([`pinfeed::study::line_cost`]).
 
-use crate::study::line_cost::{measure, section, MARKERS};
-use crate::study::mc::precision::splice_between;
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pinfeed::study::line_cost::{measure, section, MARKERS};
+use pinfeed::study::mc::precision::splice_between;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -35,7 +35,7 @@ pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()>
     }
     let mut rows = Vec::new();
     for path in &a.scenarios {
-        let scene = crate::scenario::load(path)?;
+        let scene = pinfeed::scenario::load(path)?;
         spin.set_message(format!("line: {}", path.display()));
         let row = measure(&scene, a.parts, a.reps)
             .with_context(|| format!("measuring {}", path.display()))?;
@@ -51,7 +51,7 @@ pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()>
         rows.push(row);
     }
     let marked = format!("{}\n{}{}\n", MARKERS.0, section(&rows, cmd), MARKERS.1);
-    crate::output::rewrite_file(&a.out, |old| splice_between(old, &marked, MARKERS))?;
+    pinfeed::output::rewrite_file(&a.out, |old| splice_between(old, &marked, MARKERS))?;
     eprintln!("wrote {}", a.out.display());
     Ok(())
 }

@@ -1,11 +1,11 @@
 //! `pinfeed bench map-tier`: writes the map-tier sections of results/accuracy-vs-time.md and
-//! results/line-speed.md ([`crate::study::map_tier`]).
+//! results/line-speed.md ([`pinfeed::study::map_tier`]).
 
-use crate::study::map_tier::{
-    contact_row, contact_section, line_row, line_section, marked, splice,
-};
 use anyhow::{bail, Result};
 use clap::Args;
+use pinfeed::study::map_tier::{
+    contact_row, contact_section, line_row, line_section, marked, splice,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
@@ -31,7 +31,7 @@ pub struct MapTierArgs {
 }
 
 fn write_section(path: &Path, section: &str) -> Result<()> {
-    crate::output::rewrite_file(path, |old| splice(old, &marked(section)))?;
+    pinfeed::output::rewrite_file(path, |old| splice(old, &marked(section)))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }

@@ -4,9 +4,9 @@
 //! marked section of `results/accuracy-vs-time.md` (the rest of the file is left as it is), with
 //! the largest count repeated at the cheaper fidelities (speed against bias).
 
-use crate::mechanics::Fidelity;
-use crate::study::mc::{self, precision};
 use anyhow::{bail, Result};
+use pinfeed::mechanics::Fidelity;
+use pinfeed::study::mc::{self, precision};
 use std::path::Path;
 
 /// The machine's 1-minute load average (Linux), for the record.
@@ -88,7 +88,7 @@ pub fn run(
             load_after,
         },
     );
-    crate::output::rewrite_file(out, |doc| precision::splice(doc, &section))?;
+    pinfeed::output::rewrite_file(out, |doc| precision::splice(doc, &section))?;
     print!("{section}");
     eprintln!(
         "wrote the Monte Carlo precision section of {}",

@@ -1,20 +1,20 @@
 //! `pinfeed calibrate MEASURED.csv`: fit μc centre and spread, the tripod (or smooth-density)
 //! share and the pin radius to measured bands by maximum likelihood over one reweighted ensemble
-//! ([`crate::validate::calibrate`]), with 95% profile-likelihood intervals; then score the nominal
+//! ([`pinfeed::validate::calibrate`]), with 95% profile-likelihood intervals; then score the nominal
 //! model and the fitted ensemble on the same rows with `validate`'s scorer (fresh ensembles, the
 //! same seed). With `--synthesize` the file is first written: the bundled synthetic data set drawn
-//! from hidden parameters ([`crate::validate::synthetic`]), and the report says whether each
+//! from hidden parameters ([`pinfeed::validate::synthetic`]), and the report says whether each
 //! interval holds the hidden value. Unless `--no-write`, `pinfeed-out/calibrate/<file stem>/` receives
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
 use super::validate::{emit, ensemble_spec, pool, ModelArgs};
-use crate::mechanics::support::{SmoothParams, SupportChoice};
-use crate::report::calibrate_report::{calibration_text, write_report, CalibrateReport};
-use crate::validate::calibrate::{calibrate_observed, CalibrationSettings};
-use crate::validate::input::{check_members, load_measured};
-use crate::validate::synthetic::{synthesize, SyntheticDesign};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
+use pinfeed::mechanics::support::{SmoothParams, SupportChoice};
+use pinfeed::report::calibrate_report::{calibration_text, write_report, CalibrateReport};
+use pinfeed::validate::calibrate::{calibrate_observed, CalibrationSettings};
+use pinfeed::validate::input::{check_members, load_measured};
+use pinfeed::validate::synthetic::{synthesize, SyntheticDesign};
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed calibrate`.
@@ -47,7 +47,7 @@ pub struct CalibrateArgs {
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
     /// Members of the ensembles that score the nominal model and the fit.
-    #[arg(long, default_value_t = crate::validate::DEFAULT_MEMBERS)]
+    #[arg(long, default_value_t = pinfeed::validate::DEFAULT_MEMBERS)]
     pub score_members: usize,
     #[command(flatten)]
     pub common: ModelArgs,
@@ -60,7 +60,7 @@ pub(crate) fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
         .split_once(':')
         .and_then(|(a, b)| Some((a.trim().parse::<f64>().ok()?, b.trim().parse::<f64>().ok()?)))
         .ok_or_else(|| anyhow!("--mu-c-range must be MIN:MAX, got '{}'", args.mu_c_range))?;
-    let (mu_lo, mu_hi) = crate::mechanics::limits::MU_C;
+    let (mu_lo, mu_hi) = pinfeed::mechanics::limits::MU_C;
     if !(lo.is_finite() && hi.is_finite() && mu_lo <= lo && lo + 0.05 <= hi && hi <= mu_hi) {
         bail!("--mu-c-range: need {mu_lo} ≤ MIN, MIN + 0.05 ≤ MAX ≤ {mu_hi}, got {lo}:{hi}");
     }
@@ -108,7 +108,7 @@ pub fn run(args: &CalibrateArgs, recorded: &str) -> Result<()> {
         if let Some(dir) = args.measured.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         }
-        crate::output::write_atomic(&args.measured, text)
+        pinfeed::output::write_atomic(&args.measured, text)
             .with_context(|| format!("writing {}", args.measured.display()))?;
         eprintln!("synthetic data set written to {}", args.measured.display());
         Some(SyntheticDesign::TRUTH)
@@ -132,7 +132,7 @@ pub fn run(args: &CalibrateArgs, recorded: &str) -> Result<()> {
         bar.set_message(format!("scoring {stage} "));
         pool.install(|| {
             let draw = (c.seed, args.score_members, c.passes);
-            crate::validate::validate_observed(&measured, spec, draw, &score, &tell)
+            pinfeed::validate::validate_observed(&measured, spec, draw, &score, &tell)
         })
         .map(|(_, summary, _)| summary)
         .map_err(anyhow::Error::msg)

@@ -1,8 +1,8 @@
 //! `pinfeed compare A.toml B.toml ...`: run line designs on the same part stream and print one
-//! table (pin layouts measured against fence designs; [`crate::study::compare`]).
+//! table (pin layouts measured against fence designs; [`pinfeed::study::compare`]).
 //!
 //! The same part stream: the first scenario's feed (number of parts, arrivals, orientation and
-//! lateral distributions) and seed are imposed on every scenario ([`crate::scenario::FeedSource`]),
+//! lateral distributions) and seed are imposed on every scenario ([`pinfeed::scenario::FeedSource`]),
 //! so part i arrives at the same time with the same orientation and offset in every design. The
 //! part (shape, scale, support) must be the same in every file, and the first file's lateral
 //! offsets must fit on every belt; otherwise the scenario is refused with the reason. Each
@@ -10,10 +10,10 @@
 //! first file's; `--uniform-orientation` feeds every design parts at orientations uniform on
 //! [0°, 360°) instead of the first file's distribution. Nothing is written to disk.
 
-use crate::report::compare_table;
-use crate::study::compare::{compare_observed, designs};
 use anyhow::{Context, Result};
 use clap::Args;
+use pinfeed::report::compare_table;
+use pinfeed::study::compare::{compare_observed, designs};
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed compare`.
@@ -61,7 +61,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         struct Designs<'a, T: serde::Serialize> {
             designs: &'a T,
         }
-        crate::report::versioned::pretty(&Designs { designs: &rows })?
+        pinfeed::report::versioned::pretty(&Designs { designs: &rows })?
     } else {
         let feed = compare_table::feed_line(&files[0], source, parts);
         if args.markdown {

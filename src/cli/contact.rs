@@ -5,12 +5,12 @@
 //! in −x relative to the belt (plus w per unit travel for a moving pin). All lengths in the output
 //! are in the part's units.
 
-use crate::contact_case::batch::run_batch;
-use crate::contact_case::report::{report, trace_csv};
-use crate::contact_case::{parse_fence, run_case, stop_travel, Case};
-use crate::mechanics::Fidelity;
 use anyhow::{Context, Result};
 use clap::Args;
+use pinfeed::contact_case::batch::run_batch;
+use pinfeed::contact_case::report::{report, trace_csv};
+use pinfeed::contact_case::{parse_fence, run_case, stop_travel, Case};
+use pinfeed::mechanics::Fidelity;
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed contact`.
@@ -121,23 +121,23 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         let defaults = case_of(args, model)?;
         return Ok(run_batch(&defaults, path, std::io::stdout().lock())?);
     }
-    let crate::contact_case::ModelChoice::Model(model) = args.push.model else {
+    let pinfeed::contact_case::ModelChoice::Model(model) = args.push.model else {
         return super::contact_map::run(args);
     };
     let c = case_of(args, model)?;
     let want_trace = args.trace.is_some() || args.plot.is_some();
     let (poly, out, trace) = run_case(&c, want_trace)?;
     if let Some(path) = &args.trace {
-        crate::output::write_atomic(path, trace_csv(&trace))
+        pinfeed::output::write_atomic(path, trace_csv(&trace))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.plot {
-        crate::report::plot_contact::plot_case(&c, &poly, &out, &trace, path)
+        pinfeed::report::plot_contact::plot_case(&c, &poly, &out, &trace, path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     let r = report(&c, &out).with_pin_positions(&c, poly.radius(), &out);
     if args.json {
-        print!("{}", crate::report::versioned::pretty(&r)?);
+        print!("{}", pinfeed::report::versioned::pretty(&r)?);
     } else {
         print!("{}", r.text());
     }

@@ -4,14 +4,14 @@
 //! and says which.
 
 use super::contact::{case_of, ContactArgs};
-use crate::contact_case::report::report;
-use crate::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
-use crate::engine::contact_map::prepare_observed;
-use crate::geometry::{Pose, Vec2};
-use crate::maps::tier::{self, push_with_map, Loaded, TierInputs, TierSpec};
-use crate::mechanics::{ContactSettings, Fidelity, PartModel, Support};
-use crate::scenario::Scene;
 use anyhow::{bail, Result};
+use pinfeed::contact_case::report::report;
+use pinfeed::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
+use pinfeed::engine::contact_map::prepare_observed;
+use pinfeed::geometry::{Pose, Vec2};
+use pinfeed::maps::tier::{self, push_with_map, Loaded, TierInputs, TierSpec};
+use pinfeed::mechanics::{ContactSettings, Fidelity, PartModel, Support};
+use pinfeed::scenario::Scene;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -104,7 +104,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             "source": loaded.describe(),
             "query_s": query_s,
         });
-        print!("{}", crate::report::versioned::pretty(&v)?);
+        print!("{}", pinfeed::report::versioned::pretty(&v)?);
         return Ok(());
     }
     println!(

@@ -1,7 +1,7 @@
 //! `pinfeed examples [NAME…] [--all] [--to DIR] [--force]`: list the bundled scenarios and studies,
-//! or write them into a folder ([`crate::study::bundled`]).
+//! or write them into a folder ([`pinfeed::study::bundled`]).
 
-use crate::study::bundled::{self, Kind};
+use pinfeed::study::bundled::{self, Kind};
 use std::path::PathBuf;
 
 #[derive(Debug, clap::Args)]

@@ -2,21 +2,21 @@
 //! chapter 3), their bands, and the figures and report files under `pinfeed-out/maps/<part>/`.
 //!
 //! Each map samples θ0 over [0°, 360°) with the start convention of `pinfeed contact`
-//! ([`crate::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
-//! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`crate::contact_case::case_fence`]);
+//! ([`pinfeed::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
+//! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`pinfeed::contact_case::case_fence`]);
 //! a fence map has no contact parameter, so `--d` is not taken, and its report goes to
 //! `pinfeed-out/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
 //! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
 //! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
 
-use crate::contact_case::{
-    case_fence, check_geometry, check_inputs, compile_part, parse_fence, settings_and_pin, Case,
-};
-use crate::maps::{compute_maps_with, MapFence, MapSettings};
-use crate::report::map_report::{write_csv, write_report, MapReport};
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pinfeed::contact_case::{
+    case_fence, check_geometry, check_inputs, compile_part, parse_fence, settings_and_pin, Case,
+};
+use pinfeed::maps::{compute_maps_with, MapFence, MapSettings};
+use pinfeed::report::map_report::{write_csv, write_report, MapReport};
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed map`.
@@ -106,7 +106,7 @@ pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
 
 /// The default report directory of a part: `pinfeed-out/maps/<part>` (a vertex list is `custom`).
 pub fn default_out_dir(part: &str) -> PathBuf {
-    crate::default_out(&["maps", &super::part_folder(part)])
+    pinfeed::default_out(&["maps", &super::part_folder(part)])
 }
 
 /// Run `pinfeed map`; `recorded` is the command line its report records.
@@ -117,8 +117,8 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
         bail!("--model map: the map tier tabulates still pins with one support; use --model exact with --fence or --uncertain");
     }
     let model = match args.push.model {
-        crate::contact_case::ModelChoice::Model(f) => f,
-        crate::contact_case::ModelChoice::Map => crate::mechanics::Fidelity::Exact,
+        pinfeed::contact_case::ModelChoice::Model(f) => f,
+        pinfeed::contact_case::ModelChoice::Map => pinfeed::mechanics::Fidelity::Exact,
     };
     let fence = args.fence.as_deref().map(parse_fence).transpose()?;
     let template = Case {
@@ -128,7 +128,7 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     check_inputs(&template)?;
     let fenced = args.fence.is_some();
     let (step, threshold) = (args.theta_step, args.threshold);
-    crate::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold)?;
+    pinfeed::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold)?;
     let (poly, part_model) = compile_part(&args.part, &args.push.support)?;
     if fence.is_some() {
         check_geometry(&template, &poly)?;
@@ -168,13 +168,13 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
         .context("starting the worker threads")?;
     let tier = if use_tier {
         // Only the base cells the maps' passes fall in are built.
-        let grid = crate::maps::theta_grid(args.theta_step).unwrap_or_default();
+        let grid = pinfeed::maps::theta_grid(args.theta_step).unwrap_or_default();
         let passes: Vec<_> = ds
             .iter()
             .flat_map(|&d| grid.iter().map(move |&t| (t, d)))
-            .map(|(t, d)| crate::maps::pass_start(&poly, t, d, pin.radius))
+            .map(|(t, d)| pinfeed::maps::pass_start(&poly, t, d, pin.radius))
             .collect();
-        let support = crate::mechanics::Support::parse(&args.push.support, &poly)
+        let support = pinfeed::mechanics::Support::parse(&args.push.support, &poly)
             .map_err(anyhow::Error::msg)?;
         let loaded = pool.install(|| {
             super::contact_map::load_tier(
@@ -203,7 +203,7 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     if let Some(l) = &tier {
         eprintln!(
             "{}",
-            crate::maps::tier::report::served_line(&l.map, &poly, &part_model, &ds, &settings)
+            pinfeed::maps::tier::report::served_line(&l.map, &poly, &part_model, &ds, &settings)
         );
     }
     let contacts: usize = maps.iter().map(|m| m.samples.len()).sum();
@@ -233,7 +233,7 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
         maps: &maps,
     };
     if args.json {
-        print!("{}", crate::report::versioned::pretty(&report)?);
+        print!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else if args.csv {
         write_csv(std::io::stdout().lock(), &maps)?;
     } else {

@@ -1,4 +1,4 @@
-//! `pinfeed map … --uncertain LIST`: ensemble maps ([`crate::maps::ensemble`]). Every
+//! `pinfeed map … --uncertain LIST`: ensemble maps ([`pinfeed::maps::ensemble`]). Every
 //! member passes at every (d, θ0 on the grid); per d and input state (all θ0, and each stable
 //! state) the pooled θf give the predicted bands (smallest arcs holding 90%) and the share of the
 //! circle they cover. Standard output gets the band table; unless `--no-write`, the report directory
@@ -7,12 +7,14 @@
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
 use super::map::{default_out_dir_for, MapArgs};
-use crate::geometry::Polygon;
-use crate::maps::ensemble::{ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState};
-use crate::maps::theta_grid;
-use crate::mechanics::Fidelity;
-use crate::report::ensemble_report::{table, write_report, EnsembleReport};
 use anyhow::{anyhow, bail, Result};
+use pinfeed::geometry::Polygon;
+use pinfeed::maps::ensemble::{
+    ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState,
+};
+use pinfeed::maps::theta_grid;
+use pinfeed::mechanics::Fidelity;
+use pinfeed::report::ensemble_report::{table, write_report, EnsembleReport};
 
 /// Most members of an ensemble.
 pub const MAX_MEMBERS: usize = 100_000;

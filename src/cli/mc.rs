@@ -5,11 +5,11 @@
 //! (`<out>/shard-K-of-N.json`, default `<out>` = `pinfeed-out/mc/<study name>/shards/`) for
 //! `pinfeed merge`.
 
-use crate::study::mc::report::{self, McReport, StudyHeader};
-use crate::study::mc::shard::{ShardFile, ShardSpec};
-use crate::study::mc::{self, run};
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pinfeed::study::mc::report::{self, McReport, StudyHeader};
+use pinfeed::study::mc::shard::{ShardFile, ShardSpec};
+use pinfeed::study::mc::{self, run};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -41,7 +41,7 @@ pub struct McArgs {
 
 /// The default report folder of a study.
 pub fn default_dir(study_name: &str) -> PathBuf {
-    crate::default_out(&["mc", study_name])
+    pinfeed::default_out(&["mc", study_name])
 }
 
 pub fn run(args: &McArgs) -> Result<()> {
@@ -55,7 +55,7 @@ pub fn run(args: &McArgs) -> Result<()> {
             bail!("--threads must lie in [1, 1024], got {t}");
         }
     }
-    let study = crate::study::bundled::load_study(&args.study, args.samples)?;
+    let study = pinfeed::study::bundled::load_study(&args.study, args.samples)?;
     for w in study.warnings() {
         eprintln!("warning: {w}");
     }
@@ -87,7 +87,7 @@ pub fn run(args: &McArgs) -> Result<()> {
         let path = dir.join(spec.file_name());
         let file = ShardFile::new(&header, spec, range.clone(), &tallies);
         let text = serde_json::to_string_pretty(&file)? + "\n";
-        crate::output::write_atomic(&path, text)
+        pinfeed::output::write_atomic(&path, text)
             .with_context(|| format!("writing {}", path.display()))?;
         if !args.quiet {
             eprintln!(
@@ -113,10 +113,10 @@ pub fn run(args: &McArgs) -> Result<()> {
     Ok(())
 }
 
-/// Write a report's files to `dir` ([`crate::report::study_files::mc_report_files`]) and print the table or the JSON.
+/// Write a report's files to `dir` ([`pinfeed::report::study_files::mc_report_files`]) and print the table or the JSON.
 /// `mc` and `merge` share it, so their outputs are the same bytes.
 pub fn publish(r: &McReport, dir: &Path, json: bool, quiet: bool) -> Result<()> {
-    let (json_text, md) = crate::report::study_files::mc_report_files(r, dir)?;
+    let (json_text, md) = pinfeed::report::study_files::mc_report_files(r, dir)?;
     let text = if json {
         json_text
     } else if quiet {

@@ -3,9 +3,9 @@
 //! write the report an unsharded `pinfeed mc` run writes, byte for byte.
 
 use super::mc::{default_dir, publish};
-use crate::study::mc::{report, shard};
 use anyhow::Result;
 use clap::Args;
+use pinfeed::study::mc::{report, shard};
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed merge`.
@@ -35,6 +35,9 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| default_dir(&header.study));
-    let r = report::build(&crate::study::mc::report::with_out(header, &dir), &tallies);
+    let r = report::build(
+        &pinfeed::study::mc::report::with_out(header, &dir),
+        &tallies,
+    );
     publish(&r, &dir, args.json, args.quiet)
 }

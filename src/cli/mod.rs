@@ -32,9 +32,12 @@ pub mod sense;
 pub mod stdout;
 pub mod validate;
 
+#[cfg(test)]
+mod tests;
+
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
-pub use crate::geometry::named::part_folder;
+pub use pinfeed::geometry::named::part_folder;
 
 /// pinfeed: orient planar parts on a conveyor with overhead pins and fences.
 #[derive(Debug, Parser)]

@@ -1,9 +1,9 @@
 //! `pinfeed part`: describe a part (area, centroid, a, convexity, stable states) and plot it.
 
-use crate::geometry::{named, Polygon};
-use crate::report::part_report::PartReport;
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pinfeed::geometry::{named, Polygon};
+use pinfeed::report::part_report::PartReport;
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed part`.
@@ -65,11 +65,11 @@ pub fn run(args: &PartArgs) -> Result<()> {
     let (poly, name) = resolve_part(spec, args.vertices.as_deref())?;
     let report = PartReport::of(&poly, &name);
     if let Some(path) = &args.plot {
-        crate::report::plot_part::plot_part(&poly, &name, path)
+        pinfeed::report::plot_part::plot_part(&poly, &name, path)
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if args.json {
-        print!("{}", crate::report::versioned::pretty(&report)?);
+        print!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else {
         print!("{}", report.text());
         if let Some(p) = &args.plot {

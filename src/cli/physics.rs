@@ -1,10 +1,10 @@
 //! The physics flags of one pin pass that `contact` and `map` share: one definition, so each has
 //! one meaning, one unit, one default and one help text in both commands.
 
-use crate::contact_case::{Case, ModelChoice};
-use crate::mechanics::{ContactSettings, Fidelity};
 use anyhow::{bail, Result};
 use clap::Args;
+use pinfeed::contact_case::{Case, ModelChoice};
+use pinfeed::mechanics::{ContactSettings, Fidelity};
 use std::path::PathBuf;
 
 /// Friction, fidelity (with the map tier's cache and grid), pin radius, support and tolerance.

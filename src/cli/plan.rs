@@ -1,4 +1,4 @@
-//! `pinfeed plan`: maps its arguments to [`crate::plan::design`] (the design workflow: searches,
+//! `pinfeed plan`: maps its arguments to [`pinfeed::plan::design`] (the design workflow: searches,
 //! line checks, refinement, the line's headway) and prints the result; writes the chosen design.
 //!
 //! Exit status: 0 confirmed (the line check holds the target); 3 a design was written but the
@@ -7,12 +7,12 @@
 //! confirmed design.
 
 use super::stdout::print_result;
-use crate::plan::design::{self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status};
-use crate::plan::problem::parse_mu_c_range;
-use crate::plan::{FeedKind, PlanError, Problem};
-use crate::report::plan_summary::{self as summary, write_design, DesignPaths};
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
+use pinfeed::plan::design::{self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status};
+use pinfeed::plan::problem::parse_mu_c_range;
+use pinfeed::plan::{FeedKind, PlanError, Problem};
+use pinfeed::report::plan_summary::{self as summary, write_design, DesignPaths};
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed plan`.

@@ -49,13 +49,6 @@ pub fn counter(bar: &ProgressBar) -> impl Fn(u64, u64) + Sync + '_ {
     }
 }
 
-/// A bar's next stage: a new message and length, counted from zero.
-pub fn stage(bar: &ProgressBar, message: &str, total: u64) {
-    bar.set_message(format!("{message} "));
-    bar.set_length(total);
-    bar.set_position(0);
-}
-
 /// A line on standard error that leaves `bar` drawn below it.
 pub fn note(bar: &ProgressBar, line: &str) {
     bar.suspend(|| eprintln!("{line}"));

@@ -5,9 +5,9 @@
 //! they are. Arguments that change only how a result is shown or how fast it is computed
 //! ([`NOT_RECORDED`]) are left out, so the same result has the same recorded command.
 
-use crate::output::shell_word;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Command};
+use pinfeed::output::shell_word;
 
 /// Arguments never recorded: threads, progress display, JSON on standard output, the map cache's
 /// folder. None of them changes a result.

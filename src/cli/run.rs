@@ -2,14 +2,14 @@
 //! orientation success. Writes `summary.json` (and, as the scenario's `[output]` asks, the
 //! per-part CSV, the orientation histogram SVG and the event log) under
 //! `<out>/<scenario name>/`; prints a table, or the summary as JSON with `--json`. `--draw` and
-//! `--animate` picture sample parts on the line ([`crate::report::plot_line`],
-//! [`crate::report::animate`]).
+//! `--animate` picture sample parts on the line ([`pinfeed::report::plot_line`],
+//! [`pinfeed::report::animate`]).
 
-use crate::engine::{self, RunOptions};
-use crate::report::line_table;
-use crate::report::run_folder::{write_run, RunFiles};
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use pinfeed::engine::{self, RunOptions};
+use pinfeed::report::line_table;
+use pinfeed::report::run_folder::{write_run, RunFiles};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -52,9 +52,9 @@ pub struct RunArgs {
 }
 
 pub fn run(args: &RunArgs) -> Result<()> {
-    let scene = crate::study::bundled::load_scenario(&args.scenario)?;
+    let scene = pinfeed::study::bundled::load_scenario(&args.scenario)?;
     let mut opts = RunOptions::from_scene(&scene);
-    opts.online = crate::engine::prepare::online_model(&scene)?;
+    opts.online = pinfeed::engine::prepare::online_model(&scene)?;
     if let Some(n) = args.parts {
         if !(1..=1_000_000_000).contains(&n) {
             bail!("--parts must lie in [1, 1000000000], got {n}");

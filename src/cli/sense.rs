@@ -3,21 +3,21 @@
 //! For one push (part in metres via `--scale`, pin offset `--d`, radius, μc, μs) and a set of
 //! hypotheses (the part's stable states by default, listed orientations, or `vertex-edge`), every
 //! classifier is scored on `--trials` simulated pushes at every factor of the `--noise` sweep
-//! ([`crate::sensing::evaluate`]): confusion matrix (rows true, columns decided, "unknown"
+//! ([`pinfeed::sensing::evaluate`]): confusion matrix (rows true, columns decided, "unknown"
 //! last), accuracy with a 95% Wilson interval and the mutual information between state and decision
-//! in bits. `--placement` adds the search over d × sensor kind ([`crate::sensing::placement`]).
+//! in bits. `--placement` adds the search over d × sensor kind ([`pinfeed::sensing::placement`]).
 //!
 //! Standard output gets a table per classifier (default) or the JSON document (`--json`); unless
 //! `--no-write`, the report directory (default `pinfeed-out/sensing/<part>/`) receives `report.md`
 //! headed by the command that regenerates it, `sense.json`, and the SVG figures. The time spent goes
 //! to standard error.
 
-use crate::report::sense::{text_summary, write_report};
-use crate::sensing::experiment::{self, Request, SenseError};
-use crate::sensing::placement;
-use crate::sensing::SensorSettings;
 use anyhow::{Context, Result};
 use clap::Args;
+use pinfeed::report::sense::{text_summary, write_report};
+use pinfeed::sensing::experiment::{self, Request, SenseError};
+use pinfeed::sensing::placement;
+use pinfeed::sensing::SensorSettings;
 use std::path::PathBuf;
 
 fn dflt() -> SensorSettings {
@@ -54,8 +54,8 @@ pub struct SenseArgs {
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub mu_s: f64,
     /// Fidelity: exact, ellipsoid or tip.
-    #[arg(long, default_value = "exact", value_parser = crate::contact_case::parse_model)]
-    pub model: crate::mechanics::Fidelity,
+    #[arg(long, default_value = "exact", value_parser = pinfeed::contact_case::parse_model)]
+    pub model: pinfeed::mechanics::Fidelity,
     /// Integration tolerance per step.
     #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub tol: f64,
@@ -169,7 +169,7 @@ pub struct SenseArgs {
 
 /// The default report directory: `pinfeed-out/sensing/<part>` (a vertex list is `custom`).
 pub fn default_out_dir(part: &str) -> PathBuf {
-    crate::default_out(&["sensing", &super::part_folder(part)])
+    pinfeed::default_out(&["sensing", &super::part_folder(part)])
 }
 
 /// The library's request of the arguments.
@@ -290,7 +290,7 @@ pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
 
     let (report, templates) = p.report(&req, recorded.to_string(), evaluated, placement);
     if a.json {
-        print!("{}", crate::report::versioned::pretty(&report)?);
+        print!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else {
         print!("{}", text_summary(&report));
     }

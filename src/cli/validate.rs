@@ -1,19 +1,19 @@
 //! `pinfeed validate MEASURED.csv`: measured bands against an ensemble's predictions (
-//! [`crate::validate`]). Standard output gets one line per measured row (contained, overlapping,
+//! [`pinfeed::validate`]). Standard output gets one line per measured row (contained, overlapping,
 //! centre offset, predicted probability of the measured band, log score, predicted bands) and the
 //! summary; `--json` prints the whole report instead. Unless `--no-write`, the report directory
 //! (`pinfeed-out/validate/<file stem>/`) receives `README.md` headed by the regenerating command,
 //! `validate.json` and one figure per (part, input): the measured bands over the predicted
 //! distributions and bands against d.
 
-use crate::maps::ensemble::EnsembleSpec;
-use crate::mechanics::limits::in_range;
-use crate::report::validate_report::{containment_text, rows_text, write_report, ValidateReport};
-use crate::validate::input::{self, check_members, load_measured};
-use crate::validate::measured::Measured;
-use crate::validate::score::ScoreSettings;
 use anyhow::{Context, Result};
 use clap::Args;
+use pinfeed::maps::ensemble::EnsembleSpec;
+use pinfeed::mechanics::limits::in_range;
+use pinfeed::report::validate_report::{containment_text, rows_text, write_report, ValidateReport};
+use pinfeed::validate::input::{self, check_members, load_measured};
+use pinfeed::validate::measured::Measured;
+use pinfeed::validate::score::ScoreSettings;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -25,8 +25,8 @@ pub struct ModelArgs {
     #[arg(long, value_name = "PART", allow_hyphen_values = true)]
     pub part: Option<String>,
     /// Fidelity: exact, ellipsoid or tip.
-    #[arg(long, default_value = "exact", value_parser = crate::contact_case::parse_model)]
-    pub model: crate::mechanics::Fidelity,
+    #[arg(long, default_value = "exact", value_parser = pinfeed::contact_case::parse_model)]
+    pub model: pinfeed::mechanics::Fidelity,
     /// Integration tolerance.
     #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub tol: f64,
@@ -47,7 +47,7 @@ pub struct ModelArgs {
     pub window: f64,
     /// Containment: the least share of the predicted mass inside a measured band (for input
     /// `all`, of the mass within --window of it) for the band to count as contained.
-    #[arg(long, default_value_t = crate::validate::score::CONTAINED_SHARE, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = pinfeed::validate::score::CONTAINED_SHARE, allow_hyphen_values = true)]
     pub contained_share: f64,
     /// Print the report as JSON.
     #[arg(long)]
@@ -69,10 +69,10 @@ pub struct ModelArgs {
 impl ModelArgs {
     /// The score settings and the model's, checked.
     pub fn score(&self) -> Result<ScoreSettings> {
-        let (lo, hi) = crate::mechanics::limits::TOL;
+        let (lo, hi) = pinfeed::mechanics::limits::TOL;
         in_range("--tol", self.tol, lo, hi, "per step")?;
         in_range("--passes", self.passes as f64, 1.0, 100.0, "passes")?;
-        let max = crate::maps::limits::MAX_THREADS as f64;
+        let max = pinfeed::maps::limits::MAX_THREADS as f64;
         in_range(
             "--threads",
             self.threads as f64,
@@ -94,7 +94,7 @@ impl ModelArgs {
                 .file_stem()
                 .and_then(|s| s.to_str())
                 .unwrap_or("measured");
-            crate::default_out(&[command, &super::part_folder(stem)])
+            pinfeed::default_out(&[command, &super::part_folder(stem)])
         })
     }
 }
@@ -115,7 +115,7 @@ pub struct ValidateArgs {
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub pin_radius: f64,
     /// Members of the ensemble.
-    #[arg(long, default_value_t = crate::validate::DEFAULT_MEMBERS)]
+    #[arg(long, default_value_t = pinfeed::validate::DEFAULT_MEMBERS)]
     pub members: usize,
     #[command(flatten)]
     pub common: ModelArgs,
@@ -154,7 +154,7 @@ pub fn emit<T: Serialize>(
     write: impl FnOnce(&Path) -> Result<()>,
 ) -> Result<()> {
     if c.json {
-        print!("{}", crate::report::versioned::pretty(report)?);
+        print!("{}", pinfeed::report::versioned::pretty(report)?);
     } else {
         print!("{text}");
     }
@@ -191,7 +191,7 @@ pub fn run(args: &ValidateArgs, recorded: &str) -> Result<()> {
     let (rows, summary, _) = pool(c.threads)?
         .install(|| {
             let draw = (c.seed, args.members, c.passes);
-            crate::validate::validate_observed(&measured, &spec, draw, &score, &tell)
+            pinfeed::validate::validate_observed(&measured, &spec, draw, &score, &tell)
         })
         .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();

@@ -1,25 +1,11 @@
 //! README.md and docs/*.md against the code: every relative link points at a file that exists
-//! (and, with `#anchor`, at a heading of it), and every `pinfeed …` command shown in a code block
-//! parses with the command line the binary uses (flags, values, subcommands), so a renamed or
-//! removed option cannot leave the guide behind.
+//! (and, with `#anchor`, at a heading of it), the command lines are read as a shell reads them,
+//! and the range tables quote the library's. (That every documented `pinfeed …` command parses,
+//! and that the units table matches `--help`, is tested beside the command line, in
+//! `src/cli/tests/`.)
 
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// README.md and every Markdown file in docs/.
-fn documents() -> Vec<PathBuf> {
-    let mut docs: Vec<PathBuf> = std::fs::read_dir(root().join("docs"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "md"))
-        .collect();
-    docs.sort();
-    docs.insert(0, root().join("README.md"));
-    docs
-}
+use crate::doc_commands::{commands, documents, root, shell_words};
+use std::path::Path;
 
 /// GitHub's anchor of a heading: lower case, punctuation dropped, spaces to hyphens.
 fn anchor(heading: &str) -> String {
@@ -79,120 +65,6 @@ fn relative_links_resolve() {
 
 /// Split a shell command line into words: single and double quotes, backslash escapes; a `#`
 /// starting a word begins a comment.
-pub(crate) fn shell_words(line: &str) -> Vec<String> {
-    let mut words = Vec::new();
-    let mut word = String::new();
-    let mut in_word = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match c {
-            '\'' => {
-                in_word = true;
-                for d in chars.by_ref() {
-                    if d == '\'' {
-                        break;
-                    }
-                    word.push(d);
-                }
-            }
-            '"' => {
-                in_word = true;
-                while let Some(d) = chars.next() {
-                    match d {
-                        '"' => break,
-                        '\\' => word.extend(chars.next()),
-                        _ => word.push(d),
-                    }
-                }
-            }
-            '\\' => {
-                in_word = true;
-                word.extend(chars.next());
-            }
-            '#' if !in_word => break,
-            c if c.is_whitespace() => {
-                if in_word {
-                    words.push(std::mem::take(&mut word));
-                    in_word = false;
-                }
-            }
-            c => {
-                in_word = true;
-                word.push(c);
-            }
-        }
-    }
-    if in_word {
-        words.push(word);
-    }
-    words
-}
-
-/// The `pinfeed` command lines in the code blocks of a document (fenced or indented), with
-/// `cargo run --release --` read as `pinfeed`, continuation lines joined. Lines using shell
-/// variables are skipped (they need a scheduler's environment).
-fn commands(text: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut fenced = false;
-    let mut pending: Option<String> = None;
-    for line in text.lines() {
-        if line.starts_with("```") {
-            fenced = !fenced;
-            continue;
-        }
-        let code = fenced || line.starts_with("    ");
-        if !code {
-            continue;
-        }
-        let l = line.trim();
-        let joined = match pending.take() {
-            Some(p) => format!("{p} {l}"),
-            None => match l
-                .strip_prefix("cargo run --release -- ")
-                .map(|r| format!("pinfeed {r}"))
-                .or_else(|| l.starts_with("pinfeed ").then(|| l.to_string()))
-            {
-                Some(c) => c,
-                None => continue,
-            },
-        };
-        if let Some(head) = joined.strip_suffix('\\') {
-            pending = Some(head.trim_end().to_string());
-        } else if !joined.contains('$') {
-            out.push(joined);
-        }
-    }
-    out
-}
-
-#[test]
-fn every_documented_command_parses() {
-    let mut seen = 0;
-    let mut bad = Vec::new();
-    for doc in documents() {
-        let text = std::fs::read_to_string(&doc).unwrap();
-        for cmd in commands(&text) {
-            // Output redirection and pipes are the shell's, not pinfeed's.
-            let cmd = cmd.split(['>', '|']).next().unwrap().to_string();
-            let words = shell_words(&cmd);
-            seen += 1;
-            if let Err(e) = pinfeed::cli::Cli::try_parse_from(&words) {
-                bad.push(format!(
-                    "{}: `{cmd}`: {}",
-                    doc.display(),
-                    e.to_string().lines().next().unwrap_or("")
-                ));
-            }
-        }
-    }
-    assert!(seen > 40, "only {seen} commands found");
-    assert!(
-        bad.is_empty(),
-        "commands that do not parse:\n{}",
-        bad.join("\n")
-    );
-}
-
 #[test]
 fn shell_words_and_commands_are_read_as_a_shell_would() {
     assert_eq!(
@@ -324,85 +196,5 @@ fn commands_quote_the_shared_range_table() {
             scenario::FENCE_LENGTH_OF_A
         ),
         (MU_C, TOL, FENCE_LENGTH_A)
-    );
-}
-
-/// The flags that take a length (or a ratio of lengths): each is in docs/commands.md's table of
-/// units with the unit its `--help` names, and no command has one the table leaves out.
-#[test]
-fn every_length_flag_names_its_unit_as_the_units_table_does() {
-    use clap::CommandFactory;
-    const LENGTH_FLAGS: [&str; 13] = [
-        "pin-radius",
-        "pin-radius-max",
-        "pin-radius-sd",
-        "lateral",
-        "belt-width",
-        "spacing",
-        "scale",
-        "d",
-        "pin-stop-after",
-        "pin-stop-at",
-        "pin-stop-after-touch",
-        "d-jitter",
-        "fence-overhang",
-    ];
-    const UNITS: [&str; 3] = ["part units", "metres", "units of a"];
-    let text = std::fs::read_to_string(root().join("docs/commands.md")).unwrap();
-    let section = text
-        .split("## Units of length")
-        .nth(1)
-        .expect("docs/commands.md has a section on units")
-        .split("\n## ")
-        .next()
-        .unwrap();
-    // (command, flag) → unit, from the table's rows of plain flags.
-    let mut table = std::collections::BTreeMap::new();
-    for row in section.lines().filter(|l| l.starts_with("| `")) {
-        let cells: Vec<&str> = row.trim_matches('|').split(" | ").map(str::trim).collect();
-        let unit = UNITS
-            .iter()
-            .find(|u| cells[2].to_lowercase().starts_with(*u))
-            .unwrap_or_else(|| panic!("no unit in {row}"));
-        let ticked = |cell: &str| -> Vec<String> {
-            cell.split('`')
-                .skip(1)
-                .step_by(2)
-                .map(str::to_string)
-                .collect()
-        };
-        for flag in ticked(cells[0]).iter().filter(|f| !f.contains(' ')) {
-            for cmd in ticked(cells[1]) {
-                table.insert((cmd, flag.trim_start_matches("--").to_string()), *unit);
-            }
-        }
-    }
-    let mut seen = 0;
-    let cli = pinfeed::cli::Cli::command();
-    for sub in cli.get_subcommands() {
-        for arg in sub.get_arguments() {
-            let Some(long) = arg.get_long() else { continue };
-            if !LENGTH_FLAGS.contains(&long) {
-                continue;
-            }
-            seen += 1;
-            let key = (sub.get_name().to_string(), long.to_string());
-            let unit = table
-                .get(&key)
-                .unwrap_or_else(|| panic!("{key:?} is not in docs/commands.md's table of units"));
-            let help = arg
-                .get_help()
-                .map(|h| h.to_string().to_lowercase())
-                .unwrap_or_default();
-            assert!(
-                help.contains(unit),
-                "{key:?}: the table says {unit}, --help says: {help}"
-            );
-        }
-    }
-    assert_eq!(
-        seen,
-        table.len(),
-        "rows of the table that no command has: {table:?}"
     );
 }

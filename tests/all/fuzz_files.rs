@@ -167,46 +167,6 @@ fn fuzz_driver_is_deterministic_across_threads() {
     }
 }
 
-/// The targets of the new surface run clean and their counts do not depend on the thread count:
-/// pairs of sensing/actuator/controller/policy keys, measured-band CSVs with validate and
-/// calibrate arguments, edited merge shards, and contacts with moving pins.
-#[test]
-fn new_surface_targets_run_clean_on_any_number_of_threads() {
-    let corpus = Arc::new(pinfeed::cli::fuzz::corpus(root()).unwrap());
-    let opts = |threads| options(11, threads);
-    for (target, n) in [
-        (Target::Pairs, 24),
-        (Target::Csvs, 80),
-        (Target::Merges, 80),
-        (Target::Contacts, 200),
-    ] {
-        let mut one = robustness::run_target(target, n, &corpus, &opts(1), &|_| {});
-        let mut two = robustness::run_target(target, n, &corpus, &opts(2), &|_| {});
-        one.seconds = 0.0;
-        two.seconds = 0.0;
-        assert_eq!(one, two, "{}", target.name());
-        assert_eq!(one.generated, n);
-        assert!(
-            one.problems.is_empty(),
-            "{}: {:?}",
-            target.name(),
-            one.problems
-        );
-        // Each target reaches its work, not only the parsers.
-        assert!(one.count(Class::Success) > 0, "{}: {one:?}", target.name());
-    }
-    // Half the contacts move, in each of the three ways.
-    let contacts = robustness::run_target(Target::Contacts, 200, &corpus, &opts(1), &|_| {});
-    let moving: u64 = contacts
-        .kinds
-        .iter()
-        .filter(|(k, _)| k.starts_with("moving pin"))
-        .map(|(_, c)| c.values().sum::<u64>())
-        .sum();
-    assert!((60..=140).contains(&moving), "{:?}", contacts.kinds);
-    assert_eq!(contacts.kinds.len(), 4, "{:?}", contacts.kinds);
-}
-
 /// Edited shards: an untouched set merges; every edit of a shard's content is refused.
 #[test]
 fn merge_tampering_is_refused_and_an_untouched_set_merges() {
@@ -248,39 +208,5 @@ fn merge_tampering_is_refused_and_an_untouched_set_merges() {
             r.detail
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// `pinfeed plan` arguments for a test: part, time limit, check parts, then `extra`.
-fn plan_args(part: &str, time: &str, check: &str, extra: &[&str]) -> Vec<String> {
-    let mut a = pinfeed::study::robustness::commands::base_arguments(part, time, check, "50");
-    a.extend(extra.iter().map(|s| s.to_string()));
-    a
-}
-
-/// A plan argument set runs through the command's checks and the design, and the scenario the
-/// design would write is accepted and runs; a refused argument names its flag.
-#[test]
-fn plan_argument_sets_design_and_their_written_scenario_runs() {
-    use pinfeed::cli::fuzz::plans;
-    let dir = std::env::temp_dir().join(format!("pinfeed-plan-fuzz-{}", std::process::id()));
-    let args = |extra: &[&str]| plan_args("tripoly1", "1", "50", extra);
-    let r = plans::run(&args(&[]), &dir.join("a"));
-    assert_eq!(r.class, Class::Success, "{}", r.detail);
-    let r = plans::run(&args(&["--jitter-samples=2001"]), &dir.join("b"));
-    assert_eq!(r.class, Class::Named, "{}", r.detail);
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// `plan --fewest-sets --check-parts 0` for a square wrote a belt 0.02 m wide for a part with
-/// 2a = 0.028 m fed within ±2 mm, which the scenario parser refuses: the written width is now at
-/// least 2(a + lateral).
-#[test]
-fn a_planned_scenario_has_a_belt_at_least_as_wide_as_the_part() {
-    use pinfeed::cli::fuzz::plans;
-    let dir = std::env::temp_dir().join(format!("pinfeed-plan-width-{}", std::process::id()));
-    let args = plan_args("square", "0.2", "0", &["--fewest-sets"]);
-    let r = plans::run(&args, &dir);
-    assert_eq!(r.class, Class::Success, "{}", r.detail);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,7 +1,9 @@
 //! pinfeed's integration tests, built as one test binary (`cargo test --release --test all`): one
 //! module per area, and the shared helpers (`support`: running the built `pinfeed`; `common`: the
-//! contact-model helpers; `plan_cli`: the `pinfeed plan` helpers; `shapes`: random polygons;
-//! `reference`: the independent slow contact reference). One binary links the crate once instead
+//! contact-model helpers; `plan_cli`: the `pinfeed plan` helpers; `reference`: the independent slow contact
+//! reference; and from `tests/shared/`, which the command line's own tests in `src/cli/tests/`
+//! include too: `shapes`, random polygons; `argv`, argument-vector strategies; `doc_commands`,
+//! the documents' command lines). One binary links the crate once instead
 //! of once per file. A single test is selected by its module path, e.g.
 //! `cargo test --release --test all slow_reference::many_cases -- --ignored`.
 //!
@@ -16,9 +18,15 @@
 mod common;
 mod plan_cli;
 mod reference;
-mod shapes;
 mod support;
 mod xml;
+// Shared with the command line's own tests (src/cli/tests/), which include the same files.
+#[path = "../shared/argv.rs"]
+mod argv;
+#[path = "../shared/doc_commands.rs"]
+mod doc_commands;
+#[path = "../shared/shapes.rs"]
+mod shapes;
 
 mod accuracy_study;
 mod animate;

@@ -77,7 +77,7 @@ fn step(cmd: &str) -> Option<Step> {
         !cmd.contains(['>', '|', '$']),
         "README command the test cannot follow: {cmd}"
     );
-    let words = crate::docs::shell_words(cmd);
+    let words = crate::doc_commands::shell_words(cmd);
     let w: Vec<&str> = words.iter().map(String::as_str).collect();
     match w.as_slice() {
         ["mkdir", dir] => Some(Step::Mkdir(dir.to_string())),

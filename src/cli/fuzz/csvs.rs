@@ -1,5 +1,5 @@
 //! The csvs fuzz target: measured-band CSV files
-//! ([`crate::study::robustness::measured_csv`]: seed rows with mutations) and a random set of the
+//! ([`pinfeed::study::robustness::measured_csv`]: seed rows with mutations) and a random set of the
 //! flags of `pinfeed validate` and `pinfeed calibrate` (friction, pin radius, `--uncertain`,
 //! `--part`, the score's settings, the members). Three cases in four validate with at most 5
 //! members, one in four calibrates with 10 members over the full grid. The file is read from disk
@@ -7,10 +7,10 @@
 
 use crate::cli::calibrate::CalibrateArgs;
 use crate::cli::validate::ValidateArgs;
-use crate::study::robustness::commands::CsvCase;
-use crate::study::robustness::{refused, shows_non_finite, CaseReport, Class, CommandCases};
-use crate::validate::input::load_measured;
 use clap::Parser;
+use pinfeed::study::robustness::commands::CsvCase;
+use pinfeed::study::robustness::{refused, shows_non_finite, CaseReport, Class, CommandCases};
+use pinfeed::validate::input::load_measured;
 use std::path::Path;
 
 /// The cases of the csvs target, for the fuzzing driver: a case runs with its file written into
@@ -73,7 +73,8 @@ fn run_validate(c: &CsvCase, path: &Path) -> CaseReport {
         Ok(x) => x,
         Err(e) => return refused(&format!("{e:#}")),
     };
-    match crate::validate::validate(&m, &spec, a.common.seed, a.members, a.common.passes, &score) {
+    match pinfeed::validate::validate(&m, &spec, a.common.seed, a.members, a.common.passes, &score)
+    {
         Err(e) => refused(&e.to_string()),
         Ok((rows, summary, _)) => {
             if shows_non_finite(&format!("{rows:?} {summary:?}")) {
@@ -99,13 +100,13 @@ fn run_calibrate(c: &CsvCase, path: &Path) -> CaseReport {
         Ok(x) => x,
         Err(e) => return refused(&format!("{e:#}")),
     };
-    let cal = match crate::validate::calibrate::calibrate(&m, &s) {
+    let cal = match pinfeed::validate::calibrate::calibrate(&m, &s) {
         Ok(cal) => cal,
         Err(e) => return refused(&e.to_string()),
     };
     let fitted = s.spec_at(cal.estimate());
     let scored =
-        crate::validate::validate(&m, &fitted, s.seed, a.score_members, s.passes, &s.score);
+        pinfeed::validate::validate(&m, &fitted, s.seed, a.score_members, s.passes, &s.score);
     match scored {
         Err(e) => refused(&e.to_string()),
         Ok((rows, summary, _)) => {

@@ -1,5 +1,5 @@
 //! `pinfeed fuzz TARGET`: the long-running fuzzing driver (docs/commands.md#fuzzing-and-robustness-pinfeed-fuzz;
-//! [`crate::study::robustness`]). It generates and mutates scenario and study files, random
+//! [`pinfeed::study::robustness`]). It generates and mutates scenario and study files, random
 //! contacts and random polygons, runs each case in-process under `catch_unwind` with a per-case
 //! time budget, and writes the counts to a Markdown report (default pinfeed-out/robustness.md; the committed report: --report results/robustness.md) headed
 //! by the command that regenerates it. `--case N` re-runs one case and prints its input.
@@ -12,11 +12,11 @@
 pub mod csvs;
 pub mod plans;
 
-use crate::study::robustness::counts::MAX_CASES;
-use crate::study::robustness::files::SeedsError;
-use crate::study::robustness::{self, Class, Corpus, Options, Target};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
+use pinfeed::study::robustness::counts::MAX_CASES;
+use pinfeed::study::robustness::files::SeedsError;
+use pinfeed::study::robustness::{self, Class, Corpus, Options, Target};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
@@ -166,7 +166,7 @@ pub fn run(args: &FuzzArgs, recorded: &str) -> Result<()> {
     if let Some(dir) = args.report.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    crate::output::write_atomic(&args.report, &text)
+    pinfeed::output::write_atomic(&args.report, &text)
         .with_context(|| format!("writing {}", args.report.display()))?;
     print!("{text}");
     Ok(())

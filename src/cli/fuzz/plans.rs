@@ -1,16 +1,18 @@
 //! Running the plans target's cases, `pinfeed plan` argument sets: a part and a short time limit (≤ 1 s), small line checks, one
 //! thread and no files, plus 0–4 more flags from
-//! [`crate::study::robustness::commands::PLAN_FLAGS`] with values inside, at the ends of
+//! [`pinfeed::study::robustness::commands::PLAN_FLAGS`] with values inside, at the ends of
 //! and beyond their ranges. The arguments go through the command's own parser and checks
-//! ([`crate::cli::plan::options_of`]) and the design workflow ([`crate::plan::design::design`]);
+//! ([`crate::cli::plan::options_of`]) and the design workflow ([`pinfeed::plan::design::design`]);
 //! an accepted design's numbers must be finite and the scenario it would write (with its policy
 //! file) must be accepted by the scenario parser and run ([`files::check_scenario`]) — a
 //! written plan the parser refuses counts as a self-check disagreement.
 
 use crate::cli::plan::PlanArgs;
-use crate::study::robustness::commands::{plan_arguments, plan_command};
-use crate::study::robustness::{files, refused, shows_non_finite, CaseReport, Class, CommandCases};
 use clap::Parser;
+use pinfeed::study::robustness::commands::{plan_arguments, plan_command};
+use pinfeed::study::robustness::{
+    files, refused, shows_non_finite, CaseReport, Class, CommandCases,
+};
 use std::path::Path;
 
 /// The cases of the plans target, for the fuzzing driver.
@@ -45,7 +47,7 @@ fn run_unlabelled(args: &[String], scratch: &Path) -> CaseReport {
         Ok(o) => o,
         Err(e) => return refused(&format!("{e:#}")),
     };
-    let d = match crate::plan::design::design(&o, &|_| {}) {
+    let d = match pinfeed::plan::design::design(&o, &|_| {}) {
         Ok(d) => d,
         Err(e) => return refused(&e.to_string()),
     };
