@@ -15,7 +15,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use pinfeed::report::sense::{text_summary, write_report};
-use pinfeed::sensing::experiment::{self, Request, SenseError};
+use pinfeed::sensing::experiment::{self, Request, SenseError, Setting};
 use pinfeed::sensing::placement;
 use pinfeed::sensing::SensorSettings;
 use std::path::PathBuf;
@@ -219,10 +219,23 @@ pub fn request(a: &SenseArgs) -> Request {
     }
 }
 
+/// The flag of `pinfeed sense` that sets `setting`.
+fn flag_of(setting: Setting) -> String {
+    match setting {
+        Setting::SensorKind => "--sensor".into(),
+        s => format!("--{}", s.field().replace('_', "-")),
+    }
+}
+
+/// A refused request, its message naming the flags.
+fn flagged(e: SenseError) -> anyhow::Error {
+    anyhow::anyhow!(e.describe(flag_of))
+}
+
 /// Run `pinfeed sense`; `recorded` is the command line its report records.
 pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
     let req = request(a);
-    let p = experiment::check(&req)?;
+    let p = experiment::check(&req).map_err(flagged)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.threads)
         .build()
@@ -230,7 +243,7 @@ pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
     let started = std::time::Instant::now();
     let bar = super::progress::bar(a.trials as u64, "trials", a.quiet || a.json);
     let tell = super::progress::counter(&bar);
-    let sweep = pool.install(|| p.evaluate(&req, &tell))?;
+    let sweep = pool.install(|| p.evaluate(&req, &tell)).map_err(flagged)?;
     bar.finish_and_clear();
     let elapsed = started.elapsed().as_secs_f64();
     eprintln!(
@@ -241,7 +254,7 @@ pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
         pool.current_num_threads(),
         a.trials as f64 / elapsed
     );
-    let evaluated = sweep.policy(&p)?;
+    let evaluated = sweep.policy(&p).map_err(flagged)?;
     for s in &evaluated.skipped {
         eprintln!("warning: classifier {} skipped: {}", s.classifier, s.reason);
     }
@@ -252,7 +265,7 @@ pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
         );
     }
     if evaluated.classifiers.is_empty() {
-        return Err(SenseError::NoClassifier.into());
+        return Err(flagged(SenseError::NoClassifier));
     }
     if p.point_pin_misses_vertices(&evaluated.evaluation) {
         eprintln!("note: a point pin (--pin-radius 0) first meets the part on an edge almost always; give the pin a radius for vertex contacts");
@@ -276,7 +289,9 @@ pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
             });
             bar.inc(1);
         };
-        let pl = pool.install(|| p.place(&req, &mut progress))?;
+        let pl = pool
+            .install(|| p.place(&req, &mut progress))
+            .map_err(flagged)?;
         bar.finish_and_clear();
         eprintln!(
             "placement: {} offsets × 2 sensor kinds in {:.2} s",

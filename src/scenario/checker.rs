@@ -1,7 +1,7 @@
 //! The checks every scenario section makes: a number finite and within its allowed range
 //! ([`super::limits`]), and an error located at the key at fault (through [`Locator`]).
 
-use super::error::{Locator, ScenarioError};
+use super::error::{KeyLocation, Locator, ScenarioError};
 use super::limits;
 use super::location::KeyPath;
 
@@ -21,6 +21,10 @@ impl<'a, 'b> Checker<'a, 'b> {
     /// An error at key path `path` (e.g. `belt.speed`, `obstacles[1].x`).
     pub(super) fn err(&self, path: &str, msg: impl Into<String>) -> ScenarioError {
         self.loc.at_key(&KeyPath::parse(path), msg)
+    }
+    /// Where key path `path` is written, to locate an error found after reading the file.
+    pub(super) fn locate(&self, path: &str) -> KeyLocation {
+        KeyLocation::of(self.err(path, "")).expect("a checker's errors are located")
     }
     /// `v`, if it is a finite number.
     pub(super) fn finite(&self, path: &str, v: f64) -> R<f64> {

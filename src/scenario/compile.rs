@@ -1,4 +1,4 @@
-//! Validation and compilation: [`RawScenario`] → [`Scene`]. Every check names the key and the
+//! Validation and compilation: [`RawScenario`] → [`SceneDraft`]. Every check names the key and the
 //! allowed range (docs/physics.md#frames units: m, s, degrees in the file; radians inside).
 //!
 //! Geometry rules that keep a run well defined:
@@ -9,9 +9,10 @@
 //!
 //! [`compile`] composes one function per section (`compile_belt`, `compile_part`,
 //! `compile_feed`, `compile_goal`, `compile_model`, `compile_effects`, `compile_output`), each
-//! returning its piece of the [`Scene`].
+//! returning its piece of the [`Scene`] the draft builds.
 
 use super::checker::Checker;
+use super::draft::SceneDraft;
 use super::error::{Locator, ScenarioError};
 use super::limits;
 use super::raw::*;
@@ -22,19 +23,20 @@ use crate::mechanics::{ContactSettings, PartModel, Support};
 
 type R<T> = Result<T, ScenarioError>;
 
-/// Compile a parsed scenario. `default_name` names the scene when the file does not.
+/// Compile a parsed scenario into a [`SceneDraft`]: everything checked, the sensor pins not yet
+/// trained. `default_name` names the scene when the file does not.
 ///
 /// The sections are checked in file order (name, belt, part, feed, obstacles, goal, model,
-/// effects, output, controller), so the first error reported is the same whatever else is wrong; sensor pins
-/// are trained last, on the compiled scene.
-pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene> {
+/// effects, output, the sensors' hypotheses, controller), so the first error reported is the same
+/// whatever else is wrong.
+pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<SceneDraft> {
     let c = Checker::new(loc);
     let name = scene_name(&c, raw.name.as_deref(), default_name)?;
     let seed = raw.seed.unwrap_or(1);
     let belt = compile_belt(&c, raw.belt.as_ref())?;
     let mut part = compile_part(&c, raw.part.as_ref())?;
     let feed = compile_feed(&c, raw.feed.as_ref(), &belt, &part)?;
-    let (mut obstacles, neighbours, sensor_drafts) =
+    let (obstacles, neighbours, valid_sensors) =
         super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, part.radius, part.mu_c)?;
     part.model = part.model.with_slide_tables(&pin_mu_values(&obstacles));
     let goal = compile_goal(&c, raw.goal.as_ref())?;
@@ -42,24 +44,21 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
     let map_tier = compile_map_tier(&c, &raw.model)?;
     let effects = compile_effects(&raw.effects);
     let output = compile_output(&c, &raw.output)?;
-    // Sensor pins: train each sensor's classifier on templates of this scene.
-    for (i, draft) in &sensor_drafts {
+    // Sensor pins: their hypotheses, resolved against the part and the feed.
+    let mut sensors = Vec::new();
+    for (i, valid) in &valid_sensors {
         if let Obstacle::Pin(pin) = &obstacles[*i] {
-            let trained = super::sensors::train(
-                &c, *i, draft, pin, &part, &feed, belt.speed, &contact, seed,
-            )?;
-            if let Obstacle::Pin(pin) = &mut obstacles[*i] {
-                pin.sensor = Some(std::sync::Arc::new(trained));
-            }
+            sensors.push(super::sensors::draft(&c, *i, valid, pin, &part, &feed)?);
         }
     }
-    // [controller] and [[rules]]: after training, so that rules can name the sensors' labels.
+    // [controller] and [[rules]]: after the sensors, so that rules can name their labels.
     let controller = super::dynamic_check::controller(
         &c,
         loc,
         raw.controller.as_ref(),
         &raw.rules,
         &obstacles,
+        &sensors,
         &part.label,
     )?;
     let mut scene = Scene {
@@ -78,7 +77,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<Scene>
         map_tier,
     };
     locate_belief(&c, raw, &mut scene);
-    Ok(scene)
+    Ok(SceneDraft::new(scene, sensors))
 }
 
 /// `[controller] mode = "online"`: where the belief is declared (or the mode, when the belief is

@@ -19,6 +19,7 @@ use super::error::Locator;
 use super::limits;
 use super::raw::{ObstacleKind, RawController, RawObstacle, RawPolicy, RawRule};
 use super::scene::{Belt, Obstacle};
+use super::sensors::SensorDraft;
 use super::ScenarioError;
 use std::path::Path;
 
@@ -122,12 +123,14 @@ pub(super) fn actuator(
 }
 
 /// The scene's controller from `[controller]`, `[[rules]]` and the policy file, if any.
+/// `sensors` are the scene's sensor pins, untrained: rules name their hypotheses' labels.
 pub(super) fn controller(
     c: &Checker,
     loc: &Locator,
     raw: Option<&RawController>,
     rules: &[RawRule],
     obstacles: &[Obstacle],
+    sensors: &[SensorDraft],
     part_label: &str,
 ) -> R<Option<Controller>> {
     let dynamic = obstacles
@@ -166,13 +169,13 @@ pub(super) fn controller(
             ))
         }
     };
-    let mode = control_mode(c, &rc, obstacles)?;
-    let mut compiled = compile_rules(c, "rules", rules, obstacles, on_late)?;
+    let mode = control_mode(c, &rc, obstacles, sensors)?;
+    let mut compiled = compile_rules(c, "rules", rules, obstacles, sensors, on_late)?;
     check_conflicts(c, &compiled, 0)?;
     let mut source = "scenario".to_string();
     if let Some(file) = &rc.policy {
         let path = loc.file.parent().unwrap_or(Path::new(".")).join(file);
-        compiled = policy(c, &path, compiled, obstacles, part_label, on_late)?;
+        compiled = policy(c, &path, compiled, obstacles, sensors, part_label, on_late)?;
         source = path.display().to_string();
     }
     Ok(Some(Controller {
@@ -187,7 +190,12 @@ pub(super) fn controller(
 }
 
 /// `[controller] mode` and `[controller.belief]`.
-fn control_mode(c: &Checker, rc: &RawController, obstacles: &[Obstacle]) -> R<ControlMode> {
+fn control_mode(
+    c: &Checker,
+    rc: &RawController,
+    obstacles: &[Obstacle],
+    sensors: &[SensorDraft],
+) -> R<ControlMode> {
     match rc.mode.as_deref() {
         None | Some("policy") => {
             if rc.belief.is_some() {
@@ -239,10 +247,7 @@ fn control_mode(c: &Checker, rc: &RawController, obstacles: &[Obstacle]) -> R<Co
                 .filter(|o| matches!(o, Obstacle::Pin(p) if p.actuator.is_some()))
                 .map(|o| o.x_range()[0])
                 .fold(f64::INFINITY, f64::min);
-            let sensors: Vec<&Obstacle> = obstacles
-                .iter()
-                .filter(|o| matches!(o, Obstacle::Pin(p) if p.sensor.is_some()))
-                .collect();
+            let sensors: Vec<&Obstacle> = sensors.iter().map(|s| &obstacles[s.obstacle]).collect();
             if sensors.is_empty() {
                 return Err(c.err(
                     "controller.mode",
@@ -280,6 +285,7 @@ fn policy(
     path: &Path,
     mut compiled: Vec<(String, Rule)>,
     obstacles: &[Obstacle],
+    sensors: &[SensorDraft],
     part_label: &str,
     on_late: OnLate,
 ) -> R<Vec<(String, Rule)>> {
@@ -306,7 +312,9 @@ fn policy(
         ));
     }
     let from = compiled.len();
-    compiled.extend(compile_rules(&pc, "rules", &raw.rules, obstacles, on_late)?);
+    compiled.extend(compile_rules(
+        &pc, "rules", &raw.rules, obstacles, sensors, on_late,
+    )?);
     check_conflicts(&pc, &compiled, from)?;
     Ok(compiled)
 }
@@ -316,6 +324,7 @@ fn compile_rules(
     section: &str,
     rules: &[RawRule],
     obstacles: &[Obstacle],
+    sensor_drafts: &[SensorDraft],
     on_late: OnLate,
 ) -> R<Vec<(String, Rule)>> {
     let find = |name: &str| {
@@ -330,12 +339,9 @@ fn compile_rules(
     let mut out = Vec::new();
     for (k, r) in rules.iter().enumerate() {
         let path = |key: &str| format!("{section}[{k}].{key}");
-        let sensors: Vec<&str> = obstacles
-            .iter()
-            .filter(|o| matches!(o, Obstacle::Pin(p) if p.sensor.is_some()))
-            .map(|o| o.name())
-            .collect();
-        let Some((sj, sp)) = find(&r.sensor).filter(|(_, p)| p.sensor.is_some()) else {
+        let sensors: Vec<&str> = sensor_drafts.iter().map(|s| s.name.as_str()).collect();
+        let sensor_of = |j: usize| sensor_drafts.iter().find(|s| s.obstacle == j);
+        let Some((sj, sensor)) = find(&r.sensor).and_then(|(j, _)| Some((j, sensor_of(j)?))) else {
             return Err(c.err(
                 &path("sensor"),
                 format!(
@@ -345,18 +351,18 @@ fn compile_rules(
                 ),
             ));
         };
-        let sensor = sp.sensor.as_ref().expect("filtered");
+        let labels = sensor.hypotheses.labels();
         let decides = if r.decides == "unknown" {
             None
         } else {
-            let Some(h) = sensor.labels.iter().position(|l| *l == r.decides) else {
+            let Some(h) = labels.iter().position(|l| *l == r.decides) else {
                 return Err(c.err(
                     &path("decides"),
                     format!(
                         "\"{}\" is not a hypothesis of sensor \"{}\" (its hypotheses: {}, or \"unknown\")",
                         r.decides,
                         r.sensor,
-                        list(&sensor.labels.iter().map(String::as_str).collect::<Vec<_>>())
+                        list(&labels.iter().map(String::as_str).collect::<Vec<_>>())
                     ),
                 ));
             };

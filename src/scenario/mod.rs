@@ -3,10 +3,25 @@
 //! validated with errors that name file, line, column, key and the allowed values, and compiled
 //! into an immutable [`Scene`] (docs/physics.md#frames, #the-line).
 //!
+//! Loading a scenario takes two steps:
+//!
+//! 1. **reading** the file ([`SceneDraft::read`], or [`SceneDraft::parse`] for text): parse,
+//!    validate and compile every section into a [`SceneDraft`]. Every error about the file
+//!    itself comes from this step, including the sensors' hypotheses and the rules that name
+//!    their labels; nothing is simulated;
+//! 2. **building** the scene ([`SceneDraft::build`]): train each sensor pin's classifier on
+//!    templates simulated for the scene. Its errors are located at the sensor's keys too.
+//!
+//! [`load`] (a path) and [`parse`] (text) do both and return the [`Scene`]: what a caller that
+//! runs the scene wants. A caller that only checks a file, or reports on it, stops at the draft
+//! and trains nothing.
+//!
 //! * [`raw`]: serde structs mirroring the file;
-//! * [`compile`]: checks and conversion to [`Scene`], one function per section;
+//! * [`compile`]: checks and conversion to a [`SceneDraft`], one function per section;
+//! * [`draft`]: the checked, untrained scenario and the build step;
 //! * [`checker`]: range checks and located errors, shared by every section;
 //! * [`obstacles`]: pins and fences, their checks and neighbour lists;
+//! * [`sensors`]: a sensor pin's settings and hypotheses, and its training;
 //! * [`scene`]: the compiled types the engine reads;
 //! * [`limits`]: the physically meaningful range of every number;
 //! * [`location`], [`error`]: spans → line/column and key paths, and the located error;
@@ -14,6 +29,7 @@
 
 pub mod checker;
 pub mod compile;
+pub mod draft;
 pub mod dynamic;
 pub mod dynamic_check;
 pub mod error;
@@ -25,28 +41,26 @@ pub mod scene;
 pub mod sensors;
 pub mod shared_feed;
 
+pub use draft::SceneDraft;
 pub use dynamic::{
     Actuator, BeliefSpec, ControlMode, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target,
 };
 pub use error::{InvalidScenario, KeyLocation, ScenarioError};
 pub use scene::*;
+pub use sensors::SensorDraft;
 pub use shared_feed::{FeedMismatch, FeedSource};
 
 use std::path::Path;
 
-/// Parse and compile scenario text; `file` is only used in messages and for the default name.
+/// Parse, check and build scenario text: [`SceneDraft::parse`] then [`SceneDraft::build`], which
+/// trains the sensor pins. `file` names the file in messages, gives the scene's default name and
+/// the folder a policy file is read from.
 pub fn parse(file: &Path, source: &str) -> Result<Scene, ScenarioError> {
-    let loc = error::Locator::new(file, source);
-    let raw: raw::RawScenario = toml::from_str(source).map_err(|e| loc.from_toml(&e))?;
-    let default_name = file
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("scenario")
-        .to_string();
-    compile::compile(&raw, &loc, &default_name)
+    SceneDraft::parse(file, source)?.build()
 }
 
-/// Read, parse and compile a scenario file.
+/// Read, parse, check and build a scenario file: [`SceneDraft::read`] then
+/// [`SceneDraft::build`], which trains the sensor pins.
 ///
 /// ```
 /// use std::path::Path;
@@ -58,11 +72,7 @@ pub fn parse(file: &Path, source: &str) -> Result<Scene, ScenarioError> {
 /// assert_eq!(scene.part.stable_states.len(), 3);
 /// ```
 pub fn load(path: &Path) -> Result<Scene, ScenarioError> {
-    let source = crate::input::read_text(path).map_err(|error| ScenarioError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
-    parse(path, &source)
+    SceneDraft::read(path)?.build()
 }
 
 #[cfg(test)]
@@ -213,5 +223,36 @@ any = true
         let e = err(&src);
         assert_eq!(e.key, "part");
         assert!(e.message.contains("missing section [part]"));
+    }
+
+    /// Sensors trained on this thread while `f` runs.
+    fn trainings<T>(f: impl FnOnce() -> T) -> (T, usize) {
+        let before = sensors::TRAINED.with(|n| n.get());
+        let out = f();
+        (out, sensors::TRAINED.with(|n| n.get()) - before)
+    }
+
+    #[test]
+    fn a_refused_sensor_scene_trains_nothing() {
+        let path = Path::new("scenarios/tripoly1_sensing.toml");
+        let text = include_str!("../../scenarios/tripoly1_sensing.toml");
+        // The rules name the probe's labels: a wrong one is refused without training the probe.
+        let bad = text.replacen("decides = \"0°\"", "decides = \"90°\"", 1);
+        let (e, n) = trainings(|| parse(path, &bad).unwrap_err());
+        let e = e.invalid().expect("located error").clone();
+        assert_eq!(e.key, "rules[0].decides", "{e}");
+        assert!(e.message.contains("0°, 135°, 225°"), "{e}");
+        assert_eq!(n, 0, "a refused file trained {n} sensor(s)");
+        // So is an error in a section before the rules.
+        let bad = text.replacen("[output]", "[output]\nhistogram_bin = 7", 1);
+        let (e, n) = trainings(|| parse(path, &bad).unwrap_err());
+        assert_eq!(e.invalid().unwrap().key, "output.histogram_bin", "{e}");
+        assert_eq!(n, 0);
+        // Reading the good file trains nothing either; building it trains its one sensor.
+        let (draft, n) = trainings(|| SceneDraft::parse(path, text).unwrap());
+        assert_eq!((draft.sensors().len(), n), (1, 0));
+        let (scene, n) = trainings(|| draft.build().unwrap());
+        assert_eq!(n, 1);
+        assert_eq!(scene.name, draft.name());
     }
 }

@@ -28,13 +28,13 @@ use crate::geometry::Vec2;
 
 type R<T> = Result<T, ScenarioError>;
 
-/// The obstacles of a scene and, for each, its neighbours (ascending indices).
-/// Compiled obstacles, their neighbour lists, and the sensors still to be trained (obstacle index
-/// and validated settings: training needs the whole scene, see [`super::sensors::train`]).
+/// Compiled obstacles, their neighbour lists (ascending indices), and the sensor pins' own
+/// settings (obstacle index and validated settings: their hypotheses depend on the feed, see
+/// [`super::sensors::draft`]).
 pub(super) type Compiled = (
     Vec<Obstacle>,
     Vec<Vec<usize>>,
-    Vec<(usize, super::sensors::SensorDraft)>,
+    Vec<(usize, super::sensors::ValidSensor)>,
 );
 
 pub(super) fn compile_obstacles(

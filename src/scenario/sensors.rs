@@ -1,5 +1,7 @@
-//! `[obstacles.sensor]` of a `sensor_pin`: validation of the sensor's settings and hypotheses, and
-//! training of its classifier on simulated templates (docs/scenario-format.md#sensor-pins; docs/physics.md#sensing).
+//! `[obstacles.sensor]` of a `sensor_pin`: validation of the sensor's settings and hypotheses
+//! when the file is read (into a [`SensorDraft`]), and training of its classifier on simulated
+//! templates when the scene is built ([`super::SceneDraft::build`];
+//! docs/scenario-format.md#sensor-pins; docs/physics.md#sensing).
 //!
 //! The templates model what the sensor expects: the part reaching the pin as fed — orientation
 //! one of the hypotheses (with the feed's orientation jitter), lateral offset drawn from the
@@ -10,10 +12,12 @@
 //! scene's seed on streams of their own, so the same file always trains the same classifier.
 
 use super::checker::Checker;
+use super::error::KeyLocation;
 use super::raw::{RawHypotheses, RawSensor};
-use super::scene::{Feed, Lateral, Orientation, PartSpec, PinObstacle, SensorPin, SupportKind};
+use super::scene::{
+    Feed, Lateral, Obstacle, Orientation, PartSpec, PinObstacle, Scene, SensorPin, SupportKind,
+};
 use super::ScenarioError;
-use crate::mechanics::ContactSettings;
 use crate::random::distribution::Distribution;
 use crate::sensing::classify::{self, ClassifierOptions};
 use crate::sensing::templates::{build_templates, Hypotheses, PushSetup, Uncertainty};
@@ -25,9 +29,10 @@ type R<T> = Result<T, ScenarioError>;
 const DEFAULT_TEMPLATES: u64 = 32;
 const MAX_TEMPLATES: u64 = 1024;
 
-/// A sensor's validated settings, before training.
+/// A sensor's own settings, validated with its obstacle (its hypotheses are resolved against the
+/// part and the feed by [`draft`], once those are compiled).
 #[derive(Debug, Clone)]
-pub(super) struct SensorDraft {
+pub(super) struct ValidSensor {
     pub settings: SensorSettings,
     pub classifier: String,
     pub hypotheses: Option<Vec<f64>>,
@@ -36,8 +41,39 @@ pub(super) struct SensorDraft {
     pub reject_below: f64,
 }
 
+/// A sensor pin's settings and hypotheses, validated and still to be trained: what a
+/// [`super::SceneDraft`] holds for each sensor pin, and [`super::SceneDraft::build`] trains into
+/// the pin's [`SensorPin`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorDraft {
+    /// The sensor's pin: its index among the scene's obstacles.
+    pub obstacle: usize,
+    /// The sensor's pin: its name.
+    pub name: String,
+    /// Sample rate, noise, bias, filtering and quantisation of the sensor.
+    pub settings: SensorSettings,
+    /// Classifier name (one of [`crate::sensing::classify::NAMES`]).
+    pub classifier: String,
+    /// The states the classifier is to tell apart; their labels are the ones rules name.
+    pub hypotheses: Hypotheses,
+    /// Simulated templates per hypothesis to train on.
+    pub templates: usize,
+    /// Decide "unknown" below this posterior (in [0, 1]; 0 never rejects).
+    pub reject_below: f64,
+    /// Where training errors are located in the file.
+    at: TrainingKeys,
+}
+
+/// The keys a sensor's training errors name, located in the file when it was read.
+#[derive(Debug, Clone, PartialEq)]
+struct TrainingKeys {
+    sensor: KeyLocation,
+    hypotheses: KeyLocation,
+    classifier: KeyLocation,
+}
+
 /// Validates `[obstacles.<i>.sensor]`.
-pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<SensorDraft> {
+pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<ValidSensor> {
     let path = |k: &str| format!("obstacles[{i}].sensor.{k}");
     let d = SensorSettings::default();
     let kind = raw.kind.unwrap_or_default();
@@ -119,13 +155,57 @@ pub(super) fn validate(c: &Checker, i: usize, raw: &RawSensor) -> R<SensorDraft>
         1.0,
         "a posterior probability",
     )?;
-    Ok(SensorDraft {
+    Ok(ValidSensor {
         settings,
         classifier,
         hypotheses,
         vertex_edge,
         templates: templates as usize,
         reject_below,
+    })
+}
+
+/// Resolves the hypotheses of the sensor of `pin` (obstacle `i`) against the part and the feed,
+/// and locates the keys its training errors name: the sensor as [`super::SceneDraft`] holds it.
+pub(super) fn draft(
+    c: &Checker,
+    i: usize,
+    valid: &ValidSensor,
+    pin: &PinObstacle,
+    part: &PartSpec,
+    feed: &Feed,
+) -> R<SensorDraft> {
+    let key = |k: &str| format!("obstacles[{i}].sensor{k}");
+    let hypotheses = if valid.vertex_edge {
+        match &feed.orientation {
+            // Parts fed in their stable states meet the pin in those states.
+            Orientation::Stable {
+                thetas_rad: thetas, ..
+            } => Hypotheses::VertexEdge {
+                degrees: thetas.iter().map(|t| t.to_degrees()).collect(),
+            },
+            Orientation::Uniform => Hypotheses::vertex_edge_sweep(),
+        }
+    } else {
+        match &valid.hypotheses {
+            Some(degrees) => Hypotheses::orientations(degrees.clone()),
+            None => Hypotheses::stable_states(&part.polygon),
+        }
+        .map_err(|e| c.err(&key(".hypotheses"), e.to_string()))?
+    };
+    Ok(SensorDraft {
+        obstacle: i,
+        name: pin.name.clone(),
+        settings: valid.settings,
+        classifier: valid.classifier.clone(),
+        hypotheses,
+        templates: valid.templates,
+        reject_below: valid.reject_below,
+        at: TrainingKeys {
+            sensor: c.locate(&key("")),
+            hypotheses: c.locate(&key(".hypotheses")),
+            classifier: c.locate(&key(".classifier")),
+        },
     })
 }
 
@@ -138,19 +218,21 @@ fn lateral_moments(l: &Lateral) -> (f64, f64) {
     }
 }
 
-/// Trains the sensor of `pin` (obstacle `i`) for this scene.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn train(
-    c: &Checker,
-    i: usize,
-    draft: &SensorDraft,
-    pin: &PinObstacle,
-    part: &PartSpec,
-    feed: &Feed,
-    belt_speed: f64,
-    contact: &ContactSettings,
-    seed: u64,
-) -> R<SensorPin> {
+#[cfg(test)]
+thread_local! {
+    /// How many sensors [`train`] has trained on this thread: tests check that a refused file
+    /// trains none.
+    pub(super) static TRAINED: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+/// Trains the sensor `draft` for `scene` (whose obstacle `draft.obstacle` is the sensor's pin).
+pub(super) fn train(scene: &Scene, draft: &SensorDraft) -> R<SensorPin> {
+    #[cfg(test)]
+    TRAINED.with(|n| n.set(n.get() + 1));
+    let Obstacle::Pin(pin) = &scene.obstacles[draft.obstacle] else {
+        unreachable!("a sensor draft names a pin");
+    };
+    let (part, feed, contact) = (&scene.part, &scene.feed, &scene.contact);
     let a = part.radius;
     let (y_mean, y_sd) = lateral_moments(&feed.lateral);
     let template_d = (pin.centre.y - y_mean) / a;
@@ -161,26 +243,6 @@ pub(super) fn train(
         } => jitter.to_degrees(),
         Orientation::Uniform => 0.0,
     };
-    let at_hypotheses = |e: crate::sensing::templates::HypothesesError| {
-        c.err(&format!("obstacles[{i}].sensor.hypotheses"), e.to_string())
-    };
-    let hypotheses = if draft.vertex_edge {
-        match &feed.orientation {
-            // Parts fed in their stable states meet the pin in those states.
-            Orientation::Stable {
-                thetas_rad: thetas, ..
-            } => Hypotheses::VertexEdge {
-                degrees: thetas.iter().map(|t| t.to_degrees()).collect(),
-            },
-            Orientation::Uniform => Hypotheses::vertex_edge_sweep(),
-        }
-    } else {
-        match &draft.hypotheses {
-            Some(degrees) => Hypotheses::orientations(degrees.clone()),
-            None => Hypotheses::stable_states(&part.polygon),
-        }
-        .map_err(at_hypotheses)?
-    };
     let setup = PushSetup {
         polygon: part.polygon.clone(),
         d: template_d,
@@ -190,7 +252,7 @@ pub(super) fn train(
         fidelity: contact.fidelity,
         tol: contact.tol,
         mass: part.mass,
-        belt_speed,
+        belt_speed: scene.belt.speed,
         height: draft.settings.height,
     };
     let unc = Uncertainty {
@@ -200,40 +262,37 @@ pub(super) fn train(
         d_sd: template_d_sd,
     };
     // Templates of sensor i draw from streams of their own (salted by the obstacle index).
-    let template_seed = seed ^ (0x5e05_0000_0000_0000 | i as u64);
+    let template_seed = scene.seed ^ (0x5e05_0000_0000_0000 | draft.obstacle as u64);
     let set = build_templates(
         &setup,
         &part.model,
-        &hypotheses,
+        &draft.hypotheses,
         &unc,
         draft.templates,
         template_seed,
     )
     .map_err(|e| {
-        c.err(
-            &format!("obstacles[{i}].sensor"),
-            format!("cannot simulate the templates: {e}"),
-        )
+        draft
+            .at
+            .sensor
+            .error(format!("cannot simulate the templates: {e}"))
     })?;
     if let Some(h) = set.members.iter().position(|m| m.is_empty()) {
-        return Err(c.err(
-            &format!("obstacles[{i}].sensor.hypotheses"),
-            format!(
-                "hypothesis '{}' never occurs at this pin (no template could be simulated): the pin at d = {template_d:.3} cannot tell it",
-                set.labels[h]
-            ),
-        ));
+        return Err(draft.at.hypotheses.error(format!(
+            "hypothesis '{}' never occurs at this pin (no template could be simulated): the pin at d = {template_d:.3} cannot tell it",
+            set.labels[h]
+        )));
     }
     let options = ClassifierOptions {
         reject_below: draft.reject_below,
     };
     let classifier = classify::build(&draft.classifier, &set, &draft.settings, &options)
-        .map_err(|e| c.err(&format!("obstacles[{i}].sensor.classifier"), e.to_string()))?;
+        .map_err(|e| draft.at.classifier.error(e.to_string()))?;
     Ok(SensorPin {
         settings: draft.settings,
         classifier_name: draft.classifier.clone(),
         labels: set.labels.clone(),
-        hypotheses,
+        hypotheses: draft.hypotheses.clone(),
         templates_per_hypothesis: draft.templates,
         reject_below: draft.reject_below,
         template_d,

@@ -1,12 +1,24 @@
-//! Sensor pins in scenarios and in the line: bad sensor settings are located errors; the bundled
-//! sensor scene runs, reports its readings and is reproducible; a passive scene does no sensing
-//! work at all (the `work` counters prove it).
+//! Sensor pins in scenarios and in the line: bad sensor settings are located errors; reading a
+//! sensor scene leaves its sensors to train, and building the draft gives the loaded scene; a
+//! sensor that cannot be trained is a located error; the bundled sensor scene runs, reports its
+//! readings and is reproducible; a passive scene does no sensing work at all (the `work` counters
+//! prove it).
 
-use pinfeed::engine::{run, RunOptions};
-use pinfeed::scenario::{parse, InvalidScenario, Scene};
+use pinfeed::engine::{run, RunOptions, RunResult};
+use pinfeed::scenario::{load, parse, InvalidScenario, Obstacle, Scene, SceneDraft};
 use std::path::Path;
 
 const SCENE: &str = include_str!("../../scenarios/tripoly1_sensor.toml");
+
+/// Runs `a` and `b` on the first `parts` parts of `a`'s feed, with `a`'s seed.
+fn run_both(a: &Scene, b: &Scene, parts: u64) -> (RunResult, RunResult) {
+    let opts = RunOptions {
+        parts,
+        ..RunOptions::from_scene(a)
+    };
+    let run = |s| run(s, &opts, &mut |_| {}).unwrap();
+    (run(a), run(b))
+}
 
 fn compile(src: &str) -> Result<Scene, InvalidScenario> {
     parse(Path::new("sensor.toml"), src).map_err(|e| e.invalid().expect("located error").clone())
@@ -129,12 +141,7 @@ fn bad_sensor_settings_are_located_errors() {
 #[test]
 fn sensor_scene_reads_every_part_and_is_reproducible() {
     let scene = compile(SCENE).expect("the bundled sensor scene compiles");
-    let opts = RunOptions {
-        parts: 60,
-        ..RunOptions::from_scene(&scene)
-    };
-    let a = run(&scene, &opts, &mut |_| {}).unwrap();
-    let b = run(&scene, &opts, &mut |_| {}).unwrap();
+    let (a, b) = run_both(&scene, &scene, 60);
     assert_eq!(a.summary, b.summary);
     let s = &a.summary.sensors;
     assert_eq!(s.len(), 1);
@@ -212,4 +219,73 @@ fn a_sensor_pin_pushes_like_a_plain_pin() {
     }
     assert_eq!(a.summary.outcomes, b.summary.outcomes);
     assert_eq!(a.summary.work.contact_solves, b.summary.work.contact_solves);
+}
+
+/// Reading a sensor scene trains nothing: its draft lists the probe as a sensor still to train,
+/// with the labels its rules may name. Building the draft gives the scene `load` gives: the same
+/// obstacles and sensors, and the same run, summary for summary.
+#[test]
+fn a_sensor_scene_is_read_untrained_and_builds_into_the_loaded_scene() {
+    let path = Path::new("scenarios/tripoly1_sensor.toml");
+    let draft = SceneDraft::read(path).unwrap();
+    assert_eq!(draft.name(), "tripoly1_sensor");
+    let [probe] = draft.sensors() else {
+        panic!("one sensor to train: {:?}", draft.sensors());
+    };
+    assert_eq!((probe.obstacle, probe.name.as_str()), (0, "probe"));
+    assert_eq!(probe.hypotheses.labels(), ["0°", "135°", "225°"]);
+    assert_eq!(
+        (probe.classifier.as_str(), probe.templates),
+        ("likelihood", 32)
+    );
+    let built = draft.build().unwrap();
+    let loaded = load(path).unwrap();
+    assert_eq!(built.obstacles, loaded.obstacles);
+    let Obstacle::Pin(pin) = &built.obstacles[0] else {
+        panic!("the probe is a pin");
+    };
+    let sensor = pin.sensor.as_ref().expect("the built probe has its sensor");
+    assert_eq!(sensor.labels, probe.hypotheses.labels());
+    assert_eq!(sensor.templates_per_hypothesis, 32);
+    let (a, b) = run_both(&loaded, &built, 30);
+    assert_eq!(a.summary, b.summary);
+    assert_eq!(a.summary.sensors[0].readings, 30);
+    // A scene without sensor pins has nothing to train.
+    let quick = SceneDraft::read(Path::new("scenarios/quickstart.toml")).unwrap();
+    assert!(quick.sensors().is_empty());
+}
+
+/// A sensor that cannot be trained is refused when the scene is built, not when the file is
+/// read, and the error names the file, the line and the sensor's key like any other.
+#[test]
+fn a_training_error_is_located_at_the_sensor() {
+    // The probe 5 cm off the feed line (d = 1.58) never touches a part: no vertex, no edge.
+    let src = SCENE.replacen("y = -0.004 ", "y = 0.05 ", 1).replacen(
+        "templates = 32 ",
+        "templates = 4\nhypotheses = \"vertex-edge\"",
+        1,
+    );
+    let draft = SceneDraft::parse(Path::new("far.toml"), &src).expect("the file itself is fine");
+    let e = draft.build().unwrap_err();
+    let i = e.invalid().expect("located error");
+    let line = src
+        .lines()
+        .position(|l| l.starts_with("hypotheses"))
+        .unwrap()
+        + 1;
+    assert_eq!(i.file, Path::new("far.toml"));
+    assert_eq!((i.line, i.column), (line, 14), "{e}");
+    assert_eq!(i.key, "obstacles[0].sensor.hypotheses");
+    assert!(
+        i.message
+            .starts_with("hypothesis 'vertex' never occurs at this pin"),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("hypotheses = \"vertex-edge\""),
+        "{e}"
+    );
+    // parse reads and builds: the same error.
+    let p = parse(Path::new("far.toml"), &src).unwrap_err();
+    assert_eq!(p.to_string(), e.to_string());
 }

@@ -1,6 +1,6 @@
 //! One sensing experiment as `pinfeed sense` runs it (docs/commands.md): the request (a part, one
 //! push, hypotheses, a sensor, classifiers, a noise sweep and the declared uncertainty), its
-//! checks ([`check`], errors naming the command's flags), the evaluation with the policy for
+//! checks ([`check`], errors naming the [`Setting`] at fault), the evaluation with the policy for
 //! classifiers that cannot be trained ([`Checked::evaluate`]), the placement search
 //! ([`Checked::place`]) and the typed result ([`SenseReport`]). The text and Markdown reports are
 //! in `report::sense`.
@@ -10,7 +10,7 @@ mod run;
 pub use run::{Evaluated, Placeholder, SenseReport, Skipped, Sweep, UncertaintyReport, Untrained};
 
 use crate::geometry::{named, Polygon};
-use crate::mechanics::limits::{self, in_range, num, OutOfRange};
+use crate::mechanics::limits::{self, num, OutOfRange};
 use crate::mechanics::{Fidelity, PartModel, Support};
 use crate::random::distribution::Distribution;
 use crate::sensing::classify;
@@ -90,17 +90,107 @@ pub struct Request {
     pub placement_d: Vec<f64>,
 }
 
-/// A request that cannot be run (messages name the flags of `pinfeed sense`).
-#[derive(Debug, thiserror::Error)]
+/// A setting of a [`Request`], as its errors name it: [`SenseError`]'s message names it by its
+/// field ([`Setting::field`]); a front end names it by what set it ([`SenseError::describe`];
+/// `pinfeed sense` by its flag).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Setting {
+    /// [`Request::part`].
+    Part,
+    /// [`Request::scale`].
+    Scale,
+    /// [`Request::mass`].
+    Mass,
+    /// [`Request::belt_speed`].
+    BeltSpeed,
+    /// [`Request::d`].
+    D,
+    /// [`Request::pin_radius`].
+    PinRadius,
+    /// [`Request::mu_c`].
+    MuC,
+    /// [`Request::mu_s`].
+    MuS,
+    /// [`Request::tol`].
+    Tol,
+    /// [`Request::hypotheses`].
+    Hypotheses,
+    /// A field of [`Request::sensor`] ([`SensorSettings`]), by name (`rate`, `noise_force`, …).
+    Sensor(&'static str),
+    /// [`Request::sensor_kind`].
+    SensorKind,
+    /// [`Request::classifiers`].
+    Classifiers,
+    /// [`Request::reject_below`].
+    RejectBelow,
+    /// [`Request::noise`].
+    Noise,
+    /// [`Request::mu_c_range`].
+    MuCRange,
+    /// [`Request::theta_jitter`].
+    ThetaJitter,
+    /// [`Request::d_jitter`].
+    DJitter,
+    /// [`Request::templates`].
+    Templates,
+    /// [`Request::trials`].
+    Trials,
+    /// [`Request::truth`].
+    Truth,
+    /// [`Request::threads`].
+    Threads,
+    /// [`Request::placement_d`].
+    PlacementD,
+}
+
+impl Setting {
+    /// The field of [`Request`] (or of its [`SensorSettings`]) that holds the setting.
+    pub fn field(self) -> &'static str {
+        match self {
+            Setting::Part => "part",
+            Setting::Scale => "scale",
+            Setting::Mass => "mass",
+            Setting::BeltSpeed => "belt_speed",
+            Setting::D => "d",
+            Setting::PinRadius => "pin_radius",
+            Setting::MuC => "mu_c",
+            Setting::MuS => "mu_s",
+            Setting::Tol => "tol",
+            Setting::Hypotheses => "hypotheses",
+            Setting::Sensor(field) => field,
+            Setting::SensorKind => "sensor_kind",
+            Setting::Classifiers => "classifiers",
+            Setting::RejectBelow => "reject_below",
+            Setting::Noise => "noise",
+            Setting::MuCRange => "mu_c_range",
+            Setting::ThetaJitter => "theta_jitter",
+            Setting::DJitter => "d_jitter",
+            Setting::Templates => "templates",
+            Setting::Trials => "trials",
+            Setting::Truth => "truth",
+            Setting::Threads => "threads",
+            Setting::PlacementD => "placement_d",
+        }
+    }
+}
+
+/// A request that cannot be run. Its message names the setting at fault by its [`Request`] field
+/// (`scale must be …`); [`SenseError::describe`] names it otherwise (`pinfeed sense` by its flag).
+#[derive(Debug)]
 pub enum SenseError {
     /// A number outside its range.
-    #[error(transparent)]
-    Range(#[from] OutOfRange),
+    Range {
+        /// The setting.
+        setting: Setting,
+        /// Which of the setting's numbers, when it has two (` LO`, ` HI`); empty otherwise.
+        which: &'static str,
+        /// The value, its range and what it is (`name`: the setting's field and `which`).
+        range: OutOfRange,
+    },
     /// A quantity that must be positive and finite is not, or is too large.
-    #[error("{flag} must be a finite number > 0 and at most {} ({what}), got {}", num(*hi), num(*value))]
     Positive {
-        /// The flag.
-        flag: &'static str,
+        /// The setting.
+        setting: Setting,
         /// The value given.
         value: f64,
         /// The largest value allowed.
@@ -109,23 +199,20 @@ pub enum SenseError {
         what: &'static str,
     },
     /// A count outside [1, max].
-    #[error("{flag} must lie in [1, {max}], got {value}")]
     Count {
-        /// The flag.
-        flag: &'static str,
+        /// The setting.
+        setting: Setting,
         /// The largest count allowed.
         max: usize,
         /// The count given.
         value: usize,
     },
     /// More threads than [`MAX_THREADS`].
-    #[error("--threads must lie in [0, {MAX_THREADS}] (0: one per core), got {0}")]
     Threads(usize),
     /// A list with no entries or too many.
-    #[error("{flag} takes 1 to {max} {unit}, got {value}")]
     ListLength {
-        /// The flag.
-        flag: &'static str,
+        /// The setting.
+        setting: Setting,
         /// The most entries allowed.
         max: usize,
         /// What the entries are, in words.
@@ -134,25 +221,22 @@ pub enum SenseError {
         value: usize,
     },
     /// A word that is not one of the choices.
-    #[error("{flag} must be {expected}, got '{got}'")]
     Choice {
-        /// The flag.
-        flag: &'static str,
+        /// The setting.
+        setting: Setting,
         /// The choices, in words.
         expected: &'static str,
         /// The word given.
         got: String,
     },
     /// A sensor setting outside its range.
-    #[error("--{}: {message}", field.replace('_', "-"))]
     Sensor {
-        /// The setting's field name (the flag is `--` and the name with dashes).
+        /// The setting's field name in [`SensorSettings`].
         field: &'static str,
         /// Why it is refused.
         message: String,
     },
     /// A sensor setting that leaves its range at one of the noise factors.
-    #[error("--noise {}: the sensor's {field} leaves its range: {message}", num(*factor))]
     NoiseSensor {
         /// The noise factor.
         factor: f64,
@@ -162,7 +246,6 @@ pub enum SenseError {
         message: String,
     },
     /// A part spec that names no part.
-    #[error("--part '{spec}': {error}")]
     Part {
         /// The spec given.
         spec: String,
@@ -170,27 +253,21 @@ pub enum SenseError {
         error: named::PartSpecError,
     },
     /// A part whose model cannot be built (the reason).
-    #[error("--part: {0}")]
     PartModel(crate::mechanics::PartModelError),
     /// A hypothesis that is neither `stable`, `vertex-edge` nor a number of degrees.
-    #[error("--hypotheses: '{0}' is not a number of degrees (or give stable or vertex-edge)")]
     HypothesisDegrees(String),
     /// Hypotheses that cannot be told apart or built for the part.
-    #[error("--hypotheses {spec}: {message}")]
     Hypotheses {
-        /// The `--hypotheses` value given.
+        /// The hypotheses as given.
         spec: String,
-        /// Why it is refused.
+        /// Why they are refused.
         message: crate::sensing::templates::HypothesesError,
     },
-    /// `--mu-c-range` without a colon.
-    #[error("--mu-c-range must be LO:HI (e.g. 0.3:0.7), got '{0}'")]
+    /// A μc range without a colon.
     MuCRangeForm(String),
-    /// A bound of `--mu-c-range` that is not a number.
-    #[error("--mu-c-range: '{0}' is not a number")]
+    /// A bound of the μc range that is not a number.
     MuCRangeNumber(String),
-    /// `--mu-c-range` with LO above HI.
-    #[error("--mu-c-range: LO must not exceed HI, got {}:{}", num(*lo), num(*hi))]
+    /// A μc range with LO above HI.
     MuCRangeOrder {
         /// The lower bound given.
         lo: f64,
@@ -198,24 +275,143 @@ pub enum SenseError {
         hi: f64,
     },
     /// A classifier name that is not in [`classify::NAMES`].
-    #[error("--classifiers: unknown classifier '{name}'; known: {}", classify::NAMES.join(", "))]
     UnknownClassifier {
         /// The name given.
         name: String,
     },
     /// A classifier listed twice.
-    #[error("--classifiers: '{0}' is listed twice")]
     ClassifierTwice(String),
     /// A classifier asked for by name could not be trained at any sweep point.
-    #[error("--classifiers: {0}")]
     Untrainable(String),
     /// None of the classifiers could be trained.
-    #[error("no classifier could be trained for these hypotheses and this sensor")]
     NoClassifier,
     /// The evaluation or the placement search failed.
-    #[error("{0}")]
     Evaluate(crate::sensing::evaluate::EvaluateError),
 }
+
+impl SenseError {
+    /// The setting at fault, if the error names one.
+    pub fn setting(&self) -> Option<Setting> {
+        use SenseError as E;
+        Some(match self {
+            E::Range { setting, .. }
+            | E::Positive { setting, .. }
+            | E::Count { setting, .. }
+            | E::ListLength { setting, .. }
+            | E::Choice { setting, .. } => *setting,
+            E::Threads(_) => Setting::Threads,
+            E::Sensor { field, .. } => Setting::Sensor(field),
+            E::NoiseSensor { .. } => Setting::Noise,
+            E::Part { .. } | E::PartModel(_) => Setting::Part,
+            E::HypothesisDegrees(_) | E::Hypotheses { .. } => Setting::Hypotheses,
+            E::MuCRangeForm(_) | E::MuCRangeNumber(_) | E::MuCRangeOrder { .. } => {
+                Setting::MuCRange
+            }
+            E::UnknownClassifier { .. } | E::ClassifierTwice(_) | E::Untrainable(_) => {
+                Setting::Classifiers
+            }
+            E::NoClassifier | E::Evaluate(_) => return None,
+        })
+    }
+
+    /// The message, with each setting named by `name` (its [`Setting::field`] in the error's
+    /// `Display`).
+    pub fn describe(&self, name: impl Fn(Setting) -> String) -> String {
+        use SenseError as E;
+        let n = |s: Setting| name(s);
+        match self {
+            E::Range {
+                setting,
+                which,
+                range,
+            } => OutOfRange {
+                name: format!("{}{which}", n(*setting)),
+                ..range.clone()
+            }
+            .to_string(),
+            E::Positive {
+                setting,
+                value,
+                hi,
+                what,
+            } => format!(
+                "{} must be a finite number > 0 and at most {} ({what}), got {}",
+                n(*setting),
+                num(*hi),
+                num(*value)
+            ),
+            E::Count {
+                setting,
+                max,
+                value,
+            } => format!("{} must lie in [1, {max}], got {value}", n(*setting)),
+            E::Threads(v) => format!(
+                "{} must lie in [0, {MAX_THREADS}] (0: one per core), got {v}",
+                n(Setting::Threads)
+            ),
+            E::ListLength {
+                setting,
+                max,
+                unit,
+                value,
+            } => format!("{} takes 1 to {max} {unit}, got {value}", n(*setting)),
+            E::Choice {
+                setting,
+                expected,
+                got,
+            } => format!("{} must be {expected}, got '{got}'", n(*setting)),
+            E::Sensor { field, message } => format!("{}: {message}", n(Setting::Sensor(field))),
+            E::NoiseSensor {
+                factor,
+                field,
+                message,
+            } => format!(
+                "{} {}: the sensor's {field} leaves its range: {message}",
+                n(Setting::Noise),
+                num(*factor)
+            ),
+            E::Part { spec, error } => format!("{} '{spec}': {error}", n(Setting::Part)),
+            E::PartModel(e) => format!("{}: {e}", n(Setting::Part)),
+            E::HypothesisDegrees(t) => format!(
+                "{}: '{t}' is not a number of degrees (or give stable or vertex-edge)",
+                n(Setting::Hypotheses)
+            ),
+            E::Hypotheses { spec, message } => {
+                format!("{} {spec}: {message}", n(Setting::Hypotheses))
+            }
+            E::MuCRangeForm(spec) => format!(
+                "{} must be LO:HI (e.g. 0.3:0.7), got '{spec}'",
+                n(Setting::MuCRange)
+            ),
+            E::MuCRangeNumber(t) => format!("{}: '{t}' is not a number", n(Setting::MuCRange)),
+            E::MuCRangeOrder { lo, hi } => format!(
+                "{}: LO must not exceed HI, got {}:{}",
+                n(Setting::MuCRange),
+                num(*lo),
+                num(*hi)
+            ),
+            E::UnknownClassifier { name } => format!(
+                "{}: unknown classifier '{name}'; known: {}",
+                n(Setting::Classifiers),
+                classify::NAMES.join(", ")
+            ),
+            E::ClassifierTwice(c) => format!("{}: '{c}' is listed twice", n(Setting::Classifiers)),
+            E::Untrainable(reason) => format!("{}: {reason}", n(Setting::Classifiers)),
+            E::NoClassifier => {
+                "no classifier could be trained for these hypotheses and this sensor".to_string()
+            }
+            E::Evaluate(e) => e.to_string(),
+        }
+    }
+}
+
+impl std::fmt::Display for SenseError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.describe(|s| s.field().to_string()))
+    }
+}
+
+impl std::error::Error for SenseError {}
 
 /// A request checked: the push, its part model, hypotheses, uncertainty, sensor and classifiers.
 pub struct Checked {
@@ -239,17 +435,35 @@ pub struct Checked {
     pub truth: TruthDraw,
 }
 
-/// `flag must be > 0 …` for strictly positive quantities.
-fn positive(flag: &'static str, v: f64, hi: f64, what: &'static str) -> Result<(), SenseError> {
+/// `setting must be > 0 …` for strictly positive quantities.
+fn positive(setting: Setting, v: f64, hi: f64, what: &'static str) -> Result<(), SenseError> {
     if !(v.is_finite() && v > 0.0 && v <= hi) {
         return Err(SenseError::Positive {
-            flag,
+            setting,
             value: v,
             hi,
             what,
         });
     }
     Ok(())
+}
+
+/// `setting` (with `which` of its numbers) within [lo, hi] ([`limits::in_range`]).
+fn in_range(
+    setting: Setting,
+    which: &'static str,
+    v: f64,
+    lo: f64,
+    hi: f64,
+    what: &str,
+) -> Result<(), SenseError> {
+    limits::in_range(&format!("{}{which}", setting.field()), v, lo, hi, what).map_err(|range| {
+        SenseError::Range {
+            setting,
+            which,
+            range,
+        }
+    })
 }
 
 /// Parse hypotheses for a part: `stable`, `vertex-edge` or a list of degrees.
@@ -288,8 +502,22 @@ fn parse_range(spec: &str) -> Result<Distribution, SenseError> {
     };
     let (lo, hi) = (p(lo)?, p(hi)?);
     let (min, max) = limits::MU_C;
-    in_range("--mu-c-range LO", lo, min, max, "friction coefficient")?;
-    in_range("--mu-c-range HI", hi, min, max, "friction coefficient")?;
+    in_range(
+        Setting::MuCRange,
+        " LO",
+        lo,
+        min,
+        max,
+        "friction coefficient",
+    )?;
+    in_range(
+        Setting::MuCRange,
+        " HI",
+        hi,
+        min,
+        max,
+        "friction coefficient",
+    )?;
     if lo > hi {
         return Err(SenseError::MuCRangeOrder { lo, hi });
     }
@@ -300,14 +528,14 @@ fn parse_range(spec: &str) -> Result<Distribution, SenseError> {
     })
 }
 
-/// The sensor of the request (noise factor 1), validated; errors name the flag.
+/// The sensor of the request (noise factor 1), validated; errors name the setting.
 pub fn sensor_settings(r: &Request) -> Result<SensorSettings, SenseError> {
     let kind = match r.sensor_kind.trim() {
         "ft" => SensorKind::Ft,
         "timing" => SensorKind::Timing,
         other => {
             return Err(SenseError::Choice {
-                flag: "--sensor",
+                setting: Setting::SensorKind,
                 expected: "ft or timing",
                 got: other.to_string(),
             })
@@ -375,34 +603,45 @@ pub fn check(a: &Request) -> Result<Checked, SenseError> {
 /// Check the request's numbers, counts and list lengths, each against its range (the first
 /// step of [`check`], in the order of its error messages).
 fn check_settings(a: &Request) -> Result<(), SenseError> {
-    positive("--scale", a.scale, 100.0, "metres per part unit")?;
-    positive("--mass", a.mass, 1e3, "kg")?;
-    positive("--belt-speed", a.belt_speed, 100.0, "m/s")?;
+    positive(Setting::Scale, a.scale, 100.0, "metres per part unit")?;
+    positive(Setting::Mass, a.mass, 1e3, "kg")?;
+    positive(Setting::BeltSpeed, a.belt_speed, 100.0, "m/s")?;
     in_range(
-        "--mu-c",
+        Setting::MuC,
+        "",
         a.mu_c,
         limits::MU_C.0,
         limits::MU_C.1,
         "friction coefficient",
     )?;
     in_range(
-        "--mu-s",
+        Setting::MuS,
+        "",
         a.mu_s,
         limits::MU_S.0,
         limits::MU_S.1,
         "support friction",
     )?;
     in_range(
-        "--tol",
+        Setting::Tol,
+        "",
         a.tol,
         limits::TOL.0,
         limits::TOL.1,
         "integration tolerance per step",
     )?;
-    in_range("--theta-jitter", a.theta_jitter, 0.0, 180.0, "degrees")?;
-    in_range("--d-jitter", a.d_jitter, 0.0, 1.0, "units of a")?;
     in_range(
-        "--reject-below",
+        Setting::ThetaJitter,
+        "",
+        a.theta_jitter,
+        0.0,
+        180.0,
+        "degrees",
+    )?;
+    in_range(Setting::DJitter, "", a.d_jitter, 0.0, 1.0, "units of a")?;
+    in_range(
+        Setting::RejectBelow,
+        "",
         a.reject_below,
         0.0,
         1.0,
@@ -410,14 +649,14 @@ fn check_settings(a: &Request) -> Result<(), SenseError> {
     )?;
     if !(1..=MAX_TRIALS).contains(&a.trials) {
         return Err(SenseError::Count {
-            flag: "--trials",
+            setting: Setting::Trials,
             max: MAX_TRIALS,
             value: a.trials,
         });
     }
     if !(1..=MAX_TEMPLATES).contains(&a.templates) {
         return Err(SenseError::Count {
-            flag: "--templates",
+            setting: Setting::Templates,
             max: MAX_TEMPLATES,
             value: a.templates,
         });
@@ -427,18 +666,25 @@ fn check_settings(a: &Request) -> Result<(), SenseError> {
     }
     if a.noise.is_empty() || a.noise.len() > MAX_FACTORS {
         return Err(SenseError::ListLength {
-            flag: "--noise",
+            setting: Setting::Noise,
             max: MAX_FACTORS,
             unit: "factors",
             value: a.noise.len(),
         });
     }
     for &f in &a.noise {
-        in_range("--noise", f, 0.0, 1e6, "factor on the nominal noise, ≥ 0")?;
+        in_range(
+            Setting::Noise,
+            "",
+            f,
+            0.0,
+            1e6,
+            "factor on the nominal noise, ≥ 0",
+        )?;
     }
     if a.placement && (a.placement_d.is_empty() || a.placement_d.len() > MAX_PLACEMENT_D) {
         return Err(SenseError::ListLength {
-            flag: "--placement-d",
+            setting: Setting::PlacementD,
             max: MAX_PLACEMENT_D,
             unit: "offsets",
             value: a.placement_d.len(),
@@ -454,7 +700,7 @@ fn truth_draw(spec: &str) -> Result<TruthDraw, SenseError> {
         "uniform" => TruthDraw::Uniform,
         other => {
             return Err(SenseError::Choice {
-                flag: "--truth",
+                setting: Setting::Truth,
                 expected: "cycle or uniform",
                 got: other.to_string(),
             })
@@ -481,7 +727,8 @@ fn check_noise_factors(sensor: &SensorSettings, noise: &[f64]) -> Result<(), Sen
 /// (`radius_units`, in part units).
 fn check_offsets(a: &Request, radius_units: f64) -> Result<(), SenseError> {
     in_range(
-        "--pin-radius",
+        Setting::PinRadius,
+        "",
         a.pin_radius,
         0.0,
         limits::PIN_RADIUS_A * radius_units,
@@ -493,10 +740,10 @@ fn check_offsets(a: &Request, radius_units: f64) -> Result<(), SenseError> {
     )?;
     let reach = 1.0 + a.pin_radius / radius_units;
     let beyond = "units of a; beyond it the pin cannot touch the part";
-    in_range("--d", a.d, -reach, reach, beyond)?;
+    in_range(Setting::D, "", a.d, -reach, reach, beyond)?;
     if a.placement {
         for &d in &a.placement_d {
-            in_range("--placement-d", d, -reach, reach, beyond)?;
+            in_range(Setting::PlacementD, "", d, -reach, reach, beyond)?;
         }
     }
     Ok(())
@@ -527,4 +774,121 @@ fn classifier_list(
         applicable(kind, hyps)
     };
     Ok((classifiers, explicit))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The request `pinfeed sense --part tripoly1 --d=-0.2` makes, with its defaults.
+    fn request() -> Request {
+        Request {
+            part: "tripoly1".into(),
+            scale: 0.02,
+            mass: 0.05,
+            belt_speed: 0.05,
+            d: -0.2,
+            pin_radius: 0.0,
+            mu_c: 0.5,
+            mu_s: 0.3,
+            model: Fidelity::Exact,
+            tol: 1e-6,
+            hypotheses: "stable".into(),
+            sensor: SensorSettings::default(),
+            sensor_kind: "ft".into(),
+            classifiers: Vec::new(),
+            reject_below: 0.0,
+            noise: vec![1.0],
+            mu_c_range: None,
+            tripod: false,
+            theta_jitter: 0.0,
+            d_jitter: 0.0,
+            templates: 8,
+            trials: 10,
+            truth: "cycle".into(),
+            seed: 1,
+            threads: 0,
+            placement: false,
+            placement_d: Vec::new(),
+        }
+    }
+
+    /// The error `check` gives for the request `change` makes.
+    fn refused(change: impl FnOnce(&mut Request)) -> SenseError {
+        let mut r = request();
+        change(&mut r);
+        match check(&r) {
+            Ok(_) => panic!("accepted"),
+            Err(e) => e,
+        }
+    }
+
+    #[test]
+    fn errors_name_the_setting_by_its_field_or_by_the_callers_name() {
+        assert!(check(&request()).is_ok());
+        let cases: Vec<(SenseError, Setting, &str)> = vec![
+            (
+                refused(|r| r.scale = 1e3),
+                Setting::Scale,
+                "scale must be a finite number > 0",
+            ),
+            (
+                refused(|r| r.mu_c = 99.0),
+                Setting::MuC,
+                "mu_c must be in [0, 5]",
+            ),
+            (
+                refused(|r| r.mu_c_range = Some("0.3:99".into())),
+                Setting::MuCRange,
+                "mu_c_range HI must be in [0, 5]",
+            ),
+            (
+                refused(|r| r.sensor_kind = "sonar".into()),
+                Setting::SensorKind,
+                "sensor_kind must be ft or timing, got 'sonar'",
+            ),
+            (
+                refused(|r| r.sensor.noise_force = -1.0),
+                Setting::Sensor("noise_force"),
+                "noise_force: must lie in",
+            ),
+            (
+                refused(|r| r.trials = 0),
+                Setting::Trials,
+                "trials must lie in [1, ",
+            ),
+            (
+                refused(|r| r.threads = 1 << 20),
+                Setting::Threads,
+                "threads must lie in [0, ",
+            ),
+            (
+                refused(|r| {
+                    r.sensor.noise_force = 1e5;
+                    r.noise = vec![1.0, 1e3];
+                }),
+                Setting::Noise,
+                "noise 1000: the sensor's",
+            ),
+            (
+                refused(|r| r.classifiers = vec!["oracle".into()]),
+                Setting::Classifiers,
+                "classifiers: unknown classifier 'oracle'",
+            ),
+        ];
+        for (e, setting, text) in cases {
+            assert_eq!(e.setting(), Some(setting), "{e}");
+            let message = e.to_string();
+            assert!(message.starts_with(text), "{message}");
+            assert!(
+                !message.contains("--"),
+                "a library message names a flag: {message}"
+            );
+            // A caller names the setting its own way, the rest of the message unchanged.
+            let named = e.describe(|s| format!("<{}>", s.field()));
+            let field = setting.field();
+            assert_eq!(named, format!("<{field}>{}", &message[field.len()..]));
+        }
+        assert_eq!(SenseError::NoClassifier.setting(), None);
+    }
 }
