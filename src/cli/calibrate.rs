@@ -7,13 +7,13 @@
 //! interval holds the hidden value. Unless `--no-write`, `pinfeed-out/calibrate/<file stem>/` receives
 //! `README.md` headed by the regenerating command and `calibration.json`.
 
-use super::validate::{emit, ensemble_spec, pool, ModelArgs};
+use super::validate::{check_members, emit, ensemble_spec, load_measured, pool, ModelArgs};
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use pinfeed::mechanics::support::{SmoothParams, SupportChoice};
 use pinfeed::report::calibrate_report::{calibration_text, write_report, CalibrateReport};
 use pinfeed::validate::calibrate::{calibrate_observed, CalibrationSettings};
-use pinfeed::validate::input::{check_members, load_measured};
+use pinfeed::validate::input::Setting;
 use pinfeed::validate::synthetic::{synthesize, SyntheticDesign};
 use std::path::PathBuf;
 
@@ -81,8 +81,8 @@ pub(crate) fn settings(args: &CalibrateArgs) -> Result<CalibrationSettings> {
         "smooth" => SupportChoice::Smooth(SmoothParams::default()),
         s => bail!("--support must be tripod or smooth, got '{s}'"),
     };
-    check_members("--members", args.members)?;
-    check_members("--score-members", args.score_members)?;
+    check_members(Setting::Members, args.members)?;
+    check_members(Setting::ScoreMembers, args.score_members)?;
     let c = &args.common;
     Ok(CalibrationSettings {
         members: args.members,

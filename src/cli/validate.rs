@@ -11,7 +11,7 @@ use clap::Args;
 use pinfeed::maps::ensemble::EnsembleSpec;
 use pinfeed::mechanics::limits::in_range;
 use pinfeed::report::validate_report::{containment_text, rows_text, write_report, ValidateReport};
-use pinfeed::validate::input::{self, check_members, load_measured};
+use pinfeed::validate::input::{self, InputError, Setting};
 use pinfeed::validate::measured::Measured;
 use pinfeed::validate::score::ScoreSettings;
 use serde::Serialize;
@@ -138,9 +138,34 @@ pub fn ensemble_spec(
     common: &ModelArgs,
 ) -> Result<EnsembleSpec> {
     let model = common.model;
-    Ok(input::ensemble_spec(
-        mu_c, pin_radius, model, common.tol, uncertain,
-    )?)
+    input::ensemble_spec(mu_c, pin_radius, model, common.tol, uncertain).map_err(flagged)
+}
+
+/// The flag of `pinfeed validate` and `pinfeed calibrate` that sets `setting`.
+fn flag_of(setting: Setting) -> String {
+    format!("--{}", setting.field().replace('_', "-"))
+}
+
+/// A refused input, its message naming the flags (a refused file keeps its own error chain).
+pub fn flagged(e: InputError) -> anyhow::Error {
+    match e {
+        InputError::Measured(m) => m.into(),
+        e => anyhow::anyhow!(e.describe(flag_of)),
+    }
+}
+
+/// The count `members` given by `setting`'s flag, checked.
+pub fn check_members(setting: Setting, members: usize) -> Result<()> {
+    input::check_members(setting, members).map_err(flagged)
+}
+
+/// The measured file for `spec`, checked ([`input::load_measured`]).
+pub fn load_measured(
+    path: &std::path::Path,
+    spec: &EnsembleSpec,
+    part: Option<&str>,
+) -> Result<pinfeed::validate::measured::Measured> {
+    input::load_measured(path, spec, part).map_err(flagged)
 }
 
 /// Print a report (`--json`: the document, else `text`) and, unless `--no-write`, have `write`
@@ -170,7 +195,7 @@ impl ValidateArgs {
     /// The checked inputs of a validation: the score settings, the ensemble and the measured file.
     pub fn inputs(&self) -> Result<(ScoreSettings, EnsembleSpec, Measured)> {
         let score = self.common.score()?;
-        check_members("--members", self.members)?;
+        check_members(Setting::Members, self.members)?;
         let spec = ensemble_spec(
             self.mu_c,
             self.pin_radius,

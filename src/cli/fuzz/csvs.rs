@@ -6,11 +6,11 @@
 //! as the commands read it; every number of an accepted report must be finite.
 
 use crate::cli::calibrate::CalibrateArgs;
+use crate::cli::validate::load_measured;
 use crate::cli::validate::ValidateArgs;
 use clap::Parser;
 use pinfeed::study::robustness::commands::CsvCase;
 use pinfeed::study::robustness::{refused, shows_non_finite, CaseReport, Class, CommandCases};
-use pinfeed::validate::input::load_measured;
 use std::path::Path;
 
 /// The cases of the csvs target, for the fuzzing driver: a case runs with its file written into
