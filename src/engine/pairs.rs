@@ -7,60 +7,62 @@
 
 use super::contact::ensure_trace;
 use super::event_queue::EventKind;
-use super::line::Line;
+use super::metrics::WorkCounters;
 use super::motion::Motion;
 use super::overlap::{first_touch, polygon_clearance, segment_distance};
+use super::state::Belt;
 use crate::geometry::Vec2;
 use crate::scenario::Scene;
 
-impl Line<'_> {
-    /// Check the motion part `index` has just started against every other part on the belt.
-    pub(super) fn check_pairs(&mut self, index: u64, now: f64) {
-        if !self.scene.effects.collisions || self.active.len() < 2 {
-            return;
+/// Check the motion part `index` has just started (at `now`) against every other part on the
+/// belt, and schedule a collision at the first overlap of each pair. A held part whose push kept
+/// no path gets it recorded here if the pair is close.
+pub(super) fn check_pairs(
+    scene: &Scene,
+    belt: &mut Belt,
+    work: &mut WorkCounters,
+    index: u64,
+    now: f64,
+) {
+    if !scene.effects.collisions || belt.active.len() < 2 {
+        return;
+    }
+    let active = &mut belt.active;
+    let others: Vec<u64> = active.keys().copied().filter(|&k| k != index).collect();
+    for other in others {
+        work.part_part_checks += 1;
+        let end = active[&index]
+            .motion
+            .until()
+            .min(active[&other].motion.until());
+        if end < now {
+            continue;
         }
-        let scene = self.scene;
-        let others: Vec<u64> = self
-            .active
-            .keys()
-            .copied()
-            .filter(|&k| k != index)
-            .collect();
-        for other in others {
-            self.metrics.work.part_part_checks += 1;
-            let end = self.active[&index]
-                .motion
-                .until()
-                .min(self.active[&other].motion.until());
-            if end < now {
-                continue;
+        let (p0, p1, r1) = bounding_capsule(scene, &active[&index].motion, now, end);
+        let (q0, q1, r2) = bounding_capsule(scene, &active[&other].motion, now, end);
+        if segment_distance(p0, p1, q0, q1) > r1 + r2 {
+            continue;
+        }
+        work.part_part_narrow_checks += 1;
+        for k in [index, other] {
+            let part = active.get_mut(&k).expect("active part");
+            if let Motion::Held(plan) = &mut part.motion {
+                let model = part.model.as_ref().unwrap_or(&scene.part.model);
+                ensure_trace(plan, model, work);
             }
-            let (p0, p1, r1) = bounding_capsule(scene, &self.active[&index].motion, now, end);
-            let (q0, q1, r2) = bounding_capsule(scene, &self.active[&other].motion, now, end);
-            if segment_distance(p0, p1, q0, q1) > r1 + r2 {
-                continue;
-            }
-            self.metrics.work.part_part_narrow_checks += 1;
-            for k in [index, other] {
-                let part = self.active.get_mut(&k).expect("active part");
-                if let Motion::Held(plan) = &mut part.motion {
-                    let model = part.model.as_ref().unwrap_or(&scene.part.model);
-                    ensure_trace(plan, model, &mut self.metrics.work);
-                }
-            }
-            let (pi, pj) = (&self.active[&index].motion, &self.active[&other].motion);
-            let mut evals = 0;
-            let hit = first_overlap(scene, pi, pj, now, end, &mut evals);
-            self.metrics.work.clearance_evaluations += evals;
-            if let Some(tc) = hit {
-                self.queue.schedule(
-                    tc,
-                    EventKind::Collision {
-                        first: index.min(other),
-                        second: index.max(other),
-                    },
-                );
-            }
+        }
+        let (pi, pj) = (&active[&index].motion, &active[&other].motion);
+        let mut evals = 0;
+        let hit = first_overlap(scene, pi, pj, now, end, &mut evals);
+        work.clearance_evaluations += evals;
+        if let Some(tc) = hit {
+            belt.queue.schedule(
+                tc,
+                EventKind::Collision {
+                    first: index.min(other),
+                    second: index.max(other),
+                },
+            );
         }
     }
 }
