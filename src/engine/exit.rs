@@ -108,3 +108,66 @@ fn count_untouched(scene: &Scene, sinks: &mut Sinks, part: &ActivePart, x: f64) 
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Pose;
+
+    fn quickstart() -> Scene {
+        crate::scenario::load(std::path::Path::new("scenarios/quickstart.toml")).unwrap()
+    }
+
+    /// A belt holding part 0 at rest at the belt's end (x = length) with orientation `deg`.
+    fn belt_with_part_at_end(scene: &Scene, deg: f64) -> Belt {
+        let mut belt = Belt::new();
+        let pose = Pose::new(scene.belt.length, 0.0, deg.to_radians());
+        belt.active
+            .insert(0, ActivePart::entering(1.0, pose, None, false));
+        belt
+    }
+
+    /// The quickstart's goal is 16° ± 3°: a part at 17° exits as a success, one at 40° with the
+    /// wrong orientation; each is counted once, with its record, however often its exit comes.
+    #[test]
+    fn exit_classifies_the_part_by_the_goal_and_counts_it_once() {
+        let scene = quickstart();
+        for (deg, outcome) in [
+            (17.0, PartOutcome::Success),
+            (40.0, PartOutcome::WrongOrientation),
+        ] {
+            let mut belt = belt_with_part_at_end(&scene, deg);
+            let mut sinks = Sinks::for_scene(&scene, true, None);
+            exit(&scene, None, &mut belt, &mut sinks, 2.0, 0);
+            exit(&scene, None, &mut belt, &mut sinks, 3.0, 0);
+            assert!(belt.active.is_empty());
+            assert_eq!(belt.finished, 1);
+            assert_eq!(sinks.metrics.outcomes.total(), 1);
+            assert_eq!(sinks.metrics.outcomes.get(outcome), 1, "{deg}°");
+            let records = sinks.records.as_ref().unwrap();
+            assert_eq!(records.len(), 1);
+            assert_eq!((records[0].outcome, records[0].end_s), (outcome, 2.0));
+            assert_eq!(records[0].arrival_s, 1.0);
+            assert_eq!(sinks.last_end.map(|(o, _)| o), Some(outcome));
+        }
+    }
+
+    /// A part taken off with an outcome and cause keeps them in its record, and a run that keeps
+    /// no records writes none.
+    #[test]
+    fn finish_writes_the_outcome_and_cause_and_keeps_records_only_when_asked() {
+        let scene = quickstart();
+        for keep in [true, false] {
+            let mut belt = belt_with_part_at_end(&scene, 17.0);
+            let mut sinks = Sinks::for_scene(&scene, keep, None);
+            let end = (PartOutcome::Jam, Cause::TravelLimit);
+            finish(&scene, None, &mut belt, &mut sinks, 0, 2.0, end);
+            assert_eq!(sinks.metrics.outcomes.get(PartOutcome::Jam), 1);
+            assert_eq!(belt.finished, 1);
+            match sinks.records {
+                Some(r) => assert_eq!((r[0].outcome, r[0].cause), end),
+                None => assert!(!keep),
+            }
+        }
+    }
+}

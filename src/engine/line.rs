@@ -48,16 +48,14 @@ use super::controller::Control;
 use super::decision::decide;
 use super::event_queue::{Event, EventKind};
 use super::exit::{exit, finish};
-use super::metrics::Metrics;
 use super::online_decide::{decide_online, unread};
 use super::outcome::{Cause, PartOutcome};
 use super::results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult};
-use super::sensing::SensorStats;
 use super::serve::serve;
 use super::state::{Belt, Sinks, Touch};
 use crate::geometry::Pose;
 use crate::mechanics::PartModel;
-use crate::scenario::{Obstacle, PinObstacle, Scene};
+use crate::scenario::Scene;
 
 /// The run state: the scene and options it runs, the belt, what the run has produced, the
 /// controller and the map tier. [`Line::handle`] dispatches each event to its stage, which takes
@@ -232,37 +230,11 @@ fn simulate<'a>(
         Some(m) => Some(m.clone()),
         None => super::prepare::online_model(scene).map_err(EngineError::OnlineModel)?,
     };
-    let names = scene
-        .obstacles
-        .iter()
-        .map(|o| o.name().to_string())
-        .collect();
-    let mut metrics = Metrics::new(names, scene.output.histogram_bin_deg);
-    let mut sensor_pins = Vec::new();
-    for (j, o) in scene.obstacles.iter().enumerate() {
-        if let Obstacle::Pin(PinObstacle {
-            name,
-            sensor: Some(sensor),
-            ..
-        }) = o
-        {
-            sensor_pins.push((j, metrics.sensors.len()));
-            metrics.sensors.push(SensorStats::new(name, sensor));
-        }
-    }
     let mut line = Line {
         scene,
         opts,
         belt: Belt::new(),
-        sinks: Sinks {
-            metrics,
-            records: opts.keep_records.then(Vec::new),
-            events: Vec::new(),
-            paths: Vec::new(),
-            captured,
-            last_end: None,
-            sensor_pins,
-        },
+        sinks: Sinks::for_scene(scene, opts.keep_records, captured),
         control: Control::new(
             scene,
             scene.effects.event_log || opts.sample_paths > 0,

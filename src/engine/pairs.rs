@@ -129,3 +129,62 @@ fn first_overlap(
         evals,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::state::ActivePart;
+    use crate::geometry::Pose;
+
+    /// The quickstart's scene with two parts riding the belt from time 0 until time 1, their
+    /// centroids `gap` part radii apart along the belt at the same orientation; the pair is checked as part
+    /// 1's motion starts.
+    fn check_two_parts(gap: f64) -> (Belt, WorkCounters) {
+        let path = std::path::Path::new("scenarios/quickstart.toml");
+        let scene = crate::scenario::load(path).unwrap();
+        assert!(scene.effects.collisions);
+        let gap = gap * scene.part.radius;
+        let mut belt = Belt::new();
+        for (k, x) in [(0, 0.2), (1, 0.2 + gap)] {
+            let mut part = ActivePart::entering(0.0, Pose::new(x, 0.0, 0.3), None, false);
+            part.motion = Motion::Free {
+                t0: 0.0,
+                pose: Pose::new(x, 0.0, 0.3),
+                until: 1.0,
+            };
+            belt.active.insert(k, part);
+        }
+        let mut work = WorkCounters::default();
+        check_pairs(&scene, &mut belt, &mut work, 1, 0.0);
+        (belt, work)
+    }
+
+    /// Two parts half a radius apart overlap from the start: one collision of the pair is
+    /// scheduled then, lower index first.
+    #[test]
+    fn two_overlapping_parts_collide_at_once() {
+        let (mut belt, work) = check_two_parts(0.5);
+        assert_eq!(work.part_part_checks, 1);
+        assert_eq!(work.part_part_narrow_checks, 1);
+        let ev = belt.queue.pop().expect("a collision");
+        assert_eq!(ev.time, 0.0);
+        assert_eq!(
+            ev.kind,
+            EventKind::Collision {
+                first: 0,
+                second: 1
+            }
+        );
+        assert!(belt.queue.pop().is_none());
+    }
+
+    /// Two parts four radii apart riding the belt together never touch: the broad phase skips
+    /// the pair and nothing is scheduled.
+    #[test]
+    fn two_separated_parts_do_not_collide() {
+        let (mut belt, work) = check_two_parts(4.0);
+        assert_eq!(work.part_part_checks, 1);
+        assert_eq!(work.part_part_narrow_checks, 0);
+        assert!(belt.queue.pop().is_none());
+    }
+}

@@ -7,9 +7,10 @@ use super::metrics::Metrics;
 use super::motion::Motion;
 use super::outcome::PartOutcome;
 use super::results::{CapturedPush, PartRecord, SamplePath};
-use super::sensing::SensedDecision;
+use super::sensing::{SensedDecision, SensorStats};
 use crate::geometry::Pose;
 use crate::mechanics::PartModel;
+use crate::scenario::{Obstacle, PinObstacle, Scene};
 use std::collections::BTreeMap;
 
 /// A part on the belt: where it came in, how it moves now, and what has happened to it.
@@ -115,6 +116,44 @@ pub(super) struct Sinks {
     pub(super) last_end: Option<(PartOutcome, Pose)>,
     /// Sensor pins (obstacle index, index into `metrics.sensors`); empty in a passive scene.
     pub(super) sensor_pins: Vec<(usize, usize)>,
+}
+
+impl Sinks {
+    /// Empty sinks for a run of `scene`: statistics for every obstacle and sensor pin, records
+    /// when the run keeps them (`keep_records`), captured pushes when `captured` is given.
+    pub(super) fn for_scene(
+        scene: &Scene,
+        keep_records: bool,
+        captured: Option<Vec<CapturedPush>>,
+    ) -> Sinks {
+        let names = scene
+            .obstacles
+            .iter()
+            .map(|o| o.name().to_string())
+            .collect();
+        let mut metrics = Metrics::new(names, scene.output.histogram_bin_deg);
+        let mut sensor_pins = Vec::new();
+        for (j, o) in scene.obstacles.iter().enumerate() {
+            if let Obstacle::Pin(PinObstacle {
+                name,
+                sensor: Some(sensor),
+                ..
+            }) = o
+            {
+                sensor_pins.push((j, metrics.sensors.len()));
+                metrics.sensors.push(SensorStats::new(name, sensor));
+            }
+        }
+        Sinks {
+            metrics,
+            records: keep_records.then(Vec::new),
+            events: Vec::new(),
+            paths: Vec::new(),
+            captured,
+            last_end: None,
+            sensor_pins,
+        }
+    }
 }
 
 /// An event of one part at one obstacle: a contact begin or end.
