@@ -17,6 +17,11 @@
 //! which its events are valid, and older ones are dropped when they come off the queue), and its
 //! part–part checks run again. A scene without dynamic pins has no controller and does none of
 //! this (`work.decisions`, `work.actuator_commands`, `work.replans`, `work.stale_events` stay 0).
+//!
+//! This module holds the controller's state (`Control`: the rules, the dynamic pins'
+//! timelines and command queues) and what it reports; the stages that drive it are
+//! `super::decision` (the rules), `super::online_decide` (the belief and the online decision)
+//! and `super::serve` (the dynamic pins serving their commands).
 
 use super::actuator::Track;
 use super::online::OnlineModel;

@@ -104,3 +104,57 @@ pub(super) fn plan_next(
     };
     part.motion = Motion::Free { t0, pose, until };
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Pose;
+
+    fn quickstart() -> Scene {
+        crate::scenario::load(std::path::Path::new("scenarios/quickstart.toml")).unwrap()
+    }
+
+    /// Part 0 riding the belt from x = 0.1 m at time 2 s, planned on `scene`.
+    fn plan(scene: &Scene) -> (EventQueue, ActivePart, WorkCounters) {
+        let mut part = ActivePart::entering(2.0, Pose::new(0.1, 0.0, 0.5), None, false);
+        let (mut queue, mut work) = (EventQueue::new(), WorkCounters::default());
+        plan_next(scene, None, &mut work, &mut queue, 0, &mut part, 2.0);
+        (queue, part, work)
+    }
+
+    /// On a line without obstacles the part's next event is its exit, when its centroid reaches
+    /// the belt's end riding the belt; no obstacle is cast against.
+    #[test]
+    fn without_obstacles_the_next_event_is_the_exit() {
+        let mut scene = quickstart();
+        scene.obstacles.clear();
+        let (mut queue, part, work) = plan(&scene);
+        let t_exit = 2.0 + (scene.belt.length - 0.1) / scene.belt.speed;
+        let ev = queue.pop().unwrap();
+        assert_eq!((ev.time, ev.kind), (t_exit, EventKind::Exit { part: 0 }));
+        assert!(queue.pop().is_none());
+        assert_eq!(part.motion.until(), t_exit);
+        assert_eq!(work.ray_casts, 0);
+    }
+
+    /// On the quickstart line the part meets a pin before the belt's end: the contact begin is
+    /// scheduled, and the pin it has just left is not cast against again.
+    #[test]
+    fn a_pin_in_the_way_comes_before_the_exit_and_the_last_one_is_skipped() {
+        let scene = quickstart();
+        let (mut queue, part, work) = plan(&scene);
+        let ev = queue.pop().unwrap();
+        let EventKind::ContactBegin { part: 0, obstacle } = ev.kind else {
+            panic!("a contact begin: {ev:?}");
+        };
+        assert_eq!(part.motion.until(), ev.time);
+        assert!(work.ray_casts > 0);
+        let mut again = ActivePart::entering(2.0, Pose::new(0.1, 0.0, 0.5), None, false);
+        again.last_obstacle = Some(obstacle as usize);
+        let (mut queue, mut work2) = (EventQueue::new(), WorkCounters::default());
+        plan_next(&scene, None, &mut work2, &mut queue, 0, &mut again, 2.0);
+        let next = queue.pop().unwrap();
+        assert_ne!(next.kind, ev.kind);
+        assert!(next.time >= ev.time);
+    }
+}
