@@ -335,15 +335,18 @@ impl Line<'_> {
                 hypothesis,
             } => {
                 let work = &mut sinks.metrics.work;
-                match control.as_mut() {
-                    Some(c) if c.online_model().is_some() => {
+                if let Some(c) = control.as_mut() {
+                    let taken = if c.online_model().is_some() {
                         decide_online(scene, c, &mut belt.active, work, t, part)
-                    }
-                    Some(c) => {
+                    } else {
                         let h = (hypothesis != u32::MAX).then_some(hypothesis as usize);
-                        decide(scene, c, work, t, part, obstacle as usize, h)
+                        decide(scene, c, work, t, part, obstacle as usize, h);
+                        true
+                    };
+                    // A decision taken is served at once, before the serving after every event.
+                    if taken {
+                        serve(scene, c, belt, work, t);
                     }
-                    None => {}
                 }
             }
             EventKind::Unread { part, obstacle } => {

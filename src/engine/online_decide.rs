@@ -138,7 +138,8 @@ pub(super) fn unread(
 }
 
 /// The online decision for part `index` at time `t`: the joint command of the dynamic pins that
-/// maximises P(goal) under its belief, queued like a rule's commands.
+/// maximises P(goal) under its belief, queued like a rule's commands. Returns whether it was
+/// taken (false: no model, or the part or its belief is gone).
 pub(super) fn decide_online(
     scene: &Scene,
     control: &mut Control,
@@ -146,16 +147,16 @@ pub(super) fn decide_online(
     work: &mut WorkCounters,
     t: f64,
     index: u64,
-) {
+) -> bool {
     let Some(model) = control.online_model().cloned() else {
-        return;
+        return false;
     };
     work.decisions += 1;
     let Some(part) = active.get_mut(&index) else {
-        return;
+        return false;
     };
     let Some(belief) = part.belief.as_ref() else {
-        return;
+        return false;
     };
     let choice = model.choose(belief);
     part.predicted = Some(choice.predicted);
@@ -204,4 +205,5 @@ pub(super) fn decide_online(
         work.actuator_commands += 1;
         control.queue_command(pin, index, target);
     }
+    true
 }
