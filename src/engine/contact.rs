@@ -10,15 +10,21 @@
 //! edge ([`edge_crossing`], off the belt). A sample part's path records the push
 //! (`record_path`).
 
-use super::contact_map::PushRequest;
-use super::event_queue::EventKind;
-use super::line::{ActivePart, Line};
+use super::contact_map::{push_contact, LineMaps, PushRequest};
+use super::controller::{capsule_during, pin_motion, Control};
+use super::event_queue::{EventKind, EventQueue};
+use super::exit::finish;
 use super::metrics::WorkCounters;
 use super::motion::{ContactPlan, Motion, Pusher, Stop};
+use super::online_decide::online_reading;
 use super::outcome::{Cause, PartOutcome};
 use super::overlap::{capsule_clearance, first_touch};
+use super::pairs::check_pairs;
+use super::plan::ride_on;
+use super::reading::sense;
 use super::results::CapturedPush;
 use super::sensing::SensedPass;
+use super::state::{ActivePart, Belt, Sinks, Touch};
 use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
     ContactOutcome, ContactSettings, ContactStatus, PartModel, PinPath, SolveFailure,
@@ -31,195 +37,228 @@ use crate::sensing::signal::KnotRecorder;
 /// `grazing_loop`) rather than handed between obstacles for ever.
 const MAX_GRAZES: u32 = 16;
 
-impl Line<'_> {
-    /// Part `index` touches obstacle `j` at time `t`: run the push and hold the part until it
-    /// ends (or take it off the line at once).
-    pub(super) fn contact_begin(&mut self, t: f64, index: u64, j: usize) {
-        let scene = self.scene;
-        let v = self.speed();
-        let Some(mut part) = self.active.remove(&index) else {
-            return; // the part has already left the line
-        };
-        let Motion::Free { t0, pose, .. } = part.motion else {
-            unreachable!("contact begin for a held part");
-        };
-        let obstacle = &scene.obstacles[j];
-        let placed = match obstacle {
-            Obstacle::Pin(pin) => Some(self.pin_motion(j, pin, t0)),
-            Obstacle::Fence(_) => None,
-        };
-        let (pusher, settings) = pusher_for(obstacle, &scene.contact, placed);
-        // The push is recorded as it is computed when anything will look at its path: a sensor
-        // pin's signal, a neighbouring obstacle, a fence's edge crossing, a drawn path, or another
-        // part on the belt (its overlap check). Never computed twice — except that a push the map
-        // tier answers keeps no path, and the overlap check records it if it turns out to need it
-        // (see `contact_map`).
-        let sensor = sensor_of(obstacle);
-        let must_record = sensor.is_some() || self.must_look_at_path(j, &part);
-        let record = must_record || self.may_look_at_path();
-        let mut knots = KnotRecorder::default();
-        let request = PushRequest {
-            j,
-            pusher: &pusher,
+/// Part `touch.part` touches obstacle `touch.obstacle` at `touch.t`: run the push (from `maps`
+/// where the tier answers it) and hold the part until it ends, or take it off the line at once.
+/// A sensor pin reads the push (`seed`: the run's) and, with a controller, schedules its decision.
+pub(super) fn contact_begin(
+    scene: &Scene,
+    seed: u64,
+    maps: Option<&LineMaps>,
+    control: Option<&mut Control>,
+    belt: &mut Belt,
+    sinks: &mut Sinks,
+    touch: Touch,
+) {
+    let (t, index, j) = (touch.t, touch.part, touch.obstacle);
+    let v = scene.belt.speed;
+    let Some(mut part) = belt.active.remove(&index) else {
+        return; // the part has already left the line
+    };
+    let Motion::Free { t0, pose, .. } = part.motion else {
+        unreachable!("contact begin for a held part");
+    };
+    let obstacle = &scene.obstacles[j];
+    let placed = match obstacle {
+        Obstacle::Pin(pin) => Some(pin_motion(control.as_deref(), v, j, pin, t0)),
+        Obstacle::Fence(_) => None,
+    };
+    let (pusher, settings) = pusher_for(obstacle, &scene.contact, placed);
+    // The push is recorded as it is computed when anything will look at its path: a sensor
+    // pin's signal, a neighbouring obstacle, a fence's edge crossing, a drawn path, or another
+    // part on the belt (its overlap check). Never computed twice — except that a push the map
+    // tier answers keeps no path, and the overlap check records it if it turns out to need it
+    // (see `contact_map`).
+    let sensor = sensor_of(obstacle);
+    let must_record = sensor.is_some() || must_look_at_path(scene, j, &part);
+    let record = must_record || may_look_at_path(scene, belt);
+    let mut knots = KnotRecorder::default();
+    let request = PushRequest {
+        j,
+        pusher: &pusher,
+        pose,
+        settings: &settings,
+        record,
+        must_record,
+    };
+    if let Some(list) = sinks.captured.as_mut() {
+        list.push(CapturedPush {
+            obstacle: j,
+            model: part.model.clone(),
+            pusher: pusher.clone(),
             pose,
-            settings: &settings,
-            record,
-            must_record,
-        };
-        if let Some(list) = self.captured.as_mut() {
-            list.push(CapturedPush {
-                obstacle: j,
-                model: part.model.clone(),
-                pusher: pusher.clone(),
-                pose,
-                settings,
-                recorded: record,
-            });
-        }
-        let (out, record) = self.push_contact(&part, request, &mut knots);
-        let model = part.model.as_ref().unwrap_or(&scene.part.model);
-        self.metrics.work.contact_solves += 1;
-        self.metrics.work.model_evaluations += out.evaluations;
-        if matches!(out.status, ContactStatus::PinInsidePart) {
-            self.active.insert(index, part);
-            self.finish(index, t, PartOutcome::MultiContact, Cause::PinInsidePart);
-            return;
-        }
-        if !out.contact {
-            self.graze(t, index, j, part);
-            return;
-        }
-        part.grazes = 0;
-        let mut reading = None;
-        if let Some(sensor) = sensor {
-            let (decision, sensed) =
-                self.sense(index, j, sensor, &out, &knots.samples, pose.theta_rad);
-            part.sensed.push(decision);
-            reading = Some(sensed);
-        }
-        let mut plan = plan_of(j, (t0, pose), pusher, settings, out, t, v);
-        if record {
-            plan.set_trace(&knots.samples);
-            self.metrics.work.traces_recorded += u64::from(sensor.is_none());
-        }
-        let capsules = |nb: usize| self.capsule_during(nb, plan.t_begin, plan.t_end);
-        let capsules: Vec<Option<(Vec2, Vec2, f64)>> =
-            scene.neighbours[j].iter().map(|&nb| capsules(nb)).collect();
-        let work = &mut self.metrics.work;
-        if let Some(tm) = sweep_neighbours(scene, &mut plan, model, &capsules, work) {
-            plan.t_end = tm.max(t);
-            plan.stop = Some(Stop::MultiContact {
-                cause: Cause::SecondObstacle,
-            });
-        }
-        if let Some(tm) = fence_off_belt(scene, &mut plan, model, work) {
-            plan.t_end = tm.max(t);
-            plan.stop = Some(Stop::OffBelt);
-        }
-        part.contacts += 1;
-        self.metrics.contacts += 1;
-        self.metrics.obstacles[j].contacts += 1;
-        if let Some(path) = part.path.as_mut() {
-            record_path(&mut plan, model, v, path, &mut self.metrics.work);
-        }
-        if let Some(sensed) = reading {
-            self.schedule_decision(index, &mut part, j, &sensed, plan.t_end);
-        }
-        self.hold(t, index, part, plan);
+            settings,
+            recorded: record,
+        });
     }
+    let counters = &mut sinks.metrics.work.map_tier;
+    let (out, record) = push_contact(scene, maps, counters, &part, request, &mut knots);
+    let model = part.model.as_ref().unwrap_or(&scene.part.model);
+    sinks.metrics.work.contact_solves += 1;
+    sinks.metrics.work.model_evaluations += out.evaluations;
+    if matches!(out.status, ContactStatus::PinInsidePart) {
+        belt.active.insert(index, part);
+        let end = (PartOutcome::MultiContact, Cause::PinInsidePart);
+        finish(scene, control, belt, sinks, index, t, end);
+        return;
+    }
+    if !out.contact {
+        graze(scene, control, belt, sinks, touch, part);
+        return;
+    }
+    part.grazes = 0;
+    let mut reading = None;
+    if let Some(sensor) = sensor {
+        let pass = (&out, knots.samples.as_slice());
+        let (decision, sensed) = sense(scene, seed, sinks, touch, sensor, pass, pose.theta_rad);
+        part.sensed.push(decision);
+        reading = Some(sensed);
+    }
+    let mut plan = plan_of(j, (t0, pose), pusher, settings, out, t, v);
+    let work = &mut sinks.metrics.work;
+    if record {
+        plan.set_trace(&knots.samples);
+        work.traces_recorded += u64::from(sensor.is_none());
+    }
+    let capsules =
+        |nb: usize| capsule_during(control.as_deref(), scene, nb, plan.t_begin, plan.t_end);
+    let capsules: Vec<Option<(Vec2, Vec2, f64)>> =
+        scene.neighbours[j].iter().map(|&nb| capsules(nb)).collect();
+    if let Some(tm) = sweep_neighbours(scene, &mut plan, model, &capsules, work) {
+        plan.t_end = tm.max(t);
+        plan.stop = Some(Stop::MultiContact {
+            cause: Cause::SecondObstacle,
+        });
+    }
+    if let Some(tm) = fence_off_belt(scene, &mut plan, model, work) {
+        plan.t_end = tm.max(t);
+        plan.stop = Some(Stop::OffBelt);
+    }
+    part.contacts += 1;
+    sinks.metrics.contacts += 1;
+    sinks.metrics.obstacles[j].contacts += 1;
+    let work = &mut sinks.metrics.work;
+    if let Some(path) = part.path.as_mut() {
+        record_path(&mut plan, model, v, path, work);
+    }
+    if let Some(sensed) = reading {
+        schedule_decision(
+            control,
+            &mut belt.queue,
+            index,
+            &mut part,
+            j,
+            &sensed,
+            plan.t_end,
+        );
+    }
+    hold(scene, belt, work, touch, part, plan);
+}
 
-    /// With a controller, a reading becomes a decision once the reading is over (the end of the
-    /// push) and the controller has computed (its latency).
-    fn schedule_decision(
-        &mut self,
-        index: u64,
-        part: &mut ActivePart,
-        j: usize,
-        sensed: &SensedPass,
-        t_end: f64,
-    ) {
-        let Some(c) = self.control.as_ref() else {
-            return;
-        };
-        if c.online_model().is_some() {
-            // Online: the decided label is kept for the sensor's statistics only; the belief
-            // takes the reading itself and the classifier's posterior over the states.
-            let decision = match sensed.classification.decision {
-                Decision::Hypothesis(h) => Some(h),
-                Decision::Unknown => None,
-            };
-            part.decided.push((j, decision, sensed.truth));
-            let t_ready = t_end + c.latency();
-            let posterior = sensed.classification.posterior.as_deref();
-            self.online_reading(part, index, j, sensed.reading.as_ref(), posterior, t_ready);
-            return;
-        }
-        let c12 = &sensed.classification;
-        let h = match c12.decision {
+/// With a controller, a reading becomes a decision once the reading is over (the end of the
+/// push, `t_end`) and the controller has computed (its latency).
+fn schedule_decision(
+    control: Option<&mut Control>,
+    queue: &mut EventQueue,
+    index: u64,
+    part: &mut ActivePart,
+    j: usize,
+    sensed: &SensedPass,
+    t_end: f64,
+) {
+    let Some(c) = control else {
+        return;
+    };
+    if c.online_model().is_some() {
+        // Online: the decided label is kept for the sensor's statistics only; the belief
+        // takes the reading itself and the classifier's posterior over the states.
+        let decision = match sensed.classification.decision {
             Decision::Hypothesis(h) => Some(h),
             Decision::Unknown => None,
         };
-        let posterior = h.and_then(|h| c12.posterior.as_ref().map(|p| p[h]));
-        let decision = c.decision(h, posterior);
         part.decided.push((j, decision, sensed.truth));
-        self.queue.schedule(
-            t_end + c.latency(),
-            EventKind::Decision {
-                part: index,
-                obstacle: j as u32,
-                hypothesis: decision.map_or(u32::MAX, |h| h as u32),
-            },
-        );
+        online_reading(c, queue, part, index, j, sensed, t_end);
+        return;
     }
+    let c12 = &sensed.classification;
+    let h = match c12.decision {
+        Decision::Hypothesis(h) => Some(h),
+        Decision::Unknown => None,
+    };
+    let posterior = h.and_then(|h| c12.posterior.as_ref().map(|p| p[h]));
+    let decision = c.decision(h, posterior);
+    part.decided.push((j, decision, sensed.truth));
+    queue.schedule(
+        t_end + c.latency(),
+        EventKind::Decision {
+            part: index,
+            obstacle: j as u32,
+            hypothesis: decision.map_or(u32::MAX, |h| h as u32),
+        },
+    );
+}
 
-    /// Will anything certainly look at the path of a push by obstacle `j` of this part (so that it
-    /// is recorded as it is computed)?
-    fn must_look_at_path(&self, j: usize, part: &ActivePart) -> bool {
-        let scene = self.scene;
-        let sweeps = scene.effects.obstacle_sweeps && !scene.neighbours[j].is_empty();
-        let fence_edge = matches!(scene.obstacles[j], Obstacle::Fence(_)) && {
-            let [y_min, y_max] = scene.obstacles[j].y_range();
-            let (half, a) = (scene.belt.width / 2.0, scene.part.radius);
-            y_min - a < -half || y_max + a > half
-        };
-        sweeps || fence_edge || part.path.is_some()
-    }
+/// Will anything certainly look at the path of a push by obstacle `j` of this part (so that it
+/// is recorded as it is computed)?
+fn must_look_at_path(scene: &Scene, j: usize, part: &ActivePart) -> bool {
+    let sweeps = scene.effects.obstacle_sweeps && !scene.neighbours[j].is_empty();
+    let fence_edge = matches!(scene.obstacles[j], Obstacle::Fence(_)) && {
+        let [y_min, y_max] = scene.obstacles[j].y_range();
+        let (half, a) = (scene.belt.width / 2.0, scene.part.radius);
+        y_min - a < -half || y_max + a > half
+    };
+    sweeps || fence_edge || part.path.is_some()
+}
 
-    /// May the overlap check with another part on the belt look at the path of a push?
-    fn may_look_at_path(&self) -> bool {
-        self.scene.effects.collisions && !self.active.is_empty()
-    }
+/// May the overlap check with another part on the belt look at the path of a push?
+fn may_look_at_path(scene: &Scene, belt: &Belt) -> bool {
+    scene.effects.collisions && !belt.active.is_empty()
+}
 
-    /// The model found only a grazing touch: the obstacle passes without pushing, and the part
-    /// rides on (unless it has grazed too often in a row).
-    fn graze(&mut self, t: f64, index: u64, j: usize, mut part: ActivePart) {
-        part.grazes += 1;
-        if part.grazes > MAX_GRAZES {
-            self.active.insert(index, part);
-            self.finish(index, t, PartOutcome::Solver, Cause::GrazingLoop);
-            return;
-        }
-        part.last_obstacle = Some(j);
-        self.plan_next(index, &mut part, t);
-        self.active.insert(index, part);
-        self.check_pairs(index, t);
+/// The model found only a grazing touch: the obstacle passes without pushing, and the part
+/// rides on (unless it has grazed too often in a row).
+fn graze(
+    scene: &Scene,
+    control: Option<&mut Control>,
+    belt: &mut Belt,
+    sinks: &mut Sinks,
+    touch: Touch,
+    mut part: ActivePart,
+) {
+    let (t, index) = (touch.t, touch.part);
+    part.grazes += 1;
+    if part.grazes > MAX_GRAZES {
+        belt.active.insert(index, part);
+        let end = (PartOutcome::Solver, Cause::GrazingLoop);
+        finish(scene, control, belt, sinks, index, t, end);
+        return;
     }
+    part.last_obstacle = Some(touch.obstacle);
+    let work = &mut sinks.metrics.work;
+    ride_on(scene, control.as_deref(), belt, work, index, part, t);
+}
 
-    /// Hold part `index` in `plan` from time `t`: its contact end is scheduled and its new motion
-    /// checked against the other parts.
-    fn hold(&mut self, t: f64, index: u64, mut part: ActivePart, plan: ContactPlan) {
-        let (t_end, j) = (plan.t_end, plan.obstacle);
-        part.motion = Motion::Held(Box::new(plan));
-        self.queue.schedule(
-            t_end,
-            EventKind::ContactEnd {
-                part: index,
-                obstacle: j as u32,
-            },
-        );
-        self.active.insert(index, part);
-        self.check_pairs(index, t);
-    }
+/// Hold the part `touch.part` in `plan` from `touch.t`: its contact end is scheduled and its new
+/// motion checked against the other parts.
+fn hold(
+    scene: &Scene,
+    belt: &mut Belt,
+    work: &mut WorkCounters,
+    touch: Touch,
+    mut part: ActivePart,
+    plan: ContactPlan,
+) {
+    let (t, index) = (touch.t, touch.part);
+    let (t_end, j) = (plan.t_end, plan.obstacle);
+    part.motion = Motion::Held(Box::new(plan));
+    belt.queue.schedule(
+        t_end,
+        EventKind::ContactEnd {
+            part: index,
+            obstacle: j as u32,
+        },
+    );
+    belt.active.insert(index, part);
+    check_pairs(scene, belt, work, index, t);
 }
 
 /// The obstacle as the contact model takes it, with the settings of its push: a pin's own μc

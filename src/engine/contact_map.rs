@@ -10,8 +10,9 @@
 //! exact model records it then (`work.pushes_rerun`), as for any unforeseen look. A scene without
 //! the tier runs exactly as before: no maps, no counters.
 
-use super::line::{ActivePart, Line};
+use super::metrics::MapTierCounters;
 use super::motion::Pusher;
+use super::state::ActivePart;
 use crate::geometry::Pose;
 use crate::maps::tier::{self, Fallback, Loaded, TierInputs, TierMap};
 use crate::mechanics::{ContactOutcome, ContactSettings, PinPath, Recorder, Support};
@@ -98,42 +99,41 @@ pub(super) struct PushRequest<'p> {
     pub must_record: bool,
 }
 
-impl Line<'_> {
-    /// The push: from the map where the scene uses the tier and the map can answer, else from the
-    /// contact model (recording its path into `knots` if asked). Returns the outcome and whether
-    /// its path was recorded.
-    pub(super) fn push_contact(
-        &mut self,
-        part: &ActivePart,
-        req: PushRequest,
-        knots: &mut KnotRecorder,
-    ) -> (ContactOutcome, bool) {
-        let model = part.model.as_ref().unwrap_or(&self.scene.part.model);
-        if let Some(maps) = self.maps.as_ref() {
-            let counters = &mut self.metrics.work.map_tier;
-            let answer = match (req.pusher, &maps.by_obstacle[req.j]) {
-                _ if req.must_record => Err(Fallback::Trace),
-                _ if part.model.is_some() => Err(Fallback::PartSupport),
-                (Pusher::Fence(_), _) | (_, None) => Err(Fallback::Fence),
-                (Pusher::Pin { path, .. }, _) if *path != PinPath::constant(0.0) => {
-                    Err(Fallback::MovingPin)
-                }
-                (Pusher::Pin { centre, radius, .. }, Some(map)) => {
-                    map.answer(model, req.pose, *centre, *radius)
-                }
-            };
-            match answer {
-                Ok(out) => {
-                    counters.served += 1;
-                    return (out, false);
-                }
-                Err(why) => counters.count(why),
+/// The push of `part`: from `maps` where the scene uses the tier and the map can answer (each
+/// answer or fallback counted in `counters`), else from the contact model (recording its path
+/// into `knots` if asked). Returns the outcome and whether its path was recorded.
+pub(super) fn push_contact(
+    scene: &Scene,
+    maps: Option<&LineMaps>,
+    counters: &mut MapTierCounters,
+    part: &ActivePart,
+    req: PushRequest,
+    knots: &mut KnotRecorder,
+) -> (ContactOutcome, bool) {
+    let model = part.model.as_ref().unwrap_or(&scene.part.model);
+    if let Some(maps) = maps {
+        let answer = match (req.pusher, &maps.by_obstacle[req.j]) {
+            _ if req.must_record => Err(Fallback::Trace),
+            _ if part.model.is_some() => Err(Fallback::PartSupport),
+            (Pusher::Fence(_), _) | (_, None) => Err(Fallback::Fence),
+            (Pusher::Pin { path, .. }, _) if *path != PinPath::constant(0.0) => {
+                Err(Fallback::MovingPin)
             }
+            (Pusher::Pin { centre, radius, .. }, Some(map)) => {
+                map.answer(model, req.pose, *centre, *radius)
+            }
+        };
+        match answer {
+            Ok(out) => {
+                counters.served += 1;
+                return (out, false);
+            }
+            Err(why) => counters.count(why),
         }
-        let recorder = req.record.then_some(knots as &mut dyn Recorder);
-        (
-            req.pusher.push(model, req.pose, req.settings, recorder),
-            req.record,
-        )
     }
+    let recorder = req.record.then_some(knots as &mut dyn Recorder);
+    (
+        req.pusher.push(model, req.pose, req.settings, recorder),
+        req.record,
+    )
 }

@@ -17,11 +17,13 @@
 //! which its events are valid, and older ones are dropped when they come off the queue), and its
 //! part–part checks run again. A scene without dynamic pins has no controller and does none of
 //! this (`work.decisions`, `work.actuator_commands`, `work.replans`, `work.stale_events` stay 0).
+//!
+//! This module holds the controller's state (`Control`: the rules, the dynamic pins'
+//! timelines and command queues) and what it reports; the stages that drive it are
+//! `super::decision` (the rules), `super::online_decide` (the belief and the online decision)
+//! and `super::serve` (the dynamic pins serving their commands).
 
 use super::actuator::Track;
-use super::event_queue::EventKind;
-use super::line::{ActivePart, Line};
-use super::motion::Motion;
 use super::online::OnlineModel;
 use super::outcome::PartOutcome;
 use crate::geometry::Vec2;
@@ -232,30 +234,30 @@ pub struct ControllerSummary {
 }
 
 /// Running sums behind [`OnlineSummary`].
-struct OnlineRun {
+pub(super) struct OnlineRun {
     model: Arc<OnlineModel>,
-    summary: OnlineSummary,
+    pub(super) summary: OnlineSummary,
     /// Per calibration bin: parts, Σ predicted, successes.
     bins: [(u64, f64, u64); 10],
     /// Per joint command of the model: how often it was chosen; and the names of the model's
     /// pins, to describe the commands in the summary at the end.
-    chosen: Vec<u64>,
+    pub(super) chosen: Vec<u64>,
     pin_names: Vec<String>,
 }
 
 /// The controller's run state.
 pub(super) struct Control {
-    spec: Controller,
+    pub(super) spec: Controller,
     /// Per obstacle: its timeline if it is a dynamic pin.
     pub(super) tracks: Vec<Option<Track>>,
     /// Per obstacle: targets waiting for their part's turn, by part.
-    queues: Vec<BTreeMap<u64, Target>>,
+    pub(super) queues: Vec<BTreeMap<u64, Target>>,
     pub(super) summary: ControllerSummary,
     /// Per obstacle: index into `summary.actuators`.
-    stats_of: Vec<Option<usize>>,
+    pub(super) stats_of: Vec<Option<usize>>,
     pub(super) log: Option<Vec<ControlRecord>>,
     /// The online controller's model and record (online mode only).
-    online: Option<OnlineRun>,
+    pub(super) online: Option<OnlineRun>,
 }
 
 impl Control {
@@ -435,7 +437,16 @@ impl Control {
         }
     }
 
-    fn log(&mut self, r: ControlRecord) {
+    /// Queue `target` for dynamic pin `pin`, for part `part`'s turn.
+    pub(super) fn queue_command(&mut self, pin: usize, part: u64, target: Target) {
+        self.queues[pin].insert(part, target);
+        if let Some(k) = self.stats_of[pin] {
+            self.summary.actuators[k].commands += 1;
+        }
+    }
+
+    /// Keep `r` in the control log, when the run keeps one.
+    pub(super) fn log(&mut self, r: ControlRecord) {
         if let Some(l) = self.log.as_mut() {
             l.push(r);
         }
@@ -484,7 +495,7 @@ impl Control {
 }
 
 /// A joint command as `pin=target, …` (the online summary's and the control log's words).
-fn describe_action(pin_names: &[String], action: &[Target]) -> String {
+pub(super) fn describe_action(pin_names: &[String], action: &[Target]) -> String {
     pin_names
         .iter()
         .zip(action)
@@ -494,7 +505,7 @@ fn describe_action(pin_names: &[String], action: &[Target]) -> String {
 }
 
 /// A decision of sensor pin `sensor` as its hypothesis label, or `unknown`.
-fn decision_label(scene: &Scene, sensor: usize, decision: Option<usize>) -> String {
+pub(super) fn decision_label(scene: &Scene, sensor: usize, decision: Option<usize>) -> String {
     match (decision, &scene.obstacles[sensor]) {
         (Some(h), Obstacle::Pin(p)) => p
             .sensor
@@ -504,7 +515,8 @@ fn decision_label(scene: &Scene, sensor: usize, decision: Option<usize>) -> Stri
     }
 }
 
-fn describe_target(t: Target) -> String {
+/// A command's target as `y=…`, `raised` or `withdrawn`.
+pub(super) fn describe_target(t: Target) -> String {
     match t {
         Target::Y(y) => format!("y={y}"),
         Target::Raised(true) => "raised".into(),
@@ -512,458 +524,61 @@ fn describe_target(t: Target) -> String {
     }
 }
 
-impl Line<'_> {
-    /// Where pin `j` stands at time `t0` and the path it follows from then on.
-    pub(super) fn pin_motion(&self, j: usize, pin: &PinObstacle, t0: f64) -> (Vec2, PinPath) {
-        match (&self.control, &pin.actuator) {
-            (Some(c), Some(Actuator::Moving(m))) => {
-                let track = c.tracks[j].as_ref().expect("a moving pin has a track");
-                let y = track.y_at(t0, pin.centre.y);
-                let path = track.path_from(t0, self.speed(), m.pieces);
-                (Vec2::new(pin.centre.x, y), path)
-            }
-            _ => (pin.centre, PinPath::constant(0.0)),
+/// Where pin `j` stands at time `t0` and the path it follows from then on (`speed`: the belt's,
+/// m/s): a moving pin as `control`'s timeline commands it, any other pin where the scene puts it.
+pub(super) fn pin_motion(
+    control: Option<&Control>,
+    speed: f64,
+    j: usize,
+    pin: &PinObstacle,
+    t0: f64,
+) -> (Vec2, PinPath) {
+    match (control, &pin.actuator) {
+        (Some(c), Some(Actuator::Moving(m))) => {
+            let track = c.tracks[j].as_ref().expect("a moving pin has a track");
+            let y = track.y_at(t0, pin.centre.y);
+            let path = track.path_from(t0, speed, m.pieces);
+            (Vec2::new(pin.centre.x, y), path)
         }
+        _ => (pin.centre, PinPath::constant(0.0)),
     }
+}
 
-    /// Is obstacle `j` present at time `t` (a withdrawn or moving-in retractable pin is not)?
-    pub(super) fn present_at(&self, j: usize, t: f64) -> bool {
-        match &self.control {
-            Some(c) => c.tracks[j].as_ref().is_none_or(|tr| tr.present_at(t)),
-            None => true,
-        }
+/// Is obstacle `j` present at time `t` (a withdrawn or moving-in retractable pin is not)?
+pub(super) fn present_at(control: Option<&Control>, j: usize, t: f64) -> bool {
+    match control {
+        Some(c) => c.tracks[j].as_ref().is_none_or(|tr| tr.present_at(t)),
+        None => true,
     }
+}
 
-    /// Where obstacle `j` can be during [ta, tb], as a capsule (None: absent throughout).
-    pub(super) fn capsule_during(&self, j: usize, ta: f64, tb: f64) -> Option<(Vec2, Vec2, f64)> {
-        let ob = &self.scene.obstacles[j];
-        let Some(track) = self.control.as_ref().and_then(|c| c.tracks[j].as_ref()) else {
-            return Some(ob.capsule());
-        };
-        let Obstacle::Pin(pin) = ob else {
-            return Some(ob.capsule());
-        };
-        match track {
-            Track::Moving { .. } => {
-                let (lo, hi) = track.y_span(ta, tb, pin.centre.y);
-                Some((
-                    Vec2::new(pin.centre.x, lo),
-                    Vec2::new(pin.centre.x, hi),
-                    pin.radius,
-                ))
-            }
-            Track::Retractable { .. } => track
-                .present_during(ta, tb)
-                .then_some((pin.centre, pin.centre, pin.radius)),
+/// Where obstacle `j` of `scene` can be during [ta, tb], as a capsule (None: absent throughout).
+pub(super) fn capsule_during(
+    control: Option<&Control>,
+    scene: &Scene,
+    j: usize,
+    ta: f64,
+    tb: f64,
+) -> Option<(Vec2, Vec2, f64)> {
+    let ob = &scene.obstacles[j];
+    let Some(track) = control.and_then(|c| c.tracks[j].as_ref()) else {
+        return Some(ob.capsule());
+    };
+    let Obstacle::Pin(pin) = ob else {
+        return Some(ob.capsule());
+    };
+    match track {
+        Track::Moving { .. } => {
+            let (lo, hi) = track.y_span(ta, tb, pin.centre.y);
+            Some((
+                Vec2::new(pin.centre.x, lo),
+                Vec2::new(pin.centre.x, hi),
+                pin.radius,
+            ))
         }
-    }
-
-    /// A sensor's decision on part `index` reaches the controller: the rules turn it into
-    /// commands.
-    pub(super) fn decide(&mut self, t: f64, index: u64, sensor: usize, decision: Option<usize>) {
-        if self.control.as_ref().is_some_and(|c| c.online.is_some()) {
-            self.decide_online(t, index);
-            return;
-        }
-        let Some(c) = self.control.as_mut() else {
-            return;
-        };
-        self.metrics.work.decisions += 1;
-        let label = decision_label(self.scene, sensor, decision);
-        let name = self.scene.obstacles[sensor].name().to_string();
-        c.log(ControlRecord {
-            t,
-            part: index,
-            obstacle: name,
-            kind: ControlKind::Decision,
-            what: label,
-            motion: None,
-        });
-        let commands: Vec<(usize, Target)> = c
-            .spec
-            .rules
-            .iter()
-            .filter(|r| r.sensor == sensor && r.decides == decision)
-            .map(|r| (r.pin, r.target))
-            .collect();
-        for (pin, target) in commands {
-            self.metrics.work.actuator_commands += 1;
-            c.queues[pin].insert(index, target);
-            if let Some(k) = c.stats_of[pin] {
-                c.summary.actuators[k].commands += 1;
-            }
-        }
-        self.serve(t);
-    }
-
-    /// Online mode: a part enters with the prior belief; for each sensor pin a check is scheduled
-    /// for when it could first be past the pin riding the belt (a pass without contact is
-    /// evidence too).
-    pub(super) fn online_arrival(&mut self, t: f64, index: u64, part: &mut ActivePart) {
-        let Some(model) = self
-            .control
-            .as_ref()
-            .and_then(|c| c.online_model())
-            .cloned()
-        else {
-            return;
-        };
-        part.belief = Some(model.prior.clone());
-        part.sensors_left = model.sensors.len() as u32;
-        for s in &model.sensors {
-            let clear = self.sensor_clear_x(s.obstacle);
-            self.queue.schedule(
-                t + (clear - part.motion.world_pose(t, self.speed()).x).max(0.0) / self.speed(),
-                EventKind::Unread {
-                    part: index,
-                    obstacle: s.obstacle as u32,
-                },
-            );
-        }
-    }
-
-    /// The centroid x beyond which a part can no longer touch sensor pin `j`.
-    fn sensor_clear_x(&self, j: usize) -> f64 {
-        let a = self.scene.part.radius;
-        match &self.scene.obstacles[j] {
-            Obstacle::Pin(p) => p.centre.x + p.radius + a,
-            Obstacle::Fence(_) => self.scene.obstacles[j].x_range()[1] + a,
-        }
-    }
-
-    /// A sensor pin's reading of part `index` (online mode): the belief takes it; once every
-    /// sensor has spoken the decision is scheduled at `t_ready`.
-    pub(super) fn online_reading(
-        &mut self,
-        part: &mut ActivePart,
-        index: u64,
-        j: usize,
-        reading: Option<&crate::sensing::reading::Reading>,
-        posterior: Option<&[f64]>,
-        t_ready: f64,
-    ) {
-        let Some(c) = self.control.as_mut() else {
-            return;
-        };
-        let Some(model) = c.online_model().cloned() else {
-            return;
-        };
-        let Some(sm) = model.sensor(j) else {
-            return;
-        };
-        if let Some(b) = part.belief.as_mut() {
-            let ll = sm.log_likelihood(reading, posterior);
-            let u = b.observe_reading(&sm.p_touch, ll.as_deref());
-            c.count_update(u, false);
-        }
-        self.sensor_spoke(part, index, j, t_ready);
-    }
-
-    fn sensor_spoke(&mut self, part: &mut ActivePart, index: u64, j: usize, t_ready: f64) {
-        part.sensors_left = part.sensors_left.saturating_sub(1);
-        if part.sensors_left == 0 {
-            self.queue.schedule(
-                t_ready,
-                EventKind::Decision {
-                    part: index,
-                    obstacle: j as u32,
-                    hypothesis: u32::MAX,
-                },
-            );
-        }
-    }
-
-    /// Has part `index` gone past sensor pin `j` without touching it? Then that is evidence;
-    /// a part still short of the pin (held upstream) is checked again later.
-    pub(super) fn unread(&mut self, t: f64, index: u64, j: usize) {
-        let v = self.speed();
-        let clear = self.sensor_clear_x(j);
-        let Some(mut part) = self.active.remove(&index) else {
-            return;
-        };
-        if part.sensed.iter().any(|d| d.obstacle == j) {
-            self.active.insert(index, part);
-            return;
-        }
-        let x = part.motion.world_pose(t, v).x;
-        if x < clear {
-            // Held upstream (or pushed back): look again when it could be clear riding the belt.
-            let dt = ((clear - x) / v).max(1e-6);
-            self.queue.schedule(
-                t + dt,
-                EventKind::Unread {
-                    part: index,
-                    obstacle: j as u32,
-                },
-            );
-            self.active.insert(index, part);
-            return;
-        }
-        let model = self
-            .control
-            .as_ref()
-            .and_then(|c| c.online_model())
-            .cloned();
-        if let (Some(model), Some(c)) = (model, self.control.as_mut()) {
-            if let (Some(sm), Some(b)) = (model.sensor(j), part.belief.as_mut()) {
-                let u = b.observe_no_contact(&sm.p_touch);
-                c.count_update(u, true);
-            }
-            let latency = c.latency();
-            self.sensor_spoke(&mut part, index, j, t + latency);
-        }
-        self.active.insert(index, part);
-    }
-
-    /// The online decision for part `index`: the joint command of the dynamic pins that
-    /// maximises P(goal) under its belief, queued like a rule's commands.
-    fn decide_online(&mut self, t: f64, index: u64) {
-        let Some(c) = self.control.as_mut() else {
-            return;
-        };
-        let Some(model) = c.online_model().cloned() else {
-            return;
-        };
-        self.metrics.work.decisions += 1;
-        let Some(part) = self.active.get_mut(&index) else {
-            return;
-        };
-        let Some(belief) = part.belief.as_ref() else {
-            return;
-        };
-        let choice = model.choose(belief);
-        part.predicted = Some(choice.predicted);
-        let (h0, h1) = (model.prior.entropy_bits(), belief.entropy_bits());
-        let action = &model.actions[choice.action];
-        let truth = part.decided.iter().find_map(|d| d.2);
-        let states = model
-            .hypotheses
-            .iter()
-            .map(|h| h.state)
-            .max()
-            .map_or(0, |m| m + 1);
-        let group: Vec<usize> = model.hypotheses.iter().map(|h| h.state).collect();
-        let marginal = belief.marginal(&group, states);
-        let map_state = (0..states).max_by(|&a, &b| marginal[a].total_cmp(&marginal[b]));
-        if let Some(o) = c.online.as_mut() {
-            if let Some(t) = truth {
-                o.summary.state_known += 1;
-                o.summary.state_correct += u64::from(map_state == Some(t));
-            }
-            o.summary.decisions += 1;
-            o.summary.entropy_prior_bits += h0;
-            o.summary.entropy_posterior_bits += h1;
-            o.chosen[choice.action] += 1;
-        }
-        if c.log.is_some() {
-            let names: Vec<String> = model
-                .pins
-                .iter()
-                .map(|&j| self.scene.obstacles[j].name().to_string())
-                .collect();
-            let described = describe_action(&names, action);
-            c.log(ControlRecord {
-                t,
-                part: index,
-                obstacle: "online".into(),
-                kind: ControlKind::Decision,
-                what: format!(
-                    "{described} (P = {:.3}; entropy {h0:.2} → {h1:.2} bits)",
-                    choice.predicted
-                ),
-                motion: None,
-            });
-        }
-        for (&pin, &target) in model.pins.iter().zip(action) {
-            self.metrics.work.actuator_commands += 1;
-            c.queues[pin].insert(index, target);
-            if let Some(k) = c.stats_of[pin] {
-                c.summary.actuators[k].commands += 1;
-            }
-        }
-        self.serve(t);
-    }
-
-    /// Carry out every queued command whose turn has come (see the module notes).
-    pub(super) fn serve(&mut self, now: f64) {
-        let Some(c) = self.control.as_ref() else {
-            return;
-        };
-        let pending: Vec<usize> = (0..c.queues.len())
-            .filter(|&j| !c.queues[j].is_empty())
-            .collect();
-        for j in pending {
-            while self.serve_next(j, now) {}
-        }
-    }
-
-    /// Serve the first queued command of pin `j` if its turn has come; true if one was taken.
-    fn serve_next(&mut self, j: usize, now: f64) -> bool {
-        let v = self.speed();
-        let Obstacle::Pin(pin) = &self.scene.obstacles[j] else {
-            return false;
-        };
-        let reach = self.scene.part.radius + pin.radius;
-        let x_pin = pin.centre.x;
-        let c = self.control.as_ref().expect("serving needs a controller");
-        let Some((&part, &target)) = c.queues[j].first_key_value() else {
-            return false;
-        };
-        // No later part may be in contact with the pin (it came first: wait until it is done).
-        let later_in_use = self
-            .active
-            .range(part + 1..)
-            .any(|(_, q)| matches!(&q.motion, Motion::Held(plan) if plan.obstacle == j));
-        if later_in_use {
-            return false;
-        }
-        // Every earlier part still within reach must be known to clear the pin.
-        let mut t_free = now;
-        for qp in self.active.range(..part).map(|(_, p)| p) {
-            let x = qp.motion.world_pose(now, v).x;
-            if x >= x_pin + reach {
-                continue;
-            }
-            match qp.motion {
-                Motion::Free { t0, pose, until } => {
-                    let t_clear = t0 + (x_pin + reach - pose.x) / v;
-                    if until < t_clear {
-                        return false; // it meets an obstacle first: wait
-                    }
-                    t_free = t_free.max(t_clear);
-                }
-                // Held by an obstacle: when it clears is not known yet.
-                Motion::Held(_) => return false,
-            }
-        }
-        let c = self.control.as_mut().expect("serving needs a controller");
-        c.queues[j].remove(&part);
-        let name = pin.name.clone();
-        let k = c.stats_of[j].expect("a dynamic pin has statistics");
-        let Some(p) = self.active.get(&part) else {
-            c.summary.actuators[k].dropped += 1;
-            c.log(ControlRecord {
-                t: now,
-                part,
-                obstacle: name,
-                kind: ControlKind::Dropped,
-                what: describe_target(target),
-                motion: None,
-            });
-            return true;
-        };
-        // The earliest time the part can reach the pin: riding the belt from where it is. A part
-        // already held by this pin is too late for any motion: a pin in use never moves.
-        let x_part = p.motion.world_pose(now, v).x;
-        let in_use = matches!(&p.motion, Motion::Held(plan) if plan.obstacle == j);
-        let t_reach = if in_use {
-            f64::NEG_INFINITY
-        } else {
-            now + (x_pin - reach - x_part) / v
-        };
-        let track = c.tracks[j].as_mut().expect("a dynamic pin has a track");
-        let t_start = t_free.max(track.ready_at());
-        let (duration, travel) = track.cost(target);
-        let late = t_start + duration > t_reach;
-        let from = match track.final_target() {
-            Target::Y(y) => y,
-            Target::Raised(up) => f64::from(u8::from(up)),
-        };
-        if late {
-            c.summary.actuators[k].late += 1;
-            self.metrics.work.late_actuations += 1;
-        }
-        // A late move that could only start once the part is past the pin is pointless.
-        let passed_by_then = t_start >= t_reach + 2.0 * reach / v;
-        let carry_out = duration > 0.0
-            && (!late || (c.spec.on_late == OnLate::Move && !in_use && !passed_by_then));
-        if carry_out {
-            track.command(t_start, target);
-            let a = &mut c.summary.actuators[k];
-            a.moves += 1;
-            a.travel_m += travel;
-            a.busy_s += duration;
-            let to = match target {
-                Target::Y(y) => y,
-                Target::Raised(up) => f64::from(u8::from(up)),
-            };
-            c.log(ControlRecord {
-                t: now,
-                part,
-                obstacle: name,
-                kind: if late {
-                    ControlKind::Late
-                } else {
-                    ControlKind::Actuation
-                },
-                what: describe_target(target),
-                motion: Some(MotionRecord {
-                    t_start,
-                    t_ready: t_start + duration,
-                    from,
-                    to,
-                }),
-            });
-            self.replan_near(j, now);
-        } else if late {
-            c.log(ControlRecord {
-                t: now,
-                part,
-                obstacle: name,
-                kind: ControlKind::Late,
-                what: format!("{} skipped", describe_target(target)),
-                motion: None,
-            });
-        }
-        true
-    }
-
-    /// Pin `j`'s timeline has changed: plan again every free part that could still reach it.
-    fn replan_near(&mut self, j: usize, now: f64) {
-        let v = self.speed();
-        let [_, x_max] = self.scene.obstacles[j].x_range();
-        let reach = self.scene.part.radius;
-        let parts: Vec<u64> = self
-            .active
-            .iter()
-            .filter(|(_, p)| {
-                matches!(p.motion, Motion::Free { .. })
-                    && p.motion.world_pose(now, v).x < x_max + reach
-            })
-            .map(|(&k, _)| k)
-            .collect();
-        let oldest = self
-            .active
-            .values()
-            .filter_map(|p| match p.motion {
-                Motion::Free { t0, .. } => Some(t0),
-                Motion::Held(_) => None,
-            })
-            .fold(now, f64::min);
-        if let Some(track) = self.control.as_mut().and_then(|c| c.tracks[j].as_mut()) {
-            track.forget_before(oldest);
-        }
-        for index in parts {
-            let Some(mut part) = self.active.remove(&index) else {
-                continue;
-            };
-            self.metrics.work.replans += 1;
-            part.valid_from = self.queue.next_seq();
-            self.plan_next(index, &mut part, now);
-            self.active.insert(index, part);
-            self.check_pairs(index, now);
-        }
-    }
-
-    /// Is event `kind` (taken off the queue with sequence number `seq`) stale: planned before a
-    /// part it concerns was planned again?
-    pub(super) fn stale(&self, seq: u64, kind: &EventKind) -> bool {
-        let older = |part: &u64| self.active.get(part).is_some_and(|p| seq < p.valid_from);
-        match kind {
-            EventKind::ContactBegin { part, .. } | EventKind::Exit { part } => older(part),
-            EventKind::Collision { first, second } => older(first) || older(second),
-            _ => false,
-        }
+        Track::Retractable { .. } => track
+            .present_during(ta, tb)
+            .then_some((pin.centre, pin.centre, pin.radius)),
     }
 }
 

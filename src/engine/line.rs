@@ -40,79 +40,39 @@
 //! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it. What a
 //! run takes and gives is in [`super::results`].
 
+use super::arrival::arrival;
+use super::contact::contact_begin;
+use super::contact_end::contact_end;
 use super::contact_map::LineMaps;
 use super::controller::Control;
-use super::event_queue::{Event, EventKind, EventQueue};
-use super::metrics::Metrics;
-use super::motion::{Motion, Stop};
+use super::decision::decide;
+use super::event_queue::{Event, EventKind};
+use super::exit::{exit, finish};
+use super::online_decide::{decide_online, unread};
 use super::outcome::{Cause, PartOutcome};
-use super::part_stream::{arrival_gap, draw_part};
-use super::results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult, SamplePath};
-use super::sensing::{sense_pass, SensedDecision, SensedPass, SensorStats};
-use crate::geometry::{wrap_deg, Pose};
-use crate::mechanics::{
-    fence_first_touch, pin_first_touch, ContactOutcome, PartModel, TraceSample,
-};
-use crate::scenario::{Arrival, Obstacle, PinObstacle, Scene, SensorPin};
-use crate::sensing::signal::SignalScale;
-use std::collections::BTreeMap;
+use super::results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult};
+use super::serve::serve;
+use super::state::{Belt, Sinks, Touch};
+use crate::geometry::Pose;
+use crate::mechanics::PartModel;
+use crate::scenario::Scene;
 
-/// A part on the belt: where it came in, how it moves now, and what has happened to it.
-pub(super) struct ActivePart {
-    arrival: f64,
-    theta_in: f64,
-    y_in: f64,
-    pub(super) motion: Motion,
-    /// The obstacle whose push ended last (its pin has passed; it cannot touch the part again: a
-    /// still pin's path is behind the part, and a dynamic pin only moves for the next part once
-    /// this one has cleared it, see [`super::controller`]).
-    pub(super) last_obstacle: Option<usize>,
-    pub(super) contacts: u32,
-    /// Touches in a row that pushed nothing (grazes): bounded, so that two obstacles that each
-    /// only graze the part cannot hand it back and forth for ever at one instant.
-    pub(super) grazes: u32,
-    /// Own contact model (random tripod), else the scene's.
-    pub(super) model: Option<PartModel>,
-    pub(super) path: Option<Vec<(f64, Pose)>>,
-    /// Sensor pins that have read this part (obstacle index) and their decisions.
-    pub(super) sensed: Vec<super::sensing::SensedDecision>,
-    /// Decisions taken on this part for the controller: (sensor, decision, true state).
-    pub(super) decided: Vec<(usize, Option<usize>, Option<usize>)>,
-    /// The part's events are valid from this sequence number on: a part planned again after an
-    /// actuator moved leaves its older contact, exit and collision events stale.
-    pub(super) valid_from: u64,
-    /// Online controller: the part's belief, the sensors still to speak, the prediction its
-    /// decision was taken with.
-    pub(super) belief: Option<crate::sensing::belief::Belief>,
-    pub(super) sensors_left: u32,
-    pub(super) predicted: Option<f64>,
-}
-
-/// The run state: the scene it runs, the event queue, the parts on the belt and what they have
-/// produced so far. Its event handlers live here and beside it in [`super::contact`] (contact
-/// begin) and [`super::pairs`] (part–part checks).
-pub(super) struct Line<'a> {
-    pub(super) scene: &'a Scene,
+/// The run state: the scene and options it runs, the belt, what the run has produced, the
+/// controller and the map tier. [`Line::handle`] dispatches each event to its stage, which takes
+/// only the pieces it reads and writes.
+struct Line<'a> {
+    scene: &'a Scene,
     opts: &'a RunOptions,
-    pub(super) queue: EventQueue,
-    pub(super) active: BTreeMap<u64, ActivePart>,
-    pub(super) metrics: Metrics,
-    records: Vec<PartRecord>,
-    events: Vec<Event>,
-    paths: Vec<SamplePath>,
-    finished: u64,
-    /// Sensor pins (obstacle index, index into `metrics.sensors`); empty in a passive scene.
-    sensor_pins: Vec<(usize, usize)>,
+    /// The pending events and the parts on the belt.
+    belt: Belt,
+    /// Metrics, records, events, paths and captured pushes.
+    sinks: Sinks,
     /// The controller and the dynamic pins' timelines (None without dynamic pins).
-    pub(super) control: Option<Control>,
+    control: Option<Control>,
     /// The pins' maps (None unless `[model] fidelity = "map"`).
-    pub(super) maps: Option<LineMaps>,
-    /// Every push as asked for, when the run captures them ([`run_capturing`]).
-    pub(super) captured: Option<Vec<CapturedPush>>,
+    maps: Option<LineMaps>,
     /// A forced first part ([`run_entry`]): its pose and support instead of the feed's draw.
     entry: Option<Entry>,
-    /// How and where the last part to finish left the line ([`run_single`]).
-    last_end: Option<(PartOutcome, Pose)>,
 }
 
 /// One part with a given entry pose and support, for [`run_entry`].
@@ -179,11 +139,11 @@ pub fn run_single(scene: &Scene, entry: Entry) -> Result<SingleRun, EngineError>
         online: None,
     };
     let line = simulate(scene, &opts, &mut |_| {}, None, Some(entry))?;
-    let (outcome, pose) = line.last_end.expect("one part, one end");
+    let (outcome, pose) = line.sinks.last_end.expect("one part, one end");
     Ok(SingleRun {
         outcome,
         pose,
-        model_evaluations: line.metrics.work.model_evaluations,
+        model_evaluations: line.sinks.metrics.work.model_evaluations,
     })
 }
 
@@ -235,26 +195,27 @@ fn run_inner(
     captured: Option<Vec<CapturedPush>>,
     entry: Option<Entry>,
 ) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
-    let mut line = simulate(scene, opts, progress, captured, entry)?;
+    let line = simulate(scene, opts, progress, captured, entry)?;
+    let (sinks, mut control) = (line.sinks, line.control);
     let fidelity = match scene.map_tier {
         Some(_) => "map",
         None => scene.contact.fidelity.name(),
     };
-    let mut summary = line.metrics.summary(&scene.name, opts.seed, fidelity);
+    let mut summary = sinks.metrics.summary(&scene.name, opts.seed, fidelity);
     let mut control_log = Vec::new();
-    if let Some(c) = line.control.as_mut() {
+    if let Some(c) = control.as_mut() {
         summary.controller = Some(c.finish(summary.simulated_time_s));
         control_log = c.log.take().unwrap_or_default();
     }
     let result = RunResult {
         summary,
-        metrics: line.metrics,
-        records: line.records,
-        events: line.events,
-        paths: line.paths,
+        metrics: sinks.metrics,
+        records: sinks.records.unwrap_or_default(),
+        events: sinks.events,
+        paths: sinks.paths,
         control: control_log,
     };
-    Ok((result, line.captured.unwrap_or_default()))
+    Ok((result, sinks.captured.unwrap_or_default()))
 }
 
 /// Process every event of the run and return the line as it ends.
@@ -269,105 +230,103 @@ fn simulate<'a>(
         Some(m) => Some(m.clone()),
         None => super::prepare::online_model(scene).map_err(EngineError::OnlineModel)?,
     };
-    let names = scene
-        .obstacles
-        .iter()
-        .map(|o| o.name().to_string())
-        .collect();
-    let mut metrics = Metrics::new(names, scene.output.histogram_bin_deg);
-    let mut sensor_pins = Vec::new();
-    for (j, o) in scene.obstacles.iter().enumerate() {
-        if let Obstacle::Pin(PinObstacle {
-            name,
-            sensor: Some(sensor),
-            ..
-        }) = o
-        {
-            sensor_pins.push((j, metrics.sensors.len()));
-            metrics.sensors.push(SensorStats::new(name, sensor));
-        }
-    }
     let mut line = Line {
         scene,
         opts,
-        queue: EventQueue::new(),
-        active: BTreeMap::new(),
-        metrics,
-        records: Vec::new(),
-        events: Vec::new(),
-        paths: Vec::new(),
-        finished: 0,
-        sensor_pins,
+        belt: Belt::new(),
+        sinks: Sinks::for_scene(scene, opts.keep_records, captured),
         control: Control::new(
             scene,
             scene.effects.event_log || opts.sample_paths > 0,
             online,
         ),
         maps: LineMaps::for_scene(scene),
-        captured,
         entry,
-        last_end: None,
     };
     if opts.parts > 0 {
-        line.queue.schedule(0.0, EventKind::Arrival { part: 0 });
+        line.belt
+            .queue
+            .schedule(0.0, EventKind::Arrival { part: 0 });
     }
     loop {
-        if let Some((time, kind)) = line.queue.first_refused() {
+        if let Some((time, kind)) = line.belt.queue.first_refused() {
             return Err(EngineError::NonFiniteTime {
                 time,
                 kind,
-                refused: line.queue.refused(),
+                refused: line.belt.queue.refused(),
             });
         }
-        let Some(ev) = line.queue.pop() else { break };
+        let Some(ev) = line.belt.queue.pop() else {
+            break;
+        };
         line.handle(ev)?;
-        if line.finished % 256 == 0 {
-            progress(line.finished);
+        if line.belt.finished % 256 == 0 {
+            progress(line.belt.finished);
         }
     }
-    progress(line.finished);
+    progress(line.belt.finished);
     assert!(
-        line.active.is_empty(),
+        line.belt.active.is_empty(),
         "parts left on the belt after the last event"
     );
     assert_eq!(
-        line.metrics.outcomes.total(),
-        line.metrics.parts_in,
+        line.sinks.metrics.outcomes.total(),
+        line.sinks.metrics.parts_in,
         "conservation: every part that enters ends in exactly one class"
     );
-    assert_eq!(line.metrics.parts_in, opts.parts);
+    assert_eq!(line.sinks.metrics.parts_in, opts.parts);
     Ok(line)
 }
 
 impl Line<'_> {
-    pub(super) fn speed(&self) -> f64 {
-        self.scene.belt.speed
-    }
-
+    /// Dispatch event `ev` to its stage; then, with a controller, serve the dynamic pins (a part
+    /// that moved on may have freed one for the next command).
     fn handle(&mut self, ev: Event) -> Result<(), EngineError> {
-        if self.control.is_some() && self.stale(ev.seq, &ev.kind) {
-            self.metrics.work.stale_events += 1;
+        let Line {
+            scene,
+            opts,
+            belt,
+            sinks,
+            control,
+            maps,
+            entry,
+        } = self;
+        let scene: &Scene = scene;
+        if control.is_some() && belt.stale(ev.seq, &ev.kind) {
+            sinks.metrics.work.stale_events += 1;
             return Ok(());
         }
-        self.metrics.work.events += 1;
-        self.metrics.last_event = self.metrics.last_event.max(ev.time);
-        if self.scene.effects.event_log {
-            self.events.push(ev);
+        sinks.metrics.work.events += 1;
+        sinks.metrics.last_event = sinks.metrics.last_event.max(ev.time);
+        if scene.effects.event_log {
+            sinks.events.push(ev);
         }
         let t = ev.time;
+        let touch = |part, obstacle: u32| Touch {
+            t,
+            part,
+            obstacle: obstacle as usize,
+        };
         match ev.kind {
-            EventKind::Arrival { part } => self.arrival(t, part)?,
+            EventKind::Arrival { part } => {
+                let control = control.as_ref();
+                let metrics = &mut sinks.metrics;
+                arrival(scene, opts, entry.take(), control, belt, metrics, t, part)?
+            }
             EventKind::ContactBegin { part, obstacle } => {
-                self.contact_begin(t, part, obstacle as usize)
+                let (maps, control) = (maps.as_ref(), control.as_mut());
+                let touch = touch(part, obstacle);
+                contact_begin(scene, opts.seed, maps, control, belt, sinks, touch)
             }
             EventKind::ContactEnd { part, obstacle } => {
-                self.contact_end(t, part, obstacle as usize)
+                contact_end(scene, control.as_mut(), belt, sinks, touch(part, obstacle))
             }
-            EventKind::Exit { part } => self.exit(t, part),
+            EventKind::Exit { part } => exit(scene, control.as_mut(), belt, sinks, t, part),
             EventKind::Collision { first, second } => {
-                if self.active.contains_key(&first) && self.active.contains_key(&second) {
-                    self.finish(first, t, PartOutcome::Collision, Cause::None);
-                    self.finish(second, t, PartOutcome::Collision, Cause::None);
+                if belt.active.contains_key(&first) && belt.active.contains_key(&second) {
+                    let end = (PartOutcome::Collision, Cause::None);
+                    finish(scene, control.as_mut(), belt, sinks, first, t, end);
+                    finish(scene, control.as_mut(), belt, sinks, second, t, end);
                 }
             }
             EventKind::Decision {
@@ -375,283 +334,29 @@ impl Line<'_> {
                 obstacle,
                 hypothesis,
             } => {
-                let h = (hypothesis != u32::MAX).then_some(hypothesis as usize);
-                self.decide(t, part, obstacle as usize, h);
+                let work = &mut sinks.metrics.work;
+                if let Some(c) = control.as_mut() {
+                    let taken = if c.online_model().is_some() {
+                        decide_online(scene, c, &mut belt.active, work, t, part)
+                    } else {
+                        let h = (hypothesis != u32::MAX).then_some(hypothesis as usize);
+                        decide(scene, c, work, t, part, obstacle as usize, h);
+                        true
+                    };
+                    // A decision taken is served at once, before the serving after every event.
+                    if taken {
+                        serve(scene, c, belt, work, t);
+                    }
+                }
             }
-            EventKind::Unread { part, obstacle } => self.unread(t, part, obstacle as usize),
+            EventKind::Unread { part, obstacle } => {
+                unread(scene, control.as_mut(), belt, t, part, obstacle as usize)
+            }
         }
-        // A part that moved on may have freed a dynamic pin for the next command.
-        if self.control.is_some() {
-            self.serve(t);
+        if let Some(c) = control.as_mut() {
+            serve(scene, c, belt, &mut sinks.metrics.work, t);
         }
         Ok(())
-    }
-
-    fn arrival(&mut self, t: f64, index: u64) -> Result<(), EngineError> {
-        let mut x0 = 0.0;
-        let d = match self.entry.take() {
-            Some(e) => {
-                x0 = e.x;
-                super::part_stream::PartDraw {
-                    gap: 0.0,
-                    theta_rad: e.theta_rad,
-                    y: e.y,
-                    model: e.model,
-                }
-            }
-            None => draw_part(self.scene, self.opts.seed, index)
-                .map_err(|reason| EngineError::PartDraw { index, reason })?,
-        };
-        if d.model.is_some() {
-            self.metrics.work.tripods_drawn += 1;
-        }
-        self.metrics.arrival(t);
-        if index + 1 < self.opts.parts {
-            let next = match self.scene.feed.arrival {
-                Arrival::Periodic { headway } => (index + 1) as f64 * headway,
-                Arrival::Poisson { .. } => t + arrival_gap(self.scene, self.opts.seed, index + 1),
-            };
-            self.queue
-                .schedule(next, EventKind::Arrival { part: index + 1 });
-        }
-        let pose = Pose::new(x0, d.y, d.theta_rad);
-        let mut part = ActivePart {
-            arrival: t,
-            theta_in: d.theta_rad,
-            y_in: d.y,
-            motion: Motion::Free {
-                t0: t,
-                pose,
-                until: t,
-            },
-            last_obstacle: None,
-            contacts: 0,
-            grazes: 0,
-            model: d.model,
-            path: ((index as usize) < self.opts.sample_paths).then(|| vec![(t, pose)]),
-            sensed: Vec::new(),
-            decided: Vec::new(),
-            valid_from: 0,
-            belief: None,
-            sensors_left: 0,
-            predicted: None,
-        };
-        self.online_arrival(t, index, &mut part);
-        self.plan_next(index, &mut part, t);
-        self.active.insert(index, part);
-        self.check_pairs(index, t);
-        Ok(())
-    }
-
-    /// From a free state, find the next event: the first obstacle the part will touch (first-contact
-    /// ray cast for a pin, first touch of a fence, in the belt frame exactly as the contact model
-    /// finds them), or the exit.
-    pub(super) fn plan_next(&mut self, index: u64, part: &mut ActivePart, now: f64) {
-        let Motion::Free { t0, pose, .. } = part.motion else {
-            unreachable!("plan_next on a held part");
-        };
-        let v = self.speed();
-        let a = self.scene.part.radius;
-        let scene = self.scene;
-        let model = part.model.as_ref().unwrap_or(&scene.part.model);
-        let mut best: Option<(f64, usize)> = None;
-        for (j, ob) in scene.obstacles.iter().enumerate() {
-            if Some(j) == part.last_obstacle {
-                continue;
-            }
-            // Out of lateral reach, or already behind the part: the obstacle's path misses it.
-            let ([x_min, x_max], [y_min, y_max]) = (ob.x_range(), ob.y_range());
-            if y_min > pose.y + a || y_max < pose.y - a || x_max < pose.x - a {
-                continue;
-            }
-            // Farther ahead than the earliest touch found so far: the part must ride at least
-            // x_min − (x + a) of belt before it can touch (an obstacle moves across the belt
-            // only), so this one cannot come first, nor tie.
-            if best.is_some_and(|(b, _)| x_min - (pose.x + a) > b) {
-                continue;
-            }
-            self.metrics.work.ray_casts += 1;
-            let travel = match ob {
-                // Along the pin's path (a moving pin's commanded motion from t0 on); a
-                // retractable pin withdrawn when the part would reach it lets it pass.
-                Obstacle::Pin(pin) => {
-                    let (start, path) = self.pin_motion(j, pin, t0);
-                    pin_first_touch(model, pose, start, pin.radius, &path)
-                        .filter(|&tr| self.present_at(j, t0 + tr / v))
-                }
-                Obstacle::Fence(fence) => fence_first_touch(model, pose, &fence.spec()),
-            };
-            if let Some(tr) = travel {
-                if best.is_none_or(|(b, _)| tr < b) {
-                    best = Some((tr, j));
-                }
-            }
-        }
-        let length = self.scene.belt.length;
-        let t_exit = if pose.x >= length {
-            now
-        } else {
-            (t0 + (length - pose.x) / v).max(now)
-        };
-        let until = match best {
-            Some((travel, j)) if t0 + travel / v < t_exit => {
-                let tb = (t0 + travel / v).max(now);
-                self.queue.schedule(
-                    tb,
-                    EventKind::ContactBegin {
-                        part: index,
-                        obstacle: j as u32,
-                    },
-                );
-                tb
-            }
-            _ => {
-                self.queue.schedule(t_exit, EventKind::Exit { part: index });
-                t_exit
-            }
-        };
-        part.motion = Motion::Free { t0, pose, until };
-    }
-
-    fn contact_end(&mut self, t: f64, index: u64, j: usize) {
-        let Some(mut part) = self.active.remove(&index) else {
-            return;
-        };
-        let Motion::Held(plan) = &part.motion else {
-            unreachable!("contact end for a free part");
-        };
-        self.metrics.obstacles[j].busy_s += (plan.t_end - plan.t_begin).max(0.0);
-        if let Some(stop) = plan.stop.clone() {
-            self.active.insert(index, part);
-            let (outcome, cause) = match stop {
-                Stop::MultiContact { cause } => (PartOutcome::MultiContact, cause),
-                Stop::Jam { cause } => (PartOutcome::Jam, cause),
-                Stop::OffBelt => (PartOutcome::OffBelt, Cause::None),
-                Stop::Solver { cause } => (PartOutcome::Solver, cause),
-            };
-            self.finish(index, t, outcome, cause);
-            return;
-        }
-        let end = plan.outcome.pose_final;
-        let pose = Pose::new(end.x + plan.s_end, end.y, end.theta_rad);
-        if let Some(path) = part.path.as_mut() {
-            path.push((t, pose));
-        }
-        part.motion = Motion::Free {
-            t0: t,
-            pose,
-            until: t,
-        };
-        part.last_obstacle = Some(j);
-        if pose.y.abs() > self.scene.belt.width / 2.0 {
-            self.active.insert(index, part);
-            self.finish(index, t, PartOutcome::OffBelt, Cause::None);
-            return;
-        }
-        self.plan_next(index, &mut part, t);
-        self.active.insert(index, part);
-        self.check_pairs(index, t);
-    }
-
-    fn exit(&mut self, t: f64, index: u64) {
-        let Some(part) = self.active.get(&index) else {
-            return;
-        };
-        let pose = part.motion.world_pose(t, self.speed());
-        let outcome = if self.scene.goal.matching_set(pose.theta_rad).is_some() {
-            PartOutcome::Success
-        } else {
-            PartOutcome::WrongOrientation
-        };
-        self.finish(index, t, outcome, Cause::None);
-    }
-
-    /// Take part `index` off the line at time `t` with `outcome`.
-    pub(super) fn finish(&mut self, index: u64, t: f64, outcome: PartOutcome, cause: Cause) {
-        let Some(mut part) = self.active.remove(&index) else {
-            return;
-        };
-        let pose = part.motion.world_pose(t, self.speed());
-        let theta_deg = wrap_deg(pose.theta_rad.to_degrees());
-        self.last_end = Some((outcome, pose));
-        self.metrics.finish(outcome, t, theta_deg, t - part.arrival);
-        if let Some(c) = self.control.as_mut() {
-            c.count_decisions(self.scene, &part.decided, outcome);
-            if let Some(p) = part.predicted {
-                c.calibrate(p, outcome == PartOutcome::Success);
-            }
-        }
-        self.count_untouched(&part, pose.x);
-        self.metrics.cause(outcome, cause);
-        if self.opts.keep_records {
-            self.records.push(PartRecord {
-                part: index,
-                arrival_s: part.arrival,
-                end_s: t,
-                outcome,
-                cause,
-                contacts: part.contacts,
-                theta_in_deg: wrap_deg(part.theta_in.to_degrees()),
-                theta_out_deg: theta_deg,
-                y_in_m: part.y_in,
-                y_out_m: pose.y,
-                sensed: std::mem::take(&mut part.sensed),
-            });
-        }
-        if let Some(mut poses) = part.path {
-            if poses.last().is_none_or(|&(tl, _)| tl < t) {
-                poses.push((t, pose));
-            }
-            self.paths.push(SamplePath {
-                part: index,
-                outcome,
-                poses,
-            });
-        }
-        self.finished += 1;
-    }
-
-    /// Read and classify a pass against a sensor pin: the sensor's statistics count it, and the
-    /// decision (as text for the part's record) is returned (see [`super::sensing`]).
-    pub(super) fn sense(
-        &mut self,
-        index: u64,
-        j: usize,
-        sensor: &SensorPin,
-        out: &ContactOutcome,
-        knots: &[TraceSample],
-        theta: f64,
-    ) -> (super::sensing::SensedDecision, SensedPass) {
-        let scale = SignalScale {
-            mass: self.scene.part.mass,
-            belt_speed: self.speed(),
-            height: sensor.settings.height,
-            metres_per_unit: 1.0,
-        };
-        let sensed = sense_pass(sensor, out, knots, &scale, theta, self.opts.seed, index, j);
-        self.metrics.work.sensor_readings += 1;
-        self.metrics.work.signal_knots += sensed.knots as u64;
-        self.metrics.work.classifications += 1;
-        if let Some(&(_, k)) = self.sensor_pins.iter().find(|(o, _)| *o == j) {
-            self.metrics.sensors[k].add(&sensed);
-        }
-        let name = self.scene.obstacles[j].name();
-        let decision = SensedDecision::of(j, name, &sensor.labels, &sensed.classification);
-        (decision, sensed)
-    }
-
-    /// A part leaving the line at world x `x` has gone past every sensor pin upstream of it:
-    /// those that did not read it count it as untouched.
-    fn count_untouched(&mut self, part: &ActivePart, x: f64) {
-        for &(j, k) in &self.sensor_pins {
-            let passed = match &self.scene.obstacles[j] {
-                Obstacle::Pin(p) => p.centre.x < x,
-                Obstacle::Fence(_) => false,
-            };
-            if passed && !part.sensed.iter().any(|d| d.obstacle == j) {
-                self.metrics.sensors[k].untouched += 1;
-            }
-        }
     }
 }
 

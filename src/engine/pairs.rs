@@ -7,60 +7,62 @@
 
 use super::contact::ensure_trace;
 use super::event_queue::EventKind;
-use super::line::Line;
+use super::metrics::WorkCounters;
 use super::motion::Motion;
 use super::overlap::{first_touch, polygon_clearance, segment_distance};
+use super::state::Belt;
 use crate::geometry::Vec2;
 use crate::scenario::Scene;
 
-impl Line<'_> {
-    /// Check the motion part `index` has just started against every other part on the belt.
-    pub(super) fn check_pairs(&mut self, index: u64, now: f64) {
-        if !self.scene.effects.collisions || self.active.len() < 2 {
-            return;
+/// Check the motion part `index` has just started (at `now`) against every other part on the
+/// belt, and schedule a collision at the first overlap of each pair. A held part whose push kept
+/// no path gets it recorded here if the pair is close.
+pub(super) fn check_pairs(
+    scene: &Scene,
+    belt: &mut Belt,
+    work: &mut WorkCounters,
+    index: u64,
+    now: f64,
+) {
+    if !scene.effects.collisions || belt.active.len() < 2 {
+        return;
+    }
+    let active = &mut belt.active;
+    let others: Vec<u64> = active.keys().copied().filter(|&k| k != index).collect();
+    for other in others {
+        work.part_part_checks += 1;
+        let end = active[&index]
+            .motion
+            .until()
+            .min(active[&other].motion.until());
+        if end < now {
+            continue;
         }
-        let scene = self.scene;
-        let others: Vec<u64> = self
-            .active
-            .keys()
-            .copied()
-            .filter(|&k| k != index)
-            .collect();
-        for other in others {
-            self.metrics.work.part_part_checks += 1;
-            let end = self.active[&index]
-                .motion
-                .until()
-                .min(self.active[&other].motion.until());
-            if end < now {
-                continue;
+        let (p0, p1, r1) = bounding_capsule(scene, &active[&index].motion, now, end);
+        let (q0, q1, r2) = bounding_capsule(scene, &active[&other].motion, now, end);
+        if segment_distance(p0, p1, q0, q1) > r1 + r2 {
+            continue;
+        }
+        work.part_part_narrow_checks += 1;
+        for k in [index, other] {
+            let part = active.get_mut(&k).expect("active part");
+            if let Motion::Held(plan) = &mut part.motion {
+                let model = part.model.as_ref().unwrap_or(&scene.part.model);
+                ensure_trace(plan, model, work);
             }
-            let (p0, p1, r1) = bounding_capsule(scene, &self.active[&index].motion, now, end);
-            let (q0, q1, r2) = bounding_capsule(scene, &self.active[&other].motion, now, end);
-            if segment_distance(p0, p1, q0, q1) > r1 + r2 {
-                continue;
-            }
-            self.metrics.work.part_part_narrow_checks += 1;
-            for k in [index, other] {
-                let part = self.active.get_mut(&k).expect("active part");
-                if let Motion::Held(plan) = &mut part.motion {
-                    let model = part.model.as_ref().unwrap_or(&scene.part.model);
-                    ensure_trace(plan, model, &mut self.metrics.work);
-                }
-            }
-            let (pi, pj) = (&self.active[&index].motion, &self.active[&other].motion);
-            let mut evals = 0;
-            let hit = first_overlap(scene, pi, pj, now, end, &mut evals);
-            self.metrics.work.clearance_evaluations += evals;
-            if let Some(tc) = hit {
-                self.queue.schedule(
-                    tc,
-                    EventKind::Collision {
-                        first: index.min(other),
-                        second: index.max(other),
-                    },
-                );
-            }
+        }
+        let (pi, pj) = (&active[&index].motion, &active[&other].motion);
+        let mut evals = 0;
+        let hit = first_overlap(scene, pi, pj, now, end, &mut evals);
+        work.clearance_evaluations += evals;
+        if let Some(tc) = hit {
+            belt.queue.schedule(
+                tc,
+                EventKind::Collision {
+                    first: index.min(other),
+                    second: index.max(other),
+                },
+            );
         }
     }
 }
@@ -126,4 +128,63 @@ fn first_overlap(
         1e-6 * a,
         evals,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::state::ActivePart;
+    use crate::geometry::Pose;
+
+    /// The quickstart's scene with two parts riding the belt from time 0 until time 1, their
+    /// centroids `gap` part radii apart along the belt at the same orientation; the pair is checked as part
+    /// 1's motion starts.
+    fn check_two_parts(gap: f64) -> (Belt, WorkCounters) {
+        let path = std::path::Path::new("scenarios/quickstart.toml");
+        let scene = crate::scenario::load(path).unwrap();
+        assert!(scene.effects.collisions);
+        let gap = gap * scene.part.radius;
+        let mut belt = Belt::new();
+        for (k, x) in [(0, 0.2), (1, 0.2 + gap)] {
+            let mut part = ActivePart::entering(0.0, Pose::new(x, 0.0, 0.3), None, false);
+            part.motion = Motion::Free {
+                t0: 0.0,
+                pose: Pose::new(x, 0.0, 0.3),
+                until: 1.0,
+            };
+            belt.active.insert(k, part);
+        }
+        let mut work = WorkCounters::default();
+        check_pairs(&scene, &mut belt, &mut work, 1, 0.0);
+        (belt, work)
+    }
+
+    /// Two parts half a radius apart overlap from the start: one collision of the pair is
+    /// scheduled then, lower index first.
+    #[test]
+    fn two_overlapping_parts_collide_at_once() {
+        let (mut belt, work) = check_two_parts(0.5);
+        assert_eq!(work.part_part_checks, 1);
+        assert_eq!(work.part_part_narrow_checks, 1);
+        let ev = belt.queue.pop().expect("a collision");
+        assert_eq!(ev.time, 0.0);
+        assert_eq!(
+            ev.kind,
+            EventKind::Collision {
+                first: 0,
+                second: 1
+            }
+        );
+        assert!(belt.queue.pop().is_none());
+    }
+
+    /// Two parts four radii apart riding the belt together never touch: the broad phase skips
+    /// the pair and nothing is scheduled.
+    #[test]
+    fn two_separated_parts_do_not_collide() {
+        let (mut belt, work) = check_two_parts(4.0);
+        assert_eq!(work.part_part_checks, 1);
+        assert_eq!(work.part_part_narrow_checks, 0);
+        assert!(belt.queue.pop().is_none());
+    }
 }

@@ -1,0 +1,133 @@
+//! Arrival (docs/physics.md#the-line): part i enters the belt with the pose and support its own
+//! random stream draws (or as a forced [`Entry`] says), the next arrival is scheduled, and the
+//! part's first event is planned and its motion checked against the other parts.
+
+use super::controller::Control;
+use super::event_queue::EventKind;
+use super::line::Entry;
+use super::metrics::Metrics;
+use super::online_decide::online_arrival;
+use super::part_stream::{arrival_gap, draw_part, PartDraw};
+use super::plan::ride_on;
+use super::results::{EngineError, RunOptions};
+use super::state::{ActivePart, Belt};
+use crate::geometry::Pose;
+use crate::scenario::{Arrival, Scene};
+
+/// Part `index` arrives at time `t`: drawn from the feed (or `entry`), it goes on the belt.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn arrival(
+    scene: &Scene,
+    opts: &RunOptions,
+    entry: Option<Entry>,
+    control: Option<&Control>,
+    belt: &mut Belt,
+    metrics: &mut Metrics,
+    t: f64,
+    index: u64,
+) -> Result<(), EngineError> {
+    let mut x0 = 0.0;
+    let d = match entry {
+        Some(e) => {
+            x0 = e.x;
+            PartDraw {
+                gap: 0.0,
+                theta_rad: e.theta_rad,
+                y: e.y,
+                model: e.model,
+            }
+        }
+        None => draw_part(scene, opts.seed, index)
+            .map_err(|reason| EngineError::PartDraw { index, reason })?,
+    };
+    if d.model.is_some() {
+        metrics.work.tripods_drawn += 1;
+    }
+    metrics.arrival(t);
+    if index + 1 < opts.parts {
+        let next = match scene.feed.arrival {
+            Arrival::Periodic { headway } => (index + 1) as f64 * headway,
+            Arrival::Poisson { .. } => t + arrival_gap(scene, opts.seed, index + 1),
+        };
+        belt.queue
+            .schedule(next, EventKind::Arrival { part: index + 1 });
+    }
+    let pose = Pose::new(x0, d.y, d.theta_rad);
+    let sampled = (index as usize) < opts.sample_paths;
+    let mut part = ActivePart::entering(t, pose, d.model, sampled);
+    let work = &mut metrics.work;
+    online_arrival(scene, control, &mut belt.queue, t, index, &mut part);
+    ride_on(scene, control, belt, work, index, part, t);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Part 0 of a run of `parts` (the first one's path sampled) arrives at time 0 as `entry`
+    /// says on the quickstart line (periodic feed, 4 s headway).
+    fn arrive(parts: u64) -> (Belt, Metrics) {
+        let path = std::path::Path::new("scenarios/quickstart.toml");
+        let scene = crate::scenario::load(path).unwrap();
+        let opts = RunOptions {
+            parts,
+            sample_paths: 1,
+            ..RunOptions::from_scene(&scene)
+        };
+        let entry = Entry {
+            theta_rad: 0.5,
+            y: 0.001,
+            x: 0.0,
+            model: None,
+        };
+        let mut belt = Belt::new();
+        let mut metrics = Metrics::new(vec![String::new(); scene.obstacles.len()], 1.0);
+        arrival(
+            &scene,
+            &opts,
+            Some(entry),
+            None,
+            &mut belt,
+            &mut metrics,
+            0.0,
+            0,
+        )
+        .unwrap();
+        (belt, metrics)
+    }
+
+    /// The part enters at the entry's pose with its path started and is counted in; its first
+    /// event (a pin's contact begin) is scheduled at the end of its known motion, and the next
+    /// part's arrival one headway after its own.
+    #[test]
+    fn an_arrival_puts_the_part_on_the_belt_and_schedules_the_next() {
+        let (mut belt, metrics) = arrive(2);
+        assert_eq!(metrics.parts_in, 1);
+        let part = &belt.active[&0];
+        assert_eq!(part.motion.world_pose(0.0, 1.0), Pose::new(0.0, 0.001, 0.5));
+        assert_eq!(
+            part.path.as_deref(),
+            Some(&[(0.0, Pose::new(0.0, 0.001, 0.5))][..])
+        );
+        let until = part.motion.until();
+        let own = belt.queue.pop().unwrap();
+        assert_eq!(own.time, until);
+        assert!(matches!(own.kind, EventKind::ContactBegin { part: 0, .. }));
+        let next = belt.queue.pop().unwrap();
+        assert_eq!(
+            (next.time, next.kind),
+            (4.0, EventKind::Arrival { part: 1 })
+        );
+        assert!(belt.queue.pop().is_none());
+    }
+
+    /// The last part of a run schedules no further arrival.
+    #[test]
+    fn the_last_arrival_schedules_no_other() {
+        let (mut belt, _) = arrive(1);
+        let ev = belt.queue.pop().unwrap();
+        assert!(!matches!(ev.kind, EventKind::Arrival { .. }), "{ev:?}");
+        assert!(belt.queue.pop().is_none());
+    }
+}
