@@ -204,11 +204,23 @@ mod tests {
             ensemble_spec(mu, r, Fidelity::Exact, 1e-6, u).map(|_| ())
         };
         let cases = [
-            (check_members(Setting::ScoreMembers, 0), "score_members must lie in [1, "),
-            (check_members(Setting::Members, MAX_MEMBERS + 1), "members must lie in [1, "),
+            (
+                check_members(Setting::ScoreMembers, 0),
+                "score_members must lie in [1, ",
+            ),
+            (
+                check_members(Setting::Members, MAX_MEMBERS + 1),
+                "members must lie in [1, ",
+            ),
             (spec(9.0, 0.0, None), "mu_c must lie in [0, 5], got 9"),
-            (spec(0.5, f64::NAN, None), "pin_radius must be a finite number ≥ 0, got NaN"),
-            (spec(0.5, 0.0, Some("foo=1")), "uncertain: unknown uncertain parameter 'foo'"),
+            (
+                spec(0.5, f64::NAN, None),
+                "pin_radius must be a finite number ≥ 0, got NaN",
+            ),
+            (
+                spec(0.5, 0.0, Some("foo=1")),
+                "uncertain: unknown uncertain parameter 'foo'",
+            ),
         ];
         for (result, start) in cases {
             let e = result.unwrap_err();
