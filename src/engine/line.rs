@@ -243,6 +243,8 @@ fn simulate<'a>(
         maps: LineMaps::for_scene(scene),
         entry,
     };
+    // A line of one entered part returns its end, record and pushes, never a latency summary.
+    line.sinks.metrics.record_latency = line.entry.is_none();
     if opts.parts > 0 {
         line.belt
             .queue
@@ -405,5 +407,25 @@ mod tests {
         );
         assert!(a.model_evaluations > 0);
         assert_ne!(a.pose.theta_rad.rem_euclid(std::f64::consts::TAU), 1.0);
+    }
+
+    /// A line of one entered part (an online model's pass) leaves the latency histogram empty;
+    /// the same line fed from its stream records the part's latency.
+    #[test]
+    fn only_a_fed_line_records_latencies() {
+        let scene = quickstart();
+        let opts = RunOptions {
+            parts: 1,
+            seed: scene.seed,
+            sample_paths: 0,
+            keep_records: false,
+            online: None,
+        };
+        let entered = simulate(&scene, &opts, &mut |_| {}, None, Some(entry(1.0))).unwrap();
+        assert_eq!(entered.sinks.metrics.exits, 1);
+        assert!(entered.sinks.metrics.latency_us.is_empty());
+        let fed = simulate(&scene, &opts, &mut |_| {}, None, None).unwrap();
+        assert_eq!(fed.sinks.metrics.exits, 1);
+        assert_eq!(fed.sinks.metrics.latency_us.len(), 1);
     }
 }

@@ -195,6 +195,9 @@ pub struct Metrics {
     pub last_event: f64,
     /// Entry → exit, microseconds.
     pub latency_us: Histogram<u64>,
+    /// Whether finished parts' latencies go into [`Metrics::latency_us`]: not in a line of one
+    /// entered part (every pass of an online model's build), whose latency nothing reads.
+    pub(crate) record_latency: bool,
     /// Largest latency (s), exact.
     pub latency_max: f64,
     /// Smallest latency (s), exact (+∞ before the first exit).
@@ -239,6 +242,7 @@ impl Metrics {
             // significant digits, so the same percentiles): a line of one part — every pass of
             // an online model's build — does not clear 0.6 MB of counts it never uses.
             latency_us: Histogram::new(3).expect("three significant digits are valid"),
+            record_latency: true,
             latency_max: 0.0,
             latency_min: f64::INFINITY,
             contacts: 0,
@@ -288,9 +292,11 @@ impl Metrics {
         let us = ((latency * 1e6).round().max(1.0) as u64).min(LATENCY_MAX_US);
         // `record`, not `saturating_record`: the latter clamps to the current top instead of
         // growing the histogram.
-        self.latency_us
-            .record(us)
-            .expect("an auto-resizing histogram records any latency up to 10⁶ s");
+        if self.record_latency {
+            self.latency_us
+                .record(us)
+                .expect("an auto-resizing histogram records any latency up to 10⁶ s");
+        }
         self.latency_max = self.latency_max.max(latency);
         self.latency_min = self.latency_min.min(latency);
         let n = self.orientation_bins.len();
