@@ -90,6 +90,17 @@ pub struct Entry {
     pub model: Option<PartModel>,
 }
 
+/// The options of a line of one part at the scene's seed.
+fn one_part(scene: &Scene, keep_records: bool) -> RunOptions {
+    RunOptions {
+        parts: 1,
+        seed: scene.seed,
+        sample_paths: 0,
+        keep_records,
+        online: None,
+    }
+}
+
 /// Run the line with one part entering as `entry` says (instead of a draw from the feed), keeping
 /// its record and, with `capture`, every push it met: what the online controller's model
 /// predicts a hypothesis does on the line ([`super::online`]). Same engine, same detection.
@@ -98,13 +109,7 @@ pub fn run_entry(
     entry: Entry,
     capture: bool,
 ) -> Result<(PartRecord, Vec<CapturedPush>), EngineError> {
-    let opts = RunOptions {
-        parts: 1,
-        seed: scene.seed,
-        sample_paths: 0,
-        keep_records: true,
-        online: None,
-    };
+    let opts = one_part(scene, true);
     let (mut r, captured) = run_inner(
         scene,
         &opts,
@@ -131,13 +136,7 @@ pub struct SingleRun {
 /// Run one part entering as `entry` says through `scene`, and return only how and where it
 /// left (see [`SingleRun`]).
 pub fn run_single(scene: &Scene, entry: Entry) -> Result<SingleRun, EngineError> {
-    let opts = RunOptions {
-        parts: 1,
-        seed: scene.seed,
-        sample_paths: 0,
-        keep_records: false,
-        online: None,
-    };
+    let opts = one_part(scene, false);
     let line = simulate(scene, &opts, &mut |_| {}, None, Some(entry))?;
     let (outcome, pose) = line.sinks.last_end.expect("one part, one end");
     Ok(SingleRun {
@@ -414,13 +413,7 @@ mod tests {
     #[test]
     fn only_a_fed_line_records_latencies() {
         let scene = quickstart();
-        let opts = RunOptions {
-            parts: 1,
-            seed: scene.seed,
-            sample_paths: 0,
-            keep_records: false,
-            online: None,
-        };
+        let opts = one_part(&scene, false);
         let entered = simulate(&scene, &opts, &mut |_| {}, None, Some(entry(1.0))).unwrap();
         assert_eq!(entered.sinks.metrics.exits, 1);
         assert!(entered.sinks.metrics.latency_us.is_empty());
