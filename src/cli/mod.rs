@@ -32,7 +32,9 @@ pub mod sense;
 pub mod stdout;
 pub mod validate;
 
+// The command line's own tests live with the other tests (tests/cli/), as a module of this one.
 #[cfg(test)]
+#[path = "../../tests/cli/mod.rs"]
 mod tests;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};

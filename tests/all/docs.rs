@@ -2,7 +2,7 @@
 //! (and, with `#anchor`, at a heading of it), the command lines are read as a shell reads them,
 //! and the range tables quote the library's. (That every documented `pinfeed …` command parses,
 //! and that the units table matches `--help`, is tested beside the command line, in
-//! `src/cli/tests/`.)
+//! `tests/cli/`.)
 
 use crate::doc_commands::{commands, documents, root, shell_words};
 use std::path::Path;

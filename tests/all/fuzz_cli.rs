@@ -7,7 +7,7 @@
 //!   stderr line is `error: ` and a cause) or 2 (clap's usage error), and no NaN or infinity in
 //!   any JSON or CSV printed.
 //! * (The same argument vectors in process, many more of them, are run by the command line's own
-//!   tests in `src/cli/tests/`; the strategies are `tests/shared/argv.rs`.)
+//!   tests in `tests/cli/`; the strategies are `tests/shared/argv.rs`.)
 //! * Random polygons across magnitudes 1e-300 … 1e300: a scaled copy is accepted or refused with
 //!   the polygon at unit size, with the same stable states and the same a / scale; where its mass
 //!   properties cannot be represented it is refused for that reason and no other.

@@ -1,7 +1,7 @@
 //! pinfeed's integration tests, built as one test binary (`cargo test --release --test all`): one
 //! module per area, and the shared helpers (`support`: running the built `pinfeed`; `common`: the
 //! contact-model helpers; `plan_cli`: the `pinfeed plan` helpers; `reference`: the independent slow contact
-//! reference; and from `tests/shared/`, which the command line's own tests in `src/cli/tests/`
+//! reference; and from `tests/shared/`, which the command line's own tests in `tests/cli/`
 //! include too: `shapes`, random polygons; `argv`, argument-vector strategies; `doc_commands`,
 //! the documents' command lines). One binary links the crate once instead
 //! of once per file. A single test is selected by its module path, e.g.
@@ -20,7 +20,7 @@ mod plan_cli;
 mod reference;
 mod support;
 mod xml;
-// Shared with the command line's own tests (src/cli/tests/), which include the same files.
+// Shared with the command line's own tests (tests/cli/), which include the same files.
 #[path = "../shared/argv.rs"]
 mod argv;
 #[path = "../shared/doc_commands.rs"]

@@ -1,16 +1,17 @@
-//! The command line's own tests, in process: every command shown in README.md and docs/ parses,
-//! the units table of docs/commands.md matches `--help`, random and mutated argument vectors never
+//! The command line's own tests, in process (a module of the binary's `cli`, kept here beside the
+//! other tests): every command shown in README.md and docs/ parses, the recorded command line
+//! parses back to itself, the units table of docs/commands.md matches `--help`, random and mutated argument vectors never
 //! panic, and the `pinfeed fuzz` targets that drive commands run clean on any number of threads.
 //! (The integration tests in tests/all run the built binary; these need the command line's types,
 //! which the binary keeps to itself.) They share the argument strategies, the random polygons and
 //! the documents' reader with tests/all, from tests/shared/.
 
 // The shared files, as modules of this one.
-#[path = "../../../tests/shared/argv.rs"]
+#[path = "../shared/argv.rs"]
 mod argv;
-#[path = "../../../tests/shared/doc_commands.rs"]
+#[path = "../shared/doc_commands.rs"]
 mod doc_commands;
-#[path = "../../../tests/shared/shapes.rs"]
+#[path = "../shared/shapes.rs"]
 mod shapes;
 
 use super::{fuzz, Cli};
@@ -155,6 +156,57 @@ fn every_length_flag_names_its_unit_as_the_units_table_does() {
         table.len(),
         "rows of the table that no command has: {table:?}"
     );
+}
+
+/// `pinfeed ARGS` parsed: the command line it records.
+fn recorded(args: &[&str]) -> String {
+    Cli::try_parse_from(std::iter::once("pinfeed").chain(args.iter().copied()))
+        .unwrap()
+        .recorded
+}
+
+#[test]
+fn records_what_was_given_in_definition_order_and_quotes_it() {
+    let r = recorded(&[
+        "map",
+        "--threads",
+        "2",
+        "--mu-c",
+        "0.7",
+        "--part",
+        "vertices:0,0 2,0 0,1",
+        "--d=-0.5,0.25",
+        "--quiet",
+    ]);
+    assert_eq!(
+        r,
+        "pinfeed map --part 'vertices:0,0 2,0 0,1' --d=-0.5,0.25 --mu-c 0.7"
+    );
+}
+
+#[test]
+fn the_recorded_command_parses_back_to_itself() {
+    for args in [
+        &[
+            "sense", "--part", "tripoly2", "--d=-0.3", "--tripod", "--noise", "0,1,2",
+        ][..],
+        &["validate", "my file.csv", "--members", "3", "--seed", "9"],
+        &["bench", "designs", "--random", "2", "--tripod"],
+        &[
+            "plan",
+            "--part",
+            "lshape",
+            "--fences",
+            "--mu-c-range",
+            "0.3:0.7",
+        ],
+    ] {
+        let r = recorded(args);
+        let words = shell_words(&r);
+        let again = recorded(&words.iter().skip(1).map(String::as_str).collect::<Vec<_>>());
+        assert_eq!(again, r);
+        assert!(!r.contains("--threads") && !r.contains("--quiet"), "{r}");
+    }
 }
 
 /// Driver settings for a test: seed, threads, a budget no case reaches.
