@@ -142,7 +142,9 @@ pub fn load_tier(
 ) -> Result<Loaded> {
     let (model, support, radius, settings) = inputs;
     let spec = match grid {
-        Some(g) => TierSpec::parse_grid(g)?,
+        Some(g) => {
+            TierSpec::parse_grid(g).map_err(|e| anyhow::anyhow!(e.describe("--map-grid")))?
+        }
         None => TierSpec::default(),
     };
     let inputs = TierInputs {

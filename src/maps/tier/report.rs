@@ -59,19 +59,39 @@ pub fn served_line(
     )
 }
 
-/// A `--map-grid` that is not three whole numbers in range.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+/// A map grid (`T,D,DEPTH`) that is not three whole numbers in range. Its `Display` names the
+/// setting `map_grid`; [`GridError::describe`] by the caller's name (`pinfeed contact`'s
+/// `--map-grid`).
+#[derive(Debug, Clone, PartialEq)]
 pub enum GridError {
     /// A value that is not a whole number (the text given).
-    #[error("--map-grid '{0}': expected T,D,DEPTH (whole numbers)")]
     Numbers(String),
     /// Not three values (the text given).
-    #[error("--map-grid '{0}': expected three numbers T,D,DEPTH")]
     Count(String),
     /// A value outside [4, 720] × [2, 200] × [0, 8] (θ0 cells, d cells, depth).
-    #[error("--map-grid must lie in [4, 720] × [2, 200] × [0, 8], got {0},{1},{2}")]
     Range(u32, u32, u32),
 }
+
+impl GridError {
+    /// The message, with the grid setting named `name`.
+    pub fn describe(&self, name: &str) -> String {
+        match self {
+            GridError::Numbers(t) => format!("{name} '{t}': expected T,D,DEPTH (whole numbers)"),
+            GridError::Count(t) => format!("{name} '{t}': expected three numbers T,D,DEPTH"),
+            GridError::Range(a, b, c) => {
+                format!("{name} must lie in [4, 720] × [2, 200] × [0, 8], got {a},{b},{c}")
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for GridError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.describe("map_grid"))
+    }
+}
+
+impl std::error::Error for GridError {}
 
 impl TierSpec {
     /// Parse `T,D,DEPTH`: θ0 base cells, d base cells, refinement depth (the rest default).
@@ -93,5 +113,31 @@ impl TierSpec {
             max_depth: depth,
             ..TierSpec::default()
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_errors_name_the_setting_by_its_field_or_by_the_callers_name() {
+        for (text, start) in [
+            ("a,b,c", "map_grid 'a,b,c': expected T,D,DEPTH"),
+            ("4,2", "map_grid '4,2': expected three numbers"),
+            (
+                "3,2,0",
+                "map_grid must lie in [4, 720] × [2, 200] × [0, 8], got 3,2,0",
+            ),
+        ] {
+            let e = TierSpec::parse_grid(text).unwrap_err();
+            let msg = e.to_string();
+            assert!(msg.starts_with(start), "{msg}");
+            assert_eq!(
+                e.describe("--map-grid"),
+                msg.replacen("map_grid", "--map-grid", 1)
+            );
+        }
+        assert!(TierSpec::parse_grid("4,2,0").is_ok());
     }
 }
