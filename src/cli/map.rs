@@ -128,9 +128,8 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     check_inputs(&template)?;
     let fenced = args.fence.is_some();
     let (step, threshold) = (args.theta_step, args.threshold);
-    pinfeed::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold).map_err(
-        |e| anyhow::anyhow!(e.describe(|s| format!("--{}", s.field().replace('_', "-")))),
-    )?;
+    pinfeed::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold)
+        .map_err(|e| anyhow::anyhow!(e.describe(|s| super::flag(s.field()))))?;
     let (poly, part_model) = compile_part(&args.part, &args.push.support)?;
     if fence.is_some() {
         check_geometry(&template, &poly)?;

@@ -109,6 +109,12 @@ pub enum Command {
     Completions(completions::CompletionsArgs),
 }
 
+/// The flag that sets a library setting named by its field (`mu_c` → `--mu-c`): how the
+/// command line renders the library's errors, which name settings by field.
+pub fn flag(field: &str) -> String {
+    format!("--{}", field.replace('_', "-"))
+}
+
 /// Run a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let Cli { command, recorded } = cli;

@@ -228,11 +228,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
 fn flag_of(field: &str) -> String {
     match field {
         "modes" => "--pins/--fences/--sensor".into(),
-        f => f
-            .split('/')
-            .map(|f| format!("--{}", f.replace('_', "-")))
-            .collect::<Vec<_>>()
-            .join("/"),
+        f => f.split('/').map(super::flag).collect::<Vec<_>>().join("/"),
     }
 }
 

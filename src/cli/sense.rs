@@ -223,7 +223,7 @@ pub fn request(a: &SenseArgs) -> Request {
 fn flag_of(setting: Setting) -> String {
     match setting {
         Setting::SensorKind => "--sensor".into(),
-        s => format!("--{}", s.field().replace('_', "-")),
+        s => super::flag(s.field()),
     }
 }
 

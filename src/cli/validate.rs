@@ -82,7 +82,7 @@ impl ModelArgs {
         )?;
         let (k, f, w, c) = (self.kernel, self.floor, self.window, self.contained_share);
         ScoreSettings::checked(k, f, w, c).map_err(|mut e| {
-            e.name = format!("--{}", e.name.replace('_', "-"));
+            e.name = super::flag(&e.name);
             e.into()
         })
     }
@@ -141,16 +141,11 @@ pub fn ensemble_spec(
     input::ensemble_spec(mu_c, pin_radius, model, common.tol, uncertain).map_err(flagged)
 }
 
-/// The flag of `pinfeed validate` and `pinfeed calibrate` that sets `setting`.
-fn flag_of(setting: Setting) -> String {
-    format!("--{}", setting.field().replace('_', "-"))
-}
-
 /// A refused input, its message naming the flags (a refused file keeps its own error chain).
 pub fn flagged(e: InputError) -> anyhow::Error {
     match e {
         InputError::Measured(m) => m.into(),
-        e => anyhow::anyhow!(e.describe(flag_of)),
+        e => anyhow::anyhow!(e.describe(|s| super::flag(s.field()))),
     }
 }
 

@@ -679,28 +679,10 @@ fn zero_radius_disc_is_a_point_pin() {
 
 /// Star-shaped polygon about the origin (simple by construction), radii in [0.2, 1].
 fn star_polygon() -> impl Strategy<Value = Polygon> {
-    (3usize..10)
-        .prop_flat_map(|n| {
-            (
-                prop::collection::vec(1.0f64..1.9, n),
-                prop::collection::vec(0.2f64..1.0, n),
-                0.0f64..std::f64::consts::TAU,
-            )
-        })
-        .prop_map(|(gaps, radii, start)| {
-            let total: f64 = gaps.iter().sum();
-            let mut phi = start;
-            let pts: Vec<Vec2> = gaps
-                .iter()
-                .zip(&radii)
-                .map(|(g, r)| {
-                    let p = Vec2::from_angle(phi) * *r;
-                    phi += g / total * std::f64::consts::TAU;
-                    p
-                })
-                .collect();
-            Polygon::new(&pts).unwrap()
-        })
+    crate::shapes::star_polygon(3..10).prop_map(|v| {
+        let pts: Vec<Vec2> = v.iter().map(|&(x, y)| Vec2::new(x, y)).collect();
+        Polygon::new(&pts).unwrap()
+    })
 }
 
 /// (start, unit direction, radius): a pin starting well outside the part (centred at the origin,
