@@ -145,24 +145,30 @@ pub fn sample_ft(
     let (t0, n) = window(signal, sensor.rate, phase)?;
     let dt = 1.0 / sensor.rate;
     let mut values = signal.sample(t0, dt, n);
+    // The channels' settings, looked up once rather than per sample.
+    let noise: [f64; CHANNELS] = std::array::from_fn(|c| sensor.noise(c));
+    let bias: [f64; CHANNELS] = std::array::from_fn(|c| sensor.bias(c));
+    let drift: [f64; CHANNELS] = std::array::from_fn(|c| sensor.drift(c));
+    let resolution: [f64; CHANNELS] = std::array::from_fn(|c| sensor.resolution(c));
     for (k, v) in values.iter_mut().enumerate() {
         let elapsed = k as f64 * dt;
         for (c, x) in v.iter_mut().enumerate() {
-            let noise = if sensor.noise(c) > 0.0 {
+            let noise = if noise[c] > 0.0 {
                 let z: f64 = StandardNormal.sample(rng);
-                sensor.noise(c) * z
+                noise[c] * z
             } else {
                 0.0
             };
-            *x += sensor.bias(c) + sensor.drift(c) * elapsed + noise;
+            *x += bias[c] + drift[c] * elapsed + noise;
         }
     }
     lowpass(&mut values, sensor);
-    for v in &mut values {
-        for (c, x) in v.iter_mut().enumerate() {
-            let q = sensor.resolution(c);
-            if q > 0.0 {
-                *x = q * (*x / q).round();
+    if resolution.iter().any(|&q| q > 0.0) {
+        for v in &mut values {
+            for (x, &q) in v.iter_mut().zip(&resolution) {
+                if q > 0.0 {
+                    *x = q * (*x / q).round();
+                }
             }
         }
     }

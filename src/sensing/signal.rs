@@ -166,8 +166,12 @@ impl ContactSignal {
 
     /// The clean channels at t0, t0 + dt, …, n samples: the same values as [`Self::at`] at each
     /// instant, found by walking the contacts and runs once instead of searching them per sample.
+    ///
+    /// The sample times never decrease (`dt` ≥ 0), so the knot interval of the current run is
+    /// found by walking forward from the previous sample's, not by a binary search.
     pub fn sample(&self, t0: f64, dt: f64, n: usize) -> Vec<[f64; CHANNELS]> {
-        let (mut c, mut r) = (0, 0);
+        // c: the current contact; r: the current run; p: its knots at or before the last t.
+        let (mut c, mut r, mut p) = (0, 0, 0);
         (0..n)
             .map(|k| {
                 let t = t0 + k as f64 * dt;
@@ -181,9 +185,12 @@ impl ContactSignal {
                 // the last run covering t if any run does.
                 while r + 1 < self.runs.len() && self.runs[r + 1].t[0] <= t {
                     r += 1;
+                    p = 0;
                 }
                 match self.runs.get(r) {
-                    Some(run) if run.t[0] <= t && t <= run.t[run.t.len() - 1] => run.eval(t),
+                    Some(run) if run.t[0] <= t && t <= run.t[run.t.len() - 1] => {
+                        run.eval_walk(t, &mut p)
+                    }
                     _ => self.at(t),
                 }
             })
@@ -219,12 +226,28 @@ impl ContactSignal {
 
 impl Run {
     fn eval(&self, t: f64) -> [f64; CHANNELS] {
+        // Binary search for the number of knots at or before t.
+        self.eval_interval(t, self.t.partition_point(|&x| x <= t))
+    }
+
+    /// [`Self::eval`] for times that never decrease from one call to the next: `p` holds the
+    /// number of knots at or before the previous call's t (0 before the first call) and is walked
+    /// forward to this t's, the count the binary search of [`Self::eval`] finds.
+    fn eval_walk(&self, t: f64, p: &mut usize) -> [f64; CHANNELS] {
+        while *p < self.t.len() && self.t[*p] <= t {
+            *p += 1;
+        }
+        self.eval_interval(t, *p)
+    }
+
+    /// The interpolant at t, where `p` knots lie at or before t.
+    fn eval_interval(&self, t: f64, p: usize) -> [f64; CHANNELS] {
         let n = self.t.len();
         if n == 1 {
             return self.v[0];
         }
-        // Binary search for the interval [t_i, t_{i+1}] holding t.
-        let i = match self.t.partition_point(|&x| x <= t) {
+        // The interval [t_i, t_{i+1}] holding t.
+        let i = match p {
             0 => 0,
             p => (p - 1).min(n - 2),
         };
@@ -323,6 +346,82 @@ mod tests {
         for &x in &[0.0, 0.25, 0.5, 1.0, 1.7, 2.0] {
             let y = run.eval(x);
             assert!((y[0] - (2.0 * x + 1.0)).abs() < 1e-12, "{x}: {}", y[0]);
+        }
+    }
+
+    /// A run through `t` with channel c of knot j equal to f(t_j, c).
+    fn run_of(t: &[f64], f: impl Fn(f64, usize) -> f64) -> Run {
+        let v: Vec<[f64; CHANNELS]> = t
+            .iter()
+            .map(|&x| std::array::from_fn(|c| f(x, c)))
+            .collect();
+        let m = pchip_slopes(t, &v);
+        Run {
+            t: t.to_vec(),
+            v,
+            m,
+        }
+    }
+
+    #[test]
+    fn forward_sampling_matches_at_bit_for_bit() {
+        // Three contacts with gaps between them; the second holds two runs that meet at an
+        // event (the signal jumps), the third a single knot; uneven knot spacing throughout.
+        let runs = vec![
+            run_of(&[0.010, 0.0103, 0.011, 0.0125, 0.0131, 0.020], |x, c| {
+                (x * 300.0 + c as f64).sin()
+            }),
+            run_of(&[0.030, 0.0301, 0.0302, 0.034], |x, c| {
+                (x * 1e3).powi(2) - c as f64
+            }),
+            run_of(&[0.034, 0.0355, 0.036, 0.0361, 0.041], |x, c| {
+                (c as f64 + 1.0) * (x * 500.0).cos()
+            }),
+            run_of(&[0.050], |_, c| c as f64 - 2.5),
+        ];
+        let signal = ContactSignal {
+            runs,
+            contacts: vec![(0.010, 0.020), (0.030, 0.041), (0.050, 0.050)],
+            first_feature: None,
+            knots: 16,
+        };
+        for (t0, dt, n) in [
+            (0.0, 1e-4, 700),
+            (0.00987, 1.0 / 3000.0, 150),
+            (0.0300, 1e-4, 200),
+            (0.0, 1e-3, 60),
+        ] {
+            let forward = signal.sample(t0, dt, n);
+            for (k, v) in forward.iter().enumerate() {
+                let t = t0 + k as f64 * dt;
+                let at = signal.at(t);
+                assert_eq!(v.map(f64::to_bits), at.map(f64::to_bits), "t = {t}");
+            }
+        }
+        // Samples land on knots and inside every run.
+        let hits = signal
+            .sample(0.0, 1e-4, 700)
+            .iter()
+            .filter(|v| v.iter().any(|x| *x != 0.0))
+            .count();
+        assert!(hits > 150, "{hits}");
+    }
+
+    #[test]
+    fn the_walk_finds_the_interval_the_search_finds() {
+        let run = run_of(&[0.0, 0.1, 0.15, 0.4, 1.0, 1.01], |x, c| {
+            x * x * (c as f64 + 1.0)
+        });
+        let mut p = 0;
+        for k in -20..=220 {
+            let t = k as f64 * 0.005;
+            let walked = run.eval_walk(t, &mut p);
+            assert_eq!(
+                walked.map(f64::to_bits),
+                run.eval(t).map(f64::to_bits),
+                "t = {t}"
+            );
+            assert_eq!(p, run.t.partition_point(|&x| x <= t));
         }
     }
 
