@@ -66,6 +66,14 @@ impl Arrival {
             Arrival::Periodic { headway } | Arrival::Poisson { headway } => headway,
         }
     }
+
+    /// The same arrival process with (mean) time `headway` (s) between arrivals.
+    pub fn with_headway(self, headway: f64) -> Arrival {
+        match self {
+            Arrival::Periodic { .. } => Arrival::Periodic { headway },
+            Arrival::Poisson { .. } => Arrival::Poisson { headway },
+        }
+    }
 }
 
 /// Distribution of the entry orientation.

@@ -5,6 +5,7 @@
 
 use super::LineCheck;
 use crate::engine::{run, OutcomeCounts, RunOptions, RunResult};
+use crate::scenario::Scene;
 use crate::statistics::wilson_interval;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -87,7 +88,9 @@ impl Runnable {
         out
     }
 
-    /// Run `parts` parts at headway `h` with `seed`, keeping per-part records if asked.
+    /// Run `parts` parts at headway `h` with `seed`, keeping per-part records if asked: the
+    /// scenario built for this one run (to run it at several headways, build it once with
+    /// [`Line`]).
     pub(crate) fn run(
         &self,
         scratch: &Scratch,
@@ -96,14 +99,41 @@ impl Runnable {
         seed: u64,
         records: bool,
     ) -> Result<(LineCheck, RunResult), LineError> {
-        let path = scratch.dir.join("design.toml");
-        if let Some((name, text)) = &self.policy {
-            let p = scratch.dir.join(name);
-            crate::output::write_atomic(&p, text)
-                .map_err(|source| LineError::Io { path: p, source })?;
+        Line::new(self, scratch).run(h, parts, seed, records)
+    }
+}
+
+/// A design on the line, run at any headway: its scenario is written to the scratch folder (with
+/// its policy file) and built — its sensor pins trained, the costly step of a sensor scene — on
+/// the first run only; a later run at another headway sets the built scene's feed headway to the
+/// one [`Runnable::with_headway`] would write. Only the arrivals depend on `[feed] headway`, so a
+/// run gives what building the scenario with that headway line would (a test checks it).
+pub(crate) struct Line<'a> {
+    runnable: &'a Runnable,
+    scratch: &'a Scratch,
+    /// The scene as built by the first run.
+    scene: Option<Scene>,
+}
+
+impl<'a> Line<'a> {
+    /// The design `runnable` in `scratch`, not built yet.
+    pub(crate) fn new(runnable: &'a Runnable, scratch: &'a Scratch) -> Line<'a> {
+        Line {
+            runnable,
+            scratch,
+            scene: None,
         }
-        let toml = self.with_headway(h);
-        let scene = crate::scenario::parse(&path, &toml)?;
+    }
+
+    /// Run `parts` parts at headway `h` with `seed`, keeping per-part records if asked.
+    pub(crate) fn run(
+        &mut self,
+        h: f64,
+        parts: u64,
+        seed: u64,
+        records: bool,
+    ) -> Result<(LineCheck, RunResult), LineError> {
+        let scene = self.scene(h)?;
         let opts = RunOptions {
             parts,
             seed,
@@ -112,10 +142,50 @@ impl Runnable {
             online: None,
         };
         let started = Instant::now();
-        let res = run(&scene, &opts, &mut |_| {})?;
+        let res = run(scene, &opts, &mut |_| {})?;
         let check = LineCheck::of(&res.summary.outcomes, parts, h, started);
         Ok((check, res))
     }
+
+    /// The scene at headway `h`: the built scene with its headway set, or (first, or at a headway
+    /// the scenario would refuse, or for a scenario without a `headway = …` line) the scenario
+    /// text with `h` written in, built.
+    fn scene(&mut self, h: f64) -> Result<&Scene, LineError> {
+        let written = written_headway(h).filter(|_| self.runnable.has_headway());
+        if let (Some(scene), Some(headway)) = (self.scene.as_mut(), written) {
+            scene.feed.arrival = scene.feed.arrival.with_headway(headway);
+        } else {
+            let path = self.scratch.dir.join("design.toml");
+            if let Some((name, text)) = &self.runnable.policy {
+                let p = self.scratch.dir.join(name);
+                crate::output::write_atomic(&p, text)
+                    .map_err(|source| LineError::Io { path: p, source })?;
+            }
+            let toml = self.runnable.with_headway(h);
+            self.scene = Some(crate::scenario::parse(&path, &toml)?);
+        }
+        Ok(self.scene.as_ref().expect("the scene was built"))
+    }
+}
+
+impl Runnable {
+    /// Does the scenario have a `headway = …` line for [`Self::with_headway`] to replace?
+    fn has_headway(&self) -> bool {
+        self.toml.lines().any(|l| l.starts_with("headway = "))
+    }
+}
+
+/// The headway (s) a scenario reads from the line [`Runnable::with_headway`] writes for `h`: the
+/// number as written ([`fmt_headway`]) read back by the TOML parser, if the scenario accepts it
+/// (`None` otherwise: building the scenario reports the error).
+fn written_headway(h: f64) -> Option<f64> {
+    #[derive(serde::Deserialize)]
+    struct Feed {
+        headway: f64,
+    }
+    let feed: Feed = toml::from_str(&format!("headway = {}\n", fmt_headway(h))).ok()?;
+    crate::scenario::limits::contains(crate::scenario::limits::HEADWAY, feed.headway)
+        .then_some(feed.headway)
 }
 
 /// A headway as written (s, 3 decimals at most).
@@ -152,10 +222,8 @@ pub type HeadwayProbe = (f64, u64, u64, f64);
 /// taken to pass), then with a 25% reserve, rounded up to 0.1 s and at most `hi`. Returns it with
 /// the probes. (Short headways fail by collisions, and on lines with moving pins by pins that
 /// cannot reach the next part's position in time.)
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn shortest_headway(
-    r: &Runnable,
-    scratch: &Scratch,
+    line: &mut Line,
     (lo, hi): (f64, f64),
     target: f64,
     probe_parts: u64,
@@ -166,7 +234,7 @@ pub(crate) fn shortest_headway(
     let mut probes = Vec::new();
     // The same parts with the parts far apart: a probe is compared with them (paired), so the
     // sampling noise of a short run does not pass for a loss.
-    let (iso, _) = r.run(scratch, hi, probe_parts, seed, false)?;
+    let (iso, _) = line.run(hi, probe_parts, seed, false)?;
     let i = iso.success_rate;
     let floor = if i >= target {
         target.max(i - ((i - target) / 2.0).max(0.002))
@@ -179,7 +247,7 @@ pub(crate) fn shortest_headway(
             break;
         }
         let mid = (bad * good).sqrt();
-        let (c, _) = r.run(scratch, mid, probe_parts, seed, false)?;
+        let (c, _) = line.run(mid, probe_parts, seed, false)?;
         probes.push((mid, probe_parts, c.outcomes.collision, c.success_rate));
         if c.outcomes.collision == 0 && c.success_rate >= floor {
             good = mid;
@@ -189,4 +257,88 @@ pub(crate) fn shortest_headway(
     }
     let chosen = ((good * 1.25) * 10.0).ceil() / 10.0;
     Ok((chosen.min(hi), probes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scenario(file: &str) -> String {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios")
+            .join(file);
+        std::fs::read_to_string(path).unwrap()
+    }
+
+    /// A line built at one headway and run at others gives, at each, the scene and the run of the
+    /// scenario text written with that headway and built afresh.
+    fn reuse_matches_rebuilding(r: &Runnable, headways: &[f64]) {
+        let scratch = Scratch::new().unwrap();
+        let mut line = Line::new(r, &scratch);
+        line.run(9.0, 3, 5, false).unwrap();
+        for &h in headways {
+            let (check, res) = line.run(h, 40, 5, true).unwrap();
+            let built =
+                crate::scenario::parse(&scratch.dir.join("design.toml"), &r.with_headway(h))
+                    .unwrap();
+            let reused = line.scene.as_ref().unwrap();
+            assert_eq!(reused.feed.arrival, built.feed.arrival, "h = {h}");
+            assert_eq!(format!("{reused:?}"), format!("{built:?}"), "h = {h}");
+            let opts = RunOptions {
+                parts: 40,
+                seed: 5,
+                sample_paths: 0,
+                keep_records: true,
+                online: None,
+            };
+            let fresh = run(&built, &opts, &mut |_| {}).unwrap();
+            assert_eq!(format!("{:?}", res.summary), format!("{:?}", fresh.summary));
+            assert_eq!(format!("{:?}", res.records), format!("{:?}", fresh.records));
+            assert_eq!(check.headway_s, h);
+        }
+    }
+
+    #[test]
+    fn a_sensor_line_run_at_several_headways_is_the_line_rebuilt_at_each() {
+        let r = Runnable {
+            toml: scenario("tripoly1_sensing.toml"),
+            policy: None,
+        };
+        // Headways the text rounds (to 3 decimals) and one it keeps.
+        reuse_matches_rebuilding(&r, &[4.4, 2.345_678_9, 1.0 / 3.0, 6.0004, 0.1 + 0.2]);
+    }
+
+    #[test]
+    fn a_poisson_line_keeps_its_arrival_process() {
+        let toml = scenario("quickstart.toml").replace(
+            "arrival = \"periodic\" # or \"poisson\"",
+            "arrival = \"poisson\"",
+        );
+        assert!(toml.contains("arrival = \"poisson\""));
+        let r = Runnable { toml, policy: None };
+        reuse_matches_rebuilding(&r, &[2.5, 1.0 / 7.0]);
+    }
+
+    #[test]
+    fn the_headway_read_back_is_the_one_written() {
+        for h in [
+            4.4,
+            2.345_678_9,
+            1.0 / 3.0,
+            0.1 + 0.2,
+            1e-3,
+            123_456.789_4,
+            0.0015,
+        ] {
+            let text = fmt_headway(h);
+            assert_eq!(
+                written_headway(h),
+                Some(text.parse::<f64>().unwrap()),
+                "{h}"
+            );
+        }
+        // Written as 0.0: the scenario refuses it, and so the line builds it to report the error.
+        assert_eq!(written_headway(1e-4), None);
+        assert_eq!(written_headway(f64::NAN), None);
+    }
 }

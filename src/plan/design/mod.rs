@@ -33,7 +33,7 @@ use super::fences::{FenceOptions, FenceTransition};
 use super::search::{Outcome, Plan, Planner};
 use super::{Action, PlanError, Problem};
 use crate::engine::OutcomeCounts;
-use line::{HeadwayProbe, LineError, Runnable, Scratch};
+use line::{HeadwayProbe, Line, LineError, Runnable, Scratch};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -1138,9 +1138,9 @@ impl Work<'_> {
         self.tell(Some(mode), round, "finding the line's headway".into());
         let runnable = c.runnable.clone();
         let target = o.problem.target;
+        let mut on_line = Line::new(&runnable, &scratch);
         let (h, probes) = line::shortest_headway(
-            &runnable,
-            &scratch,
+            &mut on_line,
             (lo, hi),
             target,
             o.screen_parts.min(1000),
@@ -1163,7 +1163,7 @@ impl Work<'_> {
             round,
             format!("line check ({parts} parts at {h:.1} s)"),
         );
-        let (check, res) = runnable.run(&scratch, h, parts, seed, false)?;
+        let (check, res) = on_line.run(h, parts, seed, false)?;
         self.line_runs += 1;
         let c = &mut self.candidates[i];
         if let Layout::Contingent(plan) = &c.layout {
