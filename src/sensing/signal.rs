@@ -170,28 +170,29 @@ impl ContactSignal {
     /// The sample times never decrease (`dt` ≥ 0), so the knot interval of the current run is
     /// found by walking forward from the previous sample's, not by a binary search.
     pub fn sample(&self, t0: f64, dt: f64, n: usize) -> Vec<[f64; CHANNELS]> {
-        // c: the current contact; r: the current run; p: its knots at or before the last t.
-        let (mut c, mut r, mut p) = (0, 0, 0);
-        (0..n)
-            .map(|k| {
-                let t = t0 + k as f64 * dt;
-                while c < self.contacts.len() && self.contacts[c].1 < t {
-                    c += 1;
-                }
-                if c == self.contacts.len() || self.contacts[c].0 > t {
-                    return [0.0; CHANNELS];
-                }
-                // The last run starting at or before t; runs follow each other in time, so it is
-                // the last run covering t if any run does.
-                while r + 1 < self.runs.len() && self.runs[r + 1].t[0] <= t {
-                    r += 1;
-                    p = 0;
-                }
-                match self.runs.get(r) {
-                    Some(run) if run.t[0] <= t && t <= run.t[run.t.len() - 1] => {
-                        run.eval_walk(t, &mut p)
-                    }
-                    _ => self.at(t),
+        let mut walk = Walk::default();
+        (0..n).map(|k| walk.at(self, t0 + k as f64 * dt)).collect()
+    }
+
+    /// [`Self::at`] at each of `times`, bit for bit: walked as by [`Self::sample`] while the
+    /// times do not decrease (and the contacts and runs follow each other in time, as a pass
+    /// records them), else searched per time.
+    pub fn at_each(&self, times: impl IntoIterator<Item = f64>) -> Vec<[f64; CHANNELS]> {
+        let ordered = self
+            .contacts
+            .windows(2)
+            .all(|w| w[0].0 <= w[1].0 && w[0].1 <= w[1].1)
+            && self.runs.windows(2).all(|w| w[0].t[0] <= w[1].t[0]);
+        let mut walk = Walk::default();
+        let mut last = f64::NEG_INFINITY;
+        times
+            .into_iter()
+            .map(|t| {
+                if ordered && t >= last {
+                    last = t;
+                    walk.at(self, t)
+                } else {
+                    self.at(t)
                 }
             })
             .collect()
@@ -221,6 +222,40 @@ impl ContactSignal {
             .iter()
             .flat_map(|r| r.t.iter().copied().zip(r.v.iter().copied()))
             .collect()
+    }
+}
+
+/// Where a walk through a signal at times that never decrease stands: the current contact `c`,
+/// the current run `r` and the number `p` of its knots at or before the last time.
+#[derive(Default)]
+struct Walk {
+    c: usize,
+    r: usize,
+    p: usize,
+}
+
+impl Walk {
+    /// The clean channels at `t`, not before the previous call's time.
+    fn at(&mut self, signal: &ContactSignal, t: f64) -> [f64; CHANNELS] {
+        let (contacts, runs) = (&signal.contacts, &signal.runs);
+        while self.c < contacts.len() && contacts[self.c].1 < t {
+            self.c += 1;
+        }
+        if self.c == contacts.len() || contacts[self.c].0 > t {
+            return [0.0; CHANNELS];
+        }
+        // The last run starting at or before t; runs follow each other in time, so it is the
+        // last run covering t if any run does.
+        while self.r + 1 < runs.len() && runs[self.r + 1].t[0] <= t {
+            self.r += 1;
+            self.p = 0;
+        }
+        match runs.get(self.r) {
+            Some(run) if run.t[0] <= t && t <= run.t[run.t.len() - 1] => {
+                run.eval_walk(t, &mut self.p)
+            }
+            _ => signal.at(t),
+        }
     }
 }
 
@@ -396,6 +431,21 @@ mod tests {
                 let t = t0 + k as f64 * dt;
                 let at = signal.at(t);
                 assert_eq!(v.map(f64::to_bits), at.map(f64::to_bits), "t = {t}");
+            }
+        }
+        // Any times, rising (as a classifier's lag grid), at a phase, or going back.
+        let phased: Vec<f64> = (0..400)
+            .map(|j| 0.012 + (j as f64 - 12.0 + -3.0 + 0.25) * 1e-4)
+            .collect();
+        let back: Vec<f64> = (0..300).map(|j| ((j * 37) % 300) as f64 * 2e-4).collect();
+        for times in [phased, back] {
+            let each = signal.at_each(times.iter().copied());
+            for (v, &t) in each.iter().zip(&times) {
+                assert_eq!(
+                    v.map(f64::to_bits),
+                    signal.at(t).map(f64::to_bits),
+                    "t = {t}"
+                );
             }
         }
         // Samples land on knots and inside every run.

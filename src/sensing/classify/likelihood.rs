@@ -656,12 +656,10 @@ impl Frame {
         // fine[φ][j] = s(b + (j − pre + l_lo + φ/P)·dt)
         let fine: Vec<Vec<[f64; CHANNELS]>> = (0..PHASES)
             .map(|ph| {
-                (0..frame + span_l + 1)
-                    .map(|j| {
-                        let tau = (j as f64 - pre as f64 + l_lo as f64 + ph as f64 / p) * dt;
-                        s.at(b + tau)
-                    })
-                    .collect()
+                s.at_each((0..frame + span_l + 1).map(|j| {
+                    let tau = (j as f64 - pre as f64 + l_lo as f64 + ph as f64 / p) * dt;
+                    b + tau
+                }))
             })
             .collect();
         (self.o_lo..=self.o_hi)
