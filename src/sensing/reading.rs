@@ -167,12 +167,27 @@ pub fn sample_ft(
         for v in &mut values {
             for (x, &q) in v.iter_mut().zip(&resolution) {
                 if q > 0.0 {
-                    *x = q * (*x / q).round();
+                    *x = q * round_half_away(*x / q);
                 }
             }
         }
     }
     Some(Sampled { t0, dt, values })
+}
+
+/// `y.round()` (to the nearest integer, halves away from zero), bit for bit, without the call to
+/// the library's `round` the baseline x86-64 target makes: below 2⁵² the integer part is the
+/// truncating conversion's, the fraction `|y| − t` is exact (Sterbenz), and so is `t + 1`.
+#[inline]
+fn round_half_away(y: f64) -> f64 {
+    let a = y.abs();
+    // From 2⁵² on every f64 is an integer; NaN and ±∞ pass through as `round` leaves them.
+    if a >= 4_503_599_627_370_496.0 || a.is_nan() {
+        return y;
+    }
+    let t = a as i64 as f64;
+    let r = if a - t >= 0.5 { t + 1.0 } else { t };
+    r.copysign(y)
 }
 
 /// The contact instants of a timing sensor: where the clean |F| crosses the threshold (located to
@@ -247,5 +262,49 @@ pub fn read(
     match sensor.kind {
         SensorKind::Ft => sample_ft(signal, sensor, rng).map(Reading::Ft),
         SensorKind::Timing => Some(Reading::Timing(sample_timing(signal, sensor, rng))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::RngExt;
+
+    #[test]
+    fn round_half_away_is_round_bit_for_bit() {
+        let two52 = 4_503_599_627_370_496.0_f64;
+        let mut cases = vec![
+            0.0,
+            0.5,
+            1.5,
+            2.5,
+            0.499_999_999_999_999_94,
+            1.0 - f64::EPSILON / 2.0,
+            two52 - 0.5,
+            two52 - 1.0,
+            two52,
+            two52 + 1.0,
+            2.0 * two52,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::INFINITY,
+            1e-3 / 3e-3,
+            0.0125 / 0.001,
+        ];
+        let mut rng = crate::random::stream(7, 0);
+        for _ in 0..200_000 {
+            cases.push(f64::from_bits(rng.random::<u64>()));
+            cases.push(rng.random::<f64>() * 100.0);
+            cases.push((rng.random_range(0..2000) as f64) * 0.5);
+            cases.push(rng.random::<f64>() * 1e16);
+        }
+        for y in cases.iter().flat_map(|&y| [y, -y]) {
+            let (a, b) = (round_half_away(y), y.round());
+            assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "{y:e}: {a:e} vs {b:e}"
+            );
+        }
     }
 }
