@@ -669,10 +669,19 @@ impl Frame {
                 let off = (l - l_lo) as usize;
                 let mut v: Vec<[f64; CHANNELS]> = fine[ph][off..off + frame].to_vec();
                 reading::lowpass(&mut v, sensor);
+                // Entry ci·blocks + k: channel USED[ci] summed over block k, in sample order
+                // (the frame is whole blocks).
+                debug_assert_eq!(v.len(), blocks * block);
                 let mut out = vec![0.0; dims];
-                for (ci, &c) in USED.iter().enumerate() {
-                    for (i, x) in v.iter().enumerate() {
-                        out[ci * blocks + i / block] += x[c];
+                for (k, chunk) in v.chunks(block).enumerate() {
+                    let mut acc = [0.0; USED.len()];
+                    for x in chunk {
+                        for (a, &c) in acc.iter_mut().zip(&USED) {
+                            *a += x[c];
+                        }
+                    }
+                    for (ci, a) in acc.into_iter().enumerate() {
+                        out[ci * blocks + k] = a;
                     }
                 }
                 out
