@@ -543,6 +543,24 @@ impl Polygon {
         &self.hull
     }
 
+    /// The convex hull as a polygon **in this polygon's part frame**: its vertices are
+    /// [`Self::hull`]'s, bit for bit, not re-centred on the hull's own centroid as
+    /// [`Polygon::new`] would put them, so a point of the hull is the same point of the part (what
+    /// a fence touches, pushing about the part's centroid). Its offset is zero (its frame is the
+    /// part's); its area, polar moment and size are the hull's about the hull's own centroid.
+    pub fn hull_polygon(&self) -> Result<Polygon, PolygonError> {
+        let own = Polygon::new(&self.hull)?;
+        let (edge_dirs, edge_lens) = edge_data(&self.hull);
+        Ok(Polygon {
+            vertices: self.hull.clone(),
+            offset: Vec2::ZERO,
+            hull: self.hull.clone(),
+            edge_dirs,
+            edge_lens,
+            ..own
+        })
+    }
+
     /// The same polygon scaled by `k > 0` about its centroid, or why it cannot be: `k` not positive
     /// and finite ([`PolygonError::BadScale`]), or a scaled size, area or polar moment that a
     /// double cannot hold ([`PolygonError::NotRepresentable`]). Use this for factors that come
@@ -743,6 +761,37 @@ mod tests {
 
     fn deg(x: f64) -> f64 {
         x.to_degrees()
+    }
+
+    /// The hull polygon of a concave L stays in the L's frame (the hull's own centroid is
+    /// elsewhere): each of its vertices is one of the L's, bit for bit, its edges are the hull's,
+    /// and its area and size are those of the hull built on its own.
+    #[test]
+    fn a_hull_polygon_keeps_the_part_frame() {
+        let l = Polygon::from_xy(&[
+            (0.0, 0.0),
+            (3.0, 0.0),
+            (3.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.5),
+            (0.0, 2.5),
+        ])
+        .unwrap();
+        let own = Polygon::new(l.hull()).unwrap();
+        let h = l.hull_polygon().unwrap();
+        assert!(!l.is_convex() && h.is_convex());
+        assert_eq!(h.len(), 5);
+        assert_eq!(h.vertices(), l.hull());
+        assert!(h.vertices().iter().all(|v| l.vertices().contains(v)));
+        // Built on its own, the hull is re-centred: a fence touching it there would touch a point
+        // (0.06, 0.07) away from the part's.
+        assert!((own.vertex(0) - h.vertex(0)).norm() > 0.05);
+        for k in 0..h.len() {
+            assert!((h.edge_dir(k) - own.edge_dir(k)).norm() < 1e-15);
+            assert_eq!(h.edge_len(k), own.edge_len(k));
+        }
+        assert_eq!((h.area(), h.radius()), (own.area(), own.radius()));
+        assert_eq!(h.offset(), Vec2::ZERO);
     }
 
     #[test]

@@ -99,8 +99,13 @@ fn quad_form(h: &Matrix3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 #[derive(Clone)]
 pub struct PartModel {
     poly: Polygon,
-    /// The convex hull as a polygon (what a straight fence can touch), normalised units.
+    /// The convex hull as a polygon (what a straight fence can touch), normalised units, in the
+    /// part's frame (`Polygon::hull_polygon`).
     hull: Polygon,
+    /// Per hull vertex, the polygon's vertex at the same point (a hull vertex is one of the
+    /// polygon's convex vertices): a fence on hull vertex k slides on the same vertex tables as a
+    /// pin on that polygon vertex.
+    hull_in_poly: Vec<Option<usize>>,
     scale: f64,
     support: SupportData,
     /// m_max / f_max of the ellipsoid approximation (normalised units).
@@ -144,9 +149,17 @@ impl PartModel {
         let unit = poly.scaled(1.0 / scale);
         let data = SupportData::new(&unit, scale, support)?;
         let c = data.ellipsoid_c();
-        let hull = Polygon::new(unit.hull())?;
+        // In the part's frame: a fence's contact point is a point of the part, about its centroid.
+        let hull = unit.hull_polygon()?;
+        let hull_in_poly = (0..hull.len())
+            .map(|k| {
+                let v = hull.vertex(k);
+                (0..unit.len()).find(|&i| unit.vertex(i) == v && unit.vertex_is_convex(i))
+            })
+            .collect();
         Ok(PartModel {
             hull,
+            hull_in_poly,
             poly: unit,
             scale,
             support: data,
@@ -223,6 +236,18 @@ impl PartModel {
         }
     }
 
+    /// Does the model serve slides from tables at some μc ([`PartModel::with_slide_tables`])?
+    pub fn has_slide_tables(&self) -> bool {
+        self.slide_tables.is_some()
+    }
+
+    /// The polygon vertex at hull vertex `k`, if the hull's vertex is one of the polygon's convex
+    /// vertices (always, unless rounding moved it): where a fence touching hull vertex k slides
+    /// in the slide tables.
+    pub fn hull_vertex_in_polygon(&self, k: usize) -> Option<usize> {
+        self.hull_in_poly.get(k).copied().flatten()
+    }
+
     /// What the slide tables hold so far (`None`: the model has none).
     pub fn slide_table_stats(&self) -> Option<TableStats> {
         self.slide_tables.as_ref().map(|t| t.stats())
@@ -244,7 +269,7 @@ impl PartModel {
     pub fn polygon(&self) -> &Polygon {
         &self.poly
     }
-    /// The convex hull in normalised units (fence contacts index its vertices and edges).
+    /// The convex hull in normalised units, in the part's frame (fence contacts index its vertices and edges).
     pub fn hull(&self) -> &Polygon {
         &self.hull
     }
