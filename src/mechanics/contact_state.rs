@@ -217,7 +217,18 @@ impl Ctx<'_, '_> {
                 v_pin,
                 slide_at: self.own_polygon().then_some(SlideAt::Vertex(k, y[1])),
             },
-            Feat::FenceVertex(k) | Feat::FenceEdge(k) => ContactGeom {
+            Feat::FenceVertex(k) => {
+                let n = self.to_part(self.fence_geom().n, y[0]);
+                ContactGeom {
+                    p: self.poly.vertex(k),
+                    n,
+                    v_pin,
+                    slide_at: self
+                        .hull_vertex_tables(k)
+                        .map(|i| SlideAt::Vertex(i, n.angle())),
+                }
+            }
+            Feat::FenceEdge(k) => ContactGeom {
                 p: self.poly.vertex(k),
                 n: self.to_part(self.fence_geom().n, y[0]),
                 v_pin,
@@ -227,9 +238,19 @@ impl Ctx<'_, '_> {
     }
 
     /// Does the obstacle touch the part's own polygon (a pin), not its hull (a fence and its
-    /// ends)? The model's slide tables are for the part's own edges and vertices.
+    /// ends)? The model's slide tables are for the part's own edges and vertices (a fence's hull
+    /// vertex is served by its polygon vertex's: [`Self::hull_vertex_tables`]).
     fn own_polygon(&self) -> bool {
         std::ptr::eq(self.poly, self.model.polygon())
+    }
+
+    /// The polygon vertex whose slide tables serve a fence on hull vertex k: the hull is the
+    /// model's own and the model has tables (else nothing, and no angle is computed).
+    fn hull_vertex_tables(&self, k: usize) -> Option<usize> {
+        if !(self.model.has_slide_tables() && std::ptr::eq(self.poly, self.model.hull())) {
+            return None;
+        }
+        self.model.hull_vertex_in_polygon(k)
     }
 
     /// The fence (fence features only arise with one).

@@ -9,7 +9,8 @@
 //!   w(ℓ) = (f, a_k × f + ℓ e_k × f) is a straight line in wrench space (t = ℓ, on the edge for
 //!   ℓ ∈ [0, |edge|]);
 //! * **on vertex k**: p is the vertex and n = (cos φ, sin φ) turns through the vertex's normal cone
-//!   (a disc riding round the vertex; for a point pin φ stays where it arrived), so w(φ) is an arc
+//!   (a disc riding round the vertex; for a point pin φ stays where it arrived; a fence on this
+//!   vertex of the part's hull, φ its normal in the part's frame), so w(φ) is an arc
 //!   (t = φ − φ_a, inside the cone for t ∈ [0, cone angle], φ_a the inward normal of the edge
 //!   before the vertex).
 //!

@@ -38,7 +38,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<SceneD
     let feed = compile_feed(&c, raw.feed.as_ref(), &belt, &part)?;
     let (obstacles, neighbours, valid_sensors) =
         super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, part.radius, part.mu_c)?;
-    part.model = part.model.with_slide_tables(&pin_mu_values(&obstacles));
+    part.model = part.model.with_slide_tables(&contact_mu_values(&obstacles));
     let goal = compile_goal(&c, raw.goal.as_ref())?;
     let contact = compile_model(&c, &raw.model, &part)?;
     let map_tier = compile_map_tier(&c, &raw.model)?;
@@ -97,15 +97,17 @@ fn locate_belief(c: &Checker, raw: &RawScenario, scene: &mut Scene) {
     ctl.belief_at = super::error::KeyLocation::of(c.err(at, ""));
 }
 
-/// The μc values the scene's pins push with: the shared part model tabulates its exact slides
-/// for these (built lazily, so a scene that never slides on an edge, or runs another fidelity,
-/// builds nothing; see `mechanics::slide_table`). Fences touch the hull and are not tabulated.
-fn pin_mu_values(obstacles: &[Obstacle]) -> Vec<f64> {
+/// The friction values the scene's pins (μc) and fences (μf) push with: the shared part model
+/// tabulates its exact slides for these (built lazily, so a scene that never slides on an edge or
+/// a vertex, or runs another fidelity, builds nothing; see `mechanics::slide_table`). A fence
+/// sliding on a vertex of the part's hull uses that polygon vertex's tables; a hull edge flush
+/// on a fence is solved in closed form and needs none.
+fn contact_mu_values(obstacles: &[Obstacle]) -> Vec<f64> {
     obstacles
         .iter()
-        .filter_map(|o| match o {
-            Obstacle::Pin(p) => Some(p.mu_c),
-            Obstacle::Fence(_) => None,
+        .map(|o| match o {
+            Obstacle::Pin(p) => p.mu_c,
+            Obstacle::Fence(f) => f.mu_f,
         })
         .collect()
 }
