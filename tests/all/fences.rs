@@ -399,3 +399,60 @@ fn fence_slides_on_hull_vertices_are_served_by_the_slide_tables() {
         }
     }
 }
+
+/// A fence meets a concave part where the part's own vertices are: the travel to first touch is
+/// the smallest over the part's vertices (in the world at its pose) of the travel that brings
+/// the fence's line to the vertex — the hull the contact model uses is in the part's frame, not
+/// re-centred on the hull's own centroid.
+#[test]
+fn a_fence_first_touches_a_concave_part_at_its_own_vertices() {
+    use pinfeed::mechanics::fence_first_touch;
+    let l = Polygon::from_xy(&[
+        (0.0, 0.0),
+        (3.0, 0.0),
+        (3.0, 1.0),
+        (1.0, 1.0),
+        (1.0, 2.5),
+        (0.0, 2.5),
+    ])
+    .unwrap();
+    let m = model(&l);
+    for (k, angle) in [-40.0f64, -15.0, 20.0, 45.0].into_iter().enumerate() {
+        for j in 0..12 {
+            let pose = Pose::new(0.3, -0.2, (30.0 * j as f64 + 7.0 * k as f64).to_radians());
+            let (s, c) = angle.to_radians().sin_cos();
+            let e = pinfeed::geometry::Vec2::new(c, s);
+            // A long fence whose line passes 4 units (perpendicular) clear of the part's
+            // centroid, to its right.
+            let through = pinfeed::geometry::Vec2::new(0.3 + 4.0 / s.abs(), -0.2);
+            let start = through - e * 100.0;
+            let f = FenceSpec {
+                start,
+                angle_rad: angle.to_radians(),
+                length: 200.0,
+                mu_f: 0.3,
+            };
+            // The line moved by (−t, 0) holds v when cross(e, v − start + t x̂) = 0, i.e.
+            // t = cross(e, v − start) / sin α.
+            let expected = l
+                .world_vertices(&pose)
+                .iter()
+                .map(|&v| {
+                    let d = v - start;
+                    (e.x * d.y - e.y * d.x) / s
+                })
+                .fold(f64::INFINITY, f64::min);
+            let Some(got) = fence_first_touch(&m, pose, &f) else {
+                panic!(
+                    "fence {angle}° θ {}°: no touch (expected {expected})",
+                    30 * j
+                )
+            };
+            assert!(
+                (got - expected).abs() < 1e-9,
+                "fence {angle}°, θ {}°: first touch at travel {got}, the part's vertices say {expected}",
+                30 * j
+            );
+        }
+    }
+}
