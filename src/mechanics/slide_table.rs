@@ -50,8 +50,8 @@
 //!
 //! **Opt-in, deterministic.** Tables are built lazily, one (μc, place, side) at a time, on the
 //! first slide that needs one, and only for models that ask for them with the μc values they will
-//! see ([`super::PartModel::with_slide_tables`]: a scene's shared model, a planner's, a map's, the
-//! contact benchmark's). A table's content is a fixed function of (part, μc, place, side), built
+//! see ([`super::PartModel::with_slide_tables`]: a scene's shared model, an online controller's
+//! model at every μc its belief holds, a planner's, a map's, the contact benchmark's). A table's content is a fixed function of (part, μc, place, side), built
 //! in a fixed order, so which thread builds it first changes nothing; and a served solve never
 //! depends on what was solved before it. The evaluations a build spends are the table's, not the
 //! contact's that happened to need it first ([`SlideTables::stats`]), so a contact's evaluation
