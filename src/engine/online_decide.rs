@@ -207,3 +207,177 @@ pub(super) fn decide_online(
     }
     true
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::online::OnlineModel;
+    use crate::engine::prepare::OnlineHandle;
+    use crate::geometry::Pose;
+    use crate::scenario::raw::SupportKind;
+    use crate::scenario::BeliefSpec;
+    use crate::sensing::belief::Update;
+    use std::sync::Arc;
+
+    /// tripoly2's online line with a small belief (2 μc × 2 supports × 2 offsets × its states,
+    /// 2 members each) in which the first sensor touches every other hypothesis (h odd; the
+    /// small model's members all touch it), its controller and a belt holding part 3 at `x` (m),
+    /// entered at t = 0.
+    fn line_with_part_at(x: f64) -> (Scene, Control, Belt) {
+        let path = std::path::Path::new("scenarios/tripoly2_online.toml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let cut = text.find("[controller.belief]").unwrap();
+        let end = text[cut..].find("[goal]").unwrap() + cut;
+        let text = format!("{}{}", &text[..cut], &text[end..])
+            .replace("mode = \"online\"", "mode = \"policy\"");
+        let scene = crate::scenario::parse(path, &text).unwrap();
+        let spec = BeliefSpec {
+            mu_c: vec![0.3, 0.7],
+            support: vec![SupportKind::Uniform, SupportKind::Tripod],
+            offsets: 2,
+            samples: 2,
+            targets: 5,
+        };
+        let mut model = OnlineModel::build(&scene, &spec).unwrap();
+        let n = model.hypotheses.len();
+        model.sensors[0].p_touch = (0..n).map(|h| (h % 2) as f64).collect();
+        let control = Control::new(&scene, true, Some(OnlineHandle(Arc::new(model)))).unwrap();
+        let mut belt = Belt::new();
+        let pose = Pose::new(x, 0.0, 0.0);
+        belt.active
+            .insert(3, ActivePart::entering(0.0, pose, None, false));
+        (scene, control, belt)
+    }
+
+    fn events(queue: &mut EventQueue) -> Vec<(f64, EventKind)> {
+        std::iter::from_fn(|| queue.pop().map(|e| (e.time, e.kind))).collect()
+    }
+
+    /// A part entering takes the model's prior and, for each sensor pin, a check when it could
+    /// first be clear of the pin riding the belt.
+    #[test]
+    fn an_entering_part_takes_the_prior_and_a_check_per_sensor() {
+        let (scene, control, mut belt) = line_with_part_at(0.0);
+        let model = control.online_model().unwrap().clone();
+        let part = belt.active.get_mut(&3).unwrap();
+        online_arrival(&scene, Some(&control), &mut belt.queue, 0.0, 3, part);
+        assert_eq!(part.belief.as_ref(), Some(&model.prior));
+        assert_eq!(part.sensors_left as usize, model.sensors.len());
+        let got = events(&mut belt.queue);
+        assert_eq!(got.len(), model.sensors.len());
+        for (s, (t, kind)) in model.sensors.iter().zip(got) {
+            let clear = sensor_clear_x(&scene, s.obstacle);
+            assert!(clear > 0.0);
+            assert!((t - clear / scene.belt.speed).abs() < 1e-12, "{t}");
+            let obstacle = s.obstacle as u32;
+            assert_eq!(kind, EventKind::Unread { part: 3, obstacle });
+        }
+        // No controller (or one without a model): nothing happens.
+        let part = belt.active.get_mut(&3).unwrap();
+        part.belief = None;
+        online_arrival(&scene, None, &mut belt.queue, 0.0, 3, part);
+        assert!(part.belief.is_none() && belt.queue.is_empty());
+    }
+
+    /// A part past a sensor pin without touching it: the belief removes what would have touched
+    /// (the same update as the belief's own), the pass is counted, and the last sensor to speak
+    /// schedules the decision after the latency. A part still short of the pin is looked at
+    /// again when it could be clear, its belief untouched.
+    #[test]
+    fn a_pass_without_contact_is_evidence_and_a_part_short_of_the_pin_is_checked_later() {
+        let (scene, mut control, _) = line_with_part_at(0.0);
+        let model = control.online_model().unwrap().clone();
+        let sm = &model.sensors[0];
+        let j = sm.obstacle;
+        let clear = sensor_clear_x(&scene, j);
+        // Short of the pin: rescheduled when it could be clear.
+        let (_, _, mut belt) = line_with_part_at(clear - 0.01);
+        let part = belt.active.get_mut(&3).unwrap();
+        part.belief = Some(model.prior.clone());
+        part.sensors_left = 1;
+        unread(&scene, Some(&mut control), &mut belt, 0.0, 3, j);
+        let got = events(&mut belt.queue);
+        assert_eq!(got.len(), 1);
+        assert!((got[0].0 - 0.01 / scene.belt.speed).abs() < 1e-12);
+        assert!(matches!(got[0].1, EventKind::Unread { part: 3, .. }));
+        assert_eq!(belt.active[&3].belief.as_ref(), Some(&model.prior));
+        // Past it: the update and the decision.
+        let (_, _, mut belt) = line_with_part_at(clear + 0.01);
+        let part = belt.active.get_mut(&3).unwrap();
+        part.belief = Some(model.prior.clone());
+        part.sensors_left = 1;
+        unread(&scene, Some(&mut control), &mut belt, 2.0, 3, j);
+        let mut expected = model.prior.clone();
+        assert_ne!(
+            expected.observe_no_contact(&sm.p_touch),
+            Update::Inconsistent
+        );
+        assert_eq!(belt.active[&3].belief.as_ref(), Some(&expected));
+        let (p, prior) = (expected.probabilities(), model.prior.probabilities());
+        let kept: f64 = (0..p.len()).filter(|h| h % 2 == 0).map(|h| prior[h]).sum();
+        for h in 0..p.len() {
+            // Exactly the hypotheses that would have touched are gone; the rest keep their odds.
+            let want = if h % 2 == 1 { 0.0 } else { prior[h] / kept };
+            assert!(
+                (p[h] - want).abs() < 1e-12,
+                "hypothesis {h}: {} against {want}",
+                p[h]
+            );
+        }
+        assert_eq!(
+            control.online.as_ref().unwrap().summary.no_contact_passes,
+            1
+        );
+        let got = events(&mut belt.queue);
+        assert_eq!(got.len(), 1);
+        assert!((got[0].0 - (2.0 + control.latency())).abs() < 1e-12);
+        assert!(matches!(got[0].1, EventKind::Decision { part: 3, .. }));
+    }
+
+    /// The decision queues, for each dynamic pin, the target of the joint command the model
+    /// chooses under the part's belief, logs it and counts it; a part that is gone (or has no
+    /// belief) takes none.
+    #[test]
+    fn the_decision_queues_the_models_choice_for_each_dynamic_pin() {
+        let (scene, mut control, mut belt) = line_with_part_at(0.3);
+        let model = control.online_model().unwrap().clone();
+        belt.active.get_mut(&3).unwrap().belief = Some(model.prior.clone());
+        let mut work = WorkCounters::default();
+        assert!(decide_online(
+            &scene,
+            &mut control,
+            &mut belt.active,
+            &mut work,
+            5.0,
+            3
+        ));
+        let choice = model.choose(&model.prior);
+        for (&pin, &target) in model.pins.iter().zip(&model.actions[choice.action]) {
+            assert_eq!(control.queues[pin].get(&3), Some(&target));
+        }
+        assert_eq!(belt.active[&3].predicted, Some(choice.predicted));
+        assert_eq!(work.decisions, 1);
+        assert_eq!(work.actuator_commands, model.pins.len() as u64);
+        let online = control.online.as_ref().unwrap();
+        assert_eq!(
+            (online.summary.decisions, online.chosen[choice.action]),
+            (1, 1)
+        );
+        let log = control.log.as_ref().unwrap();
+        assert!(log.len() == 1 && log[0].kind == ControlKind::Decision && log[0].part == 3);
+        // Gone (part 9), or without a belief: counted as a decision point, nothing taken.
+        for index in [9, 3] {
+            belt.active.get_mut(&3).unwrap().belief = None;
+            let active = &mut belt.active;
+            assert!(!decide_online(
+                &scene,
+                &mut control,
+                active,
+                &mut work,
+                6.0,
+                index
+            ));
+        }
+        assert_eq!(work.actuator_commands, model.pins.len() as u64);
+    }
+}
