@@ -83,7 +83,7 @@ fn bench_batch(c: &mut Criterion) {
     group.bench_function("1200 cases (shared tabled models, parallel)", |b| {
         b.iter(|| {
             let mut out = Vec::with_capacity(1 << 18);
-            run_batch(&defaults, &file, &mut out).unwrap();
+            run_batch(&defaults, &file, &mut out, &|f| f.to_string()).unwrap();
             black_box(out.len())
         })
     });

@@ -97,7 +97,7 @@ pub struct ContactArgs {
 pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
     let d = args.d.unwrap_or(0.0);
     let pin_stop = match args.pin_stop_at {
-        Some(y) => Some(stop_travel(y, d, args.pin_speed)?),
+        Some(y) => Some(stop_travel(y, d, args.pin_speed, "--pin-stop-at")?),
         None => args.pin_stop,
     };
     let part = args.part.clone().unwrap_or_default();
@@ -108,7 +108,9 @@ pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
         pin_speed: args.pin_speed,
         pin_stop,
         pin_stop_after_touch: args.pin_stop_after_touch,
-        fence: args.fence.as_deref().map(parse_fence).transpose()?,
+        fence: (args.fence.as_deref())
+            .map(|f| parse_fence(f, "--fence"))
+            .transpose()?,
         ..args.push.case(part, model)
     })
 }
@@ -119,14 +121,19 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             .push
             .fidelity("the map tier does not run --cases batches")?;
         let defaults = case_of(args, model)?;
-        return Ok(run_batch(&defaults, path, std::io::stdout().lock())?);
+        return Ok(run_batch(
+            &defaults,
+            path,
+            std::io::stdout().lock(),
+            &super::flag,
+        )?);
     }
     let pinfeed::contact_case::ModelChoice::Model(model) = args.push.model else {
         return super::contact_map::run(args);
     };
     let c = case_of(args, model)?;
     let want_trace = args.trace.is_some() || args.plot.is_some();
-    let (poly, out, trace) = run_case(&c, want_trace)?;
+    let (poly, out, trace) = run_case(&c, want_trace, &super::flag)?;
     if let Some(path) = &args.trace {
         pinfeed::output::write_atomic(path, trace_csv(&trace))
             .with_context(|| format!("writing {}", path.display()))?;

@@ -66,9 +66,9 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         bail!("--model map answers still-pin pushes only, without --trace or --plot (the map keeps no path); use --model exact for fences, moving pins, traces and plots");
     }
     let c = case_of(args, Fidelity::Exact)?;
-    check_inputs(&c)?;
+    check_inputs(&c, &super::flag)?;
     let (poly, model) = compile_part(&c.part, &c.support)?;
-    check_geometry(&c, &poly)?;
+    check_geometry(&c, &poly, &super::flag)?;
     let support = Support::parse(&c.support, &poly).map_err(anyhow::Error::msg)?;
     let settings = ContactSettings {
         mu_c: c.mu_c,

@@ -120,19 +120,21 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
         pinfeed::contact_case::ModelChoice::Model(f) => f,
         pinfeed::contact_case::ModelChoice::Map => pinfeed::mechanics::Fidelity::Exact,
     };
-    let fence = args.fence.as_deref().map(parse_fence).transpose()?;
+    let fence = (args.fence.as_deref())
+        .map(|f| parse_fence(f, "--fence"))
+        .transpose()?;
     let template = Case {
         fence,
         ..args.push.case(args.part.clone(), model)
     };
-    check_inputs(&template)?;
+    check_inputs(&template, &super::flag)?;
     let fenced = args.fence.is_some();
     let (step, threshold) = (args.theta_step, args.threshold);
     pinfeed::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold)
         .map_err(|e| anyhow::anyhow!(e.describe(|s| super::flag(s.field()))))?;
     let (poly, part_model) = compile_part(&args.part, &args.push.support)?;
     if fence.is_some() {
-        check_geometry(&template, &poly)?;
+        check_geometry(&template, &poly, &super::flag)?;
     } else {
         for &d in &args.d {
             check_geometry(
@@ -141,6 +143,7 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
                     ..template.clone()
                 },
                 &poly,
+                &super::flag,
             )?;
         }
     }

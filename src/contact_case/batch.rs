@@ -1,9 +1,7 @@
 //! A batch of contact cases from a CSV file (columns part,theta0,d,mu_c and optional
 //! model,pin_radius,mu_s), one output row per case: `pinfeed contact --cases`.
 
-use super::check::{
-    check_flag_settings, check_geometry_named, check_inputs_named, check_stop_after_touch, flag,
-};
+use super::check::{check_flag_settings, check_geometry, check_inputs, check_stop_after_touch};
 use super::{compile_part, parse_model, run_compiled, Case, CaseError};
 use crate::geometry::{wrap_deg, Polygon};
 use crate::mechanics::{ContactOutcome, PartModel};
@@ -95,7 +93,8 @@ struct CaseOut<'a> {
 /// Run every case of the CSV file `path` and write one CSV row per case to `out`. `defaults`
 /// holds the settings every row takes unless the row gives its own (model, pin radius, μs) and
 /// the ones only flags give (pin path, support, tolerance, fence); its part, θ0, d and μc are
-/// not used.
+/// not used. An error names a setting a row gives by its column (`column mu_c`), one of
+/// `defaults` by `flag(field)` (the caller's name for that field of [`Case`]).
 ///
 /// Every row is read and checked before any contact runs, so a refused row leaves `out` empty.
 /// Rows that share a part and support share one compiled model, whose slide tables serve each μc
@@ -107,8 +106,9 @@ pub fn run_batch<W: std::io::Write>(
     defaults: &Case,
     path: &Path,
     out: W,
+    flag: &dyn Fn(&str) -> String,
 ) -> Result<(), BatchError> {
-    let (cases, models) = read_batch(defaults, path)?;
+    let (cases, models) = read_batch(defaults, path, flag)?;
     let outcomes: Vec<ContactOutcome> = cases
         .par_iter()
         .map(|(c, k)| {
@@ -157,7 +157,11 @@ fn tabled(mu: &[(f64, usize)]) -> Vec<f64> {
 /// Every case of the batch, checked, each with the index of its part's shared model.
 type Batch = (Vec<(Case, usize)>, Vec<(Polygon, PartModel)>);
 
-fn read_batch(defaults: &Case, path: &Path) -> Result<Batch, BatchError> {
+fn read_batch(
+    defaults: &Case,
+    path: &Path,
+    flag: &dyn Fn(&str) -> String,
+) -> Result<Batch, BatchError> {
     let text = crate::input::read_text(path).map_err(|source| BatchError::Read {
         path: path.to_path_buf(),
         source,
@@ -173,8 +177,8 @@ fn read_batch(defaults: &Case, path: &Path) -> Result<Batch, BatchError> {
     let args = defaults;
     // Flags that apply to every row are checked once, before any row (an error there is the
     // flag's, not a row's).
-    check_flag_settings(args.pin_speed, args.pin_stop, args.tol, &flag)?;
-    check_stop_after_touch(args.pin_stop_after_touch)?;
+    check_flag_settings(args.pin_speed, args.pin_stop, args.tol, flag)?;
+    check_stop_after_touch(args.pin_stop_after_touch, flag)?;
     for (i, row) in rdr.deserialize::<CaseRow>().enumerate() {
         let row = row.map_err(|error| {
             let line = error.position().map(|p| p.line()).unwrap_or(i as u64 + 2);
@@ -216,7 +220,7 @@ fn read_batch(defaults: &Case, path: &Path) -> Result<Batch, BatchError> {
             }
         };
         let row_err = |source| BatchError::Case { at: at(), source };
-        check_inputs_named(&c, &name).map_err(row_err)?;
+        check_inputs(&c, &name).map_err(row_err)?;
         // Compile each distinct part once for the whole batch.
         let k = match index.get(&c.part) {
             Some(&k) => k,
@@ -228,7 +232,7 @@ fn read_batch(defaults: &Case, path: &Path) -> Result<Batch, BatchError> {
                 models.len() - 1
             }
         };
-        check_geometry_named(&c, &models[k].0, &name).map_err(row_err)?;
+        check_geometry(&c, &models[k].0, &name).map_err(row_err)?;
         match mu_values[k].iter_mut().find(|(m, _)| *m == c.mu_c) {
             Some((_, n)) => *n += 1,
             None => mu_values[k].push((c.mu_c, 1)),
@@ -247,6 +251,11 @@ fn read_batch(defaults: &Case, path: &Path) -> Result<Batch, BatchError> {
 mod tests {
     use super::*;
 
+    /// A setting named by its field.
+    fn field(f: &str) -> String {
+        f.to_string()
+    }
+
     fn write_cases(name: &str, rows: &[String]) -> PathBuf {
         let p =
             std::env::temp_dir().join(format!("pinfeed-batch-{name}-{}.csv", std::process::id()));
@@ -260,7 +269,7 @@ mod tests {
             .build()
             .unwrap();
         let mut out = Vec::new();
-        pool.install(|| run_batch(&Case::new("", 0.0, 0.0, 0.0), path, &mut out))?;
+        pool.install(|| run_batch(&Case::new("", 0.0, 0.0, 0.0), path, &mut out, &field))?;
         Ok(String::from_utf8(out).unwrap())
     }
 
@@ -328,7 +337,7 @@ mod tests {
         ];
         let path = write_cases("bad", &rows);
         let mut out = Vec::new();
-        let e = run_batch(&Case::new("", 0.0, 0.0, 0.0), &path, &mut out)
+        let e = run_batch(&Case::new("", 0.0, 0.0, 0.0), &path, &mut out, &field)
             .unwrap_err()
             .to_string();
         assert!(e.contains(":3"), "{e}");

@@ -1,24 +1,16 @@
 //! The ranges a contact case's settings must lie in (the table is [`crate::mechanics::limits`]),
 //! checked before any push: out-of-range or non-finite values are refused with an error naming
-//! the setting (a flag, or a column of a batch file), its range and the value.
+//! the setting by the caller's name for it (`name(field)`: a flag of the command line, a column
+//! of a batch file), its range and the value.
 
 use super::{Case, CaseError};
 use crate::geometry::Polygon;
 use crate::mechanics::limits::{self, in_range};
 
-/// The flag naming a setting (`mu_c` → `--mu-c`).
-pub fn flag(field: &str) -> String {
-    format!("--{}", field.replace('_', "-"))
-}
-
 /// Refuse non-finite or out-of-range settings of a case (the ones that do not depend on the part)
-/// with a message naming the option, its range and the value.
-pub fn check_inputs(c: &Case) -> Result<(), CaseError> {
-    check_inputs_named(c, &flag)
-}
-
-/// [`check_inputs`] with the settings named by `name` (a flag, or a CSV column).
-pub fn check_inputs_named(c: &Case, name: &dyn Fn(&str) -> String) -> Result<(), CaseError> {
+/// with a message naming the setting by `name(field)` (the caller's name for the field of
+/// [`Case`]: a flag, a CSV column), its range and the value.
+pub fn check_inputs(c: &Case, name: &dyn Fn(&str) -> String) -> Result<(), CaseError> {
     use limits::*;
     in_range(
         &name("theta0"),
@@ -54,14 +46,17 @@ pub fn check_inputs_named(c: &Case, name: &dyn Fn(&str) -> String) -> Result<(),
         });
     }
     check_flag_settings(c.pin_speed, c.pin_stop, c.tol, name)?;
-    check_stop_after_touch(c.pin_stop_after_touch)
+    check_stop_after_touch(c.pin_stop_after_touch, name)
 }
 
-/// `--pin-stop-after-touch T`: T in [0, 1000] units of a.
-pub fn check_stop_after_touch(t: Option<f64>) -> Result<(), CaseError> {
+/// [`Case::pin_stop_after_touch`] T in [0, 1000] units of a, named `name("pin_stop_after_touch")`.
+pub fn check_stop_after_touch(
+    t: Option<f64>,
+    name: &dyn Fn(&str) -> String,
+) -> Result<(), CaseError> {
     if let Some(t) = t {
         in_range(
-            "--pin-stop-after-touch",
+            &name("pin_stop_after_touch"),
             t,
             0.0,
             1e3,
@@ -88,7 +83,7 @@ pub fn check_flag_settings(
     )?;
     if let Some(s_stop) = pin_stop {
         in_range(
-            "--pin-stop-after",
+            &name("pin_stop_after"),
             s_stop,
             1e-9,
             1e3,
@@ -113,13 +108,8 @@ pub fn reach(c: &Case, a: f64) -> f64 {
 }
 
 /// Refuse settings of a case that are out of range relative to the part (`a` = its size): pin
-/// radius, d beyond what can touch, fence length.
-pub fn check_geometry(c: &Case, poly: &Polygon) -> Result<(), CaseError> {
-    check_geometry_named(c, poly, &flag)
-}
-
-/// [`check_geometry`] with the settings named by `name` (a flag, or a CSV column).
-pub fn check_geometry_named(
+/// radius, d beyond what can touch, fence length; named as by [`check_inputs`].
+pub fn check_geometry(
     c: &Case,
     poly: &Polygon,
     name: &dyn Fn(&str) -> String,
@@ -142,6 +132,7 @@ pub fn check_geometry_named(
                 let (lo, hi) = (FENCE_LENGTH_A.0 * a, FENCE_LENGTH_A.1 * a);
                 if !(l >= lo && l <= hi) {
                     return Err(CaseError::FenceLength {
+                        name: name("fence"),
                         lo,
                         hi,
                         a,

@@ -114,8 +114,10 @@ pub enum CaseError {
         value: f64,
     },
     /// A fence length outside its range for this part.
-    #[error("--fence: the length must lie in [{}, {}] (part units: {}·a to {}·a, a = {}), got {}", num(*lo), num(*hi), num(crate::mechanics::limits::FENCE_LENGTH_A.0), num(crate::mechanics::limits::FENCE_LENGTH_A.1), num(*a), num(*value))]
+    #[error("{name}: the length must lie in [{}, {}] (part units: {}·a to {}·a, a = {}), got {}", num(*lo), num(*hi), num(crate::mechanics::limits::FENCE_LENGTH_A.0), num(crate::mechanics::limits::FENCE_LENGTH_A.1), num(*a), num(*value))]
     FenceLength {
+        /// The setting's name as the caller knows it (the fence's).
+        name: String,
         /// The shortest length allowed (part units).
         lo: f64,
         /// The longest length allowed (part units).
@@ -135,10 +137,12 @@ pub enum CaseError {
         /// The largest |d| at which the pin can touch the part (units of a).
         limit: f64,
     },
-    /// `--fence ANGLE[:LENGTH]` with a part that is not a number.
-    #[error("--fence '{spec}': the {what} is not a number")]
+    /// A fence `ANGLE[:LENGTH]` with a part that is not a number.
+    #[error("{name} '{spec}': the {what} is not a number")]
     FenceNumber {
-        /// The `--fence` value given.
+        /// The setting's name as the caller knows it.
+        name: String,
+        /// The value given.
         spec: String,
         /// Which part of it: the angle or the length.
         what: &'static str,
@@ -147,17 +151,21 @@ pub enum CaseError {
         source: std::num::ParseFloatError,
     },
     /// A fence angle outside (−90°, 90°).
-    #[error("--fence '{spec}': the angle must be strictly between -90 and 90 degrees, got {}", num(*angle))]
+    #[error("{name} '{spec}': the angle must be strictly between -90 and 90 degrees, got {}", num(*angle))]
     FenceAngle {
-        /// The `--fence` value given.
+        /// The setting's name as the caller knows it.
+        name: String,
+        /// The value given.
         spec: String,
         /// The angle given (degrees).
         angle: f64,
     },
     /// A fence length that is not positive.
-    #[error("--fence '{spec}': the length must be a positive number (part units), got {}", num(*length))]
+    #[error("{name} '{spec}': the length must be a positive number (part units), got {}", num(*length))]
     FenceLengthSign {
-        /// The `--fence` value given.
+        /// The setting's name as the caller knows it.
+        name: String,
+        /// The value given.
         spec: String,
         /// The length given (part units).
         length: f64,
@@ -183,9 +191,11 @@ pub enum CaseError {
     /// The part's contact model could not be built.
     #[error(transparent)]
     Compile(#[from] crate::mechanics::PartModelError),
-    /// A `--pin-stop-at` the moving pin never reaches, or reaches too late.
-    #[error("--pin-stop-at {}: a pin starting at d = {} and moving {} per unit of travel reaches it after {} units of a; that must lie in [1e-9, 1000] (Y on the side the pin moves to, within 1000·|w| of d)", num(*y), num(*d), num(*w), num(*travel))]
+    /// A lateral stop the moving pin never reaches, or reaches too late.
+    #[error("{name} {}: a pin starting at d = {} and moving {} per unit of travel reaches it after {} units of a; that must lie in [1e-9, 1000] (Y on the side the pin moves to, within 1000·|w| of d)", num(*y), num(*d), num(*w), num(*travel))]
     StopAt {
+        /// The setting's name as the caller knows it.
+        name: String,
         /// The lateral position to stop at (units of a).
         y: f64,
         /// The pin's starting offset (units of a).
@@ -197,12 +207,13 @@ pub enum CaseError {
     },
 }
 
-/// Parse `ANGLE_DEG[:LENGTH]`.
-pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>), CaseError> {
+/// Parse `ANGLE_DEG[:LENGTH]`; an error names the setting `name` (what the caller calls it).
+pub fn parse_fence(spec: &str, name: &str) -> Result<(f64, Option<f64>), CaseError> {
     let number = |what: &'static str, t: &str| {
         t.trim()
             .parse::<f64>()
             .map_err(|source| CaseError::FenceNumber {
+                name: name.to_string(),
                 spec: spec.to_string(),
                 what,
                 source,
@@ -212,6 +223,7 @@ pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>), CaseError> {
     let angle = number("angle", it.next().unwrap_or(""))?;
     if !(angle.is_finite() && angle.abs() < 90.0) {
         return Err(CaseError::FenceAngle {
+            name: name.to_string(),
             spec: spec.to_string(),
             angle,
         });
@@ -222,6 +234,7 @@ pub fn parse_fence(spec: &str) -> Result<(f64, Option<f64>), CaseError> {
             let l = number("length", l)?;
             if !(l.is_finite() && l > 0.0) {
                 return Err(CaseError::FenceLengthSign {
+                    name: name.to_string(),
                     spec: spec.to_string(),
                     length: l,
                 });
@@ -262,11 +275,19 @@ impl std::str::FromStr for ModelChoice {
 }
 
 /// The belt travel (units of a) after which a pin starting at lateral offset `d` and moving at
-/// `w` (lateral per unit of travel) stands at offset `y`: (y − d)/w, in `--pin-stop-after`'s range.
-pub fn stop_travel(y: f64, d: f64, w: f64) -> Result<f64, CaseError> {
+/// `w` (lateral per unit of travel) stands at offset `y`: (y − d)/w, in the range of
+/// [`Case::pin_stop`]; an error names the setting `name` (what the caller calls the stop).
+pub fn stop_travel(y: f64, d: f64, w: f64, name: &str) -> Result<f64, CaseError> {
     let s = (y - d) / w;
     if !(y.is_finite() && s.is_finite() && (1e-9..=1e3).contains(&s)) {
-        return Err(CaseError::StopAt { y, d, w, travel: s });
+        let name = name.to_string();
+        return Err(CaseError::StopAt {
+            name,
+            y,
+            d,
+            w,
+            travel: s,
+        });
     }
     Ok(s)
 }
@@ -311,14 +332,16 @@ pub fn settings_and_pin(c: &Case) -> (ContactSettings, Pin) {
     (settings, pin)
 }
 
-/// Run one case; returns the polygon, the outcome and (if asked) the trace.
+/// Run one case; returns the polygon, the outcome and (if asked) the trace. An error names a
+/// setting by `name(field)` (the caller's name for the case's field).
 pub fn run_case(
     c: &Case,
     want_trace: bool,
+    name: &dyn Fn(&str) -> String,
 ) -> Result<(Polygon, ContactOutcome, Vec<TraceSample>), CaseError> {
-    check_inputs(c)?;
+    check_inputs(c, name)?;
     let (poly, model) = compile_part(&c.part, &c.support)?;
-    check_geometry(c, &poly)?;
+    check_geometry(c, &poly, name)?;
     let (out, trace) = run_compiled(c, &poly, &model, want_trace);
     Ok((poly, out, trace))
 }

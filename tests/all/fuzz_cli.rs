@@ -244,8 +244,8 @@ proptest! {
                 mu_c,
             )
         };
-        let (pu, u, _) = run_case(&case(1.0), false).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
-        let (pk, s, _) = run_case(&case(k), false).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
+        let (pu, u, _) = run_case(&case(1.0), false, &|f| f.to_string()).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
+        let (pk, s, _) = run_case(&case(k), false, &|f| f.to_string()).map_err(|e| TestCaseError::fail(format!("{e:#}")))?;
         prop_assert_eq!(pk.radius(), pu.radius() * k);
         prop_assert_eq!(u.status.name(), s.status.name());
         prop_assert_eq!(u.contact, s.contact);

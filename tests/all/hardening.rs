@@ -741,7 +741,7 @@ fn pin_stop_after_touch_stops_the_pin_that_far_past_the_first_touch() {
         tol: 1e-6,
         fence: None,
     };
-    let (poly, out, trace) = run_case(&case, true).unwrap();
+    let (poly, out, trace) = run_case(&case, true, &|f| f.to_string()).unwrap();
     let a = poly.radius();
     assert!(out.status.is_ok() && out.contact, "{:?}", out.status);
     let first = trace.first().unwrap();
