@@ -2,6 +2,8 @@
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
+use pinfeed::report::study_files::AccuracyBenchError;
+use pinfeed::study::bench_error::BenchError;
 use pinfeed::study::{contact_cost, map_cost};
 use std::path::PathBuf;
 
@@ -81,6 +83,14 @@ pub enum BenchWhat {
     Line(super::bench_line::LineArgs),
 }
 
+/// A study's error with its settings named by their flags.
+fn flagged(e: BenchError) -> anyhow::Error {
+    match e {
+        BenchError::Argument { .. } => anyhow::anyhow!(e.describe(&super::flag)),
+        other => other.into(),
+    }
+}
+
 /// Run `pinfeed bench`; `recorded` is the command line its report records.
 pub fn run(args: &BenchArgs, recorded: &str) -> Result<()> {
     // The measurements run for seconds to hours: a spinner with the elapsed time and the stage.
@@ -100,8 +110,13 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
             spin.set_message(format!(
                 "accuracy: {contacts} contacts against the reference"
             ));
-            let (table, files) =
-                pinfeed::report::study_files::accuracy_bench(*contacts, *seed, cmd, out)?;
+            let (table, files) = pinfeed::report::study_files::accuracy_bench(
+                *contacts, *seed, cmd, out,
+            )
+            .map_err(|e| match e {
+                AccuracyBenchError::Bench(b) => flagged(b),
+                other => other.into(),
+            })?;
             print!("{table}");
             let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
             eprintln!("wrote {}", files.join(", "));
@@ -116,7 +131,7 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
             let stage = |s: &str| spin.set_message(s.to_string());
             print!(
                 "{}",
-                contact_cost::bench(*contacts, *tol, *seed, cmd, out, &stage)?
+                contact_cost::bench(*contacts, *tol, *seed, cmd, out, &stage).map_err(flagged)?
             );
             eprintln!("wrote {}", out.display());
             Ok(())
@@ -126,7 +141,8 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
             // Other work on the machine slows every row: say how busy it was (Linux only).
             print!(
                 "{}",
-                map_cost::bench(*repeats, cmd, out, &super::bench_mc::load_average)?
+                map_cost::bench(*repeats, cmd, out, &super::bench_mc::load_average)
+                    .map_err(flagged)?
             );
             eprintln!("wrote {}", out.display());
             Ok(())

@@ -89,7 +89,12 @@ pub fn run(args: &RunArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(&scene.output.dir))
         .join(&scene.name);
-    let json = write_run(&scene, &result, &dir, &files)?;
+    let json = write_run(&scene, &result, &dir, &files).map_err(|e| {
+        match e.describe_setting(&super::flag) {
+            Some(message) => anyhow::anyhow!(message),
+            None => e.into(),
+        }
+    })?;
     let mut text = String::new();
     if args.json {
         text = json;

@@ -42,10 +42,9 @@ pub enum ReportError {
     /// A sensing trial of a figure could not be simulated.
     #[error("{0}")]
     Trial(crate::sensing::evaluate::EvaluateError),
-    /// An animation would last longer than allowed at the speed-up asked for.
-    #[error(
-        "--animate-speed {speedup} would make the animation last {duration_s:.0} s; at most {max_s} s (choose a larger speed-up)"
-    )]
+    /// An animation would last longer than allowed at the speed-up asked for (the setting
+    /// `animate_speed`, by its field name here and by the caller's in [`ReportError::describe_setting`]).
+    #[error("{}", too_long("animate_speed", *speedup, *duration_s, *max_s))]
     AnimationTooLong {
         /// The speed-up asked for.
         speedup: f64,
@@ -100,7 +99,30 @@ pub enum ReportError {
     },
 }
 
+/// The message of [`ReportError::AnimationTooLong`], the speed-up setting named `name`.
+fn too_long(name: &str, speedup: f64, duration_s: f64, max_s: f64) -> String {
+    format!("{name} {speedup} would make the animation last {duration_s:.0} s; at most {max_s} s (choose a larger speed-up)")
+}
+
 impl ReportError {
+    /// An animation's speed-up refused: the message with the setting named by `name(field)`
+    /// (what the caller calls it, e.g. a flag); `None` for every other error.
+    pub fn describe_setting(&self, name: &dyn Fn(&str) -> String) -> Option<String> {
+        match self {
+            ReportError::AnimationTooLong {
+                speedup,
+                duration_s,
+                max_s,
+            } => Some(too_long(
+                &name("animate_speed"),
+                *speedup,
+                *duration_s,
+                *max_s,
+            )),
+            _ => None,
+        }
+    }
+
     /// For `map_err`: the error of creating `dir`.
     pub fn creating(dir: &Path) -> impl FnOnce(std::io::Error) -> ReportError + '_ {
         move |source| ReportError::Creating {

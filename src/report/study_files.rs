@@ -44,7 +44,7 @@ pub fn mc_report_files(
 /// Why `pinfeed bench accuracy` failed.
 #[derive(Debug, thiserror::Error)]
 pub enum AccuracyBenchError {
-    /// The study could not run (or `--contacts` is out of range).
+    /// The study could not run (or its number of contacts is out of range).
     #[error(transparent)]
     Bench(#[from] BenchError),
     /// The report or its table could not be written.
@@ -82,7 +82,7 @@ pub fn accuracy_bench(
     out: &std::path::Path,
 ) -> Result<(String, [std::path::PathBuf; 3]), AccuracyBenchError> {
     if !(4..=1_000_000).contains(&contacts) {
-        return Err(BenchError::argument("--contacts", "between 4 and 1000000", contacts).into());
+        return Err(BenchError::argument("contacts", "between 4 and 1000000", contacts).into());
     }
     let st = accuracy::run(
         &["tripoly1", "tripoly2", "square", "lshape"],

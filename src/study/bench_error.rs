@@ -7,11 +7,12 @@ use crate::geometry::PartSpecError;
 /// Why a benchmark study failed.
 #[derive(Debug, thiserror::Error)]
 pub enum BenchError {
-    /// An argument is out of its range (`--contacts`, `--repeats`, `--tol`).
-    #[error("{flag} must be {range}, got {got}")]
+    /// A setting is out of its range (`contacts`, `repeats`, `tol`); named by its field here,
+    /// by the caller's name in [`BenchError::describe`].
+    #[error("{setting} must be {range}, got {got}")]
     Argument {
-        /// The flag.
-        flag: &'static str,
+        /// The setting, by its field name.
+        setting: &'static str,
         /// Its range, as the message says it ("between 1 and 1000", "in (0, 0.01]").
         range: &'static str,
         /// The value given.
@@ -64,12 +65,24 @@ pub enum BenchError {
 }
 
 impl BenchError {
-    /// `flag` is not `range` ("between 1 and 1000"): it is `got`.
-    pub fn argument(flag: &'static str, range: &'static str, got: impl ToString) -> BenchError {
+    /// Setting `setting` (a field name) is not `range` ("between 1 and 1000"): it is `got`.
+    pub fn argument(setting: &'static str, range: &'static str, got: impl ToString) -> BenchError {
         BenchError::Argument {
-            flag,
+            setting,
             range,
             got: got.to_string(),
+        }
+    }
+
+    /// The message with a setting named by `name(field)` (what the caller calls it, e.g. a flag).
+    pub fn describe(&self, name: &dyn Fn(&str) -> String) -> String {
+        match self {
+            BenchError::Argument {
+                setting,
+                range,
+                got,
+            } => format!("{} must be {range}, got {got}", name(setting)),
+            other => other.to_string(),
         }
     }
 }

@@ -540,13 +540,13 @@ pub fn bench(
 ) -> Result<String, BenchError> {
     if contacts == 0 || contacts > 1_000_000 {
         return Err(BenchError::argument(
-            "--contacts",
+            "contacts",
             "between 1 and 1000000",
             contacts,
         ));
     }
     if !(tol > 0.0 && tol <= 1e-2) {
-        return Err(BenchError::argument("--tol", "in (0, 0.01]", tol));
+        return Err(BenchError::argument("tol", "in (0, 0.01]", tol));
     }
     let parts = ["tripoly1", "tripoly2", "square", "lshape"];
     let fids = [Fidelity::Tip, Fidelity::Ellipsoid, Fidelity::Exact];

@@ -139,7 +139,7 @@ pub fn bench(
 ) -> Result<String, BenchError> {
     if repeats == 0 || repeats > 1000 {
         return Err(BenchError::argument(
-            "--repeats",
+            "repeats",
             "between 1 and 1000",
             repeats,
         ));
