@@ -341,21 +341,12 @@ fn fence_sweep_has_no_numerical_failures() {
 /// pins' μc): the same pushes, the final poses within a tenth of the integrator's tolerance per
 /// step (the tables agree with the live solve to 1e-10; the step sizes then differ slightly),
 /// with fewer evaluations per push (a table's build is counted as the table's). tripoly2 and
-/// a concave L (whose hull skips a reflex vertex), fences at ±20–50°, μf 0.3 and 0.6.
+/// the concave `lshape` (whose hull skips a reflex vertex), fences at ±20–50°, μf 0.3 and 0.6.
 #[test]
 fn fence_slides_on_hull_vertices_are_served_by_the_slide_tables() {
-    let l_shape = Polygon::new(&[
-        pinfeed::geometry::Vec2::new(0.0, 0.0),
-        pinfeed::geometry::Vec2::new(3.0, 0.0),
-        pinfeed::geometry::Vec2::new(3.0, 1.0),
-        pinfeed::geometry::Vec2::new(1.0, 1.0),
-        pinfeed::geometry::Vec2::new(1.0, 2.5),
-        pinfeed::geometry::Vec2::new(0.0, 2.5),
-    ])
-    .unwrap();
     for p in [
         pinfeed::geometry::part_from_spec("tripoly2").unwrap(),
-        l_shape,
+        pinfeed::geometry::part_from_spec("lshape").unwrap(),
     ] {
         for mu_f in [0.3, 0.6] {
             let plain = model(&p);
@@ -407,15 +398,7 @@ fn fence_slides_on_hull_vertices_are_served_by_the_slide_tables() {
 #[test]
 fn a_fence_first_touches_a_concave_part_at_its_own_vertices() {
     use pinfeed::mechanics::fence_first_touch;
-    let l = Polygon::from_xy(&[
-        (0.0, 0.0),
-        (3.0, 0.0),
-        (3.0, 1.0),
-        (1.0, 1.0),
-        (1.0, 2.5),
-        (0.0, 2.5),
-    ])
-    .unwrap();
+    let l = pinfeed::geometry::part_from_spec("lshape").unwrap();
     let m = model(&l);
     for (k, angle) in [-40.0f64, -15.0, 20.0, 45.0].into_iter().enumerate() {
         for j in 0..12 {
