@@ -317,7 +317,10 @@ pub fn run(args: &PlanArgs, recorded: &str) -> Result<()> {
     print_result(&out)?;
     match (d.status, &d.limit) {
         (Status::Confirmed, _) => Ok(()),
-        (_, Some(limit)) => Err(anyhow!("{limit}: no confirmed design")),
+        (_, Some(limit)) => Err(anyhow!(
+            "{limit} ({}): no confirmed design",
+            super::flag(limit.field())
+        )),
         (Status::NoDesign, None) => Err(super::Exit(4).into()),
         _ => Err(super::Exit(3).into()),
     }

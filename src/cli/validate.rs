@@ -144,7 +144,11 @@ pub fn ensemble_spec(
 /// A refused input, its message naming the flags (a refused file keeps its own error chain).
 pub fn flagged(e: InputError) -> anyhow::Error {
     match e {
-        InputError::Measured(m) => m.into(),
+        InputError::Measured(m) => match m.missing_setting {
+            Some(s) => anyhow::Error::from(m)
+                .context(format!("give the {s} of the file with {}", super::flag(s))),
+            None => m.into(),
+        },
         e => anyhow::anyhow!(e.describe(|s| super::flag(s.field()))),
     }
 }

@@ -33,7 +33,7 @@ use super::particles::{feed_samples, theta_quanta, y_quanta, Particle, State};
 use super::problem::FeedKind;
 use super::search::Planner;
 use super::transition::{FAILED, NO_CONTACT};
-use super::PlanError;
+use super::{Limit, PlanError};
 use serde::Serialize;
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -112,8 +112,8 @@ pub enum ContingentOutcome {
     },
     /// A limit ended the search after `depth_completed` levels.
     LimitHit {
-        /// The limit that ended it, in words (e.g. `time limit 110 s`).
-        limit: String,
+        /// The limit that ended it.
+        limit: Limit,
         /// Levels (moving pins) completed before it.
         depth_completed: usize,
     },
@@ -311,7 +311,7 @@ pub fn search(
         stats.elapsed_s = started.elapsed().as_secs_f64();
         return Ok((
             ContingentOutcome::LimitHit {
-                limit: format!("time limit {} s", p.time_limit_s),
+                limit: Limit::time(p.time_limit_s),
                 depth_completed: 0,
             },
             stats,
@@ -348,9 +348,9 @@ pub fn search(
                         || kept >= p.max_states
                     {
                         let limit = if kept >= p.max_states {
-                            format!("state limit {} (--max-states)", p.max_states)
+                            Limit::States(p.max_states)
                         } else {
-                            format!("time limit {} s", p.time_limit_s)
+                            Limit::time(p.time_limit_s)
                         };
                         stats.elapsed_s = started.elapsed().as_secs_f64();
                         stats.peak_rss_bytes = super::search::peak_rss_bytes();

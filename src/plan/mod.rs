@@ -65,6 +65,64 @@ pub use particles::{Particle, State};
 pub use problem::{FeedKind, Problem};
 pub use search::{search, Outcome, Plan, PlanStep, SearchStats};
 
+/// What cut a search or a design short: a limit the problem or the design options set.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Limit {
+    /// The search held [`Problem::max_states`] states.
+    States(usize),
+    /// The time limit, in seconds ([`Problem::time_limit_s`] or the design's), with what it left
+    /// undone when that is known (e.g. `pins not tried`).
+    Time {
+        /// The limit, in seconds.
+        seconds: f64,
+        /// What it left undone, in words.
+        left_undone: Option<String>,
+    },
+}
+
+impl Limit {
+    /// The setting that sets this limit (`max_states` or `time_limit`), as [`PlanError::field`]
+    /// names settings: a command line maps it to its option.
+    pub fn field(&self) -> &'static str {
+        match self {
+            Limit::States(_) => "max_states",
+            Limit::Time { .. } => "time_limit",
+        }
+    }
+
+    /// The time limit of `seconds`, with nothing said of what it left undone.
+    pub fn time(seconds: f64) -> Limit {
+        Limit::Time {
+            seconds,
+            left_undone: None,
+        }
+    }
+}
+
+/// A limit is written as its words (`"state limit 1000"`).
+impl serde::Serialize for Limit {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl std::fmt::Display for Limit {
+    /// `state limit 1000`, `time limit 110 s`, `time limit 110 s: pins not tried`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Limit::States(n) => write!(f, "state limit {n}"),
+            Limit::Time {
+                seconds,
+                left_undone: None,
+            } => write!(f, "time limit {seconds} s"),
+            Limit::Time {
+                seconds,
+                left_undone: Some(what),
+            } => write!(f, "time limit {seconds} s: {what}"),
+        }
+    }
+}
+
 /// Bad planner input, or a planner that cannot start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanError {

@@ -27,7 +27,7 @@ use super::bound::{may_exceed, may_exceed_parts, BoundGeometry};
 use super::particles::{best_window, initial_state, orientation_sets, Particle, State, Window};
 use super::problem::{Compiled, Problem};
 use super::transition::{PushCounters, Transition};
-use super::PlanError;
+use super::{Limit, PlanError};
 use serde::Serialize;
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -104,8 +104,8 @@ pub enum Outcome {
     /// A limit ended the search after `depth_completed` full levels (`best`: with `fewest_sets`
     /// the fewest sets so far, otherwise the most particles in one window so far).
     LimitHit {
-        /// The limit that ended it, in words (e.g. `time limit 110 s`).
-        limit: String,
+        /// The limit that ended it.
+        limit: Limit,
         /// Levels fully expanded before it.
         depth_completed: usize,
         /// The best plan so far.
@@ -316,8 +316,7 @@ impl Planner {
             for &id in &frontier {
                 if run.started.elapsed().as_secs_f64() > p.time_limit_s || self.transition.expired()
                 {
-                    let limit = format!("time limit {} s", p.time_limit_s);
-                    return self.limit(run, limit, depth - 1);
+                    return self.limit(run, Limit::time(p.time_limit_s), depth - 1);
                 }
                 let state = run.nodes[id].state.clone();
                 for (action, s) in self.successors(&mut run, &state, p.max_pins - depth) {
@@ -340,8 +339,7 @@ impl Planner {
                     }
                     if run.nodes.len() >= p.max_states {
                         run.stats.states_per_depth.push(open + next.len());
-                        let limit = format!("state limit {} (--max-states)", p.max_states);
-                        return self.limit(run, limit, depth - 1);
+                        return self.limit(run, Limit::States(p.max_states), depth - 1);
                     }
                 }
             }
@@ -525,7 +523,7 @@ impl Planner {
         (node != 0).then(|| self.plan_to(&run.nodes, node))
     }
 
-    fn limit(&self, mut run: Run, limit: String, depth_completed: usize) -> (Outcome, SearchStats) {
+    fn limit(&self, mut run: Run, limit: Limit, depth_completed: usize) -> (Outcome, SearchStats) {
         run.stats.depth_completed = depth_completed;
         let best = self.best_of(&run);
         let outcome = Outcome::LimitHit {

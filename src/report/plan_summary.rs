@@ -131,7 +131,7 @@ pub struct PlanJson<'a> {
     /// The files written.
     pub files: Vec<String>,
     /// A limit that cut the work short (the time limit), if any.
-    pub limit: Option<&'a str>,
+    pub limit: Option<&'a crate::plan::Limit>,
     /// Wall time of the planning (s).
     pub elapsed_s: f64,
     /// Every candidate considered.
@@ -166,7 +166,7 @@ pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> ReportResult<S
         headway_s: c.map(|c| c.headway_s),
         oriented_per_min: c.map(|c| c.oriented_per_min),
         files,
-        limit: d.limit.as_deref(),
+        limit: d.limit.as_ref(),
         elapsed_s: d.elapsed_s,
         candidates: &d.candidates,
         chosen: c,

@@ -43,6 +43,9 @@ pub struct MeasuredError {
     pub field: Option<String>,
     /// What is wrong.
     pub message: String,
+    /// The caller's setting that would supply what is missing (`part`: the part of a file without
+    /// a `part` column), if that is what is wrong.
+    pub missing_setting: Option<&'static str>,
 }
 
 impl MeasuredError {
@@ -115,6 +118,7 @@ pub fn load_for(
         line: 0,
         field: None,
         message: format!("cannot read the file: {e}"),
+        missing_setting: None,
     })?;
     parse_for(path, &text, max_pin_radius, part)
 }
@@ -198,6 +202,7 @@ pub fn parse_for(
         line,
         field: field.map(str::to_string),
         message,
+        missing_setting: None,
     };
     let mut lines = text
         .lines()
@@ -218,17 +223,20 @@ pub fn parse_for(
             hline,
             None,
             format!(
-                "the header must be `{}` (trials optional; part optional with --part), got `{header}`",
+                "the header must be `{}` (trials optional; part optional when one part is given for the whole file), got `{header}`",
                 COLUMNS.join(",")
             ),
         ));
     }
     if !has_part && part.is_none() {
-        return Err(err(
-            hline,
-            None,
-            "the header has no `part` column: give the part of every row with --part".into(),
-        ));
+        return Err(MeasuredError {
+            missing_setting: Some("part"),
+            ..err(
+                hline,
+                None,
+                "the header has no `part` column and no part was given for the whole file".into(),
+            )
+        });
     }
     let mut out = Measured {
         file: file.to_path_buf(),

@@ -31,7 +31,7 @@ use super::contingent::{self, ContingentOutcome, ContingentPlan};
 use super::emit::{self, LineSpec, BELT_SPEED};
 use super::fences::{FenceOptions, FenceTransition};
 use super::search::{Outcome, Plan, Planner};
-use super::{Action, PlanError, Problem};
+use super::{Action, Limit, PlanError, Problem};
 use crate::engine::OutcomeCounts;
 use line::{HeadwayProbe, Line, LineError, Runnable, Scratch};
 use serde::Serialize;
@@ -533,7 +533,7 @@ pub struct Design {
     /// The candidate chosen (written).
     pub chosen: Option<usize>,
     /// A limit that cut the work short (the time limit), if any.
-    pub limit: Option<String>,
+    pub limit: Option<Limit>,
     /// Wall time of the whole design (s).
     pub elapsed_s: f64,
     /// The chosen design's scenario text (with its header).
@@ -766,15 +766,17 @@ pub fn design(
     for (i, &mode) in modes.iter().enumerate() {
         let now = Instant::now();
         if now >= search_end {
-            w.limit = Some(format!(
-                "time limit {} s: {} not tried",
-                o.time_limit_s,
-                modes[i..]
-                    .iter()
-                    .map(|m| m.name())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
+            w.limit = Some(Limit::Time {
+                seconds: o.time_limit_s,
+                left_undone: Some(format!(
+                    "{} not tried",
+                    modes[i..]
+                        .iter()
+                        .map(|m| m.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            });
             break;
         }
         // An equal share of the search time left for each mode left (a fast mode leaves its
@@ -791,16 +793,15 @@ struct Work<'a> {
     deadline: Instant,
     candidates: Vec<Candidate>,
     line_runs: usize,
-    limit: Option<String>,
+    limit: Option<Limit>,
 }
 
 impl Work<'_> {
-    /// A search's limit as the command states it: a time limit is the command's (`--time-limit`).
-    fn command_limit(&self, limit: &str) -> String {
-        if limit.starts_with("time limit") {
-            format!("time limit {} s (--time-limit)", self.o.time_limit_s)
-        } else {
-            limit.to_string()
+    /// A search's limit as the design states it: a search's time limit is the design's.
+    fn design_limit(&self, limit: Limit) -> Limit {
+        match limit {
+            Limit::Time { .. } => Limit::time(self.o.time_limit_s),
+            l => l,
         }
     }
 
@@ -853,8 +854,7 @@ impl Work<'_> {
             let now = Instant::now();
             if now >= until {
                 if round == 0 {
-                    self.limit
-                        .get_or_insert(format!("time limit {} s", o.time_limit_s));
+                    self.limit.get_or_insert(Limit::time(o.time_limit_s));
                 }
                 return Ok(());
             }
@@ -993,7 +993,7 @@ impl Work<'_> {
                 return Ok(None);
             }
             ContingentOutcome::LimitHit { limit, .. } => {
-                self.limit.get_or_insert(self.command_limit(&limit));
+                self.limit.get_or_insert(self.design_limit(limit));
                 return Ok(None);
             }
         };
@@ -1066,13 +1066,12 @@ impl Work<'_> {
                 depth_completed,
                 best,
             } => {
-                let l = self.command_limit(&limit);
+                let said = format!(
+                    "stopped by its {limit} after depth {depth_completed}; the best so far is kept"
+                );
+                let l = self.design_limit(limit);
                 self.limit.get_or_insert(l);
-                (
-                    SearchResult::Limit,
-                    format!("stopped by its {limit} after depth {depth_completed}; the best so far is kept"),
-                    best,
-                )
+                (SearchResult::Limit, said, best)
             }
         };
         let Some(plan) = plan else {
@@ -1153,10 +1152,13 @@ impl Work<'_> {
         let mut parts = o.check_parts;
         if per_part * parts as f64 > left {
             parts = ((left / per_part) as u64).max(o.screen_parts.min(o.check_parts));
-            self.limit.get_or_insert(format!(
-                "time limit {} s: the line check ran {parts} of {} parts",
-                o.time_limit_s, o.check_parts
-            ));
+            self.limit.get_or_insert(Limit::Time {
+                seconds: o.time_limit_s,
+                left_undone: Some(format!(
+                    "the line check ran {parts} of {} parts",
+                    o.check_parts
+                )),
+            });
         }
         self.tell(
             Some(mode),
@@ -1325,7 +1327,7 @@ impl Work<'_> {
         };
         match (status, c.verdict_check()) {
             (Status::Unchecked, _) | (_, None) => format!(
-                "{what} ({} mode), predicted {:.4}; not run on the line (--check-parts 0): unchecked",
+                "{what} ({} mode), predicted {:.4}; not run on the line (0 parts were asked for the check): unchecked",
                 c.mode.name(),
                 c.predicted_success
             ),
@@ -1415,7 +1417,7 @@ pub fn header_lines(o: &DesignOptions, c: &Candidate, status: Status) -> Vec<Str
             p.target
         )),
         None if c.line_check.is_none() => {
-            l.push("Line check: none (--check-parts 0): UNCHECKED.".into())
+            l.push("Line check: none (0 parts were asked for the check): UNCHECKED.".into())
         }
         None => {}
     }
