@@ -5,11 +5,12 @@
 
 use super::contact::{case_of, ContactArgs};
 use anyhow::{bail, Result};
+use pinfeed::contact_case::maps::{self, TierSource};
 use pinfeed::contact_case::report::report;
 use pinfeed::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
 use pinfeed::engine::contact_map::prepare_observed;
 use pinfeed::geometry::{Pose, Vec2};
-use pinfeed::maps::tier::{self, push_with_map, Loaded, TierInputs, TierSpec};
+use pinfeed::maps::tier::{self, push_with_map, Loaded};
 use pinfeed::mechanics::{ContactSettings, Fidelity, PartModel, Support};
 use pinfeed::scenario::Scene;
 use std::collections::BTreeSet;
@@ -78,10 +79,13 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     };
     let (pose, start) = case_geometry(&poly, &c);
     // Only the base cell of the query is built (and kept in the cache beside any built before).
+    let source = TierSource {
+        grid: args.push.map_grid.clone(),
+        cache_dir: args.push.cache_dir.clone(),
+    };
     let loaded = load_tier(
         (&model, &support, c.pin_radius, settings),
-        args.push.map_grid.as_deref(),
-        args.push.cache_dir.as_deref(),
+        &source,
         Some(&[(pose, start)]),
         args.json || args.quiet,
     )?;
@@ -129,42 +133,23 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     Ok(())
 }
 
-/// The map of (part, support, pin radius, contact settings) on the grid `--map-grid` (default
-/// [`TierSpec::default`]), read from the cache folder or built and written there — only the base
-/// cells of `queries` (pose, pin start) when they are given; its warnings (a stale or corrupted
-/// file) go to standard error.
-pub fn load_tier(
+/// The map of (part, support, pin radius, contact settings) on the grid `--map-grid`, read from
+/// the cache folder or built there — only the base cells of `queries` when they are given
+/// ([`maps::load_tier`]); its warnings (a stale or corrupted file) go to standard error.
+fn load_tier(
     inputs: (&PartModel, &Support, f64, ContactSettings),
-    grid: Option<&str>,
-    dir: Option<&Path>,
+    source: &TierSource,
     queries: Option<&[(Pose, Vec2)]>,
     quiet: bool,
 ) -> Result<Loaded> {
-    let (model, support, radius, settings) = inputs;
-    let spec = match grid {
-        Some(g) => {
-            TierSpec::parse_grid(g).map_err(|e| anyhow::anyhow!(e.describe("--map-grid")))?
-        }
-        None => TierSpec::default(),
-    };
-    let inputs = TierInputs {
-        model,
-        support,
-        radius,
-        settings,
-        spec,
-    };
-    let cells: Option<Vec<usize>> = queries.map(|q| {
-        q.iter()
-            .filter_map(|&(pose, start)| tier::cell_of_query(&inputs, pose, start))
-            .collect()
-    });
+    let spec = maps::tier_spec(source, &super::flag)?;
     let bar = super::progress::bar(0, "base cells of the map built", quiet);
     bar.set_message("map tier ");
-    let loaded = tier::load_or_build_cells(
-        &inputs,
-        Some(&cache_dir(dir)),
-        cells.as_deref(),
+    let loaded = maps::load_tier(
+        inputs,
+        spec,
+        source,
+        queries,
         &super::progress::counter(&bar),
     );
     bar.finish_and_clear();

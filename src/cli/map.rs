@@ -10,12 +10,10 @@
 //! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use clap::Args;
-use pinfeed::contact_case::{
-    case_fence, check_geometry, check_inputs, compile_part, parse_fence, settings_and_pin, Case,
-};
-use pinfeed::maps::{compute_maps_with, MapFence, MapSettings};
+use pinfeed::contact_case::maps::{self, MapRequest, TierSource};
+use pinfeed::contact_case::{parse_fence, Case, ModelChoice};
 use pinfeed::report::map_report::{write_csv, write_report, MapReport};
 use std::path::PathBuf;
 
@@ -109,137 +107,82 @@ pub fn default_out_dir(part: &str) -> PathBuf {
     pinfeed::default_out(&["maps", &super::part_folder(part)])
 }
 
-/// Run `pinfeed map`; `recorded` is the command line its report records.
-pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
-    // The map tier answers over the exact model, which computes what it cannot vouch for.
-    let use_tier = args.push.map_tier();
-    if use_tier && (args.fence.is_some() || args.uncertain.is_some()) {
-        bail!("--model map: the map tier tabulates still pins with one support; use --model exact with --fence or --uncertain");
-    }
-    let model = match args.push.model {
-        pinfeed::contact_case::ModelChoice::Model(f) => f,
-        pinfeed::contact_case::ModelChoice::Map => pinfeed::mechanics::Fidelity::Exact,
-    };
+/// The library's request for these arguments.
+pub fn request(args: &MapArgs) -> Result<MapRequest> {
     let fence = (args.fence.as_deref())
         .map(|f| parse_fence(f, "--fence"))
         .transpose()?;
-    let template = Case {
-        fence,
-        ..args.push.case(args.part.clone(), model)
+    let model = match args.push.model {
+        ModelChoice::Model(f) => f,
+        ModelChoice::Map => pinfeed::mechanics::Fidelity::Exact,
     };
-    check_inputs(&template, &super::flag)?;
-    let fenced = args.fence.is_some();
-    let (step, threshold) = (args.theta_step, args.threshold);
-    pinfeed::maps::limits::check(args.threads, args.d.len(), fenced, step, threshold)
-        .map_err(|e| anyhow::anyhow!(e.describe(|s| super::flag(s.field()))))?;
-    let (poly, part_model) = compile_part(&args.part, &args.push.support)?;
-    if fence.is_some() {
-        check_geometry(&template, &poly, &super::flag)?;
-    } else {
-        for &d in &args.d {
-            check_geometry(
-                &Case {
-                    d,
-                    ..template.clone()
-                },
-                &poly,
-                &super::flag,
-            )?;
-        }
-    }
-    if let Some(uncertain) = &args.uncertain {
-        return super::map_ensemble::run(args, recorded, uncertain, model, &poly);
-    }
-    let (contact, pin) = settings_and_pin(&template);
-    // Every pass of the maps shares the model: its exact slides come from tables.
-    let part_model = part_model.with_slide_tables(&[contact.mu_c]);
-    let settings = MapSettings {
+    Ok(MapRequest {
+        case: Case {
+            fence,
+            ..args.push.case(args.part.clone(), model)
+        },
+        model: args.push.model,
+        ds: args.d.clone(),
         theta_step_deg: args.theta_step,
         threshold_deg: args.threshold,
-        contact,
-        pin,
-        fence: fence.map(|(angle_deg, length)| MapFence { angle_deg, length }),
-    };
-    // A fence map has one map and no contact parameter (the fence's placement ignores d).
-    let ds: Vec<f64> = if fence.is_some() {
-        vec![0.0]
-    } else {
-        args.d.clone()
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .context("starting the worker threads")?;
-    let tier = if use_tier {
-        // Only the base cells the maps' passes fall in are built.
-        let grid = pinfeed::maps::theta_grid(args.theta_step).unwrap_or_default();
-        let passes: Vec<_> = ds
-            .iter()
-            .flat_map(|&d| grid.iter().map(move |&t| (t, d)))
-            .map(|(t, d)| pinfeed::maps::pass_start(&poly, t, d, pin.radius))
-            .collect();
-        let support = pinfeed::mechanics::Support::parse(&args.push.support, &poly)
-            .map_err(anyhow::Error::msg)?;
-        let loaded = pool.install(|| {
-            super::contact_map::load_tier(
-                (&part_model, &support, args.push.pin_radius, contact),
-                args.push.map_grid.as_deref(),
-                args.push.cache_dir.as_deref(),
-                Some(&passes),
-                args.json || args.csv || args.quiet,
-            )
-        })?;
-        Some(loaded)
-    } else {
-        None
-    };
-    let started = std::time::Instant::now();
-    let maps = pool.install(|| {
-        compute_maps_with(
-            &poly,
-            &part_model,
-            &ds,
-            &settings,
-            tier.as_ref().map(|l| &*l.map),
-        )
-    })?;
-    let elapsed = started.elapsed().as_secs_f64();
-    if let Some(l) = &tier {
-        eprintln!(
-            "{}",
-            pinfeed::maps::tier::report::served_line(&l.map, &poly, &part_model, &ds, &settings)
-        );
+        threads: args.threads,
+        tier: TierSource {
+            grid: args.push.map_grid.clone(),
+            cache_dir: args.push.cache_dir.clone(),
+        },
+    })
+}
+
+/// Run `pinfeed map`; `recorded` is the command line its report records.
+pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
+    let req = request(args)?;
+    if let Some(uncertain) = &args.uncertain {
+        return super::map_ensemble::run(args, recorded, uncertain, &req);
     }
-    let contacts: usize = maps.iter().map(|m| m.samples.len()).sum();
+    let quiet = args.json || args.csv || args.quiet;
+    let bar = super::progress::bar(0, "base cells of the map built", quiet);
+    bar.set_message("map tier ");
+    let run = maps::run(&req, &super::flag, &super::progress::counter(&bar));
+    bar.finish_and_clear();
+    let run = run?;
+    if let Some(l) = &run.tier {
+        for w in &l.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    if let Some(line) = &run.served {
+        eprintln!("{line}");
+    }
     eprintln!(
-        "computed {} maps × {} θ0 = {contacts} contacts ({}) in {elapsed:.3} s on {} threads",
-        maps.len(),
-        maps.first().map_or(0, |m| m.samples.len()),
-        if use_tier { "map" } else { model.name() },
-        pool.current_num_threads()
+        "computed {} maps × {} θ0 = {} contacts ({}) in {:.3} s on {} threads",
+        run.maps.len(),
+        run.maps.first().map_or(0, |m| m.samples.len()),
+        run.contacts(),
+        run.answered_by(),
+        run.elapsed_s,
+        run.threads
     );
-    let non_ok: usize = maps.iter().map(|m| m.non_ok_samples()).sum();
+    let non_ok = run.non_ok();
     if non_ok > 0 {
         eprintln!("warning: {non_ok} contacts ended with a status other than ok (see the samples' status)");
     }
-
     let report = MapReport {
         command: recorded.to_string(),
         part: &args.part,
-        model: if use_tier { "map" } else { model.name() },
+        model: run.answered_by(),
         mu_c: args.push.mu_c,
         pin_radius: args.push.pin_radius,
         support: &args.push.support,
         theta_step_deg: args.theta_step,
         threshold_deg: args.threshold,
         tol: args.push.tol,
-        fence: fence.map(|(angle, length)| case_fence(&poly, &template, angle, length)),
-        maps: &maps,
+        fence: run.fence,
+        maps: &run.maps,
     };
     if args.json {
         print!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else if args.csv {
-        write_csv(std::io::stdout().lock(), &maps)?;
+        write_csv(std::io::stdout().lock(), &run.maps)?;
     } else {
         print!("{}", report.text());
     }

@@ -7,80 +7,40 @@
 //! `ensemble_state0.svg`, …): the predicted θf distributions and bands against d.
 
 use super::map::{default_out_dir_for, MapArgs};
-use anyhow::{anyhow, bail, Result};
-use pinfeed::geometry::Polygon;
-use pinfeed::maps::ensemble::{
-    ensemble_maps_observed, stable_states_deg, EnsembleSpec, InputState,
-};
-use pinfeed::maps::theta_grid;
-use pinfeed::mechanics::Fidelity;
+use anyhow::Result;
+use pinfeed::contact_case::maps::{run_ensemble, MapRequest};
 use pinfeed::report::ensemble_report::{table, write_report, EnsembleReport};
 
-/// Most members of an ensemble.
-pub const MAX_MEMBERS: usize = 100_000;
-/// Most passes (members × d × θ0) in one command.
-pub const MAX_PASSES: usize = 20_000_000;
-
-pub fn run(
-    args: &MapArgs,
-    recorded: &str,
-    uncertain: &str,
-    model: Fidelity,
-    poly: &Polygon,
-) -> Result<()> {
-    if args.push.support.trim() != "uniform" {
-        bail!("--support: with --uncertain the support is set by `support=` in the uncertain list; leave --support at uniform");
-    }
-    if !(1..=MAX_MEMBERS).contains(&args.members) {
-        bail!(
-            "--members must lie in [1, {MAX_MEMBERS}], got {}",
-            args.members
-        );
-    }
-    let spec = EnsembleSpec::nominal(args.push.mu_c, args.push.pin_radius, model, args.push.tol)
-        .with_settings(uncertain)
-        .map_err(|e| anyhow!("--uncertain: {e}"))?;
-    let grid = theta_grid(args.theta_step).map_err(|e| anyhow!("--theta-step: {e}"))?;
-    let passes = args.members * args.d.len() * grid.len();
-    if passes > MAX_PASSES {
-        bail!("{} members × {} d × {} θ0 = {passes} passes; at most {MAX_PASSES} are allowed in one command", args.members, args.d.len(), grid.len());
-    }
-    let pool = super::validate::pool(args.threads)?;
-    let started = std::time::Instant::now();
-    let bar = super::progress::bar(passes as u64, "passes", args.json || args.csv || args.quiet);
-    let maps = pool
-        .install(|| {
-            ensemble_maps_observed(
-                poly,
-                &spec,
-                &args.d,
-                &grid,
-                args.seed,
-                args.members,
-                &|| bar.inc(1),
-            )
-        })
-        .map_err(anyhow::Error::msg)?;
+/// Run `pinfeed map --uncertain`; `recorded` is the command line its report records.
+pub fn run(args: &MapArgs, recorded: &str, uncertain: &str, req: &MapRequest) -> Result<()> {
+    let quiet = args.json || args.csv || args.quiet;
+    let bar = super::progress::bar(0, "passes", quiet);
+    let run = run_ensemble(
+        req,
+        uncertain,
+        args.members,
+        args.seed,
+        &super::flag,
+        &|| bar.inc(1),
+    );
     bar.finish_and_clear();
+    let run = run?;
     eprintln!(
-        "computed {} members × {} d × {} θ0 = {passes} passes ({}) in {:.3} s on {} threads",
+        "computed {} members × {} d × {} θ0 = {} passes ({}) in {:.3} s on {} threads",
         args.members,
         args.d.len(),
-        grid.len(),
-        model.name(),
-        started.elapsed().as_secs_f64(),
-        pool.current_num_threads()
+        run.thetas,
+        run.passes,
+        run.fidelity.name(),
+        run.elapsed_s,
+        run.threads
     );
-    let states = stable_states_deg(poly);
-    let mut inputs = vec![InputState::All];
-    inputs.extend((0..states.len()).map(|index| InputState::State { index }));
-    let predicted = maps.predicted(&inputs, &states);
-    let text = table(&predicted);
+    let text = table(&run.predicted);
     println!(
         "{}  ensemble of {} members, seed {}",
         args.part, args.members, args.seed
     );
-    for line in spec.describe() {
+    for line in run.spec.describe() {
         println!("  {line}");
     }
     print!("{text}");
@@ -90,18 +50,24 @@ pub fn run(
     let report = EnsembleReport {
         command: recorded.to_string(),
         part: &args.part,
-        uncertain: spec.describe(),
+        uncertain: run.spec.describe(),
         members: args.members,
         seed: args.seed,
         theta_step_deg: args.theta_step,
-        predicted: &predicted,
-        draws: &maps.members,
+        predicted: &run.predicted,
+        draws: &run.maps.members,
     };
     let out_dir = args
         .out_dir
         .clone()
         .unwrap_or_else(|| default_out_dir_for(args).join("ensemble"));
-    write_report(&report, &inputs, &text, &out_dir, args.plot_dir.as_deref())?;
+    write_report(
+        &report,
+        &run.inputs,
+        &text,
+        &out_dir,
+        args.plot_dir.as_deref(),
+    )?;
     eprintln!("report written to {}", out_dir.display());
     Ok(())
 }

@@ -38,11 +38,6 @@ pub struct PushArgs {
 }
 
 impl PushArgs {
-    /// Whether `--model map` asks for the certified map tier.
-    pub fn map_tier(&self) -> bool {
-        self.model == ModelChoice::Map
-    }
-
     /// The fidelity of `--model` where the map tier does not apply (`what`: where, for the
     /// message).
     pub fn fidelity(&self, what: &str) -> Result<Fidelity> {

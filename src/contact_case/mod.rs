@@ -9,6 +9,7 @@
 
 pub mod batch;
 pub mod check;
+pub mod maps;
 pub mod report;
 
 use crate::mechanics::limits::{num, OutOfRange};

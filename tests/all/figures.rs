@@ -238,6 +238,8 @@ fn a_fence_plan_is_drawn_to_scale_at_its_angles() {
         "--fences",
         "--belt-width",
         "0.18",
+        "--check-parts",
+        "500",
         "--quiet",
         "--out",
         toml.to_str().unwrap(),

@@ -650,6 +650,8 @@ fn a_design_the_line_refutes_is_never_reported_confirmed() {
         "0",
         "--check-parts",
         "1000",
+        "--screen-parts",
+        "300",
         "--out",
         out.to_str().unwrap(),
         "--json",
