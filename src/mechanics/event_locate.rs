@@ -297,3 +297,73 @@ pub(super) fn landed_event(
         Some(landing.i)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::geometry::{Polygon, Pose, Vec2};
+    use crate::mechanics::outcome::{ContactFeature, ContactStatus, TraceSample};
+    use crate::mechanics::part_model::{PartModel, Support};
+    use crate::mechanics::{ContactSettings, Pin};
+
+    /// A square pushed near a corner by a point pin: the part turns until the pin reaches the
+    /// corner and leaves there. That edge end is an event, landed on: the last sample has the
+    /// contact point on the corner to the landing tolerance (far below the steps' lengths), and no
+    /// sample on the edge lies beyond it.
+    #[test]
+    fn an_edge_end_is_landed_on_to_the_landing_tolerance() {
+        let poly = Polygon::new(&[
+            Vec2::new(-1.0, -1.0),
+            Vec2::new(1.0, -1.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(-1.0, 1.0),
+        ])
+        .unwrap();
+        let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+        let k = model.scale();
+        let corners: Vec<Vec2> = model.polygon().vertices().iter().map(|&v| v * k).collect();
+        let pin = Pin {
+            radius: 0.0,
+            lateral_speed: 0.0,
+        };
+        for (mu, y) in [(0.05, 0.8), (0.3, 0.6), (0.05, -0.7), (0.8, -0.5)] {
+            let settings = ContactSettings {
+                mu_c: mu,
+                ..ContactSettings::default()
+            };
+            let mut trace: Vec<TraceSample> = Vec::new();
+            let out = crate::mechanics::pass::push(
+                &model,
+                Pose::new(0.0, 0.0, 0.0),
+                Vec2::new(3.0, y),
+                &pin,
+                &settings,
+                Some(&mut trace),
+            );
+            assert_eq!(out.status, ContactStatus::Ok);
+            assert!(
+                out.rotation_rad.abs() > 0.1,
+                "μc {mu}, y {y}: the part turned"
+            );
+            // The contact point in the part's frame, against the edge's end.
+            let local = |t: &TraceSample| t.pose.apply_inverse(t.contact_point);
+            let last = trace.last().unwrap();
+            assert!(matches!(last.feature, ContactFeature::Edge(_)));
+            let miss = corners
+                .iter()
+                .map(|&c| (local(last) - c).norm())
+                .fold(f64::INFINITY, f64::min)
+                / k;
+            assert!(
+                miss < 1e-8,
+                "μc {mu}, y {y}: the pin left {miss:e}·a from a corner"
+            );
+            for t in &trace {
+                let p = local(t);
+                assert!(
+                    p.x.abs().max(p.y.abs()) <= 1.0 + 1e-8,
+                    "μc {mu}, y {y}: a contact beyond the edge's end at {p:?}"
+                );
+            }
+        }
+    }
+}

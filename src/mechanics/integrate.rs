@@ -450,3 +450,118 @@ fn open_next(
     );
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Polygon, Vec2};
+    use crate::mechanics::part_model::{PartModel, Support};
+    use crate::mechanics::{mason_vote, ContactSettings};
+
+    /// A 2 × 1 rectangle (uniform pressure) and its normalised right edge: the edge's index, its
+    /// start and its length.
+    fn rectangle() -> (PartModel, usize, Vec2, f64) {
+        let poly = Polygon::new(&[
+            Vec2::new(-1.0, -0.5),
+            Vec2::new(1.0, -0.5),
+            Vec2::new(1.0, 0.5),
+            Vec2::new(-1.0, 0.5),
+        ])
+        .unwrap();
+        let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+        let v = model.polygon().vertices().to_vec();
+        let k = (0..v.len())
+            .find(|&k| v[k].x > 0.0 && v[(k + 1) % v.len()].x > 0.0)
+            .expect("a right edge");
+        let (a, b) = (v[k], v[(k + 1) % v.len()]);
+        (model, k, a, (b - a).norm())
+    }
+
+    /// A point pin moving in −x from x = 2 (normalised) at height `y`, touching the right edge at
+    /// travel `s`; the contact integrated from there until it ends.
+    fn push(
+        model: &PartModel,
+        edge: usize,
+        start: Vec2,
+        y: f64,
+        settings: &ContactSettings,
+    ) -> Finish {
+        let mut ctx = Ctx::new(
+            model,
+            model.polygon(),
+            settings,
+            settings.mu_c,
+            0.0,
+            Vec2::new(-1.0, 0.0),
+            Vec2::new(2.0, y),
+            None,
+            None,
+        );
+        let s = 2.0 - start.x;
+        let ell = y - start.y;
+        integrate_contact(
+            &mut ctx,
+            settings,
+            s,
+            Feat::Edge(edge),
+            [0.0, ell],
+            &mut Tally::default(),
+        )
+    }
+
+    #[test]
+    fn a_push_through_the_centroid_translates_until_the_travel_limit() {
+        let (model, edge, start, _) = rectangle();
+        let settings = ContactSettings {
+            max_travel: 1.5,
+            ..ContactSettings::default()
+        };
+        let (end, s, pose) = push(&model, edge, start, 0.0, &settings);
+        assert!(
+            matches!(end, End::Stop(ContactStatus::TravelLimit { .. })),
+            "{:?}",
+            match end {
+                End::Separated => "separated".to_string(),
+                End::Stop(st) => format!("{st:?}"),
+            }
+        );
+        // By symmetry the part neither turns nor leaves the line of the push.
+        assert!(pose.theta_rad.abs() < 1e-9, "θ {}", pose.theta_rad);
+        assert!(pose.y.abs() < 1e-9, "y {}", pose.y);
+        // It moved with the pin from the touch on, past the travel limit (counted from the touch;
+        // the step that crosses it is the last).
+        let touch = 2.0 - start.x;
+        assert!(s - touch >= 1.5 && s - touch < 50.0, "ended at {s}");
+        assert!(
+            (pose.x + (s - touch)).abs() < 1e-6,
+            "x {} after {}",
+            pose.x,
+            s - touch
+        );
+    }
+
+    #[test]
+    fn an_off_centre_push_turns_the_part_the_way_masons_vote_says() {
+        let (model, edge, start, len) = rectangle();
+        for mu in [0.1, 0.5, 1.5] {
+            for frac in [0.15, 0.3, 0.7, 0.85] {
+                let y = start.y + frac * len;
+                let settings = ContactSettings {
+                    mu_c: mu,
+                    max_travel: 0.05,
+                    ..ContactSettings::default()
+                };
+                let (_, _, pose) = push(&model, edge, start, y, &settings);
+                let p = Vec2::new(start.x, y);
+                let vote = mason_vote(-p, Vec2::new(-1.0, 0.0), Vec2::new(-1.0, 0.0), mu);
+                assert_ne!(vote, 0);
+                assert_eq!(
+                    pose.theta_rad.signum() as i32,
+                    vote,
+                    "μc {mu}, contact at {frac} of the edge: θ {}",
+                    pose.theta_rad
+                );
+            }
+        }
+    }
+}

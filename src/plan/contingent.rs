@@ -524,3 +524,87 @@ pub fn stage_states(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(particles: &[(i32, u32)]) -> State {
+        State::canonical(
+            particles
+                .iter()
+                .enumerate()
+                .map(|(i, &(theta_q, weight))| Particle {
+                    sample: 0,
+                    theta_q,
+                    y_q: i as i32,
+                    weight,
+                })
+                .collect(),
+            0,
+        )
+    }
+
+    #[test]
+    fn window_weights_are_the_weights_inside_every_window() {
+        // 72 steps around the circle; particles near both ends of it, so windows wrap.
+        let s = state(&[(0, 3), (1, 1), (5, 2), (35, 4), (70, 5), (71, 1), (71, 2)]);
+        for width in [0, 1, 3, 10, 71, 80] {
+            let w = window_weights(&s, width, 72);
+            assert_eq!(w.len(), 72);
+            for (c, &got) in w.iter().enumerate() {
+                let width = width.min(71);
+                assert_eq!(got, inside_at(&s, c, width, 72), "width {width}, start {c}");
+            }
+        }
+        // The whole circle holds every particle, a single step only its own.
+        assert!(window_weights(&s, 71, 72).iter().all(|&x| x == 18));
+        assert_eq!(window_weights(&s, 0, 72)[71], 3);
+    }
+
+    fn pin() -> PinAction {
+        PinAction {
+            y_q: 0,
+            y_m: 0.0,
+            lo_m: -0.001,
+            hi_m: 0.001,
+            margin_m: 0.001,
+        }
+    }
+
+    fn branch(total: u32, inside: u32) -> BranchPlan {
+        BranchPlan {
+            label: String::new(),
+            stable_deg: 0.0,
+            pins: vec![pin()],
+            targets_m: vec![0.0],
+            inside,
+            total,
+        }
+    }
+
+    #[test]
+    fn a_confusion_weighs_each_branchs_particles_by_what_they_were_decided() {
+        // Branch 0 (30 particles) all inside with its own pins, 40% with branch 1's; branch 1 (10)
+        // 90% with its own, none with branch 0's.
+        let plan = ContingentPlan {
+            sensor: pin(),
+            k: 1,
+            branches: vec![branch(30, 30), branch(10, 9)],
+            centre_deg: 0.0,
+            predicted_success: 39.0 / 40.0,
+            cross: vec![vec![1.0, 0.4], vec![0.0, 0.9]],
+        };
+        // A perfect classifier gives the prediction.
+        let perfect = plan.with_confusion(&[vec![50, 0, 0], vec![0, 20, 0]]);
+        assert!((perfect - plan.predicted_success).abs() < 1e-15);
+        // Branch 0 decided as 1 half the time, branch 1 always right.
+        let half = plan.with_confusion(&[vec![5, 5, 0], vec![0, 8, 0]]);
+        let expect = (30.0 * (0.5 * 1.0 + 0.5 * 0.4) + 10.0 * 0.9) / 40.0;
+        assert!((half - expect).abs() < 1e-15, "{half} vs {expect}");
+        // "Unknown" (the last column) counts as a failure; a branch never read is left out.
+        let unknown = plan.with_confusion(&[vec![1, 0, 1], vec![0, 0, 0]]);
+        assert!((unknown - 0.5).abs() < 1e-15, "{unknown}");
+        assert_eq!(plan.with_confusion(&[vec![0, 0, 0], vec![0, 0, 0]]), 0.0);
+    }
+}
