@@ -734,12 +734,13 @@ fn many_cases() {
 /// The open defect in [`OPEN`] as a regression test: the final pose at the default tolerance
 /// agrees with the reference. Fails until the default tolerance holds on that case (seed 7956:
 /// 4.3e-3·a of centroid after 6·a of stick, allowed 2.3e-3·a); then drop the `ignore` and move
-/// the seed to [`FIXED`]. What goes wrong: the push starts nearly through the centroid, so the
-/// part enters its stick turning slowly (0.012 rad per unit of travel); the slide before it ends
-/// with θ off by 2.3e-5 rad at the default tolerance (the local error per step is controlled, the
-/// error carried over 0.9·a of slide is not), and divided by that slow rate it becomes a shift of
-/// 2·10⁻³·a in the travel at which every later configuration is reached — 3.4·10⁻³·a at the end,
-/// the same orientation at a different place. At tolerance 1e-7 the shift is 2.7·10⁻⁵·a.
+/// the seed to [`FIXED`]. What goes wrong (traces at tolerances 1e-6 and 1e-9): the push
+/// starts nearly through the centroid; the slide before the stick ends with θ off by 2.3·10⁻⁵
+/// rad (the local error per step is controlled, the error carried over 1.1·a of slide is not),
+/// and the stick starts 8.8·10⁻⁴·a of travel later; turning slowly at first (0.0094 rad per a of
+/// travel), the stick grows that into a shift of 4.3·10⁻³·a in the travel at which every later
+/// configuration is reached: the same final orientation at a different place. At tolerance 1e-7
+/// the final centroid is 3.5·10⁻⁵·a from the converged one.
 #[test]
 #[ignore = "open production defect found by the reference (centroid error at the default tolerance after a long stick)"]
 fn known_defects_are_fixed() {
