@@ -1304,7 +1304,12 @@ mod tests {
     #[test]
     fn crossing_the_line_stretch_by_stretch_predicts_what_whole_runs_do() {
         let scene = tripoly2_line();
-        let spec = small_spec();
+        // One friction and one support: the stretches, not the hypotheses, are under test.
+        let spec = BeliefSpec {
+            mu_c: vec![0.5],
+            support: vec![SupportKind::Uniform],
+            ..small_spec()
+        };
         let staged = OnlineModel::build_with(&scene, &spec, true).unwrap();
         let whole = OnlineModel::build_with(&scene, &spec, false).unwrap();
         assert_eq!(staged.actions, whole.actions);
