@@ -17,7 +17,7 @@
 //! | [`geometry`] | polygons, named parts, stable states, first contact |
 //! | [`mechanics`] | the contact model: limit surfaces, one pin or fence pass |
 //! | [`maps`] | configuration maps θ0 → θf, their bands, ensembles, the map tier |
-//! | [`contact_case`] | one fully specified pass, as `pinfeed contact` runs it, and batches of them |
+//! | [`contact_case`] | one fully specified pass, as `pinfeed contact` runs it, batches of them, and the maps of a case as `pinfeed map` computes them ([`contact_case::maps::run`]) |
 //! | [`sensing`] | force/torque readings, classifiers, sense experiments |
 //! | [`scenario`] | TOML scenarios compiled to an immutable scene |
 //! | [`engine`] | the discrete-event feeder line, its controller and metrics |

@@ -4,8 +4,9 @@
 //! The part starts with its centroid at the origin of the belt frame at orientation θ0; the pin
 //! starts just clear of the part's circumscribed circle, at x = a + ρ + 0.01a, y = d·a, and travels
 //! in −x relative to the belt (plus w per unit travel for a moving pin). All lengths are in the
-//! part's units. [`check`] holds the input ranges, [`report`] the summary of an outcome and
-//! [`batch`] the CSV batch of cases.
+//! part's units. [`check`] holds the input ranges, [`report`] the summary of an outcome,
+//! [`batch`] the CSV batch of cases and [`maps`] the configuration maps of a case (θ0 over the
+//! circle, for each d), exact, from the map tier or over an ensemble.
 
 pub mod batch;
 pub mod check;
