@@ -164,3 +164,31 @@ impl PlanError {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_limit_says_what_it_is_and_names_its_setting() {
+        let states = Limit::States(1000);
+        assert_eq!(states.to_string(), "state limit 1000");
+        assert_eq!(states.field(), "max_states");
+        let time = Limit::time(110.0);
+        assert_eq!(time.to_string(), "time limit 110 s");
+        assert_eq!(time.field(), "time_limit");
+        let cut = Limit::Time {
+            seconds: 0.5,
+            left_undone: Some("fences, sensor not tried".into()),
+        };
+        assert_eq!(
+            cut.to_string(),
+            "time limit 0.5 s: fences, sensor not tried"
+        );
+        // Written as its words.
+        assert_eq!(
+            serde_json::to_string(&cut).unwrap(),
+            "\"time limit 0.5 s: fences, sensor not tried\""
+        );
+    }
+}
