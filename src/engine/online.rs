@@ -111,6 +111,8 @@ pub struct OnlineModel {
     success: Vec<f64>,
     /// The same table hypothesis by hypothesis: success[h · A + a] (what a decision reads).
     by_hypothesis: Vec<f64>,
+    /// The prior's entropy (bits), computed once when the model is built.
+    prior_entropy_bits: f64,
     /// Members per hypothesis.
     pub samples: usize,
     /// Line runs the build took (a run through one stretch of the line counts one).
@@ -374,6 +376,7 @@ impl OnlineModel {
         }
         let mut model = OnlineModel {
             hypotheses,
+            prior_entropy_bits: prior.entropy_bits(),
             prior,
             sensors,
             pins,
@@ -432,6 +435,11 @@ impl OnlineModel {
         (blind / total, informed / total)
     }
 
+    /// The entropy of [`OnlineModel::prior`] in bits ([`Belief::entropy_bits`]).
+    pub fn prior_entropy_bits(&self) -> f64 {
+        self.prior_entropy_bits
+    }
+
     /// The model of sensor pin `obstacle`, if it is one.
     pub fn sensor(&self, obstacle: usize) -> Option<&SensorModel> {
         self.sensors.iter().find(|s| s.obstacle == obstacle)
@@ -443,8 +451,14 @@ impl OnlineModel {
     /// from the pins' homes. The choice is a function of the belief alone (not of where the pins
     /// happen to stand), so a rule table can reproduce it.
     pub fn choose(&self, belief: &Belief) -> Choice {
+        self.choose_from(&belief.probabilities())
+    }
+
+    /// [`OnlineModel::choose`] for the belief whose probabilities are `probabilities`
+    /// ([`Belief::probabilities`]).
+    pub fn choose_from(&self, probabilities: &[f64]) -> Choice {
         let current = &self.homes;
-        let p = self.predictions(belief);
+        let p = self.predictions(probabilities);
         // The tie-breakers are computed only for actions within TIE of the best so far: the
         // same sequential comparison, without the neighbours of every action.
         let around = |a: usize| self.around(&p, a);
@@ -477,14 +491,13 @@ impl OnlineModel {
     /// hypotheses, all actions at once (hypothesis by hypothesis over the transposed table). A
     /// hypothesis of probability 0 is skipped: its products are +0, which leave every sum as it
     /// was (each is +0 or positive).
-    fn predictions(&self, belief: &Belief) -> Vec<f64> {
-        let w = belief.probabilities();
+    fn predictions(&self, w: &[f64]) -> Vec<f64> {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { self.predictions_avx2(&w) };
+            return unsafe { self.predictions_avx2(w) };
         }
-        self.predictions_plain(&w)
+        self.predictions_plain(w)
     }
 
     /// [`OnlineModel::predictions`] compiled for AVX2's wider registers: the same products and

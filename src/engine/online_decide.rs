@@ -9,6 +9,7 @@ use super::metrics::WorkCounters;
 use super::sensing::SensedPass;
 use super::state::{ActivePart, Belt};
 use crate::scenario::{Obstacle, Scene};
+use crate::sensing::belief::Belief;
 use std::collections::BTreeMap;
 
 /// Part `index` enters at time `t` (online mode): it takes the prior belief, and for each sensor
@@ -158,9 +159,11 @@ pub(super) fn decide_online(
     let Some(belief) = part.belief.as_ref() else {
         return false;
     };
-    let choice = model.choose(belief);
+    // The belief's probabilities once, for the choice, its entropy and its marginal.
+    let (p, h1) = belief.probabilities_and_entropy();
+    let choice = model.choose_from(&p);
     part.predicted = Some(choice.predicted);
-    let (h0, h1) = (model.prior.entropy_bits(), belief.entropy_bits());
+    let h0 = model.prior_entropy_bits();
     let action = &model.actions[choice.action];
     let truth = part.decided.iter().find_map(|d| d.2);
     let states = model
@@ -170,7 +173,7 @@ pub(super) fn decide_online(
         .max()
         .map_or(0, |m| m + 1);
     let group: Vec<usize> = model.hypotheses.iter().map(|h| h.state).collect();
-    let marginal = belief.marginal(&group, states);
+    let marginal = Belief::marginal_of(&p, &group, states);
     let map_state = (0..states).max_by(|&a, &b| marginal[a].total_cmp(&marginal[b]));
     if let Some(o) = control.online.as_mut() {
         if let Some(t) = truth {

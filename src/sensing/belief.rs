@@ -71,11 +71,25 @@ impl Belief {
 
     /// Shannon entropy in bits.
     pub fn entropy_bits(&self) -> f64 {
+        self.entropy_bits_of(&self.probabilities())
+    }
+
+    /// The posterior probabilities and the entropy in bits, one exponential per hypothesis for
+    /// both: [`Belief::probabilities`] and [`Belief::entropy_bits`], bit for bit.
+    pub fn probabilities_and_entropy(&self) -> (Vec<f64>, f64) {
+        let p = self.probabilities();
+        let h = self.entropy_bits_of(&p);
+        (p, h)
+    }
+
+    /// The entropy in bits from the probabilities `p` (= exp of the log weights).
+    fn entropy_bits_of(&self, p: &[f64]) -> f64 {
         -self
             .log_w
             .iter()
-            .filter(|l| l.is_finite())
-            .map(|&l| l.exp() * l)
+            .zip(p)
+            .filter(|(l, _)| l.is_finite())
+            .map(|(&l, &p)| p * l)
             .sum::<f64>()
             / std::f64::consts::LN_2
     }
@@ -93,9 +107,14 @@ impl Belief {
 
     /// The marginal over a grouping of the hypotheses: `group[h]` < `groups`.
     pub fn marginal(&self, group: &[usize], groups: usize) -> Vec<f64> {
+        Belief::marginal_of(&self.probabilities(), group, groups)
+    }
+
+    /// [`Belief::marginal`] from the probabilities `p` ([`Belief::probabilities`]).
+    pub fn marginal_of(p: &[f64], group: &[usize], groups: usize) -> Vec<f64> {
         let mut m = vec![0.0; groups];
-        for (l, &g) in self.log_w.iter().zip(group) {
-            m[g] += l.exp();
+        for (p, &g) in p.iter().zip(group) {
+            m[g] += p;
         }
         m
     }
@@ -166,6 +185,23 @@ mod tests {
         let before = b.clone();
         assert_eq!(b.observe_no_contact(&[1.0, 1.0]), Update::Inconsistent);
         assert_eq!(b, before);
+    }
+
+    /// The probabilities, entropy and marginal from one set of exponentials are those computed
+    /// apart, bit for bit, with removed hypotheses among them.
+    #[test]
+    fn probabilities_and_entropy_at_once_are_those_apart() {
+        let mut b = Belief::new(&[0.1, 0.0, 2.0, 0.7, 1e-200, 3.0]).unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for ll in [[0.0; 6], [-3.0, 0.0, -900.0, 1.5, 2.0, -0.25]] {
+            b.observe_log_likelihood(&ll);
+            let (p, h) = b.probabilities_and_entropy();
+            assert_eq!(bits(&p), bits(&b.probabilities()));
+            assert_eq!(h.to_bits(), b.entropy_bits().to_bits());
+            let group = [0, 1, 0, 2, 1, 2];
+            let m = Belief::marginal_of(&p, &group, 3);
+            assert_eq!(bits(&m), bits(&b.marginal(&group, 3)));
+        }
     }
 
     #[test]

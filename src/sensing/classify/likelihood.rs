@@ -112,6 +112,9 @@ struct Bounds {
     k: usize,
     /// Per member, `k` + [`REC_FIXED`] numbers: α, then as [`REC_FIXED`] lists.
     rec: Vec<f64>,
+    /// Per member, the flat indices of its lag-dependent entries, padded to [`MAX_VARYING`] with
+    /// index 0 (a padded entry's largest and smallest correction are 0, so it adds ±0).
+    vars: Vec<[u32; MAX_VARYING]>,
 }
 
 /// A reading's numbers for the bounds: z = V ŷ, ‖z‖, ‖ŷ − Vᵀz‖, ‖ŷ‖, max |y|.
@@ -150,6 +153,10 @@ impl Bounds {
         }
         let k = basis.len().checked_div(dims).unwrap_or(0);
         let mut rec = Vec::with_capacity(members.len() * (k + REC_FIXED));
+        let vars = members
+            .iter()
+            .map(|m| std::array::from_fn(|e| m.vidx.get(e).copied().unwrap_or(0)))
+            .collect();
         for (m, bh) in members.iter().zip(&whitened) {
             let alpha: Vec<f64> = basis
                 .chunks_exact(dims)
@@ -191,6 +198,7 @@ impl Bounds {
             basis,
             k,
             rec,
+            vars,
         }
     }
 
@@ -228,9 +236,9 @@ impl Bounds {
     }
 
     /// Member `m`'s bound without its lag term, plus its allowance for rounding; and the bound of
-    /// its lag term (`ys`: the reading at its lag-dependent entries).
+    /// its lag term, for the block sums `y` (`p`: their projection).
     #[inline(always)]
-    fn of(&self, m: usize, p: &Projected, ys: &[f64]) -> (f64, f64) {
+    fn of(&self, m: usize, p: &Projected, y: &[f64]) -> (f64, f64) {
         let k = self.k;
         let r = &self.rec[m * (k + REC_FIXED)..(m + 1) * (k + REC_FIXED)];
         let (alpha, r) = r.split_at(k);
@@ -248,7 +256,8 @@ impl Bounds {
         let (rho, kappa, bnorm, cmax, cabs, dsum) = (r[0], r[1], r[2], r[3], r[4], r[5]);
         let (hi, lo) = r[6..].split_at(MAX_VARYING);
         let mut lag = [cmax, 0.0];
-        for (e, ((&y, &h), &l)) in ys.iter().zip(hi).zip(lo).enumerate() {
+        for (e, ((&d, &h), &l)) in self.vars[m].iter().zip(hi).zip(lo).enumerate() {
+            let y = y[d as usize];
             let (a, b) = (y * h, y * l);
             lag[e % 2] += if a > b { a } else { b };
         }
@@ -349,11 +358,12 @@ impl Packed {
     }
 
     /// Per range of members (a hypothesis), the log-sum-exp of their scores minus ln n (−∞ for an
-    /// empty range), and the number of members scored. Within a range the members are scored in
-    /// decreasing order of their bound ([`Bounds`]); one whose bound (first without, then with
-    /// its exact lag correction) lies more than [`SKIP_GAP`] below the best score so far is left
-    /// out, since its term of the log-sum-exp would be +0. The result is that of every member
-    /// scored, bit for bit. The same arithmetic in the same order on every CPU; where the CPU has
+    /// empty range), and the number of members scored. Within a range the member with the largest
+    /// bound ([`Bounds`]) is scored first, then the others in order; one whose bound (first
+    /// without, then with its exact lag correction) lies more than [`SKIP_GAP`] below the best
+    /// score so far is left out, since its term of the log-sum-exp would be +0 (which members
+    /// are left out depends on the order, the result does not). The result is that of every
+    /// member scored, bit for bit. The same arithmetic in the same order on every CPU; where the CPU has
     /// AVX2 the loops are compiled for its wider registers.
     fn log_likelihoods(&self, y: &[f64], ranges: &[std::ops::Range<usize>]) -> (Vec<f64>, usize) {
         #[cfg(target_arch = "x86_64")]
@@ -385,43 +395,51 @@ impl Packed {
         let p = self.bounds.project(y);
         let mut out = Vec::with_capacity(ranges.len());
         let mut scored = 0;
-        let mut order: Vec<(f64, f64, usize)> = Vec::new();
+        // Per member of the range: its bound and its bound without the lag term.
+        let mut bounds: Vec<(f64, f64)> = Vec::new();
         let mut scores: Vec<f64> = Vec::new();
-        let mut ys = [0.0; MAX_VARYING];
         for r in ranges {
             if r.is_empty() {
                 out.push(f64::NEG_INFINITY);
                 continue;
             }
-            order.clear();
+            bounds.clear();
+            let (mut first, mut top) = (r.start, f64::NEG_INFINITY);
             for m in r.clone() {
-                let vidx = self.parts(m).0;
-                for (v, &d) in ys.iter_mut().zip(vidx) {
-                    *v = y[d as usize];
-                }
-                let (base, lag) = self.bounds.of(m, &p, &ys[..vidx.len()]);
+                let (base, lag) = self.bounds.of(m, &p, y);
                 // A bound that is not a number (a reading beyond any scale) leaves out nothing.
                 let bound = base + lag;
-                order.push((if bound.is_nan() { f64::INFINITY } else { bound }, base, m));
+                let bound = if bound.is_nan() { f64::INFINITY } else { bound };
+                if bound > top {
+                    (first, top) = (m, bound);
+                }
+                bounds.push((bound, base));
             }
-            order.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.2.cmp(&b.2)));
             scores.clear();
             scores.resize(r.len(), f64::NEG_INFINITY);
-            let mut best = f64::NEG_INFINITY;
-            for &(bound, base, m) in &order {
+            let (mut best, mut here) = (f64::NEG_INFINITY, 0);
+            for m in std::iter::once(first).chain(r.clone().filter(|&m| m != first)) {
+                let (bound, base) = bounds[m - r.start];
                 if bound < best - SKIP_GAP {
-                    break;
+                    continue;
                 }
                 let lag = self.lag_of(m, y);
                 if base + lag < best - SKIP_GAP {
                     continue;
                 }
                 let s = self.score_with(m, y, lag);
-                scored += 1;
+                here += 1;
                 scores[m - r.start] = s;
                 best = best.max(s);
             }
-            out.push(log_sum_exp(&scores) - (r.len() as f64).ln());
+            scored += here;
+            // One finite score s alone: its log-sum-exp is s + ln(e⁰) = s + 0.
+            let lse = if here == 1 && best.is_finite() {
+                best + 0.0
+            } else {
+                log_sum_exp(&scores)
+            };
+            out.push(lse - (r.len() as f64).ln());
         }
         (out, scored)
     }
@@ -1057,8 +1075,7 @@ mod tests {
                     .collect();
                 let p = packed.bounds.project(&y);
                 for (m, s) in packed.scores(&y).iter().enumerate() {
-                    let ys: Vec<f64> = members[m].vidx.iter().map(|&d| y[d as usize]).collect();
-                    let (base, lag) = packed.bounds.of(m, &p, &ys);
+                    let (base, lag) = packed.bounds.of(m, &p, &y);
                     assert!(base + lag >= *s, "member {m}: {} < {s}", base + lag);
                     assert!(base + packed.lag_of(m, &y) >= *s, "member {m}");
                 }
@@ -1090,6 +1107,23 @@ mod tests {
             packed.log_likelihoods(&[], std::slice::from_ref(&(0..0))),
             (vec![f64::NEG_INFINITY], 0)
         );
+    }
+
+    /// A hypothesis with one member scored takes that score plus 0 without the exponential and
+    /// logarithm of the log-sum-exp: the same bits as the log-sum-exp of its scores (the others
+    /// −∞), for any finite score.
+    #[test]
+    fn one_score_alone_is_its_log_sum_exp_bit_for_bit() {
+        let mut rng = crate::random::stream(17, 0);
+        let mut values = vec![0.0, -0.0, 1e-300, -1e-300, 5e-324, 1e300, -1e300, f64::MAX];
+        values.extend((0..200).map(|_| rng.random_range(-1e6..1e6)));
+        for x in values {
+            for at in 0..3 {
+                let mut v = [f64::NEG_INFINITY; 3];
+                v[at] = x;
+                assert_eq!(log_sum_exp(&v).to_bits(), (x + 0.0).to_bits(), "{x}");
+            }
+        }
     }
 
     /// The log-likelihoods compiled for AVX2 (where the CPU has it) are those of the plain loops
