@@ -139,7 +139,8 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     if let Some(uncertain) = &args.uncertain {
         return super::map_ensemble::run(args, recorded, uncertain, &req);
     }
-    let quiet = args.json || args.csv || args.quiet;
+    // A bar only while the map tier's cells are built (exact maps have none).
+    let quiet = args.json || args.csv || args.quiet || req.model != ModelChoice::Map;
     let bar = super::progress::bar(0, "base cells of the map built", quiet);
     bar.set_message("map tier ");
     let run = maps::run(&req, &super::flag, &super::progress::counter(&bar));
