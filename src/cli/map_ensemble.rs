@@ -14,7 +14,9 @@ use pinfeed::report::ensemble_report::{table, write_report, EnsembleReport};
 /// Run `pinfeed map --uncertain`; `recorded` is the command line its report records.
 pub fn run(args: &MapArgs, recorded: &str, uncertain: &str, req: &MapRequest) -> Result<()> {
     let quiet = args.json || args.csv || args.quiet;
-    let bar = super::progress::bar(0, "passes", quiet);
+    let thetas = pinfeed::maps::theta_grid(args.theta_step).map_or(0, |g| g.len());
+    let total = args.members * args.d.len() * thetas;
+    let bar = super::progress::bar(total as u64, "passes", quiet);
     let run = run_ensemble(
         req,
         uncertain,
