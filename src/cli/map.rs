@@ -112,14 +112,12 @@ pub fn request(args: &MapArgs) -> Result<MapRequest> {
     let fence = (args.fence.as_deref())
         .map(|f| parse_fence(f, "--fence"))
         .transpose()?;
-    let model = match args.push.model {
-        ModelChoice::Model(f) => f,
-        ModelChoice::Map => pinfeed::mechanics::Fidelity::Exact,
-    };
     Ok(MapRequest {
         case: Case {
             fence,
-            ..args.push.case(args.part.clone(), model)
+            ..args
+                .push
+                .case(args.part.clone(), args.push.model.computed_with())
         },
         model: args.push.model,
         ds: args.d.clone(),

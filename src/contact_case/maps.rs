@@ -42,7 +42,7 @@ pub struct TierSource {
 #[derive(Debug, Clone)]
 pub struct MapRequest {
     /// The template case: part, support, friction, pin radius, tolerance and fence (its θ0 and d
-    /// are not used).
+    /// are not used, and its model is the one [`MapRequest::model`] computes with).
     pub case: Case,
     /// How the pushes are answered: a model of the contact, or the map tier.
     pub model: ModelChoice,
@@ -147,22 +147,14 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool, rayon::ThreadPoolBuildError
     rayon::ThreadPoolBuilder::new().num_threads(threads).build()
 }
 
-/// The model a request's passes are computed with: the exact one under the map tier (which answers
-/// from it where the map cannot vouch).
-fn fidelity(model: ModelChoice) -> Fidelity {
-    match model {
-        ModelChoice::Model(f) => f,
-        ModelChoice::Map => Fidelity::Exact,
-    }
-}
-
-/// Check the request's settings; the part, compiled, when they hold.
+/// Check the request's settings; when they hold, its case (with the model its passes are
+/// computed with) and the part, compiled.
 fn checked(
     req: &MapRequest,
     name: &dyn Fn(&str) -> String,
-) -> Result<(Polygon, PartModel), MapRunError> {
+) -> Result<(Case, Polygon, PartModel), MapRunError> {
     let c = Case {
-        model: fidelity(req.model),
+        model: req.model.computed_with(),
         ..req.case.clone()
     };
     check_inputs(&c, name)?;
@@ -183,7 +175,7 @@ fn checked(
             check_geometry(&Case { d, ..c.clone() }, &poly, name)?;
         }
     }
-    Ok((poly, model))
+    Ok((c, poly, model))
 }
 
 /// Compute the maps of `req` (see the module docs); `tier_progress` follows the map tier's build
@@ -200,11 +192,7 @@ pub fn run(
             name("model")
         )));
     }
-    let (poly, part_model) = checked(req, name)?;
-    let c = Case {
-        model: fidelity(req.model),
-        ..req.case.clone()
-    };
+    let (c, poly, part_model) = checked(req, name)?;
     let (contact, pin) = settings_and_pin(&c);
     // Every pass of the maps shares the model: its exact slides come from tables.
     let part_model = part_model.with_slide_tables(&[contact.mu_c]);
@@ -284,8 +272,8 @@ pub fn run_ensemble(
             name("uncertain")
         )));
     }
-    let (poly, _) = checked(req, name)?;
-    if req.case.support.trim() != "uniform" {
+    let (c, poly, _) = checked(req, name)?;
+    if c.support.trim() != "uniform" {
         return Err(setting(format!(
             "{}: with {} the support is set by `support=` in the uncertain list; leave it uniform",
             name("support"),
@@ -298,8 +286,7 @@ pub fn run_ensemble(
             name("members")
         )));
     }
-    let c = &req.case;
-    let spec = EnsembleSpec::nominal(c.mu_c, c.pin_radius, fidelity(req.model), c.tol)
+    let spec = EnsembleSpec::nominal(c.mu_c, c.pin_radius, c.model, c.tol)
         .with_settings(uncertain)
         .map_err(|e| setting(format!("{}: {e}", name("uncertain"))))?;
     let grid = theta_grid(req.theta_step_deg)
@@ -327,7 +314,7 @@ pub fn run_ensemble(
         maps,
         inputs,
         predicted,
-        fidelity: fidelity(req.model),
+        fidelity: c.model,
         thetas: grid.len(),
         passes,
         elapsed_s,

@@ -262,6 +262,17 @@ pub enum ModelChoice {
     Map,
 }
 
+impl ModelChoice {
+    /// The model the passes are computed with: the fidelity chosen, or under the map tier the
+    /// exact model (which answers wherever the map cannot vouch).
+    pub fn computed_with(self) -> Fidelity {
+        match self {
+            ModelChoice::Model(f) => f,
+            ModelChoice::Map => Fidelity::Exact,
+        }
+    }
+}
+
 impl std::str::FromStr for ModelChoice {
     type Err = CaseError;
 
