@@ -1,7 +1,8 @@
 #!/bin/sh
 # What the planner's branch and bound saves: each search run with and without it (--no-bound),
 # one after the other on the same binary, same answers expected. Prints the Markdown table of
-# results/plans.md ("Branch and bound"). Run from the repository root on an idle machine:
+# results/plans.md ("Branch and bound"): the pin search alone (--pins --refine 0, no line check).
+# Run from the repository root on an idle machine:
 #   sh results/plans/bound.sh
 set -e
 cargo build --release --quiet
@@ -13,15 +14,17 @@ run() {
   for b in on off; do
     extra=""
     [ "$b" = off ] && extra="--no-bound"
-    "$bin" plan "$@" $extra --time-limit 300 --check-parts 0 --json > /tmp/pinfeed-bound.json 2>/dev/null || true
+    "$bin" plan "$@" --pins --refine 0 $extra --time-limit 300 --check-parts 0 --no-write --json > /tmp/pinfeed-bound.json 2>/dev/null || true
     python3 - "$label" "$b" <<'PY'
 import json, sys
 d = json.load(open('/tmp/pinfeed-bound.json'))
-s = d['stats']; p = d.get('plan') or {}
-pins = len(p.get('steps', [])) if p else '–'
-share = f"{p['predicted_success']:.3f}" if p else '–'
-res = {'found': 'shortest plan', 'none_up_to_depth': 'none up to depth 8', 'limit': 'limit: ' + d['message'].split('stopped by its ')[-1].split(' after')[0]}.get(d['result'], d['result'])
-print(f"| {sys.argv[1]} | {sys.argv[2]} | {res} | {pins} | {share} | {s['elapsed_s']:.1f} | {s['expanded']:,} | {s['generated']:,} | {s['pushes']['computed']:,} | {s['peak_rss_bytes']/1e6:.0f} MB |".replace(',', ' '))
+c = d.get('chosen') or {}
+s = c['search']; w = s['work']
+pins = len(c['obstacles'])
+share = f"{c['predicted_success']:.3f}"
+res = {'found': 'shortest plan', 'none_up_to_depth': 'none up to depth 8', 'limit': 'limit: ' + s['message'].split('stopped by its ')[-1].split(' after')[0]}.get(s['result'], s['result'])
+n = lambda x: f"{x:,}".replace(',', ' ')
+print(f"| {sys.argv[1]} | {sys.argv[2]} | {res} | {pins} | {share} | {s['elapsed_s']:.1f} | {n(w['expanded'])} | {n(w['generated'])} | {n(w['passes_computed'])} | {w['peak_rss_bytes']/1e6:.0f} MB |")
 PY
   done
 }

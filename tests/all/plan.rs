@@ -187,6 +187,53 @@ fn none_up_to_depth_is_a_reported_result_with_its_best_effort() {
     assert!(sim < 0.99, "the line agrees the goal is not reached: {sim}");
 }
 
+#[test]
+fn a_design_reports_the_work_of_its_search() {
+    // `plan --json` carries a sequence search's counts, the same the planner's own statistics
+    // give for the same problem; the sensor mode's search has none.
+    let (_, v) = plan_json(&[
+        "plan",
+        "--part",
+        "tripoly1",
+        "--pins",
+        "--depth",
+        "3",
+        "--refine",
+        "0",
+        "--check-parts",
+        "0",
+        "--no-write",
+        "--json",
+    ]);
+    let work = &v["chosen"]["search"]["work"];
+    let mut problem = Problem::new("tripoly1");
+    problem.max_pins = 3;
+    let (_, stats) = Planner::new(&problem).unwrap().search();
+    assert_eq!(work["expanded"], stats.expanded, "{work}");
+    assert_eq!(work["generated"], stats.generated, "{work}");
+    assert_eq!(work["pruned"], stats.pruned, "{work}");
+    assert_eq!(work["passes_computed"], stats.pushes.computed, "{work}");
+    assert!(stats.expanded > 0 && stats.pushes.computed > 0);
+    let (_, s) = plan_json(&[
+        "plan",
+        "--part",
+        "tripoly1",
+        "--sensor",
+        "--refine",
+        "0",
+        "--check-parts",
+        "0",
+        "--no-write",
+        "--json",
+    ]);
+    assert_eq!(s["chosen"]["mode"], "sensor");
+    assert!(
+        s["chosen"]["search"].get("work").is_none(),
+        "{}",
+        s["chosen"]
+    );
+}
+
 /// The most particles in one window over every plan of at most `depth` actions, and the fewest
 /// actions that reach it (brute force, no deduplication).
 fn most_inside(p: &mut Planner, state: &State, depth: usize, used: usize, best: &mut (u32, usize)) {

@@ -30,7 +30,7 @@ pub mod survey;
 use super::contingent::{self, ContingentOutcome, ContingentPlan};
 use super::emit::{self, LineSpec, BELT_SPEED};
 use super::fences::{FenceOptions, FenceTransition};
-use super::search::{Outcome, Plan, Planner};
+use super::search::{Outcome, Plan, Planner, SearchStats};
 use super::{Action, Limit, PlanError, Problem};
 use crate::engine::OutcomeCounts;
 use line::{HeadwayProbe, Line, LineError, Runnable, Scratch};
@@ -357,6 +357,38 @@ pub struct SearchSummary {
     pub depth_completed: usize,
     /// Wall time of the search (s).
     pub elapsed_s: f64,
+    /// A sequence search's work (pins, fences and hybrid modes; none for the sensor mode).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub work: Option<SearchWork>,
+}
+
+/// What a sequence search did: the numbers behind its time and memory.
+#[derive(Debug, Clone, Serialize)]
+pub struct SearchWork {
+    /// States expanded.
+    pub expanded: u64,
+    /// Successors generated (before deduplication).
+    pub generated: u64,
+    /// Actions and states the branch and bound cut.
+    pub pruned: u64,
+    /// Contact passes computed (the memo's misses).
+    pub passes_computed: u64,
+    /// Peak resident memory of the process when the search ended (Linux), if readable.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_rss_bytes: Option<u64>,
+}
+
+impl SearchWork {
+    /// The work counted in a sequence search's statistics.
+    fn of(stats: &SearchStats) -> SearchWork {
+        SearchWork {
+            expanded: stats.expanded,
+            generated: stats.generated,
+            pruned: stats.pruned,
+            passes_computed: stats.pushes.computed,
+            peak_rss_bytes: stats.peak_rss_bytes,
+        }
+    }
 }
 
 /// The plan behind a candidate.
@@ -438,13 +470,14 @@ struct Emitted {
 
 impl SearchSummary {
     /// How a search over `planner`'s particles ended, after `depth_completed` levels in
-    /// `elapsed_s` seconds.
+    /// `elapsed_s` seconds, with a sequence search's `work`.
     fn new(
         result: SearchResult,
         message: String,
         planner: &Planner,
         depth_completed: usize,
         elapsed_s: f64,
+        work: Option<SearchWork>,
     ) -> SearchSummary {
         SearchSummary {
             result,
@@ -452,6 +485,7 @@ impl SearchSummary {
             particles: planner.initial.total(),
             depth_completed,
             elapsed_s,
+            work,
         }
     }
 }
@@ -1015,6 +1049,7 @@ impl Work<'_> {
                 planner,
                 stats.depth_completed,
                 stats.elapsed_s,
+                None,
             ),
             layout: Layout::Contingent(plan),
             problem: problem.clone(),
@@ -1102,6 +1137,7 @@ impl Work<'_> {
                 planner,
                 stats.depth_completed,
                 stats.elapsed_s,
+                Some(SearchWork::of(&stats)),
             ),
             layout: Layout::Sequence(plan),
             problem,
