@@ -137,9 +137,10 @@ def main():
         f"python3 results/line-speed/waits.py --base BASE_BINARY --reps {a.reps}",
         "```",
         "",
-        f"Base: the binary of commit `{a.base_name}`. Machine: {os.cpu_count()} cores, shared with other work.",
-        f"Load average (1 min): {load_before:.1f} at the start of the run, {load_after:.1f} at its end; "
-        f"above {os.cpu_count()}, the wall times include waiting for a core and the CPU times do not.",
+        f"Base: the binary of commit `{a.base_name}`. Machine: {os.cpu_count()} cores.",
+        f"Load average (1 min): {load_before:.1f} at the start of the run, {load_after:.1f} at its end "
+        f"(the run's own two-thread commands count in it); above {os.cpu_count()}, the wall times "
+        f"include waiting for a core and the CPU times do not.",
         "",
         f"| command | {a.base_name}: wall / CPU / peak | now: wall / CPU / peak | speed-up (wall) | target |",
         "|---|---|---|---|---|",
