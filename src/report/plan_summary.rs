@@ -247,10 +247,10 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
                 l.ci95[1],
                 l.parts,
                 design::line::fmt_headway(l.headway_s),
-                if c.line_check.is_some() {
-                    ""
-                } else {
-                    " screen"
+                match (&c.line_check, c.screen_shared_with) {
+                    (Some(_), _) => String::new(),
+                    (None, Some(k)) => format!(" screen, as {}", k + 1),
+                    (None, None) => " screen".into(),
                 }
             ),
             None => "not run".into(),

@@ -234,6 +234,47 @@ fn a_design_reports_the_work_of_its_search() {
     );
 }
 
+#[test]
+fn a_candidate_that_is_the_same_line_shares_its_screen() {
+    // README's triangle: the mixed search places the fences mode's three fences, so its line is
+    // that one's and is not screened a second time; a shared screen is always an earlier,
+    // screened candidate's, of the same layout.
+    let (_, v) = plan_json(&[
+        "plan",
+        "--part",
+        "vertices:0,0 36,0 8,22",
+        "--scale",
+        "0.001",
+        "--refine",
+        "0",
+        "--screen-parts",
+        "300",
+        "--check-parts",
+        "300",
+        "--no-write",
+        "--json",
+    ]);
+    let c = v["candidates"].as_array().unwrap();
+    let shared: Vec<(usize, usize)> = c
+        .iter()
+        .enumerate()
+        .filter_map(|(i, x)| Some((i, x["screen_shared_with"].as_u64()? as usize)))
+        .collect();
+    let mode = |i: usize| c[i]["mode"].as_str().unwrap();
+    assert!(
+        shared
+            .iter()
+            .any(|&(i, k)| mode(i) == "hybrid" && mode(k) == "fences"),
+        "{shared:?}"
+    );
+    for (i, k) in shared {
+        assert!(k < i && c[k].get("screen_shared_with").is_none(), "{i} {k}");
+        for key in ["obstacles", "belt_length_m", "belt_width_m", "screen"] {
+            assert_eq!(c[i][key], c[k][key], "{key} of {i} and {k}");
+        }
+    }
+}
+
 /// The most particles in one window over every plan of at most `depth` actions, and the fewest
 /// actions that reach it (brute force, no deduplication).
 fn most_inside(p: &mut Planner, state: &State, depth: usize, used: usize, best: &mut (u32, usize)) {

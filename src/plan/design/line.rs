@@ -62,7 +62,7 @@ impl Drop for Scratch {
 
 /// A scenario with the feed's headway as a parameter (the `headway = …` line of `[feed]` is
 /// replaced per run), with an optional policy file written beside it.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Runnable {
     /// The scenario's text, whose `headway = …` line `with_headway` replaces.
     pub toml: String,

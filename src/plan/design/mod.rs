@@ -428,6 +428,11 @@ pub struct Candidate {
     pub belt_width_m: f64,
     /// The line with the parts far apart.
     pub screen: Option<LineCheck>,
+    /// The earlier candidate (its index in the design's candidates) that is the same line — the
+    /// same scenario, screened at the same headway, parts and seed — and whose screen this one
+    /// shares instead of running it again (a hybrid search that placed only fences, say).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub screen_shared_with: Option<usize>,
     /// The headway probes (s, parts, collisions, success).
     pub headway_probes: Vec<HeadwayProbe>,
     /// The headway chosen on the line (s).
@@ -516,6 +521,7 @@ impl Candidate {
             belt_length_m: e.belt_length_m,
             belt_width_m: e.problem.belt_width_m,
             screen: None,
+            screen_shared_with: None,
             headway_probes: Vec::new(),
             headway_s: 0.0,
             line_check: None,
@@ -850,6 +856,22 @@ impl Work<'_> {
     }
 
     /// One mode: search, screen, and refine with the line's failures.
+    /// An earlier candidate, screened on its own run, that is the same line as `cand` screened at
+    /// headway `h`: a fixed sequence with the same scenario (the contingent plans' screens also
+    /// feed their confusion predictions, which depend on the plan, so they are not shared).
+    fn screened_line(&self, cand: &Candidate, h: f64) -> Option<usize> {
+        if !matches!(cand.layout, Layout::Sequence(_)) {
+            return None;
+        }
+        self.candidates.iter().position(|c| {
+            matches!(c.layout, Layout::Sequence(_))
+                && c.screen.is_some()
+                && c.screen_shared_with.is_none()
+                && c.runnable == cand.runnable
+                && isolation_headway(c.belt_length_m) == h
+        })
+    }
+
     fn run_mode(&mut self, mode: Mode, until: Instant) -> Result<(), DesignError> {
         let o = self.o;
         let mut problem = o.problem.clone();
@@ -912,8 +934,33 @@ impl Work<'_> {
                 round,
                 format!("line screen ({} parts)", o.screen_parts),
             );
-            let scratch = Scratch::new()?;
             let h = isolation_headway(cand.belt_length_m);
+            if let Some(k) = self.screened_line(&cand, h) {
+                // The same scenario at the same headway, parts and seed runs the same: its screen
+                // is this one's. It is run again only when this mode will refine from its
+                // failures, which need the run's parts.
+                let screen = self.candidates[k]
+                    .screen
+                    .clone()
+                    .expect("a screened candidate");
+                if screen.success_rate >= problem.target || round == o.refine {
+                    self.tell(
+                        Some(mode),
+                        round,
+                        format!(
+                            "line screen: the line of candidate {}, screened already",
+                            k + 1
+                        ),
+                    );
+                    cand.headway_s = h;
+                    cand.oriented_per_min = screen.success_rate * 60.0 / h;
+                    cand.screen = Some(screen);
+                    cand.screen_shared_with = Some(k);
+                    self.candidates.push(cand);
+                    return Ok(());
+                }
+            }
+            let scratch = Scratch::new()?;
             let (screen, res) =
                 cand.runnable
                     .run(&scratch, h, o.screen_parts, problem.seed, true)?;
