@@ -855,7 +855,6 @@ impl Work<'_> {
         });
     }
 
-    /// One mode: search, screen, and refine with the line's failures.
     /// An earlier candidate, screened on its own run, that is the same line as `cand` screened at
     /// headway `h`: a fixed sequence with the same scenario (the contingent plans' screens also
     /// feed their confusion predictions, which depend on the plan, so they are not shared).
@@ -872,6 +871,7 @@ impl Work<'_> {
         })
     }
 
+    /// One mode: search, screen, and refine with the line's failures.
     fn run_mode(&mut self, mode: Mode, until: Instant) -> Result<(), DesignError> {
         let o = self.o;
         let mut problem = o.problem.clone();
@@ -929,12 +929,8 @@ impl Work<'_> {
                 self.candidates.push(cand);
                 return Ok(());
             }
-            self.tell(
-                Some(mode),
-                round,
-                format!("line screen ({} parts)", o.screen_parts),
-            );
             let h = isolation_headway(cand.belt_length_m);
+            cand.headway_s = h;
             if let Some(k) = self.screened_line(&cand, h) {
                 // The same scenario at the same headway, parts and seed runs the same: its screen
                 // is this one's. It is run again only when this mode will refine from its
@@ -952,7 +948,6 @@ impl Work<'_> {
                             k + 1
                         ),
                     );
-                    cand.headway_s = h;
                     cand.oriented_per_min = screen.success_rate * 60.0 / h;
                     cand.screen = Some(screen);
                     cand.screen_shared_with = Some(k);
@@ -960,12 +955,16 @@ impl Work<'_> {
                     return Ok(());
                 }
             }
+            self.tell(
+                Some(mode),
+                round,
+                format!("line screen ({} parts)", o.screen_parts),
+            );
             let scratch = Scratch::new()?;
             let (screen, res) =
                 cand.runnable
                     .run(&scratch, h, o.screen_parts, problem.seed, true)?;
             self.line_runs += 1;
-            cand.headway_s = h;
             if let Layout::Contingent(plan) = &cand.layout {
                 let (acc, with) = confusion_prediction(plan, &res.summary);
                 cand.sensor_accuracy = acc;
