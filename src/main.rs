@@ -1,7 +1,8 @@
 //! The `pinfeed` command: [`cli`] maps its arguments to the library's workflows and prints their
-//! results. The library (`src/lib.rs`) holds the physics, the line, the planner and the studies.
+//! results. The library `pinfeed` (crates/pinfeed) holds the physics, the line, the planner and
+//! the studies.
 
-mod cli;
+use pinfeed_cli as cli;
 
 fn main() {
     // Set but empty means unset, as the map cache's default folder reads it (clap would refuse

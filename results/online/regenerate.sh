@@ -61,7 +61,7 @@ cp $S $TMP/latency_0.02_skip.toml
 run latency_0.02_skip 2000
 
 # Noise: the sensor's white-noise sigma times a factor; the defaults are read from the source.
-DEF=$(sed -n '/^impl Default for SensorSettings/,/^}/p' src/sensing/settings.rs)
+DEF=$(sed -n '/^impl Default for SensorSettings/,/^}/p' crates/pinfeed/src/sensing/settings.rs)
 NF=$(echo "$DEF" | sed -n 's/^ *noise_force: \([0-9.e-]*\),.*/\1/p')
 NT=$(echo "$DEF" | sed -n 's/^ *noise_torque: \([0-9.e-]*\),.*/\1/p')
 echo "{\"noise_force\": $NF, \"noise_torque\": $NT}" > $OUT/runs/noise_defaults.json

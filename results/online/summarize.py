@@ -367,7 +367,7 @@ def main():
       f"{hs[0]['parts_in']} parts end in a collision. At 2 s collisions remain "
       f"({hs[2]['outcomes']['collision']}) and the controller reaches its own limit: the mover "
       "serves parts in order and may move for a part only once the earlier parts within its "
-      "reach are known to clear it (`src/engine/controller.rs`), so "
+      "reach are known to clear it (`crates/pinfeed/src/engine/controller.rs`), so "
       f"{ctl(hs[2])['late_actuations']} of {hs[2]['parts_in']} commands are late; `move` recovers "
       f"part of it ({pct(hm[2]['success_rate'])} against {pct(hs[2]['success_rate'])}). "
       f"The best oriented-part throughput is at 3 s: {hs[3]['throughput_ok_per_min']:.2f}/min "
@@ -440,7 +440,7 @@ def main():
                  "(d) sensor noise")
     w("### (d) Sensor noise\n")
     w(f"The sensor's white-noise σ (defaults `noise_force` = {nd['noise_force']:g} N, "
-      f"`noise_torque` = {nd['noise_torque']:g} N·mm, read from `src/sensing/settings.rs`) times "
+      f"`noise_torque` = {nd['noise_torque']:g} N·mm, read from `crates/pinfeed/src/sensing/settings.rs`) times "
       "a factor, on both; the classifier is trained for the noisy sensor. The factors are "
       "×1 … ×256 in powers of 4, plus ×2, ×8 and ×12 to locate the break.\n")
     w("![success and misclassifications against sensor noise](online/noise.svg)\n")
@@ -461,7 +461,7 @@ def main():
       f"{nd['noise_force']*16:g} N, as large as the whole force signal of these light parts, see "
       "[`sensing.md`](sensing.md)) the "
       "classifier's contact detector cannot see the contact any more and every reading is "
-      "`unknown` (documented in `src/sensing/classify/likelihood.rs`). The controller has no rule "
+      "`unknown` (documented in `crates/pinfeed/src/sensing/classify/likelihood.rs`). The controller has no rule "
       "for `unknown`, so the mover stays where it is — its home, the 135° position — and only the "
       "135° parts succeed. `misclassified` counts wrong labels only, so the controller reports "
       "**0** misclassifications at ×16 … ×256 while the classifier causes every failure there: "

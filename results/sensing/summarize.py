@@ -99,7 +99,7 @@ def main():
         f"**Setup.** Parts scaled to {any_r['scale_m_per_unit']} m per unit (TriPoly1: a = "
         f"{any_r['a_m'] * 1000:.1f} mm), mass {any_r['mass_kg']} kg, belt {any_r['belt_speed_m_s']} m/s, "
         f"point pin, μc = {any_r['mu_c']}, μs = {any_r['mu_s']}, model `{any_r['model']}`. Hypotheses: the "
-        f"part's stable states. Sensor defaults (ATI Nano-class, `src/sensing/settings.rs`): "
+        f"part's stable states. Sensor defaults (ATI Nano-class, `crates/pinfeed/src/sensing/settings.rs`): "
         f"{s['rate']} Hz, σ = {s['noise_force']} N and {s['noise_torque']} N·mm, resolution "
         f"{s['resolution_force']} N; timing threshold {s['threshold']} N, jitter {s['jitter']} s. "
         f"Noise sweep ×{', ×'.join(str(f) for f in any_r['noise_factors'])} on the white noise and jitter "

@@ -195,25 +195,3 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     }
     Ok(())
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::path::Path;
-
-    #[test]
-    fn default_report_directory_is_per_part() {
-        assert_eq!(
-            default_out_dir("tripoly1"),
-            Path::new("pinfeed-out/maps/tripoly1")
-        );
-        assert_eq!(
-            default_out_dir("rect:2:1"),
-            Path::new("pinfeed-out/maps/rect_2_1")
-        );
-        assert_eq!(
-            default_out_dir("vertices:0,0 1,0 0,1"),
-            Path::new("pinfeed-out/maps/custom")
-        );
-    }
-}

@@ -1,5 +1,8 @@
-//! The command-line interface: argument definitions and one module per sub-command. `main.rs` only
-//! parses and dispatches; everything a command does lives here so it can be tested.
+//! The `pinfeed` command's interface (the library `pinfeed_cli` of this workspace's top package):
+//! argument definitions and one module per sub-command, each mapping its arguments to the
+//! library `pinfeed`'s workflows and printing their results. `src/main.rs` only parses and
+//! dispatches; the command is a library so that tests/all can drive it in-process
+//! (tests/all/cli_in_process.rs) without compiling it a second time. It offers no API beyond that.
 //!
 //! The doc comments of the argument structs are the commands' `--help` text (clap prints them as
 //! written), so they are plain text rather than rustdoc Markdown: `[feed]`, `<part>` and
@@ -31,11 +34,6 @@ pub mod run;
 pub mod sense;
 pub mod stdout;
 pub mod validate;
-
-// The command line's own tests live with the other tests (tests/cli/), as a module of this one.
-#[cfg(test)]
-#[path = "../../tests/cli/mod.rs"]
-mod tests;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 

@@ -1,8 +1,7 @@
 //! README.md and docs/*.md against the code: every relative link points at a file that exists
 //! (and, with `#anchor`, at a heading of it), the command lines are read as a shell reads them,
 //! and the range tables quote the library's. (That every documented `pinfeed …` command parses,
-//! and that the units table matches `--help`, is tested beside the command line, in
-//! `tests/cli/`.)
+//! and that the units table matches `--help`, is tested in process, in `cli_in_process`.)
 
 use crate::doc_commands::{commands, documents, root, shell_words};
 use std::path::Path;

@@ -6,8 +6,8 @@
 //!   binary: never a panic (exit status 101, "panicked"), exit status 0, 1 (a refusal whose first
 //!   stderr line is `error: ` and a cause) or 2 (clap's usage error), and no NaN or infinity in
 //!   any JSON or CSV printed.
-//! * (The same argument vectors in process, many more of them, are run by the command line's own
-//!   tests in `tests/cli/`; the strategies are `tests/shared/argv.rs`.)
+//! * (The same argument vectors in process, many more of them, are run by `cli_in_process`; the
+//!   strategies are `argv`.)
 //! * Random polygons across magnitudes 1e-300 … 1e300: a scaled copy is accepted or refused with
 //!   the polygon at unit size, with the same stable states and the same a / scale; where its mass
 //!   properties cannot be represented it is refused for that reason and no other.

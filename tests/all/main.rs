@@ -1,9 +1,9 @@
 //! pinfeed's integration tests, built as one test binary (`cargo test --release --test all`): one
 //! module per area, and the shared helpers (`support`: running the built `pinfeed`; `common`: the
 //! contact-model helpers; `plan_cli`: the `pinfeed plan` helpers; `reference`: the independent slow contact
-//! reference; and from `tests/shared/`, which the command line's own tests in `tests/cli/`
-//! include too: `shapes`, random polygons; `argv`, argument-vector strategies; `doc_commands`,
-//! the documents' command lines). One binary links the crate once instead
+//! reference; `shapes`, random polygons; `argv`, argument-vector strategies; `doc_commands`, the
+//! documents' command lines). Most modules run the built `pinfeed`; `cli_in_process` drives the
+//! command in process through its library `pinfeed_cli`. One binary links the crates once instead
 //! of once per file. A single test is selected by its module path, e.g.
 //! `cargo test --release --test all slow_reference::many_cases -- --ignored`.
 //!
@@ -15,23 +15,20 @@
 //! proptest keeps each module's failure seeds in `tests/proptest-regressions/<module>.txt` (its
 //! default, `SourceParallel`, for a source file beside a `main.rs`).
 
+mod argv;
 mod common;
+mod doc_commands;
 mod plan_cli;
 mod reference;
+mod shapes;
 mod support;
 mod xml;
-// Shared with the command line's own tests (tests/cli/), which include the same files.
-#[path = "../shared/argv.rs"]
-mod argv;
-#[path = "../shared/doc_commands.rs"]
-mod doc_commands;
-#[path = "../shared/shapes.rs"]
-mod shapes;
 
 mod accuracy_study;
 mod animate;
 mod belief;
 mod cli_contact;
+mod cli_in_process;
 mod cli_part;
 mod cli_sense;
 mod compare;

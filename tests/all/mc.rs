@@ -398,7 +398,7 @@ fn names_in(dir: &Path) -> Vec<String> {
 /// A shard job killed between writing its shard and renaming it into place leaves no shard file
 /// (or the previous one, untouched), and a rerun writes the shard whole. The kill is injected, not
 /// timed: `PINFEED_FAULT=after-temp-write` aborts the process right after the hidden temporary file
-/// is complete and before the rename (src/study/mc/atomic.rs). The test fails if the shard were
+/// is complete and before the rename (crates/pinfeed/src/study/mc/atomic.rs). The test fails if the shard were
 /// written in place (a `shard-*` file after the abort, or the previous one changed), if the fault
 /// struck before the bytes were complete (the temporary file differs from what the rerun writes),
 /// if the rename came before the fault point, or if the rerun did not write a whole, readable shard.

@@ -223,7 +223,7 @@ fn missing_file() {
     );
 }
 
-// Issue 11 reproducers: each number is checked against a physical range (src/scenario/limits.rs)
+// Issue 11 reproducers: each number is checked against a physical range (crates/pinfeed/src/scenario/limits.rs)
 // before it can reach the geometry or the event queue.
 
 #[test]

@@ -5,9 +5,9 @@
 //! members, one in four calibrates with 10 members over the full grid. The file is read from disk
 //! as the commands read it; every number of an accepted report must be finite.
 
-use crate::cli::calibrate::CalibrateArgs;
-use crate::cli::validate::load_measured;
-use crate::cli::validate::ValidateArgs;
+use crate::calibrate::CalibrateArgs;
+use crate::validate::load_measured;
+use crate::validate::ValidateArgs;
 use clap::Parser;
 use pinfeed::study::robustness::commands::CsvCase;
 use pinfeed::study::robustness::{refused, shows_non_finite, CaseReport, Class, CommandCases};
@@ -92,7 +92,7 @@ fn run_calibrate(c: &CsvCase, path: &Path) -> CaseReport {
         Err(e) => return refused(&e.to_string()),
     };
     let checked = (|| {
-        let s = crate::cli::calibrate::settings(&a)?;
+        let s = crate::calibrate::settings(&a)?;
         let m = load_measured(&a.measured, &s.proposal(), a.common.part.as_deref())?;
         anyhow::Ok((s, m))
     })();

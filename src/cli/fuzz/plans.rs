@@ -2,12 +2,12 @@
 //! thread and no files, plus 0–4 more flags from
 //! [`pinfeed::study::robustness::commands::PLAN_FLAGS`] with values inside, at the ends of
 //! and beyond their ranges. The arguments go through the command's own parser and checks
-//! ([`crate::cli::plan::options_of`]) and the design workflow ([`pinfeed::plan::design::design`]);
+//! ([`crate::plan::options_of`]) and the design workflow ([`pinfeed::plan::design::design`]);
 //! an accepted design's numbers must be finite and the scenario it would write (with its policy
 //! file) must be accepted by the scenario parser and run ([`files::check_scenario`]) — a
 //! written plan the parser refuses counts as a self-check disagreement.
 
-use crate::cli::plan::PlanArgs;
+use crate::plan::PlanArgs;
 use clap::Parser;
 use pinfeed::study::robustness::commands::{plan_arguments, plan_command};
 use pinfeed::study::robustness::{
@@ -43,7 +43,7 @@ fn run_unlabelled(args: &[String], scratch: &Path) -> CaseReport {
         Ok(p) => p.args,
         Err(e) => return refused(&e.to_string()),
     };
-    let o = match crate::cli::plan::options_of(&parsed, &plan_command(args)) {
+    let o = match crate::plan::options_of(&parsed, &plan_command(args)) {
         Ok(o) => o,
         Err(e) => return refused(&format!("{e:#}")),
     };

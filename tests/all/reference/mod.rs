@@ -1,7 +1,7 @@
 //! An independent, deliberately slow reference for the contact model (docs/physics.md#one-instant), used only by tests.
 //!
 //! It computes the same physics as `pinfeed::mechanics::push` by a different algorithm, sharing no
-//! code with `src/mechanics` (only the caller's vertex list):
+//! code with `crates/pinfeed/src/mechanics` (only the caller's vertex list):
 //!
 //! * **Dissipation** D(ξ) = (1/A)∫_A |v + ω ẑ×x| dA by its own quadrature, not the library's closed
 //!   form. For a centre of rotation (COR) r within 20·a of the centroid, the divergence theorem

@@ -140,7 +140,7 @@ mod tests {
     /// centroids `gap` part radii apart along the belt at the same orientation; the pair is checked as part
     /// 1's motion starts.
     fn check_two_parts(gap: f64) -> (Belt, WorkCounters) {
-        let path = std::path::Path::new("scenarios/quickstart.toml");
+        let path = &crate::project_path("scenarios/quickstart.toml");
         let scene = crate::scenario::load(path).unwrap();
         assert!(scene.effects.collisions);
         let gap = gap * scene.part.radius;

@@ -21,7 +21,7 @@ use std::sync::Arc;
 /// use pinfeed::scenario::SceneDraft;
 /// use std::path::Path;
 ///
-/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/tripoly1_sensor.toml");
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/tripoly1_sensor.toml");
 /// let draft = SceneDraft::read(&path).unwrap(); // checks the file, trains nothing
 /// assert_eq!(draft.sensors()[0].name, "probe");
 /// assert_eq!(draft.sensors()[0].hypotheses.labels(), ["0°", "135°", "225°"]);

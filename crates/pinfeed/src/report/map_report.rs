@@ -198,7 +198,7 @@ pub fn write_report(
         Some(f) => format!(
             "a fence at {}° of length {} (part units) with friction μf = {}, its upstream end at \
              ({:.4}, {:.4}) when the part's centroid is at the origin (the placement of \
-             `pinfeed contact --fence`, `src/maps/start.rs`)",
+             `pinfeed contact --fence`, `crates/pinfeed/src/maps/start.rs`)",
             fence_angle_deg(report.maps),
             f.length,
             f.mu_f,
@@ -213,7 +213,7 @@ pub fn write_report(
     md += &format!(
         "Part `{}`, model `{}`, {obstacle}, support `{}`, \
          θ0 every {}° ({samples} samples per map), band threshold T = {}°, integration tolerance {}. \
-         Conventions: docs/physics.md#configuration-maps and the module docs of `src/maps/` (bands group neighbours in sorted \
+         Conventions: docs/physics.md#configuration-maps and the module docs of `crates/pinfeed/src/maps/` (bands group neighbours in sorted \
          final angle, circularly; an interval [a, b] with b < a straddles 0°/360°; sd uses n − 1; \
          adjusted band = mean ± sd, thesis eq. 3-2). Contacts that did not end `ok`: {non_ok}.\n\n",
         report.part,

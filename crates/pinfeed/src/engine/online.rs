@@ -1205,11 +1205,10 @@ fn distinct(values: impl Iterator<Item = f64>) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::scenario::raw::SupportKind;
-    use std::path::Path;
 
     /// tripoly2's online line with its controller in policy mode (no model built at parse).
     fn tripoly2_line() -> Scene {
-        let path = Path::new("scenarios/tripoly2_online.toml");
+        let path = &crate::project_path("scenarios/tripoly2_online.toml");
         let text = std::fs::read_to_string(path).unwrap();
         let cut = text.find("[controller.belief]").unwrap();
         let end = text[cut..].find("[goal]").unwrap() + cut;

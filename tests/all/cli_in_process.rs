@@ -1,23 +1,13 @@
-//! The command line's own tests, in process (a module of the binary's `cli`, kept here beside the
-//! other tests): every command shown in README.md and docs/ parses, the recorded command line
-//! parses back to itself, the units table of docs/commands.md matches `--help`, random and mutated argument vectors never
-//! panic, and the `pinfeed fuzz` targets that drive commands run clean on any number of threads.
-//! (The integration tests in tests/all run the built binary; these need the command line's types,
-//! which the binary keeps to itself.) They share the argument strategies, the random polygons and
-//! the documents' reader with tests/all, from tests/shared/.
+//! The command line in process, through its library `pinfeed_cli` (the other modules run the built
+//! binary): every command shown in README.md and docs/ parses, the recorded command line parses
+//! back to itself, the units table of docs/commands.md matches `--help`, random and mutated
+//! argument vectors never panic, the `pinfeed fuzz` targets that drive commands run clean on any
+//! number of threads, and a map report's default folder is per part.
 
-// The shared files, as modules of this one.
-#[path = "../shared/argv.rs"]
-mod argv;
-#[path = "../shared/doc_commands.rs"]
-mod doc_commands;
-#[path = "../shared/shapes.rs"]
-mod shapes;
-
-use super::{fuzz, Cli};
-use argv::{contact_args, part_args};
-use doc_commands::{commands, documents, root, shell_words};
+use crate::argv::{contact_args, part_args};
+use crate::doc_commands::{commands, documents, root, shell_words};
 use pinfeed::study::robustness::{self, Class, Options, Target};
+use pinfeed_cli::{fuzz, Cli};
 use proptest::prelude::*;
 use std::sync::Arc;
 use std::time::Duration;
@@ -28,7 +18,7 @@ fn check_in_process(args: &[String]) -> Result<(), TestCaseError> {
         .chain(args.iter().cloned())
         .collect();
     let result = std::panic::catch_unwind(|| match Cli::try_parse_from(&argv) {
-        Ok(cli) => super::run(cli).err().map(|e| format!("{e:#}")),
+        Ok(cli) => pinfeed_cli::run(cli).err().map(|e| format!("{e:#}")),
         Err(e) => Some(e.to_string()),
     });
     match result {
@@ -270,7 +260,7 @@ fn plan_args(part: &str, time: &str, check: &str, extra: &[&str]) -> Vec<String>
 /// design would write is accepted and runs; a refused argument names its flag.
 #[test]
 fn plan_argument_sets_design_and_their_written_scenario_runs() {
-    use crate::cli::fuzz::plans;
+    use pinfeed_cli::fuzz::plans;
     let dir = std::env::temp_dir().join(format!("pinfeed-plan-fuzz-{}", std::process::id()));
     let args = |extra: &[&str]| plan_args("tripoly1", "1", "50", extra);
     let r = plans::run(&args(&[]), &dir.join("a"));
@@ -285,10 +275,28 @@ fn plan_argument_sets_design_and_their_written_scenario_runs() {
 /// least 2(a + lateral).
 #[test]
 fn a_planned_scenario_has_a_belt_at_least_as_wide_as_the_part() {
-    use crate::cli::fuzz::plans;
+    use pinfeed_cli::fuzz::plans;
     let dir = std::env::temp_dir().join(format!("pinfeed-plan-width-{}", std::process::id()));
     let args = plan_args("square", "0.2", "0", &["--fewest-sets"]);
     let r = plans::run(&args, &dir);
     assert_eq!(r.class, Class::Success, "{}", r.detail);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn default_report_directory_is_per_part() {
+    use pinfeed_cli::map::default_out_dir;
+    use std::path::Path;
+    assert_eq!(
+        default_out_dir("tripoly1"),
+        Path::new("pinfeed-out/maps/tripoly1")
+    );
+    assert_eq!(
+        default_out_dir("rect:2:1"),
+        Path::new("pinfeed-out/maps/rect_2_1")
+    );
+    assert_eq!(
+        default_out_dir("vertices:0,0 1,0 0,1"),
+        Path::new("pinfeed-out/maps/custom")
+    );
 }

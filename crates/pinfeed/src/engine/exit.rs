@@ -115,7 +115,7 @@ mod tests {
     use crate::geometry::Pose;
 
     fn quickstart() -> Scene {
-        crate::scenario::load(std::path::Path::new("scenarios/quickstart.toml")).unwrap()
+        crate::scenario::load(&crate::project_path("scenarios/quickstart.toml")).unwrap()
     }
 
     /// A belt holding part 0 at rest at the belt's end (x = length) with orientation `deg`.

@@ -587,7 +587,7 @@ mod tests {
     use super::*;
 
     fn scene(name: &str) -> Scene {
-        let path = format!("scenarios/{name}.toml");
+        let path = crate::project_path(&format!("scenarios/{name}.toml"));
         crate::scenario::load(std::path::Path::new(&path)).unwrap()
     }
 

@@ -52,7 +52,7 @@ mod tests {
     /// with the part gone from the belt, the command is dropped and counted.
     #[test]
     fn a_decision_queues_its_rules_commands_and_a_gone_part_drops_them() {
-        let path = std::path::Path::new("scenarios/tripoly1_sensing.toml");
+        let path = &crate::project_path("scenarios/tripoly1_sensing.toml");
         let scene = crate::scenario::load(path).unwrap();
         let mut control = Control::new(&scene, true, None).expect("dynamic pins");
         let rule = control.spec.rules[0].clone();

@@ -1,14 +1,16 @@
 //! Generates the list of bundled scenarios and studies (`scenarios/*.toml`, `studies/*.toml`),
-//! embedded in the binary with `include_str!` (see `src/study/bundled.rs`).
+//! embedded in the library with `include_str!` (see `src/study/bundled.rs`). They live at the
+//! workspace's top (`../../scenarios`, `../../studies`), where the project's paths name them.
 
 use std::path::Path;
 
 fn main() {
-    let root = std::env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR");
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR");
+    let root = Path::new(&manifest).join("../..");
     let mut entries = Vec::new();
     for dir in ["scenarios", "studies"] {
-        println!("cargo:rerun-if-changed={dir}");
-        let mut names: Vec<String> = std::fs::read_dir(Path::new(&root).join(dir))
+        println!("cargo:rerun-if-changed=../../{dir}");
+        let mut names: Vec<String> = std::fs::read_dir(root.join(dir))
             .map(|rd| {
                 rd.filter_map(|e| e.ok())
                     .filter(|e| e.path().is_file())
@@ -20,9 +22,9 @@ fn main() {
         names.sort();
         for n in names {
             let rel = format!("{dir}/{n}");
-            println!("cargo:rerun-if-changed={rel}");
+            println!("cargo:rerun-if-changed=../../{rel}");
             entries.push(format!(
-                "    ({rel:?}, include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/{rel}\"))),\n"
+                "    ({rel:?}, include_str!(concat!(env!(\"CARGO_MANIFEST_DIR\"), \"/../../{rel}\"))),\n"
             ));
         }
     }

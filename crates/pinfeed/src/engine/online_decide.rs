@@ -227,7 +227,7 @@ mod tests {
     /// small model's members all touch it), its controller and a belt holding part 3 at `x` (m),
     /// entered at t = 0.
     fn line_with_part_at(x: f64) -> (Scene, Control, Belt) {
-        let path = std::path::Path::new("scenarios/tripoly2_online.toml");
+        let path = &crate::project_path("scenarios/tripoly2_online.toml");
         let text = std::fs::read_to_string(path).unwrap();
         let cut = text.find("[controller.belief]").unwrap();
         let end = text[cut..].find("[goal]").unwrap() + cut;

@@ -265,7 +265,7 @@ mod tests {
 
     fn scenario(file: &str) -> String {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenarios")
+            .join("../../scenarios")
             .join(file);
         std::fs::read_to_string(path).unwrap()
     }

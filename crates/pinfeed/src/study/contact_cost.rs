@@ -508,10 +508,10 @@ pub fn report(
          `exact+tables` is the exact model with its tables (the default for a scene's, a \
          map's and a planner's model): a pin sliding on an edge (or a disc riding a \
          vertex) gets the exact twist from per-(μc, edge or vertex, side) tables of \
-         certified cubic Hermite pieces (`src/mechanics/slide_table.rs`) instead of a \
+         certified cubic Hermite pieces (`crates/pinfeed/src/mechanics/slide_table.rs`) instead of a \
          Newton solve. `exact+sticks` adds what a map tier's build uses: a pin sticking on \
          an edge gets its twist from per-edge tables over (ℓ, direction of the pin's \
-         velocity) of certified Chebyshev pieces (`src/mechanics/stick_table.rs`). The \
+         velocity) of certified Chebyshev pieces (`crates/pinfeed/src/mechanics/stick_table.rs`). The \
          tables are built before the timed runs (a line or a map build builds them on \
          first use); the build is in the table below, with what the tables change against \
          the solves at the same tolerance.\n\n\

@@ -65,7 +65,7 @@ pub fn parse(file: &Path, source: &str) -> Result<Scene, ScenarioError> {
 /// ```
 /// use std::path::Path;
 ///
-/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/quickstart.toml");
 /// let scene = pinfeed::scenario::load(&path).unwrap();
 /// assert_eq!(scene.name, "quickstart");
 /// assert_eq!(scene.obstacles.len(), 3);
@@ -234,8 +234,8 @@ any = true
 
     #[test]
     fn a_refused_sensor_scene_trains_nothing() {
-        let path = Path::new("scenarios/tripoly1_sensing.toml");
-        let text = include_str!("../../scenarios/tripoly1_sensing.toml");
+        let path = &crate::project_path("scenarios/tripoly1_sensing.toml");
+        let text = include_str!("../../../../scenarios/tripoly1_sensing.toml");
         // The rules name the probe's labels: a wrong one is refused without training the probe.
         let bad = text.replacen("decides = \"0°\"", "decides = \"90°\"", 1);
         let (e, n) = trainings(|| parse(path, &bad).unwrap_err());

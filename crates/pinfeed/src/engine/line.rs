@@ -153,7 +153,7 @@ pub fn run_single(scene: &Scene, entry: Entry) -> Result<SingleRun, EngineError>
 /// use pinfeed::engine::{run, PartOutcome, RunOptions};
 /// use std::path::Path;
 ///
-/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/quickstart.toml");
 /// let scene = pinfeed::scenario::load(&path).unwrap();
 /// let opts = RunOptions { parts: 100, ..RunOptions::from_scene(&scene) };
 /// let result = run(&scene, &opts, &mut |_| {}).unwrap();
@@ -366,7 +366,7 @@ mod tests {
     use super::*;
 
     fn quickstart() -> Scene {
-        crate::scenario::load(std::path::Path::new("scenarios/quickstart.toml")).unwrap()
+        crate::scenario::load(&crate::project_path("scenarios/quickstart.toml")).unwrap()
     }
 
     fn entry(theta_rad: f64) -> Entry {

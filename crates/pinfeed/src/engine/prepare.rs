@@ -66,7 +66,7 @@ fn fingerprint(scene: &Scene) -> (u64, usize) {
 /// ```
 /// use std::path::Path;
 ///
-/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+/// let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/quickstart.toml");
 /// let scene = pinfeed::scenario::load(&path).unwrap();
 /// // A passive line has no controller, so nothing to build.
 /// assert!(pinfeed::engine::prepare::online_model(&scene).unwrap().is_none());

@@ -72,7 +72,7 @@ mod tests {
     /// The quickstart's scene with part 0 entered at orientation 1 rad and held by the first
     /// pin it meets; returns the belt, the sinks and its contact end.
     fn held_part() -> (Scene, Belt, Sinks, Touch) {
-        let path = std::path::Path::new("scenarios/quickstart.toml");
+        let path = &crate::project_path("scenarios/quickstart.toml");
         let scene = crate::scenario::load(path).unwrap();
         let mut belt = Belt::new();
         let mut sinks = Sinks::for_scene(&scene, true, None);

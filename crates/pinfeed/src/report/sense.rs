@@ -176,7 +176,7 @@ pub fn report_markdown(r: &SenseReport) -> String {
          model `{}`. Sensor `{}`: rate {} Hz, height {} m, noise σ {} N / {} N·mm, resolution {} N, \
          threshold {} N, jitter {} s at noise factor 1. Uncertainty: μc {}, tripod supports: {}, \
          θ jitter σ {}°, d jitter σ {}. Hypotheses: {}; {} templates each (built: {:?}); {} trials \
-         (truth {:?}, {} unscored), seed {}. Module docs of `src/sensing/evaluate.rs` give the streams \
+         (truth {:?}, {} unscored), seed {}. Module docs of `crates/pinfeed/src/sensing/evaluate.rs` give the streams \
          and the estimates; mutual information is the plug-in estimate (biased up by about \
          (k−1)(m−1)/(2n ln 2) bits on n trials).\n\n",
         r.part,

@@ -26,9 +26,10 @@
 //! | [`study`] | Monte Carlo studies, comparisons, cost and accuracy studies, the fuzzing driver |
 //! | [`report`] | tables, reports and figures |
 //!
-//! The `pinfeed` command is the crate's binary (`src/main.rs` and its `cli` module, not part of
-//! this library): it only maps its arguments to these modules and prints. `examples/` holds one push, a line run, a plan and a sensing
-//! evaluation written against this API.
+//! This crate is the library; the `pinfeed` command is the workspace's other package,
+//! `pinfeed-cli` (`src/main.rs` and `src/cli/` at the workspace's top), which depends on it, maps
+//! its arguments to these modules and prints. The workspace's `examples/` holds one push, a line
+//! run, a plan and a sensing evaluation written against this API.
 
 pub mod contact_case;
 pub mod engine;
@@ -59,6 +60,15 @@ pub const PINFEED_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// `pinfeed-out/mc/<study>/`, …): relative to the working folder, and ignored by git in the
 /// repository. An explicit `--out` (or a scenario's `[output] dir`) is used exactly as given.
 pub const DEFAULT_OUT_ROOT: &str = "pinfeed-out";
+
+/// `rel` under the workspace's top folder (scenarios/, studies/, tests/fixtures/), where the unit
+/// tests read the project's files (they run in crates/pinfeed/).
+#[cfg(test)]
+pub(crate) fn project_path(rel: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(rel)
+}
 
 /// `pinfeed-out/<parts…>`: a command's default output folder.
 pub fn default_out(parts: &[&str]) -> std::path::PathBuf {

@@ -111,7 +111,7 @@ mod tests {
     use crate::geometry::Pose;
 
     fn quickstart() -> Scene {
-        crate::scenario::load(std::path::Path::new("scenarios/quickstart.toml")).unwrap()
+        crate::scenario::load(&crate::project_path("scenarios/quickstart.toml")).unwrap()
     }
 
     /// Part 0 riding the belt from x = 0.1 m at time 2 s, planned on `scene`.

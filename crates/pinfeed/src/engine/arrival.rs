@@ -68,7 +68,7 @@ mod tests {
     /// Part 0 of a run of `parts` (the first one's path sampled) arrives at time 0 as `entry`
     /// says on the quickstart line (periodic feed, 4 s headway).
     fn arrive(parts: u64) -> (Belt, Metrics) {
-        let path = std::path::Path::new("scenarios/quickstart.toml");
+        let path = &crate::project_path("scenarios/quickstart.toml");
         let scene = crate::scenario::load(path).unwrap();
         let opts = RunOptions {
             parts,
