@@ -587,8 +587,7 @@ mod tests {
     use super::*;
 
     fn scene(name: &str) -> Scene {
-        let path = crate::project_path(&format!("scenarios/{name}.toml"));
-        crate::scenario::load(std::path::Path::new(&path)).unwrap()
+        crate::scenario::load(&crate::project_path(&format!("scenarios/{name}.toml"))).unwrap()
     }
 
     /// A line without dynamic pins runs no controller (it pays nothing for it); a line with

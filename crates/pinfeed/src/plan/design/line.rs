@@ -264,10 +264,7 @@ mod tests {
     use super::*;
 
     fn scenario(file: &str) -> String {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../scenarios")
-            .join(file);
-        std::fs::read_to_string(path).unwrap()
+        std::fs::read_to_string(crate::project_path(&format!("scenarios/{file}"))).unwrap()
     }
 
     /// A line built at one headway and run at others gives, at each, the scene and the run of the
