@@ -375,7 +375,13 @@ pub fn draw_member(spec: &EnsembleSpec, seed: u64, i: u64) -> Result<MemberDraw,
     })
 }
 
+/// Passes of one member from which [`ensemble_maps`] serves its slides from tables: a member's
+/// tables (about 10⁴ limit-surface evaluations each, a dozen for a triangle-like part) pay for
+/// themselves over about a thousand passes (`results/line-speed.md`, "Where users wait").
+pub const TABLED_PASSES: usize = 1000;
+
 /// One member: its draw and its compiled part.
+#[derive(Clone)]
 pub struct Member {
     /// The values it drew.
     pub draw: MemberDraw,
@@ -401,6 +407,15 @@ impl Member {
             draw_support(poly, &choice, &mut rng, &mut 0).map_err(MemberError::Support)?;
         let model = PartModel::new(poly, &support).map_err(MemberError::Model)?;
         Ok(Member { draw, model })
+    }
+
+    /// The member with its exact slides served from tables at its μc
+    /// (`PartModel::with_slide_tables`): for a member that passes many times.
+    pub fn tabled(&self) -> Member {
+        Member {
+            draw: self.draw,
+            model: self.model.clone().with_slide_tables(&[self.draw.mu_c]),
+        }
     }
 
     /// The uniform u and normal z of pass number `pass`.
@@ -498,21 +513,39 @@ pub fn ensemble_maps_observed(
     let members = members(poly, spec, seed, n)?;
     let (nd, nk) = (ds.len(), grid.len());
     let states = stable_states_deg(poly);
-    let theta_f: Vec<f64> = (0..n * nd * nk)
-        .into_par_iter()
-        .map(|x| {
-            let (i, j, k) = (x / (nd * nk), (x / nk) % nd, x % nk);
-            let input = InputState::Theta {
-                arc: Arc {
-                    lo: grid[k],
-                    width: 0.0,
-                },
-            };
-            let f = members[i].pass(poly, spec, &input, &states, ds[j], (j * nk + k) as u64);
-            on_pass();
-            f
-        })
-        .collect();
+    // A member passing at least TABLED_PASSES times gets its own slide tables; the members are
+    // then taken a few at a time (two per thread), so that only their tables are held at once.
+    // The tables change no answer beyond the solver's tolerance, and none with the thread count.
+    let tabulate = nd * nk >= TABLED_PASSES
+        && poly.len() <= crate::mechanics::slide_table::MAX_TABLED_VERTICES;
+    let block = if tabulate {
+        2 * rayon::current_num_threads().max(1)
+    } else {
+        n.max(1)
+    };
+    let mut theta_f: Vec<f64> = Vec::with_capacity(n * nd * nk);
+    for first in (0..n).step_by(block) {
+        let group: Vec<Member> = members[first..(first + block).min(n)]
+            .iter()
+            .map(|m| if tabulate { m.tabled() } else { m.clone() })
+            .collect();
+        let part: Vec<f64> = (0..group.len() * nd * nk)
+            .into_par_iter()
+            .map(|x| {
+                let (i, j, k) = (x / (nd * nk), (x / nk) % nd, x % nk);
+                let input = InputState::Theta {
+                    arc: Arc {
+                        lo: grid[k],
+                        width: 0.0,
+                    },
+                };
+                let f = group[i].pass(poly, spec, &input, &states, ds[j], (j * nk + k) as u64);
+                on_pass();
+                f
+            })
+            .collect();
+        theta_f.extend(part);
+    }
     Ok(EnsembleMaps {
         ds: ds.to_vec(),
         grid: grid.to_vec(),
@@ -670,5 +703,86 @@ mod tests {
             }
             assert_eq!(x.random_support, y.random_support);
         }
+    }
+
+    /// A member's slides served from its own tables (uniform pressure or a tripod) give the
+    /// passes the solver gives, within the integration's own error: the served twists differ
+    /// from the solves by about 1e-10 relative, which leaves most θf within 1e-6° but can tip a
+    /// step's acceptance, moving θf by up to the integration error (about 1e-4° at tol 1e-6);
+    /// a pass starting on a separatrix could even change sides.
+    #[test]
+    fn a_tabled_member_passes_as_its_solved_self() {
+        let poly = crate::geometry::part_from_spec("tripoly2").unwrap();
+        let spec = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
+            .with_settings("mu_c=normal:0.5:0.15,support=tripod:0.5,pin_radius=uniform:0:0.1")
+            .unwrap();
+        let states = stable_states_deg(&poly);
+        // Passes within 1e-6°, within 1e-3°, and farther apart.
+        let (mut close, mut near, mut far, mut tripods) = (0, 0, 0, 0);
+        for i in 0..6 {
+            let solved = Member::new(&poly, &spec, 3, i).unwrap();
+            let tabled = solved.tabled();
+            tripods += usize::from(solved.draw.random_support);
+            for (j, d) in [-0.6, 0.2].into_iter().enumerate() {
+                for k in 0..120 {
+                    let input = InputState::Theta {
+                        arc: Arc {
+                            lo: 3.0 * k as f64 + 0.7,
+                            width: 0.0,
+                        },
+                    };
+                    let pass = (j * 120 + k) as u64;
+                    let a = solved.pass(&poly, &spec, &input, &states, d, pass);
+                    let b = tabled.pass(&poly, &spec, &input, &states, d, pass);
+                    let diff = {
+                        let w = wrap_deg(a - b);
+                        w.min(360.0 - w)
+                    };
+                    match diff {
+                        x if x <= 1e-6 => close += 1,
+                        x if x <= 1e-3 => near += 1,
+                        _ => far += 1,
+                    }
+                }
+            }
+            // The tables were built and served.
+            assert!(tabled.model.slide_table_stats().unwrap().tables > 0);
+        }
+        assert!(
+            (2..=4).contains(&tripods),
+            "both supports drawn: {tripods} tripods"
+        );
+        assert_eq!(close + near + far, 1440);
+        assert!(
+            close >= 1368,
+            "{close} of 1440 within 1e-6°, {near} within 1e-3°"
+        );
+        assert!(far <= 14, "{far} of 1440 passes farther apart than 1e-3°");
+    }
+
+    /// Members passing TABLED_PASSES times or more are tabled and taken a few at a time, a
+    /// number that depends on the threads: the maps do not.
+    #[test]
+    fn tabled_ensemble_maps_are_the_same_on_any_number_of_threads() {
+        let poly = crate::geometry::part_from_spec("tripoly1").unwrap();
+        let spec = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
+            .with_settings("mu_c=normal:0.5:0.1,support=tripod:0.5,pin_radius=uniform:0:0.1")
+            .unwrap();
+        let grid: Vec<f64> = (0..500).map(|k| 0.72 * k as f64).collect();
+        let ds = [-0.4, 0.3];
+        assert!(ds.len() * grid.len() >= TABLED_PASSES);
+        let maps: Vec<EnsembleMaps> = [1, 3]
+            .into_iter()
+            .map(|threads| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| ensemble_maps(&poly, &spec, &ds, &grid, 5, 5))
+                    .unwrap()
+            })
+            .collect();
+        assert_eq!(maps[0].theta_f.len(), 5 * 1000);
+        assert!(maps[0] == maps[1]);
     }
 }

@@ -107,18 +107,48 @@ impl Transition {
             part: problem.part.clone(),
             reason: reason.to_string(),
         };
-        // Every pass at the nominal μc shares this model: its exact slides come from tables,
-        // built per edge on first use. A table costs ~10³ limit-surface evaluations, each linear
-        // in the vertices; past 64 vertices the tables of a part with hundreds of edges cost
-        // more than the passes they serve (ngon:500: seconds per edge), so the solver serves
-        // the slides directly.
-        let model = PartModel::new(&compiled.polygon, &Support::Uniform).map_err(part_err)?;
-        let uniform = Arc::new(if compiled.polygon.vertices().len() <= 64 {
-            model.with_slide_tables(&[problem.mu_c])
-        } else {
-            model
-        });
+        // Every physics sample's passes come from one model whose exact slides are served from
+        // tables at the sample's μc, built per edge on first use: the nominal model (uniform
+        // pressure) with a table set per μc its samples draw, and each tripod sample's own model.
+        // A search pushes every sample thousands of times, so a table (~10⁴ limit-surface
+        // evaluations) pays for itself many times over; a part with many vertices is left to
+        // the solver (`MAX_TABLED_VERTICES`).
+        let tabulate =
+            compiled.polygon.vertices().len() <= crate::mechanics::slide_table::MAX_TABLED_VERTICES;
+        let tabled = |model: PartModel, mus: &[f64]| {
+            if tabulate {
+                model.with_slide_tables(mus)
+            } else {
+                model
+            }
+        };
         let robust = problem.tripod || problem.mu_c_range.is_some();
+        let mut draws = Vec::new();
+        if robust {
+            for i in 0..n {
+                let mut rng = crate::random::stream(problem.seed ^ PHYSICS_STREAM, i as u64);
+                let mu_c = match problem.mu_c_range {
+                    Some((lo, hi)) => lo + (hi - lo) * rng.random::<f64>(),
+                    None => problem.mu_c,
+                };
+                let tripod = if problem.tripod {
+                    Some(
+                        Support::random_tripod(&compiled.polygon, &mut rng)
+                            .map_err(|e| part_err(e.into()))?,
+                    )
+                } else {
+                    None
+                };
+                draws.push((mu_c, tripod));
+            }
+        }
+        // The uniform model's μc values: the nominal one, and every draw on uniform pressure.
+        let mut uniform_mus = vec![problem.mu_c];
+        uniform_mus.extend(draws.iter().filter(|d| d.1.is_none()).map(|d| d.0));
+        let uniform = Arc::new(tabled(
+            PartModel::new(&compiled.polygon, &Support::Uniform).map_err(part_err)?,
+            &uniform_mus,
+        ));
         let mut samples = Vec::new();
         if !robust {
             samples.push(PhysicsSample {
@@ -127,21 +157,16 @@ impl Transition {
                 support: Support::Uniform,
             });
         } else {
-            for i in 0..n {
-                let mut rng = crate::random::stream(problem.seed ^ PHYSICS_STREAM, i as u64);
-                let mu_c = match problem.mu_c_range {
-                    Some((lo, hi)) => lo + (hi - lo) * rng.random::<f64>(),
-                    None => problem.mu_c,
-                };
-                let (model, support) = if problem.tripod {
-                    let s = Support::random_tripod(&compiled.polygon, &mut rng)
-                        .map_err(|e| part_err(e.into()))?;
-                    (
-                        Arc::new(PartModel::new(&compiled.polygon, &s).map_err(part_err)?),
+            for (mu_c, tripod) in draws {
+                let (model, support) = match tripod {
+                    Some(s) => (
+                        Arc::new(tabled(
+                            PartModel::new(&compiled.polygon, &s).map_err(part_err)?,
+                            &[mu_c],
+                        )),
                         s,
-                    )
-                } else {
-                    (uniform.clone(), Support::Uniform)
+                    ),
+                    None => (uniform.clone(), Support::Uniform),
                 };
                 samples.push(PhysicsSample {
                     model,
@@ -455,5 +480,40 @@ impl Transition {
     /// Largest pin position on the belt (quanta): pins stay within ±width/2.
     pub fn belt_limit_q(&self) -> i32 {
         (self.half_width / self.y_quantum + 1e-9).floor() as i32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mechanics::slide_table::{Place, Side};
+
+    /// Every physics sample of a robust problem serves its slides from tables at its own μc, on
+    /// its own support; a part with more than 64 vertices is left to the solver.
+    #[test]
+    fn every_physics_sample_has_slide_tables_at_its_friction() {
+        for tripod in [false, true] {
+            let mut p = Problem::new("tripoly2");
+            p.tripod = tripod;
+            p.mu_c_range = Some((0.3, 0.7));
+            let compiled = p.compile().unwrap();
+            let t = Transition::new(&p, &compiled, 12).unwrap();
+            assert_eq!(t.samples.len(), 12);
+            for s in &t.samples {
+                assert_eq!(matches!(s.support, Support::Uniform), !tripod);
+                let table = s.model.slide_table(s.mu_c, Place::Edge(0), Side::Left);
+                assert!(table.is_some_and(|t| t.range().is_some()), "μc {}", s.mu_c);
+                // Not at a μc no sample drew.
+                assert!(s
+                    .model
+                    .slide_table(0.71, Place::Edge(0), Side::Left)
+                    .is_none());
+            }
+        }
+        let mut p = Problem::new("ngon:80");
+        p.tripod = true;
+        let compiled = p.compile().unwrap();
+        let t = Transition::new(&p, &compiled, 2).unwrap();
+        assert!(t.samples.iter().all(|s| !s.model.has_slide_tables()));
     }
 }

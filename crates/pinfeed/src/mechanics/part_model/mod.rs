@@ -170,15 +170,16 @@ impl PartModel {
     }
 
     /// Serve the exact model's slides from tables (`mechanics::slide_table`) for contacts with
-    /// these μc values: for a model that many contacts share (a scene's, a planner's, a map's). Only uniform
-    /// pressure is tabulated; a model with point supports (a part's own tripod, used for a few
-    /// contacts) is returned unchanged. Slides at another μc, and the tip and ellipsoid
-    /// fidelities, solve as before.
+    /// these μc values: for a model that many contacts share (a scene's, a planner's or one of
+    /// its physics samples', a map's, an ensemble member's). Every support is tabulated: uniform
+    /// pressure and point supports alike (a tripod's limit surface is smooth, its patches
+    /// rounding the pivots, and its tables are certified to the same tolerance). A table costs
+    /// about 10⁴ limit-surface evaluations to build, so a model used for a few hundred contacts
+    /// is better left without. Slides at another μc, and the tip and ellipsoid fidelities, solve
+    /// as before.
     pub fn with_slide_tables(mut self, mu_values: &[f64]) -> PartModel {
-        if matches!(self.support, SupportData::Uniform(_)) {
-            let tables = SlideTables::new(self.poly.len(), mu_values);
-            self.slide_tables = (!tables.is_empty()).then(|| Arc::new(tables));
-        }
+        let tables = SlideTables::new(self.poly.len(), mu_values);
+        self.slide_tables = (!tables.is_empty()).then(|| Arc::new(tables));
         self
     }
 
