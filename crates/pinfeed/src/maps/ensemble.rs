@@ -381,7 +381,6 @@ pub fn draw_member(spec: &EnsembleSpec, seed: u64, i: u64) -> Result<MemberDraw,
 pub const TABLED_PASSES: usize = 1000;
 
 /// One member: its draw and its compiled part.
-#[derive(Clone)]
 pub struct Member {
     /// The values it drew.
     pub draw: MemberDraw,
@@ -525,10 +524,14 @@ pub fn ensemble_maps_observed(
     };
     let mut theta_f: Vec<f64> = Vec::with_capacity(n * nd * nk);
     for first in (0..n).step_by(block) {
-        let group: Vec<Member> = members[first..(first + block).min(n)]
-            .iter()
-            .map(|m| if tabulate { m.tabled() } else { m.clone() })
-            .collect();
+        let block_members = &members[first..(first + block).min(n)];
+        let tabled: Vec<Member>;
+        let group = if tabulate {
+            tabled = block_members.iter().map(Member::tabled).collect();
+            &tabled[..]
+        } else {
+            block_members
+        };
         let part: Vec<f64> = (0..group.len() * nd * nk)
             .into_par_iter()
             .map(|x| {
