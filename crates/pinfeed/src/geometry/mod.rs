@@ -11,4 +11,4 @@ pub mod vec2;
 pub use first_contact::{first_contact, first_contact_travelling_x, Feature, FirstContact};
 pub use named::{part_from_spec, PartSpecError};
 pub use polygon::{Polygon, PolygonError, StableState};
-pub use vec2::{wrap_2pi, wrap_deg, wrap_pi, Pose, Vec2};
+pub use vec2::{sin_cos, wrap_2pi, wrap_deg, wrap_pi, Pose, Vec2};

@@ -637,7 +637,7 @@ impl Polygon {
     /// [`Polygon::world_vertices`] into a buffer the caller reuses (one sine and cosine per call;
     /// the same values, bit for bit, as `pose.apply` of each vertex).
     pub fn world_vertices_into(&self, pose: &super::vec2::Pose, out: &mut Vec<Vec2>) {
-        let (s, c) = pose.theta_rad.sin_cos();
+        let (s, c) = super::vec2::sin_cos(pose.theta_rad);
         let at = pose.position();
         out.clear();
         out.extend(self.vertices.iter().map(|&p| p.rotate_sc(s, c) + at));

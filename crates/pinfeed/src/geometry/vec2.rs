@@ -8,6 +8,19 @@
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub, SubAssign};
 
+/// (sin φ, cos φ), the one sine-and-cosine every rotation in pinfeed uses.
+///
+/// It is the `libm` crate's `sincos` (the Rust port of musl's, from FreeBSD's msun: below one
+/// unit in the last place, the same kernels as its `sin` and `cos`), not the platform's: glibc's
+/// saves and restores the floating-point rounding mode on every call, which made it an eighth of
+/// a contact's time (the integrator turns vectors by the part's orientation at every stage); this
+/// one takes about half as long (`results/line-speed.md`). Being plain Rust, it gives the same bits
+/// on every platform.
+#[inline]
+pub fn sin_cos(phi: f64) -> (f64, f64) {
+    libm::sincos(phi)
+}
+
 /// A vector (or point) in the plane.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Vec2 {
@@ -29,7 +42,7 @@ impl Vec2 {
     /// Unit vector at angle `phi` (radians, counter-clockwise from +x).
     #[inline]
     pub fn from_angle(phi: f64) -> Self {
-        let (s, c) = phi.sin_cos();
+        let (s, c) = sin_cos(phi);
         Vec2 { x: c, y: s }
     }
     /// Dot product.
@@ -74,7 +87,7 @@ impl Vec2 {
     /// Rotate counter-clockwise by `phi` radians.
     #[inline]
     pub fn rotate(self, phi: f64) -> Vec2 {
-        let (s, c) = phi.sin_cos();
+        let (s, c) = sin_cos(phi);
         self.rotate_sc(s, c)
     }
     /// Rotate by the angle whose sine and cosine are given.

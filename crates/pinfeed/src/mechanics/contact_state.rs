@@ -179,7 +179,7 @@ impl Ctx<'_, '_> {
         if bits == theta.to_bits() {
             return (s, c);
         }
-        let (s, c) = theta.sin_cos();
+        let (s, c) = crate::geometry::sin_cos(theta);
         self.trig.set((theta.to_bits(), s, c));
         (s, c)
     }
@@ -305,7 +305,9 @@ impl Ctx<'_, '_> {
     }
 
     /// The right-hand side: solve the instant in `mode` at `y` (a flush edge in closed form) and
-    /// return the rates with it; non-finite rates are a solver failure.
+    /// return the rates with it; non-finite rates are a solver failure. Inlined into its callers
+    /// (the step's stages), so that the instant and the geometry are not copied on the way out.
+    #[inline]
     pub(super) fn rhs(
         &mut self,
         feat: Feat,

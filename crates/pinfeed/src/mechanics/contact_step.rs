@@ -117,7 +117,11 @@ pub(super) fn dp_step(
             if c < 1.0 && broken && margin_dip.is_none() {
                 margin_dip = Some(c);
             }
-            last = Some((inst, g));
+            // Only the last stage's (at the step's end) is kept: stages 6 and 7 sit at c = 1,
+            // and the copy is skipped for the interior ones.
+            if c == 1.0 {
+                last = Some((inst, g));
+            }
             Ok::<_, SolveFailure>(d)
         },
         y0,

@@ -46,13 +46,16 @@
 //! The accuracy this gives is that of the live solve: a live slide solve stops at a relative
 //! optimality gap g ≤ √(1e-6·tol) and takes an unevaluated last Newton step, which leaves a twist
 //! error of about 100 g² ≈ 1e-10 at the default tolerance (see `part_model::final_gap`);
-//! [`TABLE_TOL`] is 1e-10.
+//! [`TABLE_TOL`] is 1e-10. A model that stands for one sample of uncertain physics (a robust
+//! planner's physics sample, an ensemble member) has tables built for it alone, and certifies
+//! them to a hundredth of the integration tolerance instead ([`sampled_table_tol`]: 1e-8 at the
+//! default), with a third of the nodes.
 //!
 //! **Opt-in, deterministic.** Tables are built lazily, one (μc, place, side) at a time, on the
 //! first slide that needs one, and only for models that ask for them with the μc values they will
 //! see ([`super::PartModel::with_slide_tables`]: a scene's shared model, an online controller's
 //! model at every μc its belief holds, a planner's and each of its robust physics samples' (its
-//! own μc and tripod), an ensemble member's that passes a thousand times or more, a map's, the
+//! own μc and tripod), an ensemble member's that passes three hundred times or more, a map's, the
 //! contact benchmark's). Any support is tabulated: a point support's patches make its limit
 //! surface smooth, with regions of high curvature where the centre of rotation nears a support
 //! point, which the refinement resolves with more nodes (about 1.5–2× a uniform pressure's). A table's content is a fixed function of (part, μc, place, side), built
@@ -71,8 +74,28 @@ use std::sync::OnceLock;
 /// hundreds of edges cost more than the passes they serve (ngon:500: seconds per edge).
 pub const MAX_TABLED_VERTICES: usize = 64;
 
-/// Relative agreement (twist and multiplier) an interval must show at its midpoint.
+/// Relative agreement (twist and multiplier) an interval must show at its midpoint: the live
+/// solve's own accuracy at the default integration tolerance (see the module docs), so that a
+/// model's answers do not depend on whether it has tables beyond that.
 pub const TABLE_TOL: f64 = 1e-10;
+
+/// The certification tolerance of the tables of a model that stands for one *sample* of uncertain
+/// physics (an ensemble member, a robust planner's physics sample), integrated at tolerance
+/// `tol`: a hundredth of `tol`, never tighter than [`TABLE_TOL`] nor looser than 10⁻⁶ — 10⁻⁸ at
+/// the default 10⁻⁶.
+///
+/// Why this is safe: a table's error is a smooth function of the coordinate (the cubic Hermite
+/// interpolant is C¹), so unlike a solve's stopping rule it never jumps with rounding-level
+/// changes of the input. A relative error ε of the rates moves a step's end by at most ε times
+/// the step's change, which the acceptance guard bounds by 0.5 (θ in radians, ℓ in units of
+/// a): at ε = tol/100 that is half a percent of the step's error allowance. What it buys: a
+/// cubic Hermite table's nodes grow as ε^(−1/4), so a table at 10⁻⁸ has about a third of the
+/// nodes of one at 10⁻¹⁰ and costs a third to build and to hold; a sample's tables are built for
+/// it alone, and their build was the larger part of a sample's cost
+/// (`results/line-speed.md`). Scenes, maps and contact batches keep [`TABLE_TOL`].
+pub fn sampled_table_tol(tol: f64) -> f64 {
+    (1e-2 * tol).clamp(TABLE_TOL, 1e-6)
+}
 /// Equal intervals a table starts with.
 pub const START_INTERVALS: usize = 8;
 /// The shortest interval (units of a) refinement makes; one not certified there is left to the
@@ -341,6 +364,8 @@ impl WrenchPath {
 struct Builder<'a> {
     model: &'a PartModel,
     path: WrenchPath,
+    /// The relative agreement an interval must show at its midpoint.
+    tol: f64,
     evaluations: u64,
 }
 
@@ -385,7 +410,7 @@ impl Builder<'_> {
         let scale = mid.twist.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let twist_err = (0..3).fold(0.0f64, |m, c| m.max((xi[c] - mid.twist[c]).abs())) / scale;
         let lambda_err = (lambda - mid.lambda).abs() / mid.lambda.abs();
-        if twist_err <= TABLE_TOL && lambda_err <= TABLE_TOL {
+        if twist_err <= self.tol && lambda_err <= self.tol {
             out.push(b);
             certified.push(true);
         } else if b.ell - a.ell <= MIN_INTERVAL {
@@ -476,6 +501,8 @@ fn wrench_path(model: &PartModel, place: Place, s: f64, c: f64) -> WrenchPath {
 #[derive(Debug)]
 pub struct SlideTables {
     by_mu: Vec<MuTables>,
+    /// The certification tolerance of every table ([`TABLE_TOL`] unless asked otherwise).
+    tol: f64,
     evaluations: AtomicU64,
 }
 
@@ -494,8 +521,14 @@ pub struct TableStats {
 
 impl SlideTables {
     /// Empty tables for a part with `edges` edges and these μc values (duplicates dropped; NaN or
-    /// negative values ignored).
+    /// negative values ignored), certified to [`TABLE_TOL`].
     pub fn new(edges: usize, mu_values: &[f64]) -> SlideTables {
+        SlideTables::certified_to(edges, mu_values, TABLE_TOL)
+    }
+
+    /// [`SlideTables::new`] with tables certified to `tol` relative (at least [`TABLE_TOL`]; see
+    /// [`sampled_table_tol`]).
+    pub fn certified_to(edges: usize, mu_values: &[f64], tol: f64) -> SlideTables {
         let mut by_mu: Vec<MuTables> = Vec::new();
         for &mu in mu_values {
             // −0 is 0 (the lookup orders by total_cmp).
@@ -516,6 +549,11 @@ impl SlideTables {
         by_mu.sort_by(|a, b| a.mu_c.total_cmp(&b.mu_c));
         SlideTables {
             by_mu,
+            tol: if tol.is_finite() {
+                tol.max(TABLE_TOL)
+            } else {
+                TABLE_TOL
+            },
             evaluations: AtomicU64::new(0),
         }
     }
@@ -546,6 +584,7 @@ impl SlideTables {
             let builder = Builder {
                 model,
                 path: wrench_path(model, place, s, mt.cos_phi),
+                tol: self.tol,
                 evaluations: 0,
             };
             let (table, evals) = builder.build();
@@ -703,6 +742,41 @@ mod tests {
             assert!(st.uncertified * 20 < st.nodes, "{name}: {st:?}");
         }
         assert!(worst < 5e-10, "worst relative error {worst:e}");
+    }
+
+    /// A sample's tables (`sampled_table_tol`: 1e-8 at the default integration tolerance) hold
+    /// their own, looser certificate between the nodes, with a fraction of the nodes: a cubic
+    /// Hermite table's nodes grow as tol^(−1/4), so about a third (100^(−1/4) ≈ 0.32).
+    #[test]
+    fn a_samples_tables_hold_their_tolerance_with_fewer_nodes() {
+        assert_eq!(sampled_table_tol(1e-6), 1e-8);
+        assert_eq!(sampled_table_tol(1e-9), TABLE_TOL);
+        assert_eq!(sampled_table_tol(1e-2), 1e-6);
+        for (name, tripod, mu) in [("tripoly1", None, 0.5), ("lshape", Some(3), 0.3)] {
+            let poly = part_from_spec(name).unwrap();
+            let support = match tripod {
+                Some(seed) => {
+                    Support::random_tripod(&poly, &mut crate::random::stream(seed, 0)).unwrap()
+                }
+                None => Support::Uniform,
+            };
+            let plain = PartModel::new(&poly, &support).unwrap();
+            let fine = plain.clone().with_slide_tables(&[mu]);
+            let coarse = plain.with_slide_tables_to(&[mu], sampled_table_tol(1e-6));
+            let (w_fine, _, _) = worst_table_error(&fine, mu);
+            let (w_coarse, _, _) = worst_table_error(&coarse, mu);
+            assert!(w_fine < 5e-10, "{name}: {w_fine:e}");
+            assert!(w_coarse < 5e-8, "{name}: {w_coarse:e}");
+            let (n_fine, n_coarse) = (
+                fine.slide_table_stats().unwrap().nodes,
+                coarse.slide_table_stats().unwrap().nodes,
+            );
+            let ratio = n_coarse as f64 / n_fine as f64;
+            assert!(
+                (0.2..0.5).contains(&ratio),
+                "{name}: {n_coarse} / {n_fine} nodes"
+            );
+        }
     }
 
     #[test]

@@ -470,7 +470,7 @@ pub fn rotational_symmetry(poly: &Polygon) -> u32 {
         if n % k != 0 {
             continue;
         }
-        let (s, c) = (std::f64::consts::TAU / k as f64).sin_cos();
+        let (s, c) = crate::geometry::sin_cos(std::f64::consts::TAU / k as f64);
         let all = v.iter().all(|p| {
             let r = crate::geometry::Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y);
             v.iter().any(|q| (*q - r).norm() < eps)

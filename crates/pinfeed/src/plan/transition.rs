@@ -115,14 +115,22 @@ impl Transition {
         // the solver (`MAX_TABLED_VERTICES`).
         let tabulate =
             compiled.polygon.vertices().len() <= crate::mechanics::slide_table::MAX_TABLED_VERTICES;
+        // A robust search's samples each stand for one draw of uncertain physics: their tables
+        // are certified to a sample's tolerance (`sampled_table_tol`: 10⁻⁸ at the default
+        // integration tolerance, a third of the nodes of the 10⁻¹⁰ a nominal search keeps).
+        let robust = problem.tripod || problem.mu_c_range.is_some();
+        let table_tol = if robust {
+            crate::mechanics::slide_table::sampled_table_tol(problem.contact_tol)
+        } else {
+            crate::mechanics::slide_table::TABLE_TOL
+        };
         let tabled = |model: PartModel, mus: &[f64]| {
             if tabulate {
-                model.with_slide_tables(mus)
+                model.with_slide_tables_to(mus, table_tol)
             } else {
                 model
             }
         };
-        let robust = problem.tripod || problem.mu_c_range.is_some();
         let mut draws = Vec::new();
         if robust {
             for i in 0..n {

@@ -177,8 +177,15 @@ impl PartModel {
     /// about 10⁴ limit-surface evaluations to build, so a model used for a few hundred contacts
     /// is better left without. Slides at another μc, and the tip and ellipsoid fidelities, solve
     /// as before.
-    pub fn with_slide_tables(mut self, mu_values: &[f64]) -> PartModel {
-        let tables = SlideTables::new(self.poly.len(), mu_values);
+    pub fn with_slide_tables(self, mu_values: &[f64]) -> PartModel {
+        self.with_slide_tables_to(mu_values, super::slide_table::TABLE_TOL)
+    }
+
+    /// [`PartModel::with_slide_tables`] with tables certified to `tol` relative instead of
+    /// `slide_table::TABLE_TOL`: for a model standing for one sample of uncertain physics, whose
+    /// tables are built for it alone (`slide_table::sampled_table_tol`).
+    pub fn with_slide_tables_to(mut self, mu_values: &[f64], tol: f64) -> PartModel {
+        let tables = SlideTables::certified_to(self.poly.len(), mu_values, tol);
         self.slide_tables = (!tables.is_empty()).then(|| Arc::new(tables));
         self
     }

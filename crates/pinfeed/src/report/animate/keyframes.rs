@@ -259,7 +259,7 @@ mod tests {
         let pose = Pose::new(0.2, -0.01, 0.7);
         let keys = part_keys(&lay, &[(1.0, pose)], 0.0, 10.0);
         let k = keys[0];
-        let (s, c) = k.deg.to_radians().sin_cos();
+        let (s, c) = crate::geometry::sin_cos(k.deg.to_radians());
         for v in &outline {
             let (lx, ly) = (v.x * lay.k, -v.y * lay.k);
             // SVG rotate(a): (x cos a − y sin a, x sin a + y cos a).
