@@ -555,6 +555,45 @@ pub fn bench(
     stage("contact: cost against the vertex count");
     let scaling = vertex_scaling(&[3, 6, 12, 24, 48], (contacts / 4).max(1), tol, seed)?;
     let (table, doc) = report(&rows, &scaling, contacts, cmd);
-    crate::output::write_file(out, &doc)?;
+    let old = std::fs::read_to_string(out).unwrap_or_default();
+    crate::output::write_file(out, keep_batch_section(&doc, &old))?;
     Ok(table)
+}
+
+/// The markers of the report's section on batches of contacts, which a criterion benchmark
+/// measures (`cargo bench --features bench --bench contact -- contact_batch`) and
+/// `bench contact` keeps when it rewrites the report.
+pub const BATCH_SECTION: (&str, &str) =
+    ("<!-- contact-batch:begin -->", "<!-- contact-batch:end -->");
+
+/// `doc` with the batch section of the `old` report, if it has one, spliced in.
+pub fn keep_batch_section(doc: &str, old: &str) -> String {
+    use crate::study::mc::precision::{existing_between, splice_between};
+    match existing_between(old, BATCH_SECTION) {
+        Some(section) => splice_between(doc, &section, BATCH_SECTION),
+        None => doc.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rewriting the report keeps the section another command measures, in place or appended,
+    /// and nothing of the old report's own tables.
+    #[test]
+    fn the_report_keeps_its_batch_section() {
+        let (b, e) = BATCH_SECTION;
+        let old = format!("# Old\n\n| old table |\n\n{b}\n## Batches\n\n| 24.5 ms |\n{e}\n");
+        let kept = keep_batch_section("# New\n\n| new table |\n", &old);
+        assert_eq!(
+            kept,
+            format!("# New\n\n| new table |\n\n{b}\n## Batches\n\n| 24.5 ms |\n{e}\n")
+        );
+        assert!(!kept.contains("old table"));
+        // Rewritten again: the section stays, once.
+        assert_eq!(keep_batch_section("# New\n\n| new table |\n", &kept), kept);
+        // Nothing to keep: the new report as it is.
+        assert_eq!(keep_batch_section("# New\n", "# Old\n"), "# New\n");
+    }
 }
