@@ -28,11 +28,12 @@ pub fn run(args: &MapArgs, recorded: &str, uncertain: &str, req: &MapRequest) ->
     bar.finish_and_clear();
     let run = run?;
     eprintln!(
-        "computed {} members × {} d × {} θ0 = {} passes ({}) in {:.3} s on {} threads",
+        "computed {} members × {} d × {} θ0 = {} passes, {} distinct pushes ({}) in {:.3} s on {} threads",
         args.members,
         args.d.len(),
         run.thetas,
         run.passes,
+        run.maps.pushes,
         run.fidelity.name(),
         run.elapsed_s,
         run.threads

@@ -27,6 +27,7 @@ use rand::{RngExt, SeedableRng};
 use rand_distr::{Distribution as _, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::Arc as Shared;
 
 /// Mass held by the predicted bands.
 pub const BAND_MASS: f64 = 0.9;
@@ -383,11 +384,13 @@ pub fn draw_member(spec: &EnsembleSpec, seed: u64, i: u64) -> Result<MemberDraw,
 /// against 1.36 s with them, 360 passes 2.20 s against 1.76 s.
 pub const TABLED_PASSES: usize = 300;
 
-/// One member: its draw and its compiled part.
+/// One member: its draw and its compiled part. Members on uniform pressure share one compiled
+/// part (their model does not depend on what they drew); a member on a random support has its
+/// own.
 pub struct Member {
     /// The values it drew.
     pub draw: MemberDraw,
-    model: PartModel,
+    model: Shared<PartModel>,
 }
 
 impl Member {
@@ -399,16 +402,11 @@ impl Member {
         i: u64,
     ) -> Result<Member, MemberError> {
         let draw = draw_member(spec, seed, i)?;
-        let choice = if draw.random_support {
-            spec.support
-        } else {
-            SupportChoice::Uniform
-        };
-        let mut rng = ChaCha8Rng::seed_from_u64(draw.support_seed);
-        let support =
-            draw_support(poly, &choice, &mut rng, &mut 0).map_err(MemberError::Support)?;
-        let model = PartModel::new(poly, &support).map_err(MemberError::Model)?;
-        Ok(Member { draw, model })
+        let model = compile(poly, spec, &draw).map_err(|e| *e)?;
+        Ok(Member {
+            draw,
+            model: Shared::new(model),
+        })
     }
 
     /// The member with its exact slides served from tables at its μc, certified to the
@@ -418,10 +416,7 @@ impl Member {
     pub fn tabled(&self, tol: f64) -> Member {
         Member {
             draw: self.draw,
-            model: self.model.clone().with_slide_tables_to(
-                &[self.draw.mu_c],
-                crate::mechanics::slide_table::sampled_table_tol(tol),
-            ),
+            model: Shared::new(tabled_model(&self.model, self.draw.mu_c, tol)),
         }
     }
 
@@ -431,6 +426,18 @@ impl Member {
         let u = rng.random::<f64>();
         let z: f64 = StandardNormal.sample(&mut rng);
         (u, z)
+    }
+
+    /// θ0 (degrees) of pass number `pass` from `input`: the input's θ0 and the pass's jitter.
+    pub(crate) fn theta0(
+        &self,
+        spec: &EnsembleSpec,
+        input: &InputState,
+        states_deg: &[f64],
+        pass: u64,
+    ) -> f64 {
+        let (u, z) = self.pass_numbers(pass);
+        input.theta0(u, states_deg) + spec.jitter_deg * z
     }
 
     /// θf (degrees, wrapped) of pass number `pass` from `input` at contact parameter `d`.
@@ -443,8 +450,20 @@ impl Member {
         d: f64,
         pass: u64,
     ) -> f64 {
-        let (u, z) = self.pass_numbers(pass);
-        let theta0 = input.theta0(u, states_deg) + spec.jitter_deg * z;
+        let theta0 = self.theta0(spec, input, states_deg, pass);
+        self.pass_from(&self.model, poly, spec, theta0, d)
+    }
+
+    /// θf (degrees, wrapped) of a pass from `theta0` at `d` on `model` (the member's own, or
+    /// the tabled one its table group shares).
+    fn pass_from(
+        &self,
+        model: &PartModel,
+        poly: &Polygon,
+        spec: &EnsembleSpec,
+        theta0: f64,
+        d: f64,
+    ) -> f64 {
         let settings = MapSettings {
             theta_step_deg: 1.0,
             threshold_deg: 5.0,
@@ -460,25 +479,189 @@ impl Member {
             },
             fence: None,
         };
-        wrap_deg(sample_one(poly, &self.model, theta0, d, &settings).theta_final_deg)
+        wrap_deg(sample_one(poly, model, theta0, d, &settings).theta_final_deg)
     }
 }
 
-/// Compile members 0 … n − 1 in parallel (in index order). When members fail, the error is the
-/// first failing member's by index, whatever the thread count and timing.
+/// The part member `draw` rests on: its support drawn on `poly`, compiled.
+fn compile(
+    poly: &Polygon,
+    spec: &EnsembleSpec,
+    draw: &MemberDraw,
+) -> Result<PartModel, Box<MemberError>> {
+    let choice = if draw.random_support {
+        spec.support
+    } else {
+        SupportChoice::Uniform
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(draw.support_seed);
+    let support = draw_support(poly, &choice, &mut rng, &mut 0)
+        .map_err(|e| Box::new(MemberError::Support(e)))?;
+    PartModel::new(poly, &support).map_err(|e| Box::new(MemberError::Model(e)))
+}
+
+/// `model` with its slides at `mu_c` served from tables certified to a sample's tolerance.
+fn tabled_model(model: &PartModel, mu_c: f64, tol: f64) -> PartModel {
+    model.clone().with_slide_tables_to(
+        &[mu_c],
+        crate::mechanics::slide_table::sampled_table_tol(tol),
+    )
+}
+
+/// Compile members 0 … n − 1 in parallel (in index order); the members on uniform pressure share
+/// one compiled part. When members fail, the error is the first failing member's by index,
+/// whatever the thread count and timing.
 pub fn members(
     poly: &Polygon,
     spec: &EnsembleSpec,
     seed: u64,
     n: usize,
 ) -> Result<Vec<Member>, EnsembleError> {
-    let built: Vec<Result<Member, EnsembleError>> = (0..n as u64)
+    let fail = |index: u64| move |cause: MemberError| EnsembleError { index, cause };
+    let draws: Vec<Result<MemberDraw, EnsembleError>> = (0..n as u64)
         .into_par_iter()
-        .map(|i| {
-            Member::new(poly, spec, seed, i).map_err(|cause| EnsembleError { index: i, cause })
+        .map(|i| draw_member(spec, seed, i).map_err(fail(i)))
+        .collect();
+    let random = |d: &MemberDraw| d.random_support && spec.support != SupportChoice::Uniform;
+    // The shared uniform part, compiled once if any member rests on uniform pressure.
+    let uniform = draws
+        .iter()
+        .flatten()
+        .find(|d| !random(d))
+        .map(|d| compile(poly, spec, d).map(Shared::new));
+    let built: Vec<Result<Member, EnsembleError>> = draws
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, draw)| {
+            let draw = draw?;
+            let model = if random(&draw) {
+                Shared::new(compile(poly, spec, &draw).map_err(|e| fail(i as u64)(*e))?)
+            } else {
+                match uniform.as_ref().expect("a uniform member exists") {
+                    Ok(m) => m.clone(),
+                    Err(e) => return Err(fail(i as u64)((**e).clone())),
+                }
+            };
+            Ok(Member { draw, model })
         })
         .collect();
     built.into_iter().collect()
+}
+
+/// Members that serve their slides from one set of tables: those on one compiled part at one
+/// μc (the tables depend on neither the pin radius nor the pass). Groups in order of their first
+/// member; each lists its members in index order.
+pub(crate) fn table_groups(members: &[Member]) -> Vec<Vec<usize>> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let mut index: std::collections::HashMap<(usize, u64), usize> = Default::default();
+    for (i, m) in members.iter().enumerate() {
+        let key = (Shared::as_ptr(&m.model) as usize, m.draw.mu_c.to_bits());
+        let g = *index.entry(key).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i);
+    }
+    groups
+}
+
+/// A pass to make: (member, θ0 in degrees, d).
+pub(crate) type PassRequest = (usize, f64, f64);
+
+/// The key of a push: two requests with the same key in one table group are the same push
+/// (the same compiled part at the same μc, pin radius, θ0 and d).
+fn push_key(members: &[Member], &(i, theta0, d): &PassRequest) -> (u64, u64, u64) {
+    (
+        members[i].draw.pin_radius.to_bits(),
+        theta0.to_bits(),
+        d.to_bits(),
+    )
+}
+
+/// Make the passes `requests` of every table group (`groups[x]` holds group x's requests), and
+/// return their θf group by group in request order. Within a group each push is computed once
+/// (members with the same pin radius passing from the same θ0 at the same d: common inputs
+/// without jitter, such as a map's grid or a stable state). A group whose distinct pushes
+/// reach [`TABLED_PASSES`] serves its slides from tables of its own (certified to a sample's
+/// tolerance); groups are taken in chunks holding at most two tabled groups per thread, so
+/// that only their tables are held at once, and each chunk's pushes run in one parallel
+/// sweep. Also returns the number of pushes made. `on_pass` is called once per request (as its push is made, or after the chunk for
+/// a push made for another request). The answers depend on neither the thread
+/// count nor the chunks.
+pub(crate) fn serve_passes(
+    members: &[Member],
+    groups: &[Vec<PassRequest>],
+    poly: &Polygon,
+    spec: &EnsembleSpec,
+    on_pass: &(dyn Fn() + Sync),
+) -> (Vec<Vec<f64>>, usize) {
+    let tabulable = poly.len() <= crate::mechanics::slide_table::MAX_TABLED_VERTICES;
+    // Per group: its distinct pushes (a representative request each) and each request's push.
+    let plans: Vec<(Vec<usize>, Vec<usize>)> = groups
+        .par_iter()
+        .map(|requests| {
+            let mut order: Vec<usize> = (0..requests.len()).collect();
+            order.sort_by_key(|&r| push_key(members, &requests[r]));
+            let mut unique: Vec<usize> = Vec::new();
+            let mut push_of = vec![0usize; requests.len()];
+            for (n, &r) in order.iter().enumerate() {
+                let new = n == 0
+                    || push_key(members, &requests[order[n - 1]])
+                        != push_key(members, &requests[r]);
+                if new {
+                    unique.push(r);
+                }
+                push_of[r] = unique.len() - 1;
+            }
+            (unique, push_of)
+        })
+        .collect();
+    let tabled = |x: usize| tabulable && !groups[x].is_empty() && plans[x].0.len() >= TABLED_PASSES;
+    let block = 2 * rayon::current_num_threads().max(1);
+    let mut out: Vec<Vec<f64>> = vec![Vec::new(); groups.len()];
+    let mut x0 = 0;
+    while x0 < groups.len() {
+        // The chunk: groups from x0 until it holds `block` tabled groups.
+        let (mut x1, mut held) = (x0, 0);
+        while x1 < groups.len() && (held < block || !tabled(x1)) {
+            held += usize::from(tabled(x1));
+            x1 += 1;
+        }
+        let models: Vec<Option<Shared<PartModel>>> = (x0..x1)
+            .map(|x| {
+                let &(i, _, _) = groups[x].first()?;
+                let m = &members[i];
+                Some(if tabled(x) {
+                    Shared::new(tabled_model(&m.model, m.draw.mu_c, spec.tol))
+                } else {
+                    m.model.clone()
+                })
+            })
+            .collect();
+        let pushes: Vec<(usize, usize)> = (x0..x1)
+            .flat_map(|x| plans[x].0.iter().map(move |&r| (x, r)))
+            .collect();
+        let theta_f: Vec<f64> = pushes
+            .par_iter()
+            .map(|&(x, r)| {
+                let (i, theta0, d) = groups[x][r];
+                let model = models[x - x0].as_ref().expect("a group with requests");
+                let f = members[i].pass_from(model, poly, spec, theta0, d);
+                on_pass();
+                f
+            })
+            .collect();
+        let mut at = 0;
+        for x in x0..x1 {
+            let f = &theta_f[at..at + plans[x].0.len()];
+            at += plans[x].0.len();
+            out[x] = plans[x].1.iter().map(|&u| f[u]).collect();
+            // The requests served by a push already made.
+            (plans[x].0.len()..groups[x].len()).for_each(|_| on_pass());
+        }
+        x0 = x1;
+    }
+    (out, plans.iter().map(|p| p.0.len()).sum())
 }
 
 /// An ensemble of maps: θf of every member at every (d, grid θ0).
@@ -492,6 +675,9 @@ pub struct EnsembleMaps {
     pub members: Vec<MemberDraw>,
     /// θf (degrees), index (member · ds + d) · grid + θ0.
     pub theta_f: Vec<f64>,
+    /// The pushes made for them: members that share a compiled part, μc and pin radius and
+    /// pass from the same θ0 (no jitter) make each push once.
+    pub pushes: usize,
 }
 
 /// Sample the ensemble maps: `n` members, each passing at every (d, θ0 on `grid`); pass number
@@ -520,48 +706,43 @@ pub fn ensemble_maps_observed(
     let members = members(poly, spec, seed, n)?;
     let (nd, nk) = (ds.len(), grid.len());
     let states = stable_states_deg(poly);
-    // A member passing at least TABLED_PASSES times gets its own slide tables; the members are
-    // then taken a few at a time (two per thread), so that only their tables are held at once.
+    // Served by table group (the members of one compiled part at one μc: one member on a
+    // random support, or the members on uniform pressure at a fixed μc), see `serve_passes`.
     // The tables change no answer beyond the solver's tolerance, and none with the thread count.
-    let tabulate = nd * nk >= TABLED_PASSES
-        && poly.len() <= crate::mechanics::slide_table::MAX_TABLED_VERTICES;
-    let block = if tabulate {
-        2 * rayon::current_num_threads().max(1)
-    } else {
-        n.max(1)
-    };
-    let mut theta_f: Vec<f64> = Vec::with_capacity(n * nd * nk);
-    for first in (0..n).step_by(block) {
-        let block_members = &members[first..(first + block).min(n)];
-        let tabled: Vec<Member>;
-        let group = if tabulate {
-            tabled = block_members.iter().map(|m| m.tabled(spec.tol)).collect();
-            &tabled[..]
-        } else {
-            block_members
-        };
-        let part: Vec<f64> = (0..group.len() * nd * nk)
-            .into_par_iter()
-            .map(|x| {
-                let (i, j, k) = (x / (nd * nk), (x / nk) % nd, x % nk);
-                let input = InputState::Theta {
-                    arc: Arc {
-                        lo: grid[k],
-                        width: 0.0,
-                    },
-                };
-                let f = group[i].pass(poly, spec, &input, &states, ds[j], (j * nk + k) as u64);
-                on_pass();
-                f
-            })
-            .collect();
-        theta_f.extend(part);
+    let groups = table_groups(&members);
+    let requests: Vec<Vec<PassRequest>> = groups
+        .par_iter()
+        .map(|group| {
+            group
+                .iter()
+                .flat_map(|&i| (0..nd * nk).map(move |x| (i, x / nk, x % nk)))
+                .map(|(i, j, k)| {
+                    let input = InputState::Theta {
+                        arc: Arc {
+                            lo: grid[k],
+                            width: 0.0,
+                        },
+                    };
+                    let pass = (j * nk + k) as u64;
+                    (i, members[i].theta0(spec, &input, &states, pass), ds[j])
+                })
+                .collect()
+        })
+        .collect();
+    let (served, pushes) = serve_passes(&members, &requests, poly, spec, on_pass);
+    let mut theta_f: Vec<f64> = vec![f64::NAN; n * nd * nk];
+    for (group, f) in groups.iter().zip(&served) {
+        for (slot, &i) in group.iter().enumerate() {
+            theta_f[i * nd * nk..(i + 1) * nd * nk]
+                .copy_from_slice(&f[slot * nd * nk..(slot + 1) * nd * nk]);
+        }
     }
     Ok(EnsembleMaps {
         ds: ds.to_vec(),
         grid: grid.to_vec(),
         members: members.iter().map(|m| m.draw).collect(),
         theta_f,
+        pushes,
     })
 }
 
@@ -791,6 +972,82 @@ mod tests {
         );
     }
 
+    /// Members on uniform pressure share one compiled part, members on a random support each
+    /// have their own, and a member of the ensemble passes exactly as the same member compiled
+    /// alone.
+    #[test]
+    fn members_on_uniform_pressure_share_one_compiled_part() {
+        let poly = crate::geometry::part_from_spec("tripoly1").unwrap();
+        let spec = EnsembleSpec::nominal(0.5, 0.0, Fidelity::Exact, 1e-6)
+            .with_settings("mu_c=normal:0.5:0.1,support=tripod:0.5,pin_radius=uniform:0:0.1")
+            .unwrap();
+        let ms = members(&poly, &spec, 7, 12).unwrap();
+        let ptr = |m: &Member| Shared::as_ptr(&m.model) as usize;
+        let (uniform, random): (Vec<&Member>, Vec<&Member>) =
+            ms.iter().partition(|m| !m.draw.random_support);
+        assert!(uniform.len() >= 2 && random.len() >= 2, "{}", uniform.len());
+        assert!(uniform.iter().all(|m| ptr(m) == ptr(uniform[0])));
+        let mut own: Vec<usize> = random.iter().map(|m| ptr(m)).collect();
+        own.push(ptr(uniform[0]));
+        own.sort_unstable();
+        own.dedup();
+        assert_eq!(
+            own.len(),
+            random.len() + 1,
+            "each random support its own part"
+        );
+        let states = stable_states_deg(&poly);
+        let input = InputState::All;
+        for (i, m) in ms.iter().enumerate() {
+            let alone = Member::new(&poly, &spec, 7, i as u64).unwrap();
+            for pass in 0..3 {
+                let (a, b) = (
+                    m.pass(&poly, &spec, &input, &states, 0.3, pass),
+                    alone.pass(&poly, &spec, &input, &states, 0.3, pass),
+                );
+                assert_eq!(a.to_bits(), b.to_bits(), "member {i} pass {pass}");
+            }
+        }
+    }
+
+    /// Members of one physics (fixed μc and pin radius, uniform pressure) passing from a map's
+    /// grid without jitter make each push once, and every member gets that push's θf; with
+    /// jitter every pass is a push of its own. Every request is counted for the progress bar
+    /// either way.
+    #[test]
+    fn identical_members_make_each_push_once() {
+        let poly = crate::geometry::part_from_spec("tripoly1").unwrap();
+        let spec = EnsembleSpec::nominal(0.5, 0.1, Fidelity::Exact, 1e-6);
+        let grid: Vec<f64> = (0..20).map(|k| 18.0 * k as f64 + 1.5).collect();
+        let ds = [-0.4, 0.3];
+        let count = std::sync::atomic::AtomicUsize::new(0);
+        let tick = || {
+            count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        };
+        let maps = ensemble_maps_observed(&poly, &spec, &ds, &grid, 3, 6, &tick).unwrap();
+        assert_eq!(maps.pushes, 40);
+        assert_eq!(count.load(std::sync::atomic::Ordering::Relaxed), 6 * 40);
+        let lone = Member::new(&poly, &spec, 3, 0).unwrap();
+        let states = stable_states_deg(&poly);
+        for (j, &d) in ds.iter().enumerate() {
+            for (k, &t) in grid.iter().enumerate() {
+                let input = InputState::Theta {
+                    arc: Arc { lo: t, width: 0.0 },
+                };
+                let want = lone.pass(&poly, &spec, &input, &states, d, (j * 20 + k) as u64);
+                for i in 0..6 {
+                    let got = maps.theta_f[(i * 2 + j) * 20 + k];
+                    assert_eq!(got.to_bits(), want.to_bits(), "member {i} d {d} θ0 {t}");
+                }
+            }
+        }
+        let mut jittered = spec.clone();
+        jittered.jitter_deg = 1.0;
+        let maps = ensemble_maps(&poly, &jittered, &ds, &grid, 3, 6).unwrap();
+        assert_eq!(maps.pushes, 6 * 40);
+        assert!(maps.theta_f[0] != maps.theta_f[40]);
+    }
+
     /// Members passing TABLED_PASSES times or more are tabled and taken a few at a time, a
     /// number that depends on the threads: the maps do not.
     #[test]
@@ -802,18 +1059,25 @@ mod tests {
         let grid: Vec<f64> = (0..500).map(|k| 0.72 * k as f64).collect();
         let ds = [-0.4, 0.3];
         assert!(ds.len() * grid.len() >= TABLED_PASSES);
-        let maps: Vec<EnsembleMaps> = [1, 3]
-            .into_iter()
-            .map(|threads| {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                pool.install(|| ensemble_maps(&poly, &spec, &ds, &grid, 5, 5))
-                    .unwrap()
-            })
-            .collect();
-        assert_eq!(maps[0].theta_f.len(), 5 * 1000);
-        assert!(maps[0] == maps[1]);
+        // And members of one physics, with jitter: one tabled group of 5 000 pushes.
+        let fixed = EnsembleSpec::nominal(0.5, 0.05, Fidelity::Exact, 1e-6)
+            .with_settings("jitter=1")
+            .unwrap();
+        for spec in [spec, fixed] {
+            let maps: Vec<EnsembleMaps> = [1, 3]
+                .into_iter()
+                .map(|threads| {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .unwrap();
+                    pool.install(|| ensemble_maps(&poly, &spec, &ds, &grid, 5, 5))
+                        .unwrap()
+                })
+                .collect();
+            assert_eq!(maps[0].theta_f.len(), 5 * 1000);
+            assert_eq!(maps[0].pushes, 5 * 1000);
+            assert!(maps[0] == maps[1]);
+        }
     }
 }
