@@ -20,6 +20,7 @@ use crate::mechanics::{
     push_fence, push_path, ContactOutcome, ContactSettings, FenceSpec, PartModel, PinPath,
     Recorder, TraceSample,
 };
+use std::cell::Cell;
 
 /// The obstacle pushing a held part, as the contact model takes it (world frame at t_ref, m).
 #[derive(Debug, Clone, PartialEq)]
@@ -161,6 +162,13 @@ impl ContactPlan {
 
     /// Belt-frame pose at pin travel `s` (inside the contact: from the trace, if recorded).
     fn belt_pose(&self, s: f64) -> Pose {
+        self.belt_pose_from(s, None)
+    }
+
+    /// [`Self::belt_pose`], trying first the trace interval `hint` holds (the one found last)
+    /// before searching the trace; `hint` is set to the interval found. The pose is the same
+    /// either way: the interval is the one the search finds.
+    fn belt_pose_from(&self, s: f64, hint: Option<&Cell<usize>>) -> Pose {
         if s <= self.s_touch {
             return self.pose_ref;
         }
@@ -178,7 +186,14 @@ impl ContactPlan {
                 p0.theta_rad + u * (p1.theta_rad - p0.theta_rad),
             );
         };
-        let i = tr.partition_point(|(si, _)| *si <= s);
+        // The number of knots at or before s (the trace is strictly increasing in travel).
+        let i = match hint.map(Cell::get) {
+            Some(h) if h >= 1 && h < tr.len() && tr[h - 1].0 <= s && tr[h].0 > s => h,
+            _ => tr.partition_point(|(si, _)| *si <= s),
+        };
+        if let Some(h) = hint {
+            h.set(i);
+        }
         if i == 0 {
             return tr[0].1;
         }
@@ -261,5 +276,115 @@ impl Motion {
     pub fn belt_pose(&self, t: f64, speed: f64) -> Pose {
         let w = self.world_pose(t, speed);
         Pose::new(w.x - speed * t, w.y, w.theta_rad)
+    }
+}
+
+/// World poses of one motion asked for at times that mostly advance, as the overlap walk asks
+/// for them: each the pose [`Motion::world_pose`] gives, bit for bit, from the trace interval
+/// found last when the time is still in it, and the last two instants kept.
+pub struct PoseCursor<'a> {
+    motion: &'a Motion,
+    speed: f64,
+    hint: Cell<usize>,
+    /// The last two instants asked for (time bits, pose), newest first.
+    kept: Cell<[(u64, Pose); 2]>,
+}
+
+impl<'a> PoseCursor<'a> {
+    /// A cursor on `motion` on a belt running at `speed`.
+    pub fn new(motion: &'a Motion, speed: f64) -> Self {
+        let none = (f64::NAN.to_bits(), Pose::default());
+        PoseCursor {
+            motion,
+            speed,
+            hint: Cell::new(0),
+            kept: Cell::new([none, none]),
+        }
+    }
+
+    /// The world pose at `t` (= `motion.world_pose(t, speed)`).
+    pub fn at(&self, t: f64) -> Pose {
+        let kept = self.kept.get();
+        let bits = t.to_bits();
+        if let Some(&(_, pose)) = kept.iter().find(|k| k.0 == bits) {
+            return pose;
+        }
+        let pose = match self.motion {
+            Motion::Free { .. } => self.motion.world_pose(t, self.speed),
+            Motion::Held(p) => {
+                let s = p.travel_at(t, self.speed);
+                let b = p.belt_pose_from(s, Some(&self.hint));
+                Pose::new(b.x + s, b.y, b.theta_rad)
+            }
+        };
+        self.kept.set([(bits, pose), kept[0]]);
+        pose
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::part_from_spec;
+    use crate::mechanics::pin_path::PinPath;
+    use crate::mechanics::{ContactSettings, PartModel, Support};
+
+    /// The overlap walk's cursor gives, bit for bit, the poses `world_pose` gives: at the recorded
+    /// steps, between them, before the touch and after the end, forwards, backwards and twice.
+    #[test]
+    fn a_pose_cursor_gives_the_poses_world_pose_gives() {
+        let poly = part_from_spec("tripoly2").unwrap();
+        let model = PartModel::new(&poly, &Support::Uniform).unwrap();
+        let pusher = Pusher::Pin {
+            centre: Vec2::new(0.0, 0.25),
+            radius: 0.1,
+            path: PinPath::constant(0.0),
+        };
+        let pose = Pose::new(-3.0, 0.0, 0.7);
+        let settings = ContactSettings::default();
+        let outcome = pusher.push(&model, pose, &settings, None);
+        assert!(outcome.contact);
+        let speed = 0.5;
+        let (s_touch, s_end) = (
+            outcome.travel_to_contact,
+            outcome.segments.last().unwrap().s_end,
+        );
+        let mut plan = ContactPlan {
+            obstacle: 0,
+            t_ref: 0.0,
+            pose_ref: pose,
+            pusher,
+            settings,
+            outcome,
+            s_touch,
+            s_end,
+            t_begin: s_touch / speed,
+            t_end: s_end / speed,
+            stop: None,
+            trace: None,
+        };
+        plan.ensure_trace(&model);
+        assert!(plan.trace.as_ref().unwrap().len() > 5);
+        let knots = plan.path_times(speed);
+        let held = Motion::Held(Box::new(plan));
+        let mut times: Vec<f64> = vec![0.0, knots[0] - 1.0];
+        for w in knots.windows(2) {
+            times.extend([w[0], 0.3 * w[0] + 0.7 * w[1], w[1], w[1]]);
+        }
+        times.extend([
+            knots[knots.len() - 1] + 1.0,
+            knots[2],
+            knots[1],
+            0.5 * knots[3],
+        ]);
+        let cursor = PoseCursor::new(&held, speed);
+        for &t in &times {
+            let (a, b) = (cursor.at(t), held.world_pose(t, speed));
+            assert_eq!(
+                [a.x.to_bits(), a.y.to_bits(), a.theta_rad.to_bits()],
+                [b.x.to_bits(), b.y.to_bits(), b.theta_rad.to_bits()],
+                "t = {t}"
+            );
+        }
     }
 }

@@ -8,7 +8,7 @@
 use super::contact::ensure_trace;
 use super::event_queue::EventKind;
 use super::metrics::WorkCounters;
-use super::motion::Motion;
+use super::motion::{Motion, PoseCursor};
 use super::overlap::{first_touch, polygon_clearance, segment_distance};
 use super::state::Belt;
 use crate::geometry::Vec2;
@@ -27,22 +27,28 @@ pub(super) fn check_pairs(
     if !scene.effects.collisions || belt.active.len() < 2 {
         return;
     }
+    // Broad phase over every other part (no part changes here), then the narrow phase of the
+    // close pairs in the same order.
+    let close: Vec<(u64, f64)> = {
+        let active = &belt.active;
+        let me = &active[&index].motion;
+        let mut close = Vec::new();
+        for (&other, part) in active.iter().filter(|(&k, _)| k != index) {
+            work.part_part_checks += 1;
+            let end = me.until().min(part.motion.until());
+            if end < now {
+                continue;
+            }
+            let (p0, p1, r1) = bounding_capsule(scene, me, now, end);
+            let (q0, q1, r2) = bounding_capsule(scene, &part.motion, now, end);
+            if segment_distance(p0, p1, q0, q1) <= r1 + r2 {
+                close.push((other, end));
+            }
+        }
+        close
+    };
     let active = &mut belt.active;
-    let others: Vec<u64> = active.keys().copied().filter(|&k| k != index).collect();
-    for other in others {
-        work.part_part_checks += 1;
-        let end = active[&index]
-            .motion
-            .until()
-            .min(active[&other].motion.until());
-        if end < now {
-            continue;
-        }
-        let (p0, p1, r1) = bounding_capsule(scene, &active[&index].motion, now, end);
-        let (q0, q1, r2) = bounding_capsule(scene, &active[&other].motion, now, end);
-        if segment_distance(p0, p1, q0, q1) > r1 + r2 {
-            continue;
-        }
+    for (other, end) in close {
         work.part_part_narrow_checks += 1;
         for k in [index, other] {
             let part = active.get_mut(&k).expect("active part");
@@ -109,8 +115,10 @@ fn first_overlap(
     }
     breaks.sort_by(f64::total_cmp);
     let poly = &scene.part.polygon;
-    let belt_motion = |m: &Motion, ta: f64, tb: f64| -> f64 {
-        let (p, q) = (m.world_pose(ta, v), m.world_pose(tb, v));
+    // The walk asks each motion's pose at the ends of every piece, in order.
+    let (first, second) = (PoseCursor::new(first, v), PoseCursor::new(second, v));
+    let belt_motion = |m: &PoseCursor, ta: f64, tb: f64| -> f64 {
+        let (p, q) = (m.at(ta), m.at(tb));
         let d = q.position() - p.position() - Vec2::new(v * (tb - ta), 0.0);
         d.norm() + a * (q.theta_rad - p.theta_rad).abs()
     };
@@ -120,11 +128,11 @@ fn first_overlap(
         end,
         &breaks,
         &mut |tau| {
-            poly.world_vertices_into(&first.world_pose(tau, v), &mut wa);
-            poly.world_vertices_into(&second.world_pose(tau, v), &mut wb);
+            poly.world_vertices_into(&first.at(tau), &mut wa);
+            poly.world_vertices_into(&second.at(tau), &mut wb);
             polygon_clearance(&wa, &wb)
         },
-        &|ta, tb| belt_motion(first, ta, tb) + belt_motion(second, ta, tb),
+        &|ta, tb| belt_motion(&first, ta, tb) + belt_motion(&second, ta, tb),
         1e-6 * a,
         evals,
     )
