@@ -578,90 +578,99 @@ fn push_key(members: &[Member], &(i, theta0, d): &PassRequest) -> (u64, u64, u64
     )
 }
 
-/// Make the passes `requests` of every table group (`groups[x]` holds group x's requests), and
-/// return their θf group by group in request order. Within a group each push is computed once
-/// (members with the same pin radius passing from the same θ0 at the same d: common inputs
-/// without jitter, such as a map's grid or a stable state). A group whose distinct pushes
-/// reach [`TABLED_PASSES`] serves its slides from tables of its own (certified to a sample's
-/// tolerance); groups are taken in chunks holding at most two tabled groups per thread, so
-/// that only their tables are held at once, and each chunk's pushes run in one parallel
-/// sweep. Also returns the number of pushes made. `on_pass` is called once per request (as its push is made, or after the chunk for
-/// a push made for another request). The answers depend on neither the thread
-/// count nor the chunks.
+/// Make the passes of every table group — `requests_of(x)` lists group x's requests — and hand
+/// each group's θf, in request order, to `deliver(x, θf)`. Within a group each push is computed
+/// once (members with the same pin radius passing from the same θ0 at the same d: common inputs
+/// without jitter, such as a map's grid or a stable state). A group whose distinct pushes reach
+/// [`TABLED_PASSES`] serves its slides from tables of its own (certified to a sample's
+/// tolerance). Groups are taken two per thread at a time, so that only their requests and
+/// tables are held at once; each such chunk's pushes run in one parallel sweep. `on_pass` is
+/// called once per request (as its push is made, or after the chunk for a push made for another
+/// request). The answers depend on neither the thread count nor the chunks. Returns the number
+/// of pushes made.
 pub(crate) fn serve_passes(
     members: &[Member],
-    groups: &[Vec<PassRequest>],
-    poly: &Polygon,
-    spec: &EnsembleSpec,
+    groups: usize,
+    requests_of: &(dyn Fn(usize) -> Vec<PassRequest> + Sync),
+    (poly, spec): (&Polygon, &EnsembleSpec),
     on_pass: &(dyn Fn() + Sync),
-) -> (Vec<Vec<f64>>, usize) {
+    deliver: &mut dyn FnMut(usize, &[f64]),
+) -> usize {
     let tabulable = poly.len() <= crate::mechanics::slide_table::MAX_TABLED_VERTICES;
-    // Per group: its distinct pushes (a representative request each) and each request's push.
-    let plans: Vec<(Vec<usize>, Vec<usize>)> = groups
-        .par_iter()
-        .map(|requests| {
-            let mut order: Vec<usize> = (0..requests.len()).collect();
-            order.sort_by_key(|&r| push_key(members, &requests[r]));
-            let mut unique: Vec<usize> = Vec::new();
-            let mut push_of = vec![0usize; requests.len()];
-            for (n, &r) in order.iter().enumerate() {
-                let new = n == 0
-                    || push_key(members, &requests[order[n - 1]])
-                        != push_key(members, &requests[r]);
-                if new {
-                    unique.push(r);
-                }
-                push_of[r] = unique.len() - 1;
-            }
-            (unique, push_of)
-        })
-        .collect();
-    let tabled = |x: usize| tabulable && !groups[x].is_empty() && plans[x].0.len() >= TABLED_PASSES;
     let block = 2 * rayon::current_num_threads().max(1);
-    let mut out: Vec<Vec<f64>> = vec![Vec::new(); groups.len()];
-    let mut x0 = 0;
-    while x0 < groups.len() {
-        // The chunk: groups from x0 until it holds `block` tabled groups.
-        let (mut x1, mut held) = (x0, 0);
-        while x1 < groups.len() && (held < block || !tabled(x1)) {
-            held += usize::from(tabled(x1));
-            x1 += 1;
-        }
-        let models: Vec<Option<Shared<PartModel>>> = (x0..x1)
+    let mut made = 0;
+    for x0 in (0..groups).step_by(block) {
+        // Per group of the chunk: its requests, its distinct pushes (a representative request
+        // each), each request's push, and the model that serves it.
+        let chunk: Vec<Served> = (x0..(x0 + block).min(groups))
+            .into_par_iter()
             .map(|x| {
-                let &(i, _, _) = groups[x].first()?;
-                let m = &members[i];
-                Some(if tabled(x) {
-                    Shared::new(tabled_model(&m.model, m.draw.mu_c, spec.tol))
-                } else {
-                    m.model.clone()
-                })
+                let requests = requests_of(x);
+                let mut order: Vec<usize> = (0..requests.len()).collect();
+                order.sort_by_key(|&r| push_key(members, &requests[r]));
+                let mut unique: Vec<usize> = Vec::new();
+                let mut push_of = vec![0usize; requests.len()];
+                for (n, &r) in order.iter().enumerate() {
+                    let new = n == 0
+                        || push_key(members, &requests[order[n - 1]])
+                            != push_key(members, &requests[r]);
+                    if new {
+                        unique.push(r);
+                    }
+                    push_of[r] = unique.len() - 1;
+                }
+                let model = requests.first().map(|&(i, _, _)| {
+                    let m = &members[i];
+                    if tabulable && unique.len() >= TABLED_PASSES {
+                        Shared::new(tabled_model(&m.model, m.draw.mu_c, spec.tol))
+                    } else {
+                        m.model.clone()
+                    }
+                });
+                Served {
+                    requests,
+                    unique,
+                    push_of,
+                    model,
+                }
             })
             .collect();
-        let pushes: Vec<(usize, usize)> = (x0..x1)
-            .flat_map(|x| plans[x].0.iter().map(move |&r| (x, r)))
+        let pushes: Vec<(usize, usize)> = chunk
+            .iter()
+            .enumerate()
+            .flat_map(|(c, g)| g.unique.iter().map(move |&r| (c, r)))
             .collect();
         let theta_f: Vec<f64> = pushes
             .par_iter()
-            .map(|&(x, r)| {
-                let (i, theta0, d) = groups[x][r];
-                let model = models[x - x0].as_ref().expect("a group with requests");
+            .map(|&(c, r)| {
+                let g = &chunk[c];
+                let (i, theta0, d) = g.requests[r];
+                let model = g.model.as_ref().expect("a group with requests");
                 let f = members[i].pass_from(model, poly, spec, theta0, d);
                 on_pass();
                 f
             })
             .collect();
+        made += pushes.len();
         let mut at = 0;
-        for x in x0..x1 {
-            let f = &theta_f[at..at + plans[x].0.len()];
-            at += plans[x].0.len();
-            out[x] = plans[x].1.iter().map(|&u| f[u]).collect();
+        for (c, g) in chunk.iter().enumerate() {
+            let f = &theta_f[at..at + g.unique.len()];
+            at += g.unique.len();
+            let out: Vec<f64> = g.push_of.iter().map(|&u| f[u]).collect();
             // The requests served by a push already made.
-            (plans[x].0.len()..groups[x].len()).for_each(|_| on_pass());
+            (g.unique.len()..g.requests.len()).for_each(|_| on_pass());
+            deliver(x0 + c, &out);
         }
-        x0 = x1;
     }
-    (out, plans.iter().map(|p| p.0.len()).sum())
+    made
+}
+
+/// One table group of a chunk in [`serve_passes`].
+struct Served {
+    requests: Vec<PassRequest>,
+    unique: Vec<usize>,
+    push_of: Vec<usize>,
+    model: Option<Shared<PartModel>>,
 }
 
 /// An ensemble of maps: θf of every member at every (d, grid θ0).
@@ -710,33 +719,37 @@ pub fn ensemble_maps_observed(
     // random support, or the members on uniform pressure at a fixed μc), see `serve_passes`.
     // The tables change no answer beyond the solver's tolerance, and none with the thread count.
     let groups = table_groups(&members);
-    let requests: Vec<Vec<PassRequest>> = groups
-        .par_iter()
-        .map(|group| {
-            group
-                .iter()
-                .flat_map(|&i| (0..nd * nk).map(move |x| (i, x / nk, x % nk)))
-                .map(|(i, j, k)| {
-                    let input = InputState::Theta {
-                        arc: Arc {
-                            lo: grid[k],
-                            width: 0.0,
-                        },
-                    };
-                    let pass = (j * nk + k) as u64;
-                    (i, members[i].theta0(spec, &input, &states, pass), ds[j])
-                })
-                .collect()
-        })
-        .collect();
-    let (served, pushes) = serve_passes(&members, &requests, poly, spec, on_pass);
+    let requests_of = |x: usize| -> Vec<PassRequest> {
+        groups[x]
+            .iter()
+            .flat_map(|&i| (0..nd * nk).map(move |p| (i, p / nk, p % nk)))
+            .map(|(i, j, k)| {
+                let input = InputState::Theta {
+                    arc: Arc {
+                        lo: grid[k],
+                        width: 0.0,
+                    },
+                };
+                let pass = (j * nk + k) as u64;
+                (i, members[i].theta0(spec, &input, &states, pass), ds[j])
+            })
+            .collect()
+    };
     let mut theta_f: Vec<f64> = vec![f64::NAN; n * nd * nk];
-    for (group, f) in groups.iter().zip(&served) {
-        for (slot, &i) in group.iter().enumerate() {
+    let mut deliver = |x: usize, f: &[f64]| {
+        for (slot, &i) in groups[x].iter().enumerate() {
             theta_f[i * nd * nk..(i + 1) * nd * nk]
                 .copy_from_slice(&f[slot * nd * nk..(slot + 1) * nd * nk]);
         }
-    }
+    };
+    let pushes = serve_passes(
+        &members,
+        groups.len(),
+        &requests_of,
+        (poly, spec),
+        on_pass,
+        &mut deliver,
+    );
     Ok(EnsembleMaps {
         ds: ds.to_vec(),
         grid: grid.to_vec(),

@@ -93,34 +93,37 @@ pub fn predict_observed(
             .collect();
         // Every pass of a table group's members (member, prediction, pass in order).
         let tgroups = table_groups(ms);
-        let requests: Vec<Vec<PassRequest>> = tgroups
-            .iter()
-            .map(|tg| {
-                let mut req = Vec::with_capacity(tg.len() * mine.len() * passes);
-                for &i in tg {
-                    for &g in &mine {
-                        let row = &measured.rows[first_row[g]];
-                        for q in 0..passes {
-                            let pass = (g * passes + q) as u64;
-                            req.push((i, ms[i].theta0(spec, &row.input, states, pass), row.d));
-                        }
+        let requests_of = |x: usize| -> Vec<PassRequest> {
+            let mut req = Vec::with_capacity(tgroups[x].len() * mine.len() * passes);
+            for &i in &tgroups[x] {
+                for &g in &mine {
+                    let row = &measured.rows[first_row[g]];
+                    for q in 0..passes {
+                        let pass = (g * passes + q) as u64;
+                        req.push((i, ms[i].theta0(spec, &row.input, states, pass), row.d));
                     }
                 }
-                req
-            })
-            .collect();
-        let (served, made) = serve_passes(ms, &requests, poly, spec, &|| tally.add(1));
-        pushes += made;
-        for (tg, f) in tgroups.iter().zip(&served) {
+            }
+            req
+        };
+        let mut deliver = |x: usize, f: &[f64]| {
             let mut at = f.iter();
-            for &i in tg {
+            for &i in &tgroups[x] {
                 for &g in &mine {
                     for q in 0..passes {
                         predicted[g][i * passes + q] = *at.next().expect("one θf a request");
                     }
                 }
             }
-        }
+        };
+        pushes += serve_passes(
+            ms,
+            tgroups.len(),
+            &requests_of,
+            (poly, spec),
+            &|| tally.add(1),
+            &mut deliver,
+        );
     }
     let rows = group_of.iter().map(|&g| predicted[g].clone()).collect();
     let draws = compiled
