@@ -40,12 +40,14 @@ pub fn run(a: &LineArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<()>
         let row = measure(&scene, a.parts, a.reps)
             .with_context(|| format!("measuring {}", path.display()))?;
         let line = format!(
-            "{}: line {:.2} s, batch {:.2} s (recording {:.2} s), ratio {:.3}",
+            "{}: line {:.2} s, batch {:.2} s (recording {:.2} s), ratio {:.3} ({:.3}–{:.3} in the repeats)",
             path.display(),
             row.line_s,
             row.bare_s,
             row.bare_recorded_s,
-            row.ratio()
+            row.ratio(),
+            row.repeat_ratios.0,
+            row.repeat_ratios.1
         );
         super::progress::note(spin, &line);
         rows.push(row);

@@ -51,11 +51,12 @@ fn capturing_leaves_the_run_alone_and_sees_every_push() {
 }
 
 /// The measurement replays the line's own evaluations (it refuses otherwise) and reports a
-/// positive ratio; a scene on the map tier is refused with the reason.
+/// positive ratio within the range of its repeats' own ratios; a scene on the map tier is refused
+/// with the reason.
 #[test]
 fn the_batch_makes_the_lines_evaluations_and_map_scenes_are_refused() {
     let s = scene("quickstart");
-    let r = measure(&s, 30, 1).unwrap();
+    let r = measure(&s, 30, 2).unwrap();
     let opts = RunOptions {
         parts: 30,
         ..RunOptions::from_scene(&s)
@@ -66,9 +67,18 @@ fn the_batch_makes_the_lines_evaluations_and_map_scenes_are_refused() {
     // Times are not asserted (a timed test fails on a loaded machine): only that they exist.
     assert!(r.ratio() > 0.0 && r.ratio().is_finite());
     assert!(r.bare_s > 0.0 && r.bare_recorded_s > 0.0);
+    // The ratio of the fastest line to the fastest batch lies between the repeats' own ratios
+    // (whichever repeat holds each minimum).
+    let (lo, hi) = r.repeat_ratios;
+    assert!(
+        lo <= r.ratio() && r.ratio() <= hi,
+        "{lo} {} {hi}",
+        r.ratio()
+    );
+    let range = format!("| {lo:.3}–{hi:.3} |");
     let md = section(&[r], "CMD");
     assert!(
-        md.contains("CMD") && md.contains("| quickstart | exact | 30 |"),
+        md.contains("CMD") && md.contains("| quickstart | exact | 30 |") && md.contains(&range),
         "{md}"
     );
 

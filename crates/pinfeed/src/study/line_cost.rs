@@ -42,6 +42,9 @@ pub struct LineCost {
     pub bare_s: f64,
     /// The batch recording what the line recorded (s).
     pub bare_recorded_s: f64,
+    /// The smallest and the largest line / recorded-batch ratio of one repeat (its line run over
+    /// its own batch run): how far the ratio moves between runs on this machine.
+    pub repeat_ratios: (f64, f64),
 }
 
 impl LineCost {
@@ -94,12 +97,16 @@ pub fn measure(scene: &Scene, parts: u64, reps: usize) -> Result<LineCost, Bench
         });
     }
     let (mut line_s, mut bare_s, mut rec_s) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut repeat_ratios = (f64::INFINITY, f64::NEG_INFINITY);
     for _ in 0..reps.max(1) {
         let (r, t) = timed(|| engine::run(scene, &opts, &mut |_| {}));
         black_box(r?);
         line_s = line_s.min(t);
         bare_s = bare_s.min(timed(|| batch(scene, &pushes, false)).1);
-        rec_s = rec_s.min(timed(|| batch(scene, &pushes, true)).1);
+        let t_rec = timed(|| batch(scene, &pushes, true)).1;
+        rec_s = rec_s.min(t_rec);
+        let ratio = t / t_rec;
+        repeat_ratios = (repeat_ratios.0.min(ratio), repeat_ratios.1.max(ratio));
     }
     Ok(LineCost {
         scenario: scene.name.clone(),
@@ -111,6 +118,7 @@ pub fn measure(scene: &Scene, parts: u64, reps: usize) -> Result<LineCost, Bench
         line_s,
         bare_s,
         bare_recorded_s: rec_s,
+        repeat_ratios,
     })
 }
 
@@ -122,14 +130,16 @@ pub fn section(rows: &[LineCost], cmd: &str) -> String {
          Each scenario is run once to capture every push it asks of the contact model, then, \
          alternating on one thread, the line itself and the same pushes as a bare batch (without \
          and with the recorder for the pushes the line records); the minimum wall time over the \
-         repeats is shown. The batch makes exactly the line's limit-surface evaluations (checked). \
-         Machine: 2 cores, one used.\n\n\
-         | scenario | model | parts | pushes (recorded) | evaluations / push | line s | bare batch s | batch with recording s | **line / batch** | parts/s |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n"
+         repeats is shown, and **line / batch** is the line's over the batch with recording. The \
+         batch makes exactly the line's limit-surface evaluations (checked). *In the repeats* is \
+         the range of that ratio between one repeat's line and its own batch: how far it moves \
+         from run to run on this machine. Machine: 2 cores, one used.\n\n\
+         | scenario | model | parts | pushes (recorded) | evaluations / push | line s | bare batch s | batch with recording s | **line / batch** | in the repeats | parts/s |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n"
     );
     for r in rows {
         s.push_str(&format!(
-            "| {} | {} | {} | {} ({}) | {:.0} | {:.2} | {:.2} | {:.2} | **{:.3}** | {:.0} |\n",
+            "| {} | {} | {} | {} ({}) | {:.0} | {:.2} | {:.2} | {:.2} | **{:.3}** | {:.3}–{:.3} | {:.0} |\n",
             r.scenario,
             r.fidelity,
             r.parts,
@@ -140,6 +150,8 @@ pub fn section(rows: &[LineCost], cmd: &str) -> String {
             r.bare_s,
             r.bare_recorded_s,
             r.ratio(),
+            r.repeat_ratios.0,
+            r.repeat_ratios.1,
             r.parts_per_s()
         ));
     }
