@@ -160,14 +160,18 @@ impl ContactPlan {
         self.trace = Some(trace);
     }
 
-    /// Belt-frame pose at pin travel `s` (inside the contact: from the trace, if recorded).
-    fn belt_pose(&self, s: f64) -> Pose {
-        self.belt_pose_from(s, None)
+    /// World pose at time `t` of the part this plan holds, its trace searched from `hint`
+    /// ([`Self::belt_pose_from`]).
+    fn world_pose_from(&self, t: f64, speed: f64, hint: Option<&Cell<usize>>) -> Pose {
+        let s = self.travel_at(t, speed);
+        let b = self.belt_pose_from(s, hint);
+        Pose::new(b.x + s, b.y, b.theta_rad)
     }
 
-    /// [`Self::belt_pose`], trying first the trace interval `hint` holds (the one found last)
-    /// before searching the trace; `hint` is set to the interval found. The pose is the same
-    /// either way: the interval is the one the search finds.
+    /// Belt-frame pose at pin travel `s` (inside the contact: from the trace, if recorded),
+    /// trying first the trace interval `hint` holds (the one found last) before searching the
+    /// trace; `hint` is set to the interval found. The pose is the same either way: the interval
+    /// is the one the search finds.
     fn belt_pose_from(&self, s: f64, hint: Option<&Cell<usize>>) -> Pose {
         if s <= self.s_touch {
             return self.pose_ref;
@@ -263,11 +267,7 @@ impl Motion {
             Motion::Free { t0, pose, .. } => {
                 Pose::new(pose.x + speed * (t - t0), pose.y, pose.theta_rad)
             }
-            Motion::Held(p) => {
-                let s = p.travel_at(t, speed);
-                let b = p.belt_pose(s);
-                Pose::new(b.x + s, b.y, b.theta_rad)
-            }
+            Motion::Held(p) => p.world_pose_from(t, speed, None),
         }
     }
 
@@ -311,11 +311,7 @@ impl<'a> PoseCursor<'a> {
         }
         let pose = match self.motion {
             Motion::Free { .. } => self.motion.world_pose(t, self.speed),
-            Motion::Held(p) => {
-                let s = p.travel_at(t, self.speed);
-                let b = p.belt_pose_from(s, Some(&self.hint));
-                Pose::new(b.x + s, b.y, b.theta_rad)
-            }
+            Motion::Held(p) => p.world_pose_from(t, self.speed, Some(&self.hint)),
         };
         self.kept.set([(bits, pose), kept[0]]);
         pose

@@ -606,15 +606,13 @@ pub(crate) fn serve_passes(
             .into_par_iter()
             .map(|x| {
                 let requests = requests_of(x);
+                let keys: Vec<_> = requests.iter().map(|r| push_key(members, r)).collect();
                 let mut order: Vec<usize> = (0..requests.len()).collect();
-                order.sort_by_key(|&r| push_key(members, &requests[r]));
+                order.sort_by_key(|&r| keys[r]);
                 let mut unique: Vec<usize> = Vec::new();
                 let mut push_of = vec![0usize; requests.len()];
                 for (n, &r) in order.iter().enumerate() {
-                    let new = n == 0
-                        || push_key(members, &requests[order[n - 1]])
-                            != push_key(members, &requests[r]);
-                    if new {
+                    if n == 0 || keys[order[n - 1]] != keys[r] {
                         unique.push(r);
                     }
                     push_of[r] = unique.len() - 1;
