@@ -307,7 +307,7 @@ impl Ctx<'_, '_> {
     /// The right-hand side: solve the instant in `mode` at `y` (a flush edge in closed form) and
     /// return the rates with it; non-finite rates are a solver failure. Inlined into its callers
     /// (the step's stages), so that the instant and the geometry are not copied on the way out.
-    #[inline]
+    #[inline(always)]
     pub(super) fn rhs(
         &mut self,
         feat: Feat,

@@ -97,6 +97,7 @@ const MARGIN_DIP: f64 = 1e-3;
 
 /// One Dormand–Prince step of size h from (y0, f0) on `feat` in `mode`, watching the mode's
 /// margins at the interior stages.
+#[inline(always)]
 pub(super) fn dp_step(
     ctx: &mut Ctx,
     feat: Feat,
