@@ -70,6 +70,14 @@ def main():
     work = tempfile.mkdtemp(prefix="pinfeed-waits-")
     cases = os.path.join(work, "cases.csv")
     cases_csv(cases)
+    # The quickstart with the map tier: the bundled scenario with its fidelity set to "map".
+    scene_dir = os.path.join(work, "scene")
+    os.makedirs(scene_dir)
+    text = open(os.path.join(ROOT, "scenarios", "quickstart.toml")).read()
+    exact = 'fidelity = "exact"   # or "ellipsoid", "tip"'
+    assert exact in text
+    with open(os.path.join(scene_dir, "quickstart.toml"), "w") as f:
+        f.write(text.replace(exact, 'fidelity = "map"'))
     env = dict(os.environ)
     env.pop("PINFEED_CACHE", None)
     one = dict(env, RAYON_NUM_THREADS="1")
@@ -84,6 +92,9 @@ def main():
         ("map-tier build for one query: `contact --part tripoly2 --theta0 100 --d 0.3 --pin-radius 0.15 --model map`, empty cache",
          ["contact", "--part", "tripoly2", "--theta0", "100", "--d", "0.3", "--pin-radius", "0.15",
           "--model", "map", "--cache-dir", "{cache}"], env, ["cache"], "≤ 2 s", None),
+        ("quickstart on the map tier (`[model] fidelity = \"map\"`, default grid), 20 000 parts, empty cache: the map and the run",
+         ["run", "{scene}/quickstart.toml", "--parts", "20000", "--quiet", "--out", "{out}", "--cache-dir", "{cache}"],
+         env, ["out", "cache"], "≤ 2 s", 20000),
         ("`calibrate tests/fixtures/validate/synthetic.csv --jitter 3`",
          ["calibrate", fixture, "--jitter", "3", "--out-dir", "{out}"], env, ["out"], "≤ 1.2 s", None),
     ]
@@ -114,7 +125,7 @@ def main():
             for _ in range(a.reps):
                 dirs = {k: tempfile.mkdtemp(prefix=f"pinfeed-waits-{k}-", dir=work) for k in fresh}
                 own = args[name] if isinstance(args, dict) else args
-                cmd = [binary] + [x.format(**dirs) for x in own]
+                cmd = [binary] + [x.format(scene=scene_dir, **dirs) for x in own]
                 t = timed(cmd, e, ROOT)
                 if count == "ratio":
                     t = t + (line_ratio(os.path.join(dirs["out"], "line.md")),)

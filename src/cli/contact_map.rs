@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use pinfeed::contact_case::maps::{self, TierSource};
 use pinfeed::contact_case::report::report;
 use pinfeed::contact_case::{case_geometry, check_geometry, check_inputs, compile_part};
-use pinfeed::engine::contact_map::prepare_observed;
+use pinfeed::engine::contact_map;
 use pinfeed::geometry::{Pose, Vec2};
 use pinfeed::maps::tier::{self, push_with_map, Loaded};
 use pinfeed::mechanics::{ContactSettings, Fidelity, PartModel, Support};
@@ -22,41 +22,64 @@ fn cache_dir(dir: Option<&Path>) -> PathBuf {
     dir.map_or_else(tier::default_cache_dir, Path::to_path_buf)
 }
 
-/// For a scene with `fidelity = "map"`: load or build its maps into `dir` before the run and
-/// return the lines that say how (empty for any other scene, which pays nothing).
+/// For a scene with `fidelity = "map"`: read what the cache folder `dir` holds of its maps
+/// before the run (the line builds the base cells its parts reach, [`persist_maps`] writes them
+/// back) and return the lines that say so (empty for any other scene, which pays nothing).
 pub fn prepare_maps(scene: &Scene, dir: Option<&Path>, quiet: bool) -> String {
     if scene.map_tier.is_none() {
         return String::new();
     }
     let dir = cache_dir(dir);
     if !quiet {
-        eprintln!("map tier: loading or building maps in {}", dir.display());
+        eprintln!(
+            "map tier: reading maps from {}; base cells not there are built as parts reach them",
+            dir.display()
+        );
     }
-    let started = Instant::now();
-    let bar = super::progress::bar(0, "base cells built", quiet);
-    let count = super::progress::counter(&bar);
-    let prepared = prepare_observed(scene, Some(&dir), &|j, done, total| {
-        bar.set_message(format!("map of obstacle {} ", j + 1));
-        count(done, total)
-    });
-    bar.finish_and_clear();
+    let pins = contact_map::load(scene, Some(&dir));
     let mut seen = BTreeSet::new();
     let mut text = String::new();
-    for (_, loaded) in &prepared {
-        for w in &loaded.warnings {
+    for pin in &pins {
+        for w in &pin.warnings {
             eprintln!("warning: {w}");
         }
-        if seen.insert(loaded.map.key) {
-            text.push_str(&format!("map {}  {}\n", loaded.map.key, loaded.describe()));
+        if seen.insert(pin.map.key()) {
+            let (built, all) = pin.map.cells_built();
+            text.push_str(&format!(
+                "map {}  before the run: {built} of {all} base cells in the cache\n",
+                pin.map.key()
+            ));
         }
     }
-    text.push_str(&format!(
-        "map tier ready            {} map(s) for {} pin(s) in {:.2} s, cache {}\n",
-        seen.len(),
-        prepared.len(),
-        started.elapsed().as_secs_f64(),
-        dir.display()
-    ));
+    text
+}
+
+/// After a run of a scene with `fidelity = "map"`: write the base cells its line built back to
+/// the cache and return the lines that say what was built and where it went.
+pub fn persist_maps(scene: &Scene) -> String {
+    if scene.map_tier.is_none() {
+        return String::new();
+    }
+    let mut text = String::new();
+    for p in contact_map::persist(scene) {
+        if let Some(w) = &p.warning {
+            eprintln!("warning: {w}");
+        }
+        let (now, all) = p.cells;
+        let line = if p.built == 0 {
+            format!("no base cell built: the cache held every cell the parts reached ({now} of {all} built)")
+        } else {
+            let whereto = match &p.written {
+                Some(f) => format!(", written to {}", f.display()),
+                None => ", kept in memory only".to_string(),
+            };
+            format!(
+                "{} base cell(s) built as parts reached them, {:.2} s of the run's wall time; {now} of {all} built now{whereto}",
+                p.built, p.seconds
+            )
+        };
+        text.push_str(&format!("map {}  {line}\n", p.key));
+    }
     text
 }
 

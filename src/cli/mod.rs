@@ -117,6 +117,16 @@ pub fn flag(field: &str) -> String {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     let Cli { command, recorded } = cli;
     let recorded = recorded.as_str();
+    let result = command_run(command, recorded);
+    // Map-tier cells a command's lines built are kept for the next command (a file that cannot
+    // be written costs only the rebuild).
+    for w in pinfeed::maps::tier::lazy::persist_all() {
+        eprintln!("warning: {w}");
+    }
+    result
+}
+
+fn command_run(command: Command, recorded: &str) -> anyhow::Result<()> {
     match command {
         Command::Part(a) => part::run(&a),
         Command::Contact(a) => contact::run(&a),

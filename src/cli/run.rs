@@ -82,6 +82,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
         .with_context(|| format!("running {}", args.scenario.display()))?;
     let wall = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    let maps = maps + &super::contact_map::persist_maps(&scene);
     let summary = &result.summary;
 
     let dir = args

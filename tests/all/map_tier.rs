@@ -1,7 +1,8 @@
 //! The certified map tier: answers within 0.05° of the exact model where it
 //! serves, the exact model near a jump, a cache keyed by every input, corrupted files refused and
-//! rebuilt, a build independent of the thread count, and a line with `fidelity = "map"` that
-//! ends every part in the class the exact line does.
+//! rebuilt, a build independent of the thread count, a line with `fidelity = "map"` that
+//! ends every part in the class the exact line does, and maps built cell by cell as queries reach
+//! them that answer as the whole map.
 
 use crate::support::pinfeed_json;
 use pinfeed::engine::{self, contact_map, RunOptions};
@@ -609,5 +610,218 @@ fn cells_built_on_demand_answer_as_the_whole_map() {
     assert!(rest.map.is_complete());
     assert!((rest.map.stats.certified_area - whole.stats.certified_area).abs() < 1e-12);
     assert_eq!(rest.map.stats.certified_cells, whole.stats.certified_cells);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The same answer, field by field that the line uses, or the same reason for the exact model.
+fn same_answer(
+    want: Result<pinfeed::mechanics::ContactOutcome, Fallback>,
+    got: Result<pinfeed::mechanics::ContactOutcome, Fallback>,
+    what: &str,
+) {
+    match (want, got) {
+        (Ok(w), Ok(g)) => assert_eq!(
+            (
+                w.pose_final,
+                w.contact,
+                w.contact_length,
+                w.travel_to_contact
+            ),
+            (
+                g.pose_final,
+                g.contact,
+                g.contact_length,
+                g.travel_to_contact
+            ),
+            "{what}"
+        ),
+        (w, g) => assert_eq!(w.err(), g.err(), "{what}"),
+    }
+}
+
+/// A lazy map (what a line on the map tier uses) builds a base cell only when a query that needs
+/// it falls there — not for a miss (the ray cast answers) — answers every query as the whole map
+/// does, and writes back exactly the cells it built: the merged map answers as the whole map in
+/// them, keeps the others unbuilt, and survives its file.
+#[test]
+fn a_lazy_map_builds_only_the_cells_its_queries_need_and_answers_as_the_whole_map() {
+    let spec = TierSpec {
+        theta_cells: 10,
+        d_cells: 4,
+        max_depth: 1,
+        ..TierSpec::default()
+    };
+    let a = inputs(spec);
+    let whole = tier::build(&a);
+    let dir = temp_dir("lazy");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = tier::cache::file_of(&dir, &whole.key);
+    let lazy = tier::LazyMap::new(
+        std::sync::Arc::new(TierMap::unbuilt(&a)),
+        Some(file.clone()),
+    );
+    assert_eq!(
+        lazy.persist().unwrap(),
+        None,
+        "nothing built, nothing written"
+    );
+    let mut rng = stream(11, 0);
+    let mut needed = std::collections::BTreeSet::new();
+    let mut queries = Vec::new();
+    for k in 0..30 {
+        let theta = rng.random::<f64>() * std::f64::consts::TAU;
+        let d = (rng.random::<f64>() - 0.5) * 2.4;
+        let (pose, pin) = query(theta, d);
+        let want = whole.answer(model(), pose, pin, RADIUS);
+        // The cell is needed when the whole map looked it up: a touch, served or not certified.
+        if matches!(&want, Ok(o) if o.contact) || want == Err(Fallback::Uncertified) {
+            if let Some(c) = tier::cell_of_query(&a, pose, pin) {
+                needed.insert(c);
+            }
+        }
+        same_answer(want, lazy.answer(&a, pose, pin), &format!("query {k}"));
+        assert_eq!(lazy.built_now().0 as usize, needed.len(), "query {k}");
+        queries.push((pose, pin));
+    }
+    let all = (spec.theta_cells * spec.d_cells) as usize;
+    assert!(!needed.is_empty() && needed.len() < all, "{needed:?}");
+    assert_eq!(lazy.cells_built(), (needed.len() as u64, all as u64));
+    // Asked again, nothing more is built.
+    for &(pose, pin) in &queries {
+        let _ = lazy.answer(&a, pose, pin);
+    }
+    assert_eq!(lazy.built_now().0 as usize, needed.len());
+    let merged = lazy.merged().expect("cells were built");
+    assert_eq!(merged.stats.built_cells as usize, needed.len());
+    let unbuilt: Vec<usize> = merged.unbuilt_cells().collect();
+    assert_eq!(unbuilt.len(), all - needed.len());
+    assert!(unbuilt.iter().all(|c| !needed.contains(c)));
+    for (k, &(pose, pin)) in queries.iter().enumerate() {
+        same_answer(
+            whole.answer(model(), pose, pin, RADIUS),
+            merged.answer(model(), pose, pin, RADIUS),
+            &format!("merged, query {k}"),
+        );
+    }
+    // Adopting a cell already built changes nothing.
+    let mut again = merged.clone();
+    again.adopt(*needed.first().unwrap(), &whole);
+    assert_eq!(again, merged);
+    // Written once, read back whole; a second write has nothing new to write.
+    assert_eq!(lazy.persist().unwrap(), Some(file.clone()));
+    assert_eq!(tier::cache::read(&file, &whole.key).unwrap(), merged);
+    assert_eq!(lazy.persist().unwrap(), None);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A line on the map tier builds only the base cells its parts reach, and ends every part exactly
+/// as the same line with the whole map built beforehand: the same records and the same work.
+#[test]
+fn a_map_scene_builds_only_the_cells_its_parts_reach_with_the_same_results() {
+    let text = std::fs::read_to_string("scenarios/quickstart.toml").unwrap();
+    let line = "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"";
+    // A grid no other test uses: this process's lazy map of it starts empty.
+    let map_text = text.replace(line, "fidelity = \"map\"\nmap_grid = [20, 10, 1]");
+    let scene = pinfeed::scenario::parse(Path::new("q.toml"), &map_text).unwrap();
+    let pins = contact_map::load(&scene, None);
+    assert_eq!(pins.len(), 3);
+    assert_eq!(pins[0].map.cells_built(), (0, 200));
+    let opts = RunOptions {
+        parts: 200,
+        keep_records: true,
+        ..RunOptions::from_scene(&scene)
+    };
+    let lazy = engine::run(&scene, &opts, &mut |_| {}).unwrap();
+    let (built, all) = pins[0].map.cells_built();
+    assert!(built > 0 && built * 2 < all, "{built} of {all} cells built");
+    assert_eq!(pins[0].map.built_now().0, built);
+    // The whole map, built before the run, replaces the lazy one in this process.
+    let prepared = contact_map::prepare(&scene, None);
+    assert!(prepared[0].1.map.is_complete());
+    assert_eq!(
+        contact_map::load(&scene, None)[0].map.cells_built(),
+        (200, 200)
+    );
+    let whole = engine::run(&scene, &opts, &mut |_| {}).unwrap();
+    assert_eq!(lazy.records.len(), whole.records.len());
+    for (a, b) in lazy.records.iter().zip(&whole.records) {
+        assert_eq!(
+            (a.outcome, a.theta_out_deg.to_bits()),
+            (b.outcome, b.theta_out_deg.to_bits()),
+            "part {}",
+            a.part
+        );
+    }
+    assert_eq!(
+        serde_json::to_string(&lazy.summary.work).unwrap(),
+        serde_json::to_string(&whole.summary.work).unwrap()
+    );
+}
+
+/// `pinfeed run` on a map scene says what the cache held before the run and how many cells the
+/// line built, writes them to the cache folder, and a second run finds them all there and builds
+/// nothing, with the same summary.
+#[test]
+fn run_builds_the_cells_its_parts_reach_into_the_cache_and_reuses_them() {
+    let dir = temp_dir("run-lazy");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string("scenarios/quickstart.toml")
+        .unwrap()
+        .replace(
+            "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"",
+            "fidelity = \"map\"\nmap_grid = [12, 6, 1]",
+        );
+    let scene = dir.join("q.toml");
+    std::fs::write(&scene, text).unwrap();
+    let cache = dir.join("cache");
+    let run = |out: &str| {
+        let o = crate::support::pinfeed_ok(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--parts",
+            "60",
+            "--out",
+            dir.join(out).to_str().unwrap(),
+            "--cache-dir",
+            cache.to_str().unwrap(),
+        ]);
+        let text = String::from_utf8(o.stdout).unwrap();
+        let summary =
+            std::fs::read_to_string(dir.join(out).join("quickstart/summary.json")).unwrap();
+        (text, summary)
+    };
+    let number = |text: &str, after: &str| -> u64 {
+        let at = text
+            .find(after)
+            .unwrap_or_else(|| panic!("{after:?} in {text}"));
+        let digits: String = text[at + after.len()..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect();
+        digits.parse().unwrap()
+    };
+    let (first, s1) = run("a");
+    assert!(
+        first.contains("before the run: 0 of 72 base cells in the cache"),
+        "{first}"
+    );
+    let line = first
+        .lines()
+        .find(|l| l.contains("built as parts reached them"))
+        .expect(&first);
+    let built = number(line, "  ");
+    assert!(built > 0 && built < 72, "{line}");
+    assert!(line.contains("written to"), "{line}");
+    let files: Vec<_> = std::fs::read_dir(&cache).unwrap().collect();
+    assert_eq!(files.len(), 1);
+    let (second, s2) = run("b");
+    assert!(
+        second.contains(&format!(
+            "before the run: {built} of 72 base cells in the cache"
+        )),
+        "{second}"
+    );
+    assert!(second.contains("no base cell built"), "{second}");
+    assert_eq!(s1, s2);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -14,16 +14,17 @@ use super::metrics::MapTierCounters;
 use super::motion::Pusher;
 use super::state::ActivePart;
 use crate::geometry::Pose;
-use crate::maps::tier::{self, Fallback, Loaded, TierInputs, TierMap};
+use crate::maps::tier::{self, lazy, Fallback, LazyMap, Loaded, TierInputs};
 use crate::mechanics::{ContactOutcome, ContactSettings, PinPath, Recorder, Support};
 use crate::scenario::{Obstacle, Scene};
 use crate::sensing::signal::KnotRecorder;
 use std::path::Path;
 use std::sync::Arc;
 
-/// The maps of a scene's pins, by obstacle index (None for fences).
+/// The maps of a scene's pins, by obstacle index (None for fences): lazy maps, which build a
+/// base cell when a push first falls in it ([`LazyMap`]).
 pub struct LineMaps {
-    by_obstacle: Vec<Option<Arc<TierMap>>>,
+    by_obstacle: Vec<Option<Arc<LazyMap>>>,
 }
 
 /// The inputs of the map of pin `pin` of `scene` (radius and μc are the pin's).
@@ -42,8 +43,21 @@ fn inputs_for<'s>(scene: &'s Scene, radius: f64, mu_c: f64) -> Option<TierInputs
     })
 }
 
-/// Load or build the maps of every pin of a scene that uses the tier (nothing otherwise), from
-/// and into the cache folder `dir`; each pin with where its map came from.
+/// The map inputs of each pin of a scene that uses the tier, by obstacle index.
+fn pin_inputs(scene: &Scene) -> impl Iterator<Item = (usize, TierInputs<'_>)> {
+    scene
+        .obstacles
+        .iter()
+        .enumerate()
+        .filter_map(|(j, o)| match o {
+            Obstacle::Pin(p) => inputs_for(scene, p.radius, p.mu_c).map(|i| (j, i)),
+            Obstacle::Fence(_) => None,
+        })
+}
+
+/// Load or build the whole map of every pin of a scene that uses the tier (nothing otherwise),
+/// from and into the cache folder `dir`; each pin with where its map came from. The line then
+/// uses these maps (nothing is left to build during the run).
 pub fn prepare(scene: &Scene, dir: Option<&Path>) -> Vec<(usize, Loaded)> {
     prepare_observed(scene, dir, &|_, _, _| {})
 }
@@ -55,32 +69,100 @@ pub fn prepare_observed(
     dir: Option<&Path>,
     progress: &(dyn Fn(usize, u64, u64) + Sync),
 ) -> Vec<(usize, Loaded)> {
-    scene
-        .obstacles
-        .iter()
-        .enumerate()
-        .filter_map(|(j, o)| match o {
-            Obstacle::Pin(p) => inputs_for(scene, p.radius, p.mu_c).map(|i| (j, i)),
-            Obstacle::Fence(_) => None,
-        })
+    pin_inputs(scene)
         .map(|(j, inputs)| {
             let report = |done, total| progress(j, done, total);
-            (j, tier::shared_observed(&inputs, dir, &report))
+            let loaded = tier::shared_observed(&inputs, dir, &report);
+            lazy::register(&loaded);
+            (j, loaded)
         })
         .collect()
 }
 
+/// The map of one pin as the line will use it: built cells from the cache, the others built
+/// when a push first falls in them.
+pub struct PinMap {
+    /// The obstacle index of the pin.
+    pub obstacle: usize,
+    /// Its map.
+    pub map: Arc<LazyMap>,
+    /// What went wrong reading its cache file (a refused file), in words; never fatal.
+    pub warnings: Vec<String>,
+}
+
+/// The maps of every pin of a scene that uses the tier (nothing otherwise), as a line will use
+/// them: read from the cache folder `dir` where it holds them (whole or in part), never built
+/// here — the line builds the base cells its pushes reach ([`LazyMap`]); [`persist`] writes them
+/// back.
+pub fn load(scene: &Scene, dir: Option<&Path>) -> Vec<PinMap> {
+    pin_inputs(scene)
+        .map(|(j, inputs)| {
+            let (map, warnings) = lazy::lazy_shared(&inputs, dir);
+            PinMap {
+                obstacle: j,
+                map,
+                warnings,
+            }
+        })
+        .collect()
+}
+
+/// What [`persist`] did with one map.
+#[derive(Debug, Clone)]
+pub struct Persisted {
+    /// The map's key.
+    pub key: tier::TierKey,
+    /// Base cells built in this process, and their builds' wall time summed (s).
+    pub built: u64,
+    /// Wall time of those builds, summed (s).
+    pub seconds: f64,
+    /// Base cells built now (loaded or built in this process), of all.
+    pub cells: (u64, u64),
+    /// The cache file written (None: no folder, or nothing new to write).
+    pub written: Option<std::path::PathBuf>,
+    /// Why the file could not be written, in words; never fatal.
+    pub warning: Option<String>,
+}
+
+/// Write back to their cache files the maps of a scene's pins that gained base cells in this
+/// process (each map once); one entry per map.
+pub fn persist(scene: &Scene) -> Vec<Persisted> {
+    let mut seen = std::collections::BTreeSet::new();
+    let mut out = Vec::new();
+    for (_, inputs) in pin_inputs(scene) {
+        let (map, _) = lazy::lazy_shared(&inputs, None);
+        if !seen.insert(map.key()) {
+            continue;
+        }
+        let (built, seconds) = map.built_now();
+        let mut p = Persisted {
+            key: map.key(),
+            built,
+            seconds,
+            cells: map.cells_built(),
+            written: None,
+            warning: None,
+        };
+        match map.persist() {
+            Ok(file) => p.written = file,
+            Err(e) => p.warning = Some(e.to_string()),
+        }
+        out.push(p);
+    }
+    out
+}
+
 impl LineMaps {
-    /// The maps of a scene that uses the tier (from this process's maps or the default cache
-    /// folder), None otherwise.
+    /// The maps of a scene that uses the tier (this process's lazy maps, else what the default
+    /// cache folder holds), None otherwise.
     pub fn for_scene(scene: &Scene) -> Option<LineMaps> {
         scene.map_tier?;
         let mut by_obstacle = vec![None; scene.obstacles.len()];
-        for (j, loaded) in prepare(scene, Some(&tier::default_cache_dir())) {
-            for w in &loaded.warnings {
+        for pin in load(scene, Some(&tier::default_cache_dir())) {
+            for w in &pin.warnings {
                 eprintln!("warning: {w}");
             }
-            by_obstacle[j] = Some(loaded.map);
+            by_obstacle[pin.obstacle] = Some(pin.map);
         }
         Some(LineMaps { by_obstacle })
     }
@@ -120,7 +202,16 @@ pub(super) fn push_contact(
                 Err(Fallback::MovingPin)
             }
             (Pusher::Pin { centre, radius, .. }, Some(map)) => {
-                map.answer(model, req.pose, *centre, *radius)
+                // The map's inputs are the pin's (the map of this obstacle was made from them).
+                match &scene.obstacles[req.j] {
+                    Obstacle::Pin(p) if p.radius == *radius => {
+                        match inputs_for(scene, p.radius, p.mu_c) {
+                            Some(inputs) => map.answer(&inputs, req.pose, *centre),
+                            None => Err(Fallback::Unbuilt),
+                        }
+                    }
+                    _ => Err(Fallback::Unbuilt),
+                }
             }
         };
         match answer {

@@ -182,17 +182,25 @@ fn any_servable(cell: &Cell, at: &BTreeMap<u64, Sample>) -> bool {
 }
 
 /// Compute, in parallel and in key order, every lattice point the cells need that is not known.
-fn fill(cells: &[Cell], at: &mut BTreeMap<u64, Sample>, inputs: &TierInputs, lat: &Lattice) {
+fn fill(
+    cells: &[Cell],
+    at: &mut BTreeMap<u64, Sample>,
+    inputs: &TierInputs,
+    lat: &Lattice,
+    parallel: bool,
+) {
     let missing: BTreeSet<(u64, u64)> = cells
         .iter()
         .flat_map(|c| c.points())
         .filter(|&(i, j)| !at.contains_key(&lattice_key(i, j)))
         .collect();
     let missing: Vec<(u64, u64)> = missing.into_iter().collect();
-    let computed: Vec<Sample> = missing
-        .par_iter()
-        .map(|&(i, j)| exact_sample(inputs, lat.reach, lat.theta(i), lat.d(j)))
-        .collect();
+    let sample = |&(i, j): &(u64, u64)| exact_sample(inputs, lat.reach, lat.theta(i), lat.d(j));
+    let computed: Vec<Sample> = if parallel {
+        missing.par_iter().map(sample).collect()
+    } else {
+        missing.iter().map(sample).collect()
+    };
     for ((i, j), s) in missing.into_iter().zip(computed) {
         at.insert(lattice_key(i, j), s);
     }
@@ -226,30 +234,65 @@ pub fn extend_observed(
     roots: &[usize],
     progress: crate::progress::Report,
 ) {
-    let todo: BTreeSet<usize> = roots
+    // Nothing to build: no tables either.
+    if !roots
         .iter()
-        .copied()
-        .filter(|&r| map.nodes.get(r) == Some(&Node::Unbuilt))
-        .collect();
-    if todo.is_empty() {
+        .any(|&r| map.nodes.get(r) == Some(&Node::Unbuilt))
+    {
         return;
     }
-    // A map's build is a batch of ~10⁵ exact pushes over one part: its sticks pay for stick tables.
-    let model = inputs.model.clone().with_stick_tables();
+    let model = tabled_model(inputs);
     let inputs = &TierInputs {
         model: &model,
         ..*inputs
     };
-    let todo: Vec<usize> = todo.into_iter().collect();
+    extend_tabled(map, inputs, roots, progress);
+}
+
+/// The model a map is built with: the inputs' model with stick tables. A map's build is a batch
+/// of ~10⁵ exact pushes over one part, whose sticks pay for the tables; a map built cell by cell
+/// ([`super::LazyMap`]) keeps one such model for all its cells.
+pub fn tabled_model(inputs: &TierInputs) -> crate::mechanics::PartModel {
+    inputs.model.clone().with_stick_tables()
+}
+
+/// [`extend_observed`] with `inputs.model` already the [`tabled_model`].
+pub fn extend_tabled(
+    map: &mut TierMap,
+    inputs: &TierInputs,
+    roots: &[usize],
+    progress: crate::progress::Report,
+) {
+    let todo: Vec<usize> = roots
+        .iter()
+        .copied()
+        .filter(|&r| map.nodes.get(r) == Some(&Node::Unbuilt))
+        .collect::<BTreeSet<usize>>()
+        .into_iter()
+        .collect();
     let tally = crate::progress::Tally::new(todo.len() as u64, progress);
     for batch in todo.chunks(CELLS_PER_BATCH) {
-        build_cells(map, inputs, batch);
+        build_cells(map, inputs, batch, true);
         tally.add(batch.len() as u64);
     }
 }
 
-/// Build the unbuilt base cells `todo` of `map` (the model of `inputs` already has its tables).
-fn build_cells(map: &mut TierMap, inputs: &TierInputs, todo: &[usize]) {
+/// Build the unbuilt base cell `root` of `map` (`inputs.model` already the [`tabled_model`]):
+/// the same cell as [`extend`] builds, for a cell built while a query waits
+/// ([`super::LazyMap`]). Its samples are computed in parallel only when this thread is not one
+/// of rayon's workers: a worker waiting for its helpers runs other queued tasks meanwhile, and
+/// one of those could ask for the cell being built (a line of a study run in parallel), which
+/// would wait on itself. A thread outside the pool just blocks until its helpers are done.
+pub fn build_cell_here(map: &mut TierMap, inputs: &TierInputs, root: usize) {
+    if map.nodes.get(root) == Some(&Node::Unbuilt) {
+        let parallel = rayon::current_thread_index().is_none();
+        build_cells(map, inputs, &[root], parallel);
+    }
+}
+
+/// Build the unbuilt base cells `todo` of `map` (the model of `inputs` already has its tables),
+/// their samples computed in parallel or on this thread.
+fn build_cells(map: &mut TierMap, inputs: &TierInputs, todo: &[usize], parallel: bool) {
     let spec = inputs.spec;
     let per_cell = 1u64 << (spec.max_depth + 2);
     let (nt, nd) = (u64::from(spec.theta_cells), u64::from(spec.d_cells));
@@ -276,7 +319,7 @@ fn build_cells(map: &mut TierMap, inputs: &TierInputs, todo: &[usize]) {
     let (nodes, samples) = (&mut map.nodes, &mut map.samples);
     let mut area = 0.0;
     while !cells.is_empty() {
-        fill(&cells, &mut at, inputs, &lat);
+        fill(&cells, &mut at, inputs, &lat, parallel);
         let mut next = Vec::new();
         for cell in &cells {
             if certified(cell, &at, inputs) {

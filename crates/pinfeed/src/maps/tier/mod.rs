@@ -37,6 +37,7 @@
 pub mod build;
 pub mod cache;
 pub mod key;
+pub mod lazy;
 pub mod query;
 pub mod report;
 
@@ -46,6 +47,7 @@ pub use cache::{
     Loaded, Source,
 };
 pub use key::TierKey;
+pub use lazy::LazyMap;
 pub use query::{cell_of_query, push_with_map, Fallback};
 
 use crate::mechanics::{ContactSettings, PartModel, Support};
@@ -201,6 +203,46 @@ impl TierMap {
     pub fn unbuilt_cells(&self) -> impl Iterator<Item = usize> + '_ {
         let roots = self.spec.theta_cells as usize * self.spec.d_cells as usize;
         (0..roots).filter(|&r| self.nodes[r] == Node::Unbuilt)
+    }
+
+    /// Take base cell `root` as `from` (a map of the same inputs) built it, if this map has not
+    /// built it yet: its quadtree and samples are copied in (indices renumbered) and its build
+    /// statistics added. Every query in the cell is then answered as `from` answers it.
+    pub fn adopt(&mut self, root: usize, from: &TierMap) {
+        debug_assert_eq!(self.key, from.key, "a cell of another map");
+        if self.nodes.get(root) != Some(&Node::Unbuilt) || from.nodes[root] == Node::Unbuilt {
+            return;
+        }
+        let mut samples = std::collections::BTreeMap::new();
+        // Depth-first copy: (node in `from`, its slot here).
+        let mut stack = vec![(root, root)];
+        while let Some((src, dst)) = stack.pop() {
+            self.nodes[dst] = match from.nodes[src] {
+                Node::Split { first } => {
+                    let here = self.nodes.len();
+                    self.nodes.extend([Node::Fallback; 4]);
+                    for k in 0..4 {
+                        stack.push((first as usize + k, here + k));
+                    }
+                    Node::Split { first: here as u32 }
+                }
+                Node::Certified { points } => Node::Certified {
+                    points: points.map(|i| {
+                        *samples.entry(i).or_insert_with(|| {
+                            self.samples.push(from.samples[i as usize]);
+                            (self.samples.len() - 1) as u32
+                        })
+                    }),
+                },
+                leaf => leaf,
+            };
+        }
+        let (st, add) = (&mut self.stats, &from.stats);
+        st.exact_samples += add.exact_samples;
+        st.certified_cells += add.certified_cells;
+        st.fallback_cells += add.fallback_cells;
+        st.certified_area += add.certified_area;
+        st.built_cells += 1;
     }
 
     /// The leaf holding (θ0 ∈ [0, 2π), d ∈ [−r, r]) and the local coordinates (u, v) ∈ [0, 1]² in

@@ -1,0 +1,223 @@
+//! A map whose base cells are built when a query first falls in them: what a line on the map
+//! tier uses, so that it builds only the cells its parts reach.
+//!
+//! A line's pushes cover a small part of a map's θ0 × d rectangle (the feed's lateral spread, and
+//! downstream of the first pin the few orientations the pins before it leave), so building every
+//! base cell before the run computes pushes no part will ask for. A [`LazyMap`] starts from the
+//! map a cache file holds (or from an empty one) and builds a missing base cell the first time a
+//! query falls in it, exactly as a whole-map build would (a cell's quadtree and samples depend on
+//! that cell alone, [`super::build::extend`]): every answer is the one the whole map gives, and
+//! the line's output does not depend on which cells were built before or by which thread. The
+//! cells built are written back to the cache after the run ([`LazyMap::merged`]), so later runs
+//! find them.
+
+use super::{base_cell, build, Fallback, Loaded, Node, TierInputs, TierKey, TierMap};
+use crate::geometry::{wrap_2pi, Pose, Vec2};
+use crate::mechanics::{ContactOutcome, PartModel};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
+
+/// A map that builds its missing base cells on first use (see the module docs).
+pub struct LazyMap {
+    /// The map as loaded (every cell, some, or none built).
+    map: Arc<TierMap>,
+    /// Its cache file (None: kept in memory only).
+    file: Option<PathBuf>,
+    /// Base cells built in this process, each as a map of that one cell.
+    cells: Vec<OnceLock<TierMap>>,
+    /// The model the cells are built with (stick tables, shared by every cell).
+    tabled: OnceLock<PartModel>,
+    /// Cells built in this process, and their build's wall time summed (ns).
+    built: AtomicU64,
+    build_ns: AtomicU64,
+    /// Cells built in this process when the map was last written to its file.
+    written: Mutex<u64>,
+}
+
+impl LazyMap {
+    /// A lazy map over `map`, whose cache file is `file`.
+    pub fn new(map: Arc<TierMap>, file: Option<PathBuf>) -> LazyMap {
+        let cells = (0..map.spec.theta_cells as usize * map.spec.d_cells as usize)
+            .map(|_| OnceLock::new())
+            .collect();
+        LazyMap {
+            map,
+            file,
+            cells,
+            tabled: OnceLock::new(),
+            built: AtomicU64::new(0),
+            build_ns: AtomicU64::new(0),
+            written: Mutex::new(0),
+        }
+    }
+
+    /// The map as it was loaded (without the cells built since).
+    pub fn loaded(&self) -> &TierMap {
+        &self.map
+    }
+
+    /// Its key.
+    pub fn key(&self) -> TierKey {
+        self.map.key
+    }
+
+    /// Its cache file.
+    pub fn file(&self) -> Option<&PathBuf> {
+        self.file.as_ref()
+    }
+
+    /// Base cells built in this process, and the wall time their builds took (s).
+    pub fn built_now(&self) -> (u64, f64) {
+        (
+            self.built.load(Ordering::Relaxed),
+            self.build_ns.load(Ordering::Relaxed) as f64 * 1e-9,
+        )
+    }
+
+    /// [`TierMap::answer`], building the query's base cell first if neither the loaded map nor
+    /// this process has built it. `inputs` must be the map's (its key is checked in debug builds).
+    pub fn answer(
+        &self,
+        inputs: &TierInputs,
+        pose: Pose,
+        pin_start: Vec2,
+    ) -> Result<ContactOutcome, Fallback> {
+        match self
+            .map
+            .answer(inputs.model, pose, pin_start, inputs.radius)
+        {
+            Err(Fallback::Unbuilt) => {}
+            other => return other,
+        }
+        let d = (pin_start.y - pose.y) / inputs.model.scale();
+        let Some((root, _, _)) =
+            base_cell(&self.map.spec, self.map.reach, wrap_2pi(pose.theta_rad), d)
+        else {
+            return Err(Fallback::Uncertified);
+        };
+        let cell = self.cells[root].get_or_init(|| self.build_cell(inputs, root));
+        cell.answer(inputs.model, pose, pin_start, inputs.radius)
+    }
+
+    /// Base cell `root` built alone, as a map of that one cell.
+    fn build_cell(&self, inputs: &TierInputs, root: usize) -> TierMap {
+        debug_assert_eq!(TierKey::of(inputs), self.map.key, "inputs of another map");
+        let started = Instant::now();
+        let model = self.tabled.get_or_init(|| build::tabled_model(inputs));
+        let inputs = TierInputs { model, ..*inputs };
+        let mut cell = TierMap::unbuilt(&inputs);
+        build::build_cell_here(&mut cell, &inputs, root);
+        self.built.fetch_add(1, Ordering::Relaxed);
+        self.build_ns
+            .fetch_add(started.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        cell
+    }
+
+    /// The loaded map with every cell built since adopted ([`TierMap::adopt`]); None when no
+    /// cell was built.
+    pub fn merged(&self) -> Option<TierMap> {
+        if self.built.load(Ordering::Relaxed) == 0 {
+            return None;
+        }
+        let mut map = (*self.map).clone();
+        for (root, cell) in self.cells.iter().enumerate() {
+            if let Some(cell) = cell.get() {
+                map.adopt(root, cell);
+            }
+        }
+        Some(map)
+    }
+
+    /// Write the map with the cells built in this process to its cache file, if it has one and
+    /// cells were built since the last write: the file written, or None.
+    pub fn persist(&self) -> Result<Option<PathBuf>, super::CacheError> {
+        let mut written = self.written.lock().expect("lazy map write");
+        let built = self.built.load(Ordering::Relaxed);
+        let (Some(path), true) = (&self.file, built > *written) else {
+            return Ok(None);
+        };
+        let Some(merged) = self.merged() else {
+            return Ok(None);
+        };
+        super::cache::write(path, &merged)?;
+        *written = built;
+        Ok(Some(path.clone()))
+    }
+
+    /// Base cells built, in the loaded map or since, of all.
+    pub fn cells_built(&self) -> (u64, u64) {
+        let roots = self.cells.len();
+        let built = (0..roots)
+            .filter(|&r| self.map.nodes[r] != Node::Unbuilt || self.cells[r].get().is_some())
+            .count();
+        (built as u64, roots as u64)
+    }
+}
+
+/// The lazy maps of this process, by key: a line's map tier and every later line share one.
+fn memo() -> &'static Mutex<BTreeMap<TierKey, Arc<LazyMap>>> {
+    static MEMO: OnceLock<Mutex<BTreeMap<TierKey, Arc<LazyMap>>>> = OnceLock::new();
+    MEMO.get_or_init(|| Mutex::new(BTreeMap::new()))
+}
+
+/// The lazy map of `inputs` in this process; on first use, over the map the cache folder `dir`
+/// holds (read, never built: a file refused is reported in the warnings and the map starts
+/// empty), or over an empty map without a folder.
+pub fn lazy_shared(
+    inputs: &TierInputs,
+    dir: Option<&std::path::Path>,
+) -> (Arc<LazyMap>, Vec<String>) {
+    let key = TierKey::of(inputs);
+    let mut memo = memo().lock().expect("lazy map memo");
+    if let Some(m) = memo.get(&key) {
+        return (m.clone(), Vec::new());
+    }
+    let file = dir.map(|d| super::cache::file_of(d, &key));
+    let mut warnings = Vec::new();
+    let map = match &file {
+        Some(path) if path.exists() => match super::cache::read(path, &key) {
+            Ok(m) => m,
+            Err(e) => {
+                warnings.push(e.to_string());
+                TierMap::unbuilt(inputs)
+            }
+        },
+        _ => TierMap::unbuilt(inputs),
+    };
+    let lazy = Arc::new(LazyMap::new(Arc::new(map), file));
+    memo.insert(key, lazy.clone());
+    (lazy, warnings)
+}
+
+/// Make `loaded` (a map built or read whole) the lazy map of its key in this process: it
+/// replaces one there only if it is complete (a cell's content does not depend on where it was
+/// built, so nothing is lost).
+pub fn register(loaded: &Loaded) -> Arc<LazyMap> {
+    let mut memo = memo().lock().expect("lazy map memo");
+    let key = loaded.map.key;
+    if let Some(m) = memo.get(&key) {
+        if !loaded.map.is_complete() {
+            return m.clone();
+        }
+    }
+    let lazy = Arc::new(LazyMap::new(loaded.map.clone(), loaded.file.clone()));
+    memo.insert(key, lazy.clone());
+    lazy
+}
+
+/// [`LazyMap::persist`] for every lazy map of this process (a command's last step, so that the
+/// cells its lines built are found by the next): the files that could not be written, in words.
+pub fn persist_all() -> Vec<String> {
+    let maps: Vec<Arc<LazyMap>> = memo()
+        .lock()
+        .expect("lazy map memo")
+        .values()
+        .cloned()
+        .collect();
+    maps.iter()
+        .filter_map(|m| m.persist().err().map(|e| e.to_string()))
+        .collect()
+}
