@@ -703,10 +703,26 @@ fn a_lazy_map_builds_only_the_cells_its_queries_need_and_answers_as_the_whole_ma
             &format!("merged, query {k}"),
         );
     }
-    // Adopting a cell already built changes nothing.
+    // Adopting a cell already built changes nothing; a cell adopted from the whole map into an
+    // empty one answers as the whole map there.
+    let root = *needed.first().unwrap();
     let mut again = merged.clone();
-    again.adopt(*needed.first().unwrap(), &whole);
+    again.adopt(root, &whole.cell(root).unwrap());
     assert_eq!(again, merged);
+    let mut one = TierMap::unbuilt(&a);
+    one.adopt(root, &whole.cell(root).unwrap());
+    assert_eq!(one.stats.built_cells, 1);
+    let (mine, theirs) = (one.cell(root).unwrap(), whole.cell(root).unwrap());
+    assert_eq!((mine.nodes, mine.samples), (theirs.nodes, theirs.samples));
+    for (k, &(pose, pin)) in queries.iter().enumerate() {
+        if tier::cell_of_query(&a, pose, pin) == Some(root) {
+            same_answer(
+                whole.answer(model(), pose, pin, RADIUS),
+                one.answer(model(), pose, pin, RADIUS),
+                &format!("adopted, query {k}"),
+            );
+        }
+    }
     // Written once, read back whole; a second write has nothing new to write.
     assert_eq!(lazy.persist().unwrap(), Some(file.clone()));
     assert_eq!(tier::cache::read(&file, &whole.key).unwrap(), merged);

@@ -11,7 +11,8 @@
 //! cells built are written back to the cache after the run ([`LazyMap::merged`]), so later runs
 //! find them.
 
-use super::{base_cell, build, Fallback, Loaded, Node, TierInputs, TierKey, TierMap};
+use super::query::answer_from;
+use super::{base_cell, build, CellTree, Fallback, Loaded, Node, TierInputs, TierKey, TierMap};
 use crate::geometry::{wrap_2pi, Pose, Vec2};
 use crate::mechanics::{ContactOutcome, PartModel};
 use std::collections::BTreeMap;
@@ -26,8 +27,8 @@ pub struct LazyMap {
     map: Arc<TierMap>,
     /// Its cache file (None: kept in memory only).
     file: Option<PathBuf>,
-    /// Base cells built in this process, each as a map of that one cell.
-    cells: Vec<OnceLock<TierMap>>,
+    /// Base cells built in this process, each on its own (a few kB each, whatever the grid).
+    cells: Vec<OnceLock<CellTree>>,
     /// The model the cells are built with (stick tables, shared by every cell).
     tabled: OnceLock<PartModel>,
     /// Cells built in this process, and their build's wall time summed (ns).
@@ -93,23 +94,29 @@ impl LazyMap {
             other => return other,
         }
         let d = (pin_start.y - pose.y) / inputs.model.scale();
-        let Some((root, _, _)) =
-            base_cell(&self.map.spec, self.map.reach, wrap_2pi(pose.theta_rad), d)
-        else {
+        let (spec, reach) = (&self.map.spec, self.map.reach);
+        let Some((root, _, _)) = base_cell(spec, reach, wrap_2pi(pose.theta_rad), d) else {
             return Err(Fallback::Uncertified);
         };
         let cell = self.cells[root].get_or_init(|| self.build_cell(inputs, root));
-        cell.answer(inputs.model, pose, pin_start, inputs.radius)
+        answer_from(inputs.model, pose, pin_start, inputs.radius, |theta, d| {
+            let (_, u, v) = base_cell(spec, reach, theta, d)?;
+            let (node, u, v) = cell.leaf(u, v);
+            Some((node, u, v, cell.samples.as_slice()))
+        })
     }
 
-    /// Base cell `root` built alone, as a map of that one cell.
-    fn build_cell(&self, inputs: &TierInputs, root: usize) -> TierMap {
+    /// Base cell `root` built alone.
+    fn build_cell(&self, inputs: &TierInputs, root: usize) -> CellTree {
         debug_assert_eq!(TierKey::of(inputs), self.map.key, "inputs of another map");
         let started = Instant::now();
         let model = self.tabled.get_or_init(|| build::tabled_model(inputs));
         let inputs = TierInputs { model, ..*inputs };
-        let mut cell = TierMap::unbuilt(&inputs);
-        build::build_cell_here(&mut cell, &inputs, root);
+        // Built in a map of its own (the build indexes cells by their place in the grid), then
+        // kept alone: the map's other roots are not held per cell.
+        let mut map = TierMap::unbuilt(&inputs);
+        build::build_cell_here(&mut map, &inputs, root);
+        let cell = map.cell(root).expect("the cell was just built");
         self.built.fetch_add(1, Ordering::Relaxed);
         self.build_ns
             .fetch_add(started.elapsed().as_nanos() as u64, Ordering::Relaxed);

@@ -48,6 +48,7 @@ pub use cache::{
 };
 pub use key::TierKey;
 pub use lazy::LazyMap;
+
 pub use query::{cell_of_query, push_with_map, Fallback};
 
 use crate::mechanics::{ContactSettings, PartModel, Support};
@@ -205,39 +206,39 @@ impl TierMap {
         (0..roots).filter(|&r| self.nodes[r] == Node::Unbuilt)
     }
 
-    /// Take base cell `root` as `from` (a map of the same inputs) built it, if this map has not
-    /// built it yet: its quadtree and samples are copied in (indices renumbered) and its build
-    /// statistics added. Every query in the cell is then answered as `from` answers it.
-    pub fn adopt(&mut self, root: usize, from: &TierMap) {
-        debug_assert_eq!(self.key, from.key, "a cell of another map");
-        if self.nodes.get(root) != Some(&Node::Unbuilt) || from.nodes[root] == Node::Unbuilt {
+    /// Base cell `root` on its own ([`CellTree`]); None if it is not built.
+    pub fn cell(&self, root: usize) -> Option<CellTree> {
+        if self.nodes.get(root).is_none_or(|n| *n == Node::Unbuilt) {
+            return None;
+        }
+        let mut cell = CellTree {
+            nodes: vec![Node::Unbuilt],
+            samples: Vec::new(),
+            stats: BuildStats::default(),
+        };
+        copy_tree(
+            (&self.nodes, &self.samples, root),
+            (&mut cell.nodes, &mut cell.samples, 0),
+        );
+        // A cell's own statistics are known only when the map holds that cell alone.
+        if self.stats.built_cells == 1 {
+            cell.stats = self.stats;
+        }
+        Some(cell)
+    }
+
+    /// Take base cell `root` as `cell` holds it, if this map has not built it yet: its quadtree
+    /// and samples are copied in (indices renumbered) and its build statistics added. Every query
+    /// in the cell is then answered as `cell` answers it.
+    pub fn adopt(&mut self, root: usize, cell: &CellTree) {
+        if self.nodes.get(root) != Some(&Node::Unbuilt) || cell.nodes[0] == Node::Unbuilt {
             return;
         }
-        let mut samples = std::collections::BTreeMap::new();
-        // Depth-first copy: (node in `from`, its slot here).
-        let mut stack = vec![(root, root)];
-        while let Some((src, dst)) = stack.pop() {
-            self.nodes[dst] = match from.nodes[src] {
-                Node::Split { first } => {
-                    let here = self.nodes.len();
-                    self.nodes.extend([Node::Fallback; 4]);
-                    for k in 0..4 {
-                        stack.push((first as usize + k, here + k));
-                    }
-                    Node::Split { first: here as u32 }
-                }
-                Node::Certified { points } => Node::Certified {
-                    points: points.map(|i| {
-                        *samples.entry(i).or_insert_with(|| {
-                            self.samples.push(from.samples[i as usize]);
-                            (self.samples.len() - 1) as u32
-                        })
-                    }),
-                },
-                leaf => leaf,
-            };
-        }
-        let (st, add) = (&mut self.stats, &from.stats);
+        copy_tree(
+            (&cell.nodes, &cell.samples, 0),
+            (&mut self.nodes, &mut self.samples, root),
+        );
+        let (st, add) = (&mut self.stats, &cell.stats);
         st.exact_samples += add.exact_samples;
         st.certified_cells += add.certified_cells;
         st.fallback_cells += add.fallback_cells;
@@ -248,14 +249,70 @@ impl TierMap {
     /// The leaf holding (θ0 ∈ [0, 2π), d ∈ [−r, r]) and the local coordinates (u, v) ∈ [0, 1]² in
     /// it; None outside the d range.
     pub fn leaf(&self, theta: f64, d: f64) -> Option<(Node, f64, f64)> {
-        let (root, mut u, mut v) = base_cell(&self.spec, self.reach, theta, d)?;
-        let mut node = self.nodes[root];
-        while let Node::Split { first } = node {
-            let (hu, hv) = (usize::from(u >= 0.5), usize::from(v >= 0.5));
-            u = 2.0 * u - hu as f64;
-            v = 2.0 * v - hv as f64;
-            node = self.nodes[first as usize + hu + 2 * hv];
-        }
-        Some((node, u, v))
+        let (root, u, v) = base_cell(&self.spec, self.reach, theta, d)?;
+        Some(descend(&self.nodes, root, u, v))
+    }
+}
+
+/// One base cell of a map on its own: its quadtree (root first) and the samples its certified
+/// leaves interpolate, with the statistics of its build. What a lazy map builds when a query first
+/// falls in a cell ([`LazyMap`]), and what [`TierMap::adopt`] copies in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellTree {
+    /// The quadtree, root at 0.
+    pub nodes: Vec<Node>,
+    /// The samples of its certified leaves.
+    pub samples: Vec<Sample>,
+    /// How it was built.
+    pub stats: BuildStats,
+}
+
+impl CellTree {
+    /// The leaf holding the local coordinates (u, v) ∈ [0, 1]² of the cell, and the leaf's own.
+    pub fn leaf(&self, u: f64, v: f64) -> (Node, f64, f64) {
+        descend(&self.nodes, 0, u, v)
+    }
+}
+
+/// From node `at` of a quadtree down to the leaf holding the local coordinates (u, v) ∈ [0, 1]²,
+/// and the leaf's own coordinates.
+fn descend(nodes: &[Node], at: usize, mut u: f64, mut v: f64) -> (Node, f64, f64) {
+    let mut node = nodes[at];
+    while let Node::Split { first } = node {
+        let (hu, hv) = (usize::from(u >= 0.5), usize::from(v >= 0.5));
+        u = 2.0 * u - hu as f64;
+        v = 2.0 * v - hv as f64;
+        node = nodes[first as usize + hu + 2 * hv];
+    }
+    (node, u, v)
+}
+
+/// Copy the quadtree under node `from.2` of (`from.0` nodes, `from.1` samples) into node `to.2` of
+/// (`to.0`, `to.1`): children appended, samples appended once each, indices renumbered.
+fn copy_tree(from: (&[Node], &[Sample], usize), to: (&mut Vec<Node>, &mut Vec<Sample>, usize)) {
+    let ((src_nodes, src_samples, root), (nodes, samples, at)) = (from, to);
+    let mut renumbered = std::collections::BTreeMap::new();
+    // Depth-first: (node in the source, its slot here).
+    let mut stack = vec![(root, at)];
+    while let Some((src, dst)) = stack.pop() {
+        nodes[dst] = match src_nodes[src] {
+            Node::Split { first } => {
+                let here = nodes.len();
+                nodes.extend([Node::Fallback; 4]);
+                for k in 0..4 {
+                    stack.push((first as usize + k, here + k));
+                }
+                Node::Split { first: here as u32 }
+            }
+            Node::Certified { points } => Node::Certified {
+                points: points.map(|i| {
+                    *renumbered.entry(i).or_insert_with(|| {
+                        samples.push(src_samples[i as usize]);
+                        (samples.len() - 1) as u32
+                    })
+                }),
+            },
+            leaf => leaf,
+        };
     }
 }

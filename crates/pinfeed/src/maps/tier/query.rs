@@ -2,7 +2,7 @@
 //! interpolation, or the exact model where the map cannot vouch for the answer.
 
 use super::build::interpolate;
-use super::{Node, TierInputs, TierMap};
+use super::{Node, Sample, TierInputs, TierMap};
 use crate::geometry::{wrap_2pi, Pose, Vec2};
 use crate::mechanics::{
     pin_first_touch, push_path, untouched, ContactOutcome, ContactSettings, ContactStatus,
@@ -58,41 +58,56 @@ impl TierMap {
         pin_start: Vec2,
         radius: f64,
     ) -> Result<ContactOutcome, Fallback> {
-        let k = model.scale();
-        let local = pose.apply_inverse(pin_start) / k;
-        let poly = model.polygon();
-        if poly.contains(local) || poly.distance_to_boundary(local).0 < radius / k {
-            return Err(Fallback::PinInside);
-        }
-        let path = PinPath::constant(0.0);
-        let Some(touch) = pin_first_touch(model, pose, pin_start, radius, &path) else {
-            return Ok(untouched(pose, ContactStatus::Ok));
-        };
-        let d = (pin_start.y - pose.y) / k;
-        let Some((node, u, v)) = self.leaf(wrap_2pi(pose.theta_rad), d) else {
-            return Err(Fallback::Uncertified);
-        };
-        let points = match node {
-            Node::Certified { points } => points,
-            Node::Unbuilt => return Err(Fallback::Unbuilt),
-            Node::Split { .. } | Node::Fallback => return Err(Fallback::Uncertified),
-        };
-        let c = points.map(|i| &self.samples[i as usize]);
-        let [rotation, dx, dy, span] = interpolate(c, u, v);
-        Ok(ContactOutcome {
-            contact: true,
-            pose_initial: pose,
-            pose_final: Pose::new(pose.x + dx * k, pose.y + dy * k, pose.theta_rad + rotation),
-            rotation_rad: rotation,
-            travel_to_contact: touch,
-            contact_length: span * k,
-            contacts: 1,
-            segments: Vec::new(),
-            evaluations: 0,
-            steps: 0,
-            status: ContactStatus::Ok,
+        answer_from(model, pose, pin_start, radius, |theta, d| {
+            let (node, u, v) = self.leaf(theta, d)?;
+            Some((node, u, v, self.samples.as_slice()))
         })
     }
+}
+
+/// [`TierMap::answer`] with the leaf of (θ0 ∈ [0, 2π), d) looked up by `leaf`: the leaf, its
+/// local coordinates and the samples its points index (None outside the map's d range).
+pub(super) fn answer_from<'m>(
+    model: &PartModel,
+    pose: Pose,
+    pin_start: Vec2,
+    radius: f64,
+    leaf: impl FnOnce(f64, f64) -> Option<(Node, f64, f64, &'m [Sample])>,
+) -> Result<ContactOutcome, Fallback> {
+    let k = model.scale();
+    let local = pose.apply_inverse(pin_start) / k;
+    let poly = model.polygon();
+    if poly.contains(local) || poly.distance_to_boundary(local).0 < radius / k {
+        return Err(Fallback::PinInside);
+    }
+    let path = PinPath::constant(0.0);
+    let Some(touch) = pin_first_touch(model, pose, pin_start, radius, &path) else {
+        return Ok(untouched(pose, ContactStatus::Ok));
+    };
+    let d = (pin_start.y - pose.y) / k;
+    let Some((node, u, v, samples)) = leaf(wrap_2pi(pose.theta_rad), d) else {
+        return Err(Fallback::Uncertified);
+    };
+    let points = match node {
+        Node::Certified { points } => points,
+        Node::Unbuilt => return Err(Fallback::Unbuilt),
+        Node::Split { .. } | Node::Fallback => return Err(Fallback::Uncertified),
+    };
+    let c = points.map(|i| &samples[i as usize]);
+    let [rotation, dx, dy, span] = interpolate(c, u, v);
+    Ok(ContactOutcome {
+        contact: true,
+        pose_initial: pose,
+        pose_final: Pose::new(pose.x + dx * k, pose.y + dy * k, pose.theta_rad + rotation),
+        rotation_rad: rotation,
+        travel_to_contact: touch,
+        contact_length: span * k,
+        contacts: 1,
+        segments: Vec::new(),
+        evaluations: 0,
+        steps: 0,
+        status: ContactStatus::Ok,
+    })
 }
 
 /// The base cell a query of [`TierMap::answer`] falls in (None: outside the map's d range), for
