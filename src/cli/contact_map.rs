@@ -71,6 +71,7 @@ pub fn persist_maps(scene: &Scene) -> String {
         } else {
             let whereto = match &p.written {
                 Some(f) => format!(", written to {}", f.display()),
+                None if p.warning.is_some() => ", not written (see the warning)".to_string(),
                 None => ", kept in memory only".to_string(),
             };
             format!(

@@ -841,3 +841,40 @@ fn run_builds_the_cells_its_parts_reach_into_the_cache_and_reuses_them() {
     assert_eq!(s1, s2);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A cache folder that cannot be written costs the next run its cells, nothing else: the run
+/// succeeds, says the cells were not written, and warns once.
+#[test]
+fn a_cache_that_cannot_be_written_warns_once_and_the_run_goes_on() {
+    let dir = temp_dir("run-unwritable");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string("scenarios/quickstart.toml")
+        .unwrap()
+        .replace(
+            "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"",
+            "fidelity = \"map\"\nmap_grid = [12, 6, 1]",
+        );
+    let scene = dir.join("q.toml");
+    std::fs::write(&scene, text).unwrap();
+    // A file where the folder should be: nothing can be created under it.
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "").unwrap();
+    let o = crate::support::pinfeed(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--parts",
+        "30",
+        "--out",
+        dir.join("out").to_str().unwrap(),
+        "--cache-dir",
+        blocker.join("cache").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (out, err) = (
+        String::from_utf8(o.stdout).unwrap(),
+        String::from_utf8(o.stderr).unwrap(),
+    );
+    assert!(out.contains("not written (see the warning)"), "{out}");
+    assert_eq!(err.matches("warning: map cache file").count(), 1, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

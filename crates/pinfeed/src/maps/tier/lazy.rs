@@ -139,7 +139,8 @@ impl LazyMap {
     }
 
     /// Write the map with the cells built in this process to its cache file, if it has one and
-    /// cells were built since the last write: the file written, or None.
+    /// cells were built since the last attempt: the file written, or None. A write that fails is
+    /// not tried again for the same cells (its error is returned once).
     pub fn persist(&self) -> Result<Option<PathBuf>, super::CacheError> {
         let mut written = self.written.lock().expect("lazy map write");
         let built = self.built.load(Ordering::Relaxed);
@@ -149,8 +150,8 @@ impl LazyMap {
         let Some(merged) = self.merged() else {
             return Ok(None);
         };
-        super::cache::write(path, &merged)?;
         *written = built;
+        super::cache::write(path, &merged)?;
         Ok(Some(path.clone()))
     }
 
