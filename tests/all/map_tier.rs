@@ -774,12 +774,9 @@ fn a_map_scene_builds_only_the_cells_its_parts_reach_with_the_same_results() {
     );
 }
 
-/// `pinfeed run` on a map scene says what the cache held before the run and how many cells the
-/// line built, writes them to the cache folder, and a second run finds them all there and builds
-/// nothing, with the same summary.
-#[test]
-fn run_builds_the_cells_its_parts_reach_into_the_cache_and_reuses_them() {
-    let dir = temp_dir("run-lazy");
+/// A fresh folder `name` holding the quickstart on a small map grid (`q.toml`).
+fn quickstart_on_a_small_map(name: &str) -> (PathBuf, PathBuf) {
+    let dir = temp_dir(name);
     std::fs::create_dir_all(&dir).unwrap();
     let text = std::fs::read_to_string("scenarios/quickstart.toml")
         .unwrap()
@@ -789,6 +786,15 @@ fn run_builds_the_cells_its_parts_reach_into_the_cache_and_reuses_them() {
         );
     let scene = dir.join("q.toml");
     std::fs::write(&scene, text).unwrap();
+    (dir, scene)
+}
+
+/// `pinfeed run` on a map scene says what the cache held before the run and how many cells the
+/// line built, writes them to the cache folder, and a second run finds them all there and builds
+/// nothing, with the same summary.
+#[test]
+fn run_builds_the_cells_its_parts_reach_into_the_cache_and_reuses_them() {
+    let (dir, scene) = quickstart_on_a_small_map("run-lazy");
     let cache = dir.join("cache");
     let run = |out: &str| {
         let o = crate::support::pinfeed_ok(&[
@@ -846,16 +852,7 @@ fn run_builds_the_cells_its_parts_reach_into_the_cache_and_reuses_them() {
 /// succeeds, says the cells were not written, and warns once.
 #[test]
 fn a_cache_that_cannot_be_written_warns_once_and_the_run_goes_on() {
-    let dir = temp_dir("run-unwritable");
-    std::fs::create_dir_all(&dir).unwrap();
-    let text = std::fs::read_to_string("scenarios/quickstart.toml")
-        .unwrap()
-        .replace(
-            "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"",
-            "fidelity = \"map\"\nmap_grid = [12, 6, 1]",
-        );
-    let scene = dir.join("q.toml");
-    std::fs::write(&scene, text).unwrap();
+    let (dir, scene) = quickstart_on_a_small_map("run-unwritable");
     // A file where the folder should be: nothing can be created under it.
     let blocker = dir.join("file");
     std::fs::write(&blocker, "").unwrap();
