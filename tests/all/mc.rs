@@ -732,3 +732,55 @@ fn a_map_scene_builds_one_map_per_input_not_per_sample() {
     assert_eq!(varied["results"][0]["samples"], 6, "{varied}");
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// A study over a map scene whose samples run in parallel builds the map's cells as its lines
+/// reach them (a worker building a cell never waits on itself): one and two threads, each from
+/// an empty cache, give the same report, and each leaves one map file behind.
+#[test]
+fn a_map_scene_study_gives_the_same_report_on_one_and_two_threads() {
+    let d = tmp("map-threads");
+    let text = std::fs::read_to_string(scenario()).unwrap().replace(
+        "fidelity = \"exact\"   # or \"ellipsoid\", \"tip\"",
+        "fidelity = \"map\"\nmap_grid = [16, 4, 1]",
+    );
+    assert!(text.contains("map_grid"));
+    let scene = d.join("map.toml");
+    std::fs::write(&scene, text).unwrap();
+    let study = d.join("study.toml");
+    std::fs::write(
+        &study,
+        format!(
+            "scenario = \"{}\"\nname = \"map-threads\"\nsamples = 12\n\n[uncertain.pose_theta]\ndistribution = \"normal\"\nsd = 3.0\n",
+            s(&scene)
+        ),
+    )
+    .unwrap();
+    let run = |threads: &str, out: &Path, cache: &Path| {
+        let o = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+            .args([
+                "mc",
+                s(&study),
+                "--threads",
+                threads,
+                "--quiet",
+                "--out",
+                s(out),
+            ])
+            .env("PINFEED_CACHE", cache)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(std::fs::read_dir(cache).unwrap().count(), 1, "one map file");
+    };
+    let (a, b) = (d.join("a"), d.join("b"));
+    run("1", &a, &d.join("cache-1"));
+    run("2", &b, &d.join("cache-2"));
+    for f in ["report.md", "report.json"] {
+        assert_eq!(
+            crate::support::report_text(&a, f),
+            crate::support::report_text(&b, f),
+            "{f}"
+        );
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}
