@@ -112,7 +112,7 @@ pub fn load(scene: &Scene, dir: Option<&Path>) -> Vec<PinMap> {
 pub struct Persisted {
     /// The map's key.
     pub key: tier::TierKey,
-    /// Base cells built in this process, and their builds' wall time summed (s).
+    /// Base cells built in this process (by the line, as its pushes reached them).
     pub built: u64,
     /// Wall time of those builds, summed (s).
     pub seconds: f64,
