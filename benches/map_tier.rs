@@ -6,9 +6,12 @@
 //! `push_with_map` (the exact model where the map is not certified), `exact_all` — every push
 //! exact. And the build (no cache): `build/query cell` — the one base cell a single query needs
 //! (`contact --model map`: θ0 100°, d 0.3), `build/whole map 36x12x2` — every base cell of a
-//! coarser grid than the default. Run: `cargo bench --features bench --bench map_tier`.
+//! coarser grid than the default, `build/quickstart line, 2000 parts, empty map` — the bundled
+//! quickstart on the map tier (default grid) from an empty map: the line builds the base cells its
+//! parts reach as they reach them. Run: `cargo bench --features bench --bench map_tier`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use pinfeed::engine::{self, contact_map, RunOptions};
 use pinfeed::geometry::{part_from_spec, Pose, Vec2};
 use pinfeed::maps::tier::{self, push_with_map, TierInputs, TierSpec};
 use pinfeed::mechanics::{push_path, ContactSettings, PartModel, PinPath, Support};
@@ -114,6 +117,22 @@ fn bench_build(c: &mut Criterion) {
     };
     group.bench_function("whole map 36x12x2", |b| {
         b.iter(|| black_box(tier::build(&coarse).stats.exact_samples))
+    });
+    let mut scene = pinfeed::scenario::load(std::path::Path::new("scenarios/quickstart.toml"))
+        .expect("the bundled quickstart");
+    scene.map_tier = Some(TierSpec::default());
+    let opts = RunOptions {
+        parts: 2000,
+        ..RunOptions::from_scene(&scene)
+    };
+    group.bench_function("quickstart line, 2000 parts, empty map", |b| {
+        b.iter(|| {
+            // This process's maps forgotten, then an empty one (no cache folder) for the line.
+            tier::lazy::forget_all();
+            let pins = contact_map::load(&scene, None);
+            let run = engine::run(&scene, &opts, &mut |_| {}).expect("the line runs");
+            black_box((run.summary.parts_in, pins[0].map.built_now().0))
+        })
     });
     group.finish();
 }

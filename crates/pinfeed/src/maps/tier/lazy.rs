@@ -200,6 +200,13 @@ pub fn lazy_shared(
     (lazy, warnings)
 }
 
+/// Forget every lazy map of this process (their memory is freed once no line holds them): the
+/// cells built and not yet written ([`persist_all`]) are lost. The next line starts from what the
+/// cache holds — for a long-running program done with its maps, or a measurement from scratch.
+pub fn forget_all() {
+    memo().lock().expect("lazy map memo").clear();
+}
+
 /// Make `loaded` (a map built or read whole) the lazy map of its key in this process: it
 /// replaces one there only if it is complete (a cell's content does not depend on where it was
 /// built, so nothing is lost).
