@@ -14,7 +14,7 @@ use super::metrics::MapTierCounters;
 use super::motion::Pusher;
 use super::state::ActivePart;
 use crate::geometry::Pose;
-use crate::maps::tier::{self, lazy, Fallback, LazyMap, Loaded, TierInputs};
+use crate::maps::tier::{self, lazy, Fallback, LazyMap, Loaded, TierInputs, TierSpec};
 use crate::mechanics::{ContactOutcome, ContactSettings, PinPath, Recorder, Support};
 use crate::scenario::{Obstacle, Scene};
 use crate::sensing::signal::KnotRecorder;
@@ -24,14 +24,15 @@ use std::sync::Arc;
 /// The maps of a scene's pins, by obstacle index (None for fences): lazy maps, which build a
 /// base cell when a push first falls in it ([`LazyMap`]).
 pub struct LineMaps {
-    by_obstacle: Vec<Option<Arc<LazyMap>>>,
+    /// The scene's grid.
+    spec: TierSpec,
+    by_obstacle: Vec<Option<PinMap>>,
 }
 
-/// The inputs of the map of pin `pin` of `scene` (radius and μc are the pin's).
-fn inputs_for<'s>(scene: &'s Scene, radius: f64, mu_c: f64) -> Option<TierInputs<'s>> {
+/// The inputs of the map of a pin of `scene` with this radius and μc on the grid `spec`.
+fn map_inputs(scene: &Scene, spec: TierSpec, radius: f64, mu_c: f64) -> TierInputs<'_> {
     static UNIFORM: Support = Support::Uniform;
-    let spec = scene.map_tier?;
-    Some(TierInputs {
+    TierInputs {
         model: &scene.part.model,
         support: &UNIFORM,
         radius,
@@ -40,7 +41,7 @@ fn inputs_for<'s>(scene: &'s Scene, radius: f64, mu_c: f64) -> Option<TierInputs
             ..scene.contact
         },
         spec,
-    })
+    }
 }
 
 /// The map inputs of each pin of a scene that uses the tier, by obstacle index.
@@ -50,7 +51,9 @@ fn pin_inputs(scene: &Scene) -> impl Iterator<Item = (usize, TierInputs<'_>)> {
         .iter()
         .enumerate()
         .filter_map(|(j, o)| match o {
-            Obstacle::Pin(p) => inputs_for(scene, p.radius, p.mu_c).map(|i| (j, i)),
+            Obstacle::Pin(p) => scene
+                .map_tier
+                .map(|spec| (j, map_inputs(scene, spec, p.radius, p.mu_c))),
             Obstacle::Fence(_) => None,
         })
 }
@@ -84,6 +87,10 @@ pub fn prepare_observed(
 pub struct PinMap {
     /// The obstacle index of the pin.
     pub obstacle: usize,
+    /// The pin's radius (the map's).
+    pub radius: f64,
+    /// The pin's μc.
+    pub mu_c: f64,
     /// Its map.
     pub map: Arc<LazyMap>,
     /// What went wrong reading its cache file (a refused file), in words; never fatal.
@@ -100,6 +107,8 @@ pub fn load(scene: &Scene, dir: Option<&Path>) -> Vec<PinMap> {
             let (map, warnings) = lazy::lazy_shared(&inputs, dir);
             PinMap {
                 obstacle: j,
+                radius: inputs.radius,
+                mu_c: inputs.settings.mu_c,
                 map,
                 warnings,
             }
@@ -130,7 +139,9 @@ pub fn persist(scene: &Scene) -> Vec<Persisted> {
     let mut seen = std::collections::BTreeSet::new();
     let mut out = Vec::new();
     for (_, inputs) in pin_inputs(scene) {
-        let (map, _) = lazy::lazy_shared(&inputs, None);
+        let Some(map) = lazy::existing(&inputs) else {
+            continue;
+        };
         if !seen.insert(map.key()) {
             continue;
         }
@@ -156,15 +167,17 @@ impl LineMaps {
     /// The maps of a scene that uses the tier (this process's lazy maps, else what the default
     /// cache folder holds), None otherwise.
     pub fn for_scene(scene: &Scene) -> Option<LineMaps> {
-        scene.map_tier?;
-        let mut by_obstacle = vec![None; scene.obstacles.len()];
+        let spec = scene.map_tier?;
+        let mut by_obstacle: Vec<Option<PinMap>> =
+            (0..scene.obstacles.len()).map(|_| None).collect();
         for pin in load(scene, Some(&tier::default_cache_dir())) {
             for w in &pin.warnings {
                 eprintln!("warning: {w}");
             }
-            by_obstacle[pin.obstacle] = Some(pin.map);
+            let j = pin.obstacle;
+            by_obstacle[j] = Some(pin);
         }
-        Some(LineMaps { by_obstacle })
+        Some(LineMaps { spec, by_obstacle })
     }
 }
 
@@ -201,17 +214,9 @@ pub(super) fn push_contact(
             (Pusher::Pin { path, .. }, _) if *path != PinPath::constant(0.0) => {
                 Err(Fallback::MovingPin)
             }
-            (Pusher::Pin { centre, radius, .. }, Some(map)) => {
-                // The map's inputs are the pin's (the map of this obstacle was made from them).
-                match &scene.obstacles[req.j] {
-                    Obstacle::Pin(p) if p.radius == *radius => {
-                        match inputs_for(scene, p.radius, p.mu_c) {
-                            Some(inputs) => map.answer(&inputs, req.pose, *centre),
-                            None => Err(Fallback::Unbuilt),
-                        }
-                    }
-                    _ => Err(Fallback::Unbuilt),
-                }
+            (Pusher::Pin { centre, .. }, Some(pin)) => {
+                let inputs = map_inputs(scene, maps.spec, pin.radius, pin.mu_c);
+                pin.map.answer(&inputs, req.pose, *centre)
             }
         };
         match answer {

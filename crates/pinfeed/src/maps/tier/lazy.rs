@@ -13,7 +13,7 @@
 
 use super::query::answer_from;
 use super::{base_cell, build, CellTree, Fallback, Loaded, Node, TierInputs, TierKey, TierMap};
-use crate::geometry::{wrap_2pi, Pose, Vec2};
+use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{ContactOutcome, PartModel};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -79,28 +79,23 @@ impl LazyMap {
     }
 
     /// [`TierMap::answer`], building the query's base cell first if neither the loaded map nor
-    /// this process has built it. `inputs` must be the map's (its key is checked in debug builds).
+    /// this process has built it (only for a query that reaches a cell: a miss or a pin inside the
+    /// part is answered first, once). `inputs` must be the map's (its key is checked in debug
+    /// builds).
     pub fn answer(
         &self,
         inputs: &TierInputs,
         pose: Pose,
         pin_start: Vec2,
     ) -> Result<ContactOutcome, Fallback> {
-        match self
-            .map
-            .answer(inputs.model, pose, pin_start, inputs.radius)
-        {
-            Err(Fallback::Unbuilt) => {}
-            other => return other,
-        }
-        let d = (pin_start.y - pose.y) / inputs.model.scale();
-        let (spec, reach) = (&self.map.spec, self.map.reach);
-        let Some((root, _, _)) = base_cell(spec, reach, wrap_2pi(pose.theta_rad), d) else {
-            return Err(Fallback::Uncertified);
-        };
-        let cell = self.cells[root].get_or_init(|| self.build_cell(inputs, root));
+        let map = &*self.map;
         answer_from(inputs.model, pose, pin_start, inputs.radius, |theta, d| {
-            let (_, u, v) = base_cell(spec, reach, theta, d)?;
+            let (root, u, v) = base_cell(&map.spec, map.reach, theta, d)?;
+            if map.nodes[root] != Node::Unbuilt {
+                let (node, u, v) = map.leaf_in(root, u, v);
+                return Some((node, u, v, map.samples.as_slice()));
+            }
+            let cell = self.cells[root].get_or_init(|| self.build_cell(inputs, root));
             let (node, u, v) = cell.leaf(u, v);
             Some((node, u, v, cell.samples.as_slice()))
         })
@@ -169,6 +164,12 @@ impl LazyMap {
 fn memo() -> &'static Mutex<BTreeMap<TierKey, Arc<LazyMap>>> {
     static MEMO: OnceLock<Mutex<BTreeMap<TierKey, Arc<LazyMap>>>> = OnceLock::new();
     MEMO.get_or_init(|| Mutex::new(BTreeMap::new()))
+}
+
+/// The lazy map of `inputs` in this process, if a line or [`lazy_shared`] made one.
+pub fn existing(inputs: &TierInputs) -> Option<Arc<LazyMap>> {
+    let key = TierKey::of(inputs);
+    memo().lock().expect("lazy map memo").get(&key).cloned()
 }
 
 /// The lazy map of `inputs` in this process; on first use, over the map the cache folder `dir`

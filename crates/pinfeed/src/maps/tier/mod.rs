@@ -250,7 +250,13 @@ impl TierMap {
     /// it; None outside the d range.
     pub fn leaf(&self, theta: f64, d: f64) -> Option<(Node, f64, f64)> {
         let (root, u, v) = base_cell(&self.spec, self.reach, theta, d)?;
-        Some(descend(&self.nodes, root, u, v))
+        Some(self.leaf_in(root, u, v))
+    }
+
+    /// The leaf of base cell `root` holding its local coordinates (u, v) ∈ [0, 1]², and the
+    /// leaf's own.
+    pub fn leaf_in(&self, root: usize, u: f64, v: f64) -> (Node, f64, f64) {
+        descend(&self.nodes, root, u, v)
     }
 }
 
