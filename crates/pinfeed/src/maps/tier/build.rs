@@ -234,35 +234,6 @@ pub fn extend_observed(
     roots: &[usize],
     progress: crate::progress::Report,
 ) {
-    // Nothing to build: no tables either.
-    if !roots
-        .iter()
-        .any(|&r| map.nodes.get(r) == Some(&Node::Unbuilt))
-    {
-        return;
-    }
-    let model = tabled_model(inputs);
-    let inputs = &TierInputs {
-        model: &model,
-        ..*inputs
-    };
-    extend_tabled(map, inputs, roots, progress);
-}
-
-/// The model a map is built with: the inputs' model with stick tables. A map's build is a batch
-/// of ~10⁵ exact pushes over one part, whose sticks pay for the tables; a map built cell by cell
-/// ([`super::LazyMap`]) keeps one such model for all its cells.
-pub fn tabled_model(inputs: &TierInputs) -> crate::mechanics::PartModel {
-    inputs.model.clone().with_stick_tables()
-}
-
-/// [`extend_observed`] with `inputs.model` already the [`tabled_model`].
-pub fn extend_tabled(
-    map: &mut TierMap,
-    inputs: &TierInputs,
-    roots: &[usize],
-    progress: crate::progress::Report,
-) {
     let todo: Vec<usize> = roots
         .iter()
         .copied()
@@ -270,11 +241,26 @@ pub fn extend_tabled(
         .collect::<BTreeSet<usize>>()
         .into_iter()
         .collect();
+    if todo.is_empty() {
+        return;
+    }
+    let model = tabled_model(inputs);
+    let inputs = &TierInputs {
+        model: &model,
+        ..*inputs
+    };
     let tally = crate::progress::Tally::new(todo.len() as u64, progress);
     for batch in todo.chunks(CELLS_PER_BATCH) {
         build_cells(map, inputs, batch, true);
         tally.add(batch.len() as u64);
     }
+}
+
+/// The model a map is built with: the inputs' model with stick tables. A map's build is a batch
+/// of ~10⁵ exact pushes over one part, whose sticks pay for the tables; a map built cell by cell
+/// ([`super::LazyMap`]) keeps one such model for all its cells.
+pub fn tabled_model(inputs: &TierInputs) -> crate::mechanics::PartModel {
+    inputs.model.clone().with_stick_tables()
 }
 
 /// Build the unbuilt base cell `root` of `map` (`inputs.model` already the [`tabled_model`]):
