@@ -141,12 +141,19 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
     let quiet = args.json || args.csv || args.quiet || req.model != ModelChoice::Map;
     let bar = super::progress::bar(0, "base cells of the map built", quiet);
     bar.set_message("map tier ");
-    let run = maps::run(&req, &super::flag, &super::progress::counter(&bar));
+    let run = maps::run(
+        &req,
+        &super::flag,
+        &super::progress::watch(&bar, args.quiet),
+    );
     bar.finish_and_clear();
     let run = run?;
     if let Some(l) = &run.tier {
         for w in &l.warnings {
             eprintln!("warning: {w}");
+        }
+        if !args.quiet {
+            eprintln!("map tier: {}", l.describe());
         }
     }
     if let Some(line) = &run.served {

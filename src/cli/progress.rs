@@ -5,6 +5,7 @@
 //! callback (`done` of `total`, or a tick per unit of work) that the command points at a bar.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use pinfeed::progress::{Forecast, Observer};
 use std::io::IsTerminal;
 use std::time::Duration;
 
@@ -41,11 +42,33 @@ pub fn spinner(label: &str, quiet: bool) -> ProgressBar {
 /// A callback for the library's `(done, total)` reports that moves `bar` (its length follows
 /// `total`, so one bar can follow several counted stages in turn).
 pub fn counter(bar: &ProgressBar) -> impl Fn(u64, u64) + Sync + '_ {
-    move |done, total| {
-        if bar.length() != Some(total) {
-            bar.set_length(total);
+    move |done, total| watch(bar, true).progress(done, total)
+}
+
+/// An observer for the library's reports that moves `bar` as [`counter`] does and writes a
+/// forecast (a map tier's build, after its probe) as a line above it, unless `quiet`.
+pub fn watch(bar: &ProgressBar, quiet: bool) -> Watch<'_> {
+    Watch { bar, quiet }
+}
+
+/// See [`watch`].
+pub struct Watch<'a> {
+    bar: &'a ProgressBar,
+    quiet: bool,
+}
+
+impl Observer for Watch<'_> {
+    fn progress(&self, done: u64, total: u64) {
+        if self.bar.length() != Some(total) {
+            self.bar.set_length(total);
         }
-        bar.set_position(done);
+        self.bar.set_position(done);
+    }
+
+    fn forecast(&self, forecast: &Forecast) {
+        if !self.quiet {
+            note(self.bar, &forecast.said);
+        }
     }
 }
 

@@ -159,6 +159,16 @@ fn tiny() -> TierSpec {
     }
 }
 
+/// 32 base cells (more than one batch of a build), refined once.
+fn small() -> TierSpec {
+    TierSpec {
+        theta_cells: 8,
+        d_cells: 4,
+        max_depth: 1,
+        ..TierSpec::default()
+    }
+}
+
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("pinfeed-map-tier-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -507,6 +517,35 @@ fn configuration_maps_from_the_map_tier_match_exact_and_refuse_what_it_cannot_ta
     let map = pinfeed_json(&a);
     let exact = pinfeed_json(&common);
     assert_eq!(map["model"], "map");
+    // Without --json, from an empty cache: the 48 base cells' build is forecast before the
+    // rest is built, and the forecast is shown again beside the build's time.
+    let fresh = temp_dir("cli-map-forecast");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+        .args(&common[..common.len() - 2])
+        .args([
+            "--no-write",
+            "--model",
+            "map",
+            "--map-grid",
+            "24,8,2",
+            "--cache-dir",
+        ])
+        .arg(&fresh)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let said = err.find("map tier: 48 base cells to build; their first level");
+    let built = err.find("map tier: 48 base cell(s) built in");
+    assert!(
+        matches!((said, built), (Some(s), Some(b)) if s < b),
+        "{err}"
+    );
+    assert!(
+        err.contains("forecast after its first level and a"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&fresh);
     for (m, e) in map["maps"]
         .as_array()
         .unwrap()
@@ -546,12 +585,7 @@ fn se_samples(e: &serde_json::Value) -> impl Iterator<Item = &serde_json::Value>
 /// not built yet is answered exactly, with the reason `unbuilt`.
 #[test]
 fn cells_built_on_demand_answer_as_the_whole_map() {
-    let spec = TierSpec {
-        theta_cells: 8,
-        d_cells: 4,
-        max_depth: 1,
-        ..TierSpec::default()
-    };
+    let spec = small();
     let a = inputs(spec);
     let whole = tier::build(&a);
     assert!(whole.is_complete());
@@ -874,4 +908,103 @@ fn a_cache_that_cannot_be_written_warns_once_and_the_run_goes_on() {
     assert!(out.contains("not written (see the warning)"), "{out}");
     assert_eq!(err.matches("warning: map cache file").count(), 1, "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// What a build told its observer, in order.
+#[derive(Debug, Clone, PartialEq)]
+enum Told {
+    Progress(u64, u64),
+    Forecast(pinfeed::progress::Forecast),
+}
+
+#[derive(Default)]
+struct Watcher(std::sync::Mutex<Vec<Told>>);
+
+impl pinfeed::progress::Observer for Watcher {
+    fn progress(&self, done: u64, total: u64) {
+        self.0.lock().unwrap().push(Told::Progress(done, total));
+    }
+    fn forecast(&self, forecast: &pinfeed::progress::Forecast) {
+        self.0
+            .lock()
+            .unwrap()
+            .push(Told::Forecast(forecast.clone()));
+    }
+}
+
+/// A build of more than one batch of base cells computes every cell's first level, refines a
+/// probe of the cells that need it, and says how long the rest will take before building it:
+/// the forecast comes once, right after the probe's cells are counted, and its pushes (the first
+/// level and the probe's, measured; the rest's, forecast) are those of the build within a factor
+/// of two. A build of one batch forecasts nothing.
+#[test]
+fn a_build_of_many_cells_forecasts_the_rest_before_building_it() {
+    let a = inputs(small());
+    let watch = Watcher::default();
+    let loaded = tier::load_or_build_cells(&a, None, None, &watch);
+    let told = watch.0.into_inner().unwrap();
+    let Source::Built {
+        cells: 32,
+        forecast: Some(f),
+        ..
+    } = loaded.source
+    else {
+        panic!("{:?}", loaded.source)
+    };
+    assert_eq!(f.cells, 32);
+    assert!(f.refining > 0 && f.refining <= 32, "{f:?}");
+    let probe = f.refining.div_ceil(16).clamp(8, 24).min(f.refining);
+    assert_eq!(f.probe_cells, probe);
+    // Told in order: none built, the probe built, the forecast, then the rest to the end.
+    assert_eq!(told[0], Told::Progress(0, 32));
+    assert_eq!(told[1], Told::Progress(probe, 32));
+    match &told[2] {
+        Told::Forecast(g) => {
+            assert_eq!(g.seconds_left, f.seconds_left);
+            assert!(
+                g.said.contains("32 base cells to build")
+                    && g.said.contains(&format!("leaves {} to refine", f.refining))
+                    && g.said.contains(&format!("about {} pushes", f.pushes_left)),
+                "{}",
+                g.said
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        told.iter()
+            .filter(|t| matches!(t, Told::Forecast(_)))
+            .count(),
+        1
+    );
+    assert_eq!(told.last(), Some(&Told::Progress(32, 32)));
+    // The forecast's pushes against the build's.
+    let made = loaded.map.stats.exact_samples;
+    let forecast = f.first_pushes + f.probe_pushes + f.pushes_left;
+    assert!(f.first_pushes + f.probe_pushes <= made);
+    assert!(
+        forecast as f64 <= 2.0 * made as f64 && made as f64 <= 2.0 * forecast as f64,
+        "forecast {forecast} pushes, built with {made}"
+    );
+    assert!(f.seconds_left.is_finite() && f.seconds_left >= 0.0);
+    assert!(loaded.describe().contains("forecast after its first level"));
+    // The same map as a build told nothing.
+    assert_eq!(*loaded.map, tier::build(&a));
+    // One batch: no forecast.
+    let watch = Watcher::default();
+    let few: Vec<usize> = (0..24).collect();
+    let loaded = tier::load_or_build_cells(&a, None, Some(&few), &watch);
+    assert!(matches!(
+        loaded.source,
+        Source::Built {
+            cells: 24,
+            forecast: None,
+            ..
+        }
+    ));
+    let told = watch.0.into_inner().unwrap();
+    assert!(
+        told.iter().all(|t| matches!(t, Told::Progress(..))),
+        "{told:?}"
+    );
 }

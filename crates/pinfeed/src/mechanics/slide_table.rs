@@ -504,6 +504,8 @@ pub struct SlideTables {
     /// The certification tolerance of every table ([`TABLE_TOL`] unless asked otherwise).
     tol: f64,
     evaluations: AtomicU64,
+    /// Thread time (ns) spent building tables, summed over threads.
+    build_nanos: AtomicU64,
 }
 
 /// What the tables of a model hold so far.
@@ -555,6 +557,7 @@ impl SlideTables {
                 TABLE_TOL
             },
             evaluations: AtomicU64::new(0),
+            build_nanos: AtomicU64::new(0),
         }
     }
 
@@ -577,6 +580,7 @@ impl SlideTables {
             Place::Vertex(k) => mt.vertices.get(k)?,
         };
         Some(slot[side as usize].get_or_init(|| {
+            let started = std::time::Instant::now();
             let s = match side {
                 Side::Left => mt.sin_phi,
                 Side::Right => -mt.sin_phi,
@@ -589,8 +593,16 @@ impl SlideTables {
             };
             let (table, evals) = builder.build();
             self.evaluations.fetch_add(evals, Ordering::Relaxed);
+            let nanos = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
+            self.build_nanos.fetch_add(nanos, Ordering::Relaxed);
             table
         }))
+    }
+
+    /// The thread time (seconds, summed over threads) spent building tables so far: a timing,
+    /// kept out of [`TableStats`], whose counts are deterministic.
+    pub fn build_seconds(&self) -> f64 {
+        self.build_nanos.load(Ordering::Relaxed) as f64 * 1e-9
     }
 
     /// Build every table (each μc, edge and vertex, and side) now.

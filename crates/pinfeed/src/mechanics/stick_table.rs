@@ -198,9 +198,10 @@ impl EdgeTable {
         Some(i * CELLS_B + j)
     }
 
-    /// Cell `idx`, built on first use (its evaluations added to `spent`).
-    fn cell(&self, model: &PartModel, idx: usize, spent: &AtomicU64) -> &Cell {
+    /// Cell `idx`, built on first use (its evaluations and time added to `spent`).
+    fn cell(&self, model: &PartModel, idx: usize, spent: &Spent) -> &Cell {
         self.cells[idx].get_or_init(|| {
+            let started = std::time::Instant::now();
             let (i, j) = (idx / CELLS_B, idx % CELLS_B);
             let mut builder = Builder {
                 model,
@@ -210,14 +211,18 @@ impl EdgeTable {
             let l0 = self.l_lo + i as f64 * self.cell_l;
             let b0 = -B_REACH + j as f64 * self.cell_b;
             let cell = builder.refine(l0, b0, self.cell_l, self.cell_b, 0, f64::INFINITY);
-            spent.fetch_add(builder.evaluations, Ordering::Relaxed);
+            spent
+                .evaluations
+                .fetch_add(builder.evaluations, Ordering::Relaxed);
+            let nanos = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
+            spent.nanos.fetch_add(nanos, Ordering::Relaxed);
             cell
         })
     }
 
     /// The certified piece holding (ℓ, b), its cell built on first use; `None` outside the range
     /// or in a piece left to the solver.
-    fn piece_at(&self, model: &PartModel, ell: f64, b: f64, spent: &AtomicU64) -> Option<&Piece> {
+    fn piece_at(&self, model: &PartModel, ell: f64, b: f64, spent: &Spent) -> Option<&Piece> {
         let mut cell = self.cell(model, self.cell_index(ell, b)?, spent);
         loop {
             match cell {
@@ -233,7 +238,7 @@ impl EdgeTable {
     }
 
     /// The stick at ℓ for pin velocity `v` (part frame) from the table, where it serves.
-    fn at(&self, model: &PartModel, ell: f64, v: Vec2, spent: &AtomicU64) -> Option<Served> {
+    fn at(&self, model: &PartModel, ell: f64, v: Vec2, spent: &Spent) -> Option<Served> {
         let speed = v.norm();
         if !(speed > 0.0 && speed.is_finite()) {
             return None;
@@ -428,7 +433,16 @@ fn coefficients(vals: &[[[f64; 3]; NP]; NP]) -> [[[f64; 3]; NP]; NP] {
 #[derive(Debug)]
 pub struct StickTables {
     edges: Vec<OnceLock<EdgeTable>>,
+    spent: Spent,
+}
+
+/// What building the tables' cells has cost so far, from whichever threads built them.
+#[derive(Debug, Default)]
+struct Spent {
+    /// Dissipation evaluations.
     evaluations: AtomicU64,
+    /// Thread time (ns), summed over the threads.
+    nanos: AtomicU64,
 }
 
 /// What a model's stick tables hold so far.
@@ -449,7 +463,7 @@ impl StickTables {
     pub fn new(edges: usize) -> StickTables {
         StickTables {
             edges: (0..edges).map(|_| OnceLock::new()).collect(),
-            evaluations: AtomicU64::new(0),
+            spent: Spent::default(),
         }
     }
 
@@ -458,7 +472,7 @@ impl StickTables {
     #[inline]
     pub fn at(&self, model: &PartModel, k: usize, ell: f64, v: Vec2) -> Option<Served> {
         let table = self.edges.get(k)?.get_or_init(|| EdgeTable::new(model, k));
-        table.at(model, ell, v, &self.evaluations)
+        table.at(model, ell, v, &self.spent)
     }
 
     /// Build every cell of every edge now (for timing contacts without their tables' build).
@@ -466,9 +480,15 @@ impl StickTables {
         for (k, slot) in self.edges.iter().enumerate() {
             let table = slot.get_or_init(|| EdgeTable::new(model, k));
             for idx in 0..table.cells.len() {
-                table.cell(model, idx, &self.evaluations);
+                table.cell(model, idx, &self.spent);
             }
         }
+    }
+
+    /// The thread time (seconds, summed over threads) spent building cells so far: a timing, kept
+    /// out of [`StickStats`], whose counts are deterministic.
+    pub fn build_seconds(&self) -> f64 {
+        self.spent.nanos.load(Ordering::Relaxed) as f64 * 1e-9
     }
 
     /// What has been built so far.
@@ -481,7 +501,7 @@ impl StickTables {
             }
         }
         let mut s = StickStats {
-            evaluations: self.evaluations.load(Ordering::Relaxed),
+            evaluations: self.spent.evaluations.load(Ordering::Relaxed),
             ..StickStats::default()
         };
         for t in self.edges.iter().filter_map(OnceLock::get) {

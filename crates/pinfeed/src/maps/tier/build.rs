@@ -175,35 +175,75 @@ fn certified(cell: &Cell, at: &BTreeMap<u64, Sample>, inputs: &TierInputs) -> bo
     })
 }
 
+/// How far a cell is from certifying at its first level, to order cells by how deep they will
+/// refine: a cell whose points differ in contact feature or servability (a jump of θf crosses it)
+/// ranks above any smooth one, by how many of its points differ from its first node; a smooth one
+/// by its largest interpolation error at a check point, relative to the tolerance.
+fn shortfall(cell: &Cell, at: &BTreeMap<u64, Sample>, inputs: &TierInputs) -> f64 {
+    let get = |(i, j): (u64, u64)| &at[&lattice_key(i, j)];
+    let c = cell.nodes().map(get);
+    let (feature, servable) = (c[0].feature, c[0].servable);
+    let differ = cell
+        .points()
+        .filter(|&p| {
+            let s = get(p);
+            s.feature != feature || s.servable != servable
+        })
+        .count();
+    if differ > 0 || !servable {
+        return 1e9 + differ as f64;
+    }
+    let (tol_rot, tol_pos) = (inputs.spec.check_deg.to_radians(), inputs.spec.check_pos);
+    cell.checks()
+        .iter()
+        .map(|&(i, j, u, v)| {
+            let s = get((i, j));
+            let p = interpolate(c, u, v);
+            ((p[0] - s.rotation).abs() / tol_rot)
+                .max((p[1] - s.dx).abs() / tol_pos)
+                .max((p[2] - s.dy).abs() / tol_pos)
+                .max((p[3] - s.span).abs() / tol_pos)
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Does any of the cell's points push the part once and pass (else there is nothing to
 /// tabulate in it: a miss is answered by the ray cast, anything else by the exact model)?
 fn any_servable(cell: &Cell, at: &BTreeMap<u64, Sample>) -> bool {
     cell.points().any(|(i, j)| at[&lattice_key(i, j)].servable)
 }
 
-/// Compute, in parallel and in key order, every lattice point the cells need that is not known.
+/// Compute, in parallel and in key order, every lattice point the cells need that is not known;
+/// returns the thread time they took (seconds, summed over threads).
 fn fill(
     cells: &[Cell],
     at: &mut BTreeMap<u64, Sample>,
     inputs: &TierInputs,
     lat: &Lattice,
     parallel: bool,
-) {
+) -> f64 {
     let missing: BTreeSet<(u64, u64)> = cells
         .iter()
         .flat_map(|c| c.points())
         .filter(|&(i, j)| !at.contains_key(&lattice_key(i, j)))
         .collect();
     let missing: Vec<(u64, u64)> = missing.into_iter().collect();
-    let sample = |&(i, j): &(u64, u64)| exact_sample(inputs, lat.reach, lat.theta(i), lat.d(j));
-    let computed: Vec<Sample> = if parallel {
+    let sample = |&(i, j): &(u64, u64)| {
+        let started = std::time::Instant::now();
+        let s = exact_sample(inputs, lat.reach, lat.theta(i), lat.d(j));
+        (s, started.elapsed().as_secs_f64())
+    };
+    let computed: Vec<(Sample, f64)> = if parallel {
         missing.par_iter().map(sample).collect()
     } else {
         missing.iter().map(sample).collect()
     };
-    for ((i, j), s) in missing.into_iter().zip(computed) {
+    let mut seconds = 0.0;
+    for ((i, j), (s, t)) in missing.into_iter().zip(computed) {
         at.insert(lattice_key(i, j), s);
+        seconds += t;
     }
+    seconds
 }
 
 /// Build the whole map of `inputs` (deterministic; parallel over samples).
@@ -227,13 +267,17 @@ pub fn extend(map: &mut TierMap, inputs: &TierInputs, roots: &[usize]) {
 const CELLS_PER_BATCH: usize = 24;
 
 /// [`extend`], telling `progress` the base cells built of those asked for. The cells are built in
-/// batches of consecutive cells (θ-major), one after another, each batch in parallel.
+/// batches of consecutive cells (θ-major), one after another, each batch in parallel. A build of
+/// more than one batch first computes the first level of every cell it builds (its nine nodes and
+/// twelve check points), which decides which cells refine and roughly how deep, then builds a
+/// probe of the refining cells (see [`probe_cells`]) in full, and tells `progress` a [`BuildForecast`] of the rest
+/// (also returned) before building it.
 pub fn extend_observed(
     map: &mut TierMap,
     inputs: &TierInputs,
     roots: &[usize],
     progress: crate::progress::Report,
-) {
+) -> Option<BuildForecast> {
     let todo: Vec<usize> = roots
         .iter()
         .copied()
@@ -242,7 +286,7 @@ pub fn extend_observed(
         .into_iter()
         .collect();
     if todo.is_empty() {
-        return;
+        return None;
     }
     let model = tabled_model(inputs);
     let inputs = &TierInputs {
@@ -250,9 +294,183 @@ pub fn extend_observed(
         ..*inputs
     };
     let tally = crate::progress::Tally::new(todo.len() as u64, progress);
-    for batch in todo.chunks(CELLS_PER_BATCH) {
-        build_cells(map, inputs, batch, true);
+    let mut first = BTreeMap::new();
+    let mut forecast = None;
+    let mut rest = todo.clone();
+    if todo.len() > CELLS_PER_BATCH {
+        let spec = inputs.spec;
+        let lat = lattice(map.reach, spec);
+        let cells: Vec<Cell> = todo.iter().map(|&r| base_cell(r, spec)).collect();
+        let started = std::time::Instant::now();
+        fill(&cells, &mut first, inputs, &lat, true);
+        let first_seconds = started.elapsed().as_secs_f64();
+        map.stats.exact_samples += first.len() as u64;
+        let mut refining: Vec<(f64, usize)> = cells
+            .iter()
+            .filter(|c| refines(c, &first, inputs))
+            .map(|c| (shortfall(c, &first, inputs), c.node))
+            .collect();
+        refining.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let ranked: Vec<usize> = refining.iter().map(|&(_, r)| r).collect();
+        let mut probe = probe_cells(&ranked);
+        probe.sort_unstable();
+        let started = std::time::Instant::now();
+        let tables_before = inputs.model.table_build_seconds();
+        let built = build_cells(map, inputs, &probe, true, &first);
+        let seconds = started.elapsed().as_secs_f64();
+        let tables = inputs.model.table_build_seconds() - tables_before;
+        tally.add(probe.len() as u64);
+        let probed = Probe {
+            cells: probe.len() as u64,
+            pushes: built.computed,
+            seconds,
+            tables_share: (tables / built.thread_seconds.max(1e-12)).clamp(0.0, 1.0),
+        };
+        let told = BuildForecast::of(
+            (todo.len(), first.len() as u64, first_seconds),
+            ranked.len() as u64,
+            probed,
+        );
+        progress.forecast(&crate::progress::Forecast {
+            seconds_left: told.seconds_left,
+            said: told.describe(),
+        });
+        forecast = Some(told);
+        rest.retain(|r| !probe.contains(r));
+    }
+    for batch in rest.chunks(CELLS_PER_BATCH) {
+        build_cells(map, inputs, batch, true, &first);
         tally.add(batch.len() as u64);
+    }
+    forecast
+}
+
+/// Does a base cell refine, given its first level's samples (as [`build_cells`] decides)?
+fn refines(cell: &Cell, at: &BTreeMap<u64, Sample>, inputs: &TierInputs) -> bool {
+    !certified(cell, at, inputs) && cell.size > 4 && any_servable(cell, at)
+}
+
+/// The cells of `ranked` (the base cells whose first level does not certify, in increasing
+/// shortfall: the smooth ones by their largest interpolation error at a check point, then those a
+/// jump of θf crosses; roughly, how deep they will refine) that a build refines first, to forecast the
+/// rest: a sixteenth of them, at least eight and at most 24, one batch (all of them when
+/// there are no more), picked at even strides through the ranking, so that the probe holds
+/// shallow and deep cells in their proportions. A cell's quadtree depends on that cell alone, so
+/// building these first changes no answer.
+pub fn probe_cells(ranked: &[usize]) -> Vec<usize> {
+    let n = ranked.len();
+    let k = n.div_ceil(16).clamp(8, CELLS_PER_BATCH).min(n);
+    (0..k).map(|i| ranked[(2 * i + 1) * n / (2 * k)]).collect()
+}
+
+/// What a build's probe measured.
+#[derive(Debug, Clone, Copy)]
+struct Probe {
+    /// The probed base cells.
+    cells: u64,
+    /// The exact pushes (lattice samples) their refinement took (their first level was known).
+    pushes: u64,
+    /// Their wall time.
+    seconds: f64,
+    /// The share of the samples' thread time that went into the model's slide and stick tables
+    /// (built as the first pushes ask for them; later cells mostly find them built).
+    tables_share: f64,
+}
+
+/// How long the rest of a map build should take, told before the rest starts. The first level
+/// of every cell is computed first: it decides which cells refine. The probe then refines some of
+/// those (see [`probe_cells`]); the others are forecast to take as many pushes each as the
+/// probe's cells did on average, at the probe's wall time per push less the share of it that
+/// built the model's slide and stick tables (which the build's first pushes mostly pay for).
+/// Cells that certify at their first level need nothing more.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuildForecast {
+    /// Base cells of the build.
+    pub cells: u64,
+    /// Exact pushes of the first level of every cell.
+    pub first_pushes: u64,
+    /// Wall time of the first level.
+    pub first_seconds: f64,
+    /// Base cells whose first level does not certify: they refine.
+    pub refining: u64,
+    /// Refining cells probed (built in full).
+    pub probe_cells: u64,
+    /// Exact pushes the probe's refinement took.
+    pub probe_pushes: u64,
+    /// Wall time of the probe.
+    pub probe_seconds: f64,
+    /// Exact pushes forecast for the other refining cells.
+    pub pushes_left: u64,
+    /// Wall time forecast for them.
+    pub seconds_left: f64,
+}
+
+impl BuildForecast {
+    fn of(
+        (cells, first_pushes, first_seconds): (usize, u64, f64),
+        refining: u64,
+        probe: Probe,
+    ) -> BuildForecast {
+        let left = refining - probe.cells;
+        let per_cell = probe.pushes as f64 / probe.cells.max(1) as f64;
+        let pushes_left = (per_cell * left as f64).round() as u64;
+        let per_push = probe.seconds * (1.0 - probe.tables_share) / probe.pushes.max(1) as f64;
+        BuildForecast {
+            cells: cells as u64,
+            first_pushes,
+            first_seconds,
+            refining,
+            probe_cells: probe.cells,
+            probe_pushes: probe.pushes,
+            probe_seconds: probe.seconds,
+            pushes_left,
+            seconds_left: pushes_left as f64 * per_push,
+        }
+    }
+
+    /// Wall time forecast for the whole build, what was measured before the forecast included.
+    pub fn seconds_in_all(&self) -> f64 {
+        self.first_seconds + self.probe_seconds + self.seconds_left
+    }
+
+    /// The forecast in words.
+    pub fn describe(&self) -> String {
+        format!(
+            "map tier: {} base cells to build; their first level ({} exact pushes, {:.2} s) certifies {} and leaves {} to refine; {} of those took {} pushes in {:.2} s, so the other {} should take about {} pushes, {:.1} s",
+            self.cells,
+            self.first_pushes,
+            self.first_seconds,
+            self.cells - self.refining,
+            self.refining,
+            self.probe_cells,
+            self.probe_pushes,
+            self.probe_seconds,
+            self.refining - self.probe_cells,
+            self.pushes_left,
+            self.seconds_left
+        )
+    }
+}
+
+/// The lattice of a map of half-width `reach` on the grid `spec`.
+fn lattice(reach: f64, spec: super::TierSpec) -> Lattice {
+    let per_cell = 1u64 << (spec.max_depth + 2);
+    Lattice {
+        theta_points: u64::from(spec.theta_cells) * per_cell,
+        d_points: u64::from(spec.d_cells) * per_cell,
+        reach,
+    }
+}
+
+/// Base cell `root` of a map on the grid `spec`, as a cell of its lattice.
+fn base_cell(root: usize, spec: super::TierSpec) -> Cell {
+    let per_cell = 1u64 << (spec.max_depth + 2);
+    let nd = u64::from(spec.d_cells);
+    Cell {
+        i: (root as u64 / nd) * per_cell,
+        j: (root as u64 % nd) * per_cell,
+        size: per_cell,
+        node: root,
     }
 }
 
@@ -272,40 +490,53 @@ pub fn tabled_model(inputs: &TierInputs) -> crate::mechanics::PartModel {
 pub fn build_cell_here(map: &mut TierMap, inputs: &TierInputs, root: usize) {
     if map.nodes.get(root) == Some(&Node::Unbuilt) {
         let parallel = rayon::current_thread_index().is_none();
-        build_cells(map, inputs, &[root], parallel);
+        build_cells(map, inputs, &[root], parallel, &BTreeMap::new());
     }
 }
 
+/// What [`build_cells`] did.
+#[derive(Debug, Clone, Copy)]
+struct Built {
+    /// Exact pushes computed (samples not known before).
+    computed: u64,
+    /// Their thread time (seconds, summed over threads).
+    thread_seconds: f64,
+}
+
 /// Build the unbuilt base cells `todo` of `map` (the model of `inputs` already has its tables),
-/// their samples computed in parallel or on this thread.
-fn build_cells(map: &mut TierMap, inputs: &TierInputs, todo: &[usize], parallel: bool) {
+/// their samples computed in parallel or on this thread; the samples in `known` (the lattice
+/// points computed earlier, counted then) are not computed again.
+fn build_cells(
+    map: &mut TierMap,
+    inputs: &TierInputs,
+    todo: &[usize],
+    parallel: bool,
+    known: &BTreeMap<u64, Sample>,
+) -> Built {
     let spec = inputs.spec;
     let per_cell = 1u64 << (spec.max_depth + 2);
     let (nt, nd) = (u64::from(spec.theta_cells), u64::from(spec.d_cells));
-    let lat = Lattice {
-        theta_points: nt * per_cell,
-        d_points: nd * per_cell,
-        reach: map.reach,
-    };
-    let mut cells: Vec<Cell> = todo
-        .iter()
-        .map(|&r| Cell {
-            i: (r as u64 / nd) * per_cell,
-            j: (r as u64 % nd) * per_cell,
-            size: per_cell,
-            node: r,
-        })
-        .collect();
+    let lat = lattice(map.reach, spec);
+    let mut cells: Vec<Cell> = todo.iter().map(|&r| base_cell(r, spec)).collect();
     for &r in todo {
         map.nodes[r] = Node::Fallback;
     }
-    let mut at: BTreeMap<u64, Sample> = BTreeMap::new();
+    let mut at: BTreeMap<u64, Sample> = cells
+        .iter()
+        .flat_map(|c| c.points())
+        .filter_map(|(i, j)| {
+            let key = lattice_key(i, j);
+            known.get(&key).map(|s| (key, *s))
+        })
+        .collect();
+    let seeded = at.len() as u64;
     let mut index: BTreeMap<u64, u32> = BTreeMap::new();
     let stats = &mut map.stats;
     let (nodes, samples) = (&mut map.nodes, &mut map.samples);
     let mut area = 0.0;
+    let mut thread_seconds = 0.0;
     while !cells.is_empty() {
-        fill(&cells, &mut at, inputs, &lat, parallel);
+        thread_seconds += fill(&cells, &mut at, inputs, &lat, parallel);
         let mut next = Vec::new();
         for cell in &cells {
             if certified(cell, &at, inputs) {
@@ -340,7 +571,46 @@ fn build_cells(map: &mut TierMap, inputs: &TierInputs, todo: &[usize], parallel:
         }
         cells = next;
     }
-    stats.exact_samples += at.len() as u64;
+    let computed = at.len() as u64 - seeded;
+    stats.exact_samples += computed;
     stats.certified_area += area / (nt * nd) as f64;
     stats.built_cells += todo.len() as u64;
+    Built {
+        computed,
+        thread_seconds,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sixteenth of the ranked cells, 8 to 24 of them (all when fewer), at even strides from
+    /// the shallowest to the deepest, each once.
+    #[test]
+    fn a_probe_spans_the_ranking_in_proportion() {
+        assert!(probe_cells(&[]).is_empty());
+        let five: Vec<usize> = (10..15).collect();
+        assert_eq!(probe_cells(&five), five);
+        for n in [9usize, 40, 129, 384, 1000] {
+            let ranked: Vec<usize> = (0..n).rev().collect();
+            let probe = probe_cells(&ranked);
+            let k = n.div_ceil(16).clamp(8, CELLS_PER_BATCH);
+            assert_eq!(probe.len(), k, "n {n}");
+            let mut unique = probe.clone();
+            unique.sort_unstable();
+            unique.dedup();
+            assert_eq!(unique.len(), k, "n {n}: each once");
+            // Positions in the ranking: one in each of k equal strides.
+            let pos: Vec<usize> = probe.iter().map(|c| n - 1 - c).collect();
+            let stride = n as f64 / k as f64;
+            for (i, &p) in pos.iter().enumerate() {
+                let (lo, hi) = (i as f64 * stride, (i + 1) as f64 * stride);
+                assert!(
+                    lo.floor() <= p as f64 && (p as f64) < hi,
+                    "n {n}: pick {i} at {p}"
+                );
+            }
+        }
+    }
 }

@@ -12,7 +12,7 @@
 
 use super::key::{fnv1a64, TierKey, BASIS, FORMAT_VERSION};
 use super::{BuildStats, Node, Sample, TierInputs, TierMap, TierSpec};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
@@ -96,6 +96,8 @@ pub enum Source {
         seconds: f64,
         /// Base cells built now.
         cells: u64,
+        /// What was forecast for the build after its probe (none for a build of one batch).
+        forecast: Option<super::build::BuildForecast>,
     },
 }
 
@@ -170,11 +172,14 @@ pub fn load_or_build_cells(
         Some((m, path)) => (m, Some(path)),
         None => (TierMap::unbuilt(inputs), None),
     };
+    // Each cell once, however many queries fall in it.
     let wanted: Vec<usize> = match cells {
         Some(c) => c
             .iter()
             .copied()
             .filter(|&r| map.nodes.get(r) == Some(&Node::Unbuilt))
+            .collect::<BTreeSet<usize>>()
+            .into_iter()
             .collect(),
         None => map.unbuilt_cells().collect(),
     };
@@ -187,7 +192,7 @@ pub fn load_or_build_cells(
         };
     }
     let started = Instant::now();
-    super::build::extend_observed(&mut map, inputs, &wanted, progress);
+    let forecast = super::build::extend_observed(&mut map, inputs, &wanted, progress);
     let seconds = started.elapsed().as_secs_f64();
     if let Some(path) = &file {
         if let Err(e) = write(path, &map) {
@@ -199,6 +204,7 @@ pub fn load_or_build_cells(
         source: Source::Built {
             seconds,
             cells: wanted.len() as u64,
+            forecast,
         },
         file,
         warnings,

@@ -41,7 +41,7 @@ pub mod lazy;
 pub mod query;
 pub mod report;
 
-pub use build::build;
+pub use build::{build, BuildForecast};
 pub use cache::{
     default_cache_dir, load_or_build, load_or_build_cells, shared, shared_observed, CacheError,
     Loaded, Source,

@@ -19,8 +19,20 @@ impl Loaded {
             100.0 * st.certified_area
         );
         match &self.source {
-            Source::Built { seconds, cells } => {
-                format!("{cells} base cell(s) built in {seconds:.2} s ({what})")
+            Source::Built {
+                seconds,
+                cells,
+                forecast,
+            } => {
+                let told = forecast.map_or(String::new(), |f| {
+                    format!(
+                        "; forecast after its first level and a {}-cell probe ({:.2} s): {:.1} s in all",
+                        f.probe_cells,
+                        f.first_seconds + f.probe_seconds,
+                        f.seconds_in_all()
+                    )
+                });
+                format!("{cells} base cell(s) built in {seconds:.2} s{told} ({what})")
             }
             Source::Disk(p) => format!("read from {} ({what})", p.display()),
             Source::Memory => format!("already loaded ({what})"),

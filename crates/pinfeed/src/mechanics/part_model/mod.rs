@@ -210,6 +210,21 @@ impl PartModel {
         self.stick_tables.as_ref()?.at(self, k, ell, v)
     }
 
+    /// Thread time (seconds, summed over threads) spent building the model's slide and stick
+    /// tables so far (both are built as pushes first ask for them; 0 without tables). A timing,
+    /// for forecasts: the tables' content never depends on it.
+    pub fn table_build_seconds(&self) -> f64 {
+        let slides = self
+            .slide_tables
+            .as_ref()
+            .map_or(0.0, |t| t.build_seconds());
+        slides
+            + self
+                .stick_tables
+                .as_ref()
+                .map_or(0.0, |t| t.build_seconds())
+    }
+
     /// What the stick tables hold so far (`None`: the model has none).
     pub fn stick_table_stats(&self) -> Option<StickStats> {
         self.stick_tables.as_ref().map(|t| t.stats())
