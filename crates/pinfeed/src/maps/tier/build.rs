@@ -270,8 +270,8 @@ const CELLS_PER_BATCH: usize = 24;
 /// batches of consecutive cells (θ-major), one after another, each batch in parallel. A build of
 /// more than one batch first computes the first level of every cell it builds (its nine nodes and
 /// twelve check points), which decides which cells refine and roughly how deep, then builds a
-/// probe of the refining cells (see [`probe_cells`]) in full, and tells `progress` a [`BuildForecast`] of the rest
-/// (also returned) before building it.
+/// probe of the refining cells (see [`probe_cells`]) in full, and tells `progress` a
+/// [`BuildForecast`] of the rest (also returned) before building it.
 pub fn extend_observed(
     map: &mut TierMap,
     inputs: &TierInputs,
@@ -298,39 +298,8 @@ pub fn extend_observed(
     let mut forecast = None;
     let mut rest = todo.clone();
     if todo.len() > CELLS_PER_BATCH {
-        let spec = inputs.spec;
-        let lat = lattice(map.reach, spec);
-        let cells: Vec<Cell> = todo.iter().map(|&r| base_cell(r, spec)).collect();
-        let started = std::time::Instant::now();
-        fill(&cells, &mut first, inputs, &lat, true);
-        let first_seconds = started.elapsed().as_secs_f64();
-        map.stats.exact_samples += first.len() as u64;
-        let mut refining: Vec<(f64, usize)> = cells
-            .iter()
-            .filter(|c| refines(c, &first, inputs))
-            .map(|c| (shortfall(c, &first, inputs), c.node))
-            .collect();
-        refining.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let ranked: Vec<usize> = refining.iter().map(|&(_, r)| r).collect();
-        let mut probe = probe_cells(&ranked);
-        probe.sort_unstable();
-        let started = std::time::Instant::now();
-        let tables_before = inputs.model.table_build_seconds();
-        let built = build_cells(map, inputs, &probe, true, &first);
-        let seconds = started.elapsed().as_secs_f64();
-        let tables = inputs.model.table_build_seconds() - tables_before;
+        let (probe, told) = probe_and_forecast(map, inputs, &todo, &mut first);
         tally.add(probe.len() as u64);
-        let probed = Probe {
-            cells: probe.len() as u64,
-            pushes: built.computed,
-            seconds,
-            tables_share: (tables / built.thread_seconds.max(1e-12)).clamp(0.0, 1.0),
-        };
-        let told = BuildForecast::of(
-            (todo.len(), first.len() as u64, first_seconds),
-            ranked.len() as u64,
-            probed,
-        );
         progress.forecast(&crate::progress::Forecast {
             seconds_left: told.seconds_left,
             said: told.describe(),
@@ -343,6 +312,49 @@ pub fn extend_observed(
         tally.add(batch.len() as u64);
     }
     forecast
+}
+
+/// The start of a build of the base cells `todo`: the first level of every cell (its samples
+/// left in `first`), the refining cells ranked by [`shortfall`], the probe among them built in
+/// full; returns the probe's cells and the forecast for the other refining cells.
+fn probe_and_forecast(
+    map: &mut TierMap,
+    inputs: &TierInputs,
+    todo: &[usize],
+    first: &mut BTreeMap<u64, Sample>,
+) -> (Vec<usize>, BuildForecast) {
+    let spec = inputs.spec;
+    let cells: Vec<Cell> = todo.iter().map(|&r| base_cell(r, spec)).collect();
+    let started = std::time::Instant::now();
+    fill(&cells, first, inputs, &lattice(map.reach, spec), true);
+    let first_seconds = started.elapsed().as_secs_f64();
+    map.stats.exact_samples += first.len() as u64;
+    let mut refining: Vec<(f64, usize)> = cells
+        .iter()
+        .filter(|c| refines(c, first, inputs))
+        .map(|c| (shortfall(c, first, inputs), c.node))
+        .collect();
+    refining.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let ranked: Vec<usize> = refining.iter().map(|&(_, r)| r).collect();
+    let mut probe = probe_cells(&ranked);
+    probe.sort_unstable();
+    let started = std::time::Instant::now();
+    let tables_before = inputs.model.table_build_seconds();
+    let built = build_cells(map, inputs, &probe, true, first);
+    let seconds = started.elapsed().as_secs_f64();
+    let tables = inputs.model.table_build_seconds() - tables_before;
+    let probed = Probe {
+        cells: probe.len() as u64,
+        pushes: built.computed,
+        seconds,
+        tables_share: (tables / built.thread_seconds.max(1e-12)).clamp(0.0, 1.0),
+    };
+    let told = BuildForecast::of(
+        (todo.len(), first.len() as u64, first_seconds),
+        ranked.len() as u64,
+        probed,
+    );
+    (probe, told)
 }
 
 /// Does a base cell refine, given its first level's samples (as [`build_cells`] decides)?
