@@ -26,7 +26,7 @@ impl Loaded {
             } => {
                 let told = forecast.map_or(String::new(), |f| {
                     format!(
-                        "; forecast after its first level and a {}-cell probe ({:.2} s): {:.1} s in all",
+                        "; forecast after its first level and a probe of {} cells ({:.2} s): {:.1} s in all",
                         f.probe_cells,
                         f.first_seconds + f.probe_seconds,
                         f.seconds_in_all()
