@@ -39,14 +39,14 @@ pub fn spinner(label: &str, quiet: bool) -> ProgressBar {
     b
 }
 
-/// A callback for the library's `(done, total)` reports that moves `bar` (its length follows
-/// `total`, so one bar can follow several counted stages in turn).
-pub fn counter(bar: &ProgressBar) -> impl Fn(u64, u64) + Sync + '_ {
-    move |done, total| watch(bar, true).progress(done, total)
+/// An observer for the library's reports that moves `bar` (its length follows `total`, so one
+/// bar can follow several counted stages in turn) and writes nothing else.
+pub fn counter(bar: &ProgressBar) -> Watch<'_> {
+    watch(bar, true)
 }
 
-/// An observer for the library's reports that moves `bar` as [`counter`] does and writes a
-/// forecast (a map tier's build, after its probe) as a line above it, unless `quiet`.
+/// [`counter`] that also writes a forecast (a map tier's build, after its probe) as a line above
+/// the bar, unless `quiet`.
 pub fn watch(bar: &ProgressBar, quiet: bool) -> Watch<'_> {
     Watch { bar, quiet }
 }
