@@ -37,7 +37,12 @@ pub struct PlanArgs {
     /// Restrict the design to a sensor pin with moving pins.
     #[arg(long)]
     pub sensor: bool,
-    /// What the best confirmed design minimises: belt-length, obstacles, actuators, throughput.
+    /// What the best confirmed design optimises, and what it trades: belt-length, the shortest
+    /// belt (may choose a sensor and moving pins over a longer passive line); obstacles, the
+    /// fewest obstacles (may need a longer belt); actuators, the fewest sensors and moving pins
+    /// (passive lines first: more obstacles or belt); throughput, the most oriented parts per
+    /// minute at the line's own headway (may need more belt or actuators). A confirmed design of
+    /// another kind that is simpler or faster is printed as the runner-up.
     #[arg(long, default_value = "belt-length")]
     pub objective: String,
     /// Feed orientation: stable (the stable states, equal weights, with --jitter) or uniform.
@@ -317,9 +322,13 @@ pub fn run(args: &PlanArgs, recorded: &str) -> Result<()> {
     print_result(&out)?;
     match (d.status, &d.limit) {
         (Status::Confirmed, _) => Ok(()),
-        (_, Some(limit)) => Err(anyhow!(
-            "{limit} ({}): no confirmed design",
-            super::flag(limit.field())
+        (status, Some(limit)) => Err(anyhow!(
+            "{limit} ({}): {}",
+            super::flag(limit.field()),
+            match status {
+                Status::NoDesign => "no design found within it",
+                _ => "no confirmed design",
+            }
         )),
         (Status::NoDesign, None) => Err(super::Exit(4).into()),
         _ => Err(super::Exit(3).into()),

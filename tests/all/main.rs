@@ -63,6 +63,7 @@ mod online;
 mod plan;
 mod plan_fences;
 mod plan_sensing;
+mod plan_verdict;
 mod readme_tutorial;
 mod scenario_errors;
 mod sensing_classify;

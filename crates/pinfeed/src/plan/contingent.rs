@@ -266,23 +266,12 @@ pub fn branch_states(planner: &Planner) -> Result<Vec<State>, PlanError> {
     Ok(out.into_iter().map(|v| State::canonical(v, 0)).collect())
 }
 
-/// Run the contingent search with at most `max_moving` moving pins and at most
-/// `sensor_candidates` sensor positions.
-pub fn search(
-    planner: &mut Planner,
-    max_moving: usize,
-    sensor_candidates: usize,
-) -> Result<(ContingentOutcome, ContingentStats), PlanError> {
-    let started = Instant::now();
-    let p = planner.problem.clone();
-    let steps = planner.compiled.theta_steps;
-    let width_q = ((2.0 * p.tolerance_deg / p.theta_quantum_deg) + 1e-9).floor() as i32;
-    let branches = branch_states(planner)?;
-    let root = planner.initial.clone();
-    // Sensor candidates: every particle touched, none failed.
+/// The sensor pin positions that touch every particle of `root` and fail none, at the problem's
+/// `min_margin_m` from the edges of their intervals.
+fn touching_sensors(planner: &mut Planner, root: &State) -> Vec<PinAction> {
     let reach = planner.transition.reach_q;
-    let mut sensors: Vec<PinAction> = planner
-        .actions(&root)
+    planner
+        .actions(root)
         .into_iter()
         .map(|(a, _)| {
             let Action::Pin(a) = a else {
@@ -300,7 +289,51 @@ pub fn search(
                         .is_some_and(|o| o.signature != NO_CONTACT && o.signature != FAILED)
             })
         })
-        .collect();
+        .collect()
+}
+
+/// Why no sensor pin position serves, with advice only where it helps: a smaller `min_margin`
+/// when positions exist at a smaller margin (the largest such margin is named), otherwise the
+/// reason, which no margin changes.
+fn no_sensor_position(planner: &mut Planner, root: &State) -> PlanError {
+    let margin_m = planner.problem.min_margin_m;
+    if margin_m > 0.0 {
+        planner.problem.min_margin_m = 0.0;
+        let at_zero = touching_sensors(planner, root);
+        planner.problem.min_margin_m = margin_m;
+        if let Some(best) = at_zero.iter().map(|a| a.margin_m).max_by(f64::total_cmp) {
+            return PlanError::input(
+                "min_margin",
+                format!("{} mm", margin_m * 1e3),
+                format!(
+                    "no sensor pin position touches every part with this margin from a band edge; the widest margin any such position has is {:.3} mm: a min_margin at most that would let the sensor mode search (a design there is that sensitive to the pin's placement)",
+                    best * 1e3
+                ),
+            );
+        }
+    }
+    PlanError::input(
+        "sensor",
+        "mode",
+        "no sensor pin position touches every part in every stable state and lateral offset of the feed, at any margin: one pin cannot read them all (a narrower lateral spread of the feed, or another mode, may serve)",
+    )
+}
+
+/// Run the contingent search with at most `max_moving` moving pins and at most
+/// `sensor_candidates` sensor positions.
+pub fn search(
+    planner: &mut Planner,
+    max_moving: usize,
+    sensor_candidates: usize,
+) -> Result<(ContingentOutcome, ContingentStats), PlanError> {
+    let started = Instant::now();
+    let p = planner.problem.clone();
+    let steps = planner.compiled.theta_steps;
+    let width_q = ((2.0 * p.tolerance_deg / p.theta_quantum_deg) + 1e-9).floor() as i32;
+    let branches = branch_states(planner)?;
+    let root = planner.initial.clone();
+    // Sensor candidates: every particle touched, none failed.
+    let mut sensors = touching_sensors(planner, &root);
     sensors.sort_by(|a, b| b.margin_m.total_cmp(&a.margin_m).then(a.y_q.cmp(&b.y_q)));
     sensors.truncate(sensor_candidates.max(1));
     let mut stats = ContingentStats {
@@ -318,11 +351,7 @@ pub fn search(
         ));
     }
     if sensors.is_empty() {
-        return Err(PlanError::input(
-            "min_margin",
-            format!("{} mm", planner.problem.min_margin_m * 1e3),
-            "no sensor pin position touches every part with this margin from a band edge: try a smaller min_margin",
-        ));
+        return Err(no_sensor_position(planner, &root));
     }
     let total: u32 = branches.iter().map(|b| b.total()).sum();
     let mut searches: Vec<Vec<BranchSearch>> = sensors

@@ -355,6 +355,12 @@ impl Planner {
                     );
                 }
             }
+            // A level the deadline cut short dropped the successors it could not compute (a goal
+            // found before it stands): the search stopped at its limit, it did not exhaust the
+            // level.
+            if self.transition.expired() {
+                return self.limit(run, Limit::time(p.time_limit_s), depth - 1);
+            }
             if next.is_empty() {
                 return self.no_plan(run, depth, open == 0);
             }

@@ -138,6 +138,12 @@ pub struct PlanJson<'a> {
     pub candidates: &'a [Candidate],
     /// The chosen candidate (also in `candidates`).
     pub chosen: Option<&'a Candidate>,
+    /// A confirmed candidate of another mode that is simpler or faster than the chosen one (also
+    /// in `candidates`): what the objective traded away.
+    pub runner_up: Option<&'a Candidate>,
+    /// Every mode asked for, with what became of it (searched, no plan and why, not needed,
+    /// stopped by the time limit, not tried).
+    pub modes: &'a [design::ModeReport],
     /// The planning problem.
     pub problem: &'a Problem,
     /// What the planner optimised.
@@ -170,6 +176,8 @@ pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> ReportResult<S
         elapsed_s: d.elapsed_s,
         candidates: &d.candidates,
         chosen: c,
+        runner_up: d.runner_up(),
+        modes: &d.modes,
         problem: &o.problem,
         objective: o.objective,
         scenario: d.scenario_toml.as_deref(),
@@ -269,6 +277,23 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
             c.predicted_success
         );
     }
+    for (k, m) in d.modes.iter().enumerate() {
+        let what = match (m.outcome, &m.reason) {
+            (design::ModeOutcome::Searched, _) => format!("{} candidate(s)", m.candidates),
+            (outcome, reason) => format!(
+                "{}{}{}",
+                outcome.word(),
+                if m.candidates > 0 {
+                    format!(" ({} candidate(s))", m.candidates)
+                } else {
+                    String::new()
+                },
+                reason.as_ref().map_or(String::new(), |r| format!(": {r}"))
+            ),
+        };
+        let head = if k == 0 { "modes" } else { "" };
+        t += &format!("{head:<11} {:<8} {what}\n", m.mode.name());
+    }
     t += &format!("result      {}\n", d.message);
     if let Some(c) = d.chosen() {
         if let Some(l) = &c.line_check {
@@ -334,14 +359,60 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
             );
         }
     }
+    if let Some(r) = d.runner_up() {
+        t += &runner_up_line(d, r);
+    }
     if let Some(l) = &d.limit {
-        t += &format!("limit       {l}\n");
+        t += &match d.status {
+            Status::Confirmed => format!(
+                "cut short   {l}: the confirmed design is the best found within the limit; a longer limit may find a simpler or shorter one\n"
+            ),
+            _ => format!("limit       {l}\n"),
+        };
     }
     t += &format!("time        {:.1} s\n", d.elapsed_s);
     if !files.is_empty() {
         t += &format!("wrote       {}\n", files.join(", "));
     }
     t
+}
+
+/// The runner-up's line: what it is, its check, its throughput and its belt beside the chosen
+/// design's.
+fn runner_up_line(d: &Design, r: &Candidate) -> String {
+    let Some(c) = d.chosen() else {
+        return String::new();
+    };
+    let check = r.verdict_check().map_or(String::new(), |l| {
+        format!(
+            "confirmed {:.4} (95% CI {:.4}–{:.4}) of {} parts, ",
+            l.success_rate, l.ci95[0], l.ci95[1], l.parts
+        )
+    });
+    let mut why = Vec::new();
+    if r.actuators < c.actuators {
+        why.push(if r.actuators == 0 {
+            "passive (no sensor or moving pin)".to_string()
+        } else {
+            format!("{} actuator(s) against {}", r.actuators, c.actuators)
+        });
+    }
+    if r.oriented_per_min > c.oriented_per_min {
+        why.push(format!(
+            "{:.2} oriented parts/min against {:.2}",
+            r.oriented_per_min, c.oriented_per_min
+        ));
+    }
+    format!(
+        "runner-up   {} ({} mode): {check}{:.2} oriented parts/min at headway {} s, belt {:.3} m ({:+.3} m); {}\n",
+        describe_obstacles(r),
+        r.mode.name(),
+        r.oriented_per_min,
+        design::line::fmt_headway(r.headway_s),
+        r.belt_length_m,
+        r.belt_length_m - c.belt_length_m,
+        why.join(", ")
+    )
 }
 
 /// "success 9987, wrong_orientation 13".

@@ -557,6 +557,50 @@ impl Candidate {
     }
 }
 
+/// What became of a mode the design was asked to try.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModeOutcome {
+    /// Searched to the end: its candidates are in the design's list.
+    Searched,
+    /// Searched, with no plan that improves on the feed (the reason says why).
+    NoPlan,
+    /// Not searched: no line of this mode can beat one the screen already holds.
+    NotNeeded,
+    /// Its search was stopped by its share of the time limit (any candidate is the best so far).
+    Stopped,
+    /// Not tried: the search time was used up before it started.
+    NotTried,
+}
+
+impl ModeOutcome {
+    /// The outcome in words: `searched`, `no plan`, `not needed`, `stopped`, `not tried`.
+    pub fn word(self) -> &'static str {
+        match self {
+            ModeOutcome::Searched => "searched",
+            ModeOutcome::NoPlan => "no plan",
+            ModeOutcome::NotNeeded => "not needed",
+            ModeOutcome::Stopped => "stopped",
+            ModeOutcome::NotTried => "not tried",
+        }
+    }
+}
+
+/// A mode the design was asked to try, with what became of it: every mode asked for has one,
+/// whether or not it produced a candidate.
+#[derive(Debug, Clone, Serialize)]
+pub struct ModeReport {
+    /// The mode.
+    pub mode: Mode,
+    /// What became of it.
+    pub outcome: ModeOutcome,
+    /// Candidates it produced (they are in the design's list).
+    pub candidates: usize,
+    /// Why it produced no candidate, or what cut it short; None for a search that ran to its end.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
 /// A finished design.
 #[derive(Debug, Clone, Serialize)]
 pub struct Design {
@@ -572,6 +616,11 @@ pub struct Design {
     pub candidates: Vec<Candidate>,
     /// The candidate chosen (written).
     pub chosen: Option<usize>,
+    /// A confirmed candidate of another mode than the chosen one that is simpler (fewer sensors
+    /// and moving pins) or gives more oriented parts per minute: what the objective traded away.
+    pub runner_up: Option<usize>,
+    /// Every mode asked for, in the order tried, with what became of it.
+    pub modes: Vec<ModeReport>,
     /// A limit that cut the work short (the time limit), if any.
     pub limit: Option<Limit>,
     /// Wall time of the whole design (s).
@@ -588,6 +637,11 @@ impl Design {
     /// The chosen candidate, if any.
     pub fn chosen(&self) -> Option<&Candidate> {
         self.chosen.map(|i| &self.candidates[i])
+    }
+
+    /// The runner-up of another mode, if any (see [`Design::runner_up`]).
+    pub fn runner_up(&self) -> Option<&Candidate> {
+        self.runner_up.map(|i| &self.candidates[i])
     }
 }
 
@@ -798,7 +852,9 @@ pub fn design(
         o,
         progress,
         deadline,
+        started,
         candidates: Vec::new(),
+        modes: Vec::new(),
         line_runs: 0,
         limit: None,
     };
@@ -806,7 +862,18 @@ pub fn design(
     for (i, &mode) in modes.iter().enumerate() {
         let now = Instant::now();
         if now >= search_end {
-            w.limit = Some(Limit::Time {
+            for &m in &modes[i..] {
+                w.modes.push(ModeReport {
+                    mode: m,
+                    outcome: ModeOutcome::NotTried,
+                    candidates: 0,
+                    reason: Some(format!(
+                        "the search time ({:.1} s, 60% of the time limit) was used up before it started",
+                        o.time_limit_s * 0.6
+                    )),
+                });
+            }
+            w.cut(Limit::Time {
                 seconds: o.time_limit_s,
                 left_undone: Some(format!(
                     "{} not tried",
@@ -822,6 +889,12 @@ pub fn design(
         // An equal share of the search time left for each mode left (a fast mode leaves its
         // unused share to the next).
         let share = (search_end - now) / (modes.len() - i) as u32;
+        w.modes.push(ModeReport {
+            mode,
+            outcome: ModeOutcome::Searched,
+            candidates: 0,
+            reason: None,
+        });
         w.run_mode(mode, now + share)?;
     }
     w.finish(started)
@@ -831,17 +904,68 @@ struct Work<'a> {
     o: &'a DesignOptions,
     progress: &'a (dyn Fn(&Progress) + Sync),
     deadline: Instant,
+    started: Instant,
     candidates: Vec<Candidate>,
+    /// The modes begun or passed over so far; the last one is the mode being worked on.
+    modes: Vec<ModeReport>,
     line_runs: usize,
     limit: Option<Limit>,
 }
 
 impl Work<'_> {
-    /// A search's limit as the design states it: a search's time limit is the design's.
-    fn design_limit(&self, limit: Limit) -> Limit {
+    /// A search's limit as the design states it: a search's time limit is the design's, and
+    /// the search of `mode` stopped at its share of it, this far into the design.
+    fn design_limit(&self, mode: Mode, limit: Limit) -> Limit {
         match limit {
-            Limit::Time { .. } => Limit::time(self.o.time_limit_s),
+            Limit::Time { .. } => Limit::Time {
+                seconds: self.o.time_limit_s,
+                left_undone: Some(format!(
+                    "the {} search stopped at its share of it, {:.1} s into the design",
+                    mode.name(),
+                    self.started.elapsed().as_secs_f64()
+                )),
+            },
             l => l,
+        }
+    }
+
+    /// Record a limit that cut the work short: the first one, with what every later cut of the
+    /// time limit left undone said after it (`the pins search stopped …; the line check ran
+    /// 3229 of 10000 parts`).
+    fn cut(&mut self, l: Limit) {
+        match (&mut self.limit, l) {
+            (None, l) => self.limit = Some(l),
+            (
+                Some(Limit::Time {
+                    left_undone: Some(said),
+                    ..
+                }),
+                Limit::Time {
+                    left_undone: Some(more),
+                    ..
+                },
+            ) => {
+                if !said.contains(&more) {
+                    *said = format!("{said}; {more}");
+                }
+            }
+            (
+                Some(Limit::Time { left_undone, .. }),
+                Limit::Time {
+                    left_undone: more, ..
+                },
+            ) if left_undone.is_none() => {
+                *left_undone = more;
+            }
+            _ => {}
+        }
+    }
+
+    /// Record what became of the mode being worked on (the last one begun).
+    fn mode_ended(&mut self, outcome: ModeOutcome, reason: String) {
+        if let Some(m) = self.modes.last_mut() {
+            m.outcome = outcome;
+            m.reason = Some(reason);
         }
     }
 
@@ -901,7 +1025,19 @@ impl Work<'_> {
                 _ => None,
             };
             match most {
-                Some(0) => return Ok(()),
+                Some(0) => {
+                    self.mode_ended(
+                        ModeOutcome::NotNeeded,
+                        format!(
+                            "a mixed line cannot beat, by {}, a line the screen already holds",
+                            match o.objective {
+                                Objective::Obstacles => "obstacles",
+                                _ => "belt length",
+                            }
+                        ),
+                    );
+                    return Ok(());
+                }
                 Some(n) => problem.max_pins = problem.max_pins.min(n),
                 None => {}
             }
@@ -910,7 +1046,12 @@ impl Work<'_> {
             let now = Instant::now();
             if now >= until {
                 if round == 0 {
-                    self.limit.get_or_insert(Limit::time(o.time_limit_s));
+                    let l = self.design_limit(mode, Limit::time(o.time_limit_s));
+                    self.cut(l);
+                    self.mode_ended(
+                        ModeOutcome::Stopped,
+                        "its share of the search time was used up before its first search".into(),
+                    );
                 }
                 return Ok(());
             }
@@ -1052,6 +1193,7 @@ impl Work<'_> {
                     return Err(e.into());
                 }
                 self.tell(Some(mode), round, format!("no sensing plan: {e}"));
+                self.mode_ended(ModeOutcome::NoPlan, e.to_string());
                 return Ok(None);
             }
         };
@@ -1065,15 +1207,17 @@ impl Work<'_> {
                 p,
             ),
             ContingentOutcome::NoneUpTo { depth } => {
-                self.tell(
-                    Some(mode),
-                    round,
-                    format!("no contingent plan up to {depth} moving pins"),
-                );
+                let why = format!("no contingent plan up to {depth} moving pins");
+                self.tell(Some(mode), round, why.clone());
+                if round == 0 {
+                    self.mode_ended(ModeOutcome::NoPlan, why);
+                }
                 return Ok(None);
             }
             ContingentOutcome::LimitHit { limit, .. } => {
-                self.limit.get_or_insert(self.design_limit(limit));
+                let l = self.design_limit(mode, limit);
+                self.mode_ended(ModeOutcome::Stopped, format!("{l}"));
+                self.cut(l);
                 return Ok(None);
             }
         };
@@ -1150,13 +1294,23 @@ impl Work<'_> {
                 let said = format!(
                     "stopped by its {limit} after depth {depth_completed}; the best so far is kept"
                 );
-                let l = self.design_limit(limit);
-                self.limit.get_or_insert(l);
+                let l = self.design_limit(mode, limit);
+                self.mode_ended(ModeOutcome::Stopped, format!("{l}"));
+                self.cut(l);
                 (SearchResult::Limit, said, best)
             }
         };
         let Some(plan) = plan else {
             self.tell(Some(mode), round, "no obstacle improves on the feed".into());
+            if result != SearchResult::Limit && round == 0 {
+                self.mode_ended(
+                    ModeOutcome::NoPlan,
+                    format!(
+                        "no obstacle improves on the feed (the search ended {})",
+                        result.name()
+                    ),
+                );
+            }
             return Ok(None);
         };
         let a = compiled.radius;
@@ -1234,7 +1388,7 @@ impl Work<'_> {
         let mut parts = o.check_parts;
         if per_part * parts as f64 > left {
             parts = ((left / per_part) as u64).max(o.screen_parts.min(o.check_parts));
-            self.limit.get_or_insert(Limit::Time {
+            self.cut(Limit::Time {
                 seconds: o.time_limit_s,
                 left_undone: Some(format!(
                     "the line check ran {parts} of {} parts",
@@ -1351,6 +1505,13 @@ impl Work<'_> {
                 }
             }
         }
+        let runner_up = match (status, chosen) {
+            (Status::Confirmed, Some(i)) => self.runner_up(i)?,
+            _ => None,
+        };
+        for m in &mut self.modes {
+            m.candidates = self.candidates.iter().filter(|c| c.mode == m.mode).count();
+        }
         let message = self.message(status, chosen);
         let (scenario_toml, policy_toml) = match chosen {
             Some(i) => {
@@ -1371,11 +1532,72 @@ impl Work<'_> {
             tolerance_deg: o.problem.tolerance_deg,
             candidates: self.candidates,
             chosen,
+            runner_up,
+            modes: self.modes,
             limit: self.limit,
             elapsed_s: started.elapsed().as_secs_f64(),
             scenario_toml,
             policy_toml,
         })
+    }
+
+    /// The runner-up of another mode than the confirmed candidate `chosen`: among the candidates
+    /// of other modes the screen holds at the target, the simplest (fewest sensors and moving
+    /// pins, then the objective's order), confirmed on the line if the time left allows, and
+    /// kept if the line confirms it and it is simpler than the chosen one or gives more oriented
+    /// parts per minute. None otherwise.
+    fn runner_up(&mut self, chosen: usize) -> Result<Option<usize>, DesignError> {
+        let o = self.o;
+        let target = o.problem.target;
+        let mode = self.candidates[chosen].mode;
+        let obj = o.objective;
+        let Some(i) = (0..self.candidates.len())
+            .filter(|&i| {
+                let c = &self.candidates[i];
+                c.mode != mode
+                    && c.screen_shared_with.is_none()
+                    && c.screen.as_ref().is_some_and(|s| s.success_rate >= target)
+            })
+            .min_by(|&a, &b| {
+                let (x, y) = (&self.candidates[a], &self.candidates[b]);
+                x.actuators
+                    .cmp(&y.actuators)
+                    .then(
+                        x.key(obj)
+                            .partial_cmp(&y.key(obj))
+                            .unwrap_or(std::cmp::Ordering::Equal),
+                    )
+                    .then(a.cmp(&b))
+            })
+        else {
+            return Ok(None);
+        };
+        if self.candidates[i].line_check.is_none() {
+            // Its headway probes and full check, at the screen's pace, with room to spare: the
+            // runner-up never makes the design overrun its limit or cut a check short.
+            let c = &self.candidates[i];
+            let per_part = c
+                .screen
+                .as_ref()
+                .map_or(1e-3, |s| s.elapsed_s / s.parts.max(1) as f64);
+            let probes = 7 * o.screen_parts.min(1000);
+            let need = 2.0 * per_part * (o.check_parts + probes) as f64;
+            let left = (self.deadline - Instant::now().min(self.deadline)).as_secs_f64();
+            if need > left {
+                return Ok(None);
+            }
+            let limit = self.limit.clone();
+            self.confirm(i)?;
+            if self.limit != limit {
+                // The check ran short after all: its number is not comparable; say nothing.
+                self.limit = limit;
+                return Ok(None);
+            }
+        }
+        let (c, best) = (&self.candidates[i], &self.candidates[chosen]);
+        let held = c.verdict_check().is_some_and(|v| v.success_rate >= target);
+        let better = c.actuators < best.actuators || c.oriented_per_min > best.oriented_per_min;
+        Ok((held && better).then_some(i))
     }
 
     /// The best candidate by the objective among those `keep` accepts.
@@ -1396,10 +1618,27 @@ impl Work<'_> {
         let target = self.o.problem.target;
         let tol = self.o.problem.tolerance_deg;
         let Some(c) = chosen.map(|i| &self.candidates[i]) else {
-            return format!(
-                "no design: no mode ({}) produced a line that brings more parts into one window than the feed",
-                self.o.modes.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
-            );
+            let names = |keep: &dyn Fn(ModeOutcome) -> bool| {
+                self.modes
+                    .iter()
+                    .filter(|m| keep(m.outcome))
+                    .map(|m| m.mode.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let cut = names(&|o| matches!(o, ModeOutcome::Stopped | ModeOutcome::NotTried));
+            let none = names(&|o| !matches!(o, ModeOutcome::Stopped | ModeOutcome::NotTried));
+            return match (none.is_empty(), cut.is_empty()) {
+                (_, true) => format!(
+                    "no design: no mode ({none}) produced a line that brings more parts into one window than the feed"
+                ),
+                (true, false) => format!(
+                    "no design: the time limit stopped {cut} before any line improved on the feed"
+                ),
+                (false, false) => format!(
+                    "no design: no mode ({none}) produced a line that improves on the feed, and the time limit stopped {cut} first"
+                ),
+            };
         };
         let what = describe_obstacles(c);
         let under = if c.uncertain_check.is_some() {
