@@ -132,6 +132,10 @@ pub struct PlanArgs {
     /// Write nothing (print only).
     #[arg(long)]
     pub no_write: bool,
+    /// Do not measure the confirmed design's margins (the friction interval and the placement
+    /// error over which it holds, swept on the line after the check).
+    #[arg(long)]
+    pub no_margins: bool,
     /// Parts of the full line check, the verdict (0: no check; the design is unchecked).
     #[arg(long, default_value_t = 10_000)]
     pub check_parts: u64,
@@ -275,6 +279,7 @@ pub fn options_of(args: &PlanArgs, recorded: &str) -> Result<DesignOptions> {
     o.max_moving = args.max_moving;
     o.sensor_candidates = args.sensor_candidates;
     o.belt_width_given = args.belt_width.is_some();
+    o.margins = !args.no_margins;
     o.name = match (&args.name, &args.out) {
         (Some(n), _) => n.clone(),
         (None, Some(out)) => out

@@ -54,6 +54,7 @@ pub mod contingent;
 pub mod design;
 pub mod emit;
 pub mod fences;
+pub mod margins;
 pub mod particles;
 pub mod problem;
 pub mod search;

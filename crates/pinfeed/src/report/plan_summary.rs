@@ -329,6 +329,14 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
                 c.oriented_per_min
             );
         }
+        if let Some(m) = &c.margins {
+            t += &format!(
+                "margins     {} — {} parts a step, each held to the target {}\n",
+                m.describe(),
+                m.friction.first().map_or(0, |s| s.samples),
+                m.target
+            );
+        }
         t += &format!(
             "belt        length {:.3} m, width {:.3} m\n",
             c.belt_length_m, c.belt_width_m

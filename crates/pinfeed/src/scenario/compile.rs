@@ -29,7 +29,12 @@ type R<T> = Result<T, ScenarioError>;
 /// The sections are checked in file order (name, belt, part, feed, obstacles, goal, model,
 /// effects, output, the sensors' hypotheses, controller), so the first error reported is the same
 /// whatever else is wrong.
-pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<SceneDraft> {
+pub fn compile(
+    raw: &RawScenario,
+    loc: &Locator,
+    default_name: &str,
+    policy: Option<&str>,
+) -> R<SceneDraft> {
     let c = Checker::new(loc);
     let name = scene_name(&c, raw.name.as_deref(), default_name)?;
     let seed = raw.seed.unwrap_or(1);
@@ -60,6 +65,7 @@ pub fn compile(raw: &RawScenario, loc: &Locator, default_name: &str) -> R<SceneD
         &obstacles,
         &sensors,
         &part.label,
+        policy,
     )?;
     let mut scene = Scene {
         name,

@@ -45,6 +45,17 @@ impl SceneDraft {
     /// Parse and check scenario text. `file` names the file in messages, gives the scene's
     /// default name and the folder a policy file is read from.
     pub fn parse(file: &Path, source: &str) -> Result<SceneDraft, ScenarioError> {
+        SceneDraft::parse_with_policy(file, source, None)
+    }
+
+    /// [`SceneDraft::parse`], with the text of the policy file the scenario names given in
+    /// memory (`policy`; None: read from its file, as `parse` does): a design checked on the
+    /// line before it is written. Messages about the policy name the file the scenario names.
+    pub fn parse_with_policy(
+        file: &Path,
+        source: &str,
+        policy: Option<&str>,
+    ) -> Result<SceneDraft, ScenarioError> {
         let loc = Locator::new(file, source);
         let raw: super::raw::RawScenario = toml::from_str(source).map_err(|e| loc.from_toml(&e))?;
         let default_name = file
@@ -52,7 +63,7 @@ impl SceneDraft {
             .and_then(|s| s.to_str())
             .unwrap_or("scenario")
             .to_string();
-        super::compile::compile(&raw, &loc, &default_name)
+        super::compile::compile(&raw, &loc, &default_name, policy)
     }
 
     /// Read, parse and check a scenario file.

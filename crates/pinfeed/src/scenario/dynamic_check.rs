@@ -132,6 +132,7 @@ pub(super) fn controller(
     obstacles: &[Obstacle],
     sensors: &[SensorDraft],
     part_label: &str,
+    policy_text: Option<&str>,
 ) -> R<Option<Controller>> {
     let dynamic = obstacles
         .iter()
@@ -175,7 +176,13 @@ pub(super) fn controller(
     let mut source = "scenario".to_string();
     if let Some(file) = &rc.policy {
         let path = loc.file.parent().unwrap_or(Path::new(".")).join(file);
-        compiled = policy(c, &path, compiled, obstacles, sensors, part_label, on_late)?;
+        let ctx = PolicyCtx {
+            obstacles,
+            sensors,
+            part_label,
+            on_late,
+        };
+        compiled = policy(c, &path, policy_text, compiled, &ctx)?;
         source = path.display().to_string();
     }
     Ok(Some(Controller {
@@ -278,23 +285,40 @@ fn control_mode(
     }
 }
 
-/// The scenario's rules followed by those read from a policy file; a policy's errors (and a
-/// rule of it that contradicts an earlier one) are located in that file.
+/// What a policy's rules are checked against: the scene's obstacles and sensors, its part and
+/// its controller's `on_late`.
+struct PolicyCtx<'a> {
+    obstacles: &'a [Obstacle],
+    sensors: &'a [SensorDraft],
+    part_label: &'a str,
+    on_late: OnLate,
+}
+
+/// The scenario's rules followed by those of the policy file at `path` (its text `given` in
+/// memory, or read from the file); a policy's errors (and a rule of it that contradicts an
+/// earlier one) are located in that file.
 fn policy(
     c: &Checker,
     path: &Path,
+    given: Option<&str>,
     mut compiled: Vec<(String, Rule)>,
-    obstacles: &[Obstacle],
-    sensors: &[SensorDraft],
-    part_label: &str,
-    on_late: OnLate,
+    ctx: &PolicyCtx,
 ) -> R<Vec<(String, Rule)>> {
-    let source = crate::input::read_text(path).map_err(|e| {
-        c.err(
-            "controller.policy",
-            format!("cannot read the policy file {}: {e}", path.display()),
-        )
-    })?;
+    let PolicyCtx {
+        obstacles,
+        sensors,
+        part_label,
+        on_late,
+    } = *ctx;
+    let source = match given {
+        Some(text) => text.to_string(),
+        None => crate::input::read_text(path).map_err(|e| {
+            c.err(
+                "controller.policy",
+                format!("cannot read the policy file {}: {e}", path.display()),
+            )
+        })?,
+    };
     let ploc = Locator::of(
         path,
         &source,

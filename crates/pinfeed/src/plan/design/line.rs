@@ -7,8 +7,6 @@ use super::LineCheck;
 use crate::engine::{run, OutcomeCounts, RunOptions, RunResult};
 use crate::scenario::Scene;
 use crate::statistics::wilson_interval;
-use std::path::PathBuf;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Why a candidate could not be run on the line.
@@ -20,48 +18,12 @@ pub enum LineError {
     /// The engine refused to run the design.
     #[error("the line could not run the design: {0}")]
     Engine(#[from] crate::engine::EngineError),
-    /// A design file could not be written.
-    #[error("writing the design's files to {path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why it could not be written.
-        source: std::io::Error,
-    },
 }
 
-/// A scratch folder for a design's files while it is checked (a policy file must exist beside
-/// the scenario that names it); removed when dropped.
-pub(crate) struct Scratch {
-    /// The folder (under the system's temporary folder).
-    pub(crate) dir: PathBuf,
-}
-
-impl Scratch {
-    /// Create a fresh folder `pinfeed-design-<process>-<n>` in the system's temporary folder; Err if it cannot be created.
-    pub(crate) fn new() -> Result<Scratch, LineError> {
-        static NEXT: AtomicU64 = AtomicU64::new(0);
-        let dir = std::env::temp_dir().join(format!(
-            "pinfeed-design-{}-{}",
-            std::process::id(),
-            NEXT.fetch_add(1, Ordering::Relaxed)
-        ));
-        std::fs::create_dir_all(&dir).map_err(|source| LineError::Io {
-            path: dir.clone(),
-            source,
-        })?;
-        Ok(Scratch { dir })
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.dir);
-    }
-}
-
-/// A scenario with the feed's headway as a parameter (the `headway = …` line of `[feed]` is
-/// replaced per run), with an optional policy file written beside it.
+/// A design's scenario text, with its policy file's text if it names one: what the design writes.
+/// On the line it is built once, in memory ([`Line`]), and run at any headway by setting the
+/// built scene's; [`Runnable::with_headway`] writes a headway into the text for the design's
+/// output only.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Runnable {
     /// The scenario's text, whose `headway = …` line `with_headway` replaces.
@@ -93,34 +55,31 @@ impl Runnable {
     /// [`Line`]).
     pub(crate) fn run(
         &self,
-        scratch: &Scratch,
         h: f64,
         parts: u64,
         seed: u64,
         records: bool,
     ) -> Result<(LineCheck, RunResult), LineError> {
-        Line::new(self, scratch).run(h, parts, seed, records)
+        Line::new(self).run(h, parts, seed, records)
     }
 }
 
-/// A design on the line, run at any headway: its scenario is written to the scratch folder (with
-/// its policy file) and built — its sensor pins trained, the costly step of a sensor scene — on
+/// A design on the line, run at any headway: its scenario is built in memory, with its policy's
+/// text (no file is written) — its sensor pins trained, the costly step of a sensor scene — on
 /// the first run only; a later run at another headway sets the built scene's feed headway to the
 /// one [`Runnable::with_headway`] would write. Only the arrivals depend on `[feed] headway`, so a
 /// run gives what building the scenario with that headway line would (a test checks it).
 pub(crate) struct Line<'a> {
     runnable: &'a Runnable,
-    scratch: &'a Scratch,
     /// The scene as built by the first run.
     scene: Option<Scene>,
 }
 
 impl<'a> Line<'a> {
-    /// The design `runnable` in `scratch`, not built yet.
-    pub(crate) fn new(runnable: &'a Runnable, scratch: &'a Scratch) -> Line<'a> {
+    /// The design `runnable`, not built yet.
+    pub(crate) fn new(runnable: &'a Runnable) -> Line<'a> {
         Line {
             runnable,
-            scratch,
             scene: None,
         }
     }
@@ -150,19 +109,17 @@ impl<'a> Line<'a> {
     /// The scene at headway `h`: the built scene with its headway set, or (first, or at a headway
     /// the scenario would refuse, or for a scenario without a `headway = …` line) the scenario
     /// text with `h` written in, built.
-    fn scene(&mut self, h: f64) -> Result<&Scene, LineError> {
+    pub(crate) fn scene(&mut self, h: f64) -> Result<&Scene, LineError> {
         let written = written_headway(h).filter(|_| self.runnable.has_headway());
         if let (Some(scene), Some(headway)) = (self.scene.as_mut(), written) {
             scene.feed.arrival = scene.feed.arrival.with_headway(headway);
         } else {
-            let path = self.scratch.dir.join("design.toml");
-            if let Some((name, text)) = &self.runnable.policy {
-                let p = self.scratch.dir.join(name);
-                crate::output::write_atomic(&p, text)
-                    .map_err(|source| LineError::Io { path: p, source })?;
-            }
+            // Messages name the design's scenario as the file it is written to.
+            let path = std::path::Path::new("design.toml");
+            let policy = self.runnable.policy.as_ref().map(|(_, text)| text.as_str());
             let toml = self.runnable.with_headway(h);
-            self.scene = Some(crate::scenario::parse(&path, &toml)?);
+            let draft = crate::scenario::SceneDraft::parse_with_policy(path, &toml, policy)?;
+            self.scene = Some(draft.build()?);
         }
         Ok(self.scene.as_ref().expect("the scene was built"))
     }
@@ -270,13 +227,16 @@ mod tests {
     /// A line built at one headway and run at others gives, at each, the scene and the run of the
     /// scenario text written with that headway and built afresh.
     fn reuse_matches_rebuilding(r: &Runnable, headways: &[f64]) {
-        let scratch = Scratch::new().unwrap();
-        let mut line = Line::new(r, &scratch);
+        let mut line = Line::new(r);
         line.run(9.0, 3, 5, false).unwrap();
         for &h in headways {
             let (check, res) = line.run(h, 40, 5, true).unwrap();
+            let path = std::path::Path::new("design.toml");
+            let policy = r.policy.as_ref().map(|(_, t)| t.as_str());
             let built =
-                crate::scenario::parse(&scratch.dir.join("design.toml"), &r.with_headway(h))
+                crate::scenario::SceneDraft::parse_with_policy(path, &r.with_headway(h), policy)
+                    .unwrap()
+                    .build()
                     .unwrap();
             let reused = line.scene.as_ref().unwrap();
             assert_eq!(reused.feed.arrival, built.feed.arrival, "h = {h}");
@@ -293,6 +253,44 @@ mod tests {
             assert_eq!(format!("{:?}", res.records), format!("{:?}", fresh.records));
             assert_eq!(check.headway_s, h);
         }
+    }
+
+    #[test]
+    fn a_design_built_in_memory_is_the_scene_its_written_files_load() {
+        // A sensor line whose rules are in a policy file: built with the policy's text in memory,
+        // as the planner builds it, and from the files written to a folder, as a user loads them.
+        let toml = scenario("tripoly1_sensing.toml");
+        let (rules, goal) = (
+            toml.find("[[rules]]").unwrap(),
+            toml.find("[goal]").unwrap(),
+        );
+        let policy_name = "design.policy.toml";
+        let body = format!("{}{}", &toml[..rules], &toml[goal..]).replace(
+            "[controller]\n",
+            &format!("[controller]\npolicy = \"{policy_name}\"\n"),
+        );
+        let policy = format!("part = \"tripoly1\"\n\n{}", &toml[rules..goal]);
+        let r = Runnable {
+            toml: body,
+            policy: Some((policy_name.to_string(), policy.clone())),
+        };
+        let mut line = Line::new(&r);
+        let h = 7.5;
+        let in_memory = format!("{:?}", line.scene(h).unwrap());
+        assert!(
+            in_memory.contains("decides"),
+            "the policy's rules are in the scene"
+        );
+        let dir = std::env::temp_dir().join(format!("pinfeed_line_emit_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("design.toml");
+        std::fs::write(&path, r.with_headway(h)).unwrap();
+        std::fs::write(dir.join(policy_name), &policy).unwrap();
+        let loaded = format!("{:?}", crate::scenario::load(&path).unwrap());
+        std::fs::remove_dir_all(&dir).unwrap();
+        // The controller names its policy file where it was read from.
+        let loaded = loaded.replace(&dir.join(policy_name).display().to_string(), policy_name);
+        assert_eq!(in_memory, loaded);
     }
 
     #[test]

@@ -33,7 +33,7 @@ use super::fences::{FenceOptions, FenceTransition};
 use super::search::{Outcome, Plan, Planner, SearchStats};
 use super::{Action, Limit, PlanError, Problem};
 use crate::engine::OutcomeCounts;
-use line::{HeadwayProbe, Line, LineError, Runnable, Scratch};
+use line::{HeadwayProbe, Line, LineError, Runnable};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -159,6 +159,8 @@ pub struct DesignOptions {
     pub sensor_candidates: usize,
     /// Was the belt width given? If not, the fence and hybrid modes may use a wider belt.
     pub belt_width_given: bool,
+    /// Measure the chosen design's margins ([`super::margins`]) once it is confirmed.
+    pub margins: bool,
     /// The design's name: its scenario's `name` and its files' stem.
     pub name: String,
     /// The command line that asked for it (written into the scenario's header).
@@ -182,6 +184,7 @@ impl DesignOptions {
             max_moving: 3,
             sensor_candidates: 6,
             belt_width_given: false,
+            margins: true,
             command,
             name,
         }
@@ -446,6 +449,10 @@ pub struct Candidate {
     pub uncertain_check: Option<LineCheck>,
     /// Oriented parts per minute at `headway_s` (the full check's success, else the screen's).
     pub oriented_per_min: f64,
+    /// How far friction and placement may drift before the line fails (the chosen design, once
+    /// confirmed, unless the options turn it off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub margins: Option<super::margins::Margins>,
     /// The plan, as searched.
     pub layout: Layout,
     /// The problem the candidate was searched with (its belt width and particles).
@@ -527,6 +534,7 @@ impl Candidate {
             line_check: None,
             uncertain_check: None,
             oriented_per_min: 0.0,
+            margins: None,
             layout: e.layout,
             problem: e.problem,
             runnable: e.runnable,
@@ -1101,10 +1109,7 @@ impl Work<'_> {
                 round,
                 format!("line screen ({} parts)", o.screen_parts),
             );
-            let scratch = Scratch::new()?;
-            let (screen, res) =
-                cand.runnable
-                    .run(&scratch, h, o.screen_parts, problem.seed, true)?;
+            let (screen, res) = cand.runnable.run(h, o.screen_parts, problem.seed, true)?;
             self.line_runs += 1;
             if let Layout::Contingent(plan) = &cand.layout {
                 let (acc, with) = confusion_prediction(plan, &res.summary);
@@ -1354,7 +1359,6 @@ impl Work<'_> {
     fn confirm(&mut self, i: usize) -> Result<(), DesignError> {
         let o = self.o;
         let seed = o.problem.seed;
-        let scratch = Scratch::new()?;
         let c = &self.candidates[i];
         let (mode, round) = (c.mode, c.round);
         let poly = c.problem.compile()?.polygon;
@@ -1373,7 +1377,7 @@ impl Work<'_> {
         self.tell(Some(mode), round, "finding the line's headway".into());
         let runnable = c.runnable.clone();
         let target = o.problem.target;
-        let mut on_line = Line::new(&runnable, &scratch);
+        let mut on_line = Line::new(&runnable);
         let (h, probes) = line::shortest_headway(
             &mut on_line,
             (lo, hi),
@@ -1414,30 +1418,17 @@ impl Work<'_> {
         c.oriented_per_min = check.success_rate * 60.0 / h;
         c.line_check = Some(check);
         let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
-        let study = super::check::uncertainty_study(
-            &c.problem,
-            &kinds,
-            o.fences.mu_f.is_some(),
-            "design.toml",
-            "design.uncertain.toml",
-            parts,
-        );
-        if let Some(study) = study {
+        let uncertain = super::check::uncertainty(&c.problem, &kinds, o.fences.mu_f.is_some());
+        if let Some(perturbations) = uncertain {
             self.tell(
                 Some(mode),
                 round,
                 format!("line check under the planned uncertainty ({parts} samples)"),
             );
-            let toml = runnable.with_headway(h);
             let started = Instant::now();
-            let (outcomes, n) = super::check::check_uncertain(
-                &toml,
-                &study,
-                &scratch.dir,
-                "design.toml",
-                "design.uncertain.toml",
-            )
-            .map_err(|e| input("mu_c_range/tripod", "", e))?;
+            let scene = on_line.scene(h)?;
+            let (outcomes, n) = super::check::check_uncertain(scene, perturbations, seed, parts)
+                .map_err(|e| input("mu_c_range/tripod", "", e))?;
             self.line_runs += 1;
             let c = &mut self.candidates[i];
             c.uncertain_check = Some(LineCheck::of(&outcomes, n, h, started));
@@ -1505,6 +1496,9 @@ impl Work<'_> {
                 }
             }
         }
+        if let (Status::Confirmed, Some(i), true) = (status, chosen, o.margins) {
+            self.margins(i)?;
+        }
         let runner_up = match (status, chosen) {
             (Status::Confirmed, Some(i)) => self.runner_up(i)?,
             _ => None,
@@ -1539,6 +1533,40 @@ impl Work<'_> {
             scenario_toml,
             policy_toml,
         })
+    }
+
+    /// Measure candidate `i`'s margins on its line at its headway, under the uncertainty it was
+    /// planned against: as many parts per step as its check ran, at most 2000.
+    fn margins(&mut self, i: usize) -> Result<(), DesignError> {
+        let o = self.o;
+        let c = &self.candidates[i];
+        let Some(check) = c.verdict_check() else {
+            return Ok(());
+        };
+        let samples = check.parts.min(2000);
+        self.tell(
+            Some(c.mode),
+            c.round,
+            format!("margins: friction and placement sweeps ({samples} parts a step)"),
+        );
+        let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
+        let base = super::check::uncertainty(&c.problem, &kinds, o.fences.mu_f.is_some());
+        let runnable = c.runnable.clone();
+        let h = c.headway_s;
+        let mut line = Line::new(&runnable);
+        let scene = line.scene(h)?;
+        let m = super::margins::measure(
+            scene,
+            base.as_ref(),
+            o.problem.target,
+            o.problem.seed,
+            samples,
+            self.deadline,
+        )
+        .map_err(|e| input("margins", "", e))?;
+        self.line_runs += m.friction.len() + m.placement.len();
+        self.candidates[i].margins = Some(m);
+        Ok(())
     }
 
     /// The runner-up of another mode than the confirmed candidate `chosen`: among the candidates
@@ -1748,6 +1776,13 @@ pub fn header_lines(o: &DesignOptions, c: &Candidate, status: Status) -> Vec<Str
             line::fmt_headway(k.headway_s),
             c.headway_probes.len(),
             c.oriented_per_min
+        ));
+    }
+    if let Some(m) = &c.margins {
+        l.push(format!(
+            "Margins (`pinfeed plan` swept them on the line, {} parts a step): {}.",
+            m.friction.first().map_or(0, |s| s.samples),
+            m.describe()
         ));
     }
     match &c.layout {

@@ -126,6 +126,42 @@ impl Study {
     }
 }
 
+impl Study {
+    /// A study built in code, not read from a file: `samples` samples of `scene` (one part each
+    /// through a freshly perturbed copy, as `pinfeed mc` runs a study) under `declared`, with no
+    /// sweep, seeded `seed`; `name` names it in reports. What a study file would check when it is
+    /// read — that each parameter reaches an obstacle of the scene — is the caller's to know.
+    /// Its hashes are of its name, seed, samples and perturbations (a study built in code is not
+    /// sharded from a file).
+    pub fn of_scene(
+        name: &str,
+        scene: Scene,
+        seed: u64,
+        samples: u64,
+        declared: Perturbations,
+    ) -> Result<Study, StudyError> {
+        let online = crate::engine::prepare::online_model(&scene).map_err(StudyError::Scenario)?;
+        let what = format!("{name}\n{seed}\n{samples}\n{declared:?}");
+        let hash = hash::fnv1a(&[b"pinfeed-mc-study-in-code", what.as_bytes()]);
+        let file = PathBuf::from(format!("{name} (built in code)"));
+        Ok(Study {
+            name: name.to_string(),
+            scenario_file: file.clone(),
+            file,
+            scene,
+            seed,
+            samples: samples.clamp(1, MAX_SAMPLES),
+            axes: Vec::new(),
+            point_values: vec![Vec::new()],
+            points: vec![declared.clone()],
+            declared,
+            study_hash: hash,
+            scenario_hash: hash,
+            online,
+        })
+    }
+}
+
 /// Read and validate a study file; `samples` overrides the file's samples per point.
 pub fn load(path: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
     let source = crate::input::read_text(path).map_err(|error| StudyError::Io {

@@ -63,6 +63,36 @@ pub struct Perturbations {
 }
 
 impl Perturbations {
+    /// Nothing perturbed, the part resting on `support`: the start of a study built in code
+    /// ([`super::Study::of_scene`]), whose fields are then set.
+    pub fn none(support: SupportChoice) -> Perturbations {
+        Perturbations {
+            mu_c: None,
+            belt_speed: None,
+            shape: None,
+            pin_x: None,
+            pin_y: None,
+            pin_radius: None,
+            pose_theta: None,
+            pose_y: None,
+            sensor_noise: None,
+            sensor_bias: None,
+            sensor_threshold: None,
+            sensor_jitter: None,
+            fence_mu_f: None,
+            fence_angle: None,
+            fence_x: None,
+            fence_y: None,
+            fence_length: None,
+            actuator_speed: None,
+            actuator_accel: None,
+            actuator_settle: None,
+            controller_latency: None,
+            only: BTreeMap::new(),
+            support,
+        }
+    }
+
     /// Does any parameter act on sensor pins?
     pub fn perturbs_sensors(&self) -> bool {
         self.sensor_noise.is_some()

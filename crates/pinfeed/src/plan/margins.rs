@@ -1,0 +1,249 @@
+//! How far the physics may drift before a design fails: its **margins**, measured on the line.
+//!
+//! A design is confirmed at the friction and positions it was planned for; a real floor's friction
+//! is known to ±0.1 at best and pins stand a fraction of a millimetre off the drawing. Two sweeps
+//! of Monte Carlo runs (each sample one part through the line, as `pinfeed mc` runs a study built
+//! in code, [`crate::study::mc::Study::of_scene`]) say how far each may go:
+//!
+//! * **friction**: the pins' μc and the fences' μf shifted together by δ = ±0.05, ±0.10, … (up
+//!   to ±[`MU_REACH`]), stepping out from the nominal on each side until a step fails; the
+//!   interval is the steps that held on both sides of the nominal;
+//! * **placement**: every pin's and fence's position off by a uniform error in ±e (each
+//!   coordinate, drawn per obstacle and part) and every fence's angle by ±e degrees, for e in
+//!   [`PLACEMENT_MM`], until a step fails; the margin is the largest e that held.
+//!
+//! A step *holds* when its success rate is at least the design's target — the verdict's own rule,
+//! at the step's sample count. Whatever the design was planned against (random tripods, a μc
+//! range) stays in every step; a friction step fixes μ to its value.
+
+use crate::mechanics::support::SupportChoice;
+use crate::random::distribution::Distribution;
+use crate::scenario::raw::SupportKind;
+use crate::scenario::{Obstacle, Scene};
+use crate::statistics::wilson_interval;
+use crate::study::mc::{Perturbations, StudyError};
+use serde::Serialize;
+use std::time::Instant;
+
+/// The friction steps (δ added to the nominal μ).
+pub const MU_STEP: f64 = 0.05;
+/// How far the friction sweep reaches on each side of the nominal.
+pub const MU_REACH: f64 = 0.3;
+/// The placement errors tried (± mm on positions; the same number in degrees on fence angles).
+pub const PLACEMENT_MM: [f64; 4] = [0.25, 0.5, 1.0, 2.0];
+
+/// One step of a sweep: the line under one shift of its physics.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Step {
+    /// The step: μ of the pins (friction), or ±mm and ±degrees (placement).
+    pub at: f64,
+    /// Parts run (one per sample).
+    pub samples: u64,
+    /// Parts that ended in success.
+    pub success: u64,
+    /// `success` / `samples`.
+    pub success_rate: f64,
+    /// 95% Wilson interval of the success rate.
+    pub ci95: [f64; 2],
+    /// Did it hold the target?
+    pub holds: bool,
+}
+
+/// A design's margins: the friction interval and the placement error over which it holds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Margins {
+    /// The target each step is held to.
+    pub target: f64,
+    /// The pins' nominal μc (the fences' μf moves with it by the same δ).
+    pub mu_nominal: f64,
+    /// The fences' nominal μf, if the line has fences.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mu_f_nominal: Option<f64>,
+    /// The pins' μ over which every step held: from the lowest to the highest step that held
+    /// without a failing step between them and the nominal. None when the nominal itself fails.
+    pub mu_holds: Option<[f64; 2]>,
+    /// Did the sweep end on each side (low, high) still holding — at the end of its reach, the
+    /// edge of the valid range or the time limit — so that the margin may be wider?
+    pub mu_open: [bool; 2],
+    /// The friction steps, in increasing μ.
+    pub friction: Vec<Step>,
+    /// The largest placement error (± mm, ± degrees) at which the line held, if any.
+    pub placement_mm: Option<f64>,
+    /// The placement steps, in increasing error.
+    pub placement: Vec<Step>,
+    /// The time limit stopped the sweeps before they ended: what is reported is what was run.
+    pub cut_short: bool,
+}
+
+impl Margins {
+    /// "holds for μ 0.45–0.60 (pins; fences μf 0.45–0.60) and placement ±0.5 mm / ±0.5°".
+    pub fn describe(&self) -> String {
+        let mu = match self.mu_holds {
+            None => "fails at its nominal friction".to_string(),
+            Some([lo, hi]) => {
+                let fences = self.mu_f_nominal.map_or(String::new(), |f| {
+                    let d = f - self.mu_nominal;
+                    format!(" (fences' μf {:.2}–{:.2})", lo + d, hi + d)
+                });
+                let beyond = match self.mu_open {
+                    [true, true] => ", or wider: the sweep stopped holding on both sides",
+                    [true, false] => ", or lower: the sweep stopped holding",
+                    [false, true] => ", or higher: the sweep stopped holding",
+                    [false, false] => "",
+                };
+                format!("holds for friction μ {lo:.2}–{hi:.2}{fences}{beyond}")
+            }
+        };
+        let place = match self.placement_mm {
+            Some(e) => format!("placement errors up to ±{e} mm / ±{e}°"),
+            None if self.placement.is_empty() => "placement not measured".into(),
+            None => format!(
+                "fails at a placement error of ±{} mm / ±{}°",
+                PLACEMENT_MM[0], PLACEMENT_MM[0]
+            ),
+        };
+        let cut = if self.cut_short {
+            " (the time limit cut the sweeps short)"
+        } else {
+            ""
+        };
+        format!("{mu}; {place}{cut}")
+    }
+}
+
+/// Measure the margins of `scene` against `target`: `samples` parts per step with `seed`, under
+/// `base` (the uncertainty the design was planned against, or none), stopping at `deadline`.
+pub fn measure(
+    scene: &Scene,
+    base: Option<&Perturbations>,
+    target: f64,
+    seed: u64,
+    samples: u64,
+    deadline: Instant,
+) -> Result<Margins, StudyError> {
+    let (mut pins, mut fences) = (false, None);
+    for o in &scene.obstacles {
+        match o {
+            Obstacle::Pin(_) => pins = true,
+            Obstacle::Fence(f) => fences = fences.or(Some(f.mu_f)),
+        }
+    }
+    // Without a planned uncertainty: the scenario's own support, as a study without
+    // `[uncertain.support]` keeps it.
+    let base = base.cloned().unwrap_or_else(|| {
+        Perturbations::none(match scene.part.support {
+            SupportKind::Tripod => SupportChoice::Tripod,
+            SupportKind::Uniform => SupportChoice::Uniform,
+        })
+    });
+    let mu0 = scene.part.mu_c;
+    let run = |p: Perturbations, at: f64| -> Result<Step, StudyError> {
+        let (counts, n) = super::check::check_uncertain(scene, p, seed, samples)?;
+        let rate = counts.success as f64 / n.max(1) as f64;
+        Ok(Step {
+            at,
+            samples: n,
+            success: counts.success,
+            success_rate: rate,
+            ci95: wilson_interval(counts.success, n),
+            holds: rate >= target,
+        })
+    };
+    let mut cut_short = false;
+    // Friction: the nominal, then outwards on each side until a step fails.
+    let shifted = |d: f64| {
+        let mut p = base.clone();
+        if pins {
+            p.mu_c = Some(Distribution::Fixed(mu0 + d));
+        }
+        if let Some(f) = fences {
+            p.fence_mu_f = Some(Distribution::Fixed(f + d));
+        }
+        p
+    };
+    let valid = |d: f64| {
+        let (lo, hi) = crate::mechanics::limits::MU_C;
+        let ok = |m: f64| m > lo && m <= hi;
+        ok(mu0 + d) && fences.is_none_or(|f| ok(f + d))
+    };
+    let nominal = run(shifted(0.0), mu0)?;
+    let mut friction = vec![nominal.clone()];
+    let mut open = [false, false];
+    if nominal.holds {
+        for (side, sign) in [(0, -1.0), (1, 1.0)] {
+            let mut k = 1;
+            loop {
+                let d = sign * MU_STEP * k as f64;
+                if d.abs() > MU_REACH + 1e-9 || !valid(d) {
+                    open[side] = true;
+                    break;
+                }
+                if Instant::now() >= deadline {
+                    open[side] = true;
+                    cut_short = true;
+                    break;
+                }
+                let s = run(shifted(d), mu0 + d)?;
+                let held = s.holds;
+                friction.push(s);
+                if !held {
+                    break;
+                }
+                k += 1;
+            }
+        }
+    }
+    friction.sort_by(|a, b| a.at.total_cmp(&b.at));
+    let mu_holds = nominal.holds.then(|| {
+        // The contiguous run of held steps around the nominal.
+        let i0 = friction.iter().position(|s| s.at == mu0).unwrap_or(0);
+        let mut lo = i0;
+        while lo > 0 && friction[lo - 1].holds {
+            lo -= 1;
+        }
+        let mut hi = i0;
+        while hi + 1 < friction.len() && friction[hi + 1].holds {
+            hi += 1;
+        }
+        [friction[lo].at, friction[hi].at]
+    });
+    // Placement: growing errors until one fails.
+    let mut placement = Vec::new();
+    let mut placement_mm = None;
+    for e in PLACEMENT_MM {
+        if Instant::now() >= deadline {
+            cut_short = true;
+            break;
+        }
+        let mut p = base.clone();
+        let m = e * 1e-3;
+        let u = |w: f64| Some(Distribution::Uniform { min: -w, max: w });
+        if pins {
+            p.pin_x = u(m);
+            p.pin_y = u(m);
+        }
+        if fences.is_some() {
+            p.fence_x = u(m);
+            p.fence_y = u(m);
+            p.fence_angle = u(e);
+        }
+        let s = run(p, e)?;
+        let held = s.holds;
+        placement.push(s);
+        if !held {
+            break;
+        }
+        placement_mm = Some(e);
+    }
+    Ok(Margins {
+        target,
+        mu_nominal: mu0,
+        mu_f_nominal: fences,
+        mu_holds,
+        mu_open: open,
+        friction,
+        placement_mm,
+        placement,
+        cut_short,
+    })
+}
