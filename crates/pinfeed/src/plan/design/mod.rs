@@ -442,6 +442,9 @@ pub struct Candidate {
     pub headway_s: f64,
     /// The full check at `headway_s`.
     pub line_check: Option<LineCheck>,
+    /// The verdict check's 95% interval still holds the target after the parts the time and
+    /// the cap (8× the check's parts) allowed: the verdict is its number's, undecided.
+    pub undecided: bool,
     /// A problem planned against uncertainty (a μc range, tripods): the full check is also run
     /// under it, as a Monte Carlo study of `check_parts` samples (one part through a freshly
     /// perturbed line each); the verdict is then this run's.
@@ -532,6 +535,7 @@ impl Candidate {
             headway_probes: Vec::new(),
             headway_s: 0.0,
             line_check: None,
+            undecided: false,
             uncertain_check: None,
             oriented_per_min: 0.0,
             margins: None,
@@ -1405,8 +1409,33 @@ impl Work<'_> {
             round,
             format!("line check ({parts} parts at {h:.1} s)"),
         );
-        let (check, res) = on_line.run(h, parts, seed, false)?;
+        let kinds: Vec<&str> = self.candidates[i]
+            .obstacles
+            .iter()
+            .map(|o| o.kind.name())
+            .collect();
+        let uncertain =
+            super::check::uncertainty(&self.candidates[i].problem, &kinds, o.fences.mu_f.is_some());
+        let (mut check, mut res) = on_line.run(h, parts, seed, false)?;
         self.line_runs += 1;
+        // A verdict near its threshold is decided by more evidence, not by a seed: while the
+        // check's interval straddles the target, run twice the parts (up to 8× the check) if
+        // the time left allows.
+        let mut n = parts;
+        while uncertain.is_none() && straddles(&check, target) && n < 8 * o.check_parts {
+            let next = (2 * n).min(8 * o.check_parts);
+            if !self.fits(check.elapsed_s / n.max(1) as f64 * next as f64) {
+                break;
+            }
+            self.tell(
+                Some(mode),
+                round,
+                format!("line check straddles the target: {next} parts"),
+            );
+            (check, res) = on_line.run(h, next, seed, false)?;
+            self.line_runs += 1;
+            n = next;
+        }
         let c = &mut self.candidates[i];
         if let Layout::Contingent(plan) = &c.layout {
             let (acc, with) = confusion_prediction(plan, &res.summary);
@@ -1416,25 +1445,44 @@ impl Work<'_> {
         c.headway_probes = probes;
         c.headway_s = h;
         c.oriented_per_min = check.success_rate * 60.0 / h;
+        c.undecided = straddles(&check, target);
         c.line_check = Some(check);
-        let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
-        let uncertain = super::check::uncertainty(&c.problem, &kinds, o.fences.mu_f.is_some());
         if let Some(perturbations) = uncertain {
-            self.tell(
-                Some(mode),
-                round,
-                format!("line check under the planned uncertainty ({parts} samples)"),
-            );
-            let started = Instant::now();
             let scene = on_line.scene(h)?;
-            let (outcomes, n) = super::check::check_uncertain(scene, perturbations, seed, parts)
-                .map_err(|e| input("mu_c_range/tripod", "", e))?;
-            self.line_runs += 1;
-            let c = &mut self.candidates[i];
-            c.uncertain_check = Some(LineCheck::of(&outcomes, n, h, started));
-            c.oriented_per_min = outcomes.success as f64 / n.max(1) as f64 * 60.0 / h;
+            let mut samples = parts;
+            loop {
+                self.tell(
+                    Some(mode),
+                    round,
+                    format!("line check under the planned uncertainty ({samples} samples)"),
+                );
+                let started = Instant::now();
+                let (outcomes, n) =
+                    super::check::check_uncertain(scene, perturbations.clone(), seed, samples)
+                        .map_err(|e| input("mu_c_range/tripod", "", e))?;
+                self.line_runs += 1;
+                let u = LineCheck::of(&outcomes, n, h, started);
+                let next = (2 * samples).min(8 * o.check_parts);
+                let more = straddles(&u, target)
+                    && samples < next
+                    && self.fits(u.elapsed_s / n.max(1) as f64 * next as f64);
+                let c = &mut self.candidates[i];
+                c.oriented_per_min = outcomes.success as f64 / n.max(1) as f64 * 60.0 / h;
+                c.undecided = straddles(&u, target);
+                c.uncertain_check = Some(u);
+                if !more {
+                    break;
+                }
+                samples = next;
+            }
         }
         Ok(())
+    }
+
+    /// Does work of `seconds` (with a 20% reserve) fit in the time left?
+    fn fits(&self, seconds: f64) -> bool {
+        let left = (self.deadline - Instant::now().min(self.deadline)).as_secs_f64();
+        seconds * 1.2 <= left
     }
 
     fn finish(mut self, started: Instant) -> Result<Design, DesignError> {
@@ -1681,17 +1729,27 @@ impl Work<'_> {
                 c.predicted_success
             ),
             (_, Some(l)) => format!(
-                "{} — {what} ({} mode): the line{under} holds {:.4} (95% CI {:.4}–{:.4}) of {} parts in one ±{tol}° window, target {target}; predicted {:.4}",
+                "{} — {what} ({} mode): the line{under} holds {:.4} (95% CI {:.4}–{:.4}) of {} parts in one ±{tol}° window, target {target}; predicted {:.4}{}",
                 status.word(),
                 c.mode.name(),
                 l.success_rate,
                 l.ci95[0],
                 l.ci95[1],
                 l.parts,
-                c.predicted_success
+                c.predicted_success,
+                if c.undecided {
+                    format!("; undecided: the interval still holds the target after {} parts, as many as the time and the cap (8× the check) allowed", l.parts)
+                } else {
+                    String::new()
+                }
             ),
         }
     }
+}
+
+/// Does the check's 95% interval hold the target inside it (its verdict undecided)?
+fn straddles(check: &LineCheck, target: f64) -> bool {
+    check.ci95[0] < target && target <= check.ci95[1]
 }
 
 /// "3 pin(s)", "2 fence(s) and 1 pin(s)", "a sensor pin and 2 moving pin(s)".
