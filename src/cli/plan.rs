@@ -94,6 +94,11 @@ pub struct PlanArgs {
     /// Minimise the number of orientation sets instead (searches every depth unless one set is reached).
     #[arg(long)]
     pub fewest_sets: bool,
+    /// The exit orientation the next station needs (degrees, modulo the part's symmetry): the
+    /// goal window is centred there (see `pinfeed part` for the part's stable states) [default:
+    /// the planner chooses].
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub goal: Option<f64>,
     /// Smallest robustness margin of a pin position (mm).
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub min_margin: f64,
@@ -209,6 +214,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.tolerance_deg = args.tolerance;
     p.target = args.target;
     p.fewest_sets = args.fewest_sets;
+    p.goal_deg = args.goal;
     p.bound = !args.no_bound;
     p.min_margin_m = args.min_margin * 1e-3;
     p.y_quantum_m = args.y_quantum * 1e-3;
@@ -282,9 +288,20 @@ pub fn options_of(args: &PlanArgs, recorded: &str) -> Result<DesignOptions> {
     o.margins = !args.no_margins;
     o.name = match (&args.name, &args.out) {
         (Some(n), _) => n.clone(),
-        (None, Some(out)) => out
-            .file_stem()
-            .map_or(o.name.clone(), |s| s.to_string_lossy().to_string()),
+        // The scenario's name must be letters, digits, '-' and '_': a file `line_1.5.toml`
+        // names the design `line_1-5`.
+        (None, Some(out)) => out.file_stem().map_or(o.name.clone(), |s| {
+            s.to_string_lossy()
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                        c
+                    } else {
+                        '-'
+                    }
+                })
+                .collect()
+        }),
         (None, None) => o.name,
     };
     o.command = recorded.to_string();

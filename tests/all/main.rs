@@ -62,6 +62,7 @@ mod moving_pin;
 mod online;
 mod plan;
 mod plan_fences;
+mod plan_goal;
 mod plan_margins;
 mod plan_sensing;
 mod plan_verdict;

@@ -398,8 +398,18 @@ pub fn search(
         }
         // The best (sensor, window) at this level.
         let mut best: Option<(u32, f64, usize, usize)> = None; // (inside, margin, sensor, c)
+                                                               // A goal orientation fixes the window; otherwise any window start.
+        let starts: Vec<usize> = match p.goal_deg {
+            Some(g) => {
+                vec![
+                    super::particles::goal_start(g, p.tolerance_deg, p.theta_quantum_deg, steps)
+                        as usize,
+                ]
+            }
+            None => (0..steps as usize).collect(),
+        };
         for (si, row) in searches.iter().enumerate() {
-            for c in 0..steps as usize {
+            for &c in &starts {
                 let inside: u32 = row.iter().map(|bs| bs.best[c].0).sum();
                 let better = match best {
                     None => true,

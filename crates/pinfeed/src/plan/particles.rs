@@ -275,6 +275,35 @@ pub fn best_window(state: &State, tol_deg: f64, q_deg: f64, steps: i32) -> Windo
     }
 }
 
+/// The window of half-width `tol_deg` centred at `centre_deg` (taken modulo the period of `steps`
+/// quanta of `q_deg`): a goal orientation the user chose. Its start is the quantum nearest to
+/// `centre − tol`, so it holds the same quanta a window [`best_window`] finds there would.
+pub fn window_at(state: &State, centre_deg: f64, tol_deg: f64, q_deg: f64, steps: i32) -> Window {
+    let total = state.total().max(1);
+    let width_q = ((2.0 * tol_deg / q_deg) + 1e-9).floor() as i32;
+    let start = goal_start(centre_deg, tol_deg, q_deg, steps);
+    let inside: u32 = state
+        .particles
+        .iter()
+        .filter(|p| (p.theta_q - start).rem_euclid(steps) <= width_q)
+        .map(|p| p.weight)
+        .sum();
+    Window {
+        centre_deg: ((start as f64 + width_q as f64 / 2.0) * q_deg)
+            .rem_euclid(steps as f64 * q_deg),
+        inside,
+        share: inside as f64 / total as f64,
+    }
+}
+
+/// The first quantum of the window of half-width `tol_deg` centred at `centre_deg`, in
+/// `0..steps`.
+pub fn goal_start(centre_deg: f64, tol_deg: f64, q_deg: f64, steps: i32) -> i32 {
+    let width_q = ((2.0 * tol_deg / q_deg) + 1e-9).floor() as i32;
+    let c = (centre_deg / q_deg - width_q as f64 / 2.0).round() as i64;
+    c.rem_euclid(steps as i64) as i32
+}
+
 /// The number of orientation sets: windows of half-width `tol_deg` taken greedily (most weight
 /// first) until they hold `target` of the weight (lost weight counts against it). Greedy covering
 /// can overcount by a little; it is the measure `fewest_sets` minimises. `usize::MAX` if the lost

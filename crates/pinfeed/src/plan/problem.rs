@@ -94,6 +94,10 @@ pub struct Problem {
     pub target: f64,
     /// Minimise the number of orientation sets instead of requiring one.
     pub fewest_sets: bool,
+    /// Goal: the exit orientation the next station needs (degrees, taken modulo the part's
+    /// symmetry): the window is centred there. None: the planner chooses the window.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub goal_deg: Option<f64>,
     /// Smallest robustness margin of an action (m).
     pub min_margin_m: f64,
     /// Lateral quantum of particles and of the pin grid (m).
@@ -146,6 +150,7 @@ impl Problem {
             tolerance_deg: 3.0,
             target: 0.99,
             fewest_sets: false,
+            goal_deg: None,
             min_margin_m: 0.0005,
             y_quantum_m: 0.00025,
             theta_quantum_deg: 0.25,
@@ -379,6 +384,22 @@ impl Problem {
                 self.target,
                 "must lie in (0, 1]",
             ));
+        }
+        if let Some(g) = self.goal_deg {
+            if !(g.is_finite() && g.abs() <= 1e6) {
+                return Err(PlanError::input(
+                    "goal",
+                    g,
+                    "must be a finite angle in degrees (the part's exit orientation, modulo its symmetry)",
+                ));
+            }
+            if self.fewest_sets {
+                return Err(PlanError::input(
+                    "goal",
+                    g,
+                    "a goal orientation asks for one window; fewest_sets asks for the fewest windows anywhere: choose one",
+                ));
+            }
         }
         if !(self.min_margin_m.is_finite() && self.min_margin_m >= 0.0 && self.min_margin_m < a) {
             return Err(PlanError::input(

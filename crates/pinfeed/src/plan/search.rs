@@ -229,6 +229,15 @@ impl Planner {
     /// The best window of a state.
     pub fn window(&self, state: &State) -> Window {
         let p = &self.problem;
+        if let Some(goal) = p.goal_deg {
+            return super::particles::window_at(
+                state,
+                goal,
+                p.tolerance_deg,
+                p.theta_quantum_deg,
+                self.compiled.theta_steps,
+            );
+        }
         best_window(
             state,
             p.tolerance_deg,

@@ -238,12 +238,13 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
     let p = &o.problem;
     let mut t = format!("{}\n", o.command);
     t += &format!(
-        "design      {}: modes {}; objective {:?}; goal ≥ {} of the parts in one ±{}° window, on the line\n",
+        "design      {}: modes {}; objective {:?}; goal ≥ {} of the parts in one ±{}° window{}, on the line\n",
         o.name,
         o.modes.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "),
         o.objective,
         p.target,
-        p.tolerance_deg
+        p.tolerance_deg,
+        p.goal_deg.map_or(String::new(), |g| format!(" centred at {g}°"))
     );
     t += "candidates  mode     round  particles  search                obstacles                        belt (m)  width (m)  predicted  line (parts, headway)\n";
     for (i, c) in d.candidates.iter().enumerate() {

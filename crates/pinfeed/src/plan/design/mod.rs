@@ -207,7 +207,7 @@ pub fn design_name(part: &str) -> String {
     }
     p.chars()
         .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+            if c.is_ascii_alphanumeric() || c == '-' {
                 c
             } else {
                 '-'
@@ -776,18 +776,18 @@ pub fn check_goal(o: &DesignOptions) -> Result<(), DesignError> {
             "must lie in 1..=64",
         ));
     }
+    // The emitted scenario's `name`, which allows these only (it names a results folder).
     if o.name.is_empty()
         || o.name.len() > 100
         || !o
             .name
             .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
-        || o.name.starts_with('.')
+            .all(|c| c.is_ascii_alphanumeric() || "-_".contains(c))
     {
         return Err(input(
             "name",
             &o.name,
-            "must be 1–100 characters of letters, digits, '-', '_' or '.', not starting with '.'",
+            "must be 1–100 characters of letters, digits, '-' or '_' (it is the scenario's name)",
         ));
     }
     fence_options(o, p.mu_c)?;
