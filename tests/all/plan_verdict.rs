@@ -254,3 +254,24 @@ fn a_simpler_or_faster_design_of_another_kind_is_shown_as_the_runner_up() {
     let faster = runner["oriented_per_min"].as_f64() > chosen["oriented_per_min"].as_f64();
     assert!(simpler || faster, "{runner}");
 }
+
+#[test]
+fn a_plan_with_nothing_better_than_the_feed_is_no_design_exit_4() {
+    // A heptagon's pins at depth 1 bring no more parts into one window than the feed does:
+    // no design, nothing written, exit 4 (not a limit: exit 1; not a design: 0 or 3).
+    let (code, v) = plan_json(&[
+        "plan",
+        "--part",
+        "ngon:7",
+        "--pins",
+        "--depth",
+        "1",
+        "--no-write",
+        "--json",
+    ]);
+    assert_eq!(v["status"], "no_design", "{}", v["message"]);
+    assert_eq!(code, 4);
+    assert!(v["limit"].is_null());
+    assert_eq!(v["modes"][0]["outcome"], "no_plan");
+    assert!(v["files"].as_array().unwrap().is_empty());
+}
