@@ -293,6 +293,102 @@ fn merge_refuses_shards_that_do_not_fit() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+/// Run `study` as shards 0/2 and 1/2 into `shards`; their paths.
+fn two_shards(study: &Path, shards: &Path) -> [PathBuf; 2] {
+    [0, 1].map(|k| {
+        let spec = format!("{k}/2");
+        pinfeed_ok(&[
+            "mc",
+            s(study),
+            "--shard",
+            &spec,
+            "--quiet",
+            "--out",
+            s(shards),
+        ]);
+        shards.join(format!("shard-{k:04}-of-0002.json"))
+    })
+}
+
+/// Issue 57 item 19: a shard whose counts were edited (successes and wrong orientations swapped:
+/// every total still adds up) and whose `checksum` was left as it was, blanked or removed is
+/// refused, with the file, the field's line and what is wrong; only a checksum recomputed over the
+/// edit gets through (it is not cryptographic), and then the counts change the report.
+#[test]
+fn merge_refuses_a_shard_whose_checksum_is_blank_or_missing() {
+    let d = tmp("checksum");
+    let study = write_study(&d, "samples = 8\n");
+    let [a0, a1] = two_shards(&study, &d.join("shards"));
+    let merged = d.join("merged");
+    let success = |dir: &Path| -> serde_json::Value {
+        let r: serde_json::Value =
+            serde_json::from_str(&crate::support::report_text(dir, "report.json")).unwrap();
+        r["results"][0]["outcomes"]["success"].clone()
+    };
+    pinfeed_ok(&["merge", "--quiet", "--out", s(&merged), s(&a0), s(&a1)]);
+    let honest = success(&merged);
+    std::fs::remove_dir_all(&merged).unwrap();
+
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&a1).unwrap()).unwrap();
+    let o = &mut v["points"][0]["outcomes"];
+    let (ok, wrong) = (o["success"].clone(), o["wrong_orientation"].clone());
+    assert_ne!(ok, wrong, "the swap must change the counts");
+    (o["success"], o["wrong_orientation"]) = (wrong, ok);
+    let edited = d.join("edited.json");
+    let write = |v: &serde_json::Value| {
+        let text = serde_json::to_string_pretty(v).unwrap() + "\n";
+        std::fs::write(&edited, &text).unwrap();
+        // The line of the `checksum` key, 1-based.
+        text.lines()
+            .position(|l| l.contains("\"checksum\""))
+            .map(|i| i + 1)
+    };
+    let kept = v["checksum"].as_str().unwrap().to_string();
+    for (what, checksum) in [
+        ("kept", Some(kept.as_str())),
+        ("blank", Some("")),
+        ("blank", Some("  ")),
+        ("missing", None),
+    ] {
+        let mut e = v.clone();
+        match checksum {
+            Some(c) => e["checksum"] = c.into(),
+            None => {
+                e.as_object_mut().unwrap().remove("checksum");
+            }
+        }
+        let line = write(&e);
+        let err = refused(&["merge", "--quiet", "--out", s(&merged), s(&a0), s(&edited)]);
+        let at = match line {
+            Some(l) => format!("{}:{l}: field `checksum` ", edited.display()),
+            None => format!("{}: field `checksum` is missing", edited.display()),
+        };
+        assert!(err.contains(&at), "{what}: {err}");
+        let why = match what {
+            "kept" => format!("is \"{kept}\" but the content gives "),
+            "blank" => "is blank".to_string(),
+            _ => "is missing".to_string(),
+        };
+        assert!(err.contains(&why), "{what}: {err}");
+        assert!(err.contains("was edited or damaged"), "{what}: {err}");
+        assert!(!merged.exists(), "{what}: a refused merge wrote a report");
+        // The library refuses it too.
+        assert!(mc::shard::read(&edited).is_err(), "{what}");
+    }
+    // Resealed, the edited counts merge and change the report: the checksum is what stops them.
+    let mut sealed: mc::shard::ShardFile = serde_json::from_value(v.clone()).unwrap();
+    sealed.checksum = sealed.content_checksum();
+    std::fs::write(&edited, serde_json::to_string_pretty(&sealed).unwrap()).unwrap();
+    pinfeed_ok(&["merge", "--quiet", "--out", s(&merged), s(&a0), s(&edited)]);
+    assert_ne!(
+        success(&merged),
+        honest,
+        "the edit changed no report number"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
 /// A shard rewritten with `edit` and its checksum recomputed: it reads, but its counts are what
 /// `edit` made them.
 fn resealed(from: &Path, to: &Path, edit: impl FnOnce(&mut mc::shard::ShardFile)) -> PathBuf {
@@ -309,21 +405,7 @@ fn merge_refuses_resealed_shards_whose_counts_do_not_hang_together() {
     use mc::StudyError;
     let d = tmp("resealed");
     let study = write_study(&d, "samples = 4\n");
-    let shards = d.join("shards");
-    for k in 0..2 {
-        let spec = format!("{k}/2");
-        pinfeed_ok(&[
-            "mc",
-            s(&study),
-            "--shard",
-            &spec,
-            "--quiet",
-            "--out",
-            s(&shards),
-        ]);
-    }
-    let a0 = shards.join("shard-0000-of-0002.json");
-    let a1 = shards.join("shard-0001-of-0002.json");
+    let [a0, a1] = two_shards(&study, &d.join("shards"));
     let merge = |second: &Path| {
         let files: Vec<_> = [&a0, second]
             .iter()

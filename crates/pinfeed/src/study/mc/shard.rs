@@ -454,18 +454,43 @@ pub fn read(path: &Path) -> Result<ShardFile, StudyError> {
             v.map_or("missing".to_string(), |v| v.to_string())
         )));
     }
+    let stated = value.get("checksum").is_some();
     let file: ShardFile = serde_json::from_value(value)
         .map_err(|e| StudyError::Shard(format!("{}: malformed shard file: {e}", path.display())))?;
-    let expected = file.content_checksum();
-    if file.checksum != expected {
-        return Err(StudyError::Shard(format!(
-            "{}: field `checksum` is {:?} but the content gives {expected}: the shard was edited or damaged after it was written (rerun it: {})",
-            path.display(),
-            file.checksum,
-            rerun_command(&file.header, file.shard.index, file.shard.count, path)
-        )));
-    }
+    check_checksum(path, &text, stated, &file)?;
     Ok(file)
+}
+
+/// Refuse a shard whose `checksum` field is missing, blank or not its content's
+/// ([`ShardFile::content_checksum`]): every shard pinfeed writes carries it, so any of these means
+/// the file was edited (its counts perhaps) or damaged after it was written. `text` is the file's
+/// text, to give the field's line; `stated` says whether the field is there at all.
+fn check_checksum(
+    path: &Path,
+    text: &str,
+    stated: bool,
+    file: &ShardFile,
+) -> Result<(), StudyError> {
+    let expected = file.content_checksum();
+    if stated && file.checksum == expected {
+        return Ok(());
+    }
+    // The checksum is the file's last top-level field: its line is the last `"checksum"` key.
+    let at = match text.rfind("\"checksum\"") {
+        Some(i) if stated => format!("{}:{}", path.display(), text[..i].matches('\n').count() + 1),
+        _ => path.display().to_string(),
+    };
+    let what = if !stated {
+        "is missing".to_string()
+    } else if file.checksum.trim().is_empty() {
+        "is blank".to_string()
+    } else {
+        format!("is {:?} but the content gives {expected}", file.checksum)
+    };
+    Err(StudyError::Shard(format!(
+        "{at}: field `checksum` {what}: every shard pinfeed writes carries the checksum of its content, so the shard was edited or damaged after it was written (rerun it: {})",
+        rerun_command(&file.header, file.shard.index, file.shard.count, path)
+    )))
 }
 
 /// The command that rewrites shard `k` of `n` of the study into the folder of `path`.
