@@ -186,11 +186,11 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
         maps: &run.maps,
     };
     if args.json {
-        print!("{}", pinfeed::report::versioned::pretty(&report)?);
+        crate::out!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else if args.csv {
-        write_csv(std::io::stdout().lock(), &run.maps)?;
+        write_csv(super::stdout::writer(), &run.maps)?;
     } else {
-        print!("{}", report.text());
+        crate::out!("{}", report.text());
     }
     if !args.no_write {
         let out_dir = args
