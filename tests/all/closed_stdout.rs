@@ -30,36 +30,26 @@ fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
     )
 }
 
+const MAP: &[&str] = &[
+    "map",
+    "--part",
+    "tripoly2",
+    "--d",
+    "0.3",
+    "--theta-step",
+    "10",
+    "--no-write",
+];
+
 #[test]
 fn a_closed_stdout_ends_quietly_never_in_a_panic() {
     let quickstart = format!("{}/scenarios/quickstart.toml", env!("CARGO_MANIFEST_DIR"));
     let cases: [&[&str]; 7] = [
         // clap_complete's writer.
         &["completions", "bash"],
-        // print! of a command's report.
-        &[
-            "map",
-            "--part",
-            "tripoly2",
-            "--d",
-            "0.3",
-            "--theta-step",
-            "10",
-            "--json",
-            "--no-write",
-        ],
-        // A CSV written to standard output as it goes.
-        &[
-            "map",
-            "--part",
-            "tripoly2",
-            "--d",
-            "0.3",
-            "--theta-step",
-            "10",
-            "--csv",
-            "--no-write",
-        ],
+        // print! of a command's report, and a CSV written to standard output as it goes.
+        &[MAP, &["--json"]].concat(),
+        &[MAP, &["--csv"]].concat(),
         &["part", "--part", "tripoly2", "--json"],
         // The shared result printer.
         &["compare", &quickstart, "--parts", "3", "--json"],
