@@ -389,6 +389,55 @@ fn merge_refuses_a_shard_whose_checksum_is_blank_or_missing() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+/// Issue 57 item 13: merge's "rerun only the missing shards" commands name the study from the
+/// folder merge runs in, not as the shard job named it from its own folder: run as printed, from
+/// there, they write the missing shard and the merge goes through.
+#[test]
+fn merge_s_rerun_commands_work_from_where_they_are_printed() {
+    let d = tmp("rerun-here");
+    let job = d.join("job");
+    std::fs::create_dir_all(&job).unwrap();
+    write_study(&job, "samples = 8\n");
+    // The shard job runs in its own folder and names the study relative to it.
+    let o = crate::support::pinfeed_in(
+        &job,
+        &[
+            "mc",
+            "study.toml",
+            "--shard",
+            "0/2",
+            "--quiet",
+            "--out",
+            "shards",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let merge = [
+        "merge",
+        "job/shards/shard-0000-of-0002.json",
+        "job/shards/shard-0001-of-0002.json",
+    ];
+    let o =
+        crate::support::pinfeed_in(&d, &[&merge[..2], &["--quiet", "--out", "merged"]].concat());
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let rerun = err
+        .lines()
+        .find(|l| l.trim_start().starts_with("pinfeed mc "))
+        .unwrap_or_else(|| panic!("no rerun command: {err}"));
+    assert!(rerun.contains("pinfeed mc job/study.toml "), "{err}");
+    let words: Vec<&str> = rerun.split_whitespace().skip(1).collect();
+    let o = crate::support::pinfeed_in(&d, &words);
+    assert!(
+        o.status.success(),
+        "`{rerun}` fails where it is printed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let o = crate::support::pinfeed_in(&d, &[&merge[..], &["--quiet", "--out", "merged"]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
 /// A shard rewritten with `edit` and its checksum recomputed: it reads, but its counts are what
 /// `edit` made them.
 fn resealed(from: &Path, to: &Path, edit: impl FnOnce(&mut mc::shard::ShardFile)) -> PathBuf {
