@@ -438,6 +438,40 @@ fn merge_s_rerun_commands_work_from_where_they_are_printed() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+/// Issue 57 item 4: a report written into the user's folder heads with the command as the user
+/// runs it (`pinfeed mc study.toml …`, not `cargo run --release -- …`, which runs only in the
+/// source tree), and that command rewrites the report from there.
+#[test]
+fn a_report_in_the_user_s_folder_names_the_command_as_run() {
+    let d = tmp("as-run");
+    write_study(&d, "samples = 4\n");
+    crate::support::pinfeed_in(&d, &["mc", "study.toml", "--quiet", "--out", "rep"]);
+    let md = std::fs::read_to_string(d.join("rep/report.md")).unwrap();
+    assert!(!md.contains("cargo run"), "{md}");
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("pinfeed mc "))
+        .unwrap_or_else(|| panic!("no command: {md}"));
+    assert_eq!(line, "pinfeed mc study.toml --samples 4 --out rep");
+    std::fs::remove_dir_all(d.join("rep")).unwrap();
+    let words: Vec<&str> = line.split_whitespace().skip(1).collect();
+    let o = crate::support::pinfeed_in(&d, &[&words[..], &["--quiet"]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(d.join("rep/report.md").is_file());
+    // `sense` writes its report the same way.
+    let o = crate::support::pinfeed_in(
+        &d,
+        &[
+            "sense", "--part", "tripoly1", "--d=-0.2", "--trials", "3", "--out", "sense",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(d.join("sense/report.md")).unwrap();
+    assert!(!md.contains("cargo run"), "{md}");
+    assert!(md.contains("\n    pinfeed sense --part tripoly1 "), "{md}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
 /// A shard rewritten with `edit` and its checksum recomputed: it reads, but its counts are what
 /// `edit` made them.
 fn resealed(from: &Path, to: &Path, edit: impl FnOnce(&mut mc::shard::ShardFile)) -> PathBuf {
