@@ -255,6 +255,20 @@ fn merge_refuses_shards_that_do_not_fit() {
     let e = merge(&[&a0, &a1, &b1]);
     assert!(e.contains("shards overlap") && e.contains("[6, 13)"), "{e}");
     // Mismatched: another sample count is another study.
+    // A gap of one sample between shards of different splits ([0, 5) of 4, [6, 20) of 3) is
+    // named as missing, with the rerun help, not found later as a point short of samples.
+    let q0 = run_shard("q0", "0/4", &[]);
+    let t1 = run_shard("t1", "1/3", &[]);
+    let t2 = run_shard("t2", "2/3", &[]);
+    let e = merge(&[&q0, &t1, &t2]);
+    assert!(e.contains("samples [5, 6) are missing"), "{e}");
+    // Overlapping by one sample ([0, 6) of 3, [5, 10) of 4).
+    let t0 = run_shard("t0", "0/3", &[]);
+    let q1 = run_shard("q1", "1/4", &[]);
+    let q2 = run_shard("q2", "2/4", &[]);
+    let q3 = run_shard("q3", "3/4", &[]);
+    let e = merge(&[&t0, &q1, &q2, &q3]);
+    assert!(e.contains("shards overlap") && e.contains("[5, 10)"), "{e}");
     let c1 = run_shard("c1", "1/2", &["--samples", "30"]);
     let e = merge(&[&a0, &c1]);
     assert!(e.contains("belongs to a different study"), "{e}");
@@ -520,6 +534,14 @@ fn merge_refuses_resealed_shards_whose_counts_do_not_hang_together() {
             "{}: point 0: the outcome counts add up to 1, not to its 2 samples",
             short.display()
         )
+    );
+    // A point index beyond the study's grid (one point: index 1) is refused, not a panic.
+    let beyond = resealed(&a1, &d.join("beyond.json"), |f| f.points[0].point = 1);
+    let e = merge(&beyond);
+    assert!(
+        e.to_string()
+            .contains("point 1 holds 2 samples but the shard's range [2, 4) gives it 0"),
+        "{e}"
     );
     // Online counts without their calibration bins.
     let online = resealed(&a1, &d.join("online.json"), |f| {
