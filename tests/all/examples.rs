@@ -250,3 +250,27 @@ fn completions_cover_the_subcommands() {
         .status
         .success());
 }
+
+/// Issue 57 item 9: a name one or two edits from a bundled one gets a "did you mean".
+#[test]
+fn a_mistyped_bundled_name_gets_a_did_you_mean() {
+    let dir = scratch("did-you-mean");
+    for (args, meant) in [
+        (
+            &["run", "quickstrat"][..],
+            "did you mean `quickstart` (bundled: `pinfeed run quickstart`)?",
+        ),
+        (
+            &["mc", "quickstart_mu_tripd"][..],
+            "did you mean `quickstart_mu_tripod` (bundled: `pinfeed mc quickstart_mu_tripod`)?",
+        ),
+    ] {
+        let out = pinfeed(&dir, args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(meant), "{args:?}: {err}");
+    }
+    let out = pinfeed(&dir, &["run", "nothing_like_it"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("did you mean"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

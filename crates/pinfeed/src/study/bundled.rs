@@ -186,21 +186,92 @@ fn by_name(arg: &Path, kind: Kind) -> Option<&'static Bundled> {
     find(arg.to_str()?).filter(|b| b.kind() == kind)
 }
 
+/// Edit distance between `a` and `b`: insertions, deletions, substitutions and transpositions of
+/// neighbours (`quickstrat` is 1 from `quickstart`), each 1.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for j in 0..=b.len() {
+        d[0][j] = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            d[i][j] = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                d[i][j] = d[i][j].min(d[i - 2][j - 2] + 1);
+            }
+        }
+    }
+    d[a.len()][b.len()]
+}
+
+/// The bundled file of `kind` whose name is closest to `arg`'s file name, when it is a likely
+/// typo: at most 2 edits, and fewer than a third of the name's letters.
+pub fn did_you_mean(arg: &Path, kind: Kind) -> Option<&'static Bundled> {
+    let typed = arg.file_stem()?.to_str()?;
+    all()
+        .iter()
+        .filter(|b| b.kind() == kind)
+        .map(|b| (edit_distance(typed, b.name()), b))
+        .filter(|&(d, b)| d > 0 && d <= 2 && 3 * d < b.name().chars().count())
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, b)| b)
+}
+
+/// `; did you mean NAME (...)?` when `arg` is no file and close to a bundled name, else empty.
+fn hint(arg: &Path, kind: Kind, error: &std::io::Error) -> String {
+    if error.kind() != std::io::ErrorKind::NotFound {
+        return String::new();
+    }
+    let command = match kind {
+        Kind::Scenario => "run",
+        Kind::Study => "mc",
+    };
+    did_you_mean(arg, kind).map_or_else(String::new, |b| {
+        format!(
+            "; did you mean `{}` (bundled: `pinfeed {command} {}`)?",
+            b.name(),
+            b.name()
+        )
+    })
+}
+
 /// Load the scenario file `arg`, or, when there is no such file, the bundled scenario of that
-/// name (`quickstart`).
+/// name (`quickstart`); a name close to a bundled one gets a "did you mean".
 pub fn load_scenario(arg: &Path) -> Result<Scene, ScenarioError> {
     match by_name(arg, Kind::Scenario) {
         Some(b) => crate::scenario::parse(Path::new(b.path), b.text),
-        None => crate::scenario::load(arg),
+        None => crate::scenario::load(arg).map_err(|e| match e {
+            ScenarioError::Io { path, error, .. } => ScenarioError::Io {
+                hint: hint(&path, Kind::Scenario, &error),
+                path,
+                error,
+            },
+            e => e,
+        }),
     }
 }
 
 /// Load the study file `arg`, or, when there is no such file, the bundled study of that name
-/// (`quickstart_mu_tripod`), whose scenario is read from the binary too.
+/// (`quickstart_mu_tripod`), whose scenario is read from the binary too; a name close to a
+/// bundled one gets a "did you mean".
 pub fn load_study(arg: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
     match by_name(arg, Kind::Study) {
         Some(b) => crate::study::mc::parse_with(Path::new(b.path), b.text, samples, &read_bundled),
-        None => crate::study::mc::load(arg, samples),
+        None => crate::study::mc::load(arg, samples).map_err(|e| match e {
+            StudyError::Io { path, error, .. } => StudyError::Io {
+                hint: hint(&path, Kind::Study, &error),
+                path,
+                error,
+            },
+            e => e,
+        }),
     }
 }
 
@@ -223,5 +294,23 @@ mod tests {
         assert_eq!(s.needs(), vec![q]);
         assert!(q.needs().is_empty());
         assert!(!q.description().is_empty());
+    }
+
+    #[test]
+    fn a_close_name_gets_a_did_you_mean() {
+        let name = |arg: &str, kind| did_you_mean(Path::new(arg), kind).map(|b| b.name());
+        assert_eq!(name("quickstrat", Kind::Scenario), Some("quickstart"));
+        assert_eq!(name("quickstat.toml", Kind::Scenario), Some("quickstart"));
+        assert_eq!(
+            name("tripoly2_fencs", Kind::Scenario),
+            Some("tripoly2_fences")
+        );
+        // Far from every name, the wrong kind, or an exact name: nothing.
+        assert_eq!(name("robust", Kind::Scenario), None);
+        assert_eq!(name("quickstrat", Kind::Study), None);
+        assert_eq!(name("quickstart", Kind::Scenario), None);
+        assert_eq!(edit_distance("quickstrat", "quickstart"), 1);
+        assert_eq!(edit_distance("abc", ""), 3);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
     }
 }
