@@ -274,3 +274,35 @@ fn a_mistyped_bundled_name_gets_a_did_you_mean() {
     assert!(!String::from_utf8_lossy(&out.stderr).contains("did you mean"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 57 item 10: the online scenarios and their studies run by name outside the source tree
+/// (tripoly2_online named a policy under ../results/, which is not bundled).
+#[test]
+fn bundled_online_scenarios_and_studies_run_anywhere() {
+    let dir = scratch("online-anywhere");
+    for args in [
+        &["run", "tripoly2_online", "--parts", "2", "--out", "runs"][..],
+        &["run", "tripoly1_online", "--parts", "2", "--out", "runs"][..],
+        &[
+            "mc",
+            "tripoly2_online_uncertain",
+            "--samples",
+            "1",
+            "--quiet",
+            "--out",
+            "mc2",
+        ][..],
+        &[
+            "mc",
+            "tripoly1_online_uncertain",
+            "--samples",
+            "1",
+            "--quiet",
+            "--out",
+            "mc1",
+        ][..],
+    ] {
+        ok(pinfeed(&dir, args));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

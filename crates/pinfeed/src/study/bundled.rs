@@ -296,6 +296,27 @@ mod tests {
         assert!(!q.description().is_empty());
     }
 
+    /// Issue 57 item 10: a bundled file that names a file outside the bundle (a policy under
+    /// `../results/`) fails wherever the project is not.
+    #[test]
+    fn bundled_files_name_only_bundled_files() {
+        for b in all() {
+            let value: toml::Table = b.text.parse().unwrap();
+            let policy = value
+                .get("controller")
+                .and_then(|c| c.get("policy"))
+                .and_then(|p| p.as_str());
+            assert_eq!(
+                policy, None,
+                "{} names a policy file outside the bundle",
+                b.path
+            );
+            if let Some(rel) = value.get("scenario").and_then(|v| v.as_str()) {
+                assert_eq!(b.needs().len(), 1, "{}: {rel} is not bundled", b.path);
+            }
+        }
+    }
+
     #[test]
     fn a_close_name_gets_a_did_you_mean() {
         let name = |arg: &str, kind| did_you_mean(Path::new(arg), kind).map(|b| b.name());
