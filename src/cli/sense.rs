@@ -167,7 +167,7 @@ pub struct SenseArgs {
     pub quiet: bool,
 }
 
-/// The default report directory: `pinfeed-out/sensing/<part>` (a vertex list is `custom`).
+/// The default report directory: `pinfeed-out/sensing/<part>` (a vertex list is `custom-HASH`).
 pub fn default_out_dir(part: &str) -> PathBuf {
     pinfeed::default_out(&["sensing", &super::part_folder(part)])
 }
