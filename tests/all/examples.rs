@@ -306,3 +306,53 @@ fn bundled_online_scenarios_and_studies_run_anywhere() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 57 item 12: `examples --all --to DIR` writes every file or none (a failure half way left
+/// 7 of 17 files, and the retry was refused "already exists"); the OS error prints once; a
+/// dangling symbolic link is named as one, not "File exists".
+#[test]
+fn examples_write_all_files_or_none() {
+    let dir = scratch("all-or-none");
+    let to = dir.join("ex");
+    std::fs::create_dir_all(&to).unwrap();
+    // The studies' folder cannot be made: the scenarios (written first) must not stay behind.
+    std::fs::write(to.join("studies"), "in the way").unwrap();
+    let out = pinfeed(&dir, &["examples", "--all", "--to", "ex"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("nothing was written"), "{err}");
+    assert_eq!(
+        err.matches("(os error").count(),
+        1,
+        "the OS error once: {err}"
+    );
+    let mut left: Vec<_> = std::fs::read_dir(&to)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["studies"], "a failed write left files behind");
+    // The retry, with the obstacle gone, writes everything.
+    std::fs::remove_file(to.join("studies")).unwrap();
+    let wrote = ok(pinfeed(&dir, &["examples", "--all", "--to", "ex"]));
+    assert_eq!(
+        wrote.lines().count(),
+        project_files("scenarios").len() + project_files("studies").len()
+    );
+
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(dir.join("nowhere"), dir.join("link")).unwrap();
+        let out = pinfeed(&dir, &["examples", "quickstart", "--to", "link"]);
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("link is a symbolic link to")
+                && err.contains("nowhere, which does not exist"),
+            "{err}"
+        );
+        assert!(!err.contains("File exists"), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -113,13 +113,22 @@ pub enum WriteError {
     /// The target file exists and overwriting was not asked for.
     #[error("{} already exists; nothing was written (--force overwrites)", .0.display())]
     Exists(PathBuf),
-    /// A file could not be written.
-    #[error("cannot write {}: {source}", path.display())]
+    /// A file or its folder could not be written; nothing was written. (The cause is in the
+    /// message, not a `source`, so that it is printed once.)
+    #[error("cannot write {}: {error}; nothing was written", path.display())]
     Io {
-        /// The file.
+        /// The file or folder.
         path: PathBuf,
         /// Why it could not be written.
-        source: std::io::Error,
+        error: std::io::Error,
+    },
+    /// The folder is a symbolic link to nothing.
+    #[error("{} is a symbolic link to {}, which does not exist: create that folder, or write into another (--to DIR)", path.display(), target.display())]
+    DanglingLink {
+        /// The link.
+        path: PathBuf,
+        /// Where it points.
+        target: PathBuf,
     },
 }
 
@@ -139,9 +148,11 @@ pub fn select(names: &[String]) -> Result<Vec<&'static Bundled>, WriteError> {
 }
 
 /// Write `files` under `dir`, each at its project path (`DIR/scenarios/quickstart.toml`), so
-/// that their relative references resolve. Each file is written whole (a temporary file, then a
-/// rename). Unless `force`, an existing file is never overwritten: if any target exists, nothing
-/// is written. Returns the paths written.
+/// that their relative references resolve. All files or none: each is written to a temporary file
+/// first and renamed into place only when every one is complete
+/// ([`crate::output::Batch`]); on a failure the temporary files and the folders this call created
+/// are removed, so a retry finds nothing in its way. Unless `force`, an existing file is never
+/// overwritten: if any target exists, nothing is written. Returns the paths written.
 pub fn write(
     files: &[&'static Bundled],
     dir: &Path,
@@ -153,20 +164,61 @@ pub fn write(
             return Err(WriteError::Exists(t.clone()));
         }
     }
-    for (b, target) in files.iter().zip(&targets) {
-        let io = |source| WriteError::Io {
-            path: target.clone(),
-            source,
-        };
-        if let Some(parent) = target.parent() {
-            std::fs::create_dir_all(parent).map_err(io)?;
+    let mut created = Vec::new();
+    let written = write_all(files, &targets, &mut created);
+    if written.is_err() {
+        for d in created.iter().rev() {
+            let _ = std::fs::remove_dir(d);
         }
-        if !force && target.exists() {
-            return Err(WriteError::Exists(target.clone()));
-        }
-        crate::output::write_atomic(target, b.text.as_bytes()).map_err(io)?;
     }
-    Ok(targets)
+    written.map(|()| targets)
+}
+
+/// [`fn@write`]'s batch: every file staged, then all renamed; `created` collects the folders made.
+fn write_all(
+    files: &[&'static Bundled],
+    targets: &[PathBuf],
+    created: &mut Vec<PathBuf>,
+) -> Result<(), WriteError> {
+    let mut batch = crate::output::Batch::new();
+    for (b, target) in files.iter().zip(targets) {
+        if let Some(parent) = target.parent() {
+            create_folder(parent, created)?;
+        }
+        batch
+            .write(target, b.text)
+            .map_err(|error| WriteError::Io {
+                path: target.clone(),
+                error,
+            })?;
+    }
+    batch.commit().map_err(|error| WriteError::Io {
+        path: targets.first().cloned().unwrap_or_default(),
+        error,
+    })
+}
+
+/// Create `dir` and its missing ancestors, adding each one created to `created` (outermost
+/// first); a dangling symbolic link on the way is named as such.
+fn create_folder(dir: &Path, created: &mut Vec<PathBuf>) -> Result<(), WriteError> {
+    if dir.as_os_str().is_empty() || dir.is_dir() {
+        return Ok(());
+    }
+    if let (false, Ok(target)) = (dir.exists(), std::fs::read_link(dir)) {
+        return Err(WriteError::DanglingLink {
+            path: dir.to_path_buf(),
+            target,
+        });
+    }
+    if let Some(parent) = dir.parent() {
+        create_folder(parent, created)?;
+    }
+    std::fs::create_dir(dir).map_err(|error| WriteError::Io {
+        path: dir.to_path_buf(),
+        error,
+    })?;
+    created.push(dir.to_path_buf());
+    Ok(())
 }
 
 /// The text of a bundled file at `path` (a project path such as `scenarios/quickstart.toml`).
