@@ -262,6 +262,11 @@ fn merge_refuses_shards_that_do_not_fit() {
     let t2 = run_shard("t2", "2/3", &[]);
     let e = merge(&[&q0, &t1, &t2]);
     assert!(e.contains("samples [5, 6) are missing"), "{e}");
+    // The rerun help counts only the shards of the first file's split (4): 1/3 is not 1/4.
+    assert!(
+        e.contains("rerun only the missing shards of 4:") && e.contains("--shard 1/4 "),
+        "{e}"
+    );
     // Overlapping by one sample ([0, 6) of 3, [5, 10) of 4).
     let t0 = run_shard("t0", "0/3", &[]);
     let q1 = run_shard("q1", "1/4", &[]);
