@@ -1,28 +1,28 @@
 //! Issue 57 item 14: a command whose reader closes standard output early (`pinfeed completions
 //! bash | head -1`, `pinfeed map ... --json | head -c 200`) ends quietly with its own status,
-//! never a panic (exit 101). The pipe's read end is closed before the command starts, so every
-//! write it makes finds the reader gone, whatever the timing.
+//! never a panic (exit 101). The pipe's read end is closed as soon as the command is spawned,
+//! before it has started up, so its writes find the reader gone.
 
 use std::process::{Command, Stdio};
 
 /// Run `pinfeed ARGS` (in a scratch folder) with a standard output nobody reads; its status and
 /// standard error.
 fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
-    let (reader, writer) = std::io::pipe().unwrap();
-    drop(reader);
     let dir = std::env::temp_dir().join(format!(
         "pinfeed-closed-stdout-{}-{}",
         std::process::id(),
         args[0]
     ));
     std::fs::create_dir_all(&dir).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pinfeed"))
         .args(args)
         .current_dir(&dir)
-        .stdout(Stdio::from(writer))
+        .stdout(Stdio::piped())
         .stderr(Stdio::piped())
-        .output()
+        .spawn()
         .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     (
         out.status.code(),
