@@ -117,7 +117,7 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
                 AccuracyBenchError::Bench(b) => flagged(b),
                 other => other.into(),
             })?;
-            print!("{table}");
+            crate::out!("{table}");
             let files: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
             eprintln!("wrote {}", files.join(", "));
             Ok(())
@@ -129,7 +129,7 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
             out,
         } => {
             let stage = |s: &str| spin.set_message(s.to_string());
-            print!(
+            crate::out!(
                 "{}",
                 contact_cost::bench(*contacts, *tol, *seed, cmd, out, &stage).map_err(flagged)?
             );
@@ -139,7 +139,7 @@ fn measure(what: &BenchWhat, spin: &indicatif::ProgressBar, cmd: &str) -> Result
         BenchWhat::Maps { repeats, out } => {
             spin.set_message(format!("maps: {repeats} timed runs per row"));
             // Other work on the machine slows every row: say how busy it was (Linux only).
-            print!(
+            crate::out!(
                 "{}",
                 map_cost::bench(*repeats, cmd, out, &super::bench_mc::load_average)
                     .map_err(flagged)?

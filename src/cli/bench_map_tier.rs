@@ -57,13 +57,13 @@ pub fn run(a: &MapTierArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<
         rows.push(contact_row(part, a.contacts, a.seed)?);
     }
     let section = contact_section(&rows, cmd);
-    print!("{section}");
+    crate::out!("{section}");
     write_section(&a.accuracy_out, &section)?;
     let stage = format!("map tier: line runs of {}", a.scenario.display());
     super::progress::note(spin, &stage);
     spin.set_message(stage);
     let line = line_row(&a.scenario, a.line_parts)?;
     let section = line_section(&line, &a.scenario, cmd);
-    print!("{section}");
+    crate::out!("{section}");
     write_section(&a.line_out, &section)
 }

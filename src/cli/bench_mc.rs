@@ -89,7 +89,7 @@ pub fn run(
         },
     );
     pinfeed::output::rewrite_file(out, |doc| precision::splice(doc, &section))?;
-    print!("{section}");
+    crate::out!("{section}");
     eprintln!(
         "wrote the Monte Carlo precision section of {}",
         out.display()

@@ -1,34 +1,36 @@
 //! `pinfeed compare A.toml B.toml ...`: run line designs on the same part stream and print one
 //! table (pin layouts measured against fence designs; [`pinfeed::study::compare`]).
 //!
-//! The same part stream: the first scenario's feed (number of parts, arrivals, orientation and
-//! lateral distributions) and seed are imposed on every scenario ([`pinfeed::scenario::FeedSource`]),
-//! so part i arrives at the same time with the same orientation and offset in every design. The
-//! part (shape, scale, support) must be the same in every file, and the first file's lateral
-//! offsets must fit on every belt; otherwise the scenario is refused with the reason. Each
-//! scenario keeps its own belt, obstacles, goal and model. `--parts` and `--seed` override the
-//! first file's; `--uniform-orientation` feeds every design parts at orientations uniform on
-//! [0°, 360°) instead of the first file's distribution. Nothing is written to disk.
+//! Each design runs its own feed (headway, orientation and lateral distributions, seed, number of
+//! parts), so its row is the same whichever files it is compared with and in whatever order;
+//! designs whose feeds agree see the same parts in the same order. The part (shape, scale,
+//! support) must be the same in every file; otherwise the scenario is refused with the reason.
+//! `--parts`, `--seed`, `--headway` and `--uniform-orientation` impose one value on every design
+//! ([`pinfeed::scenario::FeedOverrides`]), said in the header. Nothing is written to disk.
 
 use anyhow::{Context, Result};
 use clap::Args;
 use pinfeed::report::compare_table;
+use pinfeed::scenario::FeedOverrides;
 use pinfeed::study::compare::{compare_observed, designs};
 use std::path::PathBuf;
 
 /// Arguments of `pinfeed compare`.
 #[derive(Debug, Args)]
 pub struct CompareArgs {
-    /// Scenario files; the first one's feed and seed are used for all.
+    /// Scenario files (one part); each runs its own feed unless an option below imposes one.
     #[arg(required = true, num_args = 1..)]
     pub scenarios: Vec<PathBuf>,
-    /// Number of parts (overrides the first file's [feed] parts).
+    /// Number of parts of every design (default: each file's [feed] parts).
     #[arg(long)]
     pub parts: Option<u64>,
-    /// Random seed (overrides the first file's seed).
+    /// Random seed of every design (default: each file's seed).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Feed orientations uniform on [0°, 360°) instead of the first file's distribution.
+    /// Seconds between arrivals for every design (default: each file's [feed] headway).
+    #[arg(long)]
+    pub headway: Option<f64>,
+    /// Feed orientations uniform on [0°, 360°) instead of each file's distribution.
     #[arg(long)]
     pub uniform_orientation: bool,
     /// Print the rows as a JSON array of objects.
@@ -45,14 +47,16 @@ pub struct CompareArgs {
 pub fn run(args: &CompareArgs) -> Result<()> {
     let d = designs(
         &args.scenarios,
-        args.seed,
-        args.parts,
-        args.uniform_orientation,
+        FeedOverrides {
+            seed: args.seed,
+            parts: args.parts,
+            headway: args.headway,
+            uniform_orientation: args.uniform_orientation,
+        },
     )?;
-    let (files, source, parts) = (&d.files, &d.source, d.source.feed.parts);
     let bar = super::progress::bar(0, "parts", args.quiet || args.json);
     let tell = super::progress::counter(&bar);
-    let rows = compare_observed(&d.scenes, files, &d.online, parts, &tell)
+    let rows = compare_observed(&d.scenes, &d.files, &d.online, &tell)
         .context("running the comparison")?;
     bar.finish_and_clear();
     let text = if args.json {
@@ -63,7 +67,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         }
         pinfeed::report::versioned::pretty(&Designs { designs: &rows })?
     } else {
-        let feed = compare_table::feed_line(&files[0], source, parts);
+        let feed = compare_table::feed_lines(&d.files, &d.scenes, &d.overrides);
         if args.markdown {
             format!("{feed}\n\n{}", compare_table::markdown(&rows))
         } else {

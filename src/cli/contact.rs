@@ -124,7 +124,7 @@ pub fn run(args: &ContactArgs) -> Result<()> {
         return Ok(run_batch(
             &defaults,
             path,
-            std::io::stdout().lock(),
+            super::stdout::writer(),
             &super::flag,
         )?);
     }
@@ -144,9 +144,9 @@ pub fn run(args: &ContactArgs) -> Result<()> {
     }
     let r = report(&c, &out).with_pin_positions(&c, poly.radius(), &out);
     if args.json {
-        print!("{}", pinfeed::report::versioned::pretty(&r)?);
+        crate::out!("{}", pinfeed::report::versioned::pretty(&r)?);
     } else {
-        print!("{}", r.text());
+        crate::out!("{}", r.text());
     }
     if !out.status.is_ok() && !args.json {
         eprintln!("warning: contact ended with status {:?}", out.status);

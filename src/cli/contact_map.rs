@@ -132,27 +132,30 @@ pub fn run(args: &ContactArgs) -> Result<()> {
             "source": loaded.describe(),
             "query_s": query_s,
         });
-        print!("{}", pinfeed::report::versioned::pretty(&v)?);
+        crate::out!("{}", pinfeed::report::versioned::pretty(&v)?);
         return Ok(());
     }
-    println!(
+    crate::outln!(
         "part {}  model map  θ0 {}°  d {}  μc {}",
-        r.part, r.theta0_deg, r.d, r.mu_c
+        r.part,
+        r.theta0_deg,
+        r.d,
+        r.mu_c
     );
     if r.contact {
-        print!("{}", r.motion_text());
+        crate::out!("{}", r.motion_text());
     } else {
-        println!("no contact: the pin passes the part");
+        crate::outln!("no contact: the pin passes the part");
     }
-    println!("status              {}", r.status);
-    println!("answered by         {served} in {:.1} µs", query_s * 1e6);
-    println!(
+    crate::outln!("status              {}", r.status);
+    crate::outln!("answered by         {served} in {:.1} µs", query_s * 1e6);
+    crate::outln!(
         "map                 {}  {}",
         loaded.map.key,
         loaded.describe()
     );
     if let Some(f) = file {
-        println!("map file            {f}");
+        crate::outln!("map file            {f}");
     }
     Ok(())
 }

@@ -35,12 +35,12 @@ pub fn run(args: &ExamplesArgs) -> anyhow::Result<()> {
             (Kind::Scenario, "scenarios", "pinfeed run NAME"),
             (Kind::Study, "studies", "pinfeed mc NAME"),
         ] {
-            println!("{title} ({verb}):");
+            crate::outln!("{title} ({verb}):");
             for b in bundled::all().iter().filter(|b| b.kind() == kind) {
-                println!("  {:<28} {}", b.name(), b.description());
+                crate::outln!("  {:<28} {}", b.name(), b.description());
             }
         }
-        println!("write them with: pinfeed examples NAME... --to DIR  (or --all --to DIR)");
+        crate::outln!("write them with: pinfeed examples NAME... --to DIR  (or --all --to DIR)");
         return Ok(());
     }
     let dir = args
@@ -49,7 +49,7 @@ pub fn run(args: &ExamplesArgs) -> anyhow::Result<()> {
         .ok_or_else(|| anyhow::anyhow!("--to DIR: the folder to write the examples into"))?;
     let files = bundled::select(&names)?;
     for path in bundled::write(&files, dir, args.force)? {
-        println!("wrote {}", path.display());
+        crate::outln!("wrote {}", path.display());
     }
     Ok(())
 }

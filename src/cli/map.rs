@@ -85,7 +85,7 @@ pub struct MapArgs {
 }
 
 /// The default report directory of a map command: `pinfeed-out/maps/<part>` (a vertex list is
-/// `custom`), and below it `fence_<angle>[_<length>]` for a fence map.
+/// `custom-HASH`, as `plan` names its designs), and below it `fence_<angle>[_<length>]` for a fence map.
 pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
     let dir = default_out_dir(&args.part);
     match &args.fence {
@@ -102,7 +102,7 @@ pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
     }
 }
 
-/// The default report directory of a part: `pinfeed-out/maps/<part>` (a vertex list is `custom`).
+/// The default report directory of a part: `pinfeed-out/maps/<part>` (a vertex list is `custom-HASH`).
 pub fn default_out_dir(part: &str) -> PathBuf {
     pinfeed::default_out(&["maps", &super::part_folder(part)])
 }
@@ -186,11 +186,11 @@ pub fn run(args: &MapArgs, recorded: &str) -> Result<()> {
         maps: &run.maps,
     };
     if args.json {
-        print!("{}", pinfeed::report::versioned::pretty(&report)?);
+        crate::out!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else if args.csv {
-        write_csv(std::io::stdout().lock(), &run.maps)?;
+        write_csv(super::stdout::writer(), &run.maps)?;
     } else {
-        print!("{}", report.text());
+        crate::out!("{}", report.text());
     }
     if !args.no_write {
         let out_dir = args

@@ -39,14 +39,16 @@ pub fn run(args: &MapArgs, recorded: &str, uncertain: &str, req: &MapRequest) ->
         run.threads
     );
     let text = table(&run.predicted);
-    println!(
+    crate::outln!(
         "{}  ensemble of {} members, seed {}",
-        args.part, args.members, args.seed
+        args.part,
+        args.members,
+        args.seed
     );
     for line in run.spec.describe() {
-        println!("  {line}");
+        crate::outln!("  {line}");
     }
-    print!("{text}");
+    crate::out!("{text}");
     if args.no_write {
         return Ok(());
     }

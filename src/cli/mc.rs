@@ -85,7 +85,8 @@ pub fn run(args: &McArgs) -> Result<()> {
             .unwrap_or_else(|| default_dir(&study.name).join("shards"));
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         let path = dir.join(spec.file_name());
-        let file = ShardFile::new(&header, spec, range.clone(), &tallies);
+        let file =
+            ShardFile::new(&header, spec, range.clone(), &tallies).with_study_path(&args.study);
         let text = serde_json::to_string_pretty(&file)? + "\n";
         pinfeed::output::write_atomic(&path, text)
             .with_context(|| format!("writing {}", path.display()))?;

@@ -8,6 +8,8 @@
 //! written), so they are plain text rather than rustdoc Markdown: `[feed]`, `<part>` and
 //! `random:SEED[:N]` are what the user types, not links or HTML.
 #![allow(rustdoc::broken_intra_doc_links, rustdoc::invalid_html_tags)]
+// Every print goes through `stdout` (a closed pipe ends the output quietly, never a panic).
+#![deny(clippy::print_stdout)]
 
 pub mod bench;
 pub mod bench_designs;

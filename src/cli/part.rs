@@ -69,11 +69,11 @@ pub fn run(args: &PartArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if args.json {
-        print!("{}", pinfeed::report::versioned::pretty(&report)?);
+        crate::out!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else {
-        print!("{}", report.text());
+        crate::out!("{}", report.text());
         if let Some(p) = &args.plot {
-            println!("plot            {}", p.display());
+            crate::outln!("plot            {}", p.display());
         }
     }
     Ok(())

@@ -167,7 +167,7 @@ pub struct SenseArgs {
     pub quiet: bool,
 }
 
-/// The default report directory: `pinfeed-out/sensing/<part>` (a vertex list is `custom`).
+/// The default report directory: `pinfeed-out/sensing/<part>` (a vertex list is `custom-HASH`).
 pub fn default_out_dir(part: &str) -> PathBuf {
     pinfeed::default_out(&["sensing", &super::part_folder(part)])
 }
@@ -305,9 +305,9 @@ pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
 
     let (report, templates) = p.report(&req, recorded.to_string(), evaluated, placement);
     if a.json {
-        print!("{}", pinfeed::report::versioned::pretty(&report)?);
+        crate::out!("{}", pinfeed::report::versioned::pretty(&report)?);
     } else {
-        print!("{}", text_summary(&report));
+        crate::out!("{}", text_summary(&report));
     }
     if !a.no_write {
         let out = a.out.clone().unwrap_or_else(|| default_out_dir(&a.part));

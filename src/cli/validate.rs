@@ -178,9 +178,9 @@ pub fn emit<T: Serialize>(
     write: impl FnOnce(&Path) -> Result<()>,
 ) -> Result<()> {
     if c.json {
-        print!("{}", pinfeed::report::versioned::pretty(report)?);
+        crate::out!("{}", pinfeed::report::versioned::pretty(report)?);
     } else {
-        print!("{text}");
+        crate::out!("{text}");
     }
     if !c.no_write {
         let out_dir = c.out_dir(command, file);

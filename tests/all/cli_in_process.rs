@@ -295,8 +295,17 @@ fn default_report_directory_is_per_part() {
         default_out_dir("rect:2:1"),
         Path::new("pinfeed-out/maps/rect_2_1")
     );
+    // Issue 57 item 11: each vertex list its own folder (as `plan` names its designs), so a second
+    // part never replaces the first's figures; the same list (up to spacing) the same folder.
+    let a = default_out_dir("vertices:0,0 1,0 0,1");
+    let b = default_out_dir("vertices:0,0 2,0 0,1");
+    assert_ne!(a, b);
+    assert_eq!(a, default_out_dir("vertices:0,0  1,0 0,1"));
+    let name = pinfeed::plan::design::design_name("vertices:0,0 1,0 0,1");
+    assert!(name.starts_with("custom-"), "{name}");
+    assert_eq!(a, Path::new("pinfeed-out/maps").join(&name));
     assert_eq!(
-        default_out_dir("vertices:0,0 1,0 0,1"),
-        Path::new("pinfeed-out/maps/custom")
+        pinfeed_cli::sense::default_out_dir("vertices:0,0 2,0 0,1"),
+        Path::new("pinfeed-out/sensing").join(b.file_name().unwrap())
     );
 }

@@ -1,5 +1,6 @@
-//! `pinfeed compare`: several designs on the same part stream, one row each, the same
-//! JSON byte for byte on every run; scenarios that cannot share the stream are refused.
+//! `pinfeed compare`: several designs for one part, each on its own feed, one row each, the same
+//! row whatever the order of the files, the same JSON byte for byte on every run; scenarios for
+//! another part are refused.
 
 use crate::support::pinfeed;
 use serde_json::Value;
@@ -69,8 +70,11 @@ fn pins_and_fences_on_one_part_stream() {
     let t = pinfeed(&["compare", &pins, &fences, "--parts", "40"]);
     assert!(t.status.success());
     let text = String::from_utf8_lossy(&t.stdout);
-    assert!(text.starts_with("part stream of "), "{text}");
-    assert!(text.contains("seed 1, 40 parts, one every 4 s"), "{text}");
+    assert!(text.starts_with("every design's part stream: "), "{text}");
+    assert!(
+        text.contains("seed 1, 40 parts (--parts), one every 4 s,"),
+        "{text}"
+    );
     assert_eq!(
         text.lines()
             .filter(|l| l.starts_with("quickstart "))
@@ -87,43 +91,115 @@ fn pins_and_fences_on_one_part_stream() {
     );
 }
 
+fn compare_json(args: &[&str]) -> Vec<Value> {
+    let doc: Value = crate::support::pinfeed_json(args);
+    doc["designs"].as_array().unwrap().clone()
+}
+
+/// Issue 57 item 1: each design runs at its own headway, so its row is the same in either order
+/// (the quickstart at 4 s, the crowded belt at 2 s, where parts collide), and every outcome that
+/// happened shows in the table, not only jams.
 #[test]
-fn the_first_file_s_feed_is_imposed_and_can_be_made_uniform() {
-    // The compact pins have the quickstart's feed; a different seed or a uniform feed changes
-    // the parts, identically for every design.
-    let (a, b) = (
-        scenario("quickstart.toml"),
-        scenario("tripoly2_pins_compact.toml"),
+fn compare_reports_the_same_numbers_per_design_in_either_order() {
+    let (a, b) = (scenario("quickstart.toml"), scenario("crowded_belt.toml"));
+    let ab = compare_json(&["compare", &a, &b, "--parts", "100", "--json"]);
+    let ba = compare_json(&["compare", &b, &a, "--parts", "100", "--json"]);
+    assert_eq!(ab[0], ba[1], "the quickstart's row depends on the order");
+    assert_eq!(ab[1], ba[0], "the crowded belt's row depends on the order");
+    assert_eq!(ab[0]["headway_s"], 4.0);
+    assert_eq!(ab[1]["headway_s"], 2.0);
+    assert!(
+        ab[1]["outcomes"]["collision"].as_u64().unwrap() > 0,
+        "{}",
+        ab[1]
     );
-    let run = |extra: &[&str]| -> Vec<Value> {
-        let mut args = vec!["compare", &a, &b, "--parts", "30", "--json"];
-        args.extend(extra);
-        let out = pinfeed(&args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<Value>(&out.stdout).unwrap()["designs"]
-            .as_array()
-            .unwrap()
-            .clone()
-    };
-    let same = run(&[]);
-    // The pins only moved along the belt: every part ends the same way.
-    assert_eq!(same[0]["outcomes"], same[1]["outcomes"]);
-    // Any orientation: other parts (pushes the layout was not designed for, some long enough to
-    // reach the next, closer pin), on both designs.
-    let uniform = run(&["--uniform-orientation", "--seed", "5"]);
+    assert_eq!(ab[0]["outcomes"]["collision"], 0);
+
+    let out = crate::support::pinfeed_ok(&["compare", &b, &a, "--parts", "100"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("other outcomes"), "{text}");
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("crowded_belt "))
+        .unwrap();
+    let collisions = ab[1]["outcomes"]["collision"].to_string();
+    assert!(
+        row.contains(&format!("{collisions} collision")),
+        "the collisions are not in the table: {text}"
+    );
+    // The feeds differ (their headways): the header gives each.
+    assert!(
+        text.contains("one every 2 s,") && text.contains("one every 4 s,"),
+        "{text}"
+    );
+}
+
+/// `--headway` (like `--seed`, `--parts` and `--uniform-orientation`) imposes one value on every
+/// design, and the header says so.
+#[test]
+fn a_named_headway_applies_to_every_design_and_is_said() {
+    let (a, b) = (scenario("quickstart.toml"), scenario("crowded_belt.toml"));
+    let rows = compare_json(&[
+        "compare",
+        &a,
+        &b,
+        "--parts",
+        "100",
+        "--headway",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(rows[0]["headway_s"], 2.0);
+    // The same feed and seed: the same parts, the same collisions.
+    assert_eq!(rows[0]["outcomes"], rows[1]["outcomes"]);
+    assert!(rows[0]["outcomes"]["collision"].as_u64().unwrap() > 0);
+    let out = crate::support::pinfeed_ok(&["compare", &a, &b, "--parts", "10", "--headway", "2"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.starts_with("every design's part stream: ")
+            && text.contains("one every 2 s (--headway)"),
+        "{text}"
+    );
+    let uniform = compare_json(&[
+        "compare",
+        &a,
+        &b,
+        "--parts",
+        "30",
+        "--uniform-orientation",
+        "--seed",
+        "5",
+        "--json",
+    ]);
     for r in &uniform {
         assert_eq!(
             (r["seed"].clone(), r["parts_in"].clone()),
             (5.into(), 30.into())
         );
     }
-    assert_ne!(
-        same[0]["contacts_per_part"],
-        uniform[0]["contacts_per_part"]
+    let bad = pinfeed(&["compare", &a, "--headway", "0"]);
+    assert_eq!(bad.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("--headway must lie in [0.000001, 1000000] s, got 0"),
+        "{err}"
+    );
+}
+
+/// Obstacles are named by kind, not all counted as pins.
+#[test]
+fn compare_names_obstacles_by_kind() {
+    let online = scenario("tripoly1_online.toml");
+    let rows = compare_json(&["compare", &online, "--parts", "2", "--json"]);
+    assert_eq!(
+        rows[0]["obstacle_kinds"],
+        serde_json::json!({"fixed_pins": 2, "sensor_pins": 1, "moving_pins": 1, "retractable_pins": 0, "fences": 0})
+    );
+    let out = crate::support::pinfeed_ok(&["compare", &online, "--parts", "2"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(" 1 sensor pin + 1 moving pin + 2 pins "),
+        "{text}"
     );
 }
 

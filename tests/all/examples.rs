@@ -250,3 +250,109 @@ fn completions_cover_the_subcommands() {
         .status
         .success());
 }
+
+/// Issue 57 item 9: a name one or two edits from a bundled one gets a "did you mean".
+#[test]
+fn a_mistyped_bundled_name_gets_a_did_you_mean() {
+    let dir = scratch("did-you-mean");
+    for (args, meant) in [
+        (
+            &["run", "quickstrat"][..],
+            "did you mean `quickstart` (bundled: `pinfeed run quickstart`)?",
+        ),
+        (
+            &["mc", "quickstart_mu_tripd"][..],
+            "did you mean `quickstart_mu_tripod` (bundled: `pinfeed mc quickstart_mu_tripod`)?",
+        ),
+    ] {
+        let out = pinfeed(&dir, args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(meant), "{args:?}: {err}");
+    }
+    let out = pinfeed(&dir, &["run", "nothing_like_it"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("did you mean"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 57 item 10: the online scenarios and their studies run by name outside the source tree
+/// (tripoly2_online named a policy under ../results/, which is not bundled).
+#[test]
+fn bundled_online_scenarios_and_studies_run_anywhere() {
+    let dir = scratch("online-anywhere");
+    for args in [
+        &["run", "tripoly2_online", "--parts", "2", "--out", "runs"][..],
+        &["run", "tripoly1_online", "--parts", "2", "--out", "runs"][..],
+        &[
+            "mc",
+            "tripoly2_online_uncertain",
+            "--samples",
+            "1",
+            "--quiet",
+            "--out",
+            "mc2",
+        ][..],
+        &[
+            "mc",
+            "tripoly1_online_uncertain",
+            "--samples",
+            "1",
+            "--quiet",
+            "--out",
+            "mc1",
+        ][..],
+    ] {
+        ok(pinfeed(&dir, args));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 57 item 12: `examples --all --to DIR` writes every file or none (a failure half way left
+/// 7 of 17 files, and the retry was refused "already exists"); the OS error prints once; a
+/// dangling symbolic link is named as one, not "File exists".
+#[test]
+fn examples_write_all_files_or_none() {
+    let dir = scratch("all-or-none");
+    let to = dir.join("ex");
+    std::fs::create_dir_all(&to).unwrap();
+    // The studies' folder cannot be made: the scenarios (written first) must not stay behind.
+    std::fs::write(to.join("studies"), "in the way").unwrap();
+    let out = pinfeed(&dir, &["examples", "--all", "--to", "ex"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("nothing was written"), "{err}");
+    assert_eq!(
+        err.matches("(os error").count(),
+        1,
+        "the OS error once: {err}"
+    );
+    let mut left: Vec<_> = std::fs::read_dir(&to)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["studies"], "a failed write left files behind");
+    // The retry, with the obstacle gone, writes everything.
+    std::fs::remove_file(to.join("studies")).unwrap();
+    let wrote = ok(pinfeed(&dir, &["examples", "--all", "--to", "ex"]));
+    assert_eq!(
+        wrote.lines().count(),
+        project_files("scenarios").len() + project_files("studies").len()
+    );
+
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(dir.join("nowhere"), dir.join("link")).unwrap();
+        let out = pinfeed(&dir, &["examples", "quickstart", "--to", "link"]);
+        assert_eq!(out.status.code(), Some(1));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("link is a symbolic link to")
+                && err.contains("nowhere, which does not exist"),
+            "{err}"
+        );
+        assert!(!err.contains("File exists"), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -31,6 +31,7 @@ mod cli_contact;
 mod cli_in_process;
 mod cli_part;
 mod cli_sense;
+mod closed_stdout;
 mod compare;
 mod contact_invariants;
 mod contact_regressions;

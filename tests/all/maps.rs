@@ -400,7 +400,7 @@ fn cli_writes_a_report_headed_by_its_command() {
     let readme = std::fs::read_to_string(dir.join("README.md")).unwrap();
     let command = readme
         .lines()
-        .find(|l| l.trim_start().starts_with("cargo run --release -- map"))
+        .find(|l| l.trim_start().starts_with("pinfeed map"))
         .expect("README names the command");
     assert!(command.contains("--part tripoly1") && command.contains("--model tip"));
     assert!(command.contains("--d=-0.5,0.7") && command.contains("--theta-step 5"));

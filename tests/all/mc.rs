@@ -255,6 +255,25 @@ fn merge_refuses_shards_that_do_not_fit() {
     let e = merge(&[&a0, &a1, &b1]);
     assert!(e.contains("shards overlap") && e.contains("[6, 13)"), "{e}");
     // Mismatched: another sample count is another study.
+    // A gap of one sample between shards of different splits ([0, 5) of 4, [6, 20) of 3) is
+    // named as missing, with the rerun help, not found later as a point short of samples.
+    let q0 = run_shard("q0", "0/4", &[]);
+    let t1 = run_shard("t1", "1/3", &[]);
+    let t2 = run_shard("t2", "2/3", &[]);
+    let e = merge(&[&q0, &t1, &t2]);
+    assert!(e.contains("samples [5, 6) are missing"), "{e}");
+    // The rerun help counts only the shards of the first file's split (4): 1/3 is not 1/4.
+    assert!(
+        e.contains("rerun only the missing shards of 4:") && e.contains("--shard 1/4 "),
+        "{e}"
+    );
+    // Overlapping by one sample ([0, 6) of 3, [5, 10) of 4).
+    let t0 = run_shard("t0", "0/3", &[]);
+    let q1 = run_shard("q1", "1/4", &[]);
+    let q2 = run_shard("q2", "2/4", &[]);
+    let q3 = run_shard("q3", "3/4", &[]);
+    let e = merge(&[&t0, &q1, &q2, &q3]);
+    assert!(e.contains("shards overlap") && e.contains("[5, 10)"), "{e}");
     let c1 = run_shard("c1", "1/2", &["--samples", "30"]);
     let e = merge(&[&a0, &c1]);
     assert!(e.contains("belongs to a different study"), "{e}");
@@ -293,6 +312,185 @@ fn merge_refuses_shards_that_do_not_fit() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+/// Run `study` as shards 0/2 and 1/2 into `shards`; their paths.
+fn two_shards(study: &Path, shards: &Path) -> [PathBuf; 2] {
+    [0, 1].map(|k| {
+        let spec = format!("{k}/2");
+        pinfeed_ok(&[
+            "mc",
+            s(study),
+            "--shard",
+            &spec,
+            "--quiet",
+            "--out",
+            s(shards),
+        ]);
+        shards.join(format!("shard-{k:04}-of-0002.json"))
+    })
+}
+
+/// Issue 57 item 19: a shard whose counts were edited (successes and wrong orientations swapped:
+/// every total still adds up) and whose `checksum` was left as it was, blanked or removed is
+/// refused, with the file, the field's line and what is wrong; only a checksum recomputed over the
+/// edit gets through (it is not cryptographic), and then the counts change the report.
+#[test]
+fn merge_refuses_a_shard_whose_checksum_is_blank_or_missing() {
+    let d = tmp("checksum");
+    let study = write_study(&d, "samples = 8\n");
+    let [a0, a1] = two_shards(&study, &d.join("shards"));
+    let merged = d.join("merged");
+    let success = |dir: &Path| -> serde_json::Value {
+        let r: serde_json::Value =
+            serde_json::from_str(&crate::support::report_text(dir, "report.json")).unwrap();
+        r["results"][0]["outcomes"]["success"].clone()
+    };
+    pinfeed_ok(&["merge", "--quiet", "--out", s(&merged), s(&a0), s(&a1)]);
+    let honest = success(&merged);
+    std::fs::remove_dir_all(&merged).unwrap();
+
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&a1).unwrap()).unwrap();
+    let o = &mut v["points"][0]["outcomes"];
+    let (ok, wrong) = (o["success"].clone(), o["wrong_orientation"].clone());
+    assert_ne!(ok, wrong, "the swap must change the counts");
+    (o["success"], o["wrong_orientation"]) = (wrong, ok);
+    let edited = d.join("edited.json");
+    let write = |v: &serde_json::Value| {
+        let text = serde_json::to_string_pretty(v).unwrap() + "\n";
+        std::fs::write(&edited, &text).unwrap();
+        // The line of the `checksum` key, 1-based.
+        text.lines()
+            .position(|l| l.contains("\"checksum\""))
+            .map(|i| i + 1)
+    };
+    let kept = v["checksum"].as_str().unwrap().to_string();
+    for (what, checksum) in [
+        ("kept", Some(kept.as_str())),
+        ("blank", Some("")),
+        ("blank", Some("  ")),
+        ("missing", None),
+    ] {
+        let mut e = v.clone();
+        match checksum {
+            Some(c) => e["checksum"] = c.into(),
+            None => {
+                e.as_object_mut().unwrap().remove("checksum");
+            }
+        }
+        let line = write(&e);
+        let err = refused(&["merge", "--quiet", "--out", s(&merged), s(&a0), s(&edited)]);
+        let at = match line {
+            Some(l) => format!("{}:{l}: field `checksum` ", edited.display()),
+            None => format!("{}: field `checksum` is missing", edited.display()),
+        };
+        assert!(err.contains(&at), "{what}: {err}");
+        let why = match what {
+            "kept" => format!("is \"{kept}\" but the content gives "),
+            "blank" => "is blank".to_string(),
+            _ => "is missing".to_string(),
+        };
+        assert!(err.contains(&why), "{what}: {err}");
+        assert!(err.contains("was edited or damaged"), "{what}: {err}");
+        assert!(!merged.exists(), "{what}: a refused merge wrote a report");
+        // The library refuses it too.
+        assert!(mc::shard::read(&edited).is_err(), "{what}");
+    }
+    // Resealed, the edited counts merge and change the report: the checksum is what stops them.
+    let mut sealed: mc::shard::ShardFile = serde_json::from_value(v.clone()).unwrap();
+    sealed.checksum = sealed.content_checksum();
+    std::fs::write(&edited, serde_json::to_string_pretty(&sealed).unwrap()).unwrap();
+    pinfeed_ok(&["merge", "--quiet", "--out", s(&merged), s(&a0), s(&edited)]);
+    assert_ne!(
+        success(&merged),
+        honest,
+        "the edit changed no report number"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Issue 57 item 13: merge's "rerun only the missing shards" commands name the study from the
+/// folder merge runs in, not as the shard job named it from its own folder: run as printed, from
+/// there, they write the missing shard and the merge goes through.
+#[test]
+fn merge_s_rerun_commands_work_from_where_they_are_printed() {
+    let d = tmp("rerun-here");
+    let job = d.join("job");
+    std::fs::create_dir_all(&job).unwrap();
+    write_study(&job, "samples = 8\n");
+    // The shard job runs in its own folder and names the study relative to it.
+    let o = crate::support::pinfeed_in(
+        &job,
+        &[
+            "mc",
+            "study.toml",
+            "--shard",
+            "0/2",
+            "--quiet",
+            "--out",
+            "shards",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let merge = [
+        "merge",
+        "job/shards/shard-0000-of-0002.json",
+        "job/shards/shard-0001-of-0002.json",
+    ];
+    let o =
+        crate::support::pinfeed_in(&d, &[&merge[..2], &["--quiet", "--out", "merged"]].concat());
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let rerun = err
+        .lines()
+        .find(|l| l.trim_start().starts_with("pinfeed mc "))
+        .unwrap_or_else(|| panic!("no rerun command: {err}"));
+    assert!(rerun.contains("pinfeed mc job/study.toml "), "{err}");
+    let words: Vec<&str> = rerun.split_whitespace().skip(1).collect();
+    let o = crate::support::pinfeed_in(&d, &words);
+    assert!(
+        o.status.success(),
+        "`{rerun}` fails where it is printed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let o = crate::support::pinfeed_in(&d, &[&merge[..], &["--quiet", "--out", "merged"]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Issue 57 item 4: a report written into the user's folder heads with the command as the user
+/// runs it (`pinfeed mc study.toml …`, not `cargo run --release -- …`, which runs only in the
+/// source tree), and that command rewrites the report from there.
+#[test]
+fn a_report_in_the_user_s_folder_names_the_command_as_run() {
+    let d = tmp("as-run");
+    write_study(&d, "samples = 4\n");
+    crate::support::pinfeed_in(&d, &["mc", "study.toml", "--quiet", "--out", "rep"]);
+    let md = std::fs::read_to_string(d.join("rep/report.md")).unwrap();
+    assert!(!md.contains("cargo run"), "{md}");
+    let line = md
+        .lines()
+        .find(|l| l.starts_with("pinfeed mc "))
+        .unwrap_or_else(|| panic!("no command: {md}"));
+    assert_eq!(line, "pinfeed mc study.toml --samples 4 --out rep");
+    std::fs::remove_dir_all(d.join("rep")).unwrap();
+    let words: Vec<&str> = line.split_whitespace().skip(1).collect();
+    let o = crate::support::pinfeed_in(&d, &[&words[..], &["--quiet"]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(d.join("rep/report.md").is_file());
+    // `sense` writes its report the same way.
+    let o = crate::support::pinfeed_in(
+        &d,
+        &[
+            "sense", "--part", "tripoly1", "--d=-0.2", "--trials", "3", "--out", "sense",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(d.join("sense/report.md")).unwrap();
+    assert!(!md.contains("cargo run"), "{md}");
+    assert!(md.contains("\n    pinfeed sense --part tripoly1 "), "{md}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
 /// A shard rewritten with `edit` and its checksum recomputed: it reads, but its counts are what
 /// `edit` made them.
 fn resealed(from: &Path, to: &Path, edit: impl FnOnce(&mut mc::shard::ShardFile)) -> PathBuf {
@@ -309,21 +507,7 @@ fn merge_refuses_resealed_shards_whose_counts_do_not_hang_together() {
     use mc::StudyError;
     let d = tmp("resealed");
     let study = write_study(&d, "samples = 4\n");
-    let shards = d.join("shards");
-    for k in 0..2 {
-        let spec = format!("{k}/2");
-        pinfeed_ok(&[
-            "mc",
-            s(&study),
-            "--shard",
-            &spec,
-            "--quiet",
-            "--out",
-            s(&shards),
-        ]);
-    }
-    let a0 = shards.join("shard-0000-of-0002.json");
-    let a1 = shards.join("shard-0001-of-0002.json");
+    let [a0, a1] = two_shards(&study, &d.join("shards"));
     let merge = |second: &Path| {
         let files: Vec<_> = [&a0, second]
             .iter()
@@ -355,6 +539,14 @@ fn merge_refuses_resealed_shards_whose_counts_do_not_hang_together() {
             "{}: point 0: the outcome counts add up to 1, not to its 2 samples",
             short.display()
         )
+    );
+    // A point index beyond the study's grid (one point: index 1) is refused, not a panic.
+    let beyond = resealed(&a1, &d.join("beyond.json"), |f| f.points[0].point = 1);
+    let e = merge(&beyond);
+    assert!(
+        e.to_string()
+            .contains("point 1 holds 2 samples but the shard's range [2, 4) gives it 0"),
+        "{e}"
     );
     // Online counts without their calibration bins.
     let online = resealed(&a1, &d.join("online.json"), |f| {

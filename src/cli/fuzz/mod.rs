@@ -133,7 +133,7 @@ pub fn run(args: &FuzzArgs, recorded: &str) -> Result<()> {
     };
     if let Some(i) = args.case {
         for t in targets(args.target) {
-            print!("{}", robustness::counts::replay(t, &corpus, args.seed, i));
+            crate::out!("{}", robustness::counts::replay(t, &corpus, args.seed, i));
         }
         return Ok(());
     }
@@ -168,6 +168,6 @@ pub fn run(args: &FuzzArgs, recorded: &str) -> Result<()> {
     }
     pinfeed::output::write_atomic(&args.report, &text)
         .with_context(|| format!("writing {}", args.report.display()))?;
-    print!("{text}");
+    crate::out!("{text}");
     Ok(())
 }

@@ -221,12 +221,25 @@ pub fn part_from_spec(spec: &str) -> Result<Polygon, PartSpecError> {
     Ok(Polygon::new(&v)?)
 }
 
+/// The name of a vertex-list part (`vertices:…`): `custom-` and a hash of its text (FNV-1a over
+/// the list with its spaces normalised, stable across runs and platforms), so that different parts
+/// never share a folder or a design name.
+pub fn custom_name(part: &str) -> String {
+    let norm: String = part.split_whitespace().collect::<Vec<_>>().join(" ");
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in norm.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("custom-{:08x}", (h >> 32) as u32 ^ h as u32)
+}
+
 /// The folder name of a part's reports: the part spec with anything but letters, digits, `-` and
-/// `.` replaced by `_` (`rect:2:1` → `rect_2_1`); a vertex list is `custom`.
+/// `.` replaced by `_` (`rect:2:1` → `rect_2_1`); a vertex list is [`custom_name`].
 pub fn part_folder(part: &str) -> String {
     let p = part.trim();
     if p.to_lowercase().starts_with("vertices:") {
-        return "custom".into();
+        return custom_name(p);
     }
     p.chars()
         .map(|c| {

@@ -1,13 +1,15 @@
 //! The table of `pinfeed compare`: one row per line design run on the same part stream (definitions
 //! in [`crate::study::compare`]), as aligned plain text for the terminal or as Markdown.
 
-use crate::scenario::{FeedSource, Lateral, Orientation};
+use crate::engine::PartOutcome;
+use crate::scenario::{FeedOverrides, Lateral, Orientation, Scene};
 use crate::study::compare::{ComparisonRow, GoalWindow};
 
-const HEADER: [&str; 11] = [
+const HEADER: [&str; 12] = [
     "scenario",
     "obstacles",
     "parts",
+    "headway s",
     "goal",
     "success (95% CI)",
     "footprint m",
@@ -15,7 +17,7 @@ const HEADER: [&str; 11] = [
     "oriented/min",
     "latency mean / p99 s",
     "contacts/part",
-    "jams",
+    "other outcomes",
 ];
 
 fn opt(v: Option<f64>, digits: usize) -> String {
@@ -38,17 +40,27 @@ pub fn goal_text(goal: &[GoalWindow]) -> String {
     sets.join("; ")
 }
 
-fn cells(r: &ComparisonRow) -> [String; 11] {
-    let obstacles = match (r.pins, r.fences) {
-        (0, 0) => "none".to_string(),
-        (p, 0) => format!("{p} pin{}", if p == 1 { "" } else { "s" }),
-        (0, f) => format!("{f} fence{}", if f == 1 { "" } else { "s" }),
-        (p, f) => format!("{p} pins + {f} fences"),
-    };
+/// Every outcome class besides success that happened, with its count (`2294 collision, 3 jam`),
+/// `none` when every part succeeded.
+pub fn other_outcomes(r: &ComparisonRow) -> String {
+    let named: Vec<String> = PartOutcome::ALL
+        .iter()
+        .filter(|&&o| o != PartOutcome::Success && r.outcomes.get(o) > 0)
+        .map(|&o| format!("{} {}", r.outcomes.get(o), o.name()))
+        .collect();
+    if named.is_empty() {
+        "none".into()
+    } else {
+        named.join(", ")
+    }
+}
+
+fn cells(r: &ComparisonRow) -> [String; 12] {
     [
         r.scenario.clone(),
-        obstacles,
+        r.obstacle_kinds.to_string(),
         r.parts_in.to_string(),
+        r.headway_s.to_string(),
         goal_text(&r.goal),
         format!(
             "{:.4} ({:.4}–{:.4})",
@@ -59,13 +71,13 @@ fn cells(r: &ComparisonRow) -> [String; 11] {
         opt(r.throughput_ok_per_min, 2),
         format!("{} / {}", opt(r.latency_mean_s, 2), opt(r.latency_p99_s, 2)),
         format!("{:.3}", r.contacts_per_part),
-        r.jams.to_string(),
+        other_outcomes(r),
     ]
 }
 
 /// Aligned plain text.
 pub fn text(rows: &[ComparisonRow]) -> String {
-    let body: Vec<[String; 11]> = rows.iter().map(cells).collect();
+    let body: Vec<[String; 12]> = rows.iter().map(cells).collect();
     super::aligned::aligned_lines(&HEADER, &body).concat()
 }
 
@@ -82,9 +94,30 @@ pub fn markdown(rows: &[ComparisonRow]) -> String {
     s
 }
 
-/// One line saying which part stream every design ran on.
-pub fn feed_line(file: &str, source: &FeedSource, parts: u64) -> String {
-    let feed = &source.feed;
+/// What the designs ran on: one line when their feeds (and seeds) agree, otherwise a line per
+/// design; what the user imposed is marked `(--headway)`, `(--seed)`, ….
+pub fn feed_lines(files: &[String], scenes: &[Scene], overrides: &FeedOverrides) -> String {
+    let lines: Vec<String> = scenes.iter().map(|s| feed_text(s, overrides)).collect();
+    if lines.windows(2).all(|w| w[0] == w[1]) {
+        format!("every design's part stream: {}", lines[0])
+    } else {
+        let mut s = "each design runs its own feed (as its file says):".to_string();
+        for (file, line) in files.iter().zip(&lines) {
+            s += &format!("\n  {file}: {line}");
+        }
+        s
+    }
+}
+
+fn feed_text(scene: &Scene, overrides: &FeedOverrides) -> String {
+    let mark = |imposed: bool, flag: &str| {
+        if imposed {
+            format!(" ({flag})")
+        } else {
+            String::new()
+        }
+    };
+    let feed = &scene.feed;
     let orientation = match &feed.orientation {
         Orientation::Uniform => "uniform on [0°, 360°)".to_string(),
         Orientation::Stable {
@@ -116,7 +149,12 @@ pub fn feed_line(file: &str, source: &FeedSource, parts: u64) -> String {
         }
     };
     format!(
-        "part stream of {file}: seed {}, {parts} parts, {arrival}, orientation {orientation}, {lateral}",
-        source.seed
+        "seed {}{}, {} parts{}, {arrival}{}, orientation {orientation}{}, {lateral}",
+        scene.seed,
+        mark(overrides.seed.is_some(), "--seed"),
+        feed.parts,
+        mark(overrides.parts.is_some(), "--parts"),
+        mark(overrides.headway.is_some(), "--headway"),
+        mark(overrides.uniform_orientation, "--uniform-orientation"),
     )
 }

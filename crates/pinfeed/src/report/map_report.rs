@@ -190,9 +190,9 @@ pub fn write_report(
     let samples = report.maps.first().map_or(0, |m| m.samples.len());
     let non_ok: usize = report.maps.iter().map(|m| m.non_ok_samples()).sum();
     let mut md = format!(
-        "# Configuration maps: {part}\n\nRegenerate from the repository root with\n\n    cargo run --release -- {cmd}\n\n",
+        "# Configuration maps: {part}\n\nRegenerate with\n\n    {cmd}\n\n",
         part = report.part,
-        cmd = report.command.trim_start_matches("pinfeed "),
+        cmd = report.command,
     );
     let obstacle = match &report.fence {
         Some(f) => format!(

@@ -167,9 +167,8 @@ pub fn write_report(
 pub fn report_markdown(r: &SenseReport) -> String {
     let ev = &r.evaluation;
     let mut md = format!(
-        "# What a sensor tells: {}\n\nRegenerate from the repository root with\n\n    cargo run --release -- {}\n\n",
-        r.part,
-        r.command.trim_start_matches("pinfeed ")
+        "# What a sensor tells: {}\n\nRegenerate with\n\n    {}\n\n",
+        r.part, r.command
     );
     md += &format!(
         "Part `{}` scaled to a = {:.4} m, mass {} kg, belt {} m/s; pin at d = {}, radius {} m, μs = {}, \

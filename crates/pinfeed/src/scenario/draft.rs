@@ -71,6 +71,7 @@ impl SceneDraft {
         let source = crate::input::read_text(path).map_err(|error| ScenarioError::Io {
             path: path.to_path_buf(),
             error,
+            hint: String::new(),
         })?;
         SceneDraft::parse(path, &source)
     }

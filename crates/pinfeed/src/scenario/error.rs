@@ -12,12 +12,14 @@ use thiserror::Error;
 pub enum ScenarioError {
     /// The file could not be read.
     /// (The cause is in the message, not a `source`, so that it is printed once.)
-    #[error("{}: cannot read the scenario: {error}", path.display())]
+    #[error("{}: cannot read the scenario: {error}{hint}", path.display())]
     Io {
         /// The file that could not be read.
         path: PathBuf,
         /// Why it could not be read.
         error: std::io::Error,
+        /// What the user may have meant (`; did you mean …`), or empty.
+        hint: String,
     },
     /// The file is not valid TOML, or a key or value is wrong.
     #[error("{0}")]

@@ -48,7 +48,7 @@ pub use dynamic::{
 pub use error::{InvalidScenario, KeyLocation, ScenarioError};
 pub use scene::*;
 pub use sensors::SensorDraft;
-pub use shared_feed::{FeedMismatch, FeedSource};
+pub use shared_feed::{same_part, FeedMismatch, FeedOverrides, OverrideError};
 
 use std::path::Path;
 

@@ -1,25 +1,23 @@
-//! One part stream for several scenes (`pinfeed compare`; docs/physics.md#the-line "a run is a pure function of
-//! (scenario, seed)").
+//! One part for several scenes (`pinfeed compare`; docs/physics.md#the-line "a run is a pure
+//! function of (scenario, seed)").
 //!
 //! Part i of a run is drawn from its own random stream (seed, i) by the scene's feed and part
 //! ([`crate::engine::part_stream`]): its arrival time, orientation, lateral offset and, for a
-//! tripod support, its tripod. So two scenes with the same feed, seed, part polygon and support
-//! see exactly the same parts, whatever their belts and obstacles. A [`FeedSource`] takes those
-//! from a reference scene and imposes them on others:
-//!
-//! * the feed (number of parts, arrival process, orientation distribution, lateral distribution)
-//!   and the seed replace the scene's own;
-//! * the part must be the same polygon in metres (shape and scale, to 1e-12 relative) with the same
-//!   support kind, or the scene is refused — another part would be another stream. Friction
-//!   coefficients may differ: they belong to the obstacles as much as to the part;
-//! * the reference's lateral offsets must fit on the scene's belt (within width/2 − a), or the scene
-//!   is refused.
+//! tripod support, its tripod. So two scenes with the same seed, orientation and lateral
+//! distributions, part polygon and support see exactly the same parts in the same order, whatever
+//! their belts, obstacles and headways. `pinfeed compare` keeps each scene's own feed (a design is
+//! measured at the rate and on the feed its file was made for, so the numbers do not depend on the
+//! order of the files) and imposes only what the user names ([`FeedOverrides`]); the part must be
+//! the same polygon in metres (shape and scale, to 1e-12 relative) with the same support kind, or
+//! the scene is refused ([`same_part`]): another part would be another comparison. Friction
+//! coefficients may differ: they belong to the obstacles as much as to the part.
 
-use super::scene::{Feed, Lateral, Orientation, Scene, SupportKind};
+use super::limits;
+use super::scene::{Orientation, Scene, SupportKind};
 use crate::geometry::Polygon;
 use thiserror::Error;
 
-/// Why a scene cannot run on a reference's part stream.
+/// Why a scene cannot be compared with a reference scene.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum FeedMismatch {
     /// Another part: the stream would differ.
@@ -30,26 +28,6 @@ pub enum FeedMismatch {
         /// This scene's part, described the same way.
         found: String,
     },
-    /// The reference feeds parts wider than this belt allows.
-    #[error("the reference feed puts centroids up to {need:.6} m from the centre line, beyond this belt's {reach:.6} m (half its width minus the part's a)")]
-    Lateral {
-        /// The farthest centroid offset from the centre line the reference feeds (m).
-        need: f64,
-        /// The farthest this belt allows: half its width minus the part's a (m).
-        reach: f64,
-    },
-}
-
-/// The feed, seed and part of a reference scene.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FeedSource {
-    /// The reference's feed, which replaces each scene's own.
-    pub feed: Feed,
-    /// The reference's seed, which replaces each scene's own.
-    pub seed: u64,
-    polygon: Polygon,
-    support: SupportKind,
-    label: String,
 }
 
 fn describe(label: &str, polygon: &Polygon, support: SupportKind) -> String {
@@ -63,53 +41,72 @@ fn describe(label: &str, polygon: &Polygon, support: SupportKind) -> String {
     )
 }
 
-impl FeedSource {
-    /// The part stream of `scene`.
-    pub fn from_scene(scene: &Scene) -> FeedSource {
-        FeedSource {
-            feed: scene.feed.clone(),
-            seed: scene.seed,
-            polygon: scene.part.polygon.clone(),
-            support: scene.part.support,
-            label: scene.part.label.clone(),
-        }
+/// Is `scene`'s part the `reference`'s (same polygon in metres to 1e-12 relative, same support)?
+pub fn same_part(reference: &Scene, scene: &Scene) -> Result<(), FeedMismatch> {
+    let (p, q) = (&reference.part, &scene.part);
+    let (a, b) = (p.polygon.vertices(), q.polygon.vertices());
+    let tol = 1e-12 * p.polygon.radius();
+    let same_polygon = a.len() == b.len() && a.iter().zip(b).all(|(u, v)| (*u - *v).norm() <= tol);
+    if !same_polygon || p.support != q.support {
+        return Err(FeedMismatch::Part {
+            reference: describe(&p.label, &p.polygon, p.support),
+            found: describe(&q.label, &q.polygon, q.support),
+        });
     }
+    Ok(())
+}
 
-    /// Feed parts at orientations uniform on [0°, 360°) instead of the reference's distribution.
-    pub fn with_uniform_orientation(mut self) -> FeedSource {
-        self.feed.orientation = Orientation::Uniform;
-        self
-    }
+/// What the user imposes on every scene's feed (None / false: each keeps its file's own).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FeedOverrides {
+    /// The seed of every scene.
+    pub seed: Option<u64>,
+    /// The number of parts of every scene, in [1, 10⁹].
+    pub parts: Option<u64>,
+    /// The (mean) time between arrivals of every scene (s), in [`limits::HEADWAY`]; each keeps
+    /// its arrival process (periodic or Poisson).
+    pub headway: Option<f64>,
+    /// Orientations uniform on [0°, 360°) instead of each file's distribution.
+    pub uniform_orientation: bool,
+}
 
-    /// How far from the centre line the feed can put a centroid (m).
-    fn lateral_reach(&self) -> f64 {
-        match self.feed.lateral {
-            Lateral::Fixed(y) => y.abs(),
-            Lateral::Uniform { min, max } => min.abs().max(max.abs()),
-            Lateral::Normal { lo, hi, .. } => lo.abs().max(hi.abs()),
-        }
-    }
+/// An override out of its range.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum OverrideError {
+    /// `--parts` out of range.
+    #[error("--parts must lie in [1, 1000000000], got {0}")]
+    Parts(u64),
+    /// `--headway` out of range or not a number.
+    #[error("--headway must lie in [{lo}, {hi}] s, got {0}", lo = limits::HEADWAY.0, hi = limits::HEADWAY.1)]
+    Headway(f64),
+}
 
-    /// Make `scene` run on this part stream (see the module docs).
-    pub fn apply(&self, scene: &mut Scene) -> Result<(), FeedMismatch> {
-        let (a, b) = (self.polygon.vertices(), scene.part.polygon.vertices());
-        let tol = 1e-12 * self.polygon.radius();
-        let same_polygon =
-            a.len() == b.len() && a.iter().zip(b).all(|(p, q)| (*p - *q).norm() <= tol);
-        if !same_polygon || scene.part.support != self.support {
-            return Err(FeedMismatch::Part {
-                reference: describe(&self.label, &self.polygon, self.support),
-                found: describe(&scene.part.label, &scene.part.polygon, scene.part.support),
-            });
+impl FeedOverrides {
+    /// Check the overrides' ranges.
+    pub fn check(&self) -> Result<(), OverrideError> {
+        if let Some(n) = self.parts.filter(|n| !(1..=1_000_000_000).contains(n)) {
+            return Err(OverrideError::Parts(n));
         }
-        let reach = scene.belt.width / 2.0 - scene.part.radius;
-        let need = self.lateral_reach();
-        if need > reach + 1e-12 {
-            return Err(FeedMismatch::Lateral { need, reach });
+        if let Some(h) = self
+            .headway
+            .filter(|h| !(limits::HEADWAY.0..=limits::HEADWAY.1).contains(h))
+        {
+            return Err(OverrideError::Headway(h));
         }
-        scene.feed = self.feed.clone();
-        scene.seed = self.seed;
         Ok(())
+    }
+
+    /// Impose the overrides on `scene` (their ranges checked by [`FeedOverrides::check`]).
+    pub fn apply(&self, scene: &mut Scene) {
+        scene.seed = self.seed.unwrap_or(scene.seed);
+        let feed = &mut scene.feed;
+        feed.parts = self.parts.unwrap_or(feed.parts);
+        if let Some(h) = self.headway {
+            feed.arrival = feed.arrival.with_headway(h);
+        }
+        if self.uniform_orientation {
+            feed.orientation = Orientation::Uniform;
+        }
     }
 }
 
@@ -128,65 +125,72 @@ mod tests {
     }
 
     #[test]
-    fn the_reference_feed_and_seed_replace_the_scene_s() {
-        let reference = scene(
-            "shape = \"tripoly2\"\nscale = 0.02",
-            0.1,
-            "distribution = \"uniform\"\nmin = -0.004\nmax = 0.003",
-            9,
+    fn overrides_replace_only_what_they_name() {
+        let lateral = "distribution = \"uniform\"\nmin = -0.004\nmax = 0.003";
+        let reference = scene("shape = \"tripoly2\"\nscale = 0.02", 0.1, lateral, 9);
+        let mut other = reference.clone();
+        FeedOverrides::default().apply(&mut other);
+        assert_eq!((&other.feed, other.seed), (&reference.feed, 9));
+        let o = FeedOverrides {
+            seed: Some(4),
+            parts: Some(3),
+            headway: Some(1.5),
+            uniform_orientation: true,
+        };
+        o.apply(&mut other);
+        assert_eq!(other.seed, 4);
+        assert_eq!(other.feed.parts, 3);
+        // The arrival process stays Poisson; only its mean changes.
+        assert_eq!(
+            other.feed.arrival,
+            crate::scenario::Arrival::Poisson { headway: 1.5 }
         );
-        let mut other = scene(
-            "shape = \"tripoly2\"\nscale = 0.02\nmu_c = 0.2",
-            0.2,
-            "distribution = \"fixed\"\nvalue = 0.05",
-            2,
-        );
-        let source = FeedSource::from_scene(&reference);
-        source.apply(&mut other).unwrap();
-        assert_eq!(other.feed, reference.feed);
-        assert_eq!(other.seed, 9);
-        // The same stream: part i is drawn identically.
-        for i in 0..7 {
-            let (p, q) = (
-                crate::engine::part_stream::draw_part(&reference, 9, i).unwrap(),
-                crate::engine::part_stream::draw_part(&other, 9, i).unwrap(),
-            );
-            assert_eq!((p.gap, p.theta_rad, p.y), (q.gap, q.theta_rad, q.y));
-        }
-        let uniform = source.clone().with_uniform_orientation();
-        uniform.apply(&mut other).unwrap();
         assert_eq!(other.feed.orientation, Orientation::Uniform);
+        assert_eq!(other.feed.lateral, reference.feed.lateral);
+        for bad in [
+            FeedOverrides {
+                parts: Some(0),
+                ..o
+            },
+            FeedOverrides {
+                headway: Some(0.0),
+                ..o
+            },
+            FeedOverrides {
+                headway: Some(f64::NAN),
+                ..o
+            },
+        ] {
+            assert!(bad.check().is_err(), "{bad:?}");
+        }
+        assert!(o.check().is_ok());
     }
 
     #[test]
-    fn another_part_or_a_narrow_belt_is_refused() {
-        let reference = scene(
-            "shape = \"tripoly2\"\nscale = 0.02",
-            0.2,
-            "distribution = \"uniform\"\nmin = -0.04\nmax = 0.04",
-            1,
-        );
-        let source = FeedSource::from_scene(&reference);
+    fn another_part_is_refused() {
         let fixed = "distribution = \"fixed\"\nvalue = 0.0";
-        let mut scaled = scene("shape = \"tripoly2\"\nscale = 0.021", 0.2, fixed, 1);
+        let reference = scene("shape = \"tripoly2\"\nscale = 0.02", 0.2, fixed, 1);
+        let friction = scene(
+            "shape = \"tripoly2\"\nscale = 0.02\nmu_c = 0.2",
+            0.3,
+            fixed,
+            2,
+        );
+        assert_eq!(same_part(&reference, &friction), Ok(()));
+        let scaled = scene("shape = \"tripoly2\"\nscale = 0.021", 0.2, fixed, 1);
         assert!(matches!(
-            source.apply(&mut scaled),
+            same_part(&reference, &scaled),
             Err(FeedMismatch::Part { .. })
         ));
-        let mut tripod = scene(
+        let tripod = scene(
             "shape = \"tripoly2\"\nscale = 0.02\nsupport = \"tripod\"",
             0.2,
             fixed,
             1,
         );
         assert!(matches!(
-            source.apply(&mut tripod),
+            same_part(&reference, &tripod),
             Err(FeedMismatch::Part { .. })
         ));
-        // Half-width 0.06 − a 0.0275 = 0.0325 m < 0.04 m.
-        let mut narrow = scene("shape = \"tripoly2\"\nscale = 0.02", 0.12, fixed, 1);
-        let e = source.apply(&mut narrow).unwrap_err();
-        assert!(matches!(e, FeedMismatch::Lateral { .. }), "{e}");
-        assert!(e.to_string().contains("0.040000"), "{e}");
     }
 }

@@ -113,13 +113,22 @@ pub enum WriteError {
     /// The target file exists and overwriting was not asked for.
     #[error("{} already exists; nothing was written (--force overwrites)", .0.display())]
     Exists(PathBuf),
-    /// A file could not be written.
-    #[error("cannot write {}: {source}", path.display())]
+    /// A file or its folder could not be written; nothing was written. (The cause is in the
+    /// message, not a `source`, so that it is printed once.)
+    #[error("cannot write {}: {error}; nothing was written", path.display())]
     Io {
-        /// The file.
+        /// The file or folder.
         path: PathBuf,
         /// Why it could not be written.
-        source: std::io::Error,
+        error: std::io::Error,
+    },
+    /// The folder is a symbolic link to nothing.
+    #[error("{} is a symbolic link to {}, which does not exist: create that folder, or write into another (--to DIR)", path.display(), target.display())]
+    DanglingLink {
+        /// The link.
+        path: PathBuf,
+        /// Where it points.
+        target: PathBuf,
     },
 }
 
@@ -139,9 +148,11 @@ pub fn select(names: &[String]) -> Result<Vec<&'static Bundled>, WriteError> {
 }
 
 /// Write `files` under `dir`, each at its project path (`DIR/scenarios/quickstart.toml`), so
-/// that their relative references resolve. Each file is written whole (a temporary file, then a
-/// rename). Unless `force`, an existing file is never overwritten: if any target exists, nothing
-/// is written. Returns the paths written.
+/// that their relative references resolve. All files or none: each is written to a temporary file
+/// first and renamed into place only when every one is complete
+/// ([`crate::output::Batch`]); on a failure the temporary files and the folders this call created
+/// are removed, so a retry finds nothing in its way. Unless `force`, an existing file is never
+/// overwritten: if any target exists, nothing is written. Returns the paths written.
 pub fn write(
     files: &[&'static Bundled],
     dir: &Path,
@@ -153,20 +164,61 @@ pub fn write(
             return Err(WriteError::Exists(t.clone()));
         }
     }
-    for (b, target) in files.iter().zip(&targets) {
-        let io = |source| WriteError::Io {
-            path: target.clone(),
-            source,
-        };
-        if let Some(parent) = target.parent() {
-            std::fs::create_dir_all(parent).map_err(io)?;
+    let mut created = Vec::new();
+    let written = write_all(files, &targets, &mut created);
+    if written.is_err() {
+        for d in created.iter().rev() {
+            let _ = std::fs::remove_dir(d);
         }
-        if !force && target.exists() {
-            return Err(WriteError::Exists(target.clone()));
-        }
-        crate::output::write_atomic(target, b.text.as_bytes()).map_err(io)?;
     }
-    Ok(targets)
+    written.map(|()| targets)
+}
+
+/// [`fn@write`]'s batch: every file staged, then all renamed; `created` collects the folders made.
+fn write_all(
+    files: &[&'static Bundled],
+    targets: &[PathBuf],
+    created: &mut Vec<PathBuf>,
+) -> Result<(), WriteError> {
+    let mut batch = crate::output::Batch::new();
+    for (b, target) in files.iter().zip(targets) {
+        if let Some(parent) = target.parent() {
+            create_folder(parent, created)?;
+        }
+        batch
+            .write(target, b.text)
+            .map_err(|error| WriteError::Io {
+                path: target.clone(),
+                error,
+            })?;
+    }
+    batch.commit().map_err(|error| WriteError::Io {
+        path: targets.first().cloned().unwrap_or_default(),
+        error,
+    })
+}
+
+/// Create `dir` and its missing ancestors, adding each one created to `created` (outermost
+/// first); a dangling symbolic link on the way is named as such.
+fn create_folder(dir: &Path, created: &mut Vec<PathBuf>) -> Result<(), WriteError> {
+    if dir.as_os_str().is_empty() || dir.is_dir() {
+        return Ok(());
+    }
+    if let (false, Ok(target)) = (dir.exists(), std::fs::read_link(dir)) {
+        return Err(WriteError::DanglingLink {
+            path: dir.to_path_buf(),
+            target,
+        });
+    }
+    if let Some(parent) = dir.parent() {
+        create_folder(parent, created)?;
+    }
+    std::fs::create_dir(dir).map_err(|error| WriteError::Io {
+        path: dir.to_path_buf(),
+        error,
+    })?;
+    created.push(dir.to_path_buf());
+    Ok(())
 }
 
 /// The text of a bundled file at `path` (a project path such as `scenarios/quickstart.toml`).
@@ -186,21 +238,92 @@ fn by_name(arg: &Path, kind: Kind) -> Option<&'static Bundled> {
     find(arg.to_str()?).filter(|b| b.kind() == kind)
 }
 
+/// Edit distance between `a` and `b`: insertions, deletions, substitutions and transpositions of
+/// neighbours (`quickstrat` is 1 from `quickstart`), each 1.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            d[i][j] = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                d[i][j] = d[i][j].min(d[i - 2][j - 2] + 1);
+            }
+        }
+    }
+    d[a.len()][b.len()]
+}
+
+/// The bundled file of `kind` whose name is closest to `arg`'s file name, when it is a likely
+/// typo: at most 2 edits, and fewer than a third of the name's letters.
+pub fn did_you_mean(arg: &Path, kind: Kind) -> Option<&'static Bundled> {
+    let typed = arg.file_stem()?.to_str()?;
+    all()
+        .iter()
+        .filter(|b| b.kind() == kind)
+        .map(|b| (edit_distance(typed, b.name()), b))
+        .filter(|&(d, b)| d > 0 && d <= 2 && 3 * d < b.name().chars().count())
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, b)| b)
+}
+
+/// `; did you mean NAME (...)?` when `arg` is no file and close to a bundled name, else empty.
+fn hint(arg: &Path, kind: Kind, error: &std::io::Error) -> String {
+    if error.kind() != std::io::ErrorKind::NotFound {
+        return String::new();
+    }
+    let command = match kind {
+        Kind::Scenario => "run",
+        Kind::Study => "mc",
+    };
+    did_you_mean(arg, kind).map_or_else(String::new, |b| {
+        format!(
+            "; did you mean `{}` (bundled: `pinfeed {command} {}`)?",
+            b.name(),
+            b.name()
+        )
+    })
+}
+
 /// Load the scenario file `arg`, or, when there is no such file, the bundled scenario of that
-/// name (`quickstart`).
+/// name (`quickstart`); a name close to a bundled one gets a "did you mean".
 pub fn load_scenario(arg: &Path) -> Result<Scene, ScenarioError> {
     match by_name(arg, Kind::Scenario) {
         Some(b) => crate::scenario::parse(Path::new(b.path), b.text),
-        None => crate::scenario::load(arg),
+        None => crate::scenario::load(arg).map_err(|e| match e {
+            ScenarioError::Io { path, error, .. } => ScenarioError::Io {
+                hint: hint(&path, Kind::Scenario, &error),
+                path,
+                error,
+            },
+            e => e,
+        }),
     }
 }
 
 /// Load the study file `arg`, or, when there is no such file, the bundled study of that name
-/// (`quickstart_mu_tripod`), whose scenario is read from the binary too.
+/// (`quickstart_mu_tripod`), whose scenario is read from the binary too; a name close to a
+/// bundled one gets a "did you mean".
 pub fn load_study(arg: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
     match by_name(arg, Kind::Study) {
         Some(b) => crate::study::mc::parse_with(Path::new(b.path), b.text, samples, &read_bundled),
-        None => crate::study::mc::load(arg, samples),
+        None => crate::study::mc::load(arg, samples).map_err(|e| match e {
+            StudyError::Io { path, error, .. } => StudyError::Io {
+                hint: hint(&path, Kind::Study, &error),
+                path,
+                error,
+            },
+            e => e,
+        }),
     }
 }
 
@@ -223,5 +346,44 @@ mod tests {
         assert_eq!(s.needs(), vec![q]);
         assert!(q.needs().is_empty());
         assert!(!q.description().is_empty());
+    }
+
+    /// Issue 57 item 10: a bundled file that names a file outside the bundle (a policy under
+    /// `../results/`) fails wherever the project is not.
+    #[test]
+    fn bundled_files_name_only_bundled_files() {
+        for b in all() {
+            let value: toml::Table = b.text.parse().unwrap();
+            let policy = value
+                .get("controller")
+                .and_then(|c| c.get("policy"))
+                .and_then(|p| p.as_str());
+            assert_eq!(
+                policy, None,
+                "{} names a policy file outside the bundle",
+                b.path
+            );
+            if let Some(rel) = value.get("scenario").and_then(|v| v.as_str()) {
+                assert_eq!(b.needs().len(), 1, "{}: {rel} is not bundled", b.path);
+            }
+        }
+    }
+
+    #[test]
+    fn a_close_name_gets_a_did_you_mean() {
+        let name = |arg: &str, kind| did_you_mean(Path::new(arg), kind).map(|b| b.name());
+        assert_eq!(name("quickstrat", Kind::Scenario), Some("quickstart"));
+        assert_eq!(name("quickstat.toml", Kind::Scenario), Some("quickstart"));
+        assert_eq!(
+            name("tripoly2_fencs", Kind::Scenario),
+            Some("tripoly2_fences")
+        );
+        // Far from every name, the wrong kind, or an exact name: nothing.
+        assert_eq!(name("robust", Kind::Scenario), None);
+        assert_eq!(name("quickstrat", Kind::Study), None);
+        assert_eq!(name("quickstart", Kind::Scenario), None);
+        assert_eq!(edit_distance("quickstrat", "quickstart"), 1);
+        assert_eq!(edit_distance("abc", ""), 3);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
     }
 }

@@ -1,7 +1,10 @@
-//! Several line designs on one part stream (`pinfeed compare`: pin layouts measured
-//! against fence designs). Each scene runs on the same parts ([`crate::scenario::FeedSource`]);
-//! the runs are independent and go in parallel, each a pure function of its scene, so the rows do
-//! not depend on the thread count.
+//! Several line designs for one part side by side (`pinfeed compare`: pin layouts measured
+//! against fence designs). Each scene runs its own feed (its headway, orientation and lateral
+//! distributions, seed and number of parts) unless the user imposes one on all
+//! ([`crate::scenario::FeedOverrides`]), so a design's row does not depend on which other files
+//! are compared, nor on their order; scenes whose feeds agree see the same parts in the same order
+//! ([`crate::scenario::shared_feed`]). The runs are independent and go in parallel, each a pure
+//! function of its scene, so the rows do not depend on the thread count.
 //!
 //! Per scene:
 //! * **goal**: what counts as a success, each goal set's orientations and tolerance (designs with
@@ -16,12 +19,14 @@
 //! * **throughput of oriented parts** (successes per minute over the steady window, as `run`);
 //! * **latency**: mean and 99th percentile of entry → exit time of the parts that exit, from the
 //!   run's HDR histogram (3 significant digits);
-//! * **contacts per part** and the number of **jams**, with every outcome count beside them.
+//! * **contacts per part** and every outcome class that happened besides success (collisions,
+//!   jams, …), with every outcome count in the JSON;
+//! * its **obstacles** by kind ([`ObstacleKinds`]: "1 sensor pin + 2 moving pins").
 
 use crate::engine::prepare::OnlineHandle;
 use crate::engine::{self, EngineError, OutcomeCounts, RunOptions};
 use crate::geometry::Polygon;
-use crate::scenario::{Goal, Obstacle, Scene};
+use crate::scenario::{Actuator, FeedOverrides, Goal, Obstacle, Scene};
 use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
@@ -33,14 +38,18 @@ pub struct ComparisonRow {
     pub scenario: String,
     /// The scenario file, as given.
     pub file: String,
-    /// Number of pins on the line.
+    /// Number of pins on the line (of every kind).
     pub pins: usize,
     /// Number of fences on the line.
     pub fences: usize,
+    /// The obstacles by kind.
+    pub obstacle_kinds: ObstacleKinds,
     /// Seed of the run's part stream.
     pub seed: u64,
     /// Parts fed in.
     pub parts_in: u64,
+    /// (Mean) time between arrivals (s): the file's, or `--headway`.
+    pub headway_s: f64,
     /// What counts as a success: the goal sets; empty when every exiting part does (`any`).
     pub goal: Vec<GoalWindow>,
     /// Share of parts that ended in success, in [0, 1].
@@ -71,6 +80,64 @@ pub struct ComparisonRow {
     pub jams: u64,
     /// Count per outcome class.
     pub outcomes: OutcomeCounts,
+}
+
+/// A line's obstacles by kind (the file format's `pin`, `sensor_pin`, `moving_pin`,
+/// `retractable_pin` and `fence`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct ObstacleKinds {
+    /// Fixed pins without a sensor.
+    pub fixed_pins: usize,
+    /// Fixed pins with a sensor.
+    pub sensor_pins: usize,
+    /// Pins that move across the belt.
+    pub moving_pins: usize,
+    /// Pins raised or withdrawn per part.
+    pub retractable_pins: usize,
+    /// Fences.
+    pub fences: usize,
+}
+
+impl ObstacleKinds {
+    /// Count `scene`'s obstacles by kind.
+    pub fn of(scene: &Scene) -> ObstacleKinds {
+        let mut k = ObstacleKinds::default();
+        for o in &scene.obstacles {
+            *match o {
+                Obstacle::Fence(_) => &mut k.fences,
+                Obstacle::Pin(p) => match (&p.actuator, &p.sensor) {
+                    (Some(Actuator::Moving(_)), _) => &mut k.moving_pins,
+                    (Some(Actuator::Retractable(_)), _) => &mut k.retractable_pins,
+                    (None, Some(_)) => &mut k.sensor_pins,
+                    (None, None) => &mut k.fixed_pins,
+                },
+            } += 1;
+        }
+        k
+    }
+}
+
+impl std::fmt::Display for ObstacleKinds {
+    /// "1 sensor pin + 2 moving pins", "3 pins", "2 pins + 1 fence", "none".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kinds = [
+            (self.sensor_pins, "sensor pin"),
+            (self.moving_pins, "moving pin"),
+            (self.retractable_pins, "retractable pin"),
+            (self.fixed_pins, "pin"),
+            (self.fences, "fence"),
+        ];
+        let named: Vec<String> = kinds
+            .iter()
+            .filter(|(n, _)| *n > 0)
+            .map(|&(n, kind)| format!("{n} {kind}{}", if n == 1 { "" } else { "s" }))
+            .collect();
+        if named.is_empty() {
+            f.write_str("none")
+        } else {
+            f.write_str(&named.join(" + "))
+        }
+    }
 }
 
 /// One goal set of a scene: a part succeeds when its final orientation is within
@@ -127,17 +194,17 @@ fn span(scene: &Scene, range: fn(&Obstacle) -> [f64; 2]) -> Option<[f64; 2]> {
         .reduce(|a, b| [a[0].min(b[0]), a[1].max(b[1])])
 }
 
-/// The designs of a comparison, on one part stream: what [`designs`] returns.
+/// The designs of a comparison: what [`designs`] returns.
 #[derive(Debug)]
 pub struct Designs {
-    /// The scenes, in the order given, each with the first one's feed and seed.
+    /// The scenes, in the order given, each with its own feed and the overrides applied.
     pub scenes: Vec<Scene>,
     /// Where each scene came from (as given).
     pub files: Vec<String>,
     /// Each scene's online controller's model, built from the file as written (None without one).
     pub online: Vec<Option<OnlineHandle>>,
-    /// The part stream every scene runs.
-    pub source: crate::scenario::FeedSource,
+    /// What the user imposed on every feed.
+    pub overrides: FeedOverrides,
 }
 
 /// Why the designs of a comparison cannot be set up.
@@ -149,31 +216,29 @@ pub enum DesignsError {
     /// No scenario file was given.
     #[error("compare needs at least one scenario file")]
     Empty,
-    /// `--parts` out of range.
-    #[error("--parts must lie in [1, 1000000000], got {0}")]
-    Parts(u64),
-    /// A design cannot take the first one's part stream.
+    /// An override out of range.
+    #[error(transparent)]
+    Override(#[from] crate::scenario::OverrideError),
+    /// A design is for another part than the first one.
     #[error("{file} cannot run on the part stream of {first}: {reason}")]
     Stream {
         /// The design refused.
         file: String,
-        /// The first design's file, whose stream is imposed.
+        /// The first design's file.
         first: String,
-        /// Why (a different part, or offsets the belt cannot hold).
+        /// Why (a different part).
         reason: crate::scenario::FeedMismatch,
     },
 }
 
-/// Read the scenario files `paths` and put them on one part stream: the first file's feed and
-/// seed (`seed` and `parts` override its own; `uniform_orientation` feeds orientations uniform on
-/// [0°, 360°) instead). Each online controller's model is built from its file as written, before
-/// the stream is imposed: the controller was designed for its own feed.
+/// Read the scenario files `paths`, check that they describe one part, and impose `overrides` on
+/// each one's feed. Each online controller's model is built from its file as written, before the
+/// overrides: the controller was designed for its own feed.
 pub fn designs(
     paths: &[std::path::PathBuf],
-    seed: Option<u64>,
-    parts: Option<u64>,
-    uniform_orientation: bool,
+    overrides: FeedOverrides,
 ) -> Result<Designs, DesignsError> {
+    overrides.check()?;
     let (mut scenes, mut files, mut online) = (Vec::new(), Vec::new(), Vec::new());
     for path in paths {
         let scene = crate::scenario::load(path)?;
@@ -181,32 +246,24 @@ pub fn designs(
         scenes.push(scene);
         files.push(path.display().to_string());
     }
-    let mut source =
-        crate::scenario::FeedSource::from_scene(scenes.first().ok_or(DesignsError::Empty)?);
-    source.seed = seed.unwrap_or(source.seed);
-    if uniform_orientation {
-        source = source.with_uniform_orientation();
-    }
-    source.feed.parts = parts.unwrap_or(source.feed.parts);
-    if !(1..=1_000_000_000).contains(&source.feed.parts) {
-        return Err(DesignsError::Parts(source.feed.parts));
-    }
+    let first = scenes.first().ok_or(DesignsError::Empty)?.clone();
     for (scene, file) in scenes.iter_mut().zip(&files) {
-        source.apply(scene).map_err(|reason| DesignsError::Stream {
+        crate::scenario::same_part(&first, scene).map_err(|reason| DesignsError::Stream {
             file: file.clone(),
             first: files[0].clone(),
             reason,
         })?;
+        overrides.apply(scene);
     }
     Ok(Designs {
         scenes,
         files,
         online,
-        source,
+        overrides,
     })
 }
 
-/// Run every scene (already on one part stream) with `parts` parts; one row per scene, in order.
+/// Run every scene with its own feed's number of parts; one row per scene, in order.
 /// `files` names where each scene came from; `online` holds, per scene, the online controller's
 /// model of the scene as written, before it was given the shared part stream
 /// ([`crate::engine::prepare::online_model`]; None: built from the scene run).
@@ -214,9 +271,8 @@ pub fn compare(
     scenes: &[Scene],
     files: &[String],
     online: &[Option<OnlineHandle>],
-    parts: u64,
 ) -> Result<Vec<ComparisonRow>, EngineError> {
-    compare_observed(scenes, files, online, parts, &crate::progress::silent)
+    compare_observed(scenes, files, online, &crate::progress::silent)
 }
 
 /// [`compare`], telling `progress` the parts finished over all scenes of all.
@@ -224,17 +280,16 @@ pub fn compare_observed(
     scenes: &[Scene],
     files: &[String],
     online: &[Option<OnlineHandle>],
-    parts: u64,
     progress: crate::progress::Report,
 ) -> Result<Vec<ComparisonRow>, EngineError> {
-    let tally = crate::progress::Tally::new(parts * scenes.len() as u64, progress);
+    let total = scenes.iter().map(|s| s.feed.parts).sum();
+    let tally = crate::progress::Tally::new(total, progress);
     scenes
         .par_iter()
         .zip(files.par_iter())
         .enumerate()
         .map(|(k, (scene, file))| {
             let opts = RunOptions {
-                parts,
                 online: online.get(k).cloned().flatten(),
                 ..RunOptions::from_scene(scene)
             };
@@ -248,14 +303,16 @@ pub fn compare_observed(
             let y_span = self::span(scene, Obstacle::y_range);
             let length = part_length(&scene.part.polygon);
             let hist = &r.metrics.latency_us;
-            let count = |f: fn(&Obstacle) -> bool| scene.obstacles.iter().filter(|o| f(o)).count();
+            let kinds = ObstacleKinds::of(scene);
             Ok(ComparisonRow {
                 scenario: scene.name.clone(),
                 file: file.clone(),
-                pins: count(|o| matches!(o, Obstacle::Pin(_))),
-                fences: count(|o| matches!(o, Obstacle::Fence(_))),
+                pins: scene.obstacles.len() - kinds.fences,
+                fences: kinds.fences,
+                obstacle_kinds: kinds,
                 seed: s.seed,
                 parts_in: s.parts_in,
+                headway_s: scene.feed.arrival.headway(),
                 goal: goal_windows(&scene.goal),
                 success_rate: s.success_rate,
                 success_ci95: s.success_ci95,
@@ -282,6 +339,24 @@ pub fn compare_observed(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn obstacles_are_named_by_kind() {
+        let k = |sensor_pins, moving_pins, fixed_pins, fences| {
+            ObstacleKinds {
+                fixed_pins,
+                sensor_pins,
+                moving_pins,
+                retractable_pins: 0,
+                fences,
+            }
+            .to_string()
+        };
+        assert_eq!(k(1, 2, 0, 0), "1 sensor pin + 2 moving pins");
+        assert_eq!(k(0, 0, 3, 0), "3 pins");
+        assert_eq!(k(0, 0, 1, 2), "1 pin + 2 fences");
+        assert_eq!(k(0, 0, 0, 0), "none");
+    }
 
     #[test]
     fn part_length_is_the_largest_dimension() {

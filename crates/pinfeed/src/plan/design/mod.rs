@@ -196,14 +196,7 @@ impl DesignOptions {
 pub fn design_name(part: &str) -> String {
     let p = part.trim();
     if p.to_lowercase().starts_with("vertices:") {
-        // FNV-1a over the normalised list: stable across runs and platforms.
-        let norm: String = p.split_whitespace().collect::<Vec<_>>().join(" ");
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        for b in norm.bytes() {
-            h ^= b as u64;
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        return format!("custom-{:08x}", (h >> 32) as u32 ^ h as u32);
+        return crate::geometry::named::custom_name(p);
     }
     p.chars()
         .map(|c| {

@@ -13,12 +13,14 @@ use thiserror::Error;
 pub enum StudyError {
     /// The study file could not be read.
     /// (The cause is in the message, not a `source`, so that it is printed once.)
-    #[error("{}: cannot read the study: {error}", path.display())]
+    #[error("{}: cannot read the study: {error}{hint}", path.display())]
     Io {
         /// The study file.
         path: PathBuf,
         /// Why it could not be read.
         error: std::io::Error,
+        /// What the user may have meant (`; did you mean …`), or empty.
+        hint: String,
     },
     /// A located problem in the study file (file:line:column, key, what is allowed).
     #[error("{0}")]

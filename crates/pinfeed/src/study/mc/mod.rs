@@ -167,6 +167,7 @@ pub fn load(path: &Path, samples: Option<u64>) -> Result<Study, StudyError> {
     let source = crate::input::read_text(path).map_err(|error| StudyError::Io {
         path: path.to_path_buf(),
         error,
+        hint: String::new(),
     })?;
     parse(path, &source, samples)
 }

@@ -108,10 +108,7 @@ impl StudyHeader {
                 .collect(),
             points: study.point_values.clone(),
             uncertain: study.declared.describe(),
-            command: format!(
-                "cargo run --release -- mc {file} --samples {}",
-                study.samples
-            ),
+            command: format!("pinfeed mc {file} --samples {}", study.samples),
             sensors: study
                 .scene
                 .obstacles

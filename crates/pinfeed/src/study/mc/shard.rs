@@ -225,6 +225,11 @@ pub struct ShardFile {
     pub samples: [u64; 2],
     /// Counts of each sweep point the shard's range touches.
     pub points: Vec<ShardPoint>,
+    /// The study file's absolute path where the shard ran (empty when unknown, as in shards
+    /// written before it was added): `merge`'s rerun commands name the study from wherever they
+    /// are printed, not as the shard job named it (relative to its own folder).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub study_path: String,
     /// FNV-1a of the file's content with this field empty ([`ShardFile::content_checksum`]):
     /// `merge` refuses a shard whose content was edited or damaged. Not cryptographic: it catches
     /// hand edits and corruption, not a forger who recomputes it.
@@ -276,9 +281,35 @@ impl ShardFile {
             },
             samples: [range.start, range.end],
             points,
+            study_path: String::new(),
             checksum: String::new(),
         }
         .sealed()
+    }
+
+    /// The same file recording where its study file is: `study` made absolute (symbolic links
+    /// resolved when it exists), so that rerun commands work from any folder.
+    pub fn with_study_path(mut self, study: &Path) -> ShardFile {
+        let abs = std::fs::canonicalize(study)
+            .or_else(|_| std::path::absolute(study))
+            .unwrap_or_else(|_| study.to_path_buf());
+        self.study_path = abs.display().to_string();
+        self.sealed()
+    }
+
+    /// The study file as a path that works from the current folder: the recorded absolute path
+    /// (relative when it lies under the current folder), else the study file as the shard job
+    /// named it.
+    pub fn study_path_here(&self) -> String {
+        if self.study_path.is_empty() {
+            return self.header.study_file.clone();
+        }
+        let abs = Path::new(&self.study_path);
+        let here = std::env::current_dir().and_then(std::fs::canonicalize);
+        match here.as_deref().map(|h| abs.strip_prefix(h)) {
+            Ok(Ok(rel)) if !rel.as_os_str().is_empty() => rel.display().to_string(),
+            _ => self.study_path.clone(),
+        }
     }
 
     /// The checksum of the file's content: its JSON with `checksum` empty.
@@ -454,29 +485,56 @@ pub fn read(path: &Path) -> Result<ShardFile, StudyError> {
             v.map_or("missing".to_string(), |v| v.to_string())
         )));
     }
+    let stated = value.get("checksum").is_some();
     let file: ShardFile = serde_json::from_value(value)
         .map_err(|e| StudyError::Shard(format!("{}: malformed shard file: {e}", path.display())))?;
-    let expected = file.content_checksum();
-    if file.checksum != expected {
-        return Err(StudyError::Shard(format!(
-            "{}: field `checksum` is {:?} but the content gives {expected}: the shard was edited or damaged after it was written (rerun it: {})",
-            path.display(),
-            file.checksum,
-            rerun_command(&file.header, file.shard.index, file.shard.count, path)
-        )));
-    }
+    check_checksum(path, &text, stated, &file)?;
     Ok(file)
 }
 
-/// The command that rewrites shard `k` of `n` of the study into the folder of `path`.
-fn rerun_command(h: &StudyHeader, k: u64, n: u64, path: &Path) -> String {
+/// Refuse a shard whose `checksum` field is missing, blank or not its content's
+/// ([`ShardFile::content_checksum`]): every shard pinfeed writes carries it, so any of these means
+/// the file was edited (its counts perhaps) or damaged after it was written. `text` is the file's
+/// text, to give the field's line; `stated` says whether the field is there at all.
+fn check_checksum(
+    path: &Path,
+    text: &str,
+    stated: bool,
+    file: &ShardFile,
+) -> Result<(), StudyError> {
+    let expected = file.content_checksum();
+    if stated && file.checksum == expected {
+        return Ok(());
+    }
+    // The checksum is the file's last top-level field: its line is the last `"checksum"` key.
+    let at = match text.rfind("\"checksum\"") {
+        Some(i) if stated => format!("{}:{}", path.display(), text[..i].matches('\n').count() + 1),
+        _ => path.display().to_string(),
+    };
+    let what = if !stated {
+        "is missing".to_string()
+    } else if file.checksum.trim().is_empty() {
+        "is blank".to_string()
+    } else {
+        format!("is {:?} but the content gives {expected}", file.checksum)
+    };
+    Err(StudyError::Shard(format!(
+        "{at}: field `checksum` {what}: every shard pinfeed writes carries the checksum of its content, so the shard was edited or damaged after it was written (rerun it: {})",
+        rerun_command(file, file.shard.index, file.shard.count, path)
+    )))
+}
+
+/// The command that rewrites shard `k` of `n` of `file`'s study into the folder of `path`, from the
+/// current folder.
+fn rerun_command(file: &ShardFile, k: u64, n: u64, path: &Path) -> String {
+    let h = &file.header;
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     format!(
         "pinfeed mc {} --samples {} --shard {k}/{n} --out {} --quiet",
-        h.study_file,
+        file.study_path_here(),
         h.samples_per_point,
         dir.display()
     )
@@ -484,7 +542,7 @@ fn rerun_command(h: &StudyHeader, k: u64, n: u64, path: &Path) -> String {
 
 /// What to run when shards are missing: each missing shard of `n` (by the indices the given
 /// files do not hold) as a `--shard K/N` command, and the Slurm `--array=` list of them.
-fn missing_shards_help(h: &StudyHeader, files: &[(PathBuf, ShardFile)], total: u64) -> String {
+fn missing_shards_help(files: &[(PathBuf, ShardFile)], total: u64) -> String {
     let (first_path, first) = &files[0];
     let n = first.shard.count;
     let have: std::collections::BTreeSet<u64> = files
@@ -504,12 +562,12 @@ fn missing_shards_help(h: &StudyHeader, files: &[(PathBuf, ShardFile)], total: u
     }
     let mut s = format!("\nrerun only the missing shards of {n}:\n");
     for &k in &missing {
-        s += &format!("  {}\n", rerun_command(h, k, n, first_path));
+        s += &format!("  {}\n", rerun_command(first, k, n, first_path));
     }
     let list: Vec<String> = missing.iter().map(u64::to_string).collect();
     // The array's task ids are the shard indices themselves (`--shard /N` would subtract
     // SLURM_ARRAY_TASK_MIN and run shard 0).
-    let each = rerun_command(h, 0, n, first_path).replace(
+    let each = rerun_command(first, 0, n, first_path).replace(
         &format!("--shard 0/{n}"),
         &format!("--shard \\$SLURM_ARRAY_TASK_ID/{n}"),
     );
@@ -591,7 +649,7 @@ pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTa
         if a > covered {
             return bad(format!(
                 "samples [{covered}, {a}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?){}",
-                missing_shards_help(h0, files, total)
+                missing_shards_help(files, total)
             ));
         }
         covered = b;
@@ -600,7 +658,7 @@ pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<(StudyHeader, Vec<PointTa
     if covered < total {
         return bad(format!(
             "samples [{covered}, {total}) are missing: no shard covers them (the study has {total} samples; did a shard job fail?){}",
-            missing_shards_help(h0, files, total)
+            missing_shards_help(files, total)
         ));
     }
     let mut tallies: Vec<PointTally> = (0..h0.points.len())
