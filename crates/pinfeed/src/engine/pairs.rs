@@ -196,6 +196,16 @@ mod tests {
         assert!(belt.queue.pop().is_none());
     }
 
+    /// Two parts 1.5 radii apart can touch (their vertices reach a from each centroid): the broad
+    /// phase hands them to the narrow phase (capsules closer than the sum of their radii), and
+    /// two parts 2.5 radii apart it skips.
+    #[test]
+    fn parts_closer_than_the_sum_of_their_reaches_reach_the_narrow_phase() {
+        assert_eq!(check_two_parts(1.5).1.part_part_narrow_checks, 1);
+        assert_eq!(check_two_parts(1.99).1.part_part_narrow_checks, 1);
+        assert_eq!(check_two_parts(2.5).1.part_part_narrow_checks, 0);
+    }
+
     use proptest::prelude::*;
 
     fn scene_of(file: &str) -> Scene {
@@ -227,9 +237,15 @@ mod tests {
     fn excess(scene: &Scene, motion: &Motion, now: f64, end: f64) -> f64 {
         let v = scene.belt.speed;
         let (p0, p1, r) = bounding_capsule(scene, motion, now, end);
-        let mut times: Vec<f64> = (0..=200).map(|k| now + (end - now) * k as f64 / 200.0).collect();
+        let mut times: Vec<f64> = (0..=200)
+            .map(|k| now + (end - now) * k as f64 / 200.0)
+            .collect();
         if let Motion::Held(plan) = motion {
-            times.extend(plan.step_times(v).into_iter().filter(|t| (now..=end).contains(t)));
+            times.extend(
+                plan.step_times(v)
+                    .into_iter()
+                    .filter(|t| (now..=end).contains(t)),
+            );
         }
         let mut worst = f64::NEG_INFINITY;
         for t in times {

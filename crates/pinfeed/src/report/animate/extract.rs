@@ -93,7 +93,7 @@ pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation 
     }
     marks.extend(control_marks(scene, &result.control, &parts));
     Animation {
-        title: format!("{} — {} on the line", scene.name, scene.part.label),
+        title: format!("{} — {} on the line", scene.name, part_name(scene)),
         belt_length: scene.belt.length,
         belt_width: scene.belt.width,
         belt_speed: scene.belt.speed,
@@ -185,4 +185,13 @@ fn contact_interval(poses: &[(f64, Pose)], pin: Vec2, reach: f64) -> Option<(f64
         j += 1;
     }
     Some((poses[i].0, poses[j].0))
+}
+
+/// The part as a title names it: its shape's name, or `a part of N vertices` for a vertex list
+/// (whose label is the key it came from, `vertices`).
+fn part_name(scene: &Scene) -> String {
+    match scene.part.label.as_str() {
+        "vertices" => format!("a part of {} vertices", scene.part.polygon.len()),
+        name => name.to_string(),
+    }
 }
