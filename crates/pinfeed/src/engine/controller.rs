@@ -47,7 +47,7 @@ pub struct ControlRecord {
     pub obstacle: String,
     /// What the controller did.
     pub kind: ControlKind,
-    /// The decision's label, or the target (`y=+12.00 mm` / `raised` / `withdrawn`).
+    /// The decision's label, or the target (`y=0.012` / `raised` / `withdrawn`).
     pub what: String,
     /// An actuation's motion: start, ready (s), and a moving pin's lateral positions (m).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -515,11 +515,11 @@ pub(super) fn decision_label(scene: &Scene, sensor: usize, decision: Option<usiz
     }
 }
 
-/// A command's target as `y=+12.00 mm` (the unit `plan` prints pins in), `raised` or
-/// `withdrawn`.
+/// A command's target as `y=…` (m, every digit: a policy can be written back from it),
+/// `raised` or `withdrawn`.
 pub(super) fn describe_target(t: Target) -> String {
     match t {
-        Target::Y(y) => format!("y={:+.2} mm", y * 1e3),
+        Target::Y(y) => format!("y={y}"),
         Target::Raised(true) => "raised".into(),
         Target::Raised(false) => "withdrawn".into(),
     }
@@ -585,14 +585,6 @@ pub(super) fn capsule_during(
 
 #[cfg(test)]
 mod tests {
-    /// Issue 57 item 16: a mover's target read `y=0.027487370837451` (metres, every digit);
-    /// it reads in mm to 2 decimals, as `plan` prints pins.
-    #[test]
-    fn targets_read_in_mm_to_two_decimals() {
-        assert_eq!(describe_target(Target::Y(0.027487370837451)), "y=+27.49 mm");
-        assert_eq!(describe_target(Target::Y(-0.0004)), "y=-0.40 mm");
-        assert_eq!(describe_target(Target::Raised(true)), "raised");
-    }
 
     use super::*;
 

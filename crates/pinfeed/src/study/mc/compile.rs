@@ -874,9 +874,13 @@ pub fn check_first_samples(
     let failed = points
         .par_iter()
         .enumerate()
-        .map(|(i, p)| super::sample::draw_scene(scene, p, seed, 0).map_err(|e| (i, e)))
-        .find_first(|r| r.is_err());
-    let Some(Err((point, e))) = failed else {
+        .map(|(i, p)| {
+            super::sample::draw_scene(scene, p, seed, 0)
+                .err()
+                .map(|e| (i, e))
+        })
+        .find_first(Option::is_some);
+    let Some(Some((point, e))) = failed else {
         return Ok(());
     };
     let values = grid(axes).swap_remove(point);
