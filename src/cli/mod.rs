@@ -160,3 +160,11 @@ impl std::fmt::Display for Exit {
 }
 
 impl std::error::Error for Exit {}
+
+/// Print the warning for a `--pin-radius` (part units) thinner than a real pin at `scale`
+/// ([`pinfeed::scenario::limits::thin_pin_warning`]).
+pub(crate) fn warn_thin_pin(radius_units: f64, scale: f64) {
+    if let Some(w) = pinfeed::scenario::limits::thin_pin_warning(radius_units, scale) {
+        eprintln!("warning: --pin-radius {radius_units}: {w}");
+    }
+}

@@ -205,6 +205,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.tripod = args.tripod;
     if let Some(r) = args.pin_radius {
         p.set_pin_radius_units(r).map_err(|e| flagged(e.into()))?;
+        super::warn_thin_pin(r, args.scale);
     }
     if let Some(w) = args.belt_width {
         p.belt_width_m = w;

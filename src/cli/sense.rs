@@ -236,6 +236,7 @@ fn flagged(e: SenseError) -> anyhow::Error {
 pub fn run(a: &SenseArgs, recorded: &str) -> Result<()> {
     let req = request(a);
     let p = experiment::check(&req).map_err(flagged)?;
+    super::warn_thin_pin(a.pin_radius, a.scale);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.threads)
         .build()

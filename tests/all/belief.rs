@@ -361,6 +361,23 @@ fn online_mode_errors_are_located() {
     assert!(e.contains("controller.belief.mu_c"), "{e}");
     let e = refused(&base.replace("samples = 4", "mu_c = [0.5, 9.0]"));
     assert!(e.contains("controller.belief.mu_c[1]"), "{e}");
+    // Issue 57 item 7: a class (or friction value) listed twice counted twice; refused like a
+    // three-entry list, at the repeated entry.
+    for (list, key) in [
+        (
+            "support = [\"uniform\", \"uniform\"]",
+            "controller.belief.support[1]",
+        ),
+        (
+            "support = [\"tripod\", \"uniform\", \"tripod\"]",
+            "controller.belief.support",
+        ),
+        ("mu_c = [0.3, 0.5, 0.3]", "controller.belief.mu_c[2]"),
+    ] {
+        let e = refused(&base.replace("samples = 4", list));
+        assert!(e.contains(&format!("key `{key}`: ")), "{list}: {e}");
+        assert!(e.contains("once"), "{list}: {e}");
+    }
     let e = refused(&base.replace("samples = 4", "colour = 3"));
     assert!(e.contains("colour"), "{e}");
     let e = refused(&base.replace("mode = \"online\"", "mode = \"policy\""));

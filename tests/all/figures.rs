@@ -442,3 +442,132 @@ fn crowded_marks_take_separate_rows() {
     let doc = animate::render(&anim, &AnimateOptions::default());
     check_animation_labels(&doc, "crowded");
 }
+
+/// Issue 57 item 16: the part figure's legend covered the part. No legend label's box meets the
+/// bounding box of the drawn part (its filled polygon) or of the circle of radius a, for parts
+/// of every shape.
+#[test]
+fn the_part_figures_legend_stays_off_the_part() {
+    let dir = fresh_dir("figures-part-legend");
+    for part in [
+        "tripoly1",
+        "tripoly2",
+        "lshape",
+        "vertices:0,0 40,0 40,10 10,10 10,30 0,30",
+    ] {
+        let svg = dir.join("part.svg");
+        let o = pinfeed(&["part", "--part", part, "--plot", svg.to_str().unwrap()]);
+        assert!(
+            o.status.success(),
+            "{part}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let doc = read_svg(&svg);
+        // The outline's chart: the part's polygon (the first filled one) and its frame.
+        let part_box = polygons(&doc)[0];
+        let boxes = text_boxes(&doc);
+        for label in ["radius a", "convex hull", "part", "centroid"] {
+            let b = boxes
+                .iter()
+                .find(|b| b.text == label)
+                .unwrap_or_else(|| panic!("{part}: no legend label {label}"));
+            let meets = b.x0 < part_box[1]
+                && b.x1 > part_box[0]
+                && b.y0 < part_box[3]
+                && b.y1 > part_box[2];
+            assert!(
+                !meets,
+                "{part}: legend label {label} {b:?} meets the part {part_box:?}"
+            );
+            // Below the outline's square chart (460 px), not over the circle of radius a.
+            assert!(
+                b.y0 >= 460.0,
+                "{part}: legend label {label} inside the outline: {b:?}"
+            );
+        }
+        no_overlaps(&boxes, part);
+    }
+}
+
+/// Issue 57 item 16: a study without a sweep drew its outcome bars with no axis label and no
+/// word of what was perturbed; the x axis names the perturbations.
+#[test]
+fn an_unswept_study_figure_names_what_it_perturbs() {
+    let dir = fresh_dir("figures-unswept");
+    let study = dir.join("s.toml");
+    std::fs::write(
+        &study,
+        format!(
+            "scenario = \"{}/scenarios/quickstart.toml\"\nsamples = 20\n[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = 0.3\nmax = 0.7\n",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+    )
+    .unwrap();
+    let out = dir.join("o");
+    crate::support::pinfeed_ok(&[
+        "mc",
+        study.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let svg = out.join("sensitivity.svg");
+    let boxes = text_boxes(&read_svg(&svg));
+    assert!(
+        boxes
+            .iter()
+            .any(|b| b.text.starts_with("outcome of each sample under mu_c")),
+        "{:?}",
+        boxes.iter().map(|b| &b.text).collect::<Vec<_>>()
+    );
+}
+
+/// Issue 57 item 16: the animation of a vertex-list part was titled "vertices", and its mover
+/// targets were labelled in metres with every digit (`y=0.027487370837451`) where `plan` prints
+/// mm. The title says what the part is; targets read `y=+12.00 mm`.
+#[test]
+fn an_animation_names_a_vertex_part_and_labels_targets_in_mm() {
+    let text = std::fs::read_to_string("scenarios/tripoly1_sensing.toml").unwrap();
+    let shape = "shape = \"tripoly1\"";
+    assert!(text.contains(shape));
+    // tripoly1 written out as its vertices (the same part, at the same scale).
+    let poly = pinfeed::geometry::part_from_spec("tripoly1").unwrap();
+    let vertices: Vec<String> = poly
+        .vertices()
+        .iter()
+        .map(|v| format!("[{}, {}]", v.x, v.y))
+        .collect();
+    let text = text.replacen(shape, &format!("vertices = [{}]", vertices.join(", ")), 1);
+    let scene = pinfeed::scenario::parse(Path::new("v.toml"), &text).unwrap();
+    let mut opts = RunOptions::from_scene(&scene);
+    opts.parts = 6;
+    opts.sample_paths = animate::DEFAULT_PARTS;
+    opts.keep_records = true;
+    let result = run(&scene, &opts, &mut |_| {}).unwrap();
+    let anim = animate::from_run(&scene, &result, animate::DEFAULT_PARTS);
+    let n = poly.vertices().len();
+    assert!(
+        anim.title
+            .contains(&format!("a part of {n} vertices on the line")),
+        "{}",
+        anim.title
+    );
+    let doc = animate::render(&anim, &AnimateOptions::default());
+    // Labels `y=…` (not the attributes `y="…"`).
+    let targets: Vec<&str> = doc
+        .split("y=")
+        .skip(1)
+        .filter(|t| !t.starts_with('"'))
+        .collect();
+    assert!(!targets.is_empty(), "no mover target in the animation");
+    for t in targets {
+        let value = t.split(" mm").next().unwrap();
+        assert!(
+            value.starts_with(['+', '-'])
+                && value.len() <= 7
+                && t[value.len()..].starts_with(" mm"),
+            "a target not in mm to 2 decimals: y={}",
+            &t[..t.len().min(30)]
+        );
+    }
+}

@@ -802,3 +802,101 @@ fn pin_stop_after_touch_stops_the_pin_that_far_past_the_first_touch() {
         "{e}"
     );
 }
+
+/// The L part of docs/commands.md drawn in millimetres.
+const MM_PART: &str = "vertices:0,0 40,0 40,10 10,10 10,30 0,30";
+
+/// Issue 57 item 8: a part in mm without `--scale` blamed `--belt-width`, which the user never
+/// passed; a scenario without `[part] scale` blamed `belt.width`. Both name the likely cause.
+#[test]
+fn a_part_in_mm_read_at_a_larger_scale_names_the_mm_scale() {
+    let o = pinfeed(&["plan", "--part", MM_PART, "--pins", "--no-write"]);
+    let e = refused(&o, "plan of a mm part");
+    assert!(
+        e.contains("--scale 0.02: the part (2a = 1.0770 m) is wider than the belt (0.1 m): vertices in mm? add --scale 0.001 (2a = 0.0539 m)"),
+        "{e}"
+    );
+    assert!(!e.contains("--belt-width"), "{e}");
+    let dir = scratch("mm-part");
+    let line = bundled("quickstart.toml");
+    let start = line.find("[part]").unwrap();
+    let end = start + line[start..].find("\n\n").unwrap();
+    let mm = |scale: &str| {
+        format!(
+            "{}[part]\nvertices = [[0, 0], [40, 0], [40, 10], [10, 10], [10, 30], [0, 30]]\n{scale}{}",
+            &line[..start],
+            &line[end..]
+        )
+    };
+    for (scale, key, given) in [
+        ("", "part", "scale 1, the default: [part] gives no scale"),
+        ("scale = 1.0\n", "part.scale", "scale 1)"),
+    ] {
+        let f = dir.join("mm.toml");
+        std::fs::write(&f, mm(scale)).unwrap();
+        let e = refused(&pinfeed(&["run", f.to_str().unwrap()]), "a mm scenario");
+        assert!(
+            e.contains(&format!("key `{key}`: the part (2a = 53.8516 m at {given}")),
+            "{e}"
+        );
+        assert!(e.contains("vertices in mm? give scale = 0.001"), "{e}");
+        assert!(!e.contains("belt.width"), "{e}");
+    }
+    // A named part without a scale (1 m per unit) is told to give one; with a scale, a belt too
+    // narrow for a part not drawn in mm is still the belt's fault.
+    let f = dir.join("named.toml");
+    let named = line.replace("scale = 0.02        # metres per unit of the shape", "");
+    std::fs::write(&f, &named).unwrap();
+    let e = refused(&pinfeed(&["run", f.to_str().unwrap()]), "no scale");
+    assert!(e.contains("key `part`: the part (2a = "), "{e}");
+    assert!(
+        e.contains("give scale, the metres per unit of the shape"),
+        "{e}"
+    );
+    std::fs::write(
+        &f,
+        line.replace("width = 0.1         #", "width = 0.03        #"),
+    )
+    .unwrap();
+    let e = refused(&pinfeed(&["run", f.to_str().unwrap()]), "narrow belt");
+    assert!(e.contains("key `belt.width`: "), "{e}");
+    // At the right scale the same file runs.
+    let f = dir.join("mm.toml");
+    std::fs::write(&f, mm("scale = 0.001\n")).unwrap();
+    pinfeed::scenario::load(&f).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 57 item 8: `--pin-radius 0.002` on a mm part (metres by mistake: a 2 µm pin) was
+/// accepted silently; a pin thinner than 0.1 mm is warned about, a real one is not.
+#[test]
+fn a_pin_thinner_than_a_tenth_of_a_millimetre_is_warned_about() {
+    // --belt-width 100 stops plan after the radius is read, before any search.
+    let plan = |radius: &str| {
+        stderr(&pinfeed(&[
+            "plan",
+            "--part",
+            MM_PART,
+            "--scale",
+            "0.001",
+            "--pin-radius",
+            radius,
+            "--belt-width",
+            "100",
+            "--no-write",
+        ]))
+    };
+    let e = plan("0.002");
+    assert!(
+        e.contains("warning: --pin-radius 0.002: a pin of radius 2e-6 m (0.002 part units × scale 0.001) is thinner than 0.1 mm"),
+        "{e}"
+    );
+    assert!(e.contains("read 1000 times too small"), "{e}");
+    for real in ["2", "0.1", "0"] {
+        assert!(
+            !plan(real).contains("warning"),
+            "--pin-radius {real}: {}",
+            plan(real)
+        );
+    }
+}

@@ -216,3 +216,27 @@ fn a_pin_beside_a_fence_is_a_second_contact() {
     )));
     assert_eq!(off.summary.outcomes.multi_contact, 0);
 }
+
+/// Issue 57 item 15: `busy 102%` for a fence was explained nowhere. It is the fence's push time
+/// summed over the parts it pushes, per second of the run: above 100% when parts slide along it
+/// together, and the table says so then (and only then).
+#[test]
+fn a_fence_busy_above_100_percent_is_parts_sliding_along_it_together() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/tripoly1_fences.toml");
+    let mut s = scenario::load(&path).unwrap();
+    s.feed.parts = 60;
+    let note = pinfeed::report::line_table::BUSY_ABOVE_100;
+    let busy = |s: &Scene| {
+        let r = engine::run(s, &RunOptions::from_scene(s), &mut |_| {}).unwrap();
+        let table = pinfeed::report::line_table::table(&r.summary);
+        (r.summary.obstacles[0].busy_fraction, table.contains(note))
+    };
+    // At the bundled 6 s headway one part at a time slides along the first fence.
+    let (b, noted) = busy(&s);
+    assert!(b < 1.0 && !noted, "busy {b}, noted {noted}");
+    // At 3 s two parts are on it at times: more than a second of pushing per second.
+    s.feed.arrival = scenario::Arrival::Periodic { headway: 3.0 };
+    let (b, noted) = busy(&s);
+    assert!(b > 1.0, "busy {b}");
+    assert!(noted, "no note for busy {b}");
+}

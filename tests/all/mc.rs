@@ -837,8 +837,15 @@ fn invalid_perturbed_polygons_are_redrawn_or_reported() {
     };
     let (uniform, tripod) = (redraws("uniform"), redraws("tripod"));
     assert!(tripod > uniform, "tripod {tripod}, uniform {uniform}");
-    let st = big(10.0, "uniform");
-    let e = sample::draw_scene(&st.scene, &st.points[0], st.seed, 0)
+    let st = big(0.03, "uniform");
+    let mut p = st.points[0].clone();
+    p.shape = Some(mc::distribution::Distribution::Normal {
+        mean: 0.0,
+        sd: 10.0,
+        lo: f64::NEG_INFINITY,
+        hi: f64::INFINITY,
+    });
+    let e = sample::draw_scene(&st.scene, &p, st.seed, 0)
         .err()
         .expect("refused");
     assert!(
@@ -849,8 +856,16 @@ fn invalid_perturbed_polygons_are_redrawn_or_reported() {
         e.to_string().contains("shape tolerance is too large"),
         "{e}"
     );
+    // The study file says so when it is read, at the table (the first sample cannot be drawn).
+    write_study(
+        &d,
+        "samples = 10\n[uncertain.shape]\ndistribution = \"normal\"\nsd = 10.0\n",
+    );
     let e = refused(&["mc", s(&d.join("study.toml")), "--out", s(&d.join("o"))]);
-    assert!(e.contains("sample 0 of sweep point 0: shape:"), "{e}");
+    assert!(
+        e.contains("key `uncertain.shape`: no valid sample can be drawn on this scenario: shape:"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&d).unwrap();
 }
 

@@ -419,8 +419,7 @@ fn a_parameter_that_reaches_nothing_is_a_located_error() {
     let d = tmp("reach");
     let quickstart = bundled("quickstart.toml");
     let fences = bundled("tripoly1_fences.toml");
-    // (scenario, study body, line, key, words)
-    let cases: [(&str, &str, usize, &str, &[&str]); 9] = [
+    let cases: [Refusal; 9] = [
         (
             &quickstart,
             "[uncertain.fence_angle]\ndistribution = \"normal\"\nsd = 1.0\n",
@@ -485,23 +484,8 @@ fn a_parameter_that_reaches_nothing_is_a_located_error() {
             &["applies only to the actuator parameters"],
         ),
     ];
-    for (k, (scenario, body, line, key, words)) in cases.iter().enumerate() {
-        let file = format!("case{k}.toml");
-        let study = study_of(&d, &file, scenario, body);
-        let e = refused(&["mc", s(&study), "--out", s(&d.join("o"))]);
-        let head = format!("{file}:{line}:");
-        assert!(e.contains(&head), "case {k}: expected '{head}' in:\n{e}");
-        assert!(
-            e.contains(&format!("key `{key}`: ")),
-            "case {k}: expected key `{key}` in:\n{e}"
-        );
-        for w in *words {
-            assert!(e.contains(w), "case {k}: expected '{w}' in:\n{e}");
-        }
-        assert!(
-            e.contains(&format!("{line} | ")),
-            "case {k}: no excerpt:\n{e}"
-        );
+    for (k, case) in cases.iter().enumerate() {
+        refused_at(&d, k, case);
     }
     // A selector naming a pin of the wrong kind says what it is.
     let study = mixed_study(
@@ -515,6 +499,31 @@ fn a_parameter_that_reaches_nothing_is_a_located_error() {
         "{e}"
     );
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A study case: its scenario (a path), its body, and the line, key and words of its error.
+type Refusal<'a> = (&'a str, &'a str, usize, &'a str, &'a [&'a str]);
+
+/// Study `case` number `k`, written in `d`, is refused at its line and key (with the excerpt),
+/// with its words; returns the error.
+fn refused_at(d: &Path, k: usize, (scenario, body, line, key, words): &Refusal) -> String {
+    let file = format!("case{k}.toml");
+    let study = study_of(d, &file, scenario, body);
+    let e = refused(&["mc", s(&study), "--out", s(&d.join("o"))]);
+    let head = format!("{file}:{line}:");
+    assert!(e.contains(&head), "case {k}: expected '{head}' in:\n{e}");
+    assert!(
+        e.contains(&format!("key `{key}`: ")),
+        "case {k}: expected key `{key}` in:\n{e}"
+    );
+    for w in *words {
+        assert!(e.contains(w), "case {k}: expected '{w}' in:\n{e}");
+    }
+    assert!(
+        e.contains(&format!("{line} | ")),
+        "case {k}: no excerpt:\n{e}"
+    );
+    e
 }
 
 /// Every new parameter on the mixed line, swept over fence μf's upper bound.
@@ -716,5 +725,94 @@ fn mu_c_on_a_line_with_fences_warns_that_it_does_not_reach_them() {
     // No μc, no warning.
     let st = mc::load(&mixed_study(&d, "none.toml", ""), None).unwrap();
     assert!(st.warnings().is_empty());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Issue 57 item 6: values inside a parameter's documented range that no sample can be drawn
+/// with on the scenario passed the parser and failed at sample 0 ("1001 draws in a row …", no
+/// file:line). They are refused when the study is read, at the parameter (or its sweep), with
+/// the range the scenario allows.
+#[test]
+fn values_no_sample_can_be_drawn_with_are_refused_when_the_study_is_read() {
+    let d = tmp("undrawable");
+    let sensing = bundled("tripoly1_sensing.toml");
+    std::fs::write(d.join("line.toml"), LINE).unwrap();
+    let cases: [Refusal; 5] = [
+        (
+            "line.toml",
+            "[uncertain.mu_c]\ndistribution = \"normal\"\nmean = 0.5\nsd = 0.1\nmin = 0.5\nmax = 0.5\n",
+            7,
+            "uncertain.mu_c.max",
+            &["keeps 0.00% of normal", "give distribution = \"fixed\", value = 0.5"],
+        ),
+        (
+            "line.toml",
+            "[uncertain.mu_c]\ndistribution = \"normal\"\nmean = 0.5\nsd = 0.1\nmin = 0.5\nmax = 0.505\n",
+            6,
+            "uncertain.mu_c.min",
+            &["keeps 1.99% of normal", "at least 5% must land in [min, max]"],
+        ),
+        (
+            "line.toml",
+            "[uncertain.actuator_speed]\ndistribution = \"fixed\"\nvalue = 1e-6\n",
+            2,
+            "uncertain.actuator_speed",
+            &[
+                "no valid sample can be drawn on this scenario",
+                "pin `m1`",
+                "actuator_speed must lie in [1e-5, 500] (its speed 0.1 m/s must stay in [1e-6, 50] m/s)",
+            ],
+        ),
+        (
+            &sensing,
+            "[uncertain.sensor_noise]\ndistribution = \"fixed\"\nvalue = 100000\n",
+            2,
+            "uncertain.sensor_noise",
+            &[
+                "no valid sample can be drawn on this scenario",
+                "at sensor_noise = 100000 the sensor's jitter: must lie in [0, 10] (s, ≥ 0), got 100",
+            ],
+        ),
+        (
+            "line.toml",
+            "[[sweep]]\nparameter = \"actuator_speed\"\nvalues = [1.0, 1e-6]\n",
+            3,
+            "sweep[0].parameter",
+            &["no valid sample can be drawn at actuator_speed = 1e-6 on this scenario"],
+        ),
+    ];
+    for (k, case) in cases.iter().enumerate() {
+        let e = refused_at(&d, k, case);
+        assert!(!e.contains("sample 0 of sweep point"), "case {k}: {e}");
+        assert!(!d.join("o").exists(), "case {k}: wrote a report");
+    }
+    // The range the error states is the real one: just inside it the study loads and draws.
+    for (body, what) in [
+        (
+            "[uncertain.actuator_speed]\ndistribution = \"fixed\"\nvalue = 1.0001e-5\npins = [\"m1\"]\n",
+            "slowest speed",
+        ),
+        (
+            "[uncertain.actuator_speed]\ndistribution = \"fixed\"\nvalue = 499.9\n",
+            "fastest speed",
+        ),
+        (
+            "[uncertain.mu_c]\ndistribution = \"normal\"\nmean = 0.5\nsd = 0.1\nmin = 0.5\nmax = 0.513\n",
+            "truncation",
+        ),
+    ] {
+        let study = study_of(&d, "inside.toml", "line.toml", body);
+        let st = mc::load(&study, None).unwrap_or_else(|e| panic!("{what}: {e}"));
+        for i in 0..20 {
+            sample::draw_scene(&st.scene, &st.points[0], st.seed, i).unwrap();
+        }
+    }
+    let study = study_of(
+        &d,
+        "inside.toml",
+        &sensing,
+        "[uncertain.sensor_noise]\ndistribution = \"fixed\"\nvalue = 10000\n",
+    );
+    mc::load(&study, None).unwrap();
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -328,7 +328,7 @@ pub fn stop_of(status: &ContactStatus) -> Option<Stop> {
 /// The plan of a push by obstacle `j` of a part at world pose `pose_ref` at anchor time `t_ref`,
 /// touched at time `t_begin`: its contact spans the pin travel from first touch to the end of the
 /// last contact; `speed` is the belt's (m/s).
-fn plan_of(
+pub(super) fn plan_of(
     j: usize,
     (t_ref, pose_ref): (f64, Pose),
     pusher: Pusher,

@@ -515,7 +515,8 @@ pub(super) fn decision_label(scene: &Scene, sensor: usize, decision: Option<usiz
     }
 }
 
-/// A command's target as `y=…`, `raised` or `withdrawn`.
+/// A command's target as `y=…` (m, every digit: a policy can be written back from it),
+/// `raised` or `withdrawn`.
 pub(super) fn describe_target(t: Target) -> String {
     match t {
         Target::Y(y) => format!("y={y}"),
@@ -584,6 +585,7 @@ pub(super) fn capsule_during(
 
 #[cfg(test)]
 mod tests {
+
     use super::*;
 
     fn scene(name: &str) -> Scene {

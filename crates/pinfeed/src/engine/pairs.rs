@@ -195,4 +195,97 @@ mod tests {
         assert_eq!(work.part_part_narrow_checks, 0);
         assert!(belt.queue.pop().is_none());
     }
+
+    /// Two parts 1.5 radii apart can touch (their vertices reach a from each centroid): the broad
+    /// phase hands them to the narrow phase (capsules closer than the sum of their radii), and
+    /// two parts 2.5 radii apart it skips.
+    #[test]
+    fn parts_closer_than_the_sum_of_their_reaches_reach_the_narrow_phase() {
+        assert_eq!(check_two_parts(1.5).1.part_part_narrow_checks, 1);
+        assert_eq!(check_two_parts(1.99).1.part_part_narrow_checks, 1);
+        assert_eq!(check_two_parts(2.5).1.part_part_narrow_checks, 0);
+    }
+
+    use proptest::prelude::*;
+
+    fn scene_of(file: &str) -> Scene {
+        crate::scenario::load(&crate::project_path(&format!("scenarios/{file}"))).unwrap()
+    }
+
+    /// Obstacle `j` of `scene` pushing a part that rides in at lateral offset `y` (m) and
+    /// orientation `theta` (rad), from 3a upstream at time 0: its held motion (with the path
+    /// recorded, as the narrow phase sees it), or None if the part passes untouched.
+    fn held(scene: &Scene, j: usize, y: f64, theta: f64) -> Option<Motion> {
+        let (v, a) = (scene.belt.speed, scene.part.radius);
+        let ob = &scene.obstacles[j];
+        let pose = Pose::new(ob.x_range()[0] - 3.0 * a, y, theta);
+        let (pusher, settings) = super::super::contact::pusher_for(ob, &scene.contact, None);
+        let outcome = pusher.push(&scene.part.model, pose, &settings, None);
+        if !outcome.contact {
+            return None;
+        }
+        let t_begin = outcome.travel_to_contact / v;
+        let mut plan =
+            super::super::contact::plan_of(j, (0.0, pose), pusher, settings, outcome, t_begin, v);
+        plan.ensure_trace(&scene.part.model);
+        Some(Motion::Held(Box::new(plan)))
+    }
+
+    /// The largest amount (m) by which a vertex of the part moving along `motion` leaves the
+    /// broad phase's capsule over [now, end] (≤ 0: never), at 200 times and at every step of a
+    /// push. The capsule lives in the belt frame that is the world at `now`.
+    fn excess(scene: &Scene, motion: &Motion, now: f64, end: f64) -> f64 {
+        let v = scene.belt.speed;
+        let (p0, p1, r) = bounding_capsule(scene, motion, now, end);
+        let mut times: Vec<f64> = (0..=200)
+            .map(|k| now + (end - now) * k as f64 / 200.0)
+            .collect();
+        if let Motion::Held(plan) = motion {
+            times.extend(
+                plan.step_times(v)
+                    .into_iter()
+                    .filter(|t| (now..=end).contains(t)),
+            );
+        }
+        let mut worst = f64::NEG_INFINITY;
+        for t in times {
+            let shift = Vec2::new(v * (t - now), 0.0);
+            for w in scene.part.polygon.world_vertices(&motion.world_pose(t, v)) {
+                let b = w - shift;
+                worst = worst.max(segment_distance(b, b, p0, p1) - r);
+            }
+        }
+        worst
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 48, rng_seed: proptest::test_runner::RngSeed::Fixed(57021), .. ProptestConfig::default() })]
+
+        /// Issue 57 item 21: every vertex of a part held by a pin, held against a fence or in
+        /// free travel stays inside the capsule the part–part broad phase gives it, from any
+        /// moment of the motion to its end (a broad phase one part radius too small passed
+        /// every test).
+        #[test]
+        fn every_vertex_stays_inside_the_broad_phase_capsule(
+            y in -1.0f64..1.0,
+            theta in 0.0f64..std::f64::consts::TAU,
+            from in 0.0f64..1.0,
+            fence in any::<bool>(),
+            j in 0usize..2,
+        ) {
+            let scene = scene_of(if fence { "tripoly1_fences.toml" } else { "quickstart.toml" });
+            let a = scene.part.radius;
+            let j = j % scene.obstacles.len();
+            let (centre, _, _) = scene.obstacles[j].capsule();
+            let y = (centre.y + y * 1.5 * a).clamp(-scene.belt.width / 2.0 + a, scene.belt.width / 2.0 - a);
+            let free = Motion::Free { t0: 0.0, pose: Pose::new(0.1, y, theta), until: 2.0 };
+            prop_assert!(excess(&scene, &free, 2.0 * from, 2.0) <= 1e-12 * a);
+            if let Some(m) = held(&scene, j, y, theta) {
+                let Motion::Held(plan) = &m else { unreachable!() };
+                let now = plan.t_begin + from * (plan.t_end - plan.t_begin);
+                let out = excess(&scene, &m, now, plan.t_end);
+                prop_assert!(out <= 1e-9 * a, "a vertex leaves the capsule by {} a", out / a);
+            }
+        }
+    }
 }

@@ -37,6 +37,16 @@ pub fn num(v: f64) -> String {
     }
 }
 
+/// [`num`] rounded to 6 significant digits first, for a number computed from others (a ratio of
+/// limits, a plotted coordinate): `27.48737083745107` prints as `27.4874`, `9.999999999999999e-6`
+/// as `1e-5`, `0.39999999999999997` as `0.4`.
+pub fn short(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return num(v);
+    }
+    num(format!("{v:.5e}").parse().unwrap_or(v))
+}
+
 /// A value outside its closed range (or not finite).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{name} must be {}in [{}, {}] ({what}), got {}", if value.is_finite() { "" } else { "a finite number " }, num(*lo), num(*hi), num(*value))]

@@ -308,6 +308,20 @@ impl Problem {
                 "must lie in (0, 10] m",
             ));
         }
+        if let Some(mm) = crate::scenario::limits::mm_scale_fit(a, self.scale, self.belt_width_m)
+            .filter(|_| self.belt_width_m < 2.0 * a)
+        {
+            return Err(PlanError::input(
+                "scale",
+                self.scale,
+                format!(
+                    "the part (2a = {:.4} m) is wider than the belt ({} m): vertices in mm? add --scale 0.001 (2a = {:.4} m)",
+                    2.0 * a,
+                    self.belt_width_m,
+                    mm
+                ),
+            ));
+        }
         if self.belt_width_m < 2.0 * a {
             return Err(PlanError::input(
                 "belt_width",

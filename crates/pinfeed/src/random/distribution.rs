@@ -129,6 +129,19 @@ impl Distribution {
         }
     }
 
+    /// The probability that one raw draw lands in the distribution's own truncation: the normal
+    /// mass of `[lo, hi]` (1 for the other kinds, and for a normal with sd 0, whose mean lies in
+    /// its truncation).
+    pub fn truncation_mass(&self) -> f64 {
+        match *self {
+            Distribution::Normal { mean, sd, lo, hi } if sd > 0.0 => {
+                let cdf = |x: f64| 0.5 * libm::erfc(-(x - mean) / (sd * std::f64::consts::SQRT_2));
+                (cdf(hi) - cdf(lo)).max(0.0)
+            }
+            _ => 1.0,
+        }
+    }
+
     /// Is the distribution a single value?
     pub fn is_fixed(&self) -> bool {
         matches!(self, Distribution::Fixed(_))

@@ -11,6 +11,9 @@ fn opt(v: Option<f64>, digits: usize) -> String {
     }
 }
 
+/// What a `busy` above 100% means, printed under the obstacles when one is.
+pub const BUSY_ABOVE_100: &str = "busy: an obstacle's push time per second of the run, summed over the parts it pushes; above 100% it pushes several parts at once (parts sliding along a fence together)";
+
 /// A readable multi-line summary.
 pub fn table(s: &Summary) -> String {
     let mut o = String::new();
@@ -74,6 +77,9 @@ pub fn table(s: &Summary) -> String {
                 ob.contacts,
                 100.0 * ob.busy_fraction
             );
+        }
+        if s.obstacles.iter().any(|ob| ob.busy_fraction > 1.0) {
+            let _ = writeln!(o, "  {BUSY_ABOVE_100}");
         }
     }
     for (label, map) in [

@@ -11,11 +11,13 @@ use std::path::Path;
 pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> ReportResult<()> {
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
-    let root = SVGBackend::new(&tmp, (1000, 460)).into_drawing_area();
+    let root = SVGBackend::new(&tmp, (1000, 500)).into_drawing_area();
     root.fill(&WHITE)?;
     let (left, right) = root.split_horizontally(460);
+    // The legend gets its own strip under the outline, so it never covers the part.
+    let (outline, legend) = left.split_vertically(460);
     let a = poly.radius() * 1.15;
-    let mut ch = ChartBuilder::on(&left)
+    let mut ch = ChartBuilder::on(&outline)
         .caption(format!("{title}: outline (part frame)"), ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(30)
@@ -28,14 +30,11 @@ pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> ReportResult<()> {
             (p.x, p.y)
         })
         .collect();
-    ch.draw_series(LineSeries::new(circle, RGBColor(190, 190, 190)))?
-        .label("radius a")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(190, 190, 190)));
+    let grey = RGBColor(190, 190, 190);
+    ch.draw_series(LineSeries::new(circle, grey))?;
     let mut hull: Vec<(f64, f64)> = poly.hull().iter().map(|p| (p.x, p.y)).collect();
     hull.push(hull[0]);
-    ch.draw_series(LineSeries::new(hull, BLUE.mix(0.4)))?
-        .label("convex hull")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.mix(0.4)));
+    ch.draw_series(LineSeries::new(hull, BLUE.mix(0.4)))?;
     let pts: Vec<(f64, f64)> = poly.vertices().iter().map(|p| (p.x, p.y)).collect();
     ch.draw_series(std::iter::once(plotters::element::Polygon::new(
         pts.clone(),
@@ -43,16 +42,27 @@ pub fn plot_part(poly: &Polygon, title: &str, path: &Path) -> ReportResult<()> {
     )))?;
     let mut ring = pts;
     ring.push(ring[0]);
-    ch.draw_series(LineSeries::new(ring, BLACK.stroke_width(2)))?
-        .label("part")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
-    ch.draw_series(std::iter::once(Circle::new((0.0, 0.0), 4, RED.filled())))?
-        .label("centroid")
-        .legend(|(x, y)| Circle::new((x + 8, y), 4, RED.filled()));
-    ch.configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.8))
-        .draw()?;
+    ch.draw_series(LineSeries::new(ring, BLACK.stroke_width(2)))?;
+    ch.draw_series(std::iter::once(Circle::new((0.0, 0.0), 4, RED.filled())))?;
+    let font = ("sans-serif", 14).into_font();
+    let mut x = 52;
+    for (label, colour, dot) in [
+        ("radius a", grey.to_rgba(), false),
+        ("convex hull", BLUE.mix(0.4), false),
+        ("part", BLACK.to_rgba(), false),
+        ("centroid", RED.to_rgba(), true),
+    ] {
+        if dot {
+            legend.draw(&Circle::new((x + 8, 18), 4, colour.filled()))?;
+        } else {
+            legend.draw(&PathElement::new(
+                vec![(x, 18), (x + 16, 18)],
+                colour.stroke_width(2),
+            ))?;
+        }
+        legend.draw(&Text::new(label, (x + 22, 11), font.clone()))?;
+        x += 30 + 8 * label.len() as i32;
+    }
 
     let samples: Vec<(f64, f64)> = (0..=720)
         .map(|k| {

@@ -128,6 +128,16 @@ fn success_lines(
     Ok(())
 }
 
+/// The axis of the outcome bars: each sample's outcome, under what the study perturbs (a study
+/// without a sweep names no parameter anywhere else in its figure).
+fn outcome_axis(uncertain: &[String]) -> String {
+    if uncertain.is_empty() {
+        "outcome of each sample (nothing uncertain: the nominal line)".to_string()
+    } else {
+        format!("outcome of each sample under {}", uncertain.join("; "))
+    }
+}
+
 fn outcome_bars(
     r: &McReport,
     root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
@@ -158,6 +168,7 @@ fn outcome_bars(
                 String::new()
             }
         })
+        .x_desc(outcome_axis(&r.header.uncertain))
         .y_desc("share of samples (%), 95% interval")
         .draw()?;
     for (i, c) in classes.iter().enumerate() {

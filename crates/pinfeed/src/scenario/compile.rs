@@ -39,7 +39,7 @@ pub fn compile(
     let name = scene_name(&c, raw.name.as_deref(), default_name)?;
     let seed = raw.seed.unwrap_or(1);
     let belt = compile_belt(&c, raw.belt.as_ref())?;
-    let mut part = compile_part(&c, raw.part.as_ref())?;
+    let mut part = compile_part(&c, raw.part.as_ref(), &belt)?;
     let feed = compile_feed(&c, raw.feed.as_ref(), &belt, &part)?;
     let (obstacles, neighbours, valid_sensors) =
         super::obstacles::compile_obstacles(&c, &raw.obstacles, &belt, part.radius, part.mu_c)?;
@@ -151,8 +151,10 @@ fn compile_belt(c: &Checker, rb: Option<&RawBelt>) -> R<Belt> {
 }
 
 /// `[part]`: the shape (named or a vertex list) scaled to metres, its friction and mass, and its
-/// contact model and stable states compiled once.
-fn compile_part(c: &Checker, rp: Option<&RawPart>) -> R<PartSpec> {
+/// contact model and stable states compiled once. A part wider than the `belt` that would fit
+/// in millimetres is refused here, naming that likely cause (any other too-wide part is refused
+/// at `belt.width` by the feed).
+fn compile_part(c: &Checker, rp: Option<&RawPart>, belt: &Belt) -> R<PartSpec> {
     let Some(rp) = rp else {
         return Err(c.missing(
             "part",
@@ -186,6 +188,31 @@ fn compile_part(c: &Checker, rp: Option<&RawPart>) -> R<PartSpec> {
     }
     let polygon = poly.scaled(scale);
     let radius = polygon.radius();
+    if 2.0 * radius > belt.width {
+        let mm = limits::mm_scale_fit(radius, scale, belt.width);
+        let (key, given) = match rp.scale {
+            Some(_) => ("part.scale", ""),
+            None => ("part", ", the default: [part] gives no scale"),
+        };
+        let hint = match mm {
+            Some(two_a) => format!(
+                "vertices in mm? give scale = 0.001 (2a = {} m)",
+                crate::mechanics::limits::short(two_a)
+            ),
+            None => "give scale, the metres per unit of the shape".to_string(),
+        };
+        if mm.is_some() || rp.scale.is_none() {
+            return Err(c.err(
+                key,
+                format!(
+                    "the part (2a = {} m at scale {}{given}) is wider than the belt ({} m): {hint}",
+                    crate::mechanics::limits::short(2.0 * radius),
+                    limits::num(scale),
+                    limits::num(belt.width),
+                ),
+            ));
+        }
+    }
     let mu_c = c.range(
         "part.mu_c",
         rp.mu_c.unwrap_or(0.5),

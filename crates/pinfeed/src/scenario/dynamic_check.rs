@@ -238,6 +238,12 @@ fn control_mode(
                     }
                     for (i, &m) in v.iter().enumerate() {
                         c.range(&format!("controller.belief.mu_c[{i}]"), m, limits::FRICTION, "friction")?;
+                        if v[..i].contains(&m) {
+                            return Err(c.err(
+                                &format!("controller.belief.mu_c[{i}]"),
+                                format!("{m} is listed twice; each friction value is one hypothesis, list it once"),
+                            ));
+                        }
                     }
                     v
                 }
@@ -247,6 +253,12 @@ fn control_mode(
                 return Err(c.err(
                     "controller.belief.support",
                     "lists support classes, \"uniform\" and/or \"tripod\", each once",
+                ));
+            }
+            if let Some(i) = (1..support.len()).find(|&i| support[..i].contains(&support[i])) {
+                return Err(c.err(
+                    &format!("controller.belief.support[{i}]"),
+                    "lists support classes, \"uniform\" and/or \"tripod\", each once; this one is listed twice",
                 ));
             }
             let first_dynamic = obstacles

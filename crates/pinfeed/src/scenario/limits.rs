@@ -58,6 +58,44 @@ pub const HISTOGRAM_BIN_DEG: (f64, f64) = (0.01, 90.0);
 /// ([`crate::mechanics::limits::FENCE_LENGTH_A`]).
 pub use crate::mechanics::limits::FENCE_LENGTH_A as FENCE_LENGTH_OF_A;
 
+/// Metres per millimetre: the scale a part drawn in millimetres needs.
+pub const MM_SCALE: f64 = 1e-3;
+
+/// The smallest a, in the part's own units, of a part that looks drawn in millimetres (a ≥ 5 mm);
+/// the named parts have a of 1 to 2 units.
+pub const MM_PART_UNITS: f64 = 5.0;
+
+/// The likely cause of a part (circumradius `radius_m` at `scale` metres per unit) wider than its
+/// belt (`belt_width`, m): vertices in millimetres read at a larger scale (a scenario's default 1,
+/// `plan`'s 0.02). Returns the part's 2a (m) at [`MM_SCALE`] when the part looks drawn in mm (a
+/// of at least [`MM_PART_UNITS`] units), that scale is smaller than `scale` and it fits the part
+/// on the belt, else None (then the belt is the likelier culprit).
+pub fn mm_scale_fit(radius_m: f64, scale: f64, belt_width: f64) -> Option<f64> {
+    let two_a = 2.0 * radius_m * MM_SCALE / scale;
+    let mm_like = radius_m / scale >= MM_PART_UNITS;
+    (mm_like && scale > MM_SCALE && two_a <= belt_width).then_some(two_a)
+}
+
+/// The thinnest pin a warning lets pass without a word (m): 0.1 mm. Thinner pins are legal
+/// (down to a point pin, radius 0) but no feeder's pin is that thin, so a radius below it is
+/// most likely a length given in the wrong unit (metres where part units were asked).
+pub const PIN_RADIUS_FLOOR_M: f64 = 1e-4;
+
+/// A warning for a pin of radius `radius_m` (m) thinner than [`PIN_RADIUS_FLOOR_M`] but not a
+/// point pin (0), with the radius in part units (`units`) and the metres per unit (`scale`).
+pub fn thin_pin_warning(units: f64, scale: f64) -> Option<String> {
+    let radius_m = units * scale;
+    (radius_m > 0.0 && radius_m < PIN_RADIUS_FLOOR_M).then(|| {
+        format!(
+            "a pin of radius {} m ({} part units × scale {}) is thinner than 0.1 mm, thinner than any real pin: the radius is in part units (metres = part units × scale), so a radius in metres is read {} times too small; give 0 for a point pin",
+            crate::mechanics::limits::short(radius_m),
+            num(units),
+            num(scale),
+            crate::mechanics::limits::short(1.0 / scale)
+        )
+    })
+}
+
 /// A number as a message shows it: plain between 10⁻⁴ and 10¹⁵, else in exponent notation (so
 /// 1e-300 is not printed with 300 zeros).
 pub fn num(v: f64) -> String {

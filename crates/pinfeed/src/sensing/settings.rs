@@ -124,13 +124,20 @@ impl std::fmt::Display for SettingError {
     }
 }
 
+use crate::mechanics::limits::num;
+
 fn check(field: &'static str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), SettingError> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(())
     } else {
         Err(SettingError {
             field,
-            message: format!("must lie in [{lo:e}, {hi:e}] ({unit}), got {v}"),
+            message: format!(
+                "must lie in [{}, {}] ({unit}), got {}",
+                num(lo),
+                num(hi),
+                num(v)
+            ),
         })
     }
 }

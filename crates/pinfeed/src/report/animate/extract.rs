@@ -93,7 +93,7 @@ pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation 
     }
     marks.extend(control_marks(scene, &result.control, &parts));
     Animation {
-        title: format!("{} — {} on the line", scene.name, scene.part.label),
+        title: format!("{} — {} on the line", scene.name, part_name(scene)),
         belt_length: scene.belt.length,
         belt_width: scene.belt.width,
         belt_speed: scene.belt.speed,
@@ -144,17 +144,16 @@ fn control_marks(scene: &Scene, control: &[ControlRecord], parts: &[AnimPart]) -
             else {
                 return None;
             };
+            let what = target_in_mm(&r.what);
             let (kind, text) = match r.kind {
-                ControlKind::Decision => {
-                    (MarkKind::Decision, format!("part {} → {}", r.part, r.what))
-                }
+                ControlKind::Decision => (MarkKind::Decision, format!("part {} → {what}", r.part)),
                 ControlKind::Actuation => (
                     MarkKind::Actuation,
-                    format!("{} {} for part {}", r.obstacle, r.what, r.part),
+                    format!("{} {what} for part {}", r.obstacle, r.part),
                 ),
                 ControlKind::Late => (
                     MarkKind::Late,
-                    format!("late: {} {} for part {}", r.obstacle, r.what, r.part),
+                    format!("late: {} {what} for part {}", r.obstacle, r.part),
                 ),
                 ControlKind::Dropped => return None,
             };
@@ -185,4 +184,40 @@ fn contact_interval(poses: &[(f64, Pose)], pin: Vec2, reach: f64) -> Option<(f64
         j += 1;
     }
     Some((poses[i].0, poses[j].0))
+}
+
+/// The part as a title names it: its shape's name, or `a part of N vertices` for a vertex list
+/// (whose label is the key it came from, `vertices`).
+fn part_name(scene: &Scene) -> String {
+    match scene.part.label.as_str() {
+        "vertices" => format!("a part of {} vertices", scene.part.polygon.len()),
+        name => name.to_string(),
+    }
+}
+
+/// A control record's words with a moving pin's target `y=0.027487370837451` (m, every digit,
+/// as the control log keeps it) shown as `y=+27.49 mm`, the unit `plan` prints pins in; other
+/// words as they are.
+fn target_in_mm(what: &str) -> String {
+    let Some(rest) = what.strip_prefix("y=") else {
+        return what.to_string();
+    };
+    let (number, tail) = rest.split_at(rest.find(' ').unwrap_or(rest.len()));
+    match number.parse::<f64>() {
+        Ok(y) => format!("y={:+.2} mm{tail}", y * 1e3),
+        Err(_) => what.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Issue 57 item 16: a mover's target read `y=0.027487370837451` in the animation.
+    #[test]
+    fn targets_read_in_mm_to_two_decimals() {
+        use super::target_in_mm;
+        assert_eq!(target_in_mm("y=0.027487370837451"), "y=+27.49 mm");
+        assert_eq!(target_in_mm("y=-0.0004 skipped"), "y=-0.40 mm skipped");
+        assert_eq!(target_in_mm("raised"), "raised");
+        assert_eq!(target_in_mm("probe=a"), "probe=a");
+    }
 }

@@ -147,6 +147,11 @@ fn slot_mut<'a>(u: &'a mut RawUncertain, name: &str) -> &'a mut Option<RawDistri
     }
 }
 
+/// Smallest share of a normal's draws its truncation `[min, max]` may keep: a draw outside is
+/// redrawn, at most [`super::distribution::MAX_REDRAWS`] times, so with 5% a sample fails to draw
+/// with probability 0.95¹⁰⁰¹ ≈ 5·10⁻²³ (docs/study-format.md).
+pub const MIN_TRUNCATION_MASS: f64 = 0.05;
+
 /// Largest error (m) a study may add to a length (shape, pin position and radius, lateral pose):
 /// the longest belt (docs/study-format.md).
 pub const LENGTH_ERROR: (f64, f64) = (-1e3, 1e3);
@@ -411,7 +416,35 @@ fn build_distribution(
             }
             let where_ = if d.mean.is_some() { "mean" } else { "sd" };
             check_in_domain(loc, name, where_, mean)?;
-            Distribution::Normal { mean, sd, lo, hi }
+            let dist = Distribution::Normal { mean, sd, lo, hi };
+            let kept = dist.truncation_mass();
+            if kept < MIN_TRUNCATION_MASS {
+                let hint = if lo == hi {
+                    format!(
+                        "a normal truncated to the single value {} never draws it: give distribution = \"fixed\", value = {}",
+                        num(lo),
+                        num(lo)
+                    )
+                } else {
+                    "widen [min, max] or lower sd, or use a uniform distribution on [min, max]"
+                        .to_string()
+                };
+                return Err(err(
+                    loc,
+                    &key(if lo == hi { "max" } else { "min" }),
+                    format!(
+                        "the truncation [{}, {}] keeps {:.2}% of normal (mean {}, sd {}) draws; a value is redrawn at most {} times, so at least {}% must land in [min, max]: {hint}",
+                        num(lo),
+                        num(hi),
+                        100.0 * kept,
+                        num(mean),
+                        num(sd),
+                        super::distribution::MAX_REDRAWS,
+                        100.0 * MIN_TRUNCATION_MASS
+                    ),
+                ));
+            }
+            dist
         }
     };
     Ok(dist)
@@ -801,6 +834,78 @@ pub fn compile_points(
         out.push(p);
     }
     Ok(out)
+}
+
+/// Where a study gives parameter `name`: the first sweep of it (a sweep of `name` or of one of
+/// its fields) when `swept`, else its `[uncertain.NAME]` table, else a sweep of it.
+fn parameter_key(u: &RawUncertain, sweeps: &[RawSweep], name: &str, swept: bool) -> Option<String> {
+    let sweep = sweeps
+        .iter()
+        .position(|s| s.parameter.split('.').next() == Some(name))
+        .map(|k| format!("sweep[{k}].parameter"));
+    let table = match name {
+        "support" => u.support.is_some(),
+        _ => DISTRIBUTION_PARAMETERS.contains(&name) && slot(u, name).is_some(),
+    }
+    .then(|| format!("uncertain.{name}"));
+    if swept {
+        sweep.or(table)
+    } else {
+        table.or(sweep)
+    }
+}
+
+/// The first sample of every sweep point must draw: a value inside its documented range can
+/// still leave every draw invalid on this scenario (an actuator factor that takes a pin's speed
+/// below the slowest allowed, a noise factor that takes a sensor's jitter past 10 s), which would
+/// otherwise stop the run at sample 0. The first sample is the one the run draws first (a pure
+/// function of the seed), so a study this accepts does not fail there; the error is located at
+/// the parameter the failure names (at its sweep, when swept), with the sweep point's values.
+pub fn check_first_samples(
+    loc: &Locator,
+    u: &RawUncertain,
+    sweeps: &[RawSweep],
+    axes: &[SweepAxis],
+    points: &[Perturbations],
+    scene: &crate::scenario::Scene,
+    seed: u64,
+) -> R<()> {
+    use rayon::prelude::*;
+    let failed = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            super::sample::draw_scene(scene, p, seed, 0)
+                .err()
+                .map(|e| (i, e))
+        })
+        .find_first(Option::is_some);
+    let Some(Some((point, e))) = failed else {
+        return Ok(());
+    };
+    let values = grid(axes).swap_remove(point);
+    let key = e
+        .parameters()
+        .iter()
+        .find_map(|name| parameter_key(u, sweeps, name, !axes.is_empty()))
+        .unwrap_or_else(|| "uncertain".to_string());
+    let at = if axes.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " at {}",
+            axes.iter()
+                .zip(&values)
+                .map(|(a, v)| format!("{} = {}", a.parameter, num(*v)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    Err(err(
+        loc,
+        &key,
+        format!("no valid sample can be drawn{at} on this scenario: {e}"),
+    ))
 }
 
 /// Sensor parameters need a sensor pin: with none in the scenario, the first sensor parameter the

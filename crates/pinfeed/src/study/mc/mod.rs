@@ -242,6 +242,16 @@ pub fn parse_with(
     } else {
         compile::compile_points(&loc, &raw.uncertain, &axes, scene.part.support)?
     };
+    let seed = raw.seed.unwrap_or(1);
+    compile::check_first_samples(
+        &loc,
+        &raw.uncertain,
+        &raw.sweep,
+        &axes,
+        &points,
+        &scene,
+        seed,
+    )?;
     let samples_text = samples.to_string();
     // The policy file the scenario names shapes every sample: its bytes are hashed too (a study
     // without one hashes what it did before policies existed).
@@ -273,7 +283,7 @@ pub fn parse_with(
         file: file.to_path_buf(),
         scenario_file,
         scene,
-        seed: raw.seed.unwrap_or(1),
+        seed,
         samples,
         point_values: compile::grid(&axes),
         axes,

@@ -62,10 +62,11 @@ use super::perturbations::Perturbations;
 use crate::engine::part_stream::draw_part;
 use crate::engine::{self, PartOutcome, RunOptions};
 use crate::geometry::{Polygon, PolygonError, Vec2};
+use crate::mechanics::limits::short;
 use crate::mechanics::support::{draw_support, SupportDrawError};
 use crate::mechanics::{PartModel, PartModelError};
 use crate::random::{stream, ChaCha8Rng};
-use crate::scenario::limits::{show, ACTUATOR_TIME};
+use crate::scenario::limits::{num, show, ACTUATOR_TIME};
 use crate::scenario::{
     Actuator, Arrival, Controller, Feed, FenceObstacle, Lateral, MovingSpec, Obstacle, Orientation,
     PartSpec, PinObstacle, RetractSpec, Scene, SensorPin, SupportKind,
@@ -330,14 +331,15 @@ pub enum SampleError {
     },
     /// Every perturbed actuator of a pin was invalid.
     #[error(
-        "pin `{pin}`: {} perturbed actuators in a row were invalid (a speed above the belt's limit of {max_speed} m/s, or a time or acceleration out of range)",
-        MAX_REDRAWS + 1
+        "pin `{pin}`: {} perturbed actuators in a row were invalid; on this pin {}",
+        MAX_REDRAWS + 1,
+        .allowed.iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")
     )]
     Actuator {
         /// The pin's name.
         pin: String,
-        /// The largest pin speed the sample's belt allows (m/s).
-        max_speed: f64,
+        /// The values of each actuator parameter reaching the pin that keep its actuator valid.
+        allowed: Vec<ActuatorRange>,
     },
     /// The scenario's feed could not draw the part's entry.
     #[error("{0}")]
@@ -345,6 +347,22 @@ pub enum SampleError {
 }
 
 impl SampleError {
+    /// The study parameters that may have caused the error, most likely first (the study's error
+    /// is located at the first one the study gives).
+    pub fn parameters(&self) -> Vec<&'static str> {
+        use super::compile::{FENCE_PARAMETERS, SENSOR_PARAMETERS};
+        match self {
+            SampleError::Value { name, .. } => vec![name],
+            SampleError::ShapeDraw(_) | SampleError::Shape { .. } => vec!["shape"],
+            SampleError::Support(_) | SampleError::Model(_) => vec!["support", "shape"],
+            SampleError::SensorSettings { .. } => SENSOR_PARAMETERS.to_vec(),
+            SampleError::Pin { .. } => vec!["pin_x", "pin_y", "pin_radius"],
+            SampleError::Fence { .. } => FENCE_PARAMETERS.to_vec(),
+            SampleError::Actuator { allowed, .. } => allowed.iter().map(|r| r.parameter).collect(),
+            SampleError::Entry(_) => vec!["pose_theta", "pose_y"],
+        }
+    }
+
     /// A failed value draw with the range its values left (other errors as they are).
     fn left(self, left: Option<RangeLeft>) -> SampleError {
         match self {
@@ -356,6 +374,87 @@ impl SampleError {
             other => other,
         }
     }
+}
+
+/// The values of one actuator parameter that keep one pin's actuator in the scenario's ranges
+/// ([`SampleError::Actuator`]), with the setting they act on.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "{parameter} must lie in [{}, {}] (its {setting} {} {unit} must stay in {} {unit})",
+    short(.values.0),
+    short(.values.1),
+    num(*.nominal),
+    show(*.setting_range)
+)]
+pub struct ActuatorRange {
+    /// `actuator_speed`, `actuator_accel` or `actuator_settle`.
+    pub parameter: &'static str,
+    /// The factors (speed, accel) or errors (settle) that keep the setting in range.
+    pub values: (f64, f64),
+    /// The setting, in words (`speed`, `raise and lower times`, …).
+    pub setting: &'static str,
+    /// The scenario's value of the setting (the longer of a retractable pin's two times).
+    pub nominal: f64,
+    /// The setting's range.
+    pub setting_range: (f64, f64),
+    /// The setting's unit.
+    pub unit: &'static str,
+}
+
+/// The actuator parameters' allowed values on actuator `a` (only those in `reached`) on a belt
+/// running at `belt_speed`.
+fn actuator_ranges(a: Actuator, belt_speed: f64, reached: [bool; 3]) -> Vec<ActuatorRange> {
+    use crate::scenario::limits::{max_pin_speed, ACTUATOR_ACCEL, ACTUATOR_SPEED};
+    let factor = |parameter, setting, nominal: f64, range: (f64, f64), unit| ActuatorRange {
+        parameter,
+        values: (range.0 / nominal, range.1 / nominal),
+        setting,
+        nominal,
+        setting_range: range,
+        unit,
+    };
+    let mut out = Vec::new();
+    match a {
+        Actuator::Moving(m) => {
+            let speed = (ACTUATOR_SPEED.0, max_pin_speed(belt_speed));
+            if reached[0] {
+                out.push(factor("actuator_speed", "speed", m.speed, speed, "m/s"));
+            }
+            if reached[1] {
+                out.push(factor(
+                    "actuator_accel",
+                    "acceleration",
+                    m.accel,
+                    ACTUATOR_ACCEL,
+                    "m/s²",
+                ));
+            }
+            if reached[2] {
+                out.push(ActuatorRange {
+                    parameter: "actuator_settle",
+                    values: (ACTUATOR_TIME.0 - m.settle, ACTUATOR_TIME.1 - m.settle),
+                    setting: "settle time",
+                    nominal: m.settle,
+                    setting_range: ACTUATOR_TIME,
+                    unit: "s",
+                });
+            }
+        }
+        Actuator::Retractable(r) if reached[0] => {
+            // The times are divided by the factor: t / f ≤ the longest time.
+            let t = r.raise_time.max(r.lower_time);
+            out.push(ActuatorRange {
+                parameter: "actuator_speed",
+                values: (t / ACTUATOR_TIME.1, super::compile::ACTUATOR_FACTOR.1),
+                setting: "longer raise/lower time, divided by it,",
+                nominal: t,
+                setting_range: ACTUATOR_TIME,
+                unit: "s",
+            });
+        }
+        Actuator::Retractable(_) => {}
+    }
+    out
 }
 
 /// Which range a parameter's values left ([`SampleError::Value`]).
@@ -798,7 +897,11 @@ fn draw_actuator(
     }
     Err(SampleError::Actuator {
         pin: name.to_string(),
-        max_speed: max_pin_speed(belt.speed),
+        allowed: actuator_ranges(
+            a,
+            belt.speed,
+            [d_speed.is_some(), d_accel.is_some(), d_settle.is_some()],
+        ),
     })
 }
 
