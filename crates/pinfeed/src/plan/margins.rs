@@ -91,7 +91,13 @@ impl Margins {
                     [false, true] => ", or higher: the sweep stopped holding",
                     [false, false] => "",
                 };
-                format!("holds for friction μ {lo:.2}–{hi:.2}{fences}{beyond}")
+                if lo == hi {
+                    format!(
+                        "holds only at its nominal friction μ {lo:.2}{fences} (fails ±{MU_STEP} off it)"
+                    )
+                } else {
+                    format!("holds for friction μ {lo:.2}–{hi:.2}{fences}{beyond}")
+                }
             }
         };
         let place = match self.placement_mm {
