@@ -1,7 +1,7 @@
 //! A design checked under the uncertainty it was planned against: the perturbations, as values
 //! ([`uncertainty`]) for the check the planner runs in memory ([`check_uncertain`]) and as the
 //! study file written beside the design ([`uncertainty_study`]) for `pinfeed mc` to run again.
-//! Both come from one description of the uncertainty ([`Uncertain`]), and a test checks that the
+//! Both come from one description of the uncertainty (`Uncertain`), and a test checks that the
 //! written file, read back, is the same study.
 
 use crate::mechanics::support::SupportChoice;
@@ -122,7 +122,9 @@ mod tests {
     /// memory), is the study the planner runs: the same perturbations, seed and samples.
     #[test]
     fn the_written_uncertainty_study_is_the_one_the_planner_runs() {
-        let cases: [(&str, &[&str], Option<(f64, f64)>, bool, bool); 6] = [
+        /// (scenario, obstacle kinds, μc range, tripod, fences' μf given)
+        type Case<'a> = (&'a str, &'a [&'a str], Option<(f64, f64)>, bool, bool);
+        let cases: [Case; 6] = [
             (
                 "quickstart.toml",
                 &["pin", "pin", "pin"],

@@ -123,7 +123,9 @@ pub(super) fn actuator(
 }
 
 /// The scene's controller from `[controller]`, `[[rules]]` and the policy file, if any.
-/// `sensors` are the scene's sensor pins, untrained: rules name their hypotheses' labels.
+/// `sensors` are the scene's sensor pins, untrained: rules name their hypotheses' labels;
+/// `policy_text`: the policy file's text given in memory (None: read from its file).
+#[allow(clippy::too_many_arguments)] // one per section of the file the controller checks against
 pub(super) fn controller(
     c: &Checker,
     loc: &Locator,

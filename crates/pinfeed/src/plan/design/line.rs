@@ -21,7 +21,7 @@ pub enum LineError {
 }
 
 /// A design's scenario text, with its policy file's text if it names one: what the design writes.
-/// On the line it is built once, in memory ([`Line`]), and run at any headway by setting the
+/// On the line it is built once, in memory, and run at any headway by setting the
 /// built scene's; [`Runnable::with_headway`] writes a headway into the text for the design's
 /// output only.
 #[derive(Debug, Clone, PartialEq)]

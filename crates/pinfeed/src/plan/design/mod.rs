@@ -949,11 +949,7 @@ impl Work<'_> {
                     left_undone: Some(more),
                     ..
                 },
-            ) => {
-                if !said.contains(&more) {
-                    *said = format!("{said}; {more}");
-                }
-            }
+            ) if !said.contains(&more) => *said = format!("{said}; {more}"),
             (
                 Some(Limit::Time { left_undone, .. }),
                 Limit::Time {
