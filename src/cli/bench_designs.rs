@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use pinfeed::plan::design::survey::{page, survey_part, SurveyPart, SurveySettings};
+use pinfeed::plan::design::UncertaintyChoice;
 use pinfeed::plan::problem::parse_mu_c_range;
 use std::path::PathBuf;
 
@@ -30,6 +31,13 @@ pub struct DesignsArgs {
     /// Robust designs: random tripod supports.
     #[arg(long)]
     pub tripod: bool,
+    /// Design against the harsh uncertainty, as `pinfeed plan --robust`.
+    #[arg(long, conflicts_with = "nominal")]
+    pub robust: bool,
+    /// Design for nominal physics, as `pinfeed plan --nominal` [default: plan's default
+    /// uncertainty].
+    #[arg(long)]
+    pub nominal: bool,
     /// Worker threads (0: one per core); the results do not depend on it.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -58,6 +66,13 @@ pub fn run(a: &DesignsArgs, spin: &indicatif::ProgressBar, cmd: &str) -> Result<
         check_parts: a.check_parts,
         mu_c_range,
         tripod: a.tripod,
+        uncertainty: if a.robust {
+            UncertaintyChoice::Robust
+        } else if a.nominal {
+            UncertaintyChoice::Nominal
+        } else {
+            UncertaintyChoice::Default
+        },
         seed: 1,
     };
     let pool = rayon::ThreadPoolBuilder::new()

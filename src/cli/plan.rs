@@ -9,7 +9,9 @@
 use super::stdout::print_result;
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
-use pinfeed::plan::design::{self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status};
+use pinfeed::plan::design::{
+    self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status, UncertaintyChoice,
+};
 use pinfeed::plan::problem::parse_mu_c_range;
 use pinfeed::plan::{FeedKind, PlanError, Problem};
 use pinfeed::report::plan_summary::{self as summary, write_design, DesignPaths};
@@ -66,10 +68,25 @@ pub struct PlanArgs {
     /// Pin–part friction μc.
     #[arg(long, default_value_t = 0.5, allow_hyphen_values = true)]
     pub mu_c: f64,
-    /// Be robust against μc: each particle draws its own μc uniformly in LO:HI.
+    /// Design against the harsh uncertainty: friction uniform in [0.3, 0.7] at pins and fences
+    /// and a random tripod support per part, with the default's placement and angle errors
+    /// (docs/commands.md#plan).
+    #[arg(long, conflicts_with_all = ["nominal", "uncertain"])]
+    pub robust: bool,
+    /// Design for the nominal physics only (no uncertainty; the verdict is the line at nominal
+    /// friction and support).
+    #[arg(long, conflicts_with = "uncertain")]
+    pub nominal: bool,
+    /// Design against the `[uncertain.*]` tables of FILE.toml, as a study declares them
+    /// (docs/study-format.md) [default: friction ±0.1 at pins and fences, pins and fences ±0.5 mm,
+    /// fence angles ±0.5°].
+    #[arg(long, value_name = "FILE.toml")]
+    pub uncertain: Option<PathBuf>,
+    /// The pins' friction (and the fences', without --mu-f) uniform in LO:HI instead of the
+    /// uncertainty's (with --nominal: only this).
     #[arg(long, value_name = "LO:HI")]
     pub mu_c_range: Option<String>,
-    /// Be robust against the support: each particle gets its own random tripod.
+    /// A random tripod support per part, added to the uncertainty (with --nominal: only this).
     #[arg(long)]
     pub tripod: bool,
     /// Pin radius in part units, like the part's vertices and as in every command (0 = point pin;
@@ -287,6 +304,19 @@ pub fn options_of(args: &PlanArgs, recorded: &str) -> Result<DesignOptions> {
     o.sensor_candidates = args.sensor_candidates;
     o.belt_width_given = args.belt_width.is_some();
     o.margins = !args.no_margins;
+    o.uncertainty = if args.robust {
+        UncertaintyChoice::Robust
+    } else if args.nominal {
+        UncertaintyChoice::Nominal
+    } else if let Some(path) = &args.uncertain {
+        let text = pinfeed::input::read_text(path)
+            .with_context(|| format!("--uncertain: reading {}", path.display()))?;
+        UncertaintyChoice::Given(Box::new(
+            design::Uncertainty::from_file(path, &text).map_err(|e| anyhow!("--uncertain: {e}"))?,
+        ))
+    } else {
+        UncertaintyChoice::Default
+    };
     o.name = match (&args.name, &args.out) {
         (Some(n), _) => n.clone(),
         // The scenario's name must be letters, digits, '-' and '_': a file `line_1.5.toml`

@@ -62,7 +62,7 @@ fn every_json_a_command_prints_carries_both_versions() {
         "compare {ROOT}/scenarios/quickstart.toml {ROOT}/scenarios/tripoly2_fences.toml --parts 20 --json",
         "mc quickstart_mu_tripod --samples 3 --json --quiet --out {DIR}/mc",
         "sense --part tripoly1 --d=0.1 --trials 20 --templates 4 --json --no-write",
-        "plan --part square --pins --check-parts 200 --screen-parts 200 --no-write --json",
+        "plan --part square --pins --nominal --check-parts 200 --screen-parts 200 --no-write --json",
         "validate {DIR}/m.csv --members 20 --json --no-write",
         "calibrate {DIR}/m.csv --members 100 --score-members 20 --json --no-write",
     ];

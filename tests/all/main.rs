@@ -66,6 +66,7 @@ mod plan_fences;
 mod plan_goal;
 mod plan_margins;
 mod plan_sensing;
+mod plan_uncertain;
 mod plan_verdict;
 mod readme_tutorial;
 mod scenario_errors;

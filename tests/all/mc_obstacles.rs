@@ -660,30 +660,50 @@ fn a_study_without_the_new_parameters_does_no_extra_work() {
 
 #[test]
 fn a_plans_uncertainty_study_perturbs_the_fences_friction_with_the_pins() {
-    use pinfeed::plan::check::uncertainty_study;
-    let mut problem = pinfeed::plan::Problem::new("tripoly1");
-    problem.mu_c_range = Some((0.3, 0.7));
-    let study = |kinds: &[&str], mu_f_given: bool| {
-        uncertainty_study(&problem, kinds, mu_f_given, "plan.toml", "u.toml", 100).unwrap()
+    use pinfeed::plan::check::Uncertainty;
+    let range = Uncertainty::custom(Some((0.3, 0.7)), false, false);
+    let own_mu_f = Uncertainty::custom(Some((0.3, 0.7)), false, true);
+    let study = |u: &Uncertainty, kinds: &[&str]| {
+        u.study_text(kinds, "plan.toml", "u.toml", 1, 100).unwrap()
     };
     // Fences whose μf is the nominal μc vary with it; μc itself only where there are pins.
-    let fences = study(&["fence", "fence"], false);
+    let fences = study(&range, &["fence", "fence"]);
     assert!(
         fences.contains("[uncertain.fence_mu_f]\ndistribution = \"uniform\"\nmin = 0.3\nmax = 0.7")
     );
     assert!(!fences.contains("[uncertain.mu_c]"), "{fences}");
-    let both = study(&["pin", "fence"], false);
+    let both = study(&range, &["pin", "fence"]);
     assert!(both.contains("[uncertain.mu_c]") && both.contains("[uncertain.fence_mu_f]"));
     // Given their own μf (--mu-f), the fences keep it.
-    let own = study(&["fence", "moving_pin"], true);
+    let own = study(&own_mu_f, &["fence", "moving_pin"]);
     assert!(
         own.contains("[uncertain.mu_c]") && !own.contains("fence_mu_f"),
         "{own}"
     );
+    // The default set: friction around each nominal value, placement of pins (a moving pin is
+    // a pin) and fences, fence angles.
+    let default = study(
+        &Uncertainty::default_around(0.5, 0.4),
+        &["fence", "moving_pin"],
+    );
+    for table in [
+        "mu_c",
+        "pin_x",
+        "pin_y",
+        "fence_mu_f",
+        "fence_angle",
+        "fence_x",
+        "fence_y",
+    ] {
+        assert!(
+            default.contains(&format!("[uncertain.{table}]")),
+            "{table}: {default}"
+        );
+    }
     // Every study it writes loads: nothing declared reaches nothing.
     let d = tmp("plan");
     std::fs::write(d.join("line.toml"), LINE).unwrap();
-    for text in [&fences, &both, &own] {
+    for text in [&fences, &both, &own, &default] {
         std::fs::write(d.join("u.toml"), text.replace("plan.toml", "line.toml")).unwrap();
         mc::load(&d.join("u.toml"), None).unwrap();
     }

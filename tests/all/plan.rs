@@ -14,6 +14,7 @@ fn default_tripoly2_plan_orients_the_line() {
     let o = out.to_str().unwrap();
     let v = plan_ok(&[
         "plan",
+        "--nominal",
         "--part",
         "tripoly2",
         "--pins",
@@ -62,6 +63,7 @@ fn plans_are_deterministic_for_a_seed_and_thread_count() {
     for (f, threads) in [(&a, "1"), (&b, "2")] {
         let out = pinfeed(&[
             "plan",
+            "--nominal",
             "--part",
             "square",
             "--pins",
@@ -161,6 +163,7 @@ fn none_up_to_depth_is_a_reported_result_with_its_best_effort() {
     let out = tmp("none.toml");
     let (code, v) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "tripoly1",
         "--pins",
@@ -193,6 +196,7 @@ fn a_design_reports_the_work_of_its_search() {
     // give for the same problem; the sensor mode's search has none.
     let (_, v) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "tripoly1",
         "--pins",
@@ -216,6 +220,7 @@ fn a_design_reports_the_work_of_its_search() {
     assert!(stats.expanded > 0 && stats.pushes.computed > 0);
     let (_, s) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "tripoly1",
         "--sensor",
@@ -241,6 +246,7 @@ fn a_candidate_that_is_the_same_line_shares_its_screen() {
     // screened candidate's, of the same layout.
     let (_, v) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "vertices:0,0 36,0 8,22",
         "--scale",
@@ -503,6 +509,7 @@ fn survey_of_designs_agrees_with_the_planner_it_runs() {
     let out = pinfeed(&[
         "bench",
         "designs",
+        "--nominal",
         "--random",
         "1",
         "--first",
@@ -522,6 +529,7 @@ fn survey_of_designs_agrees_with_the_planner_it_runs() {
     let md = std::fs::read_to_string(&report).unwrap();
     let (_, v) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "random:2",
         "--time-limit",
@@ -667,6 +675,7 @@ fn a_plan_the_line_does_not_confirm_is_replanned_with_the_lines_failures() {
     // Every round is kept with its line result; the written design is the best of them.
     let args = [
         "plan",
+        "--nominal",
         "--part",
         "random:9",
         "--pins",
@@ -731,6 +740,7 @@ fn a_design_the_line_refutes_is_never_reported_confirmed() {
     let out = tmp("pentagon.toml");
     let (code, v) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "vertices:0,0 40,0 46,18 20,32 -4,14",
         "--scale",

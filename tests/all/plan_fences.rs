@@ -12,6 +12,7 @@ fn tripoly1_fence_plan_orients_the_line_and_runs() {
     let o = out.to_str().unwrap();
     let v = plan_ok(&[
         "plan",
+        "--nominal",
         "--part",
         "tripoly1",
         "--fences",

@@ -20,6 +20,7 @@ fn goal_orientations(design: &std::path::Path) -> Vec<f64> {
 fn plan_to(design: &std::path::Path, extra: &[&str]) -> (i32, Value) {
     let mut args = vec![
         "plan",
+        "--nominal",
         "--part",
         "tripoly2",
         "--pins",

@@ -2,7 +2,7 @@
 //! `pinfeed plan` reports hold when another study sweeps them with another seed, and the step
 //! past each end fails there too.
 
-use crate::plan_cli::{plan_ok, tmp};
+use crate::plan_cli::{mc_successes, plan_ok, tmp};
 use serde_json::Value;
 
 /// `pinfeed mc` of a study of `scenario` (another seed) at each value of `parameter`: the
@@ -24,26 +24,7 @@ fn swept(
         ),
     )
     .unwrap();
-    let out = tmp(&format!("{name}_mc"));
-    let v = plan_ok(&[
-        "mc",
-        study.to_str().unwrap(),
-        "--json",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    v["results"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| {
-            (
-                r["outcomes"]["success"].as_u64().unwrap(),
-                r["samples"].as_u64().unwrap(),
-            )
-        })
-        .collect()
+    mc_successes(&study, &format!("{name}_mc"))
 }
 
 #[test]
@@ -51,6 +32,7 @@ fn a_reported_friction_margin_holds_when_swept_independently() {
     let design = tmp("margins_tripoly2.toml");
     let v: Value = plan_ok(&[
         "plan",
+        "--nominal",
         "--part",
         "tripoly2",
         "--pins",

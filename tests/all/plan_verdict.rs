@@ -34,6 +34,7 @@ fn a_line_check_just_below_its_target_is_not_confirmed() {
     // verdict off by a little (≥ target − 0.01, say) calls it confirmed.
     let (code, v) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "tripoly1",
         "--pins",
@@ -125,6 +126,7 @@ fn a_design_whose_time_limit_binds_keeps_its_searches_to_their_share_and_says_wh
     let limit_s = 2.0;
     let (code, v, err) = plan_any(&[
         "plan",
+        "--nominal",
         "--part",
         "lshape",
         "--pins",
@@ -171,6 +173,7 @@ const BRACKET: &str = "vertices:0,0 48,0 48,20 40,20 40,8 10,8 10,26 0,26";
 fn bracket_plan(min_margin: &str, json: bool) -> std::process::Output {
     let mut args = vec![
         "plan",
+        "--nominal",
         "--part",
         BRACKET,
         "--scale",
@@ -228,6 +231,7 @@ fn a_simpler_or_faster_design_of_another_kind_is_shown_as_the_runner_up() {
     // line, a little longer, is confirmed too and gives more oriented parts per minute.
     let (code, v) = plan_json(&[
         "plan",
+        "--nominal",
         "--part",
         "vertices:0,0 42,3 35,19 6,14",
         "--scale",

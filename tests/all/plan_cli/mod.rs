@@ -65,3 +65,27 @@ pub fn plan_ok(args: &[&str]) -> Value {
     }
     json_ok(args)
 }
+
+/// `pinfeed mc STUDY --json` with its reports in a temporary folder named `out`: the
+/// (success, samples) of each point, in order.
+pub fn mc_successes(study: &Path, out: &str) -> Vec<(u64, u64)> {
+    let v = json_ok(&[
+        "mc",
+        study.to_str().unwrap(),
+        "--json",
+        "--quiet",
+        "--out",
+        tmp(out).to_str().unwrap(),
+    ]);
+    v["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            (
+                r["outcomes"]["success"].as_u64().unwrap(),
+                r["samples"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}

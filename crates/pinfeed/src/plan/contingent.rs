@@ -248,7 +248,7 @@ pub fn branch_states(planner: &Planner) -> Result<Vec<State>, PlanError> {
             "the part has fewer than two stable states: there is nothing to sense",
         ));
     }
-    let robust = p.tripod || p.mu_c_range.is_some();
+    let robust = p.is_robust();
     let per = p.jitter_samples * p.offset_samples;
     let mut out = vec![Vec::new(); c.stable_deg.len()];
     for (i, (t, y)) in feed_samples(p, c)

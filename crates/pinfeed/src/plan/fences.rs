@@ -149,7 +149,7 @@ impl FenceTransition {
             start: Vec2::new(x0, y0),
             angle_rad: angle,
             length,
-            mu_f: self.options.mu_f,
+            mu_f: phys.mu_f.unwrap_or(self.options.mu_f),
         };
         let settings = ContactSettings {
             fidelity: Fidelity::Exact,
@@ -348,5 +348,35 @@ mod tests {
         let j = FenceOptions::grid(1.0, 5.0, 80.0);
         assert!(j.angles_deg.iter().all(|a| a.abs() < 45.0));
         assert_eq!(FenceOptions::default_for(0.5).angles_deg.len(), 20);
+    }
+
+    /// A fence pass uses the physics sample's own fence friction when the problem is robust
+    /// against it: at 55° a fence jams a part whose μf is at least tan 35° ≈ 0.70, so a sample
+    /// drawn from [0.75, 0.8] is lost where the planner's nominal μf 0.5 slides it along.
+    #[test]
+    fn a_fence_pass_uses_its_samples_fence_friction() {
+        let mut p = Problem::new("square");
+        p.mu_f_range = Some((0.75, 0.8));
+        let compiled = p.compile().unwrap();
+        let tr = Transition::new(&p, &compiled, 3).unwrap();
+        let mut options = FenceOptions::grid(0.5, 5.0, 60.0);
+        options.angles_deg = vec![55.0];
+        let ft = FenceTransition::new(options);
+        // Upstream end 3a to the right of the part's centroid, downstream end 3a to its left.
+        let reach = (3.0 * tr.radius() / p.y_quantum_m).round() as i32;
+        let outcome = |sample: u32| ft.pass(&tr, &p, (sample, 0, 0, -reach, reach));
+        for k in 0..3 {
+            assert!(
+                outcome(k).is_none(),
+                "sample {k} (μf {:?})",
+                tr.samples[k as usize].mu_f
+            );
+        }
+        // The same pass at the nominal μf (a problem without the range) slides the part on.
+        let q = Problem::new("square");
+        let tq = Transition::new(&q, &compiled, 1).unwrap();
+        assert!(ft
+            .pass(&tq, &q, (0, 0, 0, -reach, reach))
+            .is_some_and(|o| o.2));
     }
 }

@@ -78,6 +78,9 @@ pub struct Problem {
     pub mu_c: f64,
     /// Robustness: each particle carries its own μc drawn uniformly from [lo, hi].
     pub mu_c_range: Option<(f64, f64)>,
+    /// Robust against the fences' μf: each particle draws its own fence μf uniformly in this
+    /// range (None: the fence planner's own μf).
+    pub mu_f_range: Option<(f64, f64)>,
     /// Robustness: each particle carries its own random tripod support.
     pub tripod: bool,
     /// Pin radius (m; 0 = point pin).
@@ -142,6 +145,7 @@ impl Problem {
             orientation_samples: 72,
             mu_c: 0.5,
             mu_c_range: None,
+            mu_f_range: None,
             tripod: false,
             pin_radius_m: 0.002,
             belt_width_m: 0.1,
@@ -278,16 +282,27 @@ impl Problem {
                 format!("must lie in {range}"),
             ));
         }
-        if let Some((lo, hi)) = self.mu_c_range {
-            if !(lo.is_finite() && hi.is_finite() && mu_lo <= lo && lo <= hi && hi <= mu_hi) {
-                return Err(PlanError::input(
-                    "mu_c_range",
-                    format!("{lo}:{hi}"),
-                    format!("must be LO:HI with {mu_lo} ≤ LO ≤ HI ≤ {mu_hi}"),
-                ));
+        for (field, range) in [
+            ("mu_c_range", self.mu_c_range),
+            ("mu_f_range", self.mu_f_range),
+        ] {
+            if let Some((lo, hi)) = range {
+                if !(lo.is_finite() && hi.is_finite() && mu_lo <= lo && lo <= hi && hi <= mu_hi) {
+                    return Err(PlanError::input(
+                        field,
+                        format!("{lo}:{hi}"),
+                        format!("must be LO:HI with {mu_lo} ≤ LO ≤ HI ≤ {mu_hi}"),
+                    ));
+                }
             }
         }
         Ok(())
+    }
+
+    /// Is the problem robust against uncertain physics (a friction range at the pins or the
+    /// fences, or tripods)? Then every feed sample carries its own physics sample.
+    pub fn is_robust(&self) -> bool {
+        self.tripod || self.mu_c_range.is_some() || self.mu_f_range.is_some()
     }
 
     /// Check the line's settings against the part's size `a` (m): pin radius, belt width (and

@@ -183,7 +183,7 @@ impl Planner {
     pub fn new(problem: &Problem) -> Result<Planner, PlanError> {
         let compiled = problem.compile()?;
         let n = super::particles::feed_samples(problem, &compiled).len();
-        let robust = problem.tripod || problem.mu_c_range.is_some();
+        let robust = problem.is_robust();
         let transition = Transition::new(problem, &compiled, n)?;
         let initial = initial_state(problem, &compiled, robust);
         Ok(Planner {

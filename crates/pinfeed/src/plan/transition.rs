@@ -44,6 +44,9 @@ pub struct PhysicsSample {
     pub mu_c: f64,
     /// The tripod's points (m, part frame) and weights, if any (for reports).
     pub support: Support,
+    /// Fence–part friction of this sample, when the problem is robust against it
+    /// ([`Problem::mu_f_range`]; None: the fence planner's own μf).
+    pub mu_f: Option<f64>,
 }
 
 /// The outcome of one pass, as the planner keeps it.
@@ -118,7 +121,7 @@ impl Transition {
         // A robust search's samples each stand for one draw of uncertain physics: their tables
         // are certified to a sample's tolerance (`sampled_table_tol`: 10⁻⁸ at the default
         // integration tolerance, a third of the nodes of the 10⁻¹⁰ a nominal search keeps).
-        let robust = problem.tripod || problem.mu_c_range.is_some();
+        let robust = problem.is_robust();
         let table_tol = if robust {
             crate::mechanics::slide_table::sampled_table_tol(problem.contact_tol)
         } else {
@@ -147,7 +150,11 @@ impl Transition {
                 } else {
                     None
                 };
-                draws.push((mu_c, tripod));
+                // Drawn after the others, so that a problem without a fence range draws as it did.
+                let mu_f = problem
+                    .mu_f_range
+                    .map(|(lo, hi)| lo + (hi - lo) * rng.random::<f64>());
+                draws.push((mu_c, tripod, mu_f));
             }
         }
         // The uniform model's μc values: the nominal one, and every draw on uniform pressure.
@@ -163,9 +170,10 @@ impl Transition {
                 model: uniform,
                 mu_c: problem.mu_c,
                 support: Support::Uniform,
+                mu_f: None,
             });
         } else {
-            for (mu_c, tripod) in draws {
+            for (mu_c, tripod, mu_f) in draws {
                 let (model, support) = match tripod {
                     Some(s) => (
                         Arc::new(tabled(
@@ -180,6 +188,7 @@ impl Transition {
                     model,
                     mu_c,
                     support,
+                    mu_f,
                 });
             }
         }
@@ -523,5 +532,35 @@ mod tests {
         let compiled = p.compile().unwrap();
         let t = Transition::new(&p, &compiled, 2).unwrap();
         assert!(t.samples.iter().all(|s| !s.model.has_slide_tables()));
+    }
+
+    /// A problem robust against the fences' friction draws each sample's fence μf from its
+    /// range, after the other draws: the pins' μc and tripods are what they were without it.
+    #[test]
+    fn a_fence_friction_range_gives_every_sample_its_own_fence_friction() {
+        let mut p = Problem::new("tripoly2");
+        p.tripod = true;
+        p.mu_c_range = Some((0.3, 0.7));
+        let compiled = p.compile().unwrap();
+        let before = Transition::new(&p, &compiled, 10).unwrap();
+        assert!(before.samples.iter().all(|s| s.mu_f.is_none()));
+        p.mu_f_range = Some((0.45, 0.55));
+        let after = Transition::new(&p, &compiled, 10).unwrap();
+        let mut seen = Vec::new();
+        for (a, b) in before.samples.iter().zip(&after.samples) {
+            assert_eq!(a.mu_c, b.mu_c);
+            assert_eq!(format!("{:?}", a.support), format!("{:?}", b.support));
+            let f = b.mu_f.expect("a fence friction per sample");
+            assert!((0.45..=0.55).contains(&f), "{f}");
+            seen.push(f);
+        }
+        seen.sort_by(f64::total_cmp);
+        seen.dedup();
+        assert_eq!(seen.len(), 10, "each sample draws its own: {seen:?}");
+        // A fence range alone makes the problem robust.
+        let mut q = Problem::new("tripoly2");
+        q.mu_f_range = Some((0.4, 0.6));
+        assert!(q.is_robust());
+        assert_eq!(Transition::new(&q, &compiled, 4).unwrap().samples.len(), 4);
     }
 }

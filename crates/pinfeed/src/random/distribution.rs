@@ -147,6 +147,48 @@ impl Distribution {
         matches!(self, Distribution::Fixed(_))
     }
 
+    /// The distribution as the keys of a study's `[uncertain.NAME]` table (docs/study-format.md),
+    /// one `key = value` a line, every number written so that it reads back exactly.
+    pub fn toml_fields(&self) -> String {
+        let num = |v: f64| {
+            if v == f64::INFINITY {
+                "inf".to_string()
+            } else if v == f64::NEG_INFINITY {
+                "-inf".to_string()
+            } else {
+                format!("{v:?}")
+            }
+        };
+        match *self {
+            Distribution::Fixed(v) => format!("distribution = \"fixed\"\nvalue = {}\n", num(v)),
+            Distribution::Uniform { min, max } => format!(
+                "distribution = \"uniform\"\nmin = {}\nmax = {}\n",
+                num(min),
+                num(max)
+            ),
+            Distribution::Normal { mean, sd, lo, hi } => {
+                let mut s = format!(
+                    "distribution = \"normal\"\nmean = {}\nsd = {}\n",
+                    num(mean),
+                    num(sd)
+                );
+                if lo.is_finite() {
+                    s += &format!("min = {}\n", num(lo));
+                }
+                if hi.is_finite() {
+                    s += &format!("max = {}\n", num(hi));
+                }
+                s
+            }
+            Distribution::Triangular { min, mode, max } => format!(
+                "distribution = \"triangular\"\nmin = {}\nmode = {}\nmax = {}\n",
+                num(min),
+                num(mode),
+                num(max)
+            ),
+        }
+    }
+
     /// A short description: `uniform [0.3, 0.7]`, `normal (mean 0, sd 0.0002)`.
     pub fn describe(&self) -> String {
         match *self {

@@ -78,14 +78,10 @@ pub fn write_design(
                 .file_name()
                 .map_or(String::new(), |f| f.to_string_lossy().to_string());
             let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
-            if let Some(study) = crate::plan::check::uncertainty_study(
-                &c.problem,
-                &kinds,
-                o.fences.mu_f.is_some(),
-                &file,
-                &study_file,
-                u.parts,
-            ) {
+            if let Some(study) =
+                o.uncertainty()
+                    .study_text(&kinds, &file, &study_file, o.problem.seed, u.parts)
+            {
                 write(&study_path, &study)?;
                 files.push(study_path.display().to_string());
             }
@@ -118,6 +114,8 @@ pub struct PlanJson<'a> {
     /// The line check under the problem's uncertainty (a Monte Carlo study), when planned against
     /// one.
     pub uncertain_check: Option<&'a design::LineCheck>,
+    /// The uncertainty the design was planned and checked against, in words.
+    pub uncertainty: String,
     /// The chosen design's obstacles.
     pub obstacles: Option<&'a [design::ObstacleInfo]>,
     /// Belt length of the chosen design (m).
@@ -166,6 +164,7 @@ pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> ReportResult<S
         predicted_success: c.map(|c| c.predicted_success),
         line_check: c.and_then(|c| c.line_check.as_ref()),
         uncertain_check: c.and_then(|c| c.uncertain_check.as_ref()),
+        uncertainty: o.uncertainty().describe(),
         obstacles: c.map(|c| c.obstacles.as_slice()),
         belt_length_m: c.map(|c| c.belt_length_m),
         belt_width_m: c.map(|c| c.belt_width_m),
@@ -246,6 +245,7 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
         p.tolerance_deg,
         p.goal_deg.map_or(String::new(), |g| format!(" centred at {g}°"))
     );
+    t += &format!("uncertainty {}\n", o.uncertainty().describe());
     t += "candidates  mode     round  particles  search                obstacles                        belt (m)  width (m)  predicted  line (parts, headway)\n";
     for (i, c) in d.candidates.iter().enumerate() {
         let line = match c.measured() {
@@ -315,11 +315,12 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
             );
             if let Some(u) = &c.uncertain_check {
                 t += &format!(
-                    "uncertain   {} samples under the planned μc range / tripods: success {:.4} (95% CI {:.4}–{:.4}); {} — the verdict\n",
+                    "uncertain   {} samples under the uncertainty: success {:.4} (95% CI {:.4}–{:.4}; one-sided 95% lower bound {:.4}); {} — the verdict\n",
                     u.parts,
                     u.success_rate,
                     u.ci95[0],
                     u.ci95[1],
+                    u.lower95,
                     outcome_mix(&u.outcomes)
                 );
             }

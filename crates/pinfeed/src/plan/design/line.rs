@@ -163,6 +163,7 @@ impl LineCheck {
             success: o.success,
             success_rate: o.success as f64 / parts.max(1) as f64,
             ci95: wilson_interval(o.success, parts),
+            lower95: crate::statistics::wilson_lower_one_sided(o.success, parts),
             outcomes: *o,
             headway_s,
             elapsed_s: started.elapsed().as_secs_f64(),

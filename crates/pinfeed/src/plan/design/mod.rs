@@ -27,6 +27,7 @@
 pub mod line;
 pub mod survey;
 
+pub use super::check::{Uncertainty, UncertaintySet};
 use super::contingent::{self, ContingentOutcome, ContingentPlan};
 use super::emit::{self, LineSpec, BELT_SPEED};
 use super::fences::{FenceOptions, FenceTransition};
@@ -161,6 +162,9 @@ pub struct DesignOptions {
     pub belt_width_given: bool,
     /// Measure the chosen design's margins ([`super::margins`]) once it is confirmed.
     pub margins: bool,
+    /// The uncertainty the designs are planned and checked against ([`UncertaintyChoice`];
+    /// [`DesignOptions::uncertainty`] gives it as values).
+    pub uncertainty: UncertaintyChoice,
     /// The design's name: its scenario's `name` and its files' stem.
     pub name: String,
     /// The command line that asked for it (written into the scenario's header).
@@ -185,9 +189,73 @@ impl DesignOptions {
             sensor_candidates: 6,
             belt_width_given: false,
             margins: true,
+            uncertainty: UncertaintyChoice::Default,
             command,
             name,
         }
+    }
+}
+
+/// Which uncertainty a design is planned against (`pinfeed plan`'s default, `--robust`,
+/// `--nominal`, `--uncertain FILE`). The problem's own [`Problem::mu_c_range`] and
+/// [`Problem::tripod`] (`--mu-c-range`, `--tripod`) replace the set's friction range at the pins
+/// (and at the fences whose μf is the pins' μc) and its support.
+#[derive(Debug, Clone, PartialEq)]
+pub enum UncertaintyChoice {
+    /// [`Uncertainty::default_around`] the problem's μc and the fences' μf.
+    Default,
+    /// [`Uncertainty::robust`].
+    Robust,
+    /// Nominal physics.
+    Nominal,
+    /// These values (a file's tables).
+    Given(Box<Uncertainty>),
+}
+
+impl DesignOptions {
+    /// The uncertainty the designs are planned and checked against, as values.
+    pub fn uncertainty(&self) -> Uncertainty {
+        let p = &self.problem;
+        let mu_f = self.fences.mu_f.unwrap_or(p.mu_c);
+        let mut u = match &self.uncertainty {
+            UncertaintyChoice::Default => Uncertainty::default_around(p.mu_c, mu_f),
+            UncertaintyChoice::Robust => Uncertainty::robust(),
+            UncertaintyChoice::Nominal => {
+                return Uncertainty::custom(p.mu_c_range, p.tripod, self.fences.mu_f.is_some())
+            }
+            UncertaintyChoice::Given(u) => (**u).clone(),
+        };
+        if let Some((min, max)) = p.mu_c_range {
+            let d = crate::random::distribution::Distribution::Uniform { min, max };
+            u.perturbations.mu_c = Some(d);
+            if self.fences.mu_f.is_none() {
+                u.perturbations.fence_mu_f = Some(d);
+            }
+        }
+        if p.tripod {
+            u.perturbations.support = crate::mechanics::support::SupportChoice::Tripod;
+        }
+        u
+    }
+
+    /// The options the workflow runs: the uncertainty resolved to values, and the problem's
+    /// particles robust against what of it they can carry (the friction ranges, tripods).
+    /// The uncertainty of options [`Self::resolved`] has resolved (or resolves them).
+    fn planned(&self) -> Uncertainty {
+        match &self.uncertainty {
+            UncertaintyChoice::Given(u) => (**u).clone(),
+            _ => self.uncertainty(),
+        }
+    }
+
+    fn resolved(&self) -> DesignOptions {
+        let u = self.uncertainty();
+        let mut o = self.clone();
+        o.problem.mu_c_range = u.pins_friction();
+        o.problem.mu_f_range = u.fences_friction();
+        o.problem.tripod = u.tripod();
+        o.uncertainty = UncertaintyChoice::Given(Box::new(u));
+        o
     }
 }
 
@@ -246,6 +314,8 @@ pub struct LineCheck {
     pub success_rate: f64,
     /// 95% Wilson interval of the success rate.
     pub ci95: [f64; 2],
+    /// One-sided 95% Wilson lower bound of the success rate: what designs are ranked by.
+    pub lower95: f64,
     /// Parts per final outcome.
     pub outcomes: OutcomeCounts,
     /// Seconds between parts.
@@ -817,15 +887,19 @@ fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignErr
             "must lie in [0.5, 45] degrees",
         ));
     }
-    let mut opts = FenceOptions::grid(mu_f, f.angle_step_deg, f.max_angle_deg);
+    // Robust against the fences' friction, every fence stays below the jam limit of the
+    // range's highest μf.
+    let jam_mu_f = o.problem.mu_f_range.map_or(mu_f, |(_, hi)| hi.max(mu_f));
+    let mut opts = FenceOptions::grid(jam_mu_f, f.angle_step_deg, f.max_angle_deg);
+    opts.mu_f = mu_f;
     opts.overhang_a = f.overhang_a;
     if opts.angles_deg.is_empty() && o.modes.contains(&Mode::Fences) {
         return Err(input(
             "max_fence_angle",
             f.max_angle_deg,
             format!(
-                "no candidate angle (from ±15°, below the jam limit {:.1}° for μf {mu_f}) is left",
-                90.0 - mu_f.atan().to_degrees()
+                "no candidate angle (from ±15°, below the jam limit {:.1}° for μf {jam_mu_f}) is left",
+                90.0 - jam_mu_f.atan().to_degrees()
             ),
         ));
     }
@@ -849,6 +923,8 @@ pub fn design(
     progress: &(dyn Fn(&Progress) + Sync),
 ) -> Result<Design, DesignError> {
     check_goal(o)?;
+    let resolved = o.resolved();
+    let o = &resolved;
     let started = Instant::now();
     let deadline = started + std::time::Duration::from_secs_f64(o.time_limit_s);
     // Searches stop early enough to leave the line checks their time.
@@ -1109,6 +1185,12 @@ impl Work<'_> {
                 cand.sensor_accuracy = acc;
                 cand.predicted_with_confusion = with;
             }
+            // Planned against an uncertainty, the screen is a Monte Carlo run under it (the
+            // nominal run above keeps the sensor's confusion and the failures to refine with).
+            let screen = match self.uncertain_screen(&cand, h)? {
+                Some(u) => u,
+                None => screen,
+            };
             cand.oriented_per_min = screen.success_rate * 60.0 / h;
             let held = screen.success_rate >= problem.target;
             cand.screen = Some(screen);
@@ -1116,12 +1198,15 @@ impl Work<'_> {
             if held || round == o.refine {
                 return Ok(());
             }
-            // Refine: the sensor mode with more particles everywhere; the others with the parts
-            // the line got wrong.
-            if mode == Mode::Sensor {
+            // Refine: the sensor mode, and any mode planned against an uncertainty (whose
+            // failures come from physics the particles did not draw), with more particles
+            // everywhere; the others with the parts the line got wrong.
+            if mode == Mode::Sensor || !o.planned().is_nominal() {
                 problem.jitter_samples += 2;
                 problem.offset_samples += 2;
-                continue;
+                if mode == Mode::Sensor {
+                    continue;
+                }
             }
             let base = (problem.jitter_samples * problem.offset_samples).max(25);
             let mut added = 0;
@@ -1139,11 +1224,41 @@ impl Work<'_> {
                     added += 1;
                 }
             }
-            if added == 0 {
+            if added == 0 && o.planned().is_nominal() {
                 return Ok(());
             }
         }
         Ok(())
+    }
+
+    /// Candidate `cand`'s screen under the planned uncertainty at headway `h` (a Monte Carlo
+    /// run of the screen's parts); None when nothing uncertain reaches its line.
+    fn uncertain_screen(
+        &mut self,
+        cand: &Candidate,
+        h: f64,
+    ) -> Result<Option<LineCheck>, DesignError> {
+        let o = self.o;
+        let kinds: Vec<&str> = cand.obstacles.iter().map(|o| o.kind.name()).collect();
+        let Some(perturbations) = o.planned().for_line(&kinds) else {
+            return Ok(None);
+        };
+        self.tell(
+            Some(cand.mode),
+            cand.round,
+            format!(
+                "line screen under the uncertainty ({} samples)",
+                o.screen_parts
+            ),
+        );
+        let mut line = Line::new(&cand.runnable);
+        let scene = line.scene(h)?;
+        let started = Instant::now();
+        let (outcomes, n) =
+            super::check::check_uncertain(scene, perturbations, o.problem.seed, o.screen_parts)
+                .map_err(|e| input("uncertain", "", e))?;
+        self.line_runs += 1;
+        Ok(Some(LineCheck::of(&outcomes, n, h, started)))
     }
 
     /// Search one mode and emit its plan (found or best effort) as a candidate; None when no
@@ -1403,8 +1518,7 @@ impl Work<'_> {
             .iter()
             .map(|o| o.kind.name())
             .collect();
-        let uncertain =
-            super::check::uncertainty(&self.candidates[i].problem, &kinds, o.fences.mu_f.is_some());
+        let uncertain = o.planned().for_line(&kinds);
         let (mut check, mut res) = on_line.run(h, parts, seed, false)?;
         self.line_runs += 1;
         // A verdict near its threshold is decided by more evidence, not by a seed: while the
@@ -1437,8 +1551,13 @@ impl Work<'_> {
         c.undecided = straddles(&check, target);
         c.line_check = Some(check);
         if let Some(perturbations) = uncertain {
+            // The verdict is a Monte Carlo study of at least the check's parts under the
+            // uncertainty. It starts with a screen's worth of samples: a line the uncertainty
+            // clearly breaks (the 95% interval below the target) is decided there; otherwise the
+            // samples double up to the check's, and beyond it (to 8×) while the interval holds
+            // the target.
             let scene = on_line.scene(h)?;
-            let mut samples = parts;
+            let mut samples = o.screen_parts.clamp(1, parts);
             loop {
                 self.tell(
                     Some(mode),
@@ -1448,18 +1567,32 @@ impl Work<'_> {
                 let started = Instant::now();
                 let (outcomes, n) =
                     super::check::check_uncertain(scene, perturbations.clone(), seed, samples)
-                        .map_err(|e| input("mu_c_range/tripod", "", e))?;
+                        .map_err(|e| input("uncertain", "", e))?;
                 self.line_runs += 1;
                 let u = LineCheck::of(&outcomes, n, h, started);
-                let next = (2 * samples).min(8 * o.check_parts);
-                let more = straddles(&u, target)
+                let fails = u.ci95[1] < target;
+                let next = if samples < parts {
+                    (2 * samples).min(parts)
+                } else {
+                    (2 * samples).min(8 * o.check_parts)
+                };
+                let wanted = !fails && (samples < parts || straddles(&u, target));
+                let more = wanted
                     && samples < next
-                    && self.fits(u.elapsed_s / n.max(1) as f64 * next as f64);
+                    && self.fits(u.elapsed_s / n.max(1) as f64 * (next - samples) as f64);
                 let c = &mut self.candidates[i];
                 c.oriented_per_min = outcomes.success as f64 / n.max(1) as f64 * 60.0 / h;
                 c.undecided = straddles(&u, target);
                 c.uncertain_check = Some(u);
                 if !more {
+                    if wanted && samples < parts {
+                        self.cut(Limit::Time {
+                            seconds: o.time_limit_s,
+                            left_undone: Some(format!(
+                                "the check under the uncertainty ran {samples} of {parts} samples"
+                            )),
+                        });
+                    }
                     break;
                 }
                 samples = next;
@@ -1506,11 +1639,12 @@ impl Work<'_> {
                 }
             }
             if chosen.is_none() {
-                // The best the line measured: confirm it (if not yet) so its number is the full
-                // check's.
+                // The best the line measured, by the one-sided 95% Wilson lower bound of its
+                // success (a rate measured on few parts ranks below the same rate on many):
+                // confirm it (if not yet) so its number is the full check's.
                 let best = (0..self.candidates.len()).max_by(|&a, &b| {
                     let (x, y) = (&self.candidates[a], &self.candidates[b]);
-                    let r = |c: &Candidate| c.measured().map_or(-1.0, |m| m.success_rate);
+                    let r = |c: &Candidate| c.measured().map_or(-1.0, |m| m.lower95);
                     r(x).total_cmp(&r(y)).then(
                         y.key(o.objective)
                             .partial_cmp(&x.key(o.objective))
@@ -1587,7 +1721,7 @@ impl Work<'_> {
             format!("margins: friction and placement sweeps ({samples} parts a step)"),
         );
         let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
-        let base = super::check::uncertainty(&c.problem, &kinds, o.fences.mu_f.is_some());
+        let base = o.planned().for_line(&kinds);
         let runnable = c.runnable.clone();
         let h = c.headway_s;
         let mut line = Line::new(&runnable);

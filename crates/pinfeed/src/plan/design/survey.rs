@@ -47,6 +47,9 @@ pub struct SurveySettings {
     pub mu_c_range: Option<(f64, f64)>,
     /// Robustness: plan and check against random tripod supports.
     pub tripod: bool,
+    /// The uncertainty every design is planned and checked against (with `mu_c_range` and
+    /// `tripod` applied to it as `pinfeed plan` applies them).
+    pub uncertainty: super::UncertaintyChoice,
     /// Seed of every design's planning and line runs.
     pub seed: u64,
 }
@@ -64,7 +67,7 @@ pub struct SurveyCell {
     pub mode: Option<Mode>,
     /// The chosen design's obstacles, in one line (`–` without one).
     pub obstacles: String,
-    /// Success rate of the full line check (None without one).
+    /// Success rate of the verdict's check (under the uncertainty if any; None without one).
     pub success_rate: Option<f64>,
     /// Its 95% Wilson interval.
     pub ci95: Option<[f64; 2]>,
@@ -85,7 +88,7 @@ pub struct SurveyCell {
 impl SurveyCell {
     fn of(modes: &str, d: &Design) -> SurveyCell {
         let c = d.chosen();
-        let l = c.and_then(|c| c.line_check.as_ref());
+        let l = c.and_then(|c| c.verdict_check());
         SurveyCell {
             modes: modes.into(),
             status: d.status,
@@ -156,6 +159,7 @@ pub fn survey_part(s: &SurveySettings, part: &SurveyPart) -> SurveyRow {
         o.time_limit_s = s.time_limit_s;
         o.check_parts = s.check_parts;
         o.screen_parts = o.screen_parts.min(s.check_parts.max(1));
+        o.uncertainty = s.uncertainty.clone();
         cells.push(match design(&o, &|_| {}) {
             Ok(d) => SurveyCell::of(name, &d),
             Err(e) => SurveyCell::refused(name, e.to_string()),
@@ -234,15 +238,16 @@ pub fn page(command: &str, s: &SurveySettings, rows: &[SurveyRow]) -> String {
         "# Designs the line confirms (`pinfeed bench designs`)\n\nRegenerate:\n\n    {command}\n\n"
     );
     m += "Each cell is one run of `pinfeed plan` (the design workflow) allowed one mode — fixed pins, fences, a sensor pin with moving pins — or all of them together with lines that mix pins and fences (the default). Every other setting is `pinfeed plan`'s default: a stable-state feed with equal weights, 2° jitter, ±2 mm lateral; μc 0.5 (fences μf = μc), 2 mm pins 15 cm apart, a 10 cm belt for pins (fences may widen it: the width is reported); goal ≥ 0.99 of the parts in one ±3° window modulo the part's symmetry. A design is **confirmed** when its line check (the parts below, at the headway the workflow chose on the line) holds the goal; otherwise the best design the line measured is reported **not confirmed** with its number. Cells: verdict, line success [95% CI] of N parts; obstacles (the mode chosen); belt length × width; headway and oriented parts per minute; wall time of the whole design on this 2-core machine.\n\n";
-    let title = match (&s.mu_c_range, s.tripod) {
-        (None, false) => "Nominal physics".to_string(),
-        (r, t) => format!(
-            "Under uncertainty:{}{} (planned and checked against it)",
-            r.map_or(String::new(), |(lo, hi)| format!(
-                " μc uniform in [{lo}, {hi}]"
-            )),
-            if t { ", random tripod supports" } else { "" }
-        ),
+    let mut p = Problem::new("square");
+    p.mu_c_range = s.mu_c_range;
+    p.tripod = s.tripod;
+    let mut o = DesignOptions::new(p);
+    o.uncertainty = s.uncertainty.clone();
+    let u = o.uncertainty();
+    let title = if u.is_nominal() {
+        "Nominal physics".to_string()
+    } else {
+        format!("Under {} (planned and checked against it)", u.describe())
     };
     m += &markdown(&title, rows);
     m

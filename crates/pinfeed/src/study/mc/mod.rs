@@ -295,6 +295,39 @@ pub fn parse_with(
     })
 }
 
+/// A file of `[uncertain.*]` tables alone, as a study declares them (docs/study-format.md), for a
+/// line that does not exist yet (`pinfeed plan --uncertain FILE`): the perturbations, with the
+/// part on uniform pressure unless `[uncertain.support]` says otherwise. What needs the line —
+/// `fences = [...]` or `pins = [...]` naming its obstacles — is refused, located; whether a
+/// parameter reaches the line is the planner's to decide when it has one.
+pub fn parse_uncertain(file: &Path, source: &str) -> Result<Perturbations, StudyError> {
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Tables {
+        #[serde(default)]
+        uncertain: raw::RawUncertain,
+    }
+    let loc = Locator::new(file, source);
+    let t: Tables = toml::from_str(source).map_err(|e| loc.from_toml(&e))?;
+    let p = compile::compile_uncertain(&loc, &t.uncertain, crate::scenario::SupportKind::Uniform)?;
+    if let Some(name) = p.only.keys().next() {
+        let key = if compile::FENCE_PARAMETERS.contains(&name.as_str()) {
+            "fences"
+        } else {
+            "pins"
+        };
+        return Err(loc
+            .at_key(
+                &KeyPath::parse(&format!("uncertain.{name}.{key}")),
+                format!(
+                    "names obstacles of a line not designed yet; leave `{key}` out (the planner's uncertainty reaches every obstacle of its kind)"
+                ),
+            )
+            .into());
+    }
+    Ok(p)
+}
+
 /// `a/b/../c` → `a/c` (lexically; a leading `..` is kept).
 pub(crate) fn normalise(p: &Path) -> PathBuf {
     use std::path::Component;

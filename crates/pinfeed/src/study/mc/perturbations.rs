@@ -93,6 +93,61 @@ impl Perturbations {
         }
     }
 
+    /// Every distribution parameter by name, in [`super::compile::DISTRIBUTION_PARAMETERS`]'s
+    /// order.
+    pub fn slots(&self) -> [(&'static str, &Option<Distribution>); 21] {
+        [
+            ("mu_c", &self.mu_c),
+            ("belt_speed", &self.belt_speed),
+            ("shape", &self.shape),
+            ("pin_x", &self.pin_x),
+            ("pin_y", &self.pin_y),
+            ("pin_radius", &self.pin_radius),
+            ("pose_theta", &self.pose_theta),
+            ("pose_y", &self.pose_y),
+            ("sensor_noise", &self.sensor_noise),
+            ("sensor_bias", &self.sensor_bias),
+            ("sensor_threshold", &self.sensor_threshold),
+            ("sensor_jitter", &self.sensor_jitter),
+            ("fence_mu_f", &self.fence_mu_f),
+            ("fence_angle", &self.fence_angle),
+            ("fence_x", &self.fence_x),
+            ("fence_y", &self.fence_y),
+            ("fence_length", &self.fence_length),
+            ("actuator_speed", &self.actuator_speed),
+            ("actuator_accel", &self.actuator_accel),
+            ("actuator_settle", &self.actuator_settle),
+            ("controller_latency", &self.controller_latency),
+        ]
+    }
+
+    /// [`Self::slots`], to change them.
+    pub fn slots_mut(&mut self) -> [(&'static str, &mut Option<Distribution>); 21] {
+        [
+            ("mu_c", &mut self.mu_c),
+            ("belt_speed", &mut self.belt_speed),
+            ("shape", &mut self.shape),
+            ("pin_x", &mut self.pin_x),
+            ("pin_y", &mut self.pin_y),
+            ("pin_radius", &mut self.pin_radius),
+            ("pose_theta", &mut self.pose_theta),
+            ("pose_y", &mut self.pose_y),
+            ("sensor_noise", &mut self.sensor_noise),
+            ("sensor_bias", &mut self.sensor_bias),
+            ("sensor_threshold", &mut self.sensor_threshold),
+            ("sensor_jitter", &mut self.sensor_jitter),
+            ("fence_mu_f", &mut self.fence_mu_f),
+            ("fence_angle", &mut self.fence_angle),
+            ("fence_x", &mut self.fence_x),
+            ("fence_y", &mut self.fence_y),
+            ("fence_length", &mut self.fence_length),
+            ("actuator_speed", &mut self.actuator_speed),
+            ("actuator_accel", &mut self.actuator_accel),
+            ("actuator_settle", &mut self.actuator_settle),
+            ("controller_latency", &mut self.controller_latency),
+        ]
+    }
+
     /// Does any parameter act on sensor pins?
     pub fn perturbs_sensors(&self) -> bool {
         self.sensor_noise.is_some()
