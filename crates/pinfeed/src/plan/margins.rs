@@ -86,9 +86,9 @@ impl Margins {
                     format!(" (fences' μf {:.2}–{:.2})", lo + d, hi + d)
                 });
                 let beyond = match self.mu_open {
-                    [true, true] => ", or wider: the sweep stopped holding on both sides",
-                    [true, false] => ", or lower: the sweep stopped holding",
-                    [false, true] => ", or higher: the sweep stopped holding",
+                    [true, true] => ", or wider: the sweep ended on both sides still holding",
+                    [true, false] => ", or lower: the sweep ended below it still holding",
+                    [false, true] => ", or higher: the sweep ended above it still holding",
                     [false, false] => "",
                 };
                 if lo == hi {
@@ -252,4 +252,35 @@ pub fn measure(
         placement,
         cut_short,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The margins say where the sweep ended: at a failing step (a closed end), or still holding
+    /// at its reach (an open end, "or lower"/"or higher"), never that it "stopped holding".
+    #[test]
+    fn the_margins_say_which_end_of_the_friction_sweep_still_held() {
+        let m = |open: [bool; 2]| Margins {
+            target: 0.99,
+            mu_nominal: 0.5,
+            mu_f_nominal: None,
+            mu_holds: Some([0.2, 0.55]),
+            mu_open: open,
+            friction: Vec::new(),
+            placement_mm: Some(0.5),
+            placement: Vec::new(),
+            cut_short: false,
+        };
+        assert_eq!(
+            m([true, false]).describe(),
+            "holds for friction μ 0.20–0.55, or lower: the sweep ended below it still holding; placement errors up to ±0.5 mm / ±0.5°"
+        );
+        assert!(m([false, true])
+            .describe()
+            .contains("or higher: the sweep ended above it"));
+        assert!(m([true, true]).describe().contains("or wider"));
+        assert!(!m([false, false]).describe().contains(", or"));
+    }
 }
