@@ -5,7 +5,8 @@
 //! ([`pinfeed::maps::pass_start`]). With `--fence ANGLE[:LENGTH]` the one map is of a fence instead
 //! (docs/physics.md#fences), placed as `pinfeed contact --fence` places it ([`pinfeed::contact_case::case_fence`]);
 //! a fence map has no contact parameter, so `--d` is not taken, and its report goes to
-//! `pinfeed-out/maps/<part>/fence_<angle>[_<length>]/` by default. Standard output gets a band table (default), the JSON document
+//! `pinfeed-out/maps/<part>/fence_<angle>[_<length>][_tail<radius>]/` by default (`--tail R` ends the fence in a
+//! curved tail of radius R). Standard output gets a band table (default), the JSON document
 //! (`--json`) or the samples as CSV (`--csv`); unless `--no-write`, the report directory receives
 //! `README.md` (headed by the command that regenerates it), `map.json`, `samples.csv` and the SVG
 //! figures (or the figures go to `--plot-dir`). The time spent computing goes to standard error.
@@ -43,6 +44,15 @@ pub struct MapArgs {
         conflicts_with = "pin_radius"
     )]
     pub fence: Option<String>,
+    /// End the fence in a curved tail of this radius (part units, 0.01a to 1000a): a circular arc
+    /// tangent to the fence that turns it parallel to the belt (docs/physics.md#fences).
+    #[arg(
+        long,
+        value_name = "RADIUS",
+        requires = "fence",
+        allow_hyphen_values = true
+    )]
+    pub tail: Option<f64>,
     /// Spacing of the initial orientations θ0 (degrees; must divide 360).
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub theta_step: f64,
@@ -97,7 +107,10 @@ pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
                 .map(|c| if c == ':' { '_' } else { c })
                 .filter(|c| c.is_ascii_alphanumeric() || "-_.".contains(*c))
                 .collect();
-            dir.join(format!("fence_{name}"))
+            match args.tail {
+                Some(r) => dir.join(format!("fence_{name}_tail{r}")),
+                None => dir.join(format!("fence_{name}")),
+            }
         }
     }
 }
@@ -115,6 +128,7 @@ pub fn request(args: &MapArgs) -> Result<MapRequest> {
     Ok(MapRequest {
         case: Case {
             fence,
+            fence_tail: args.tail,
             ..args
                 .push
                 .case(args.part.clone(), args.push.model.computed_with())

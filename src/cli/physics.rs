@@ -64,6 +64,7 @@ impl PushArgs {
             support: self.support.clone(),
             tol: self.tol,
             fence: None,
+            fence_tail: None,
         }
     }
 }

@@ -178,6 +178,7 @@ fn demo(n_parts: usize, steps_per_part: usize) -> Animation {
                 shape: AnimShape::Fence {
                     p0: Vec2::new(0.5, -0.05),
                     p1: Vec2::new(0.58, -0.03),
+                    tail: None,
                 },
                 sensor: false,
                 track: vec![],

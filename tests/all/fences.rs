@@ -414,6 +414,7 @@ fn a_fence_first_touches_a_concave_part_at_its_own_vertices() {
                 angle_rad: angle.to_radians(),
                 length: 200.0,
                 mu_f: 0.3,
+                tail_radius: None,
             };
             // The line moved by (−t, 0) holds v when cross(e, v − start + t x̂) = 0, i.e.
             // t = cross(e, v − start) / sin α.

@@ -740,6 +740,7 @@ fn pin_stop_after_touch_stops_the_pin_that_far_past_the_first_touch() {
         support: "uniform".into(),
         tol: 1e-6,
         fence: None,
+        fence_tail: None,
     };
     let (poly, out, trace) = run_case(&case, true, &|f| f.to_string()).unwrap();
     let a = poly.radius();

@@ -37,6 +37,7 @@ mod contact_invariants;
 mod contact_regressions;
 mod docs;
 mod examples;
+mod fence_tail;
 mod fences;
 mod figures;
 mod first_contact;

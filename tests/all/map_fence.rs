@@ -75,6 +75,7 @@ fn fence_maps_do_not_depend_on_the_thread_count_and_refuse_bad_fences() {
     s.fence = Some(MapFence {
         angle_deg: -35.0,
         length: Some(6.0),
+        tail: None,
     });
     let pool = |n| {
         rayon::ThreadPoolBuilder::new()
@@ -91,6 +92,7 @@ fn fence_maps_do_not_depend_on_the_thread_count_and_refuse_bad_fences() {
         s.fence = Some(MapFence {
             angle_deg: angle,
             length,
+            tail: None,
         });
         assert!(
             compute_maps(&poly, &model, &[0.0], &s).is_err(),

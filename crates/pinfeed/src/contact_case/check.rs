@@ -125,6 +125,21 @@ pub fn check_geometry(
             value: c.pin_radius,
         });
     }
+    if let Some(r) = c.fence_tail {
+        if c.fence.is_none() {
+            return Err(CaseError::TailWithoutFence { name: name("tail") });
+        }
+        let (lo, hi) = (FENCE_TAIL_RADIUS_A.0 * a, FENCE_TAIL_RADIUS_A.1 * a);
+        if !(r >= lo && r <= hi) {
+            return Err(CaseError::FenceTail {
+                name: name("tail"),
+                lo,
+                hi,
+                a,
+                value: r,
+            });
+        }
+    }
     match c.fence {
         Some((_, length)) => {
             in_range(&name("d"), c.d, -FENCE_D, FENCE_D, "units of a")?;

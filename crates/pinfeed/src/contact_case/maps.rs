@@ -202,7 +202,11 @@ pub fn run(
         threshold_deg: req.threshold_deg,
         contact,
         pin,
-        fence: fence.map(|(angle_deg, length)| MapFence { angle_deg, length }),
+        fence: fence.map(|(angle_deg, length)| MapFence {
+            angle_deg,
+            length,
+            tail: c.fence_tail,
+        }),
     };
     // A fence map has one map and no contact parameter (the fence's placement ignores d).
     let ds: Vec<f64> = if fence.is_some() {

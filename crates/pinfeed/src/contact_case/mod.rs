@@ -55,6 +55,8 @@ pub struct Case {
     pub tol: f64,
     /// A fence (angle in degrees, length in part units; None = default length) instead of a pin.
     pub fence: Option<(f64, Option<f64>)>,
+    /// The fence's tail radius (part units; None: no tail), with a fence.
+    pub fence_tail: Option<f64>,
 }
 
 impl Case {
@@ -76,6 +78,7 @@ impl Case {
             support: "uniform".into(),
             tol: 1e-6,
             fence: None,
+            fence_tail: None,
         }
     }
 }
@@ -128,6 +131,26 @@ pub enum CaseError {
         a: f64,
         /// The length given (part units).
         value: f64,
+    },
+    /// A fence tail radius outside its range for this part.
+    #[error("{name} must lie in [{}, {}] (part units: {}·a to {}·a, a = {}: a sharper tail is the fence's corner, a wider one turns the fence over more than a thousand part sizes), got {}", num(*lo), num(*hi), num(crate::mechanics::limits::FENCE_TAIL_RADIUS_A.0), num(crate::mechanics::limits::FENCE_TAIL_RADIUS_A.1), num(*a), num(*value))]
+    FenceTail {
+        /// The setting's name as the caller knows it (the tail's).
+        name: String,
+        /// The smallest radius allowed (part units).
+        lo: f64,
+        /// The largest radius allowed (part units).
+        hi: f64,
+        /// The part's circumradius a (part units).
+        a: f64,
+        /// The radius given (part units).
+        value: f64,
+    },
+    /// A fence tail without a fence.
+    #[error("{name} is the tail of a fence: give a fence too")]
+    TailWithoutFence {
+        /// The setting's name as the caller knows it (the tail's).
+        name: String,
     },
     /// An offset d at which the pin cannot touch the part.
     #[error("{name} = {} is out of range: it must lie in [-{}, {}] (units of a: beyond it this pin cannot touch the part)", num(*d), num(*limit), num(*limit))]
@@ -309,7 +332,7 @@ pub fn stop_travel(y: f64, d: f64, w: f64, name: &str) -> Result<f64, CaseError>
 /// the centroid, crossing y = d·a; its upstream end 1.5a beyond the part's band on the side it
 /// comes from), with the case's μc as the fence friction μf.
 pub fn case_fence(poly: &Polygon, c: &Case, angle_deg: f64, length: Option<f64>) -> FenceSpec {
-    crate::maps::fence_pass_start(poly, c.d, angle_deg, length, c.mu_c)
+    crate::maps::fence_pass_start(poly, c.d, angle_deg, length, c.mu_c).with_tail(c.fence_tail)
 }
 
 /// The initial pose and pin start for a case (part centred at the origin, pin just clear of it):

@@ -73,6 +73,18 @@ pub enum MapError {
     /// A fence length that is not positive (part units; the value).
     #[error("fence length must be a positive number (part units), got {0}")]
     FenceLength(f64),
+    /// A fence tail radius outside [10⁻² a, 10³ a] (part units; the value).
+    #[error("fence tail radius must lie in [{}, {}] (part units: 0.01a to 1000a, a = {}), got {}", crate::mechanics::limits::num(*lo), crate::mechanics::limits::num(*hi), crate::mechanics::limits::num(*a), crate::mechanics::limits::num(*value))]
+    FenceTail {
+        /// The smallest radius allowed.
+        lo: f64,
+        /// The largest radius allowed.
+        hi: f64,
+        /// The part's circumradius a.
+        a: f64,
+        /// The radius given.
+        value: f64,
+    },
 }
 
 /// A fence to map instead of a pin (docs/physics.md#fences): its friction is the settings' `mu_c`.
@@ -83,6 +95,9 @@ pub struct MapFence {
     pub angle_deg: f64,
     /// Length in the part's units (default 20a).
     pub length: Option<f64>,
+    /// Radius of the fence's curved tail in the part's units (None: no tail).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tail: Option<f64>,
 }
 
 /// What a map is computed with.
@@ -197,10 +212,16 @@ impl ConfigurationMap {
     pub fn label(&self) -> String {
         match self.fence {
             None => format!("{:+}", self.d),
-            Some(f) => match f.length {
-                None => format!("fence {}°", f.angle_deg),
-                Some(l) => format!("fence {}°:{l}", f.angle_deg),
-            },
+            Some(f) => {
+                let fence = match f.length {
+                    None => format!("fence {}°", f.angle_deg),
+                    Some(l) => format!("fence {}°:{l}", f.angle_deg),
+                };
+                match f.tail {
+                    None => fence,
+                    Some(r) => format!("{fence} tail {r}"),
+                }
+            }
         }
     }
 }
@@ -273,6 +294,18 @@ pub fn compute_maps_with(
         if let Some(l) = f.length {
             if !(l.is_finite() && l > 0.0) {
                 return Err(MapError::FenceLength(l));
+            }
+        }
+        if let Some(r) = f.tail {
+            let a = poly.radius();
+            let (lo, hi) = crate::mechanics::limits::FENCE_TAIL_RADIUS_A;
+            if !(r >= lo * a && r <= hi * a) {
+                return Err(MapError::FenceTail {
+                    lo: lo * a,
+                    hi: hi * a,
+                    a,
+                    value: r,
+                });
             }
         }
     }

@@ -73,7 +73,8 @@ pub fn sample_one_with(
             None => push(model, pose, start, pin, contact, None),
         },
         Some(f) => {
-            let fence = super::fence_pass_start(poly, d, f.angle_deg, f.length, contact.mu_c);
+            let fence = super::fence_pass_start(poly, d, f.angle_deg, f.length, contact.mu_c)
+                .with_tail(f.tail);
             push_fence(model, pose, &fence, contact, None)
         }
     };

@@ -55,6 +55,7 @@ pub fn fence_pass_start(
         angle_rad: angle,
         length: length.unwrap_or(20.0 * a),
         mu_f,
+        tail_radius: None,
     }
 }
 

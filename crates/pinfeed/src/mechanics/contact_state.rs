@@ -66,6 +66,14 @@ pub(super) struct Ctx<'a, 'r> {
     pub(super) start: Vec2,
     /// The fence, when the obstacle is one (`poly` is then the part's hull).
     pub(super) fence: Option<FenceGeom>,
+    /// The pin is the fence's tail (a disc of the tail's radius about its centre, `start`): its
+    /// contact normal is held to the arc's span ([`Ctx::arc_start_event`]).
+    pub(super) arc: bool,
+    /// The pieces of the fence (one straight piece and its arc each, see [`super::fence`]) and
+    /// the one in contact (`fence` is that piece): a fence with a tail is one piece; a chain of
+    /// pieces joined by rounded corners approximates a curved fence by straight ones.
+    pub(super) chain: Vec<FenceGeom>,
+    pub(super) piece: usize,
     pub(super) tol: f64,
     /// μs: the trace reports forces in units of m g (the model's are in units of μs m g).
     pub(super) mu_s: f64,
@@ -121,6 +129,9 @@ impl<'a, 'r> Ctx<'a, 'r> {
             vdir,
             start,
             fence,
+            arc: false,
+            chain: fence.into_iter().collect(),
+            piece: 0,
             tol: settings.tol,
             mu_s: settings.mu_s,
             scale: model.scale(),
@@ -364,9 +375,11 @@ impl Ctx<'_, '_> {
 
     /// The geometric event functions (positive while the contact stays on its feature): an edge's
     /// two ends (units of a), a disc's normal cone at a vertex (sines), a fence vertex's
-    /// neighbours and the fence's two ends (units of a).
+    /// neighbours and the fence's two ends (units of a); on a fence's arc, its start and (if the
+    /// fence goes on beyond it) its end (sines, events 5 and 6).
     pub(super) fn feature_events(&self, feat: Feat, y: [f64; 2]) -> [f64; 4] {
-        let (mut e5, mut e6) = (1.0, 1.0);
+        // On a fence's tail, the contact normal stays past the arc's start.
+        let (mut e5, mut e6) = (self.arc_start_event(feat, y), self.arc_end_event(feat, y));
         let (e3, e4) = match feat {
             Feat::Edge(k) => (y[1], self.poly.edge_len(k) - y[1]),
             Feat::Vertex(k) => {

@@ -5,13 +5,17 @@
 //! Event indices are those of [`Ctx::events`]: 0 separation (the pin's path turns tangent), 1 / 2
 //! the mode's margins (stick ↔ slide), 3–6 the feature's geometric events (an edge's two ends; the
 //! edges of a disc's normal cone at a vertex; on the fence line the neighbouring hull edges turning
-//! flush and the fence's two ends, see [`super::fence`]), and [`TURN`], a turn of the pin's path.
+//! flush and the fence's two ends; on a fence's tail, 5 is the arc's start, see [`super::fence`]),
+//! and [`TURN`], a turn of the pin's path.
 //! At a convex vertex a point pin passes onto the next edge in its direction of sliding (or
 //! separates if that edge faces away); a reflex vertex means a second contact in a notch, which is
 //! reported as [`ContactStatus::MultiContact`], not simulated.
 
 use super::contact_state::{Ctx, Feat, TURN};
-use super::fence::{edge_turns_flush, fence_vertex_event, flush_pivot, settle_flush, Flush};
+use super::fence::{
+    arc_back_to_line, arc_on_to_next_line, edge_turns_flush, fence_vertex_event, flush_pivot,
+    settle_flush, Flush,
+};
 use super::instant::{classify, solve_in_mode, Instant, Mode};
 use super::outcome::ContactStatus;
 
@@ -114,6 +118,8 @@ pub(super) fn apply_event(
         }
         (4, Feat::Vertex(k)) => to(Some((Feat::Edge(k), [y[0], 0.0]))),
         (3..=6, Feat::FenceVertex(k)) => to(Some(fence_vertex_event(ctx, i, k, y))),
+        (5, Feat::Edge(_) | Feat::Vertex(_)) => to(Some(arc_back_to_line(ctx, feat, y))),
+        (6, Feat::Edge(_) | Feat::Vertex(_)) => to(Some(arc_on_to_next_line(ctx, feat, y))),
         _ => unreachable!("event index out of range"),
     }
 }

@@ -72,7 +72,8 @@ impl Tally {
     /// a fence's end acting as one; a part dragged along a fence by a sticking vertex or a flush
     /// edge is held stably, not balanced).
     fn ride(&mut self, ctx: &Ctx, feat: Feat, omega: f64, travel: f64) {
-        let pin_like = matches!(feat, Feat::Edge(_) | Feat::Vertex(_));
+        // A fence's tail holds the part as the fence does: not a pin balancing it.
+        let pin_like = matches!(feat, Feat::Edge(_) | Feat::Vertex(_)) && !ctx.arc;
         if pin_like && omega.abs() < NOISE_RATE * ctx.tol {
             self.still += travel;
         }

@@ -23,6 +23,10 @@ pub const TOL: (f64, f64) = (1e-10, 1e-2);
 /// steps of at most 2a: 10⁶ a (a 0.1 mm part along a 100 m fence) bounds that worst case to
 /// 5·10⁵ steps.
 pub const FENCE_LENGTH_A: (f64, f64) = (1e-6, 1e6);
+/// A fence's tail radius in units of a: a tail sharper than a hundredth of the part is its
+/// corner (the straight fence's end does that), one wider than a thousand parts turns the fence
+/// over more than a thousand part sizes.
+pub const FENCE_TAIL_RADIUS_A: (f64, f64) = (1e-2, 1e3);
 /// |d| for a fence pass (the fence's placement does not depend on d; beyond this its start
 /// would lose precision).
 pub const FENCE_D: f64 = 100.0;

@@ -27,9 +27,9 @@ enum Touch {
 /// The next touch between the obstacle and the part resting at `cur`, after travel `s`.
 fn next_touch(ctx: &mut Ctx, cur: &Pose, s: f64, after_separation: bool) -> Touch {
     let k = ctx.scale;
-    if let Some(f) = ctx.fence {
+    if ctx.fence.is_some() {
         let s_from = if after_separation { s + 1e-9 } else { s };
-        return match next_fence_touch(ctx, &f, cur, s_from) {
+        return match next_fence_touch(ctx, cur, s_from) {
             None => Touch::None,
             Some((t, feat, y)) => Touch::At(t, feat, y),
         };
@@ -329,13 +329,26 @@ pub fn push_fence(
     settings: &ContactSettings,
     recorder: Option<&mut dyn Recorder>,
 ) -> ContactOutcome {
-    let k = model.scale();
-    let geom = FenceGeom::new(fence, k);
+    let geom = FenceGeom::new(fence, model.scale());
+    push_fence_chain(model, pose, vec![geom], fence.mu_f, settings, recorder)
+}
+
+/// [`push_fence`] against a chain of fence pieces (normalised units; see
+/// [`super::fence::tangent_chain`]) with friction `mu_f`.
+pub(crate) fn push_fence_chain(
+    model: &PartModel,
+    pose: Pose,
+    chain: Vec<FenceGeom>,
+    mu_f: f64,
+    settings: &ContactSettings,
+    recorder: Option<&mut dyn Recorder>,
+) -> ContactOutcome {
+    let geom = chain[0];
     let mut ctx = Ctx::new(
         model,
         model.hull(),
         settings,
-        fence.mu_f,
+        mu_f,
         0.0,
         Vec2::new(-1.0, 0.0),
         geom.p1(),
@@ -343,9 +356,14 @@ pub fn push_fence(
         recorder,
     );
     // Sliding along a steep fence is slow (it stops altogether at the jam angle): allow the belt
-    // travel a fence of this length can take before calling the part held.
+    // travel a fence of this length (and its tail) can take before calling the part held.
+    let length: f64 = chain
+        .iter()
+        .map(|f| f.len + f.tail.map_or(0.0, |t| t.radius * t.sweep.abs()))
+        .sum();
+    ctx.chain = chain;
     let settings = ContactSettings {
-        max_travel: settings.max_travel + 50.0 * geom.len,
+        max_travel: settings.max_travel + 50.0 * length,
         ..*settings
     };
     run_passes(&mut ctx, &settings, pose)

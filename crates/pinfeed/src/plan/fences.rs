@@ -150,6 +150,7 @@ impl FenceTransition {
             angle_rad: angle,
             length,
             mu_f: phys.mu_f.unwrap_or(self.options.mu_f),
+            tail_radius: None,
         };
         let settings = ContactSettings {
             fidelity: Fidelity::Exact,

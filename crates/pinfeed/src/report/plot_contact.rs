@@ -12,7 +12,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 /// The obstacle of a pass as drawn (belt frame at the start of the pass, part units).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum PassObstacle {
     /// A pin of radius `radius` whose centre starts at `start` and moves (−1, `lateral_speed`) per
     /// unit travel.
@@ -24,12 +24,15 @@ pub enum PassObstacle {
         /// Lateral motion per unit of travel (fraction of the belt speed).
         lateral_speed: f64,
     },
-    /// A fence segment from `start` to `end`.
+    /// A fence segment from `start` to `end`, and on through `tail` (points along its curved
+    /// tail, if it has one).
     Fence {
         /// The segment's start (part units).
         start: Vec2,
         /// The segment's end (part units).
         end: Vec2,
+        /// Points along the fence's tail after `end` (part units; empty without a tail).
+        tail: Vec<Vec2>,
     },
 }
 
@@ -140,19 +143,29 @@ pub fn plot_contact(
                 )))?;
             }
         }
-        PassObstacle::Fence { start, end } => {
+        PassObstacle::Fence {
+            start,
+            end,
+            ref tail,
+        } => {
             // The fence where the contact begins (thick) and where it ends, inside the view.
             let view = (
                 Vec2::new(cx - span / 2.0, cy - span / 2.0),
                 Vec2::new(cx + span / 2.0, cy + span / 2.0),
             );
+            let pts: Vec<Vec2> = [start, end]
+                .into_iter()
+                .chain(tail.iter().copied())
+                .collect();
             for (s, width) in [(out.travel_to_contact, 3), (pin_end_s, 1)] {
                 let shift = Vec2::new(-s, 0.0);
-                if let Some((p, q)) = clip_segment(start + shift, end + shift, view) {
-                    ch.draw_series(LineSeries::new(
-                        vec![(p.x, p.y), (q.x, q.y)],
-                        FENCE_COLOUR.stroke_width(width),
-                    ))?;
+                for w in pts.windows(2) {
+                    if let Some((p, q)) = clip_segment(w[0] + shift, w[1] + shift, view) {
+                        ch.draw_series(LineSeries::new(
+                            vec![(p.x, p.y), (q.x, q.y)],
+                            FENCE_COLOUR.stroke_width(width),
+                        ))?;
+                    }
                 }
             }
         }
@@ -217,9 +230,17 @@ fn pass_obstacle(poly: &Polygon, c: &Case) -> (Pose, PassObstacle) {
     let obstacle = match c.fence {
         Some((angle, length)) => {
             let fence = case_fence(poly, c, angle, length);
+            let mut pts = fence.polyline(48);
+            let tail = if fence.tail_arc().is_some() {
+                pts.drain(..2);
+                pts
+            } else {
+                Vec::new()
+            };
             PassObstacle::Fence {
                 start: fence.start,
-                end: fence.start + Vec2::from_angle(fence.angle_rad) * fence.length,
+                end: fence.straight_end(),
+                tail,
             }
         }
         None => PassObstacle::Pin {

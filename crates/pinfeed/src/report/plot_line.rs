@@ -193,9 +193,10 @@ fn draw_line(ch: &mut Chart, scene: &Scene, labels: &[Label], px_per_m: f64) -> 
                 )))?;
             }
             Obstacle::Fence(fence) => {
-                let (p, q) = (fence.start, fence.end());
+                // The straight part and its tail (if any) as a polyline of 48 arc pieces.
+                let pts = fence.spec().polyline(48);
                 ch.draw_series(LineSeries::new(
-                    vec![(p.x, p.y), (q.x, q.y)],
+                    pts.iter().map(|p| (p.x, p.y)),
                     OBSTACLE_COLOUR.stroke_width(3),
                 ))?;
             }

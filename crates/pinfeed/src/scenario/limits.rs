@@ -57,6 +57,9 @@ pub const HISTOGRAM_BIN_DEG: (f64, f64) = (0.01, 90.0);
 /// Fence length, in units of the part's a: the contact's range
 /// ([`crate::mechanics::limits::FENCE_LENGTH_A`]).
 pub use crate::mechanics::limits::FENCE_LENGTH_A as FENCE_LENGTH_OF_A;
+/// A fence's tail radius, in units of the part's a
+/// ([`crate::mechanics::limits::FENCE_TAIL_RADIUS_A`]).
+pub use crate::mechanics::limits::FENCE_TAIL_RADIUS_A as FENCE_TAIL_RADIUS_OF_A;
 
 /// Metres per millimetre: the scale a part drawn in millimetres needs.
 pub const MM_SCALE: f64 = 1e-3;

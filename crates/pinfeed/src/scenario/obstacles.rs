@@ -10,7 +10,9 @@
 //!   parts to the left, negative ones mirror that) for `length` (m > 0), with friction `mu_f` ≥ 0
 //!   (default: the part's `mu_c`). Both ends lie over the belt (|y| ≤ width/2), the upstream end
 //!   beyond a from the entry (x > a: since x grows along any allowed angle, no part enters touching
-//!   the fence) and the downstream end no further than the exit (x ≤ length);
+//!   the fence) and the downstream end no further than the exit (x ≤ length). An optional
+//!   `tail_radius` (m, 10⁻² a to 10³ a) ends it in a circular arc tangent to it that turns it
+//!   parallel to the belt; the tail's end is then the downstream end;
 //! * each kind takes only its own keys: a pin's `radius`/`mu_c` on a fence (or a fence's
 //!   `angle`/`length`/`mu_f` on a pin) is refused, naming the keys that kind takes;
 //! * names are unique (default `pinN` / `fenceN`, N the 1-based position in the list).
@@ -121,6 +123,7 @@ fn only_keys(c: &Checker, i: usize, ro: &RawObstacle, kind: &str, takes: &str) -
         ("angle", ro.angle.is_some()),
         ("length", ro.length.is_some()),
         ("mu_f", ro.mu_f.is_some()),
+        ("tail_radius", ro.tail_radius.is_some()),
         ("travel", ro.travel.is_some()),
         ("speed", ro.speed.is_some()),
         ("accel", ro.accel.is_some()),
@@ -244,7 +247,13 @@ fn pin(at: &At, ro: &RawObstacle, kind: ObstacleKind) -> R<PinObstacle> {
 
 fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
     let (c, belt) = (at.c, at.belt);
-    only_keys(c, at.i, ro, "fence", "x, y, angle, length, mu_f")?;
+    only_keys(
+        c,
+        at.i,
+        ro,
+        "fence",
+        "x, y, angle, length, mu_f, tail_radius",
+    )?;
     let needs = "a fence needs x, y (its upstream end, m), angle (degrees) and length (m)";
     let x = at.need("x", ro.x, needs)?;
     let x = at.x_within(x, at.part_radius, "the fence's upstream end", "a")?;
@@ -272,14 +281,36 @@ fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
             ),
         ));
     }
+    let tail_radius = match ro.tail_radius {
+        None => None,
+        Some(r) => {
+            let (lo, hi) = super::limits::FENCE_TAIL_RADIUS_OF_A;
+            let (min_r, max_r) = (lo * at.part_radius, hi * at.part_radius);
+            let r = c.finite(&at.path("tail_radius"), r)?;
+            if !(min_r..=max_r).contains(&r) {
+                return Err(c.err(
+                    &at.path("tail_radius"),
+                    format!(
+                        "must lie in [{}, {}] m (10⁻² a to 10³ a, a = {} m: a sharper tail is the fence's corner, a wider one turns the fence over more than a thousand part sizes), got {}",
+                        crate::mechanics::limits::short(min_r),
+                        crate::mechanics::limits::short(max_r),
+                        crate::mechanics::limits::short(at.part_radius),
+                        super::limits::num(r)
+                    ),
+                ));
+            }
+            Some(r)
+        }
+    };
     let f = FenceObstacle {
         name: at.name(&ro.name, "fence")?,
         start: Vec2::new(x, y),
         angle_rad: angle.to_radians(),
         length,
         mu_f: at.friction("mu_f", ro.mu_f)?,
+        tail_radius,
     };
-    let end = f.end();
+    let end = f.far_end();
     let half = belt.width / 2.0;
     // A little slack for ends placed exactly on an edge by trigonometry.
     let slack = 1e-9 * (belt.width + belt.length);
@@ -287,8 +318,10 @@ fn fence(at: &At, ro: &RawObstacle) -> R<FenceObstacle> {
         return Err(c.err(
             &at.path("length"),
             format!(
-                "the fence's downstream end ({:.6}, {:.6}) m lies off the belt (it must keep x ≤ belt.length = {} and |y| ≤ width/2 = {half}): shorten the fence or change its angle, got length {length}",
-                end.x, end.y, belt.length
+                "the fence's downstream end{} ({:.6}, {:.6}) m lies off the belt (it must keep x ≤ belt.length = {} and |y| ≤ width/2 = {half}): shorten the fence{} or change its angle, got length {length}",
+                if f.tail_radius.is_some() { " (its tail's end)" } else { "" },
+                end.x, end.y, belt.length,
+                if f.tail_radius.is_some() { " or its tail" } else { "" }
             ),
         ));
     }

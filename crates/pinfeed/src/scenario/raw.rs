@@ -199,6 +199,9 @@ pub struct RawObstacle {
     pub length: Option<f64>,
     /// Fence–part friction (default: the part's mu_c).
     pub mu_f: Option<f64>,
+    /// Radius of the fence's curved tail (m): an arc tangent to the fence at its downstream end
+    /// that turns it parallel to the belt (default: none, the fence ends abruptly).
+    pub tail_radius: Option<f64>,
     /// `[obstacles.sensor]`: the sensor of a `sensor_pin` (or of a `moving_pin`).
     pub sensor: Option<RawSensor>,
     /// Moving pin: its lateral range [min, max] (m, over the belt, holding the home `y`).

@@ -217,12 +217,36 @@ pub struct FenceObstacle {
     pub length: f64,
     /// Fence–part friction μf.
     pub mu_f: f64,
+    /// Radius of the fence's curved tail (m), if it ends in one: an arc tangent to the fence at
+    /// its downstream end that turns it parallel to the belt (docs/physics.md#fences).
+    pub tail_radius: Option<f64>,
 }
 
 impl FenceObstacle {
-    /// Downstream end, world frame (m).
+    /// Downstream end of the straight part, world frame (m): where a tail begins.
     pub fn end(&self) -> Vec2 {
         self.start + Vec2::from_angle(self.angle_rad) * self.length
+    }
+    /// The fence's far end, world frame (m): its tail's end, or [`Self::end`] without a tail.
+    pub fn far_end(&self) -> Vec2 {
+        self.spec().far_end()
+    }
+    /// How far (m) the fence strays from the chord between its start and its far end: 0 for a
+    /// straight fence (a little more than the exact figure for a tailed one, from 64 points of its
+    /// arc and their sagitta).
+    pub fn chord_offset(&self) -> f64 {
+        let spec = self.spec();
+        let Some((_, r, _, _)) = spec.tail_arc() else {
+            return 0.0;
+        };
+        let pts = spec.polyline(64);
+        let (p, q) = (self.start, self.far_end());
+        let dir = (q - p).normalized();
+        let sag = r * (1.0 - (self.angle_rad / 128.0).cos());
+        pts.iter()
+            .map(|&x| (x - p).cross(dir).abs())
+            .fold(0.0, f64::max)
+            + sag
     }
     /// The fence as the contact model takes it (world frame, metres).
     pub fn spec(&self) -> FenceSpec {
@@ -231,6 +255,7 @@ impl FenceObstacle {
             angle_rad: self.angle_rad,
             length: self.length,
             mu_f: self.mu_f,
+            tail_radius: self.tail_radius,
         }
     }
 }
@@ -255,7 +280,8 @@ impl Obstacle {
     }
     /// The obstacle as a capsule: the points within `radius` of the segment [p, q] (world, m). A
     /// pin is a disc (p = q = its centre), a moving pin the whole of its travel; a fence is its
-    /// segment (radius 0).
+    /// segment (radius 0), a tailed fence the chord from its start to its tail's end with the
+    /// radius that holds the whole fence ([`FenceObstacle::chord_offset`]).
     pub fn capsule(&self) -> (Vec2, Vec2, f64) {
         match self {
             Obstacle::Pin(PinObstacle {
@@ -269,17 +295,24 @@ impl Obstacle {
                 *radius,
             ),
             Obstacle::Pin(p) => (p.centre, p.centre, p.radius),
-            Obstacle::Fence(f) => (f.start, f.end(), 0.0),
+            Obstacle::Fence(f) => (f.start, f.far_end(), f.chord_offset()),
         }
     }
-    /// The obstacle's extent along the belt, [x_min, x_max] (m).
+    /// The obstacle's extent along the belt, [x_min, x_max] (m). A fence (with or without a tail)
+    /// runs monotonically in x and in y from its start to its far end.
     pub fn x_range(&self) -> [f64; 2] {
-        let (p, q, r) = self.capsule();
+        let (p, q, r) = match self {
+            Obstacle::Fence(f) => (f.start, f.far_end(), 0.0),
+            _ => self.capsule(),
+        };
         [p.x.min(q.x) - r, p.x.max(q.x) + r]
     }
     /// The obstacle's extent across the belt, [y_min, y_max] (m).
     pub fn y_range(&self) -> [f64; 2] {
-        let (p, q, r) = self.capsule();
+        let (p, q, r) = match self {
+            Obstacle::Fence(f) => (f.start, f.far_end(), 0.0),
+            _ => self.capsule(),
+        };
         [p.y.min(q.y) - r, p.y.max(q.y) + r]
     }
 }

@@ -55,6 +55,10 @@ pub fn from_run(scene: &Scene, result: &RunResult, n_parts: usize) -> Animation 
                 shape: AnimShape::Fence {
                     p0: f.start,
                     p1: f.end(),
+                    tail: f
+                        .spec()
+                        .tail_arc()
+                        .map(|(_, r, _, _)| (r, f.far_end(), f.angle_rad > 0.0)),
                 },
                 sensor: false,
                 track: Vec::new(),

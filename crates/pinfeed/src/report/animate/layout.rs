@@ -95,8 +95,9 @@ impl Layout {
         let margin = (1.2 * a).max(0.02 * length);
         let (mut y_lo, mut y_hi) = (-width / 2.0 - margin, width / 2.0 + margin);
         for ob in &anim.obstacles {
-            if let AnimShape::Fence { p0, p1 } = ob.shape {
-                for y in [p0.y, p1.y] {
+            if let AnimShape::Fence { p0, p1, tail } = ob.shape {
+                let p2 = tail.map_or(p1, |(_, p2, _)| p2);
+                for y in [p0.y, p1.y, p2.y] {
                     if y.is_finite() {
                         y_lo = y_lo.min(y - margin);
                         y_hi = y_hi.max(y + margin);

@@ -40,12 +40,15 @@ pub enum AnimShape {
         /// Radius (m).
         radius: f64,
     },
-    /// A fence from `p0` to `p1`.
+    /// A fence from `p0` to `p1`, and on along its curved tail if it has one.
     Fence {
         /// One end (m).
         p0: Vec2,
-        /// The other end (m).
+        /// The other end of the straight part (m).
         p1: Vec2,
+        /// The tail: its radius and far end (m), turning clockwise when `clockwise` (a fence at a
+        /// positive angle).
+        tail: Option<(f64, Vec2, bool)>,
     },
 }
 

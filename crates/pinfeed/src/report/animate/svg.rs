@@ -136,7 +136,7 @@ fn finite_track(ob: &AnimObstacle) -> Vec<(f64, f64, bool)> {
 /// An obstacle's (x of its label, m; above the belt?).
 fn obstacle_anchor(ob: &AnimObstacle, lay: &Layout) -> (f64, bool) {
     match ob.shape {
-        AnimShape::Fence { p0, p1 } => ((p0.x + p1.x) / 2.0, p0.y + p1.y >= 0.0),
+        AnimShape::Fence { p0, p1, .. } => ((p0.x + p1.x) / 2.0, p0.y + p1.y >= 0.0),
         AnimShape::Pin { x, .. } => {
             let track = finite_track(ob);
             let y0 = pin_state(&track, lay.t_start).map_or(0.0, |p| p.0);
@@ -492,7 +492,7 @@ fn obstacle(s: &mut String, ob: &AnimObstacle, lay: &Layout, anim: &Animation, r
     let name = esc(&ob.name);
     let half = half_width(anim);
     match ob.shape {
-        AnimShape::Fence { p0, p1 } => {
+        AnimShape::Fence { p0, p1, tail: None } => {
             let _ = writeln!(
                 s,
                 r#"<g class="obstacle" data-name="{name}" data-kind="fence"><line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{PIN_FILL}" stroke-width="3" stroke-linecap="round"/><text x="{}" y="{}" font-size="11" fill="{PIN_FILL}" text-anchor="middle">{name}</text></g>"#,
@@ -500,6 +500,29 @@ fn obstacle(s: &mut String, ob: &AnimObstacle, lay: &Layout, anim: &Animation, r
                 px(lay.y(p0.y)),
                 px(lay.x(p1.x)),
                 px(lay.y(p1.y)),
+                px(lay.x((p0.x + p1.x) / 2.0)),
+                px(label_y(lay, half, row)),
+            );
+        }
+        AnimShape::Fence {
+            p0,
+            p1,
+            tail: Some((r, p2, clockwise)),
+        } => {
+            // The straight part, then the tail's arc (SVG's sweep flag 1 draws the arc the way
+            // a clockwise turn in the world runs once the screen's y points down).
+            let _ = writeln!(
+                s,
+                r#"<g class="obstacle" data-name="{name}" data-kind="fence"><path d="M {} {} L {} {} A {} {} 0 0 {} {} {}" fill="none" stroke="{PIN_FILL}" stroke-width="3" stroke-linecap="round"/><text x="{}" y="{}" font-size="11" fill="{PIN_FILL}" text-anchor="middle">{name}</text></g>"#,
+                px(lay.x(p0.x)),
+                px(lay.y(p0.y)),
+                px(lay.x(p1.x)),
+                px(lay.y(p1.y)),
+                px(r * lay.k),
+                px(r * lay.k),
+                u8::from(clockwise),
+                px(lay.x(p2.x)),
+                px(lay.y(p2.y)),
                 px(lay.x((p0.x + p1.x) / 2.0)),
                 px(label_y(lay, half, row)),
             );

@@ -794,8 +794,10 @@ fn draw_fence(
             angle_rad: fence.angle_rad + ea.unwrap_or(0.0).to_radians(),
             length: fence.length + el.unwrap_or(0.0),
             mu_f,
+            // A perturbed fence keeps its tail, which turns it from its drawn angle to 0°.
+            tail_radius: fence.tail_radius,
         };
-        let end = drawn.end();
+        let end = drawn.far_end();
         let valid = drawn.angle_rad.abs() < std::f64::consts::FRAC_PI_2
             && drawn.start.x > radius
             && drawn.start.x < belt.length
