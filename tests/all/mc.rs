@@ -617,6 +617,30 @@ fn merge_refuses_resealed_shards_whose_counts_do_not_hang_together() {
             online.display()
         )
     );
+    // A shard that lacks the counts of a point its range touches: the point ends up short
+    // (a mutant checking only for too many samples after merging passed every test).
+    let lacking = resealed(&a1, &d.join("lacking.json"), |f| f.points.clear());
+    let e = merge(&lacking);
+    assert!(
+        e.to_string()
+            .contains("point 0 has 2 samples after merging, expected 4"),
+        "{e}"
+    );
+    // An extra point just past the grid (index 1 of one point) with no samples: refused, not
+    // an index out of bounds (a mutant testing `point > len` passed every test).
+    let extra = resealed(&a1, &d.join("extra.json"), |f| {
+        let mut p = f.points[0].clone();
+        p.point = 1;
+        p.samples = 0;
+        p.outcomes.values_mut().for_each(|n| *n = 0);
+        f.points.push(p);
+    });
+    let e = merge(&extra);
+    assert!(
+        e.to_string()
+            .contains("point 1 holds 0 samples but the shard's range [2, 4) gives it 0"),
+        "{e}"
+    );
     assert!(!d.join("merged").exists(), "a refused merge wrote a report");
     std::fs::remove_dir_all(&d).unwrap();
 }
