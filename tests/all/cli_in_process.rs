@@ -211,7 +211,8 @@ fn options(seed: u64, threads: usize) -> Options {
 
 /// The targets of the new surface run clean and their counts do not depend on the thread count:
 /// pairs of sensing/actuator/controller/policy keys, measured-band CSVs with validate and
-/// calibrate arguments, edited merge shards, and contacts with moving pins.
+/// calibrate arguments, edited merge shards, contacts with moving pins, and designs compared in
+/// both orders.
 #[test]
 fn new_surface_targets_run_clean_on_any_number_of_threads() {
     let corpus = Arc::new(fuzz::corpus(&root()).unwrap());
@@ -221,6 +222,7 @@ fn new_surface_targets_run_clean_on_any_number_of_threads() {
         (Target::Csvs, 80),
         (Target::Merges, 80),
         (Target::Contacts, 200),
+        (Target::Compares, 8),
     ] {
         let mut one = robustness::run_target(target, n, &corpus, &opts(1), &|_| {});
         let mut two = robustness::run_target(target, n, &corpus, &opts(2), &|_| {});

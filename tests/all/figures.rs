@@ -140,24 +140,29 @@ fn band(lo: f64, hi: f64, mean: f64, sd: f64) -> pinfeed::maps::Band {
     }
 }
 
+/// Configuration maps of one band each, at the given d.
+fn one_band_each(bands: Vec<(f64, pinfeed::maps::Band)>) -> Vec<pinfeed::maps::ConfigurationMap> {
+    bands
+        .into_iter()
+        .map(|(d, b)| pinfeed::maps::ConfigurationMap {
+            d,
+            samples: vec![],
+            bands: vec![b],
+            no_contact_ranges_deg: vec![],
+            fence: None,
+        })
+        .collect()
+}
+
 #[test]
 fn band_interval_figures_zoom_on_the_bands() {
     let dir = fresh_dir("figures-bands");
     // Bands between 92° and 121° at three d: the θf axis should hold them, not 0–420°.
-    let maps: Vec<pinfeed::maps::ConfigurationMap> = [
+    let maps = one_band_each(vec![
         (-0.4, band(92.0, 104.0, 98.0, 3.0)),
         (0.0, band(100.0, 112.0, 106.0, 2.5)),
         (0.4, band(108.0, 121.0, 115.0, 4.0)),
-    ]
-    .into_iter()
-    .map(|(d, b)| pinfeed::maps::ConfigurationMap {
-        d,
-        samples: vec![],
-        bands: vec![b],
-        no_contact_ranges_deg: vec![],
-        fence: None,
-    })
-    .collect();
+    ]);
     for adjusted in [false, true] {
         let path = dir.join(format!("bands-{adjusted}.svg"));
         pinfeed::report::plot_map::plot_band_intervals(&maps, adjusted, "t", &path).unwrap();
@@ -177,6 +182,89 @@ fn band_interval_figures_zoom_on_the_bands() {
         assert!(texts.contains("band mean"), "{texts}");
         no_overlaps(&boxes, "band intervals");
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Issue 57 item 16: a band-interval axis wider than 300° across 0°/360° read "…, 300, 350, 40,
+/// 90" (plotters' 50° step, 400° wrapped). Its ticks are multiples of a step dividing 360, so the
+/// labels advance evenly and read 0 where the axis crosses 360°.
+#[test]
+fn a_band_axis_across_360_is_ticked_on_a_step_dividing_360_with_a_zero() {
+    let dir = fresh_dir("figures-bands-wrap");
+    // Bands over 60°…375° (15° past 0): a gap of 45°, so the axis zooms to about 55°…380°.
+    let maps = one_band_each(vec![
+        (-0.4, band(60.0, 120.0, 90.0, 10.0)),
+        (-0.2, band(130.0, 200.0, 165.0, 10.0)),
+        (0.0, band(210.0, 280.0, 245.0, 10.0)),
+        (0.2, band(290.0, 350.0, 320.0, 10.0)),
+        (0.4, band(355.0, 375.0, 5.0, 3.0)),
+    ]);
+    for adjusted in [false, true] {
+        let path = dir.join(format!("bands-{adjusted}.svg"));
+        pinfeed::report::plot_map::plot_band_intervals(&maps, adjusted, "t", &path).unwrap();
+        let boxes = text_boxes(&read_svg(&path));
+        // The y tick labels from the bottom of the axis up.
+        let mut ys = ticks(&boxes, "end");
+        ys.sort_by(|a, b| b.1.y0.total_cmp(&a.1.y0));
+        let labels: Vec<f64> = ys.iter().map(|t| t.0).collect();
+        assert!(labels.len() >= 5, "{labels:?}");
+        let step = (labels[1] - labels[0]).rem_euclid(360.0);
+        assert_eq!(
+            360.0 % step,
+            0.0,
+            "a step of {step}° does not divide 360: {labels:?}"
+        );
+        for w in labels.windows(2) {
+            assert_eq!((w[0] + step) % 360.0, w[1], "{labels:?}");
+        }
+        assert!(
+            labels.contains(&0.0),
+            "the axis crosses 0° without a 0: {labels:?}"
+        );
+        no_overlaps(&boxes, "band intervals across 360°");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Issue 57 item 16: every transitional sample of a map (a θ0 whose θf lands apart from both
+/// neighbouring bands: a band of one sample) had a legend entry of its own. They share one:
+/// `transitional (N samples …)`, and the real bands keep their numbers from the band table.
+#[test]
+fn a_map_figure_gives_its_transitional_samples_one_legend_entry() {
+    let dir = fresh_dir("figures-map-transitional");
+    // ngon:5 at d = -0.5: five bands of 71 samples, and five single samples between them.
+    let out = crate::support::pinfeed_ok(&[
+        "map",
+        "--part",
+        "ngon:5",
+        "--d=-0.5",
+        "--quiet",
+        "--out-dir",
+        dir.to_str().unwrap(),
+    ]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("B10"), "ten bands expected:\n{table}");
+    let boxes = text_boxes(&read_svg(&dir.join("map_d-0.5.svg")));
+    let legend: Vec<&str> = boxes.iter().map(|b| b.text.as_str()).collect();
+    let transitional: Vec<&&str> = legend
+        .iter()
+        .filter(|t| t.starts_with("transitional"))
+        .collect();
+    assert_eq!(
+        transitional,
+        [&"transitional (5 samples, each a band of its own)"],
+        "{legend:?}"
+    );
+    let bands: Vec<&&str> = legend.iter().filter(|t| t.starts_with('B')).collect();
+    assert_eq!(bands.len(), 5, "{legend:?}");
+    for (b, n) in bands.iter().zip(["B1 ", "B3 ", "B5 ", "B7 ", "B9 "]) {
+        assert!(b.starts_with(n), "{legend:?}");
+    }
+    // The θ0 axis is ticked every 30°, 0 to 360.
+    let xs: Vec<f64> = ticks(&boxes, "middle").into_iter().map(|t| t.0).collect();
+    let expected: Vec<f64> = (0..=12).map(|k| 30.0 * k as f64).collect();
+    assert_eq!(xs, expected);
+    no_overlaps(&boxes, "map figure");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -8,7 +8,9 @@
 //! accepted file's run has no NaN or inf. The deeper run is `pinfeed fuzz` (README "Fuzzing and
 //! robustness"). Failures proptest finds are kept in tests/fuzz_files.proptest-regressions.
 
-use pinfeed::study::robustness::files::{self, Mutation, Seeds, EXTREMES, KNOWN_KEYS};
+use pinfeed::study::robustness::files::{
+    self, Mutation, Seeds, BELIEF_LISTS, EXTREMES, KNOWN_KEYS, RANGED,
+};
 use pinfeed::study::robustness::{self, Class, Corpus, Options, Target};
 use proptest::prelude::*;
 use std::path::Path;
@@ -37,6 +39,8 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         1 => (any::<usize>(), 0usize..4).prop_map(|(which, kind)| Mutation::ChangeType { which, kind }),
         1 => any::<usize>().prop_map(|which| Mutation::DropSection { which }),
         1 => (0u32..1000).prop_map(|permille| Mutation::Truncate { permille }),
+        1 => (0..RANGED.len(), 0usize..5, 0usize..7).prop_map(|(param, form, at)| Mutation::Ranged { param, form, at }),
+        1 => (0..BELIEF_LISTS.len(), 0usize..16).prop_map(|(key, list)| Mutation::Belief { key, list }),
     ]
 }
 
@@ -132,6 +136,129 @@ fn issue_reproducers_as_mutations_are_located() {
         assert!(text.contains(from), "{from}");
         let r = files::check_scenario(path, &text.replacen(from, to, 1));
         assert_eq!(r.class, Class::Located, "{to}: {}", r.detail);
+    }
+}
+
+/// The seed file whose path ends with `name`.
+fn seed_file<'a>(
+    files: &'a [(std::path::PathBuf, String)],
+    name: &str,
+) -> &'a (std::path::PathBuf, String) {
+    files
+        .iter()
+        .find(|(p, _)| p.ends_with(name))
+        .unwrap_or_else(|| panic!("no seed {name}"))
+}
+
+/// The fuzzer's study-range tables (issue 57 item 6): a value just beyond either end of any
+/// ranged parameter's documented range, and a normal truncated to one value, are refused where
+/// they stand (file, line, column), in every form; a value at an end passes the range check (it
+/// runs, or is refused for another reason: a parameter that reaches nothing on this line).
+#[test]
+fn study_range_tables_beyond_their_ends_are_located() {
+    let (path, text) = seed_file(&seeds().studies, "studies/quickstart_mu_tripod.toml");
+    for (param, name) in RANGED.iter().enumerate() {
+        for (form, at) in [(0, 2), (0, 3), (1, 3), (2, 2), (4, 3), (3, 6)] {
+            let t = files::apply(text, &Mutation::Ranged { param, form, at });
+            let r = files::check_study(path, &t);
+            assert_eq!(r.class, Class::Located, "{name}: {}\n{t}", r.detail);
+        }
+    }
+    // At the ends of μc's range, on a line of pins: it runs.
+    for at in [0, 1, 4, 5] {
+        let t = files::apply(
+            text,
+            &Mutation::Ranged {
+                param: 0,
+                form: 0,
+                at,
+            },
+        );
+        let r = files::check_study(path, &t);
+        assert_eq!(r.class, Class::Success, "{}\n{t}", r.detail);
+    }
+}
+
+/// The fuzzer's belief lists (issue 57 item 7): a support or friction listed twice, an empty or
+/// unknown list is refused at its line (an empty support list ran, meaning the part's own
+/// support, while an empty friction list was refused); distinct values run the online
+/// controller.
+#[test]
+fn belief_lists_with_duplicates_or_none_are_located_and_distinct_ones_run() {
+    let (path, text) = seed_file(&seeds().scenarios, "scenarios/tripoly1_online.toml");
+    let list = |key: &str, l: &str| {
+        let k = BELIEF_LISTS.iter().position(|(n, _)| *n == key).unwrap();
+        let j = BELIEF_LISTS[k].1.iter().position(|x| *x == l).unwrap();
+        files::apply(text, &Mutation::Belief { key: k, list: j })
+    };
+    for (key, l) in [
+        ("support", "[\"uniform\", \"uniform\"]"),
+        ("support", "[\"tripod\", \"uniform\", \"tripod\"]"),
+        ("support", "[]"),
+        ("support", "[\"bogus\"]"),
+        ("mu_c", "[0.5, 0.5]"),
+        ("mu_c", "[]"),
+        ("mu_c", "[5.01]"),
+    ] {
+        let t = list(key, l);
+        let r = files::check_scenario(path, &t);
+        assert_eq!(r.class, Class::Located, "{key} = {l}: {}\n{t}", r.detail);
+    }
+    for (key, l) in [
+        ("support", "[\"uniform\", \"tripod\"]"),
+        ("mu_c", "[0.3, 0.7]"),
+    ] {
+        let t = list(key, l);
+        let r = files::check_scenario(path, &t);
+        assert_eq!(r.class, Class::Success, "{key} = {l}: {}\n{t}", r.detail);
+    }
+}
+
+/// The fuzzer's compare cases (issue 57 item 1): designs for one part give each row the same in
+/// both orders and alone, with the feed the case imposes; designs for two parts are refused in
+/// both orders.
+#[test]
+fn compare_cases_agree_in_both_orders_and_refuse_two_parts() {
+    use pinfeed::scenario::FeedOverrides;
+    use pinfeed::study::robustness::compares::{self, CompareCase};
+    let corpus = Corpus::load(root()).unwrap();
+    let s = &corpus.compare_seeds;
+    let at = |name: &str| s.iter().position(|(p, _)| p.ends_with(name)).unwrap();
+    let dir = std::env::temp_dir().join(format!("pinfeed-compare-fuzz-{}", std::process::id()));
+    let overrides = FeedOverrides {
+        parts: Some(4),
+        seed: Some(3),
+        headway: Some(3.0),
+        uniform_orientation: true,
+    };
+    for (files, expected) in [
+        (
+            vec![
+                "scenarios/quickstart.toml",
+                "scenarios/tripoly2_fences.toml",
+            ],
+            Class::Success,
+        ),
+        (
+            vec![
+                "scenarios/tripoly1_sensing.toml",
+                "scenarios/tripoly1_online.toml",
+                "scenarios/tripoly1.toml",
+            ],
+            Class::Success,
+        ),
+        (
+            vec!["scenarios/quickstart.toml", "scenarios/tripoly1.toml"],
+            Class::Named,
+        ),
+    ] {
+        let c = CompareCase {
+            files: files.iter().map(|f| at(f)).collect(),
+            overrides,
+        };
+        let r = compares::run(&c, s, &dir);
+        assert_eq!(r.class, expected, "{}: {}", c.command(s), r.detail);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
 

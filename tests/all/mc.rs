@@ -491,6 +491,53 @@ fn a_report_in_the_user_s_folder_names_the_command_as_run() {
     std::fs::remove_dir_all(&d).unwrap();
 }
 
+/// Issue 57 item 16: a sweep given as `from`, `to`, `steps` printed the values it computes with
+/// every digit (`0.9000000000000001`, `0.3666666666666667`) in the report, its table and the
+/// figure's legend; they print rounded to 6 significant digits, while report.json keeps every
+/// digit (it is read back by programs).
+#[test]
+fn a_swept_range_prints_its_computed_values_rounded() {
+    let d = tmp("sweep-digits");
+    let study = write_study(
+        &d,
+        "samples = 2\n[uncertain.mu_c]\ndistribution = \"uniform\"\nmin = 0.05\nmax = 0.7\n\
+         [uncertain.pose_theta]\ndistribution = \"normal\"\nsd = 1\n\
+         [[sweep]]\nparameter = \"mu_c.max\"\nfrom = 0.1\nto = 0.9\nsteps = 4\n\
+         [[sweep]]\nparameter = \"pose_theta.sd\"\nfrom = 0.1\nto = 0.5\nsteps = 3\n",
+    );
+    let out = d.join("rep");
+    pinfeed_ok(&["mc", s(&study), "--quiet", "--out", s(&out)]);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("- swept: `mu_c.max` over 0.1, 0.366667, 0.633333, 0.9\n"),
+        "{md}"
+    );
+    assert!(
+        md.contains("- swept: `pose_theta.sd` over 0.1, 0.3, 0.5\n"),
+        "{md}"
+    );
+    assert!(md.contains("\n| 0.9 | 0.3 | 2 |"), "{md}");
+    // The figure's words (not its attributes, whose font sizes carry digits of their own).
+    let svg = std::fs::read_to_string(out.join("sensitivity.svg")).unwrap();
+    let words: Vec<&str> = svg
+        .split('>')
+        .filter_map(|p| p.split('<').next())
+        .map(str::trim)
+        .filter(|t| !t.is_empty())
+        .collect();
+    assert!(words.contains(&"pose_theta.sd = 0.3"), "{words:?}");
+    let words = words.join("\n");
+    for text in [&md, &words] {
+        assert!(
+            !text.contains("0000000") && !text.contains("6666666") && !text.contains("3333333"),
+            "a value with every digit: {text}"
+        );
+    }
+    let json = std::fs::read_to_string(out.join("report.json")).unwrap();
+    assert!(json.contains("0.9000000000000001"), "{json}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
 /// A shard rewritten with `edit` and its checksum recomputed: it reads, but its counts are what
 /// `edit` made them.
 fn resealed(from: &Path, to: &Path, edit: impl FnOnce(&mut mc::shard::ShardFile)) -> PathBuf {
@@ -569,6 +616,30 @@ fn merge_refuses_resealed_shards_whose_counts_do_not_hang_together() {
             "{}: point 0: online: 0 calibration bins, not 10",
             online.display()
         )
+    );
+    // A shard that lacks the counts of a point its range touches: the point ends up short
+    // (a mutant checking only for too many samples after merging passed every test).
+    let lacking = resealed(&a1, &d.join("lacking.json"), |f| f.points.clear());
+    let e = merge(&lacking);
+    assert!(
+        e.to_string()
+            .contains("point 0 has 2 samples after merging, expected 4"),
+        "{e}"
+    );
+    // An extra point just past the grid (index 1 of one point) with no samples: refused, not
+    // an index out of bounds (a mutant testing `point > len` passed every test).
+    let extra = resealed(&a1, &d.join("extra.json"), |f| {
+        let mut p = f.points[0].clone();
+        p.point = 1;
+        p.samples = 0;
+        p.outcomes.values_mut().for_each(|n| *n = 0);
+        f.points.push(p);
+    });
+    let e = merge(&extra);
+    assert!(
+        e.to_string()
+            .contains("point 1 holds 0 samples but the shard's range [2, 4) gives it 0"),
+        "{e}"
     );
     assert!(!d.join("merged").exists(), "a refused merge wrote a report");
     std::fs::remove_dir_all(&d).unwrap();

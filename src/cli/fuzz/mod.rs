@@ -36,13 +36,15 @@ pub enum FuzzTarget {
     Csvs,
     /// Shard files edited before `merge`.
     Merges,
+    /// `compare` of bundled designs in both orders and each alone.
+    Compares,
     All,
 }
 
 /// Arguments of `pinfeed fuzz`.
 #[derive(Debug, Args)]
 pub struct FuzzArgs {
-    /// scenarios, studies, contacts, polygons, pairs, plans, csvs, merges or all.
+    /// scenarios, studies, contacts, polygons, pairs, plans, csvs, merges, compares or all.
     #[arg(value_enum)]
     pub target: FuzzTarget,
     /// Cases per target.
@@ -91,6 +93,7 @@ fn targets(t: FuzzTarget) -> Vec<Target> {
         FuzzTarget::Plans => vec![Target::Plans],
         FuzzTarget::Csvs => vec![Target::Csvs],
         FuzzTarget::Merges => vec![Target::Merges],
+        FuzzTarget::Compares => vec![Target::Compares],
         FuzzTarget::All => Target::ALL.to_vec(),
     }
 }

@@ -206,16 +206,84 @@ mod tests {
         assert_eq!(check_two_parts(2.5).1.part_part_narrow_checks, 0);
     }
 
+    /// A held part whose push kept no path (the engine records it only when something needs
+    /// it) gets it recorded before a close pair is resolved, whichever part of the pair it is:
+    /// the collision is where the recorded path puts it, not on the straight line between the
+    /// push's ends. (A mutant that recorded only the path of the part whose motion just started
+    /// passed every test.)
+    #[test]
+    fn a_held_part_s_path_is_recorded_whichever_part_of_the_pair_it_is() {
+        let scene = scene_of("quickstart.toml");
+        let v = scene.belt.speed;
+        let mut tried = 0;
+        for (j, y, theta) in entries(&scene) {
+            let (Some(traced), Some(bare)) = (
+                held_traced(&scene, j, y, theta, true),
+                held_traced(&scene, j, y, theta, false),
+            ) else {
+                continue;
+            };
+            let Motion::Held(plan) = &traced else {
+                unreachable!()
+            };
+            let (begin, end) = (plan.t_begin, plan.t_end);
+            // A free part in the held one's pose at the end of the push, upstream before.
+            let pose = traced.world_pose(end, v);
+            let free = Motion::Free {
+                t0: end,
+                pose,
+                until: end,
+            };
+            let expected = collisions_of(&scene, free.clone(), traced.clone(), begin);
+            let Some(&first) = expected.first() else {
+                continue;
+            };
+            if first <= begin {
+                continue;
+            }
+            tried += 1;
+            assert_eq!(
+                collisions_of(&scene, free.clone(), bare.clone(), begin),
+                expected,
+                "obstacle {j}, y {y}: the held part is the other one"
+            );
+            assert_eq!(
+                collisions_of(&scene, bare, free, begin),
+                expected,
+                "obstacle {j}, y {y}: the held part is the one checked"
+            );
+        }
+        assert!(
+            tried >= 2,
+            "only {tried} configurations collided during the push"
+        );
+    }
+
     use proptest::prelude::*;
 
     fn scene_of(file: &str) -> Scene {
         crate::scenario::load(&crate::project_path(&format!("scenarios/{file}"))).unwrap()
     }
 
+    /// The quickstart line with pins ten times as thick (radius 0.02 m, 0.73 a): a bound that
+    /// forgets the pin's radius shows.
+    fn thick_pins() -> Scene {
+        let path = crate::project_path("scenarios/quickstart.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.matches("radius = 0.002").count(), 3);
+        crate::scenario::parse(&path, &text.replace("radius = 0.002", "radius = 0.02")).unwrap()
+    }
+
     /// Obstacle `j` of `scene` pushing a part that rides in at lateral offset `y` (m) and
     /// orientation `theta` (rad), from 3a upstream at time 0: its held motion (with the path
     /// recorded, as the narrow phase sees it), or None if the part passes untouched.
     fn held(scene: &Scene, j: usize, y: f64, theta: f64) -> Option<Motion> {
+        held_traced(scene, j, y, theta, true)
+    }
+
+    /// [`held`], with the push's path recorded only if `traced` (the engine records it when
+    /// something needs it: a close pair, a neighbouring obstacle).
+    fn held_traced(scene: &Scene, j: usize, y: f64, theta: f64, traced: bool) -> Option<Motion> {
         let (v, a) = (scene.belt.speed, scene.part.radius);
         let ob = &scene.obstacles[j];
         let pose = Pose::new(ob.x_range()[0] - 3.0 * a, y, theta);
@@ -227,7 +295,9 @@ mod tests {
         let t_begin = outcome.travel_to_contact / v;
         let mut plan =
             super::super::contact::plan_of(j, (0.0, pose), pusher, settings, outcome, t_begin, v);
-        plan.ensure_trace(&scene.part.model);
+        if traced {
+            plan.ensure_trace(&scene.part.model);
+        }
         Some(Motion::Held(Box::new(plan)))
     }
 
@@ -258,6 +328,135 @@ mod tests {
         worst
     }
 
+    /// The first time in [now, end] at which the parts moving along `first` and `second`
+    /// overlap, by brute force: the polygon clearance at 4000 even times and at every step of
+    /// either push (None: never).
+    fn first_overlap_sampled(
+        scene: &Scene,
+        first: &Motion,
+        second: &Motion,
+        now: f64,
+        end: f64,
+    ) -> Option<f64> {
+        let v = scene.belt.speed;
+        let mut times: Vec<f64> = (0..=4000)
+            .map(|k| now + (end - now) * k as f64 / 4000.0)
+            .collect();
+        for m in [first, second] {
+            if let Motion::Held(plan) = m {
+                times.extend(
+                    plan.step_times(v)
+                        .into_iter()
+                        .filter(|t| (now..=end).contains(t)),
+                );
+            }
+        }
+        times.sort_by(f64::total_cmp);
+        let poly = &scene.part.polygon;
+        times.into_iter().find(|&t| {
+            let wa = poly.world_vertices(&first.world_pose(t, v));
+            let wb = poly.world_vertices(&second.world_pose(t, v));
+            polygon_clearance(&wa, &wb) <= 0.0
+        })
+    }
+
+    /// The start and end of a push (s).
+    struct Push {
+        begin: f64,
+        end: f64,
+    }
+
+    /// [`held`], with the start and end of its push.
+    fn held_with_push(scene: &Scene, j: usize, y: f64, theta: f64) -> Option<(Motion, Push)> {
+        let m = held(scene, j, y, theta)?;
+        let Motion::Held(plan) = &m else {
+            unreachable!()
+        };
+        let push = Push {
+            begin: plan.t_begin,
+            end: plan.t_end,
+        };
+        Some((m, push))
+    }
+
+    /// Ways for a part to ride into each obstacle of `scene`: (obstacle, lateral offset y in m,
+    /// orientation in rad), the part's centroid 0.5 a to either side of the obstacle's line.
+    fn entries(scene: &Scene) -> Vec<(usize, f64, f64)> {
+        let a = scene.part.radius;
+        (0..scene.obstacles.len())
+            .flat_map(|j| {
+                let y = scene.obstacles[j].capsule().0.y;
+                [(0.3, 0.4), (-0.3, 1.9), (0.1, 3.5), (-0.5, 5.0)]
+                    .map(|(dy, theta)| (j, y + dy * a, theta))
+            })
+            .collect()
+    }
+
+    /// Two parts on the belt: part 0 moving along `other`, part 1 along `me`, checked as part
+    /// 1's motion starts at `now`; the collisions scheduled.
+    fn collisions_of(scene: &Scene, me: Motion, other: Motion, now: f64) -> Vec<f64> {
+        let mut belt = Belt::new();
+        for (k, m) in [(0u64, other), (1u64, me)] {
+            let mut part = ActivePart::entering(0.0, Pose::new(0.0, 0.0, 0.0), None, false);
+            part.motion = m;
+            belt.active.insert(k, part);
+        }
+        let mut work = WorkCounters::default();
+        check_pairs(scene, &mut belt, &mut work, 1, now);
+        std::iter::from_fn(|| belt.queue.pop())
+            .map(|e| e.time)
+            .collect()
+    }
+
+    /// A pair is checked over the time both motions are known, up to the earlier of their
+    /// ends: a free part that would run into a held one only after its own motion ends (at its
+    /// next event, where it is checked again) gets no collision; the same part moving until the
+    /// push ends gets one, at the first overlap. (A mutant taking the later of the two ends
+    /// passed every test.)
+    #[test]
+    fn a_pair_is_checked_only_until_the_earlier_of_the_two_motions_ends() {
+        let scene = scene_of("quickstart.toml");
+        let v = scene.belt.speed;
+        let mut tried = 0;
+        for (j, y, theta) in entries(&scene) {
+            let Some((me, t)) = held_with_push(&scene, j, y, theta) else {
+                continue;
+            };
+            // A free part overlapping the held one fully at the end of the push (the same
+            // pose), upstream of it before: when does it first touch?
+            let at_end = me.world_pose(t.end, v);
+            let free = |until: f64| Motion::Free {
+                t0: t.end,
+                pose: at_end,
+                until,
+            };
+            let Some(touch) = first_overlap_sampled(&scene, &me, &free(t.end), t.begin, t.end)
+            else {
+                continue;
+            };
+            if touch <= t.begin + 0.1 * (t.end - t.begin) {
+                continue;
+            }
+            tried += 1;
+            let hits = collisions_of(&scene, me.clone(), free(t.end), t.begin);
+            assert_eq!(hits.len(), 1, "obstacle {j}, y {y}: {hits:?}");
+            assert!(
+                hits[0] <= touch + 1e-9 && hits[0] > t.begin,
+                "{hits:?} vs {touch}"
+            );
+            // The free part's motion ends halfway to the touch: nothing to schedule yet.
+            let until = 0.5 * (t.begin + touch);
+            let hits = collisions_of(&scene, me.clone(), free(until), t.begin);
+            assert!(hits.is_empty(), "obstacle {j}, y {y}: collision at {hits:?} after the free part's motion ended at {until}");
+            // And with the roles swapped: the held part's motion is the one checked.
+            let hits = collisions_of(&scene, free(until), me.clone(), t.begin);
+            assert!(hits.is_empty(), "obstacle {j}, y {y} (swapped): {hits:?}");
+        }
+        assert!(
+            tried >= 2,
+            "only {tried} configurations ran into each other"
+        );
+    }
     proptest! {
         #![proptest_config(ProptestConfig { cases: 48, rng_seed: proptest::test_runner::RngSeed::Fixed(57021), .. ProptestConfig::default() })]
 
@@ -271,9 +470,14 @@ mod tests {
             theta in 0.0f64..std::f64::consts::TAU,
             from in 0.0f64..1.0,
             fence in any::<bool>(),
+            thick in any::<bool>(),
             j in 0usize..2,
         ) {
-            let scene = scene_of(if fence { "tripoly1_fences.toml" } else { "quickstart.toml" });
+            let scene = match (fence, thick) {
+                (true, _) => scene_of("tripoly1_fences.toml"),
+                (false, false) => scene_of("quickstart.toml"),
+                (false, true) => thick_pins(),
+            };
             let a = scene.part.radius;
             let j = j % scene.obstacles.len();
             let (centre, _, _) = scene.obstacles[j].capsule();
@@ -285,6 +489,55 @@ mod tests {
                 let now = plan.t_begin + from * (plan.t_end - plan.t_begin);
                 let out = excess(&scene, &m, now, plan.t_end);
                 prop_assert!(out <= 1e-9 * a, "a vertex leaves the capsule by {} a", out / a);
+            }
+        }
+
+        /// The narrow phase finds the first overlap of a held part and a free part no later than
+        /// dense sampling of their clearance does (a bound on how fast the clearance can fall
+        /// without the part's rotation skipped pieces where a turning vertex reached the other
+        /// part: a mutant passed every test), and only where they do overlap.
+        #[test]
+        fn the_narrow_phase_finds_the_first_overlap_that_sampling_finds(
+            y in -1.0f64..1.0,
+            theta in 0.0f64..std::f64::consts::TAU,
+            at in 0.0f64..1.0,
+            dist in 1.0f64..2.2,
+            dir in 0.0f64..std::f64::consts::TAU,
+            theta2 in 0.0f64..std::f64::consts::TAU,
+            j in 0usize..3,
+        ) {
+            let scene = scene_of("quickstart.toml");
+            let (v, a) = (scene.belt.speed, scene.part.radius);
+            let j = j % scene.obstacles.len();
+            let (centre, _, _) = scene.obstacles[j].capsule();
+            let y = centre.y + y * a;
+            let Some((me, t)) = held_with_push(&scene, j, y, theta) else {
+                return Ok(());
+            };
+            // A free part placed `dist` radii from the held one at a moment of the push.
+            let ts = t.begin + at * (t.end - t.begin);
+            let p = me.world_pose(ts, v);
+            let pose = Pose::new(p.x + dist * a * dir.cos(), p.y + dist * a * dir.sin(), theta2);
+            let free = Motion::Free { t0: ts, pose, until: t.end };
+            let sampled = first_overlap_sampled(&scene, &me, &free, t.begin, t.end);
+            let tol = 1e-5 * a / v;
+            // Either part first: the held one's steps are breaks of the walk either way.
+            for (first, second) in [(&me, &free), (&free, &me)] {
+                let mut evals = 0;
+                let found = first_overlap(&scene, first, second, t.begin, t.end, &mut evals);
+                match (found, sampled) {
+                    (None, Some(s)) => prop_assert!(false, "missed the overlap at {s}"),
+                    (Some(f), Some(s)) => prop_assert!(f <= s + tol, "found at {f}, sampled at {s}"),
+                    (Some(f), None) => {
+                        let poly = &scene.part.polygon;
+                        let c = polygon_clearance(
+                            &poly.world_vertices(&me.world_pose(f, v)),
+                            &poly.world_vertices(&free.world_pose(f, v)),
+                        );
+                        prop_assert!(c <= 1e-5 * a, "an overlap at {f} where the clearance is {c}");
+                    }
+                    (None, None) => {}
+                }
             }
         }
     }

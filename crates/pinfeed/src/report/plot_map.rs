@@ -3,17 +3,20 @@
 //! * [`plot_map`]: one map as θ0 against θf (the thesis's Figure 3-3): samples coloured by band,
 //!   each band B_j shaded over the θ0 runs K_j that feed it, its adjusted interval (mean ± sd) as
 //!   dashed lines, no-contact samples as red crosses on the diagonal with their runs NC_j drawn along
-//!   it, and samples whose contact did not end `ok` ringed in black.
+//!   it, and samples whose contact did not end `ok` ringed in black. Transitional bands (at most
+//!   [`TRANSITIONAL_SAMPLES`] samples) are grey, under one legend entry; both axes are ticked
+//!   every 30°.
 //! * [`plot_band_intervals`]: band intervals against d for every map given (Figure 3-6), with "+"
 //!   at the ends and a dot at the mean; with `adjusted` the intervals are mean ± sd (Figure 3-8),
 //!   drawn over the raw ones in grey. Its orientation axis zooms on the bands
-//!   (`plot_zoom`; an interval across 0°/360° is then one piece) and its legend stands in
-//!   a row above the chart, where it hides no interval.
+//!   (`plot_zoom`; an interval across 0°/360° is then one piece), ticked on multiples of a step
+//!   that divides 360 (labels wrapped into [0, 360) read evenly, 0 where the axis crosses 360°),
+//!   and its legend stands in a row above the chart, where it hides no interval.
 //!
 //! In the map figure, intervals straddling 0°/360° are drawn as two pieces.
 
 use super::plot_labels::text_width;
-use super::plot_zoom::{degree_view, DegreeView};
+use super::plot_zoom::{degree_axis, degree_view, DegreeAxis, DegreeView};
 use crate::geometry::wrap_deg;
 use crate::maps::{Band, ConfigurationMap};
 use crate::output::Staged;
@@ -60,15 +63,18 @@ fn raw_arc(b: &Band) -> Vec<(f64, f64)> {
     arc_pieces(b.final_min_deg, b.width_deg)
 }
 
+/// A chart of orientations against orientations (a configuration map).
 pub(crate) type Chart<'a, 'b> =
-    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<DegreeAxis, DegreeAxis>>;
 
-/// A white chart with a title, `x` across and orientations 0°…`y_top` up.
+/// A chart of orientations up against contact parameter d across ([`d_chart`]).
+pub(crate) type DChart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, DegreeAxis>>;
+
+/// A white chart with a title and orientations 0°…360° on both axes, ticked every 30°.
 pub(crate) fn degree_chart<'a, 'b>(
     root: &'a DrawingArea<SVGBackend<'b>, Shift>,
     title: &str,
-    x: std::ops::Range<f64>,
-    y_top: f64,
 ) -> ReportResult<Chart<'a, 'b>> {
     root.fill(&WHITE)?;
     Ok(ChartBuilder::on(root)
@@ -76,7 +82,7 @@ pub(crate) fn degree_chart<'a, 'b>(
         .margin(14)
         .x_label_area_size(40)
         .y_label_area_size(50)
-        .build_cartesian_2d(x, 0.0..y_top)?)
+        .build_cartesian_2d(degree_axis(0.0..360.0, 13), degree_axis(0.0..360.0, 13))?)
 }
 
 /// How a legend entry in a header row ([`header_with_legend`]) is marked.
@@ -150,6 +156,40 @@ pub(crate) fn draw_legend<'a, 'b: 'a>(
     Ok(())
 }
 
+/// Bands of at most this many samples are *transitional*: the few θ0 where θf turns fast between
+/// two real bands land apart from both (and from each other), each a band of its own. The map
+/// figure draws them grey under one legend entry instead of one entry each.
+pub const TRANSITIONAL_SAMPLES: usize = 2;
+
+/// The colour of transitional samples ([`TRANSITIONAL_SAMPLES`]).
+const TRANSITIONAL: RGBColor = RGBColor(128, 128, 128);
+
+fn is_transitional(b: &Band) -> bool {
+    b.samples <= TRANSITIONAL_SAMPLES
+}
+
+/// A real band's legend entry: its number (as in the band table), interval, mean ± sd.
+fn band_label(j: usize, band: &Band) -> String {
+    format!(
+        "B{} [{:.1}°, {:.1}°], mean ± sd {:.1}° ± {:.1}°",
+        j + 1,
+        band.final_min_deg,
+        band.final_max_deg,
+        band.mean_deg,
+        band.sd_deg
+    )
+}
+
+/// The one legend entry of `samples` transitional samples in `bands` bands.
+fn transitional_label(samples: usize, bands: usize) -> String {
+    let s = if samples == 1 { "" } else { "s" };
+    if samples == bands {
+        format!("transitional ({samples} sample{s}, each a band of its own)")
+    } else {
+        format!("transitional ({samples} sample{s} in {bands} bands of ≤ {TRANSITIONAL_SAMPLES})")
+    }
+}
+
 /// Draw one configuration map (θ0 against θf) into an SVG file; `step_deg` is the θ0 grid spacing.
 pub fn plot_map(
     map: &ConfigurationMap,
@@ -160,18 +200,27 @@ pub fn plot_map(
     let staged = Staged::new(path);
     let tmp = staged.tmp().to_path_buf();
     let root = SVGBackend::new(&tmp, (760, 680)).into_drawing_area();
-    let mut ch = degree_chart(&root, title, 0.0..360.0, 360.0)?;
+    let mut ch = degree_chart(&root, title)?;
     ch.configure_mesh()
-        .x_labels(13)
-        .y_labels(13)
         .x_label_formatter(&|v| format!("{v:.0}"))
         .y_label_formatter(&|v| format!("{v:.0}"))
         .light_line_style(WHITE)
         .x_desc("initial orientation θ0 (deg)")
         .y_desc("final orientation θf (deg)")
         .draw()?;
+    // Colours go to the real bands in order; transitional ones are grey and share one entry.
+    let mut colours = Vec::with_capacity(map.bands.len());
+    let mut next = 0;
+    for band in &map.bands {
+        if is_transitional(band) {
+            colours.push(TRANSITIONAL);
+        } else {
+            colours.push(PALETTE[next % PALETTE.len()]);
+            next += 1;
+        }
+    }
     for (j, band) in map.bands.iter().enumerate() {
-        let colour = PALETTE[j % PALETTE.len()];
+        let colour = colours[j];
         let runs: Vec<(f64, f64)> = band
             .initial_ranges_deg
             .iter()
@@ -187,6 +236,9 @@ pub fn plot_map(
             }
         }
         ch.draw_series(shades)?;
+        if is_transitional(band) {
+            continue;
+        }
         for &(x0, x1) in &runs {
             for y in [band.adjusted_min_deg, band.adjusted_max_deg] {
                 ch.draw_series(DashedLineSeries::new(
@@ -203,15 +255,24 @@ pub fn plot_map(
             .filter(|s| s.band == Some(j))
             .map(|s| Circle::new((s.theta0_deg, s.theta_final_deg), 2, colour.filled()));
         ch.draw_series(points)?
-            .label(format!(
-                "B{} [{:.1}°, {:.1}°], mean ± sd {:.1}° ± {:.1}°",
-                j + 1,
-                band.final_min_deg,
-                band.final_max_deg,
-                band.mean_deg,
-                band.sd_deg
-            ))
+            .label(band_label(j, band))
             .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
+    }
+    let transitional: Vec<usize> = (0..map.bands.len())
+        .filter(|&j| is_transitional(&map.bands[j]))
+        .collect();
+    if !transitional.is_empty() {
+        let points = map
+            .samples
+            .iter()
+            .filter(|s| s.band.is_some_and(|j| transitional.contains(&j)));
+        let n = points.clone().count();
+        ch.draw_series(
+            points
+                .map(|s| Circle::new((s.theta0_deg, s.theta_final_deg), 2, TRANSITIONAL.filled())),
+        )?
+        .label(transitional_label(n, transitional.len()))
+        .legend(|(x, y)| Circle::new((x + 8, y), 4, TRANSITIONAL.filled()));
     }
     for r in &map.no_contact_ranges_deg {
         for (x0, x1) in run_pieces(*r, step_deg) {
@@ -289,7 +350,8 @@ fn d_label(v: f64) -> String {
     }
 }
 
-/// A chart of orientations on `view` (up, tick labels wrapped into [0, 360)) against contact
+/// A chart of orientations on `view` (up, ticked on multiples of a step dividing 360, labels
+/// wrapped into [0, 360)) against contact
 /// parameter d over `x`, on the body below a [`header_with_legend`].
 pub(crate) fn d_chart<'a, 'b>(
     body: &'a DrawingArea<SVGBackend<'b>, Shift>,
@@ -297,15 +359,14 @@ pub(crate) fn d_chart<'a, 'b>(
     view: DegreeView,
     x_desc: &str,
     y_desc: &str,
-) -> ReportResult<Chart<'a, 'b>> {
+) -> ReportResult<DChart<'a, 'b>> {
     let mut ch = ChartBuilder::on(body)
         .margin(14)
         .margin_top(4)
         .x_label_area_size(40)
         .y_label_area_size(50)
-        .build_cartesian_2d(x, view.lo..view.hi)?;
+        .build_cartesian_2d(x, degree_axis(view.lo..view.hi, 15))?;
     ch.configure_mesh()
-        .y_labels(15)
         .y_label_formatter(&|v| DegreeView::label(*v))
         .x_label_formatter(&|v| d_label(*v))
         .light_line_style(WHITE)

@@ -3,7 +3,7 @@
 //! outside the view named in the caption below the axis) and the goal's tolerance bands shaded and
 //! labelled. Counts are whole numbers.
 
-use super::plot_zoom::{degree_view, DegreeView};
+use super::plot_zoom::{degree_axis, degree_view, DegreeView};
 use crate::engine::Summary;
 use crate::geometry::wrap_deg;
 use crate::output::Staged;
@@ -88,11 +88,10 @@ pub fn plot_orientation_histogram(scene: &Scene, s: &Summary, path: &Path) -> Re
         .margin(15)
         .x_label_area_size(40)
         .y_label_area_size(55)
-        .build_cartesian_2d(view.lo..view.hi, 0.0..ymax)?;
+        .build_cartesian_2d(degree_axis(view.lo..view.hi, 12), 0.0..ymax)?;
     ch.configure_mesh()
         .x_desc(x_desc)
         .y_desc("parts")
-        .x_labels(12)
         .x_label_formatter(&|v| DegreeView::label(*v))
         .y_label_formatter(&|v| {
             if (v - v.round()).abs() < 1e-6 {

@@ -3,6 +3,7 @@
 //! parameter; without a sweep: the share of every outcome class that occurred, with whiskers.
 
 use crate::engine::PartOutcome;
+use crate::mechanics::limits::short;
 use crate::output::Staged;
 use crate::report::ReportResult;
 use crate::study::mc::report::McReport;
@@ -63,7 +64,7 @@ fn success_lines(
         .y_desc("success rate (%), 95% interval")
         .x_label_formatter(&|v| {
             if *v == 0.0 || (0.01..1000.0).contains(&v.abs()) {
-                format!("{}", (v * 1e4).round() / 1e4)
+                short((v * 1e4).round() / 1e4)
             } else {
                 format!("{v:.2e}")
             }
@@ -75,7 +76,7 @@ fn success_lines(
         Some(a1) => (0..a1.values.len())
             .map(|k| {
                 (
-                    format!("{} = {}", a1.parameter, a1.values[k]),
+                    format!("{} = {}", a1.parameter, short(a1.values[k])),
                     (0..axis0.values.len())
                         .map(|i| i * a1.values.len() + k)
                         .collect(),

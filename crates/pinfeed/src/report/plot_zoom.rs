@@ -4,6 +4,41 @@
 //! drawn in one piece. Tick labels print the angle wrapped into [0, 360).
 
 use crate::geometry::wrap_deg;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
+use plotters::coord::types::RangedCoordf64;
+
+/// A plotters axis of degrees whose ticks are [`degree_ticks`] (on multiples of a step dividing
+/// 360); no light mesh lines.
+pub(crate) struct DegreeAxis {
+    range: RangedCoordf64,
+    ticks: Vec<f64>,
+}
+
+impl Ranged for DegreeAxis {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.range.map(value, limit)
+    }
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+    fn range(&self) -> std::ops::Range<f64> {
+        self.range.range()
+    }
+}
+
+/// The degree axis over `range` with at most `max` ticks ([`degree_ticks`]).
+pub(crate) fn degree_axis(range: std::ops::Range<f64>, max: usize) -> DegreeAxis {
+    DegreeAxis {
+        ticks: degree_ticks(range.start, range.end, max),
+        range: range.into(),
+    }
+}
 
 /// An unwrapped degree range of an axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +85,32 @@ impl DegreeView {
         let w = if (w - 360.0).abs() < 1e-6 { 0.0 } else { w };
         format!("{w:.0}")
     }
+}
+
+/// Tick steps of an orientation axis (degrees): each divides 360, so ticks at its multiples put
+/// one on 0°/360° and keep the same spacing across it (a step of 50° would label an axis crossing
+/// 360° "…, 300, 350, 40, 90": 400 wrapped).
+const DEGREE_STEPS: [f64; 12] = [
+    1.0, 2.0, 5.0, 10.0, 15.0, 20.0, 30.0, 45.0, 60.0, 90.0, 120.0, 180.0,
+];
+
+/// Tick positions over [lo, hi] (degrees, unwrapped): the multiples of the smallest step in
+/// [`DEGREE_STEPS`] that gives at most `max` ticks (at least 2 asked for). Labelled wrapped into
+/// [0, 360) ([`DegreeView::label`]) they read evenly spaced, with 0 where the axis crosses
+/// 0°/360°.
+pub fn degree_ticks(lo: f64, hi: f64, max: usize) -> Vec<f64> {
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+        return Vec::new();
+    }
+    let max = max.max(2);
+    let step = DEGREE_STEPS
+        .iter()
+        .copied()
+        .find(|s| (hi / s).floor() - (lo / s).ceil() < max as f64)
+        .unwrap_or(180.0);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last).map(|k| k as f64 * step).collect()
 }
 
 /// The view holding every arc `(start, width)` (degrees), widened each side by `margin` (at least
@@ -144,6 +205,50 @@ mod tests {
         let arcs: Vec<(f64, f64)> = (0..12).map(|k| (k as f64 * 30.0, 5.0)).collect();
         assert_eq!(degree_view(&arcs, 5.0, 0.0, 30.0), DegreeView::FULL);
         assert_eq!(degree_view(&[], 5.0, 0.0, 30.0), DegreeView::FULL);
+    }
+
+    /// Issue 57 item 16: an axis across 0°/360° was labelled "…, 350, 40" (plotters' 50° step
+    /// put a tick at 400°). Ticks are multiples of a step dividing 360: evenly spaced once
+    /// wrapped, with a 0 where the axis crosses 360°.
+    #[test]
+    fn ticks_across_360_read_evenly_with_a_zero() {
+        for (lo, hi, max) in [
+            (60.0, 420.0, 15),
+            (-40.0, 300.0, 15),
+            (250.0, 430.0, 8),
+            (353.0, 367.0, 15),
+            (0.0, 360.0, 13),
+            (-200.0, 200.0, 7),
+        ] {
+            let ticks = degree_ticks(lo, hi, max);
+            assert!(
+                ticks.len() >= 2 && ticks.len() <= max,
+                "{lo}..{hi}: {ticks:?}"
+            );
+            assert!(ticks.iter().all(|t| (lo..=hi).contains(t)));
+            let step = ticks[1] - ticks[0];
+            assert_eq!(360.0 % step, 0.0, "{lo}..{hi}: step {step}");
+            let labels: Vec<f64> = ticks
+                .iter()
+                .map(|&t| DegreeView::label(t).parse().unwrap())
+                .collect();
+            for w in labels.windows(2) {
+                // Each label is the one before plus the step, around the circle.
+                assert_eq!((w[0] + step) % 360.0, w[1], "{lo}..{hi}: {labels:?}");
+            }
+            if lo < 360.0 && hi > 360.0 || lo < 0.0 && hi > 0.0 {
+                assert!(labels.contains(&0.0), "{lo}..{hi}: {labels:?}");
+            }
+        }
+        let labels: Vec<String> = degree_ticks(60.0, 420.0, 15)
+            .into_iter()
+            .map(DegreeView::label)
+            .collect();
+        assert_eq!(
+            labels.join(", "),
+            "60, 90, 120, 150, 180, 210, 240, 270, 300, 330, 0, 30, 60"
+        );
+        assert_eq!(degree_ticks(0.0, 360.0, 13).len(), 13);
     }
 
     #[test]

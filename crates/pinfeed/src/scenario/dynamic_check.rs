@@ -250,7 +250,16 @@ fn control_mode(
                     v
                 }
             };
+            // Left out: the part's own support. An empty list is refused like an empty `mu_c`
+            // (it would silently mean the same as leaving the key out).
+            let given_empty = rb.support.as_ref().is_some_and(|v| v.is_empty());
             let support = rb.support.unwrap_or_default();
+            if given_empty {
+                return Err(c.err(
+                    "controller.belief.support",
+                    "must list 1 or 2 support classes, \"uniform\" and/or \"tripod\", got none (leave the key out for the part's own support)",
+                ));
+            }
             if support.len() > 2 {
                 return Err(c.err(
                     "controller.belief.support",

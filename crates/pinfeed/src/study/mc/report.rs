@@ -8,6 +8,7 @@
 use super::tally::PointTally;
 use super::Study;
 use crate::engine::{OutcomeCounts, PartOutcome};
+use crate::mechanics::limits::short;
 use crate::statistics::wilson_interval;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -339,7 +340,7 @@ pub fn table(r: &McReport) -> String {
             .header
             .sweep
             .iter()
-            .map(|a| format!("{}", p.values[&a.parameter]))
+            .map(|a| short(p.values[&a.parameter]))
             .collect();
         row.push(p.samples.to_string());
         for c in &shown {
@@ -405,7 +406,7 @@ pub fn markdown(r: &McReport, figure: &str) -> String {
             a.parameter,
             a.values
                 .iter()
-                .map(|v| v.to_string())
+                .map(|&v| short(v))
                 .collect::<Vec<_>>()
                 .join(", ")
         ));
@@ -429,7 +430,7 @@ pub fn markdown(r: &McReport, figure: &str) -> String {
             } else {
                 p.values
                     .iter()
-                    .map(|(k, v)| format!("{k} = {v}"))
+                    .map(|(k, v)| format!("{k} = {}", short(*v)))
                     .collect::<Vec<_>>()
                     .join(", ")
             };

@@ -23,9 +23,9 @@ use rand::RngExt;
 use std::path::{Path, PathBuf};
 
 /// What a case of the scenarios target is (in the fuzz report).
-pub const SCENARIO_DESCRIPTION: &str = "the bundled scenarios/*.toml and tests/fixtures/scenarios/*.toml, three times in four a bundled one, with 1–4 text mutations (one half the time) (numbers set to extremes: 0, negatives, 5e-324, 1e-200, 1e308, nan, ±inf, huge integers, or scaled by 10^±k; known keys set to extremes or inserted; lines deleted, duplicated or swapped; keys renamed; types changed; sections dropped; truncation), parsed, compiled and run for at most 3 parts";
+pub const SCENARIO_DESCRIPTION: &str = "the bundled scenarios/*.toml and tests/fixtures/scenarios/*.toml, three times in four a bundled one, with 1–4 text mutations (one half the time) (numbers set to extremes: 0, negatives, 5e-324, 1e-200, 1e308, nan, ±inf, huge integers, or scaled by 10^±k; known keys set to extremes or inserted; lines deleted, duplicated or swapped; keys renamed; types changed; sections dropped; truncation; `[controller.belief]` lists with duplicates, empty, unknown or out-of-range entries; `[uncertain.*]` tables of every ranged study parameter at, just inside and just beyond its range's ends), parsed, compiled and run for at most 3 parts";
 /// What a case of the studies target is (in the fuzz report).
-pub const STUDY_DESCRIPTION: &str = "the bundled studies/*.toml and tests/fixtures/studies/*.toml, mutated as the scenarios are (plus [uncertain.*] tables, sweeps and the scenario path), parsed, compiled and run for 3 samples at the first and last sweep points";
+pub const STUDY_DESCRIPTION: &str = "the bundled studies/*.toml and tests/fixtures/studies/*.toml, mutated as the scenarios are (plus [uncertain.*] tables — each ranged parameter's value at, just inside and just beyond the ends of its documented range, as a fixed value, a uniform's max, a normal's mean or truncation to one value, a triangular's mode — sweeps and the scenario path), parsed, compiled and run for 3 samples at the first and last sweep points";
 
 /// Parts run per accepted scenario (bounded: a case never runs a whole feed).
 pub const PARTS_PER_CASE: u64 = 3;
@@ -221,13 +221,107 @@ pub enum Mutation {
         /// Thousandths of the file kept, in [0, 1000).
         permille: u32,
     },
+    /// Replace the study's `[uncertain.P]` table (P = `RANGED[param]`) by one whose value lies
+    /// at, just inside or just beyond an end of P's documented range ([`range_value`]), as a
+    /// fixed value, a uniform's max, a normal's mean (sd the range's width, or truncated to the
+    /// value alone) or a triangular's mode ([`ranged_table`]).
+    Ranged {
+        /// Index into [`RANGED`] of the parameter (modulo their number).
+        param: usize,
+        /// Picks the distribution (modulo 5).
+        form: usize,
+        /// Picks the value (modulo 7).
+        at: usize,
+    },
+    /// Set a `[controller.belief]` list (`support` or `mu_c`) to `BELIEF_LISTS[key].1[list]`:
+    /// duplicates, empty, unknown or out-of-range entries, too many values.
+    Belief {
+        /// Index into [`BELIEF_LISTS`] of the key (modulo their number).
+        key: usize,
+        /// Index of the list (modulo the key's lists).
+        list: usize,
+    },
+}
+
+/// The study parameters, each with a documented range ([`crate::study::mc::compile::domain`]),
+/// that [`Mutation::Ranged`] sets.
+pub use crate::study::mc::compile::DISTRIBUTION_PARAMETERS as RANGED;
+
+/// The lists [`Mutation::Belief`] gives a `[controller.belief]` key (issue 57 item 7: a support
+/// listed twice ran with the class counted twice).
+pub const BELIEF_LISTS: [(&str, &[&str]); 2] = [
+    (
+        "support",
+        &[
+            "[\"uniform\"]",
+            "[\"tripod\"]",
+            "[\"uniform\", \"tripod\"]",
+            "[\"uniform\", \"uniform\"]",
+            "[\"tripod\", \"uniform\", \"tripod\"]",
+            "[]",
+            "[\"smooth\"]",
+            "[\"bogus\"]",
+            "\"uniform\"",
+        ],
+    ),
+    (
+        "mu_c",
+        &[
+            "[0.5]",
+            "[0.3, 0.7]",
+            "[0.5, 0.5]",
+            "[0.3, 0.5, 0.3]",
+            "[]",
+            "[0, 5]",
+            "[-0.1]",
+            "[5.01]",
+            "[nan]",
+            "[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6]",
+            "[0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7]",
+        ],
+    ),
+];
+
+/// A value for a parameter whose range is [lo, hi]: `at` (modulo 7) picks lo, hi, just below lo,
+/// just above hi, just inside lo, just inside hi, or the middle.
+pub fn range_value(lo: f64, hi: f64, at: usize) -> f64 {
+    let step = |x: f64| (x.abs() * 1e-9).max(1e-12);
+    match at % 7 {
+        0 => lo,
+        1 => hi,
+        2 => lo - step(lo),
+        3 => hi + step(hi),
+        4 => lo + step(lo),
+        5 => hi - step(hi),
+        _ => 0.5 * (lo + hi),
+    }
+}
+
+/// The `[uncertain.NAME]` table of [`Mutation::Ranged`]: `v` (a value from [`range_value`]) as a
+/// fixed value, a uniform's max (from lo), a normal's mean with the range's width as its sd, a
+/// normal truncated to `v` alone, or a triangular's mode over [lo, hi] (`form` modulo 5). Numbers
+/// in exponent notation, every digit kept.
+pub fn ranged_table(name: &str, form: usize, v: f64) -> Vec<String> {
+    let ((lo, hi), _) = crate::study::mc::compile::domain(name);
+    let mut t = vec![format!("[uncertain.{name}]")];
+    let fields: Vec<(&str, f64)> = match form % 5 {
+        0 => vec![("value", v)],
+        1 => vec![("min", lo), ("max", v)],
+        2 => vec![("mean", v), ("sd", hi - lo)],
+        3 => vec![("mean", v), ("sd", 1.0), ("min", v), ("max", v)],
+        _ => vec![("min", lo), ("mode", v), ("max", hi)],
+    };
+    let kind = ["fixed", "uniform", "normal", "normal", "triangular"][form % 5];
+    t.push(format!("distribution = \"{kind}\""));
+    t.extend(fields.into_iter().map(|(k, x)| format!("{k} = {x:e}")));
+    t
 }
 
 impl Mutation {
     /// A random mutation.
     pub fn random(rng: &mut ChaCha8Rng) -> Mutation {
         let which = rng.random_range(0..10_000usize);
-        match rng.random_range(0..20u32) {
+        match rng.random_range(0..23u32) {
             0..=5 => Mutation::Number {
                 which,
                 value: rng.random_range(0..EXTREMES.len()),
@@ -255,6 +349,15 @@ impl Mutation {
                 kind: rng.random_range(0..4),
             },
             18 => Mutation::DropSection { which },
+            19 | 20 => Mutation::Ranged {
+                param: rng.random_range(0..RANGED.len()),
+                form: rng.random_range(0..5),
+                at: rng.random_range(0..7),
+            },
+            21 => Mutation::Belief {
+                key: rng.random_range(0..BELIEF_LISTS.len()),
+                list: rng.random_range(0..16),
+            },
             _ => Mutation::Truncate {
                 permille: rng.random_range(0..1000),
             },
@@ -352,6 +455,15 @@ pub(crate) fn header_name(line: &str) -> Option<&str> {
     Some(t.trim())
 }
 
+/// The end (exclusive) of the section whose header is line `h`: the next header, or the end.
+fn section_end(lines: &[String], h: usize) -> usize {
+    lines[h + 1..]
+        .iter()
+        .position(|l| is_header(l))
+        .map(|p| h + 1 + p)
+        .unwrap_or(lines.len())
+}
+
 fn set_key(lines: &mut Vec<String>, section: &str, key: &str, value: &str) {
     // The section's line range: top level runs to the first header.
     let (start, end) = if section.is_empty() {
@@ -364,14 +476,7 @@ fn set_key(lines: &mut Vec<String>, section: &str, key: &str, value: &str) {
         )
     } else {
         match lines.iter().position(|l| header_name(l) == Some(section)) {
-            Some(h) => {
-                let end = lines[h + 1..]
-                    .iter()
-                    .position(|l| is_header(l))
-                    .map(|p| h + 1 + p)
-                    .unwrap_or(lines.len());
-                (h + 1, end)
-            }
+            Some(h) => (h + 1, section_end(lines, h)),
             None => {
                 lines.push(String::new());
                 lines.push(format!("[{section}]"));
@@ -470,13 +575,30 @@ pub fn apply(text: &str, m: &Mutation) -> String {
         Mutation::DropSection { which } => {
             let headers: Vec<usize> = (0..lines.len()).filter(|&i| is_header(&lines[i])).collect();
             if let Some(&h) = headers.get(which % headers.len().max(1)) {
-                let end = lines[h + 1..]
-                    .iter()
-                    .position(|l| is_header(l))
-                    .map(|p| h + 1 + p)
-                    .unwrap_or(lines.len());
+                let end = section_end(&lines, h);
                 lines.drain(h..end);
             }
+        }
+        Mutation::Ranged { param, form, at } => {
+            let name = RANGED[param % RANGED.len()];
+            let ((lo, hi), _) = crate::study::mc::compile::domain(name);
+            let header = format!("uncertain.{name}");
+            // The table replaces the file's own for the parameter, if it has one.
+            if let Some(h) = lines.iter().position(|l| header_name(l) == Some(&header)) {
+                let end = section_end(&lines, h);
+                lines.drain(h..end);
+            }
+            lines.push(String::new());
+            lines.extend(ranged_table(name, form, range_value(lo, hi, at)));
+        }
+        Mutation::Belief { key, list } => {
+            let (k, lists) = BELIEF_LISTS[key % BELIEF_LISTS.len()];
+            set_key(
+                &mut lines,
+                "controller.belief",
+                k,
+                lists[list % lists.len()],
+            );
         }
         Mutation::Truncate { permille } => {
             let mut cut = text.len() * (permille.min(1000) as usize) / 1000;
@@ -627,14 +749,14 @@ pub fn classify_invalid(i: &InvalidScenario) -> CaseReport {
     }
 }
 
-fn classify_scenario_error(e: &ScenarioError) -> CaseReport {
+pub(crate) fn classify_scenario_error(e: &ScenarioError) -> CaseReport {
     match e.invalid() {
         Some(i) => classify_invalid(i),
         None => CaseReport::new(Class::Named), // I/O: names the path and the reason
     }
 }
 
-fn engine_error(e: &EngineError) -> CaseReport {
+pub(crate) fn engine_error(e: &EngineError) -> CaseReport {
     match e {
         EngineError::NonFiniteTime { .. } => CaseReport::with(Class::NonFinite, e.to_string()),
         EngineError::OnlineModel(se) => classify_scenario_error(se),

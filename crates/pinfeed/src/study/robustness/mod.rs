@@ -6,7 +6,8 @@
 //! * [`files`]: scenario and study files mutated from the bundled ones and the test fixtures;
 //! * [`contacts`]: random star polygons pushed by point and disc pins at two tolerances;
 //! * [`polygons`]: vertex lists at extreme magnitudes, near-degenerate and self-intersecting;
-//! * [`pairs`], [`merges`]: scenarios with pairs of keys set together, edited shard files.
+//! * [`pairs`], [`merges`]: scenarios with pairs of keys set together, edited shard files;
+//! * [`compares`]: `pinfeed compare` of two or three designs in both orders and each alone.
 //!
 //! The plans and csvs targets fuzz `pinfeed` command lines through the command's own argument
 //! parser: their cases come from the command line, given to the driver as [`CommandCases`].
@@ -22,6 +23,7 @@
 //! stops, so runaway threads cannot pile up).
 
 pub mod commands;
+pub mod compares;
 pub mod contacts;
 pub mod counts;
 pub mod files;
@@ -68,11 +70,13 @@ pub enum Target {
     Csvs,
     /// Edited Monte Carlo shard sets given to `merge`.
     Merges,
+    /// `compare` of bundled designs in both orders and each alone.
+    Compares,
 }
 
 impl Target {
     /// Every target, in report order.
-    pub const ALL: [Target; 8] = [
+    pub const ALL: [Target; 9] = [
         Target::Scenarios,
         Target::Studies,
         Target::Contacts,
@@ -81,6 +85,7 @@ impl Target {
         Target::Plans,
         Target::Csvs,
         Target::Merges,
+        Target::Compares,
     ];
     /// The target's name on the command line and in the report (`scenarios`, `contacts`, …).
     pub fn name(self) -> &'static str {
@@ -93,6 +98,7 @@ impl Target {
             Target::Plans => "plans",
             Target::Csvs => "csvs",
             Target::Merges => "merges",
+            Target::Compares => "compares",
         }
     }
     /// Mixed into the seed so that the targets draw different streams.
@@ -106,6 +112,7 @@ impl Target {
             Target::Plans => 0x1000_0006,
             Target::Csvs => 0x1000_0007,
             Target::Merges => 0x1000_0008,
+            Target::Compares => 0x1000_0009,
         }
     }
     /// What a case of this target is.
@@ -119,6 +126,7 @@ impl Target {
             Target::Plans => PLANS_DESCRIPTION,
             Target::Csvs => CSVS_DESCRIPTION,
             Target::Merges => merges::DESCRIPTION,
+            Target::Compares => compares::DESCRIPTION,
         }
     }
 }
@@ -313,6 +321,8 @@ pub struct Corpus {
     pub files: files::Seeds,
     /// The seed scenarios of the pairs target.
     pub pair_seeds: Vec<(PathBuf, String)>,
+    /// The seed scenarios of the compares target.
+    pub compare_seeds: Vec<(PathBuf, String)>,
     root: PathBuf,
     /// The merges target's shards, made on first use.
     shards: std::sync::OnceLock<Result<Vec<(String, String)>, merges::ShardsError>>,
@@ -327,6 +337,7 @@ impl Corpus {
         let files = files::Seeds::load(root)?;
         Ok(Corpus {
             pair_seeds: pairs::seeds(&files),
+            compare_seeds: compares::seeds(&files),
             files,
             root: root.to_path_buf(),
             shards: std::sync::OnceLock::new(),
@@ -407,6 +418,10 @@ pub fn run_case(target: Target, corpus: &Corpus, seed: u64, index: u64) -> CaseR
             Ok(shards) => merges::run(shards, &merges::edits(&mut rng), scratch().path()),
             Err(e) => CaseReport::with(Class::Unlocated, format!("cannot make the shards: {e}")),
         },
+        Target::Compares => {
+            let c = compares::CompareCase::random(&corpus.compare_seeds, &mut rng);
+            compares::run(&c, &corpus.compare_seeds, scratch().path())
+        }
     }
 }
 
@@ -441,6 +456,16 @@ pub fn case_input(target: Target, corpus: &Corpus, seed: u64, index: u64) -> Str
             "studies/quickstart_mu_tripod.toml (3 samples)",
             merges::edits(&mut rng)
         ),
+        Target::Compares => {
+            let c = compares::CompareCase::random(&corpus.compare_seeds, &mut rng);
+            let mut s = format!("{}\n", c.command(&corpus.compare_seeds));
+            for &k in &c.files {
+                if let Some((path, text)) = corpus.compare_seeds.get(k) {
+                    s.push_str(&format!("# {}:\n{text}", path.display()));
+                }
+            }
+            s
+        }
     }
 }
 
@@ -613,7 +638,8 @@ is finite (a contact: `ok` at both tolerances and agreeing within 1°); *other s
 contacts that ended with a named status other than `ok` at the default tolerance; *panics*, \
 *hangs* (slower than the budget) and *non-finite outputs* are problems; a *self-check \
 disagreement* is a contact `ok` at both tolerances whose rotations differ by more than 1°, or a \
-plan whose written scenario the parser refuses; *ok, then failed* is a contact `ok` at the \
+plan whose written scenario the parser refuses, or a design whose row of a comparison depends on \
+the order of the files or on the other designs; *ok, then failed* is a contact `ok` at the \
 default tolerance that ends in another status at the 1000× tighter one (listed, not a wrong \
 answer); an *edited shard accepted* is a merge that succeeded though a shard's content was \
 changed.\n\n",
@@ -680,7 +706,13 @@ changed.\n\n",
 /// The totals the acceptance targets are stated in: the new surface's cases and their problems,
 /// and the contacts (with moving pins apart) and their disagreements.
 fn totals(tallies: &[(Target, Tally)]) -> String {
-    let surface = [Target::Pairs, Target::Plans, Target::Csvs, Target::Merges];
+    let surface = [
+        Target::Pairs,
+        Target::Plans,
+        Target::Csvs,
+        Target::Merges,
+        Target::Compares,
+    ];
     let of = |ts: &[Target], c: Option<Class>| -> u64 {
         tallies
             .iter()
@@ -691,7 +723,7 @@ fn totals(tallies: &[(Target, Tally)]) -> String {
     let mut s = String::from("\n## Totals\n\n");
     if tallies.iter().any(|(t, _)| surface.contains(t)) {
         s.push_str(&format!(
-            "* sensing/actuator/controller/policy key pairs, plan argument sets, validate/calibrate CSV files and edited merge shards: **{}** generated; {} panics, {} hangs, {} non-finite outputs, {} unlocated errors, {} self-check disagreements, {} edited shards accepted\n",
+            "* sensing/actuator/controller/policy key pairs, plan argument sets, validate/calibrate CSV files, edited merge shards and compared designs: **{}** generated; {} panics, {} hangs, {} non-finite outputs, {} unlocated errors, {} self-check disagreements, {} edited shards accepted\n",
             of(&surface, None),
             of(&surface, Some(Class::Panic)),
             of(&surface, Some(Class::Hang)),
