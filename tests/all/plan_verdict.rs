@@ -121,9 +121,11 @@ fn a_plan_the_time_limit_stops_exits_1_and_says_which_search_it_stopped() {
 
 #[test]
 fn a_design_whose_time_limit_binds_keeps_its_searches_to_their_share_and_says_what_it_cut() {
-    // lshape's depth-8 pin search cannot finish in 60% of 2 s: it stops at its share, and the
-    // line check gets what is left of the limit, no more, and says how many parts it ran.
-    let limit_s = 2.0;
+    // lshape's depth-8 pin search cannot finish in 60% of 5 s: it stops at its share, and the
+    // line check gets what is left of the limit, no more, and says how many parts it ran. (The
+    // tolerances allow for a loaded machine, where one pass may take a second; a search that
+    // took the whole limit would overrun them.)
+    let limit_s = 5.0;
     let (code, v, err) = plan_any(&[
         "plan",
         "--nominal",
@@ -133,7 +135,7 @@ fn a_design_whose_time_limit_binds_keeps_its_searches_to_their_share_and_says_wh
         "--depth",
         "8",
         "--time-limit",
-        "2",
+        "5",
         "--no-write",
         "--json",
     ]);
@@ -147,13 +149,14 @@ fn a_design_whose_time_limit_binds_keeps_its_searches_to_their_share_and_says_wh
         .iter()
         .map(|c| c["search"]["elapsed_s"].as_f64().unwrap())
         .sum();
-    // The searches stop at 60% of the limit (checked at each pass: a few ms late at most).
+    // The searches stop at 60% of the limit (checked at each pass: a few ms late at most on an
+    // idle machine).
     assert!(
-        searched <= 0.6 * limit_s + 0.3,
+        searched <= 0.6 * limit_s + 1.0,
         "the searches took {searched} s of a {limit_s} s limit"
     );
     let elapsed = v["elapsed_s"].as_f64().unwrap();
-    assert!(elapsed <= limit_s + 1.0, "the design took {elapsed} s");
+    assert!(elapsed <= limit_s + 1.5, "the design took {elapsed} s");
     let limit = v["limit"].as_str().unwrap();
     let parts = v["line_check"]["parts"].as_u64().unwrap();
     let asked = 10_000;
