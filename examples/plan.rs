@@ -1,5 +1,6 @@
 //! A short design search: fixed pins that orient tripoly1 parts, found within a 3 s time limit and
-//! checked on the simulated line with 500 parts.
+//! checked on the simulated line with 500 parts under the default uncertainty (friction ±0.1,
+//! pins ±0.5 mm off; `o.uncertainty = UncertaintyChoice::Nominal` plans for nominal physics).
 //!
 //!     cargo run --release --example plan
 
@@ -16,6 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let d = design(&o, &|_| {})?;
 
+    println!("planned against {}", o.uncertainty().describe());
     println!("{}", d.message);
     if let Some(c) = d.chosen() {
         println!(
@@ -33,9 +35,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 1e3 * ob.y_m
             );
         }
-        if let Some(check) = &c.line_check {
+        if let Some(check) = c.verdict_check() {
             println!(
-                "line check: {} of {} parts oriented ({:.1}%)",
+                "verdict's check: {} of {} parts oriented ({:.1}%)",
                 check.success,
                 check.parts,
                 100.0 * check.success_rate
