@@ -23,10 +23,13 @@ use pinfeed::report::plan_summary::{self, write_design, DesignPaths};
 use pinfeed::report::versioned;
 use pinfeed::study::mc::report as mc_report;
 use pinfeed::study::mc::{run as mc_run, MAX_SAMPLES};
+use pyo3::conversion::FromPyObjectOwned;
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyCFunction, PyDict, PyTuple};
+use pyo3::IntoPyObjectExt;
+use std::ffi::CStr;
 use std::path::PathBuf;
 
 create_exception!(
@@ -66,7 +69,6 @@ fn keyword(field: &str) -> String {
 /// The part a spec names (`tripoly1`, `rect:2:1`, `vertices:0,0 4,0 …`): what `pinfeed part
 /// --json` prints, as JSON text. A spec that names no part is refused with the reason, as
 /// `pinfeed contact` refuses it (`part 'SPEC': …`).
-#[pyfunction]
 fn part(py: Python<'_>, spec: &str) -> PyResult<String> {
     py.detach(|| {
         let poly = named::part_from_spec(spec).map_err(|source| {
@@ -85,8 +87,6 @@ fn part(py: Python<'_>, spec: &str) -> PyResult<String> {
 }
 
 /// One pin (or fence) pass, as `pinfeed contact --json` prints it (JSON text).
-#[pyfunction]
-#[pyo3(signature = (part, theta0, d, mu_c, model, mu_s, pin_radius, pin_speed, support, tol, fence, tail))]
 #[allow(clippy::too_many_arguments)]
 fn push(
     py: Python<'_>,
@@ -144,8 +144,6 @@ struct Columns {
 /// A line run of a scenario file or bundled scenario, as `pinfeed run SCENARIO` runs it (same
 /// seed, same numbers): the summary's JSON (`pinfeed run --json`) and the per-part records as a
 /// dict of lists. Writes no file.
-#[pyfunction]
-#[pyo3(signature = (scenario, parts=None, seed=None))]
 fn run<'py>(
     py: Python<'py>,
     scenario: PathBuf,
@@ -205,8 +203,6 @@ fn run<'py>(
 /// A Monte Carlo study (a study file or a bundled study), as `pinfeed mc STUDY` runs it: the
 /// report's JSON (`pinfeed mc --json`, the same numbers for any number of threads) and the
 /// study's warnings. Writes no file.
-#[pyfunction]
-#[pyo3(signature = (study, samples=None, threads=None))]
 fn mc(
     py: Python<'_>,
     study: PathBuf,
@@ -242,8 +238,7 @@ fn mc(
 
 /// The settings of a design, by the names of `pinfeed plan`'s flags (`--time-limit` →
 /// `time_limit`); None keeps the command's default.
-#[derive(Debug, Default, FromPyObject)]
-#[pyo3(from_item_all)]
+#[derive(Debug, Default)]
 struct PlanSettings {
     scale: Option<f64>,
     name: Option<String>,
@@ -370,8 +365,6 @@ fn options(part: &str, s: PlanSettings) -> PyResult<DesignOptions> {
 /// A design for a part, as `pinfeed plan --part PART --json` prints it (JSON text, its
 /// `scenario` the design's scenario as TOML text). Writes the design's files (scenario, policy,
 /// drawing) only when `out` is given (the scenario's path, as `--out`).
-#[pyfunction]
-#[pyo3(signature = (part, settings, out=None))]
 fn plan(
     py: Python<'_>,
     part: &str,
@@ -396,7 +389,6 @@ fn plan(
 }
 
 /// The bundled scenarios and studies: (name, kind, description).
-#[pyfunction]
 fn examples() -> Vec<(String, String, String)> {
     pinfeed::study::bundled::all()
         .iter()
@@ -410,18 +402,165 @@ fn examples() -> Vec<(String, String, String)> {
         .collect()
 }
 
-/// The extension module of the Python package `pinfeed`.
-#[pymodule]
-#[pyo3(name = "_native")]
-fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add("PinfeedError", m.py().get_type::<PinfeedError>())?;
+/// A positional argument of a native function (the Python layer passes every one).
+fn arg<'py, T: FromPyObjectOwned<'py>>(args: &Bound<'py, PyTuple>, i: usize) -> PyResult<T>
+where
+    for<'a> <T as FromPyObject<'a, 'py>>::Error: Into<PyErr>,
+{
+    args.get_item(i)?.extract::<T>().map_err(Into::into)
+}
+
+/// An item of a settings dict: None when missing or None.
+fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Option<T>>
+where
+    for<'a> <T as FromPyObject<'a, 'py>>::Error: Into<PyErr>,
+{
+    match d.get_item(key)? {
+        Some(v) if !v.is_none() => v.extract::<T>().map(Some).map_err(Into::into),
+        _ => Ok(None),
+    }
+}
+
+impl PlanSettings {
+    fn from_dict(d: &Bound<'_, PyDict>) -> PyResult<PlanSettings> {
+        Ok(PlanSettings {
+            scale: item(d, "scale")?,
+            name: item(d, "name")?,
+            modes: item(d, "modes")?,
+            objective: item(d, "objective")?,
+            feed: item(d, "feed")?,
+            jitter: item(d, "jitter")?,
+            lateral: item(d, "lateral")?,
+            mu_c: item(d, "mu_c")?,
+            uncertainty: item(d, "uncertainty")?,
+            mu_c_range: item(d, "mu_c_range")?,
+            tripod: item(d, "tripod")?,
+            pin_radius: item(d, "pin_radius")?,
+            belt_width: item(d, "belt_width")?,
+            spacing: item(d, "spacing")?,
+            max_pins: item(d, "max_pins")?,
+            tolerance: item(d, "tolerance")?,
+            target: item(d, "target")?,
+            goal: item(d, "goal")?,
+            time_limit: item(d, "time_limit")?,
+            check_parts: item(d, "check_parts")?,
+            screen_parts: item(d, "screen_parts")?,
+            refine: item(d, "refine")?,
+            margins: item(d, "margins")?,
+            mu_f: item(d, "mu_f")?,
+            seed: item(d, "seed")?,
+            command: item(d, "command")?,
+        })
+    }
+}
+
+/// A function of the module: its positional arguments to a Python object.
+type Native = fn(&Bound<'_, PyTuple>) -> PyResult<Py<PyAny>>;
+
+/// A Rust value as a Python object.
+fn object<'py, T: IntoPyObject<'py>>(py: Python<'py>, value: T) -> PyResult<Py<PyAny>> {
+    value.into_py_any(py)
+}
+
+/// The module's functions: name, docstring, body. Written without PyO3's procedural macros,
+/// whose `syn` features would make cargo compile the library a second time for this crate
+/// instead of reusing the command's build (crates/pinfeed-py/Cargo.toml).
+const FUNCTIONS: [(&CStr, &CStr, Native); 6] = [
+    (c"part", c"part(spec) -> JSON of `pinfeed part --json`", |a| {
+        object(a.py(), part(a.py(), &arg::<String>(a, 0)?)?)
+    }),
+    (
+        c"push",
+        c"push(part, theta0, d, mu_c, model, mu_s, pin_radius, pin_speed, support, tol, fence, tail) -> JSON of `pinfeed contact --json`",
+        |a| {
+            let json = push(
+                a.py(),
+                &arg::<String>(a, 0)?,
+                arg(a, 1)?,
+                arg(a, 2)?,
+                arg(a, 3)?,
+                &arg::<String>(a, 4)?,
+                arg(a, 5)?,
+                arg(a, 6)?,
+                arg(a, 7)?,
+                &arg::<String>(a, 8)?,
+                arg(a, 9)?,
+                arg::<Option<String>>(a, 10)?.as_deref(),
+                arg(a, 11)?,
+            )?;
+            object(a.py(), json)
+        },
+    ),
+    (
+        c"run",
+        c"run(scenario, parts, seed) -> (JSON of `pinfeed run --json`, per-part columns)",
+        |a| {
+            let out = run(a.py(), arg(a, 0)?, arg(a, 1)?, arg(a, 2)?)?;
+            object(a.py(), out)
+        },
+    ),
+    (
+        c"mc",
+        c"mc(study, samples, threads) -> (JSON of `pinfeed mc --json`, warnings)",
+        |a| object(a.py(), mc(a.py(), arg(a, 0)?, arg(a, 1)?, arg(a, 2)?)?),
+    ),
+    (
+        c"plan",
+        c"plan(part, settings, out) -> JSON of `pinfeed plan --json`",
+        |a| {
+            let settings = PlanSettings::from_dict(&arg::<Bound<'_, PyDict>>(a, 1)?)?;
+            let json = plan(a.py(), &arg::<String>(a, 0)?, settings, arg(a, 2)?)?;
+            object(a.py(), json)
+        },
+    ),
+    (
+        c"examples",
+        c"examples() -> [(name, kind, description)]",
+        |a| object(a.py(), examples()),
+    ),
+];
+
+/// The module's definition, which CPython reads when it creates the module and keeps.
+static mut DEFINITION: pyo3::ffi::PyModuleDef = pyo3::ffi::PyModuleDef {
+    m_base: pyo3::ffi::PyModuleDef_HEAD_INIT,
+    m_name: c"pinfeed._native".as_ptr(),
+    m_doc: c"The library's entry points for the Python package pinfeed (docs/python.md).".as_ptr(),
+    // No per-module state: the functions hold none.
+    m_size: -1,
+    m_methods: std::ptr::null_mut(),
+    m_slots: std::ptr::null_mut(),
+    m_traverse: None,
+    m_clear: None,
+    m_free: None,
+};
+
+/// The module `pinfeed._native` with the exception, the versions and [`FUNCTIONS`].
+fn module(py: Python<'_>) -> PyResult<Bound<'_, PyModule>> {
+    // SAFETY: the definition is a static that lives as long as the process and that only
+    // CPython touches; a null result is turned into the error CPython set.
+    let m = unsafe {
+        let raw = pyo3::ffi::PyModule_Create(std::ptr::addr_of_mut!(DEFINITION));
+        Bound::from_owned_ptr_or_err(py, raw)?.cast_into_unchecked::<PyModule>()
+    };
+    m.add("PinfeedError", py.get_type::<PinfeedError>())?;
     m.add("__version__", pinfeed::PINFEED_VERSION)?;
     m.add("SCHEMA_VERSION", pinfeed::SCHEMA_VERSION)?;
-    m.add_function(wrap_pyfunction!(part, m)?)?;
-    m.add_function(wrap_pyfunction!(push, m)?)?;
-    m.add_function(wrap_pyfunction!(run, m)?)?;
-    m.add_function(wrap_pyfunction!(mc, m)?)?;
-    m.add_function(wrap_pyfunction!(plan, m)?)?;
-    m.add_function(wrap_pyfunction!(examples, m)?)?;
-    Ok(())
+    for (name, doc, f) in FUNCTIONS {
+        let function = PyCFunction::new_closure(py, Some(name), Some(doc), move |a, _| f(a))?;
+        m.add(name.to_str().unwrap_or_default(), function)?;
+    }
+    Ok(m)
+}
+
+/// The module's initialisation, which CPython calls on `import pinfeed._native`: the module,
+/// or NULL with the exception set (an error here is an ImportError's cause, never a panic).
+#[no_mangle]
+pub extern "C" fn PyInit__native() -> *mut pyo3::ffi::PyObject {
+    Python::attach(|py| match module(py) {
+        Ok(m) => m.into_ptr(),
+        Err(e) => {
+            e.restore(py);
+            std::ptr::null_mut()
+        }
+    })
 }
