@@ -331,12 +331,7 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
                     outcome_mix(&u.outcomes)
                 );
             }
-            t += &format!(
-                "headway     {} s, the shortest with no collision and no loss of success over {} probe(s), with a 25% reserve: {:.2} oriented parts per minute\n",
-                design::line::fmt_headway(c.headway_s),
-                c.headway_probes.len(),
-                c.oriented_per_min
-            );
+            t += &headway_line(c.headway_s, c.headway_probes.len(), c.oriented_per_min);
         }
         if let Some(m) = &c.margins {
             t += &format!(
@@ -449,4 +444,37 @@ pub fn outcome_mix(o: &crate::engine::OutcomeCounts) -> String {
         .map(|(k, n)| format!("{k} {n}"))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// The `headway` line: the headway chosen by its search, or, when the time limit left the
+/// search no probe, the one at which the parts ran far apart, said as such.
+fn headway_line(headway_s: f64, probes: usize, per_min: f64) -> String {
+    let h = design::line::fmt_headway(headway_s);
+    if probes == 0 {
+        format!(
+            "headway     {h} s, the parts far apart (the time limit left the headway search no probe; a shorter one may hold): {per_min:.2} oriented parts per minute\n"
+        )
+    } else {
+        format!(
+            "headway     {h} s, the shortest with no collision and no loss of success over {probes} probe(s), with a 25% reserve: {per_min:.2} oriented parts per minute\n"
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A headway no probe tested is not called the shortest.
+    #[test]
+    fn an_unprobed_headway_is_not_called_the_shortest() {
+        let none = headway_line(51.0, 0, 0.58);
+        assert!(!none.contains("shortest"), "{none}");
+        assert!(none.contains("no probe"), "{none}");
+        let some = headway_line(2.0, 6, 29.7);
+        assert!(
+            some.contains("the shortest") && some.contains("over 6 probe(s)"),
+            "{some}"
+        );
+    }
 }
