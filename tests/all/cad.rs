@@ -636,3 +636,30 @@ fn check_layout_sensors(scene: &Scene, d: &Drawing, sensors: &[usize]) {
         .collect();
     check_layout(&others, d);
 }
+
+#[test]
+fn the_readme_from_cad_example_prints_what_it_shows() {
+    // README's "From CAD" block: the command, then its output block.
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let section = readme.split("## From CAD").nth(1).unwrap();
+    let section = section.split("\n## ").next().unwrap();
+    let blocks: Vec<&str> = section.split("```").skip(1).step_by(2).collect();
+    let cmd = blocks[0]
+        .trim()
+        .strip_prefix("cargo run --release -- ")
+        .unwrap();
+    let words: Vec<&str> = cmd.split_whitespace().collect();
+    let out = pinfeed_ok(&words);
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        blocks[1].trim()
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("1 hole ignored"), "{err}");
+    // The example is an exporter-style file: a header with $INSUNITS and no tables.
+    let p = read(Path::new("examples/cad/bracket.dxf"));
+    assert_eq!((p.unit.name, p.unit_source), ("mm", "$INSUNITS"));
+    let exact = 1800.0 + PI * 15.0 * 15.0 / 2.0;
+    let lost = exact - mass(&p).0;
+    assert!((0.0..=0.05 * PI * 15.0).contains(&lost), "{lost}");
+}

@@ -917,3 +917,70 @@ pub fn csv_outline(
         notes: Vec::new(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn a_bulge_of_one_is_a_counter_clockwise_semicircle() {
+        let s = Seg::bulged(Vec2::new(0.0, 0.0), Vec2::new(2.0, 0.0), 1.0);
+        let Seg::Arc {
+            centre,
+            radius,
+            sweep,
+            ..
+        } = s
+        else {
+            panic!("{s:?}")
+        };
+        assert!((centre - Vec2::new(1.0, 0.0)).norm() < 1e-12);
+        assert!((radius - 1.0).abs() < 1e-12 && (sweep - PI).abs() < 1e-12);
+        // Counter-clockwise from (0, 0) to (2, 0) about (1, 0) passes below the chord.
+        let mut pts = Vec::new();
+        s.flatten(0.01, &mut pts).unwrap();
+        assert!(pts.iter().all(|p| p.y <= 1e-12));
+        assert!((pts[pts.len() - 1] - Vec2::new(2.0, 0.0)).norm() < 1e-12);
+        // A negative bulge is the mirror image, and a reversed arc runs back to the start.
+        let m = Seg::bulged(Vec2::new(0.0, 0.0), Vec2::new(2.0, 0.0), -1.0);
+        assert!((m.start() - s.start()).norm() < 1e-12 && (m.end() - s.end()).norm() < 1e-12);
+        assert!((s.reversed().end() - s.start()).norm() < 1e-12);
+    }
+
+    #[test]
+    fn flattened_chords_stay_within_the_tolerance() {
+        for (r, tol) in [(1.0, 0.05), (10.0, 0.001), (0.01, 0.05), (100.0, 1e-5)] {
+            let s = Seg::Arc {
+                centre: Vec2::new(0.0, 0.0),
+                radius: r,
+                start: 0.3,
+                sweep: -2.5,
+            };
+            let mut pts = vec![s.start()];
+            s.flatten(tol, &mut pts).unwrap();
+            for w in pts.windows(2) {
+                // The chord's midpoint is its farthest point from the arc.
+                let mid = (w[0] + w[1]) * 0.5;
+                assert!(r - mid.norm() <= tol * (1.0 + 1e-9), "r {r} tol {tol}");
+                assert!(((w[0]).norm() - r).abs() < 1e-9 * r.max(1.0));
+            }
+        }
+        let fine = Seg::Arc {
+            centre: Vec2::new(0.0, 0.0),
+            radius: 1e6,
+            start: 0.0,
+            sweep: 6.0,
+        };
+        assert!(fine.flatten(1e-9, &mut Vec::new()).is_none());
+    }
+
+    #[test]
+    fn units_parse_by_name_and_alias() {
+        assert_eq!(Unit::parse("Inch").unwrap().mm, 25.4);
+        assert_eq!(Unit::parse("in").unwrap().name, "inch");
+        assert_eq!(Unit::parse("metres").unwrap().mm, 1000.0);
+        assert!(Unit::parse("furlong").is_err());
+        assert!(is_part_file("a/B.DXF") && is_part_file(" p.csv ") && !is_part_file("tripoly2"));
+    }
+}
