@@ -90,6 +90,13 @@ pub struct PartFileOptions {
     pub units: Option<Unit>,
 }
 
+impl PartFileOptions {
+    /// Are these the default options?
+    pub fn is_default(&self) -> bool {
+        *self == PartFileOptions::default()
+    }
+}
+
 impl Default for PartFileOptions {
     fn default() -> Self {
         PartFileOptions {

@@ -64,7 +64,8 @@ pub struct Problem {
     /// Metres per unit of the part's coordinates.
     pub scale: f64,
     /// How a part file (`part` = `FILE.dxf` or `FILE.csv`) is read: its flattening tolerance
-    /// and its unit when the file does not state it.
+    /// and its unit when the file does not state it (left out of the JSON when the defaults).
+    #[serde(skip_serializing_if = "PartFileOptions::is_default")]
     pub part_file: PartFileOptions,
     /// How parts arrive: in their stable states, or uniformly oriented.
     pub feed: FeedKind,
