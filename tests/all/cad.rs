@@ -133,6 +133,15 @@ fn polygons_in_inch_and_mm_give_exact_area_and_centroid() {
         rel(c.x, 250.0 / 3.0) < 1e-6 && rel(c.y, 250.0 / 3.0) < 1e-6,
         "{c:?}"
     );
+    // Drawn from below (extrusion −Z): the object coordinates are mirrored in x.
+    let mut d = drawing(Units::Millimeters);
+    let mut below = closed(&[(0.0, 0.0), (3.0, 0.0), (0.0, 1.0)]);
+    if let EntityType::LwPolyline(pl) = &mut below {
+        pl.extrusion_direction = dxf::Vector::new(0.0, 0.0, -1.0);
+    }
+    add(&mut d, below);
+    let (_, c) = mass(&read(&save(&d, &dir, "below.dxf")));
+    assert!(rel(c.x, -1.0) < 1e-6 && rel(c.y, 1.0 / 3.0) < 1e-6, "{c:?}");
     // The same triangle as a CSV of x,y rows (mm, a header row and a comment).
     let csv = dir.join("tri.csv");
     std::fs::write(&csv, "x,y\n# a triangle\n0,0\n76.2,0\n0,25.4\n").unwrap();
@@ -311,6 +320,21 @@ fn malformed_outlines_are_errors_naming_the_entity() {
     add(&mut d, line((0.0, 0.0), (10.0, 0.0)));
     let a = add(&mut d, line((10.0, 0.0), (f64::NAN, 10.0)));
     check("nan.dxf", &d, &["not a finite number"], &[&a]);
+    // An arc flattened so finely that the outline would have too many vertices.
+    let mut d = drawing(Units::Millimeters);
+    let a = add(
+        &mut d,
+        EntityType::Circle(Circle::new(Point::new(0.0, 0.0, 0.0), 1000.0)),
+    );
+    let fine = PartFileOptions {
+        flatten_mm: 1e-6,
+        ..Default::default()
+    };
+    let e = read_err(&save(&d, &dir, "fine.dxf"), &fine);
+    assert!(
+        e.contains("more than 10000 vertices") && e.contains(&format!("handle {a},")),
+        "{e}"
+    );
     // No outline at all: a text only.
     let mut d = drawing(Units::Millimeters);
     add(&mut d, EntityType::Text(Text::default()));

@@ -29,6 +29,10 @@ pub const JOIN_TOLERANCE: f64 = 1e-6;
 /// The most chords one arc is flattened into (a tolerance finer than this allows is refused).
 const MAX_CHORDS_PER_ARC: f64 = 100_000.0;
 
+/// The most vertices a part file's outline may have, flattened arcs included (the part's checks
+/// and its contact model grow with the count).
+pub const MAX_VERTICES: usize = 10_000;
+
 /// The largest coordinate of a part file, in millimetres (1 km).
 const MAX_COORD_MM: f64 = 1e6;
 
@@ -299,13 +303,10 @@ impl Seg {
                 } else {
                     2.0 * (1.0 - tol / radius).acos()
                 };
+                // At most 120° per chord, so that a circle (or two half circles) gets at least
+                // three chords and encloses an area.
+                let max_step = max_step.min(std::f64::consts::TAU / 3.0);
                 let n = (sweep.abs() / max_step).ceil().max(1.0);
-                // A full circle needs at least three chords to enclose an area.
-                let n = if sweep.abs() > std::f64::consts::PI {
-                    n.max(3.0)
-                } else {
-                    n
-                };
                 if n.is_nan() || n > MAX_CHORDS_PER_ARC {
                     return None;
                 }
@@ -461,6 +462,8 @@ pub fn dxf_outline(
         use dxf::entities::EntityType as T;
         let p2 = |p: &dxf::Point| Vec2::new(p.x, p.y);
         let piece = match &e.specific {
+            // A zero-length line joins nothing: it is left out.
+            T::Line(l) if l.p1.x == l.p2.x && l.p1.y == l.p2.y => None,
             T::Line(l) => Some(Piece {
                 entity: entity("LINE"),
                 segs: vec![Seg::Line(p2(&l.p1), p2(&l.p2))],
@@ -493,7 +496,8 @@ pub fn dxf_outline(
                     sweep: std::f64::consts::TAU,
                 }],
                 closed: true,
-            }),
+            })
+            .map(|p| mirror_piece(p, &c.normal)),
             T::LwPolyline(pl) => {
                 let pts: Vec<(Vec2, f64)> = pl
                     .vertices
@@ -835,6 +839,15 @@ fn flatten_loop(
             ));
         }
         owner.extend(std::iter::repeat_n(*k, pts.len() - before));
+        if pts.len() > MAX_VERTICES {
+            return Err(outline_err(
+                path,
+                format!(
+                    "the outline {} flattens to more than {MAX_VERTICES} vertices; give a larger flatten tolerance (--flatten MM), or simplify the drawing",
+                    lp.names()
+                ),
+            ));
+        }
     }
     // Vertex i ends a chord of entity owner[i]; the last one is the loop's start.
     let mut area = 0.0;
@@ -895,6 +908,9 @@ pub fn csv_outline(
                     ));
                 }
                 vertices.push(Vec2::new(x * unit.mm, y * unit.mm));
+                if vertices.len() > MAX_VERTICES {
+                    return Err(outline_err(path, format!("line {}: more than {MAX_VERTICES} vertices; a part file holds at most that many", i + 1)));
+                }
             }
             [None, None] if vertices.is_empty() => {} // a header row
             _ => {
