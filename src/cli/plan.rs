@@ -10,7 +10,8 @@ use super::stdout::print_result;
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use pinfeed::plan::design::{
-    self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status, UncertaintyChoice,
+    self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status, TailChoice,
+    UncertaintyChoice,
 };
 use pinfeed::plan::problem::parse_mu_c_range;
 use pinfeed::plan::{FeedKind, PlanError, Problem};
@@ -195,6 +196,11 @@ pub struct PlanArgs {
     /// Fence designs: step between candidate angles (degrees; from ±15°).
     #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub fence_angle_step: f64,
+    /// Fence designs: largest curved tail tried (units of a; 0: straight fences only) [default:
+    /// 40 on random tripods (--robust, --tripod), else 0]; each angle is also tried with the
+    /// largest tail from 4a up to this that fits the belt.
+    #[arg(long, allow_hyphen_values = true)]
+    pub tail_max: Option<f64>,
     /// Search rounds after the first while the line does not hold the target, each with the
     /// parts the line got wrong added to the particles (0: never).
     #[arg(long, default_value_t = 2)]
@@ -320,6 +326,11 @@ pub fn options_of(args: &PlanArgs, recorded: &str) -> Result<DesignOptions> {
         overhang_a: args.fence_overhang,
         max_angle_deg: args.max_fence_angle,
         angle_step_deg: args.fence_angle_step,
+        tails: match args.tail_max {
+            None => TailChoice::Auto,
+            Some(0.0) => TailChoice::Off,
+            Some(r) => TailChoice::UpTo(r),
+        },
     };
     o.max_moving = args.max_moving;
     o.sensor_candidates = args.sensor_candidates;

@@ -3,28 +3,13 @@
 //! study under it, written beside the design; that file is the study the verdict ran, and another
 //! seed does not refute a confirmed design.
 
-use crate::plan_cli::{mc_successes, pinfeed, plan_json, tmp};
+use crate::plan_cli::{mc_successes, pinfeed, quick_fence_design, tmp};
 use serde_json::Value;
 use std::path::Path;
 
 /// tripoly2's fence line (a quick, confirmed design) under `extra`, written to `file`.
 fn fence_design(file: &Path, extra: &[&str]) -> (i32, Value) {
-    let mut args = vec![
-        "plan",
-        "--part",
-        "tripoly2",
-        "--fences",
-        "--check-parts",
-        "2000",
-        "--screen-parts",
-        "500",
-        "--no-margins",
-        "--out",
-        file.to_str().unwrap(),
-        "--json",
-    ];
-    args.extend(extra);
-    plan_json(&args)
+    quick_fence_design("tripoly2", file, extra)
 }
 
 /// `pinfeed mc STUDY`: its one point's (success, samples).

@@ -89,3 +89,24 @@ pub fn mc_successes(study: &Path, out: &str) -> Vec<(u64, u64)> {
         })
         .collect()
 }
+
+/// `part`'s fence design with a short check (2000 parts, 500 screened, no margins) under
+/// `extra`, written to `file`: (exit status, JSON).
+pub fn quick_fence_design(part: &str, file: &Path, extra: &[&str]) -> (i32, Value) {
+    let mut args = vec![
+        "plan",
+        "--part",
+        part,
+        "--fences",
+        "--check-parts",
+        "2000",
+        "--screen-parts",
+        "500",
+        "--no-margins",
+        "--out",
+        file.to_str().unwrap(),
+        "--json",
+    ];
+    args.extend(extra);
+    plan_json(&args)
+}

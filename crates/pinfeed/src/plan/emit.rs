@@ -115,6 +115,12 @@ pub fn sequence_toml(
                     num(f.length_m, 6),
                     num(f.mu_f, 6),
                 );
+                if let Some(r) = f.tail_radius_m {
+                    t += &format!(
+                        "tail_radius = {}   # m: a curved tail turning it parallel to the belt\n",
+                        num(r, 6)
+                    );
+                }
             }
         }
     }
@@ -384,6 +390,7 @@ mod tests {
             hi_m: -0.01,
             margin_m: 0.01,
             max_lag_m: 0.0,
+            tail_radius_m: None,
         };
         let state = State::canonical(vec![], 1);
         let plan = Plan {
@@ -438,5 +445,83 @@ mod tests {
         );
         assert_eq!(json["steps"][0]["sets"], 2);
         assert!(json["steps"][1]["sets"].is_null(), "{json}");
+    }
+
+    /// A fence with a curved tail is written with its `tail_radius`, and the scenario parses back
+    /// to a fence whose tail is that radius, placed along the belt with the tail's extent.
+    #[test]
+    fn a_tailed_fence_is_emitted_with_its_tail_and_parses_back() {
+        let problem = Problem::new("tripoly2");
+        let window = Window {
+            centre_deg: 10.0,
+            inside: 1,
+            share: 1.0,
+        };
+        let tailed = FenceAction {
+            angle_deg: 25.0,
+            y0_m: -0.03,
+            y1_m: 0.02,
+            length_m: 0.05 / 25f64.to_radians().sin(),
+            mu_f: 0.5,
+            lo_m: -0.06,
+            hi_m: -0.02,
+            margin_m: 0.01,
+            max_lag_m: 0.0,
+            tail_radius_m: Some(0.3),
+        };
+        let state = State::canonical(vec![], 0);
+        let step = |action| PlanStep {
+            action,
+            state: state.clone(),
+            window,
+            sets: 1,
+        };
+        let plan = Plan {
+            initial: state.clone(),
+            initial_window: window,
+            initial_sets: 1,
+            steps: vec![
+                step(Action::Fence(tailed)),
+                step(Action::Fence(FenceAction {
+                    angle_deg: -25.0,
+                    y0_m: 0.05,
+                    y1_m: 0.0,
+                    tail_radius_m: None,
+                    ..tailed
+                })),
+            ],
+            window,
+            predicted_success: 1.0,
+            sets: 1,
+        };
+        let line = LineSpec {
+            name: "t".into(),
+            headway_s: 6.0,
+            belt_width_m: 0.16,
+            parts: 10,
+        };
+        let toml = sequence_toml(&problem, &plan, 3, 1, &line);
+        assert_eq!(toml.matches("tail_radius = 0.3").count(), 1, "{toml}");
+        let scene = crate::scenario::parse(std::path::Path::new("t.toml"), &toml).unwrap();
+        let fences: Vec<_> = scene
+            .obstacles
+            .iter()
+            .filter_map(|o| match o {
+                crate::scenario::Obstacle::Fence(f) => Some(f),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(fences.len(), 2);
+        assert_eq!(fences[0].tail_radius, Some(0.3));
+        assert_eq!(fences[1].tail_radius, None);
+        // The second fence starts a part diameter and 2 cm past the first one's tail.
+        let radius = problem.compile().unwrap().radius;
+        let gap = super::super::fences::fence_gap_m(radius);
+        let want = fences[0].start.x + tailed.x_extent_m() + gap;
+        assert!(
+            (fences[1].start.x - want).abs() < 1e-6,
+            "{} vs {want}",
+            fences[1].start.x
+        );
     }
 }

@@ -47,14 +47,39 @@ pub struct FenceAction {
     pub margin_m: f64,
     /// Largest lag behind the belt a part takes on this fence (m, belt frame; see [`headway_s`]).
     pub max_lag_m: f64,
+    /// Radius of the curved tail past the downstream end `y1_m` (m; None: a straight fence).
+    pub tail_radius_m: Option<f64>,
 }
 
 impl FenceAction {
-    /// The fence's extent along the belt (m).
+    /// The fence's extent along the belt (m), its tail included.
     pub fn x_extent_m(&self) -> f64 {
-        self.length_m * self.angle_deg.to_radians().cos()
+        let alpha = self.angle_deg.to_radians();
+        self.length_m * alpha.cos() + self.tail_radius_m.map_or(0.0, |r| r * alpha.sin().abs())
+    }
+
+    /// Lateral position of the fence's far end (m): the tail's end, or `y1_m` without a tail.
+    pub fn far_y_m(&self) -> f64 {
+        self.y1_m + tail_rise(self.angle_deg, self.tail_radius_m.unwrap_or(0.0))
     }
 }
+
+/// How far across the belt a tail of radius `radius` turns a fence at `angle_deg` on from its
+/// straight end: R (1 − cos α), towards the side the fence slides parts to (docs/physics.md,
+/// "Curved tails").
+pub fn tail_rise(angle_deg: f64, radius: f64) -> f64 {
+    let alpha = angle_deg.to_radians();
+    alpha.signum() * radius * (1.0 - alpha.cos())
+}
+
+/// The smallest tail the planner tries, in units of a: a smaller one hardly narrows the spread
+/// of exit orientations on uneven supports (docs/physics.md, "Curved tails": 2.6° at 4a against
+/// 9.6° without a tail for the square on tripods).
+pub const TAIL_MIN_A: f64 = 4.0;
+
+/// The largest tail the planner tries by default, in units of a: exits on tripods within 0.5° of
+/// parallel (docs/physics.md, "Curved tails": 0.34° at 40a for the square).
+pub const TAIL_MAX_A: f64 = 40.0;
 
 /// Settings of the fence actions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -65,6 +90,10 @@ pub struct FenceOptions {
     pub mu_f: f64,
     /// Overhang of the downstream end past the parts' reach, in units of a.
     pub overhang_a: f64,
+    /// Largest tail radius tried, in units of a (None: straight fences only). Each angle is then
+    /// tried straight and with the largest tail up to this radius, and at least [`TAIL_MIN_A`],
+    /// that keeps the fence's far end over the belt.
+    pub tail_max_a: Option<f64>,
 }
 
 impl FenceOptions {
@@ -91,6 +120,7 @@ impl FenceOptions {
             angles_deg: angles,
             mu_f,
             overhang_a: 0.0,
+            tail_max_a: None,
         }
     }
 }
@@ -98,8 +128,9 @@ impl FenceOptions {
 /// Largest integration tolerance of a fence pass (the line's, `[model] tol = 1e-6`).
 pub const FENCE_TOL: f64 = 1e-6;
 
-/// Memo key: (sample, θ quanta, angle index, y0 − y quanta, y1 − y quanta).
-type FenceKey = (u32, i32, u16, i32, i32);
+/// Memo key: (sample, θ quanta, angle index, y0 − y quanta, y1 − y quanta, tail radius quanta
+/// (0: no tail)).
+type FenceKey = (u32, i32, u16, i32, i32, i32);
 
 /// A fence pass as the planner keeps it: `None` = lost (not ok), else (θ final deg, Δy m,
 /// touched, lag behind the belt m).
@@ -130,7 +161,7 @@ impl FenceTransition {
     }
 
     fn pass(&self, tr: &Transition, problem: &Problem, key: FenceKey) -> FenceOutcome {
-        let (sample, theta_q, ai, d0, d1) = key;
+        let (sample, theta_q, ai, d0, d1, rq) = key;
         let phys = &tr.samples[sample as usize];
         let q = problem.y_quantum_m;
         let a = tr.radius();
@@ -150,7 +181,7 @@ impl FenceTransition {
             angle_rad: angle,
             length,
             mu_f: phys.mu_f.unwrap_or(self.options.mu_f),
-            tail_radius: None,
+            tail_radius: (rq > 0).then_some(rq as f64 * q),
         };
         let settings = ContactSettings {
             fidelity: Fidelity::Exact,
@@ -180,6 +211,25 @@ impl FenceTransition {
         ))
     }
 
+    /// The tail (radius in quanta of `q`) a fence at `deg` whose straight part ends at the
+    /// parts' reach gets: the largest radius up to `tail_max_a`·a whose far end stays over the
+    /// belt (|y| ≤ `half`), if that is at least [`TAIL_MIN_A`]·a; None without tails. `y1q` is
+    /// the straight fence's downstream end, which lies at least as far out as the tailed one's.
+    fn tail_quanta(&self, deg: f64, y1q: i32, a: f64, q: f64, half: f64) -> Option<i32> {
+        let most = self.options.tail_max_a? * a;
+        // Room from the straight fence's downstream end (overhang included: it is no nearer the
+        // parts than the tailed fence's straight end) to the belt's edge, a conservative bound.
+        let room = half - (y1q as f64 * q).abs();
+        let rise = tail_rise(deg.abs(), 1.0);
+        let r = if rise > 0.0 {
+            most.min(room / rise)
+        } else {
+            most
+        };
+        let rq = (r / q).floor() as i32;
+        (rq as f64 * q >= TAIL_MIN_A * a - 1e-12).then_some(rq)
+    }
+
     /// The fence actions of `state` with their successors.
     pub fn actions(
         &mut self,
@@ -198,7 +248,7 @@ impl FenceTransition {
         let ymin = state.particles.iter().map(|p| p.y_q).min().unwrap() as f64 * q;
         let ymax = state.particles.iter().map(|p| p.y_q).max().unwrap() as f64 * q;
         let over = self.options.overhang_a * a;
-        // (angle index, y0 quanta, y1 quanta, interval lo, hi)
+        // (angle index, y0 quanta, y1 quanta, tail radius quanta, interval lo, hi)
         let mut cands = Vec::new();
         for (ai, &deg) in self.options.angles_deg.iter().enumerate() {
             let (y0, y1, lo, hi) = if deg > 0.0 {
@@ -225,12 +275,22 @@ impl FenceTransition {
             if (y0q as f64 * q).abs() > lim || (y1q as f64 * q).abs() > lim {
                 continue;
             }
-            cands.push((ai as u16, y0q, y1q, lo, hi));
+            cands.push((ai as u16, y0q, y1q, 0, lo, hi));
+            if let Some(rq) = self.tail_quanta(deg, y1q, a, q, half) {
+                // The straight part ends where the parts' reach does (no overhang: the tail
+                // carries them on), and the tail turns it parallel to the belt.
+                let end = if deg > 0.0 {
+                    ((ymax + a + gap) / q).ceil() as i32
+                } else {
+                    ((ymin - a - gap) / q).floor() as i32
+                };
+                cands.push((ai as u16, y0q, end, rq, lo, hi));
+            }
         }
         let mut missing: Vec<FenceKey> = Vec::new();
-        for &(ai, y0q, y1q, _, _) in &cands {
+        for &(ai, y0q, y1q, rq, _, _) in &cands {
             for p in &state.particles {
-                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q);
+                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q, rq);
                 if !self.memo.contains_key(&k) {
                     missing.push(k);
                 }
@@ -255,12 +315,12 @@ impl FenceTransition {
         self.computed += out.len() as u64;
         self.memo.extend(missing.into_iter().zip(out));
         let mut res = Vec::new();
-        for (ai, y0q, y1q, lo, hi) in cands {
+        for (ai, y0q, y1q, rq, lo, hi) in cands {
             let mut lost = state.lost;
             let mut parts = Vec::with_capacity(state.particles.len());
             let mut max_lag: f64 = 0.0;
             for p in &state.particles {
-                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q);
+                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q, rq);
                 match self.memo[&k] {
                     None => lost += p.weight,
                     Some((_, _, false, _)) => parts.push(*p),
@@ -298,6 +358,7 @@ impl FenceTransition {
                     hi_m: hi,
                     margin_m: margin,
                     max_lag_m: max_lag,
+                    tail_radius_m: (rq > 0).then_some(rq as f64 * q),
                 }),
                 next,
             ));
@@ -365,7 +426,7 @@ mod tests {
         let ft = FenceTransition::new(options);
         // Upstream end 3a to the right of the part's centroid, downstream end 3a to its left.
         let reach = (3.0 * tr.radius() / p.y_quantum_m).round() as i32;
-        let outcome = |sample: u32| ft.pass(&tr, &p, (sample, 0, 0, -reach, reach));
+        let outcome = |sample: u32| ft.pass(&tr, &p, (sample, 0, 0, -reach, reach, 0));
         for k in 0..3 {
             assert!(
                 outcome(k).is_none(),
@@ -377,7 +438,111 @@ mod tests {
         let q = Problem::new("square");
         let tq = Transition::new(&q, &compiled, 1).unwrap();
         assert!(ft
-            .pass(&tq, &q, (0, 0, 0, -reach, reach))
+            .pass(&tq, &q, (0, 0, 0, -reach, reach, 0))
             .is_some_and(|o| o.2));
+    }
+
+    /// Every angle gets, besides its straight fence, the largest tail up to the most allowed
+    /// whose far end stays over the belt, and none below 4a; the tailed fence's far end is
+    /// R (1 − cos α) beyond its straight end, towards the side it slides parts to.
+    #[test]
+    fn tails_are_the_largest_that_fit_the_belt() {
+        let p = Problem::new("square");
+        let compiled = p.compile().unwrap();
+        let tr = Transition::new(&p, &compiled, 1).unwrap();
+        let a = tr.radius();
+        let q = p.y_quantum_m;
+        let mut options = FenceOptions::grid(0.5, 5.0, 55.0);
+        options.tail_max_a = Some(40.0);
+        let ft = FenceTransition::new(options.clone());
+        for &deg in &options.angles_deg {
+            for half in [0.05, 0.1, 0.3, 1.0] {
+                // A straight fence whose downstream end lies 1.5a inside the belt's edge.
+                let y1q = (deg.signum() * (half - 1.5 * a) / q).round() as i32;
+                let rise = 1.0 - deg.to_radians().cos();
+                match ft.tail_quanta(deg, y1q, a, q, half) {
+                    Some(rq) => {
+                        let r = rq as f64 * q;
+                        assert!(r >= TAIL_MIN_A * a - 1e-12 && r <= 40.0 * a + 1e-12);
+                        let far = y1q as f64 * q + tail_rise(deg, r);
+                        assert!(far.abs() <= half + 1e-12, "{deg}° {half}: far end {far}");
+                        // The largest: one quantum more would leave the belt or pass 40a.
+                        let more = (rq + 1) as f64 * q;
+                        assert!(
+                            more > 40.0 * a || (y1q as f64 * q + tail_rise(deg, more)).abs() > half
+                        );
+                    }
+                    None => assert!(1.5 * a / rise < TAIL_MIN_A * a, "{deg}° {half}"),
+                }
+            }
+        }
+        assert!((tail_rise(-30.0, 2.0) + 2.0 * (1.0 - 30f64.to_radians().cos())).abs() < 1e-15);
+        // Without tails, none.
+        let straight = FenceTransition::new(FenceOptions::grid(0.5, 5.0, 55.0));
+        assert_eq!(straight.tail_quanta(30.0, 0, a, q, 1.0), None);
+        // A tailed action's extent along the belt takes in the tail's R sin α.
+        let f = FenceAction {
+            angle_deg: -30.0,
+            y0_m: 0.02,
+            y1_m: -0.02,
+            length_m: 0.08,
+            mu_f: 0.5,
+            lo_m: 0.0,
+            hi_m: 0.05,
+            margin_m: 0.0,
+            max_lag_m: 0.0,
+            tail_radius_m: Some(0.1),
+        };
+        let c = 30f64.to_radians().cos();
+        assert!((f.x_extent_m() - (0.08 * c + 0.05)).abs() < 1e-12);
+        assert!((f.far_y_m() - (-0.02 - 0.1 * (1.0 - c))).abs() < 1e-12);
+    }
+
+    /// A tailed fence pass carries the part onto the tail: it leaves further across the belt, and
+    /// on a tripod nearer parallel to the belt than off a straight fence's end.
+    #[test]
+    fn a_tailed_pass_leaves_its_part_parallel_to_the_tail() {
+        let mut p = Problem::new("square");
+        p.tripod = true;
+        let compiled = p.compile().unwrap();
+        let tr = Transition::new(&p, &compiled, 8).unwrap();
+        let a = tr.radius();
+        let mut options = FenceOptions::grid(0.5, 5.0, 60.0);
+        options.angles_deg = vec![30.0];
+        let ft = FenceTransition::new(options);
+        let (r0, r1) = (
+            (-1.5 * a / p.y_quantum_m).round() as i32,
+            (1.5 * a / p.y_quantum_m).round() as i32,
+        );
+        let rq = (40.0 * a / p.y_quantum_m).round() as i32;
+        // Exit orientations modulo the square's 90°, in [−45°, 45°): the tail's end is parallel
+        // to the belt (0°), the straight fence's end at 30°.
+        let m = |th: f64| (th + 45.0).rem_euclid(90.0) - 45.0;
+        let (mut straight, mut tailed) = (Vec::new(), Vec::new());
+        for sample in 0..8 {
+            for theta_q in [0, 40, 100, 170, 260, 330] {
+                let s = ft.pass(&tr, &p, (sample, theta_q, 0, r0, r1, 0)).unwrap();
+                let t = ft.pass(&tr, &p, (sample, theta_q, 0, r0, r1, rq)).unwrap();
+                assert!(s.2 && t.2);
+                assert!(t.1 > s.1 + 0.5 * 40.0 * a * (1.0 - 30f64.to_radians().cos()));
+                straight.push(m(s.0));
+                tailed.push(m(t.0));
+            }
+        }
+        let spread = |v: &[f64]| {
+            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            (lo, hi)
+        };
+        let (s_lo, s_hi) = spread(&straight);
+        let (t_lo, t_hi) = spread(&tailed);
+        assert!(
+            t_lo.abs() < 0.5 && t_hi.abs() < 0.5,
+            "tailed exits {t_lo}°…{t_hi}° off parallel"
+        );
+        assert!(
+            s_hi - s_lo > 4.0 * (t_hi - t_lo),
+            "straight {s_lo}°…{s_hi}°"
+        );
     }
 }

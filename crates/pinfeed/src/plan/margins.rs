@@ -92,9 +92,19 @@ impl Margins {
                     [false, false] => "",
                 };
                 if lo == hi {
-                    format!(
-                        "holds only at its nominal friction μ {lo:.2}{fences} (fails ±{MU_STEP} off it)"
-                    )
+                    // No step off the nominal held: say of each side whether a step there
+                    // failed or none was run (the time limit, or the edge of the valid range).
+                    let at = format!("at its nominal friction μ {lo:.2}{fences}");
+                    match self.mu_open {
+                        [false, false] => format!("holds only {at} (fails ±{MU_STEP} off it)"),
+                        [true, true] => format!("holds {at}; the sweep ran no step off it"),
+                        [true, false] => format!(
+                            "holds {at}, fails +{MU_STEP} off it; the sweep ran no step below"
+                        ),
+                        [false, true] => format!(
+                            "holds {at}, fails −{MU_STEP} off it; the sweep ran no step above"
+                        ),
+                    }
                 } else {
                     format!("holds for friction μ {lo:.2}–{hi:.2}{fences}{beyond}")
                 }
@@ -282,5 +292,19 @@ mod tests {
             .contains("or higher: the sweep ended above it"));
         assert!(m([true, true]).describe().contains("or wider"));
         assert!(!m([false, false]).describe().contains(", or"));
+        // Held at the nominal alone: a side on which no step ran is not said to fail.
+        let only = |open: [bool; 2]| {
+            let mut x = m(open);
+            x.mu_holds = Some([0.5, 0.5]);
+            x.describe()
+        };
+        assert!(only([false, false]).contains("(fails ±0.05 off it)"));
+        let none = only([true, true]);
+        assert!(
+            none.contains("the sweep ran no step off it") && !none.contains("fails"),
+            "{none}"
+        );
+        assert!(only([true, false]).contains("fails +0.05 off it; the sweep ran no step below"));
+        assert!(only([false, true]).contains("fails −0.05 off it; the sweep ran no step above"));
     }
 }

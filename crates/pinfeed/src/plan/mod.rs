@@ -20,6 +20,9 @@
 //!   below the jam limit, placed clear of every particle's reach, passes through
 //!   [`crate::mechanics::push_fence`]; the same search runs over them;
 //! * [`mod@search`]: breadth-first search with deduplication, limits and statistics;
+//! * [`certificate`]: a certificate that no line touching only the convex hull can orient a
+//!   part whose hull is more symmetric than the part (a hexagon with a small notch), with the
+//!   bound it implies;
 //! * [`bound`]: its branch and bound — what r more pins can at most bring into one window, from
 //!   the pins' lateral reach alone;
 //! * [`contingent`]: the contingent planner with sensing (a sensor pin, then per-decision moving
@@ -49,6 +52,7 @@
 
 pub mod actions;
 pub mod bound;
+pub mod certificate;
 pub mod check;
 pub mod contingent;
 pub mod design;

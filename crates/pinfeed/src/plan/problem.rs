@@ -223,13 +223,14 @@ impl Problem {
         self.check_goal_and_search(a)?;
         let q = self.theta_quantum_deg;
         let n = (360.0 / q).round();
-        // Rotational symmetry: orientations a symmetry apart are the same part pose (uniform
-        // support only: a tripod is fixed in the part frame and breaks the symmetry).
-        let mut symmetry = if self.tripod {
-            1
-        } else {
-            rotational_symmetry(&polygon)
-        };
+        // Rotational symmetry of the outline: orientations a symmetry apart are the same part
+        // pose for the next station, whatever the support. A tripod is fixed in the part frame,
+        // but random tripods are drawn uniformly inside the outline
+        // ([`crate::mechanics::Support::random_tripod`]), a distribution with the outline's
+        // symmetry: a particle whose orientation is taken modulo the period carries a tripod
+        // that is as likely turned by the period as not, so the particles stay a sample of the
+        // same physics (the verdict comes from the line, which keeps each part's own tripod).
+        let mut symmetry = rotational_symmetry(&polygon);
         let mut period_steps = 360.0 / symmetry as f64 / q;
         if (period_steps - period_steps.round()).abs() > 1e-9 {
             symmetry = 1;
@@ -507,8 +508,8 @@ pub struct Compiled {
     /// Orientation quanta per symmetry period (360 / symmetry / theta_quantum_deg): particle
     /// orientations are kept modulo the period.
     pub theta_steps: i32,
-    /// Order of the part's rotational symmetry (1: none; 4 for a square; forced to 1 with tripod
-    /// supports, or when the period is not a whole number of quanta).
+    /// Order of the outline's rotational symmetry (1: none; 4 for a square, with tripod supports
+    /// too; forced to 1 when the period is not a whole number of quanta).
     pub symmetry: u32,
 }
 
@@ -519,12 +520,17 @@ impl Compiled {
     }
 }
 
+/// How close (units of a) a turned vertex must come to a vertex for [`rotational_symmetry`]: a
+/// part drawn to 4 decimals of a millimetre is as symmetric as its drawing (a regular hexagon of
+/// 20 mm written to 0.1 µm is 8 µm, 4·10⁻⁶ a, off exact), and no push tells 10⁻⁴ a apart.
+pub const SYMMETRY_TOL_A: f64 = 1e-4;
+
 /// The order k of the polygon's rotational symmetry about its centroid: the largest k ≥ 1 such
-/// that a rotation by 360°/k maps every vertex onto a vertex (to 1e-9·a).
+/// that a rotation by 360°/k maps every vertex onto a vertex (to [`SYMMETRY_TOL_A`]·a).
 pub fn rotational_symmetry(poly: &Polygon) -> u32 {
     let v = poly.vertices();
     let n = v.len();
-    let eps = 1e-9 * poly.radius();
+    let eps = SYMMETRY_TOL_A * poly.radius();
     for k in (2..=n).rev() {
         if n % k != 0 {
             continue;
@@ -570,6 +576,22 @@ mod tests {
         assert_eq!(sym("rect:2:1"), 2);
         assert_eq!(sym("lshape"), 1);
         assert_eq!(sym("ngon:6"), 6);
+        // A hexagon drawn to 4 decimals of a millimetre is a hexagon; one vertex 0.01 mm off
+        // (5·10⁻⁴ a) is not.
+        let hexagon = |nudge: f64| {
+            let v: Vec<String> = (0..6)
+                .map(|k| {
+                    let t = (60.0 * k as f64).to_radians();
+                    let x = 20.0 * t.cos() + if k == 2 { nudge } else { 0.0 };
+                    format!("{x:.4},{:.4}", 20.0 * t.sin())
+                })
+                .collect();
+            let mut p = Problem::new(&format!("vertices:{}", v.join(" ")));
+            p.scale = 0.001;
+            p.compile().unwrap().symmetry
+        };
+        assert_eq!(hexagon(0.0), 6);
+        assert_eq!(hexagon(0.01), 1);
         let bad = |f: &dyn Fn(&mut Problem), flag: &str| {
             let mut q = Problem::new("tripoly2");
             f(&mut q);

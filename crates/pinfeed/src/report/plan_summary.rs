@@ -130,6 +130,9 @@ pub struct PlanJson<'a> {
     pub files: Vec<String>,
     /// A limit that cut the work short (the time limit), if any.
     pub limit: Option<&'a crate::plan::Limit>,
+    /// Why lines touching only the hull cannot reach the target, if they cannot.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub certificate: Option<&'a crate::plan::certificate::Certificate>,
     /// Wall time of the planning (s).
     pub elapsed_s: f64,
     /// Every candidate considered.
@@ -172,6 +175,7 @@ pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> ReportResult<S
         oriented_per_min: c.map(|c| c.oriented_per_min),
         files,
         limit: d.limit.as_ref(),
+        certificate: d.certificate.as_ref(),
         elapsed_s: d.elapsed_s,
         candidates: &d.candidates,
         chosen: c,
@@ -294,6 +298,9 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
         };
         let head = if k == 0 { "modes" } else { "" };
         t += &format!("{head:<11} {:<8} {what}\n", m.mode.name());
+    }
+    if let Some(c) = &d.certificate {
+        t += &format!("certificate {}\n", c.describe());
     }
     t += &format!("result      {}\n", d.message);
     if let Some(c) = d.chosen() {

@@ -337,7 +337,7 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> Re
             Action::Fence(f) => {
                 fences += 1;
                 names.push(format!("fence{fences}"));
-                ys.extend([f.y0_m * 1e3, f.y1_m * 1e3]);
+                ys.extend([f.y0_m * 1e3, f.y1_m * 1e3, f.far_y_m() * 1e3]);
                 labels.push(Label {
                     text: format!(
                         "fence{fences} {:+}° ±{:.2} mm",
@@ -374,9 +374,20 @@ pub fn plot_plan(problem: &Problem, plan: &Plan, title: &str, path: &Path) -> Re
         match s.action {
             Action::Pin(p) => draw_pin(&mut ch, &view, x, &p, pin_px)?,
             Action::Fence(f) => {
-                let x1 = x + f.x_extent_m() * 1e3;
+                let spec = crate::mechanics::FenceSpec {
+                    start: crate::geometry::Vec2::new(x * 1e-3, f.y0_m),
+                    angle_rad: f.angle_deg.to_radians(),
+                    length: f.length_m,
+                    mu_f: f.mu_f,
+                    tail_radius: f.tail_radius_m,
+                };
+                let path: Vec<(f64, f64)> = spec
+                    .polyline(24)
+                    .iter()
+                    .map(|p| (p.x * 1e3, p.y * 1e3))
+                    .collect();
                 ch.draw_series(std::iter::once(PathElement::new(
-                    vec![(x, f.y0_m * 1e3), (x1, f.y1_m * 1e3)],
+                    path,
                     OBSTACLE.stroke_width(3),
                 )))?;
             }

@@ -122,6 +122,8 @@ pub struct FenceSettings {
     pub max_angle_deg: f64,
     /// Step between candidate angles (degrees, from ±15°).
     pub angle_step_deg: f64,
+    /// Curved tails ([`TailChoice`]).
+    pub tails: TailChoice,
 }
 
 impl Default for FenceSettings {
@@ -131,8 +133,27 @@ impl Default for FenceSettings {
             overhang_a: 0.0,
             max_angle_deg: 55.0,
             angle_step_deg: 5.0,
+            tails: TailChoice::Auto,
         }
     }
+}
+
+/// Whether fence designs try curved tails (`pinfeed plan --tail-max A`; docs/physics.md, "Curved
+/// tails"). With tails every candidate angle is tried straight and with the largest tail that
+/// fits the belt, from [`super::fences::TAIL_MIN_A`]·a up to the most allowed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TailChoice {
+    /// Tails up to [`super::fences::TAIL_MAX_A`]·a where the uncertainty planned against has
+    /// random tripod supports (`--robust`, `--tripod`): there a straight fence's exit
+    /// orientation spreads by degrees with the support, a tail's by less than 0.5°. On a uniform
+    /// support the exit off a straight fence's end depends on friction alone and varies little,
+    /// and tails, which double the actions of every fence, are not tried.
+    Auto,
+    /// Straight fences only.
+    Off,
+    /// Tails up to this radius (units of a, in [`super::fences::TAIL_MIN_A`], 1000]).
+    UpTo(f64),
 }
 
 /// Everything a design needs. [`DesignOptions::new`] gives the defaults.
@@ -251,6 +272,13 @@ impl DesignOptions {
     fn resolved(&self) -> DesignOptions {
         let u = self.uncertainty();
         let mut o = self.clone();
+        if o.fences.tails == TailChoice::Auto {
+            o.fences.tails = if u.tripod() {
+                TailChoice::UpTo(super::fences::TAIL_MAX_A)
+            } else {
+                TailChoice::Off
+            };
+        }
         o.problem.mu_c_range = u.pins_friction();
         o.problem.mu_f_range = u.fences_friction();
         o.problem.tripod = u.tripod();
@@ -413,6 +441,9 @@ pub struct ObstacleInfo {
     /// A fence's length (m; None for pins).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub length_m: Option<f64>,
+    /// A fence's tail radius (m; None for pins and straight fences).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tail_radius_m: Option<f64>,
     /// A moving pin's lateral targets, one per decision (m).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub targets_m: Vec<f64>,
@@ -654,6 +685,9 @@ pub enum ModeOutcome {
     Stopped,
     /// Not tried: the search time was used up before it started.
     NotTried,
+    /// Not searched: a [`super::certificate::Certificate`] proves that no line of this mode
+    /// reaches the target.
+    Impossible,
 }
 
 impl ModeOutcome {
@@ -665,6 +699,7 @@ impl ModeOutcome {
             ModeOutcome::NotNeeded => "not needed",
             ModeOutcome::Stopped => "stopped",
             ModeOutcome::NotTried => "not tried",
+            ModeOutcome::Impossible => "impossible",
         }
     }
 }
@@ -706,6 +741,10 @@ pub struct Design {
     pub modes: Vec<ModeReport>,
     /// A limit that cut the work short (the time limit), if any.
     pub limit: Option<Limit>,
+    /// Why lines that touch only the part's convex hull cannot reach the target, if they cannot
+    /// (the modes it covers were not searched).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub certificate: Option<super::certificate::Certificate>,
     /// Wall time of the whole design (s).
     pub elapsed_s: f64,
     /// The chosen design's scenario text (with its header).
@@ -901,6 +940,21 @@ fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignErr
     let mut opts = FenceOptions::grid(jam_mu_f, f.angle_step_deg, f.max_angle_deg);
     opts.mu_f = mu_f;
     opts.overhang_a = f.overhang_a;
+    opts.tail_max_a = match f.tails {
+        TailChoice::Off => None,
+        TailChoice::Auto => Some(super::fences::TAIL_MAX_A),
+        TailChoice::UpTo(r) => {
+            let lo = super::fences::TAIL_MIN_A;
+            if !(r.is_finite() && (lo..=1000.0).contains(&r)) {
+                return Err(input(
+                    "tail_max",
+                    r,
+                    format!("must lie in [{lo}, 1000] (units of a; 0 turns tails off)"),
+                ));
+            }
+            Some(r)
+        }
+    };
     if opts.angles_deg.is_empty() && o.modes.contains(&Mode::Fences) {
         return Err(input(
             "max_fence_angle",
@@ -948,7 +1002,32 @@ pub fn design(
         limit: None,
     };
     let modes = o.modes.clone();
+    // A certificate that lines touching only the hull cannot reach the target: the modes it
+    // covers are not searched.
+    let certificate = o
+        .problem
+        .compile()
+        .ok()
+        .and_then(|c| super::certificate::of(&o.problem, &c))
+        .filter(|c| c.bound < o.problem.target);
     for (i, &mode) in modes.iter().enumerate() {
+        if let Some(c) = certificate
+            .as_ref()
+            .filter(|c| mode == Mode::Fences || c.covers_pins())
+        {
+            w.modes.push(ModeReport {
+                mode,
+                outcome: ModeOutcome::Impossible,
+                candidates: 0,
+                reason: Some(format!(
+                    "no {} line can hold more than {:.1}% (the certificate), target {}",
+                    mode.name(),
+                    c.bound * 100.0,
+                    o.problem.target,
+                )),
+            });
+            continue;
+        }
         let now = Instant::now();
         if now >= search_end {
             for &m in &modes[i..] {
@@ -986,7 +1065,22 @@ pub fn design(
         });
         w.run_mode(mode, now + share)?;
     }
-    w.finish(started)
+    let mut design = w.finish(started)?;
+    if let Some(c) = &certificate {
+        let ruled_out = design
+            .modes
+            .iter()
+            .all(|m| m.outcome == ModeOutcome::Impossible);
+        if ruled_out && design.status == Status::NoDesign {
+            design.message = format!(
+                "no design: no line of the kinds asked for can bring more than {:.1}% of the parts into one window (the certificate), target {}",
+                c.bound * 100.0,
+                o.problem.target
+            );
+        }
+    }
+    design.certificate = certificate;
+    Ok(design)
 }
 
 struct Work<'a> {
@@ -1708,6 +1802,7 @@ impl Work<'_> {
             runner_up,
             modes: self.modes,
             limit: self.limit,
+            certificate: None,
             elapsed_s: started.elapsed().as_secs_f64(),
             scenario_toml,
             policy_toml,
@@ -2034,7 +2129,12 @@ fn sequence_width(problem: &Problem, plan: &Plan, a: f64) -> f64 {
     for s in &plan.steps {
         match s.action {
             Action::Pin(p) => reach = reach.max(p.y_m.abs() + problem.pin_radius_m),
-            Action::Fence(f) => reach = reach.max(f.y0_m.abs()).max(f.y1_m.abs()),
+            Action::Fence(f) => {
+                reach = reach
+                    .max(f.y0_m.abs())
+                    .max(f.y1_m.abs())
+                    .max(f.far_y_m().abs())
+            }
         }
     }
     // At least 2(a + lateral): the scenario parser refuses a belt on which the fed part
@@ -2059,6 +2159,7 @@ fn sequence_obstacles(plan: &Plan, xs: &[f64]) -> Vec<ObstacleInfo> {
                     y_m: p.y_m,
                     angle_deg: None,
                     length_m: None,
+                    tail_radius_m: None,
                     targets_m: Vec::new(),
                 }
             }
@@ -2071,6 +2172,7 @@ fn sequence_obstacles(plan: &Plan, xs: &[f64]) -> Vec<ObstacleInfo> {
                     y_m: f.y0_m,
                     angle_deg: Some(f.angle_deg),
                     length_m: Some(f.length_m),
+                    tail_radius_m: f.tail_radius_m,
                     targets_m: Vec::new(),
                 }
             }
@@ -2088,6 +2190,7 @@ fn contingent_obstacles(problem: &Problem, plan: &ContingentPlan) -> Vec<Obstacl
         y_m: plan.sensor.y_m,
         angle_deg: None,
         length_m: None,
+        tail_radius_m: None,
         targets_m: Vec::new(),
     }];
     for j in 0..plan.k {
@@ -2108,6 +2211,7 @@ fn contingent_obstacles(problem: &Problem, plan: &ContingentPlan) -> Vec<Obstacl
             y_m: ys[0],
             angle_deg: None,
             length_m: None,
+            tail_radius_m: None,
             targets_m: if fixed { Vec::new() } else { ys },
         });
     }
