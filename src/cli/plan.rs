@@ -21,12 +21,19 @@ use std::path::PathBuf;
 /// Arguments of `pinfeed plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], or vertices:"x,y x,y ...".
+    /// Part: tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N],
+    /// vertices:"x,y x,y ...", or a part file FILE.dxf or FILE.csv (in mm; docs/cad.md).
     #[arg(long)]
     pub part: String,
-    /// Metres per unit of the part's coordinates (0.001 for vertices in mm).
-    #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
-    pub scale: f64,
+    /// Metres per unit of the part's coordinates (0.001 for vertices in mm) [default: 0.02; a
+    /// part file, in mm: 0.001].
+    #[arg(long, allow_hyphen_values = true)]
+    pub scale: Option<f64>,
+    #[command(flatten)]
+    pub file: super::part::PartFileArgs,
+    /// Also write the design's line as a fabrication drawing (DXF, in mm; docs/outputs.md).
+    #[arg(long, value_name = "FILE.dxf", conflicts_with = "no_write")]
+    pub dxf: Option<PathBuf>,
     /// Name of the design: its scenario's name and its files' stem [default: from the part; a
     /// vertex list gets custom-HASH].
     #[arg(long)]
@@ -205,8 +212,22 @@ pub struct PlanArgs {
 
 /// The problem described by the arguments.
 pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
-    let mut p = Problem::new(&args.part);
-    p.scale = args.scale;
+    let file_part = pinfeed::geometry::cad::is_part_file(&args.part);
+    // A part file is read here once, for its warnings; the planner reads it again by its path,
+    // made absolute so that the design's scenario finds it from any folder.
+    let part = if file_part {
+        super::part::read_file_part(&args.part, &args.file)?;
+        std::path::absolute(args.part.trim())
+            .with_context(|| format!("--part '{}'", args.part))?
+            .to_string_lossy()
+            .into_owned()
+    } else {
+        args.part.clone()
+    };
+    let scale = args.scale.unwrap_or(if file_part { 0.001 } else { 0.02 });
+    let mut p = Problem::new(&part);
+    p.part_file = args.file.options()?;
+    p.scale = scale;
     p.feed = FeedKind::from_name(&args.feed).ok_or_else(|| {
         anyhow!(
             "--feed '{}': expected 'stable' or 'uniform'",
@@ -228,7 +249,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
     p.tripod = args.tripod;
     if let Some(r) = args.pin_radius {
         p.set_pin_radius_units(r).map_err(|e| flagged(e.into()))?;
-        super::warn_thin_pin(r, args.scale);
+        super::warn_thin_pin(r, scale);
     }
     if let Some(w) = args.belt_width {
         p.belt_width_m = w;
@@ -255,7 +276,7 @@ pub fn problem_of(args: &PlanArgs) -> Result<Problem> {
             Err(anyhow!(
                 "the default pin radius, 2 mm, is larger than the part at --scale {} (its largest \
                  centroid–vertex distance a); give --pin-radius in part units, at most a",
-                args.scale
+                scale
             ))
         }
         r => r.map(|_| p).map_err(|e| flagged(e.into())),
@@ -373,11 +394,19 @@ pub fn run(args: &PlanArgs, recorded: &str) -> Result<()> {
         .chosen()
         .is_some_and(|c| matches!(c.layout, Layout::Contingent(_)));
     let paths = DesignPaths::new(args.out.as_deref(), args.draw.as_deref(), &o, sensor);
-    let files = if args.no_write {
+    let mut files = if args.no_write {
         Vec::new()
     } else {
         write_design(&o, &d, &paths)?
     };
+    if let (Some(path), Some(toml)) = (&args.dxf, &d.scenario_toml) {
+        let policy = d.policy_toml.as_ref().map(|(_, text)| text.as_str());
+        let draft = pinfeed::scenario::SceneDraft::parse_with_policy(&paths.scenario, toml, policy)
+            .context("reading the design's scenario for --dxf")?;
+        let sensors: Vec<usize> = draft.sensors().iter().map(|s| s.obstacle).collect();
+        pinfeed::report::layout_dxf::write_layout_dxf(draft.untrained(), &sensors, path)?;
+        files.push(path.display().to_string());
+    }
     let out = if args.json {
         summary::json(&o, &d, files)?
     } else {

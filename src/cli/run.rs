@@ -37,6 +37,10 @@ pub struct RunArgs {
     /// Draw the line from above, to scale, with a few sample parts, into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     pub draw: Option<PathBuf>,
+    /// Write the line as a fabrication drawing into this DXF file (millimetres; belt, pins,
+    /// sensors, moving pins, fences and names on named layers; docs/outputs.md).
+    #[arg(long, value_name = "FILE.dxf")]
+    pub dxf: Option<PathBuf>,
     /// Animate the line into this SVG file (plays in a browser, looping): the first sample parts
     /// travelling the belt to scale, the obstacles, sensor readings and decisions as they happen,
     /// and each part's outcome colour when it ends.
@@ -75,6 +79,9 @@ pub fn run(args: &RunArgs) -> Result<()> {
         animate_speed: args.animate_speed,
     };
     files.record_into(&scene, &mut opts);
+    if let Some(path) = &args.dxf {
+        pinfeed::report::layout_dxf::write_layout_dxf(&scene, &[], path)?;
+    }
     let bar = super::progress::bar(opts.parts, "parts", args.quiet);
     let maps = super::contact_map::prepare_maps(&scene, args.cache_dir.as_deref(), args.quiet);
     let started = Instant::now();

@@ -73,7 +73,7 @@ fn every_documented_command_parses() {
 #[test]
 fn every_length_flag_names_its_unit_as_the_units_table_does() {
     use clap::CommandFactory;
-    const LENGTH_FLAGS: [&str; 13] = [
+    const LENGTH_FLAGS: [&str; 14] = [
         "pin-radius",
         "pin-radius-max",
         "pin-radius-sd",
@@ -87,6 +87,7 @@ fn every_length_flag_names_its_unit_as_the_units_table_does() {
         "pin-stop-after-touch",
         "d-jitter",
         "fence-overhang",
+        "tail-max",
     ];
     const UNITS: [&str; 3] = ["part units", "metres", "units of a"];
     let text = std::fs::read_to_string(root().join("docs/commands.md")).unwrap();

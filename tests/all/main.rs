@@ -27,6 +27,7 @@ mod xml;
 mod accuracy_study;
 mod animate;
 mod belief;
+mod cad;
 mod cli_contact;
 mod cli_in_process;
 mod cli_part;

@@ -10,7 +10,9 @@
 //! | `lshape` | concave L made of three unit squares |
 //! | `random:SEED` or `random:SEED:N` | a seeded random star-shaped polygon (see [`random_vertices`]) |
 //! | `vertices:x1,y1 x2,y2 …` | any simple polygon (also accepted by `--vertices`) |
+//! | `FILE.dxf`, `FILE.csv` | the outline in a drawing or a CSV of `x,y` rows, in millimetres ([`super::cad`]) |
 
+use super::cad::{is_part_file, read_part_file, PartFileOptions};
 use super::polygon::{Polygon, PolygonError};
 use super::vec2::Vec2;
 use thiserror::Error;
@@ -19,7 +21,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum PartSpecError {
     /// Not a known part name or form.
-    #[error("unknown part '{0}'; expected one of tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], vertices:\"x1,y1 x2,y2 ...\"")]
+    #[error("unknown part '{0}'; expected one of tripoly1, tripoly2, square, rect:W:H, ngon:N, lshape, random:SEED[:N], vertices:\"x1,y1 x2,y2 ...\", FILE.dxf, FILE.csv")]
     Unknown(String),
     /// A known form with a parameter out of range or malformed (e.g. `ngon:2`).
     #[error("bad part '{spec}': {reason}")]
@@ -35,6 +37,9 @@ pub enum PartSpecError {
     /// The vertices do not make a valid polygon.
     #[error(transparent)]
     Polygon(#[from] PolygonError),
+    /// A part file (`.dxf`, `.csv`) that could not be read into an outline.
+    #[error(transparent)]
+    File(#[from] super::cad::CadError),
 }
 
 /// Names accepted by [`part_from_spec`] (for help texts).
@@ -215,8 +220,20 @@ pub fn parse_vertex_list(text: &str) -> Result<Vec<Vec2>, PartSpecError> {
     Ok(out)
 }
 
-/// Build a validated part from a specification (see the module table).
+/// Build a validated part from a specification (see the module table); a part file is read
+/// with the default [`PartFileOptions`] (see [`part_from_spec_with`]).
 pub fn part_from_spec(spec: &str) -> Result<Polygon, PartSpecError> {
+    part_from_spec_with(spec, &PartFileOptions::default())
+}
+
+/// Build a validated part from a specification; a part file (`FILE.dxf`, `FILE.csv`, a path
+/// relative to the working folder) is read with `file` ([`super::cad`]), its coordinates in
+/// millimetres.
+pub fn part_from_spec_with(spec: &str, file: &PartFileOptions) -> Result<Polygon, PartSpecError> {
+    if is_part_file(spec) {
+        let part = read_part_file(std::path::Path::new(spec.trim()), file)?;
+        return Ok(part.polygon()?);
+    }
     let v = named_vertices(spec)?;
     Ok(Polygon::new(&v)?)
 }
@@ -241,6 +258,14 @@ pub fn part_folder(part: &str) -> String {
     if p.to_lowercase().starts_with("vertices:") {
         return custom_name(p);
     }
+    // A part file: its name without folder and extension.
+    let stem = std::path::Path::new(p)
+        .file_stem()
+        .map(|s| s.to_string_lossy());
+    let p = match stem {
+        Some(s) if is_part_file(p) => s.into_owned(),
+        _ => p.to_string(),
+    };
     p.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || c == '-' || c == '.' {

@@ -221,6 +221,20 @@ fn line_sections(problem: &Problem, line: &LineSpec, length: f64, stable_count: 
             .map(|p| format!("[{}, {}]", num(p.x, 9), num(p.y, 9)))
             .collect();
         t += &format!("vertices = [{}]\n", list.join(", "));
+    } else if crate::geometry::cad::is_part_file(&problem.part) {
+        let path = problem
+            .part
+            .trim()
+            .replace('\\', "\\\\")
+            .replace('"', "\\\"");
+        t += &format!("shape = \"{path}\"        # a part file, in mm\n");
+        if let Some(u) = problem.part_file.units {
+            t += &format!("units = \"{}\"\n", u.name);
+        }
+        let flatten = problem.part_file.flatten_mm;
+        if flatten != crate::geometry::cad::DEFAULT_FLATTEN_MM {
+            t += &format!("flatten = {}        # mm\n", num(flatten, 9));
+        }
     } else {
         t += &format!("shape = \"{}\"\n", problem.part.trim());
     }

@@ -2,7 +2,8 @@
 //! and their checks. Lengths are metres, angles degrees (SPEC §1).
 
 use super::PlanError;
-use crate::geometry::{part_from_spec, Polygon};
+use crate::geometry::cad::PartFileOptions;
+use crate::geometry::{part_from_spec_with, Polygon};
 
 /// How the parts arrive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -62,6 +63,10 @@ pub struct Problem {
     pub part: String,
     /// Metres per unit of the part's coordinates.
     pub scale: f64,
+    /// How a part file (`part` = `FILE.dxf` or `FILE.csv`) is read: its flattening tolerance
+    /// and its unit when the file does not state it (left out of the JSON when the defaults).
+    #[serde(skip_serializing_if = "PartFileOptions::is_default")]
+    pub part_file: PartFileOptions,
     /// How parts arrive: in their stable states, or uniformly oriented.
     pub feed: FeedKind,
     /// Standard deviation of the orientation jitter of a stable feed (degrees).
@@ -137,6 +142,7 @@ impl Problem {
         Problem {
             part: part.to_string(),
             scale: 0.02,
+            part_file: PartFileOptions::default(),
             feed: FeedKind::Stable,
             jitter_deg: 2.0,
             lateral_m: 0.002,
@@ -174,7 +180,9 @@ impl Problem {
     /// that is negative, not finite or larger than the part (its a, in part units) is refused;
     /// a part that cannot be built is left to [`Problem::compile`].
     pub fn set_pin_radius_units(&mut self, r: f64) -> Result<(), PlanError> {
-        let a = part_from_spec(&self.part).map(|p| p.radius()).ok();
+        let a = part_from_spec_with(&self.part, &self.part_file)
+            .map(|p| p.radius())
+            .ok();
         if !(r.is_finite() && r >= 0.0 && a.is_none_or(|a| r <= a)) {
             let bound = a.map_or(String::new(), |a| format!(", a = {a:.6}"));
             return Err(PlanError::input(
@@ -193,10 +201,11 @@ impl Problem {
     /// Check every value and build the part in metres. Errors name the field.
     pub fn compile(&self) -> Result<Compiled, PlanError> {
         check_finite_pos("scale", self.scale)?;
-        let unit = part_from_spec(&self.part).map_err(|err| PlanError::Part {
-            part: self.part.clone(),
-            reason: err.to_string(),
-        })?;
+        let unit =
+            part_from_spec_with(&self.part, &self.part_file).map_err(|err| PlanError::Part {
+                part: self.part.clone(),
+                reason: err.to_string(),
+            })?;
         let polygon = unit.try_scaled(self.scale).map_err(|err| PlanError::Part {
             part: self.part.clone(),
             reason: err.to_string(),

@@ -6,6 +6,7 @@ pub mod calibrate_report;
 pub mod compare_table;
 pub mod ensemble_report;
 pub mod error;
+pub mod layout_dxf;
 pub mod line_table;
 pub mod map_report;
 pub mod map_table;

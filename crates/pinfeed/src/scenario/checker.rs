@@ -18,6 +18,10 @@ impl<'a, 'b> Checker<'a, 'b> {
         Checker { loc }
     }
 
+    /// The folder of the file being checked (where its relative paths start).
+    pub(super) fn folder(&self) -> &std::path::Path {
+        self.loc.file.parent().unwrap_or(std::path::Path::new(""))
+    }
     /// An error at key path `path` (e.g. `belt.speed`, `obstacles[1].x`).
     pub(super) fn err(&self, path: &str, msg: impl Into<String>) -> ScenarioError {
         self.loc.at_key(&KeyPath::parse(path), msg)

@@ -162,9 +162,14 @@ fn compile_part(c: &Checker, rp: Option<&RawPart>, belt: &Belt) -> R<PartSpec> {
         ));
     };
     let (label, poly) = part_shape(c, rp)?;
+    // A part file is in millimetres.
+    let file_part = rp
+        .shape
+        .as_deref()
+        .is_some_and(crate::geometry::cad::is_part_file);
     let scale = c.range(
         "part.scale",
-        rp.scale.unwrap_or(1.0),
+        rp.scale.unwrap_or(if file_part { 0.001 } else { 1.0 }),
         limits::PART_SCALE,
         "m per unit",
     )?;
@@ -272,11 +277,39 @@ fn part_shape(c: &Checker, rp: &RawPart) -> R<(String, Polygon)> {
                     "write a vertex list as vertices = [[x, y], ...], not as a shape",
                 ));
             }
+            if crate::geometry::cad::is_part_file(shape) {
+                return Ok((shape.trim().to_string(), file_polygon(c, rp, shape)?));
+            }
+            if rp.units.is_some() || rp.flatten.is_some() {
+                let key = if rp.units.is_some() {
+                    "part.units"
+                } else {
+                    "part.flatten"
+                };
+                return Err(c.err(key, "units and flatten apply to a part file (shape = \"FILE.dxf\" or \"FILE.csv\") only"));
+            }
             let p = named::part_from_spec(shape).map_err(|e| c.err("part.shape", e.to_string()))?;
             Ok((shape.trim().to_string(), p))
         }
         (None, Some(vs)) => Ok(("vertices".to_string(), vertex_polygon(c, vs)?)),
     }
+}
+
+/// `part.shape = "FILE.dxf"` (or `.csv`): the outline read from the file, a path relative to the
+/// scenario's folder, with `part.units` and `part.flatten` (docs/cad.md).
+fn file_polygon(c: &Checker, rp: &RawPart, shape: &str) -> R<Polygon> {
+    use crate::geometry::cad::{read_part_file, PartFileOptions, Unit};
+    let mut options = PartFileOptions::default();
+    if let Some(u) = &rp.units {
+        options.units = Some(Unit::parse(u).map_err(|e| c.err("part.units", e.to_string()))?);
+    }
+    if let Some(f) = rp.flatten {
+        options.flatten_mm = c.within("part.flatten", f, 1e-6, 10.0, "mm")?;
+    }
+    let path = c.folder().join(shape.trim());
+    let part = read_part_file(&path, &options).map_err(|e| c.err("part.shape", e.to_string()))?;
+    part.polygon()
+        .map_err(|e| c.err("part.shape", format!("{}: {e}", path.display())))
 }
 
 /// `part.vertices`: every coordinate finite and within the allowed magnitude, the polygon simple.

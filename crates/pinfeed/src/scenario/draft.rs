@@ -81,6 +81,12 @@ impl SceneDraft {
         &self.scene.name
     }
 
+    /// The scene with its sensor pins still untrained (for drawings of the line: see
+    /// [`Self::sensors`] for which pins carry a sensor).
+    pub fn untrained(&self) -> &Scene {
+        &self.scene
+    }
+
     /// The sensor pins still to be trained, in obstacle order (none for a scene without sensors).
     pub fn sensors(&self) -> &[SensorDraft] {
         &self.sensors

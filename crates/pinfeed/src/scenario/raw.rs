@@ -75,6 +75,10 @@ pub struct RawPart {
     pub vertices: Option<Vec<[f64; 2]>>,
     /// Metres per unit of the shape's coordinates.
     pub scale: Option<f64>,
+    /// A part file's unit when the file does not state it (`mm`, `inch`, ...; docs/cad.md).
+    pub units: Option<String>,
+    /// A part file's chordal tolerance of flattened arcs (mm; docs/cad.md).
+    pub flatten: Option<f64>,
     /// Pin–part friction coefficient (default 0.5; a pin may override it).
     pub mu_c: Option<f64>,
     /// Part–belt friction coefficient (default 0.3; scales forces only).

@@ -294,6 +294,14 @@ pub fn design_name(part: &str) -> String {
     if p.to_lowercase().starts_with("vertices:") {
         return crate::geometry::named::custom_name(p);
     }
+    // A part file: its name without folder and extension.
+    let stem = std::path::Path::new(p)
+        .file_stem()
+        .map(|s| s.to_string_lossy());
+    let p = match stem {
+        Some(s) if crate::geometry::cad::is_part_file(p) => s.into_owned(),
+        _ => p.to_string(),
+    };
     p.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || c == '-' {
