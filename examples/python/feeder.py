@@ -6,8 +6,10 @@ pin–part friction μ with a Monte Carlo study, plot the three, print a short s
     python examples/python/feeder.py    # files go to a new temporary folder
     python examples/python/feeder.py --part "vertices:0,0 42,3 35,19 6,14" --scale 0.001 --out feeder-out
 
---part takes any part spec the command's --part takes (a name, rect:W:H, a vertex list …);
---scale is metres per unit of the part's coordinates (0.001 for millimetres).
+The part comes from a CAD drawing by default (examples/cad/quad.dxf, a closed polyline in
+millimetres; docs/cad.md). --part takes any part spec the command's --part takes (a DXF or CSV
+file, a name, rect:W:H, a vertex list …); --scale is metres per unit of the part's coordinates
+(0.001 for millimetres, which a part file always is).
 """
 
 import argparse
@@ -22,8 +24,8 @@ import numpy as np  # noqa: E402
 
 import pinfeed  # noqa: E402
 
-# A quadrilateral bracket, 42 mm long, given by its corners in millimetres.
-PART = "vertices:0,0 42,3 35,19 6,14"
+# A quadrilateral bracket, 42 mm long, drawn in CAD (corners 0,0 42,3 35,19 6,14 in millimetres).
+PART = str(Path(__file__).resolve().parent.parent / "cad" / "quad.dxf")
 
 
 def main() -> None:
@@ -39,7 +41,8 @@ def main() -> None:
 
     # 1. The part.
     part = pinfeed.Part(args.part)
-    print(f"part: {part.name}, {len(part.vertices)} vertices, area {part.area:.1f}, "
+    name = Path(part.name).name if Path(part.name).suffix.lower() in (".dxf", ".csv") else part.name
+    print(f"part: {name}, {len(part.vertices)} vertices, area {part.area:.1f}, "
           f"a = {part.a:.2f} (units), stable states {np.round(part.stable_states_deg, 1)} deg")
 
     # 2. A design: fixed pins for nominal physics (μ = 0.5), checked on the line; its scenario
@@ -95,7 +98,7 @@ def main() -> None:
     ax_mu.set(xlabel="pin–part friction μ", ylabel="success (%)", ylim=(0, 102),
               title=f"{args.samples} samples per μ")
     ax_mu.legend(fontsize=8)
-    fig.suptitle(f"{part.name}: {design['message'].split(':')[0]}", fontsize=10)
+    fig.suptitle(f"{name}: {design['message'].split(':')[0]}", fontsize=10)
     fig.tight_layout()
     png = out / "feeder.png"
     fig.savefig(png, dpi=110)

@@ -55,6 +55,28 @@ def test_a_bad_part_raises_with_its_location(cli):
         pinfeed.Part(3)
 
 
+def test_a_part_from_a_dxf_drawing_is_its_vertex_list(cli, tmp_path, root):
+    # examples/cad/quad.dxf is QUAD drawn as a closed polyline in millimetres (docs/cad.md).
+    drawn = pinfeed.Part(str(root / "examples" / "cad" / "quad.dxf"))
+    listed = pinfeed.Part(QUAD)
+    assert drawn.area == pytest.approx(listed.area, rel=1e-12)
+    # The same corners, the same way round (the file's outline may start at another corner).
+    assert any(
+        np.allclose(np.roll(drawn.vertices, k, axis=0), listed.vertices, rtol=1e-12, atol=1e-12)
+        for k in range(4)
+    )
+    assert drawn.stable_states_deg.tolist() == pytest.approx(listed.stable_states_deg.tolist())
+    # An open outline is refused with the entity's handle and layer, as the command says it.
+    bad = tmp_path / "open.dxf"
+    text = (root / "examples" / "cad" / "quad.dxf").read_text()
+    bad.write_text(text.replace(" 70\n1\n", " 70\n0\n", 1))
+    with pytest.raises(pinfeed.PinfeedError) as e:
+        pinfeed.Part(str(bad))
+    assert "2F" in str(e.value) and "OUTLINE" in str(e.value), str(e.value)
+    # (The command names its flag, Python the argument.)
+    assert str(e.value) == cli.error("part", "--part", str(bad)).replace("--part", "part", 1)
+
+
 # --- one push --------------------------------------------------------------------------------
 
 
