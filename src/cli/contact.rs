@@ -86,15 +86,8 @@ pub struct ContactArgs {
     /// The fence line crosses the part's path at y = d·a; `--mu-c` is the fence friction μf.
     #[arg(long, value_name = "ANGLE_DEG[:LENGTH]", allow_hyphen_values = true)]
     pub fence: Option<String>,
-    /// End the fence in a curved tail of this radius (part units, 0.01a to 1000a): a circular arc
-    /// tangent to the fence that turns it parallel to the belt (docs/physics.md#fences).
-    #[arg(
-        long,
-        value_name = "RADIUS",
-        requires = "fence",
-        allow_hyphen_values = true
-    )]
-    pub tail: Option<f64>,
+    #[command(flatten)]
+    pub tail: super::physics::TailArgs,
     /// Batch mode: a CSV with columns part,theta0,d,mu_c (+ optional model,pin_radius,mu_s); one
     /// output row per case goes to stdout. `--fence`, `--pin-speed`, `--support`, `--tol` and the
     /// defaults of the optional columns apply to every row.
@@ -120,7 +113,7 @@ pub(crate) fn case_of(args: &ContactArgs, model: Fidelity) -> Result<Case> {
         fence: (args.fence.as_deref())
             .map(|f| parse_fence(f, "--fence"))
             .transpose()?,
-        fence_tail: args.tail,
+        fence_tail: args.tail.tail,
         ..args.push.case(part, model)
     })
 }

@@ -44,15 +44,8 @@ pub struct MapArgs {
         conflicts_with = "pin_radius"
     )]
     pub fence: Option<String>,
-    /// End the fence in a curved tail of this radius (part units, 0.01a to 1000a): a circular arc
-    /// tangent to the fence that turns it parallel to the belt (docs/physics.md#fences).
-    #[arg(
-        long,
-        value_name = "RADIUS",
-        requires = "fence",
-        allow_hyphen_values = true
-    )]
-    pub tail: Option<f64>,
+    #[command(flatten)]
+    pub tail: super::physics::TailArgs,
     /// Spacing of the initial orientations θ0 (degrees; must divide 360).
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub theta_step: f64,
@@ -107,7 +100,7 @@ pub fn default_out_dir_for(args: &MapArgs) -> PathBuf {
                 .map(|c| if c == ':' { '_' } else { c })
                 .filter(|c| c.is_ascii_alphanumeric() || "-_.".contains(*c))
                 .collect();
-            match args.tail {
+            match args.tail.tail {
                 Some(r) => dir.join(format!("fence_{name}_tail{r}")),
                 None => dir.join(format!("fence_{name}")),
             }
@@ -128,7 +121,7 @@ pub fn request(args: &MapArgs) -> Result<MapRequest> {
     Ok(MapRequest {
         case: Case {
             fence,
-            fence_tail: args.tail,
+            fence_tail: args.tail.tail,
             ..args
                 .push
                 .case(args.part.clone(), args.push.model.computed_with())

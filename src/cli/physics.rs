@@ -7,6 +7,20 @@ use pinfeed::contact_case::{Case, ModelChoice};
 use pinfeed::mechanics::{ContactSettings, Fidelity};
 use std::path::PathBuf;
 
+/// The curved tail of `--fence` (both commands have a `--fence` flag of their own).
+#[derive(Debug, Clone, Args)]
+pub struct TailArgs {
+    /// End the fence in a curved tail of this radius (part units, 0.01a to 1000a): a circular arc
+    /// tangent to the fence that turns it parallel to the belt (docs/physics.md#fences).
+    #[arg(
+        long,
+        value_name = "RADIUS",
+        requires = "fence",
+        allow_hyphen_values = true
+    )]
+    pub tail: Option<f64>,
+}
+
 /// Friction, fidelity (with the map tier's cache and grid), pin radius, support and tolerance.
 #[derive(Debug, Clone, Args)]
 pub struct PushArgs {
