@@ -152,15 +152,15 @@ fn invariant(states: &[f64], turn: f64) -> bool {
 /// overlap an edge beside it; a point pin, r = 0, touches any edge).
 pub fn pins_reach_notches(part: &Polygon, r: f64) -> bool {
     let v = part.vertices();
+    // The hull as a polygon, re-centred on its own centroid (`offset` in the part's frame).
     let hull = Polygon::new(part.hull()).ok();
+    let offset = area_centroid(part.hull());
     let a = part.radius();
     // A point on the hull's boundary (to the symmetry tolerance): an edge whose ends and middle
     // all are lies along a hull edge, where any obstacle may touch it.
     let on_hull = |p: Vec2| {
-        hull.as_ref().is_some_and(|h| {
-            let offset = area_centroid(part.hull());
-            h.distance_to_boundary(p - offset).0 <= SYMMETRY_TOL_A * a
-        })
+        hull.as_ref()
+            .is_some_and(|h| h.distance_to_boundary(p - offset).0 <= SYMMETRY_TOL_A * a)
     };
     let n = v.len();
     // Outward normal side: the vertices are counter-clockwise when the signed area is positive.
