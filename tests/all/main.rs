@@ -32,6 +32,7 @@ mod cli_contact;
 mod cli_in_process;
 mod cli_part;
 mod cli_sense;
+mod closed_loop;
 mod closed_stdout;
 mod compare;
 mod contact_invariants;

@@ -7,7 +7,7 @@ use super::event_queue::EventKind;
 use super::line::Entry;
 use super::metrics::Metrics;
 use super::online_decide::online_arrival;
-use super::part_stream::{arrival_gap, draw_part, PartDraw};
+use super::part_stream::{arrival_gap, draw_part, draw_reentry, PartDraw};
 use super::plan::ride_on;
 use super::results::{EngineError, RunOptions};
 use super::state::{ActivePart, Belt};
@@ -15,6 +15,7 @@ use crate::geometry::Pose;
 use crate::scenario::{Arrival, Scene};
 
 /// Part `index` arrives at time `t`: drawn from the feed (or `entry`), it goes on the belt.
+/// With a closed loop's merge it joins the parts waiting there instead (see [`merge`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn arrival(
     scene: &Scene,
@@ -26,10 +27,16 @@ pub(super) fn arrival(
     t: f64,
     index: u64,
 ) -> Result<(), EngineError> {
+    if let Some(lp) = belt.closed_loop.as_mut().filter(|l| l.merges()) {
+        lp.new_part(index, t);
+        schedule_next(scene, opts, belt, t, index);
+        return merge(scene, opts, control, belt, metrics, t);
+    }
     let mut x0 = 0.0;
     let d = match entry {
         Some(e) => {
             x0 = e.x;
+            metrics.work.tripods_drawn += u64::from(e.model.is_some());
             PartDraw {
                 gap: 0.0,
                 theta_rad: e.theta_rad,
@@ -37,13 +44,35 @@ pub(super) fn arrival(
                 model: e.model,
             }
         }
-        None => draw_part(scene, opts.seed, index)
-            .map_err(|reason| EngineError::PartDraw { index, reason })?,
+        None => fresh_part(scene, opts.seed, index, metrics)?,
     };
+    if let Some(lp) = belt.closed_loop.as_mut() {
+        lp.open_entry(t);
+    }
+    metrics.arrival(t);
+    schedule_next(scene, opts, belt, t, index);
+    let pose = Pose::new(x0, d.y, d.theta_rad);
+    enter(scene, opts, control, belt, metrics, t, index, pose, d.model);
+    Ok(())
+}
+
+/// Part `index` as the feed draws it (its random tripod counted).
+fn fresh_part(
+    scene: &Scene,
+    seed: u64,
+    index: u64,
+    metrics: &mut Metrics,
+) -> Result<PartDraw, EngineError> {
+    let d =
+        draw_part(scene, seed, index).map_err(|reason| EngineError::PartDraw { index, reason })?;
     if d.model.is_some() {
         metrics.work.tripods_drawn += 1;
     }
-    metrics.arrival(t);
+    Ok(d)
+}
+
+/// The feed's next part after part `index` (arrived at `t`), unless it was the last.
+fn schedule_next(scene: &Scene, opts: &RunOptions, belt: &mut Belt, t: f64, index: u64) {
     if index + 1 < opts.parts {
         let next = match scene.feed.arrival {
             Arrival::Periodic { headway } => (index + 1) as f64 * headway,
@@ -52,13 +81,60 @@ pub(super) fn arrival(
         belt.queue
             .schedule(next, EventKind::Arrival { part: index + 1 });
     }
-    let pose = Pose::new(x0, d.y, d.theta_rad);
-    let sampled = (index as usize) < opts.sample_paths;
-    let mut part = ActivePart::entering(t, pose, d.model, sampled);
-    let work = &mut metrics.work;
-    online_arrival(scene, control, &mut belt.queue, t, index, &mut part);
-    ride_on(scene, control, belt, work, index, part, t);
+}
+
+/// A closed loop's merge at `t`: when it is free and a part waits, the part enters the belt as
+/// the next entry (a returning one with a new pose and its own support, a new one as the feed
+/// drew it).
+pub(super) fn merge(
+    scene: &Scene,
+    opts: &RunOptions,
+    control: Option<&Control>,
+    belt: &mut Belt,
+    metrics: &mut Metrics,
+    t: f64,
+) -> Result<(), EngineError> {
+    let Some(lp) = belt.closed_loop.as_mut() else {
+        return Ok(());
+    };
+    let Some(e) = lp.merge(t, &mut belt.queue) else {
+        return Ok(());
+    };
+    let (theta, y, model) = match e.model {
+        Some(model) => {
+            let (theta, y) = draw_reentry(scene, opts.seed, e.part, e.pass);
+            (theta, y, model)
+        }
+        None => {
+            let d = fresh_part(scene, opts.seed, e.part, metrics)?;
+            (d.theta_rad, d.y, d.model)
+        }
+    };
+    metrics.arrival(t);
+    let pose = Pose::new(0.0, y, theta);
+    enter(scene, opts, control, belt, metrics, t, e.entry, pose, model);
     Ok(())
+}
+
+/// Entry `id` goes on the belt at `t` at world pose `pose` with its own support `model` (if
+/// any): its first event is planned and its motion checked against the other parts.
+#[allow(clippy::too_many_arguments)]
+fn enter(
+    scene: &Scene,
+    opts: &RunOptions,
+    control: Option<&Control>,
+    belt: &mut Belt,
+    metrics: &mut Metrics,
+    t: f64,
+    id: u64,
+    pose: Pose,
+    model: Option<crate::mechanics::PartModel>,
+) {
+    let sampled = (id as usize) < opts.sample_paths;
+    let mut part = ActivePart::entering(t, pose, model, sampled);
+    let work = &mut metrics.work;
+    online_arrival(scene, control, &mut belt.queue, t, id, &mut part);
+    ride_on(scene, control, belt, work, id, part, t);
 }
 
 #[cfg(test)]

@@ -140,6 +140,13 @@ pub(super) fn contact_begin(
     if let Some(path) = part.path.as_mut() {
         record_path(&mut plan, model, v, path, work);
     }
+    if reading.is_some() {
+        let gate = scene.closed_loop.as_ref().map(|cl| &cl.gate);
+        if let Some(g) = gate.filter(|g| g.decided_by == Some(j)) {
+            let label = part.sensed.last().and_then(|d| d.label.as_deref());
+            part.gate_call = Some(g.call(label, plan.t_end));
+        }
+    }
     if let Some(sensed) = reading {
         schedule_decision(
             control,

@@ -55,6 +55,14 @@ pub enum EventKind {
         /// Index into the sensor's hypotheses, or `u32::MAX` for no decision.
         hypothesis: u32,
     },
+    /// A closed loop: part `part` (its number in the feed) reaches the merge's buffer off the
+    /// return conveyor.
+    Return {
+        /// Number of the part in the feed.
+        part: u64,
+    },
+    /// A closed loop: the merge is free to let the next waiting part onto the belt.
+    MergeFree,
     /// The online controller asks whether part `part` has gone past sensor pin `obstacle`
     /// without touching it (evidence for the part's belief).
     Unread {

@@ -23,6 +23,13 @@ pub(super) fn exit(
         return;
     };
     let pose = part.motion.world_pose(t, scene.belt.speed);
+    let call = part.gate_call;
+    if let Some(lp) = belt.closed_loop.as_mut() {
+        if lp.gate_takes(index, t, pose.y, call) {
+            divert(scene, belt, sinks, index, t);
+            return;
+        }
+    }
     let outcome = if scene.goal.matching_set(pose.theta_rad).is_some() {
         PartOutcome::Success
     } else {
@@ -53,6 +60,9 @@ pub(super) fn finish(
     let Some(mut part) = belt.active.remove(&index) else {
         return;
     };
+    if let Some(lp) = belt.closed_loop.as_mut() {
+        lp.finished(index, t, outcome);
+    }
     let pose = part.motion.world_pose(t, scene.belt.speed);
     let theta_deg = wrap_deg(pose.theta_rad.to_degrees());
     sinks.last_end = Some((outcome, pose));
@@ -92,6 +102,19 @@ pub(super) fn finish(
             poses,
         });
     }
+    belt.finished += 1;
+}
+
+/// The closed loop's gate takes part `index` off the belt at its end at time `t`: it goes to the
+/// return path (or out of the line); the sensors it passed count it, and it ends in no outcome
+/// class (the loop counts it).
+fn divert(scene: &Scene, belt: &mut Belt, sinks: &mut Sinks, index: u64, t: f64) {
+    let Some(mut part) = belt.active.remove(&index) else {
+        return;
+    };
+    count_untouched(scene, sinks, &part, scene.belt.length);
+    let lp = belt.closed_loop.as_mut().expect("a gate");
+    lp.rejected(index, t, part.model.take(), &mut belt.queue);
     belt.finished += 1;
 }
 

@@ -40,7 +40,8 @@
 //! Every part that enters ends in exactly one class ([`super::outcome`]); the run asserts it. What a
 //! run takes and gives is in [`super::results`].
 
-use super::arrival::arrival;
+use super::arrival::{arrival, merge};
+use super::closed_loop::LoopState;
 use super::contact::contact_begin;
 use super::contact_end::contact_end;
 use super::contact_map::LineMaps;
@@ -195,12 +196,15 @@ fn run_inner(
     entry: Option<Entry>,
 ) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
     let line = simulate(scene, opts, progress, captured, entry)?;
+    let closed_loop =
+        (line.belt.closed_loop.as_ref()).map(|l| l.summary(line.sinks.metrics.last_event));
     let (sinks, mut control) = (line.sinks, line.control);
     let fidelity = match scene.map_tier {
         Some(_) => "map",
         None => scene.contact.fidelity.name(),
     };
     let mut summary = sinks.metrics.summary(&scene.name, opts.seed, fidelity);
+    summary.closed_loop = closed_loop;
     let mut control_log = Vec::new();
     if let Some(c) = control.as_mut() {
         summary.controller = Some(c.finish(summary.simulated_time_s));
@@ -242,8 +246,13 @@ fn simulate<'a>(
         maps: LineMaps::for_scene(scene),
         entry,
     };
-    // A line of one entered part returns its end, record and pushes, never a latency summary.
+    // A line of one entered part returns its end, record and pushes, never a latency summary;
+    // nor does it pass a closed loop's gate (the online model's passes run the line up to it).
     line.sinks.metrics.record_latency = line.entry.is_none();
+    if line.entry.is_none() {
+        line.belt.closed_loop = (scene.closed_loop.as_ref())
+            .map(|cl| LoopState::new(cl, &scene.feed, opts.seed, opts.parts));
+    }
     if opts.parts > 0 {
         line.belt
             .queue
@@ -270,12 +279,17 @@ fn simulate<'a>(
         line.belt.active.is_empty(),
         "parts left on the belt after the last event"
     );
+    let metrics = &line.sinks.metrics;
+    let diverted = line.belt.closed_loop.as_ref().map_or(0, |l| l.diverted());
     assert_eq!(
-        line.sinks.metrics.outcomes.total(),
-        line.sinks.metrics.parts_in,
-        "conservation: every part that enters ends in exactly one class"
+        metrics.outcomes.total() + diverted,
+        metrics.parts_in,
+        "conservation: every part that enters ends in exactly one class or at the gate"
     );
-    assert_eq!(line.sinks.metrics.parts_in, opts.parts);
+    match &line.belt.closed_loop {
+        Some(l) => l.assert_conserved(opts.parts),
+        None => assert_eq!(metrics.parts_in, opts.parts),
+    }
     Ok(line)
 }
 
@@ -349,6 +363,20 @@ impl Line<'_> {
                         serve(scene, c, belt, work, t);
                     }
                 }
+            }
+            EventKind::Return { part } => {
+                if let Some(lp) = belt.closed_loop.as_mut() {
+                    lp.returned(part, t);
+                }
+                let control = control.as_ref();
+                merge(scene, opts, control, belt, &mut sinks.metrics, t)?
+            }
+            EventKind::MergeFree => {
+                if let Some(lp) = belt.closed_loop.as_mut() {
+                    lp.merge_freed();
+                }
+                let control = control.as_ref();
+                merge(scene, opts, control, belt, &mut sinks.metrics, t)?
             }
             EventKind::Unread { part, obstacle } => {
                 unread(scene, control.as_mut(), belt, t, part, obstacle as usize)

@@ -408,6 +408,9 @@ pub struct Summary {
     /// The controller of dynamic pins (absent from the JSON without one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub controller: Option<super::controller::ControllerSummary>,
+    /// The closed loop: gate, return path and merge (absent from the JSON on an open line).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<super::closed_loop::LoopSummary>,
 }
 
 pub use crate::statistics::wilson_interval;
@@ -491,6 +494,7 @@ impl Metrics {
             work: self.work,
             sensors: self.sensors.clone(),
             controller: None,
+            closed_loop: None,
         }
     }
 }

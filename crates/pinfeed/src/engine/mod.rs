@@ -44,6 +44,7 @@
 
 pub(crate) mod actuator;
 mod arrival;
+pub mod closed_loop;
 pub mod contact;
 mod contact_end;
 pub mod contact_map;

@@ -49,7 +49,38 @@ pub fn draw_part(
 ) -> Result<PartDraw, crate::mechanics::PartModelError> {
     let mut rng = stream(seed, index);
     let gap = draw_gap(scene, &mut rng);
-    let theta = match &scene.feed.orientation {
+    let theta = draw_orientation(scene, &mut rng);
+    let y = draw_lateral(&scene.feed.lateral, &mut rng);
+    let model = match scene.part.support {
+        SupportKind::Uniform => None,
+        SupportKind::Tripod => {
+            let support = Support::random_tripod(&scene.part.polygon, &mut rng)?;
+            Some(PartModel::new(&scene.part.polygon, &support)?)
+        }
+    };
+    Ok(PartDraw {
+        gap,
+        theta_rad: theta,
+        y,
+        model,
+    })
+}
+
+/// The pose of part `part` entering the belt again on pass `pass` (≥ 1) of a closed loop: its
+/// orientation and lateral offset drawn as the feed draws them, from a stream of its own (the
+/// part keeps its support: a warped part stays warped).
+pub fn draw_reentry(scene: &Scene, seed: u64, part: u64, pass: u32) -> (f64, f64) {
+    let mut rng = crate::random::substream(seed, REENTRY_PURPOSE + u64::from(pass), part);
+    let theta = draw_orientation(scene, &mut rng);
+    (theta, draw_lateral(&scene.feed.lateral, &mut rng))
+}
+
+/// The purposes of [`crate::random::substream`] from this one up are the re-entries' (one per
+/// pass).
+const REENTRY_PURPOSE: u64 = 0x5245_0000;
+
+fn draw_orientation(scene: &Scene, rng: &mut ChaCha8Rng) -> f64 {
+    match &scene.feed.orientation {
         Orientation::Uniform => std::f64::consts::TAU * rng.random::<f64>(),
         Orientation::Stable {
             thetas_rad: thetas,
@@ -66,24 +97,10 @@ pub fn draw_part(
                     break;
                 }
             }
-            let z: f64 = StandardNormal.sample(&mut rng);
+            let z: f64 = StandardNormal.sample(rng);
             wrap_2pi(thetas[pick] + jitter * z)
         }
-    };
-    let y = draw_lateral(&scene.feed.lateral, &mut rng);
-    let model = match scene.part.support {
-        SupportKind::Uniform => None,
-        SupportKind::Tripod => {
-            let support = Support::random_tripod(&scene.part.polygon, &mut rng)?;
-            Some(PartModel::new(&scene.part.polygon, &support)?)
-        }
-    };
-    Ok(PartDraw {
-        gap,
-        theta_rad: theta,
-        y,
-        model,
-    })
+    }
 }
 
 fn draw_lateral(lateral: &Lateral, rng: &mut ChaCha8Rng) -> f64 {

@@ -42,6 +42,8 @@ pub(super) struct ActivePart {
     pub(super) belief: Option<crate::sensing::belief::Belief>,
     pub(super) sensors_left: u32,
     pub(super) predicted: Option<f64>,
+    /// A closed loop's gate: its call on this part, once its sensor pin has read it.
+    pub(super) gate_call: Option<super::closed_loop::GateCall>,
 }
 
 impl ActivePart {
@@ -68,6 +70,7 @@ impl ActivePart {
             belief: None,
             sensors_left: 0,
             predicted: None,
+            gate_call: None,
         }
     }
 }
@@ -78,6 +81,8 @@ pub(super) struct Belt {
     pub(super) queue: EventQueue,
     pub(super) active: BTreeMap<u64, ActivePart>,
     pub(super) finished: u64,
+    /// A closed loop's gate, return path and merge (None: an open line).
+    pub(super) closed_loop: Option<super::closed_loop::LoopState>,
 }
 
 impl Belt {
@@ -87,6 +92,7 @@ impl Belt {
             queue: EventQueue::new(),
             active: BTreeMap::new(),
             finished: 0,
+            closed_loop: None,
         }
     }
 

@@ -29,7 +29,18 @@ pub fn table(s: &Summary) -> String {
         "scenario {}  seed {}  fidelity {}",
         s.scenario, s.seed, s.fidelity
     );
-    let _ = writeln!(o, "parts in                  {}", s.parts_in);
+    match &s.closed_loop {
+        None => {
+            let _ = writeln!(o, "parts in                  {}", s.parts_in);
+        }
+        Some(l) => {
+            let _ = writeln!(
+                o,
+                "parts in                  {}  (passes onto the belt; {} taken off by the gate)",
+                s.parts_in, l.gate_counts.acted
+            );
+        }
+    }
     for outcome in PartOutcome::ALL {
         let k = s.outcomes.get(outcome);
         let _ = writeln!(o, "  {:<22}  {:>8}  {:5.1}%", outcome.name(), k, pct(k));
@@ -98,6 +109,9 @@ pub fn table(s: &Summary) -> String {
     if let Some(c) = &s.controller {
         controller_table(&mut o, c);
     }
+    if let Some(l) = &s.closed_loop {
+        loop_table(&mut o, l);
+    }
     // The most populated orientation bins.
     let h = &s.orientation_histogram;
     let mut bins: Vec<(usize, u64)> = h
@@ -129,6 +143,76 @@ pub fn table(s: &Summary) -> String {
     );
     map_tier_line(&mut o, &s.work.map_tier);
     o
+}
+
+/// The closed loop's block: where the new parts ended, purity, passes, the gate, the return path
+/// and the merge, and the delivered rates.
+pub fn loop_table(o: &mut String, l: &crate::engine::closed_loop::LoopSummary) {
+    let f = &l.fates;
+    let _ = writeln!(
+        o,
+        "closed loop               gate {}: {} new parts, {} passes; yield per pass {:.4}",
+        l.gate, l.new_parts, l.passes, l.yield_per_pass
+    );
+    let _ = writeln!(
+        o,
+        "  delivered               {} (in the goal {}, not {}): purity {:.4} (95% CI {:.4}–{:.4})",
+        f.delivered(),
+        f.delivered_ok,
+        f.delivered_wrong,
+        l.purity,
+        l.purity_ci95[0],
+        l.purity_ci95[1]
+    );
+    let counts: Vec<String> = (l.passes_per_delivered.counts.iter().enumerate())
+        .filter(|(_, &n)| n > 0)
+        .map(|(k, n)| format!("{}: {n}", k + 1))
+        .collect();
+    let _ = writeln!(
+        o,
+        "  passes per delivered    mean {:.3}  ({})",
+        l.passes_per_delivered.mean,
+        if counts.is_empty() {
+            "none".to_string()
+        } else {
+            counts.join(", ")
+        }
+    );
+    let _ = writeln!(
+        o,
+        "  lost / rejected / scrapped  {} / {} / {} (last pass {}, buffer full {})",
+        f.lost,
+        f.rejected,
+        f.scrapped_max_passes + f.scrapped_full,
+        f.scrapped_max_passes,
+        f.scrapped_full
+    );
+    let g = &l.gate_counts;
+    let _ = writeln!(
+        o,
+        "  gate                    acted {}, accepted {}, busy {}, late {}, out of reach {}, unread {}",
+        g.acted, g.accepted, g.busy, g.late, g.out_of_reach, g.unread
+    );
+    let _ = writeln!(
+        o,
+        "  return path             recirculated {}, blocked {}; load mean {:.2} max {}; buffer mean {:.2} max {}",
+        l.recirculated, l.blocked, l.return_load.mean, l.return_load.max, l.buffer.mean, l.buffer.max
+    );
+    let _ = writeln!(
+        o,
+        "  merge wait              new {:.3} s, returning {:.3} s",
+        l.merge_wait_s.new, l.merge_wait_s.returning
+    );
+    let window = match l.steady_window_s {
+        Some([a, b]) => format!("  (window {a:.1}–{b:.1} s)"),
+        None => String::new(),
+    };
+    let _ = writeln!(
+        o,
+        "  delivered / in goal     {} / {} parts/min{window}",
+        opt(l.delivered_per_min, 2),
+        opt(l.oriented_per_min, 2)
+    );
 }
 
 /// With the map tier: how many pushes the map served and why the others were computed exactly.

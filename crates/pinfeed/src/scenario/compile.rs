@@ -67,6 +67,16 @@ pub fn compile(
         &part.label,
         policy,
     )?;
+    let closed_loop = super::closed_loop::compile(
+        &c,
+        &raw.obstacles,
+        raw.recirculation.as_ref(),
+        &obstacles,
+        &sensors,
+        &belt,
+        &part,
+        &goal,
+    )?;
     let mut scene = Scene {
         name,
         seed,
@@ -81,6 +91,7 @@ pub fn compile(
         output,
         controller,
         map_tier,
+        closed_loop,
     };
     locate_belief(&c, raw, &mut scene);
     Ok(SceneDraft::new(scene, sensors))

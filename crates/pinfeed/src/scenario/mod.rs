@@ -28,6 +28,7 @@
 //! * [`shared_feed`]: one reference scene's part stream imposed on others (`pinfeed compare`).
 
 pub mod checker;
+pub mod closed_loop;
 pub mod compile;
 pub mod draft;
 pub mod dynamic;
@@ -41,6 +42,7 @@ pub mod scene;
 pub mod sensors;
 pub mod shared_feed;
 
+pub use closed_loop::{ClosedLoop, LoopTime, Recirculation, RejectGate, WhenFull};
 pub use draft::SceneDraft;
 pub use dynamic::{
     Actuator, BeliefSpec, ControlMode, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target,

@@ -65,6 +65,8 @@ pub(super) fn compile_obstacles(
         }
         let ob = match ro.kind {
             ObstacleKind::Fence => Obstacle::Fence(fence(&at, ro)?),
+            // Not an obstacle a part meets: compiled with the closed loop (it is listed last).
+            ObstacleKind::RejectGate => continue,
             kind => {
                 let mut p = pin(&at, ro, kind)?;
                 p.actuator = dynamic_check::actuator(c, i, ro, kind, p.centre.y, belt)?;
@@ -116,8 +118,9 @@ pub fn obstacle_distance(a: &Obstacle, b: &Obstacle) -> f64 {
 }
 
 /// Refuse the keys of the other kind.
-fn only_keys(c: &Checker, i: usize, ro: &RawObstacle, kind: &str, takes: &str) -> R<()> {
+pub(super) fn only_keys(c: &Checker, i: usize, ro: &RawObstacle, kind: &str, takes: &str) -> R<()> {
     let given = [
+        ("y", ro.y.is_some()),
         ("radius", ro.radius.is_some()),
         ("mu_c", ro.mu_c.is_some()),
         ("angle", ro.angle.is_some()),
@@ -132,6 +135,12 @@ fn only_keys(c: &Checker, i: usize, ro: &RawObstacle, kind: &str, takes: &str) -
         ("raised", ro.raised.is_some()),
         ("raise_time", ro.raise_time.is_some()),
         ("lower_time", ro.lower_time.is_some()),
+        ("decided_by", ro.decided_by.is_some()),
+        ("accept", ro.accept.is_some()),
+        ("unknown", ro.unknown.is_some()),
+        ("reach", ro.reach.is_some()),
+        ("actuation", ro.actuation.is_some()),
+        ("busy", ro.busy.is_some()),
     ];
     for (k, present) in given {
         if present && !takes.split(", ").any(|t| t == k) {

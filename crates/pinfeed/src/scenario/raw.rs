@@ -39,6 +39,53 @@ pub struct RawScenario {
     /// `[[rules]]`: sensor decision → pin target rules for the policy controller.
     #[serde(default)]
     pub rules: Vec<RawRule>,
+    /// `[recirculation]`: the return path of the parts a reject gate takes off the belt
+    /// (docs/scenario-format.md#closed-loop).
+    pub recirculation: Option<RawRecirculation>,
+}
+
+/// A time (s) given as a number (always that long) or as a distribution table.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum RawTime {
+    /// Always this many seconds.
+    Fixed(f64),
+    /// `{ distribution = "fixed" | "uniform" | "exponential", value | min, max | mean }`.
+    Table(RawTimeTable),
+}
+
+/// A time's distribution table (see [`RawTime`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTimeTable {
+    /// `fixed`, `uniform` or `exponential`.
+    pub distribution: String,
+    /// The value of `fixed` (s).
+    pub value: Option<f64>,
+    /// The lower end of `uniform` (s).
+    pub min: Option<f64>,
+    /// The upper end of `uniform` (s).
+    pub max: Option<f64>,
+    /// The mean of `exponential` (s).
+    pub mean: Option<f64>,
+}
+
+/// `[recirculation]`: the return conveyor from the reject gate back to the feed.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRecirculation {
+    /// Transit time from the gate to the merge with the feed (s, or a distribution).
+    pub transit: Option<RawTime>,
+    /// Parts the buffer before the merge holds (default: unbounded).
+    pub buffer: Option<u64>,
+    /// `block` (default: a part finding the buffer full waits on the return conveyor) or
+    /// `drop` (it is scrapped).
+    pub when_full: Option<String>,
+    /// Passes a part may make; a part rejected on its last pass is scrapped (default 10).
+    pub max_passes: Option<u32>,
+    /// Least time between two parts entering the belt at the merge (s, or a distribution;
+    /// default: the time the belt takes to carry two part diameters).
+    pub merge_gap: Option<RawTime>,
 }
 
 /// `[belt]`: speed (m/s), width (m, the belt spans y ∈ [−width/2, width/2]) and usable length (m,
@@ -176,6 +223,9 @@ pub enum ObstacleKind {
     RetractablePin,
     /// A straight fence (a segment with no thickness).
     Fence,
+    /// A reject gate at the belt's end (an air jet or a diverter) that takes off the parts a
+    /// sensor pin decided are not in the goal.
+    RejectGate,
 }
 
 /// `[[obstacles]]`: one element over the belt. A pin takes x, y, radius and mu_c; a fence takes
@@ -224,6 +274,19 @@ pub struct RawObstacle {
     pub raise_time: Option<f64>,
     /// Retractable pin: time to withdraw (s, in [0, 10⁴], default 0.1).
     pub lower_time: Option<f64>,
+    /// Reject gate: the sensor pin whose decision commands it (default: none, the gate takes
+    /// every part it can).
+    pub decided_by: Option<String>,
+    /// Reject gate: the sensor's hypotheses that pass (default: those in the goal).
+    pub accept: Option<Vec<String>>,
+    /// Reject gate: what an `unknown` decision does: `reject` (default) or `pass`.
+    pub unknown: Option<String>,
+    /// Reject gate: half-width of the band across the belt it acts on, about its `y` (m).
+    pub reach: Option<f64>,
+    /// Reject gate: time from the end of the reading to the gate ready to act (s).
+    pub actuation: Option<f64>,
+    /// Reject gate: time it cannot act again after acting (s, or a distribution).
+    pub busy: Option<RawTime>,
 }
 
 /// `[controller]`: how decisions become actuator commands (docs/scenario-format.md#controller-and-rules).

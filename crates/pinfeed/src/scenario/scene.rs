@@ -408,4 +408,7 @@ pub struct Scene {
     /// `[model] fidelity = "map"`: the map tier's grid (None: the contact model answers every
     /// push).
     pub map_tier: Option<crate::maps::tier::TierSpec>,
+    /// A reject gate at the belt's end and the return path of the parts it takes off
+    /// (docs/scenario-format.md#closed-loop); None: an open line.
+    pub closed_loop: Option<super::closed_loop::ClosedLoop>,
 }

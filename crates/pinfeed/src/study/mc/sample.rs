@@ -989,6 +989,7 @@ pub fn draw_scene(
         output: base.output.clone(),
         // One map per sample would cost far more than the sample's few exact contacts.
         map_tier: base.map_tier.filter(|_| p.varies_map_inputs().is_none()),
+        closed_loop: base.closed_loop.clone(),
     };
     scene.feed = draw_entry(&scene, base, p, &mut st, &mut other)?;
     let run_seed = if sensors(base).is_empty() {

@@ -1,0 +1,290 @@
+//! The closed loop (reject gate, return path, merge) against queueing theory and its own
+//! invariants: the lossy gate's Erlang loss rate for exponential and deterministic service, a
+//! recirculating loop's delivered rate and geometric passes, the merge's Pollaczek–Khinchine mean
+//! wait, conservation with a full buffer (block and drop), an open loop reproducing the open
+//! line, determinism, and located errors for bad settings.
+
+use pinfeed::engine::closed_loop::LoopSummary;
+use pinfeed::engine::{run, RunOptions, RunResult};
+use pinfeed::scenario::{parse, Scene};
+use std::path::Path;
+
+/// A belt with no obstacle: parts ride it unchanged, so the loop alone decides what happens.
+/// Square parts of a = 3.5 mm, Poisson arrivals (1 s mean), offsets uniform over ±5 cm.
+const BARE: &str = r#"
+name = "bare"
+seed = 3
+[belt]
+speed = 0.1
+width = 0.2
+length = 0.2
+[part]
+shape = "square"
+scale = 0.005
+[feed]
+parts = 20000
+arrival = "poisson"
+headway = 1.0
+orientation = "uniform"
+[feed.lateral]
+distribution = "uniform"
+min = -0.05
+max = 0.05
+[[obstacles]]
+kind = "reject_gate"
+name = "jet"
+#GATE
+#LOOP
+[goal]
+any = true
+[effects]
+collisions = false
+"#;
+
+fn scene(gate: &str, recirculation: &str) -> Scene {
+    let src = BARE.replace("#GATE", gate).replace("#LOOP", recirculation);
+    parse(Path::new("bare.toml"), &src).unwrap_or_else(|e| panic!("{e}\n{src}"))
+}
+
+fn run_scene(scene: &Scene) -> RunResult {
+    run(scene, &RunOptions::from_scene(scene), &mut |_| {}).unwrap()
+}
+
+fn loop_of(r: &RunResult) -> &LoopSummary {
+    r.summary.closed_loop.as_ref().expect("a closed loop")
+}
+
+/// Within 2% of `theory`, or within 1.96 standard errors `se` where that is wider.
+fn close(measured: f64, theory: f64, se: f64, what: &str) {
+    let tol = (0.02 * theory.abs()).max(1.96 * se);
+    assert!(
+        (measured - theory).abs() <= tol,
+        "{what}: measured {measured}, theory {theory} (tolerance {tol})"
+    );
+}
+
+/// A gate that takes every part it can and cannot act again for S after acting loses the parts
+/// arriving while busy: with Poisson arrivals at λ it acts on λ/(1 + λE[S]) per second, for
+/// exponential and for deterministic S alike (the M/G/1/1 loss system's insensitivity).
+#[test]
+fn a_lossy_gate_acts_at_erlangs_loss_rate_for_any_service() {
+    let lambda = 1.0;
+    for busy in [
+        "busy = { distribution = \"exponential\", mean = 0.5 }",
+        "busy = 0.5",
+        "busy = { distribution = \"uniform\", min = 0.0, max = 1.0 }",
+    ] {
+        let s = scene(busy, "");
+        let r = run_scene(&s);
+        let l = loop_of(&r);
+        let span = r.summary.simulated_time_s;
+        let rate = l.gate_counts.acted as f64 / span;
+        let theory = lambda / (1.0 + lambda * 0.5);
+        // The count acted on is close to binomial in the parts: its relative error.
+        let p = l.gate_counts.acted as f64 / l.new_parts as f64;
+        let se = theory * (p * (1.0 - p) / l.new_parts as f64).sqrt() / p;
+        close(rate, theory, se, busy);
+        assert_eq!(l.gate_counts.acted + l.gate_counts.busy, l.new_parts);
+        assert_eq!(l.fates.rejected, l.gate_counts.acted);
+        assert_eq!(l.fates.delivered(), l.gate_counts.busy);
+    }
+}
+
+/// A gate acting on the parts within `reach` of the centre line rejects a share r/w of uniform
+/// offsets over ±w on every pass, independently: passes are geometric with yield p = 1 − r/w,
+/// truncated at max_passes M. Delivered share 1 − q^M (q = 1 − p), mean passes of the delivered
+/// parts 1/p − M q^M / (1 − q^M), and at steady state the delivered rate is the arrival rate
+/// times the scrap-free share.
+#[test]
+fn a_recirculating_loop_delivers_the_scrap_free_share_after_geometric_passes() {
+    let s = scene(
+        "reach = 0.03\nbusy = 0.0",
+        "[recirculation]\ntransit = { distribution = \"uniform\", min = 5.0, max = 15.0 }\nmax_passes = 4\nmerge_gap = 0.3",
+    );
+    let r = run_scene(&s);
+    let l = loop_of(&r);
+    let (q, m): (f64, i32) = (0.03 / 0.05, 4);
+    let p = 1.0 - q;
+    let share = 1.0 - q.powi(m);
+    let n = l.new_parts as f64;
+    let delivered = l.fates.delivered() as f64 / n;
+    close(
+        delivered,
+        share,
+        (share * (1.0 - share) / n).sqrt(),
+        "delivered share",
+    );
+    let mean_passes = 1.0 / p - m as f64 * q.powi(m) / (1.0 - q.powi(m));
+    close(l.passes_per_delivered.mean, mean_passes, 0.0, "mean passes");
+    close(
+        l.yield_per_pass,
+        p,
+        (p * q / l.passes as f64).sqrt(),
+        "yield per pass",
+    );
+    let rate = l.delivered_per_min.unwrap();
+    close(rate, 60.0 * share, 0.0, "delivered per minute");
+    // Every rejection on the last pass is scrapped, every other one goes round again.
+    assert_eq!(
+        l.gate_counts.acted,
+        l.recirculated + l.fates.scrapped_max_passes
+    );
+    assert_eq!(l.passes, l.new_parts + l.recirculated);
+    assert!(l.return_load.mean > 0.0 && l.return_load.max >= 1);
+}
+
+/// The merge is a single server whose service is the least gap between entries: with Poisson
+/// arrivals and nothing returning, new parts wait λE[G²] / (2(1 − λE[G])) on average
+/// (Pollaczek–Khinchine), here 0.28 s for G uniform on [0.2, 0.8] s at λ = 1/s.
+#[test]
+fn the_merge_waits_as_pollaczek_khinchine_says() {
+    let mut s = scene(
+        "y = 0.09\nreach = 0.001",
+        "[recirculation]\ntransit = 1.0\nmerge_gap = { distribution = \"uniform\", min = 0.2, max = 0.8 }",
+    );
+    s.feed.parts = 40_000;
+    s.feed.lateral = pinfeed::scenario::Lateral::Fixed(0.0);
+    let r = run_scene(&s);
+    let l = loop_of(&r);
+    assert_eq!(l.recirculated, 0);
+    let (eg, eg2) = (0.5, (0.04 + 0.16 + 0.64) / 3.0);
+    let theory = eg2 / (2.0 * (1.0 - eg));
+    close(l.merge_wait_s.new, theory, 0.0, "mean wait at the merge");
+}
+
+/// A buffer of one before the merge, with returns outpacing the merge: dropping scraps parts,
+/// blocking keeps them (they wait on the conveyor); either way every part has one fate.
+#[test]
+fn a_full_buffer_blocks_or_drops_and_every_part_has_one_fate() {
+    for (when, dropped) in [("drop", true), ("block", false)] {
+        let mut s = scene(
+            "reach = 0.04\nbusy = 0.0",
+            &format!("[recirculation]\ntransit = {{ distribution = \"exponential\", mean = 3.0 }}\nbuffer = 1\nwhen_full = \"{when}\"\nmax_passes = 20\nmerge_gap = 0.9"),
+        );
+        s.feed.parts = 2000;
+        let r = run_scene(&s);
+        let l = loop_of(&r);
+        let f = &l.fates;
+        assert_eq!(f.total(), l.new_parts, "{when}");
+        assert_eq!(l.new_parts, 2000);
+        if dropped {
+            assert!(f.scrapped_full > 0, "{f:?}");
+            assert_eq!(l.blocked, 0);
+        } else {
+            assert!(l.blocked > 0, "{when}");
+            assert_eq!(f.scrapped_full, 0);
+        }
+        assert!(l.buffer.max >= 1);
+        // Outcomes plus the gate's takings account for every pass.
+        assert_eq!(
+            r.summary.outcomes.total() + l.gate_counts.acted,
+            r.summary.parts_in
+        );
+    }
+}
+
+/// A loop whose gate never acts and whose merge never holds a part (gap below the headway)
+/// runs exactly the open line: the same parts, pushes and ends, record for record.
+#[test]
+fn a_loop_that_never_rejects_runs_the_open_line_record_for_record() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/quickstart.toml");
+    let open_src = std::fs::read_to_string(&path).unwrap();
+    let gate = "\n[[obstacles]]\nkind = \"reject_gate\"\ny = 0.05\nreach = 0.0001\n\n[recirculation]\ntransit = 2.0\nmerge_gap = 0.5\n";
+    let at = open_src.find("[goal]").expect("quickstart has a goal");
+    let closed_src = format!("{}{gate}\n{}", &open_src[..at], &open_src[at..]);
+    let open = parse(&path, &open_src).unwrap();
+    let closed = parse(&path, &closed_src).unwrap();
+    let opts = |s: &Scene| RunOptions {
+        parts: 300,
+        keep_records: true,
+        ..RunOptions::from_scene(s)
+    };
+    let a = run(&open, &opts(&open), &mut |_| {}).unwrap();
+    let b = run(&closed, &opts(&closed), &mut |_| {}).unwrap();
+    assert_eq!(a.records, b.records);
+    let mut sb = b.summary.clone();
+    let l = sb.closed_loop.take().unwrap();
+    assert_eq!(a.summary.outcomes, sb.outcomes);
+    assert_eq!(a.summary.orientation_histogram, sb.orientation_histogram);
+    assert_eq!(a.summary.latency_s, sb.latency_s);
+    assert_eq!(l.gate_counts.acted, 0);
+    assert_eq!(l.passes, 300);
+    assert_eq!(l.merge_wait_s.new, 0.0);
+}
+
+/// The same scene and seed give the same summary to the byte; another seed another one.
+#[test]
+fn a_loop_is_a_pure_function_of_scene_and_seed() {
+    let mut s = scene(
+        "reach = 0.03\nbusy = { distribution = \"exponential\", mean = 0.2 }",
+        "[recirculation]\ntransit = { distribution = \"exponential\", mean = 4.0 }\nbuffer = 3\nmerge_gap = 0.4",
+    );
+    s.feed.parts = 3000;
+    let json = |s: &Scene| serde_json::to_string(&run_scene(s).summary).unwrap();
+    let (a, b) = (json(&s), json(&s));
+    assert_eq!(a, b);
+    s.seed = 4;
+    assert_ne!(a, json(&s));
+}
+
+/// Bad gate and return-path settings are refused at their key, with what is allowed.
+#[test]
+fn bad_loop_settings_are_located_errors() {
+    let cases: [(&str, &str, &str, &str); 11] = [
+        ("x = 0.1", "", "obstacles[0].x", "belt's end"),
+        ("reach = 0.0", "", "obstacles[0].reach", "must lie in (0, 0.2]"),
+        ("decided_by = \"probe\"", "", "obstacles[0].decided_by", "no sensor pin"),
+        ("accept = [\"0°\"]", "", "obstacles[0].accept", "only with decided_by"),
+        ("unknown = \"maybe\"", "", "obstacles[0].unknown", "\"reject\" or \"pass\""),
+        ("busy = { distribution = \"exponential\", min = 1.0 }", "", "obstacles[0].busy.min", "takes mean"),
+        ("busy = -1.0", "", "obstacles[0].busy", "must lie in [0, 1000000]"),
+        ("", "[recirculation]\ntransit = 1.0\nmerge_gap = { distribution = \"exponential\", mean = 1.0 }", "recirculation.merge_gap", "positive"),
+        ("", "[recirculation]\ntransit = 1.0\nmax_passes = 0", "recirculation.max_passes", "[1, 1000]"),
+        ("", "[recirculation]\ntransit = 1.0\nwhen_full = \"wait\"", "recirculation.when_full", "\"block\" or \"drop\""),
+        ("", "[recirculation]\nbuffer = 2", "recirculation", "needs `transit`"),
+    ];
+    for (gate, lp, key, says) in cases {
+        let src = BARE.replace("#GATE", gate).replace("#LOOP", lp);
+        let e = parse(Path::new("bare.toml"), &src).expect_err(key);
+        let i = e.invalid().unwrap_or_else(|| panic!("{e}"));
+        assert_eq!(i.key, key, "{e}");
+        assert!(i.message.contains(says), "{key}: {}", i.message);
+    }
+    // A return path without a gate, a gate before a pin, and two gates.
+    let no_gate = BARE
+        .replace(
+            "[[obstacles]]\nkind = \"reject_gate\"\nname = \"jet\"\n",
+            "",
+        )
+        .replace("#GATE", "")
+        .replace("#LOOP", "[recirculation]\ntransit = 1.0");
+    let e = parse(Path::new("bare.toml"), &no_gate).unwrap_err();
+    assert_eq!(e.invalid().unwrap().key, "recirculation");
+    let pin_after = BARE
+        .replace(
+            "#GATE",
+            "\n[[obstacles]]\nkind = \"pin\"\nx = 0.1\ny = 0.0\nradius = 0.001",
+        )
+        .replace("#LOOP", "");
+    let e = parse(Path::new("bare.toml"), &pin_after).unwrap_err();
+    assert_eq!(e.invalid().unwrap().key, "obstacles[0].kind");
+    assert!(e.to_string().contains("after every pin and fence"), "{e}");
+    let two = BARE
+        .replace(
+            "#GATE",
+            "\n[[obstacles]]\nkind = \"reject_gate\"\nname = \"second\"",
+        )
+        .replace("#LOOP", "");
+    let e = parse(Path::new("bare.toml"), &two).unwrap_err();
+    assert_eq!(e.invalid().unwrap().key, "obstacles[1].kind");
+    // A gate's keys on a pin are refused like any key of another kind.
+    let pin_reach = BARE
+        .replace(
+            "[[obstacles]]\nkind = \"reject_gate\"\nname = \"jet\"\n",
+            "[[obstacles]]\nkind = \"pin\"\nx = 0.1\ny = 0.0\nradius = 0.001\nreach = 0.01\n",
+        )
+        .replace("#GATE", "")
+        .replace("#LOOP", "");
+    let e = parse(Path::new("bare.toml"), &pin_reach).unwrap_err();
+    assert_eq!(e.invalid().unwrap().key, "obstacles[0].reach", "{e}");
+}
