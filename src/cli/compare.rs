@@ -68,10 +68,11 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         pinfeed::report::versioned::pretty(&Designs { designs: &rows })?
     } else {
         let feed = compare_table::feed_lines(&d.files, &d.scenes, &d.overrides);
+        let loops = compare_table::loop_lines(&rows);
         if args.markdown {
-            format!("{feed}\n\n{}", compare_table::markdown(&rows))
+            format!("{feed}\n\n{}{loops}", compare_table::markdown(&rows))
         } else {
-            format!("{feed}\n{}", compare_table::text(&rows))
+            format!("{feed}\n{}{loops}", compare_table::text(&rows))
         }
     };
     super::stdout::print_result(&text)

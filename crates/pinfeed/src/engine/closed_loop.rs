@@ -36,7 +36,7 @@
 use super::event_queue::{EventKind, EventQueue};
 use crate::mechanics::PartModel;
 use crate::random::substream;
-use crate::scenario::{Arrival, ClosedLoop, Feed, RejectGate, WhenFull};
+use crate::scenario::{Arrival, ClosedLoop, Feed, RejectGate, RejectOn, WhenFull};
 use crate::statistics::wilson_interval;
 use serde::Serialize;
 use std::collections::{BTreeMap, VecDeque};
@@ -56,6 +56,14 @@ pub(super) struct GateCall {
 }
 
 impl RejectGate {
+    /// The gate's call on a part that touched its contact pin, the touch over at `t_end`.
+    pub(super) fn call_touched(&self, t_end: f64) -> GateCall {
+        GateCall {
+            reject: true,
+            ready_at: t_end + self.actuation,
+        }
+    }
+
     /// The gate's call on a part whose sensor decided `label` (None: unknown), the reading over
     /// at `t_end`.
     pub(super) fn call(&self, label: Option<&str>, t_end: f64) -> GateCall {
@@ -347,6 +355,11 @@ impl LoopState {
                 ready_at: t,
             },
             (Some(_), Some(c)) => c,
+            // A contact switch the part did not touch: it passes.
+            (Some(_), None) if g.reject_on == RejectOn::Contact => GateCall {
+                reject: false,
+                ready_at: t,
+            },
             (Some(_), None) => {
                 counts.unread += 1;
                 GateCall {

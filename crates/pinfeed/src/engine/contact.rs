@@ -29,7 +29,7 @@ use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
     ContactOutcome, ContactSettings, ContactStatus, PartModel, PinPath, SolveFailure,
 };
-use crate::scenario::{Obstacle, Scene, SensorPin};
+use crate::scenario::{Obstacle, RejectOn, Scene, SensorPin};
 use crate::sensing::classify::Decision;
 use crate::sensing::signal::KnotRecorder;
 
@@ -140,11 +140,15 @@ pub(super) fn contact_begin(
     if let Some(path) = part.path.as_mut() {
         record_path(&mut plan, model, v, path, work);
     }
-    if reading.is_some() {
-        let gate = scene.closed_loop.as_ref().map(|cl| &cl.gate);
-        if let Some(g) = gate.filter(|g| g.decided_by == Some(j)) {
-            let label = part.sensed.last().and_then(|d| d.label.as_deref());
-            part.gate_call = Some(g.call(label, plan.t_end));
+    let gate = scene.closed_loop.as_ref().map(|cl| &cl.gate);
+    if let Some(g) = gate.filter(|g| g.decided_by == Some(j)) {
+        match g.reject_on {
+            RejectOn::Contact => part.gate_call = Some(g.call_touched(plan.t_end)),
+            RejectOn::Decision if reading.is_some() => {
+                let label = part.sensed.last().and_then(|d| d.label.as_deref());
+                part.gate_call = Some(g.call(label, plan.t_end));
+            }
+            RejectOn::Decision => {}
         }
     }
     if let Some(sensed) = reading {

@@ -81,6 +81,27 @@ pub fn text(rows: &[ComparisonRow]) -> String {
     super::aligned::aligned_lines(&HEADER, &body).concat()
 }
 
+/// A line per closed loop among the rows (empty without one): its purity, passes and scrap, and
+/// what its success column counts.
+pub fn loop_lines(rows: &[ComparisonRow]) -> String {
+    let mut s = String::new();
+    for r in rows {
+        if let Some(l) = &r.closed_loop {
+            s += &format!(
+                "closed loop {}: purity {:.4} ({:.4}–{:.4}), {:.3} passes per delivered part, {} scrapped, {} delivered/min; its success is the parts delivered in the goal per new part\n",
+                r.scenario,
+                l.purity,
+                l.purity_ci95[0],
+                l.purity_ci95[1],
+                l.passes_per_delivered,
+                l.scrapped,
+                opt(l.delivered_per_min, 2)
+            );
+        }
+    }
+    s
+}
+
 /// A Markdown table.
 pub fn markdown(rows: &[ComparisonRow]) -> String {
     let mut s = format!(

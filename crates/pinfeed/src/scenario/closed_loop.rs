@@ -107,6 +107,16 @@ pub enum WhenFull {
     Drop,
 }
 
+/// What makes the gate take a part off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RejectOn {
+    /// Its sensor pin's decision: a hypothesis outside `accept`, or unknown (by `unknown`).
+    Decision,
+    /// Any touch of its pin (a contact switch, or a light barrier across the lane): a part that
+    /// does not touch the pin passes.
+    Contact,
+}
+
 /// The reject gate at the belt's end.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RejectGate {
@@ -115,6 +125,8 @@ pub struct RejectGate {
     /// The sensor pin (index in `Scene::obstacles`) whose decision commands it; None: it takes
     /// every part it can.
     pub decided_by: Option<usize>,
+    /// What takes a part off.
+    pub reject_on: RejectOn,
     /// The labels of the sensor's hypotheses that pass.
     pub accept: Vec<String>,
     /// Does an `unknown` decision reject the part?
@@ -217,7 +229,7 @@ fn time(c: &Checker, path: &str, t: &RawTime) -> R<LoopTime> {
 }
 
 /// The keys a reject gate takes.
-const GATE_KEYS: &str = "y, reach, decided_by, accept, unknown, actuation, busy";
+const GATE_KEYS: &str = "y, reach, decided_by, reject_on, accept, unknown, actuation, busy";
 
 /// The gate and return path of a scene: the reject gate of `raw` (if any) and `[recirculation]`.
 /// `obstacles` are the compiled pins and fences, `sensors` their sensor pins' drafts.
@@ -334,6 +346,56 @@ fn gate(
             ))
         }
     };
+    let reject_on = match ro.reject_on.as_deref() {
+        None | Some("decision") => RejectOn::Decision,
+        Some("contact") => RejectOn::Contact,
+        Some(other) => {
+            return Err(c.err(
+                &path("reject_on"),
+                format!("must be \"decision\" or \"contact\", got \"{other}\""),
+            ))
+        }
+    };
+    if ro.reject_on.is_some() && ro.decided_by.is_none() {
+        return Err(c.err(
+            &path("reject_on"),
+            "applies only with decided_by (the pin whose decision or touch commands the gate)",
+        ));
+    }
+    if reject_on == RejectOn::Contact {
+        if ro.accept.is_some() || ro.unknown.is_some() {
+            let k = if ro.accept.is_some() {
+                "accept"
+            } else {
+                "unknown"
+            };
+            return Err(c.err(
+                &path(k),
+                "does not apply with reject_on = \"contact\": any touch rejects the part",
+            ));
+        }
+        let by = ro.decided_by.as_deref().unwrap_or_default();
+        let Some(j) = obstacles
+            .iter()
+            .position(|o| o.name() == by && matches!(o, Obstacle::Pin(_)))
+        else {
+            return Err(c.err(
+                &path("decided_by"),
+                format!("'{by}' is not a pin of this scene (reject_on = \"contact\" needs a pin)"),
+            ));
+        };
+        return Ok(RejectGate {
+            name,
+            decided_by: Some(j),
+            reject_on,
+            accept: Vec::new(),
+            unknown_rejects: true,
+            y,
+            reach,
+            actuation,
+            busy,
+        });
+    }
     let Some(by) = &ro.decided_by else {
         if ro.accept.is_some() || ro.unknown.is_some() {
             let k = if ro.accept.is_some() {
@@ -349,6 +411,7 @@ fn gate(
         return Ok(RejectGate {
             name,
             decided_by: None,
+            reject_on,
             accept: Vec::new(),
             unknown_rejects,
             y,
@@ -406,6 +469,7 @@ fn gate(
     Ok(RejectGate {
         name,
         decided_by: Some(j),
+        reject_on,
         accept,
         unknown_rejects,
         y,

@@ -42,7 +42,7 @@ pub mod scene;
 pub mod sensors;
 pub mod shared_feed;
 
-pub use closed_loop::{ClosedLoop, LoopTime, Recirculation, RejectGate, WhenFull};
+pub use closed_loop::{ClosedLoop, LoopTime, Recirculation, RejectGate, RejectOn, WhenFull};
 pub use draft::SceneDraft;
 pub use dynamic::{
     Actuator, BeliefSpec, ControlMode, Controller, MovingSpec, OnLate, RetractSpec, Rule, Target,

@@ -78,8 +78,28 @@ pub struct ComparisonRow {
     pub contacts_per_part: f64,
     /// Parts that jammed.
     pub jams: u64,
-    /// Count per outcome class.
+    /// Count per outcome class (of the passes, on a closed loop).
     pub outcomes: OutcomeCounts,
+    /// A closed loop's purity, passes and scrap (absent from the JSON on an open line). On a
+    /// closed loop `parts_in` counts the new parts, `success_rate` the parts delivered in the
+    /// goal per new part and `throughput_ok_per_min` the loop's oriented parts per minute.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<LoopRow>,
+}
+
+/// What a closed loop adds to its row.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LoopRow {
+    /// Delivered parts in the goal / delivered parts.
+    pub purity: f64,
+    /// Its 95% Wilson interval.
+    pub purity_ci95: [f64; 2],
+    /// Mean passes per delivered part.
+    pub passes_per_delivered: f64,
+    /// Parts scrapped (last pass or a full buffer).
+    pub scrapped: u64,
+    /// Parts delivered per minute over the loop's steady window.
+    pub delivered_per_min: Option<f64>,
 }
 
 /// A line's obstacles by kind (the file format's `pin`, `sensor_pin`, `moving_pin`,
@@ -232,7 +252,8 @@ pub enum DesignsError {
 }
 
 /// Read the scenario files `paths`, check that they describe one part, and impose `overrides` on
-/// each one's feed. Each online controller's model is built from its file as written, before the
+/// each one's feed; a closed loop is followed by its open line (`<name>-open`: the same scene
+/// without its gate and return path). Each online controller's model is built from its file as written, before the
 /// overrides: the controller was designed for its own feed.
 pub fn designs(
     paths: &[std::path::PathBuf],
@@ -242,9 +263,21 @@ pub fn designs(
     let (mut scenes, mut files, mut online) = (Vec::new(), Vec::new(), Vec::new());
     for path in paths {
         let scene = crate::scenario::load(path)?;
-        online.push(crate::engine::prepare::online_model(&scene)?);
+        let model = crate::engine::prepare::online_model(&scene)?;
+        // A closed loop runs beside its open line: the same scene without gate or return path.
+        let open = scene.closed_loop.is_some().then(|| Scene {
+            name: format!("{}-open", scene.name),
+            closed_loop: None,
+            ..scene.clone()
+        });
+        online.push(model.clone());
         scenes.push(scene);
         files.push(path.display().to_string());
+        if let Some(open) = open {
+            online.push(model);
+            scenes.push(open);
+            files.push(format!("{} (open)", path.display()));
+        }
     }
     let first = scenes.first().ok_or(DesignsError::Empty)?.clone();
     for (scene, file) in scenes.iter_mut().zip(&files) {
@@ -304,7 +337,7 @@ pub fn compare_observed(
             let length = part_length(&scene.part.polygon);
             let hist = &r.metrics.latency_us;
             let kinds = ObstacleKinds::of(scene);
-            Ok(ComparisonRow {
+            let mut row = ComparisonRow {
                 scenario: scene.name.clone(),
                 file: file.clone(),
                 pins: scene.obstacles.len() - kinds.fences,
@@ -331,7 +364,23 @@ pub fn compare_observed(
                 contacts_per_part: s.contacts_per_part,
                 jams: s.outcomes.jam,
                 outcomes: s.outcomes,
-            })
+                closed_loop: None,
+            };
+            if let Some(l) = &s.closed_loop {
+                let ok = l.fates.delivered_ok;
+                row.parts_in = l.new_parts;
+                row.success_rate = ok as f64 / l.new_parts.max(1) as f64;
+                row.success_ci95 = crate::statistics::wilson_interval(ok, l.new_parts);
+                row.throughput_ok_per_min = l.oriented_per_min;
+                row.closed_loop = Some(LoopRow {
+                    purity: l.purity,
+                    purity_ci95: l.purity_ci95,
+                    passes_per_delivered: l.passes_per_delivered.mean,
+                    scrapped: l.fates.scrapped_max_passes + l.fates.scrapped_full,
+                    delivered_per_min: l.delivered_per_min,
+                });
+            }
+            Ok(row)
         })
         .collect()
 }
