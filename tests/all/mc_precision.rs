@@ -238,6 +238,11 @@ fn bad_precisions_are_refused_naming_the_flag() {
         );
         assert!(!d.join("report.json").exists(), "{bad}: nothing is run");
     }
+    // The message docs/commands.md quotes.
+    let out = pinfeed(&["mc", s(&study), "--precision", "0.5"]);
+    assert!(String::from_utf8_lossy(&out.stderr).starts_with(
+        "error: invalid value '0.5' for '--precision <E>': --precision must lie in (0, 0.5) "
+    ));
     let out = pinfeed(&["mc", s(&study), "--precision", "0.1", "--shard", "0/2"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
