@@ -1,7 +1,7 @@
 //! Small statistics shared by the layers that report rates: the line's success rate, Monte Carlo
 //! studies, sensor accuracies; and output analysis (docs/output-analysis.md): where a series'
-//! warm-up ends ([`mser5`]), an interval for the mean of a correlated series ([`batch_means`]),
-//! and an interval for a rate that may be watched after every sample ([`confidence_sequence`]).
+//! warm-up ends ([`mser5`]), an interval for the mean of a correlated series ([`batch_means()`]),
+//! and an interval for a rate that may be watched after every sample ([`confidence_sequence()`]).
 
 pub mod batch_means;
 pub mod confidence_sequence;

@@ -4,7 +4,7 @@
 //! The samples run in deterministic rounds: in each, every point not yet stopped runs its next
 //! [`BLOCK`] samples (sample indices in order, fewer in the last block at the cap), and the point
 //! stops when the half-width of the 95% confidence sequence of its success rate
-//! ([`crate::statistics::confidence_sequence`]: Robbins' beta-binomial mixture, Howard et al.
+//! ([`crate::statistics::confidence_sequence()`]: Robbins' beta-binomial mixture, Howard et al.
 //! 2021) is at most E, checked after each block. Because the sequence holds at every sample count
 //! at once, the interval reported at the stop keeps its 95% coverage although the stop was chosen
 //! by looking at the data — which a Wilson interval, checked after every block, would not
