@@ -37,6 +37,18 @@ pub struct McArgs {
     /// No table and no progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Run each sweep point in blocks of 1000 samples until the 95% confidence sequence of its
+    /// success rate has a half-width of at most E (in (0, 0.5)), or its samples (the cap) are spent.
+    #[arg(long, value_name = "E", value_parser = parse_precision, conflicts_with = "shard")]
+    pub precision: Option<f64>,
+}
+
+/// `--precision E`: a number in (0, 0.5).
+fn parse_precision(text: &str) -> Result<f64, String> {
+    let e: f64 = text
+        .parse()
+        .map_err(|_| format!("--precision must be a number in (0, 0.5), got '{text}'"))?;
+    mc::sequential::check_precision(e)
 }
 
 /// The default report folder of a study.
@@ -68,11 +80,29 @@ pub fn run(args: &McArgs) -> Result<()> {
     let range = shard.map_or(0..total, |s| s.range(total));
     let bar = super::progress::bar(range.end - range.start, "samples", args.quiet);
     let started = Instant::now();
-    let tallies = run::run_range_with_threads(&study, range.clone(), args.threads, &|| bar.inc(1))
-        .with_context(|| format!("running {}", args.study.display()))?;
+    let running = || format!("running {}", args.study.display());
+    let (tallies, stops) = match args.precision {
+        None => {
+            let tallies =
+                run::run_range_with_threads(&study, range.clone(), args.threads, &|| bar.inc(1))
+                    .with_context(running)?;
+            (tallies, None)
+        }
+        Some(e) => {
+            let (tallies, stops) = mc::sequential::run_to_precision(
+                &study,
+                e,
+                mc::sequential::BLOCK,
+                args.threads,
+                &|| bar.inc(1),
+            )
+            .with_context(running)?;
+            (tallies.into_iter().enumerate().collect(), Some(stops))
+        }
+    };
     let wall = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let n = range.end - range.start;
+    let n: u64 = tallies.values().map(|t| t.samples).sum();
     let speed = format!(
         "{n} samples in {wall:.2} s wall: {:.0} samples/s",
         n as f64 / wall.max(1e-9)
@@ -106,7 +136,16 @@ pub fn run(args: &McArgs) -> Result<()> {
         .map(|j| tallies.get(&j).cloned().unwrap_or_default())
         .collect();
     let dir = args.out.clone().unwrap_or_else(|| default_dir(&study.name));
-    let r = report::build(&report::with_out(header, &dir), &tallies);
+    let r = match (args.precision, stops) {
+        (Some(e), Some(stops)) => report::with_sequential(
+            report::build(
+                &report::with_out(report::with_precision(header, e), &dir),
+                &tallies,
+            ),
+            &stops,
+        ),
+        _ => report::build(&report::with_out(header, &dir), &tallies),
+    };
     publish(&r, &dir, args.json, args.quiet)?;
     if !args.quiet && !args.json {
         eprintln!("{speed}");

@@ -61,6 +61,7 @@ mod map_tier;
 mod maps;
 mod mc;
 mod mc_obstacles;
+mod mc_precision;
 mod mc_sensing;
 mod moving_pin;
 mod online;

@@ -24,7 +24,9 @@
 //! * [`sample`]: one perturbed line and its one part; [`run`]: many samples in parallel;
 //! * [`tally`], [`shard`], [`report`]: counts, shard files and merging, the report; [`online`]:
 //!   what an online controller decided and predicted, against what happened;
-//! * [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time.
+//! * [`hash`]: the study's content hash; [`precision`]: CI half-width against samples and time;
+//! * [`sequential`]: `--precision E`, each point run in blocks until its success rate is known to
+//!   ± E (an anytime-valid confidence sequence) or the samples are spent.
 
 pub mod compile;
 pub use crate::random::distribution;
@@ -37,6 +39,7 @@ pub mod raw;
 pub mod report;
 pub mod run;
 pub mod sample;
+pub mod sequential;
 pub mod shard;
 pub mod tally;
 

@@ -201,6 +201,10 @@ pub struct PointReport {
     /// What an online controller decided and predicted; only when the line has one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub online: Option<super::online::OnlineShare>,
+    /// How the point's sequential run stopped; only under `--precision`
+    /// ([`super::sequential`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sequential: Option<super::sequential::Sequential>,
 }
 
 /// The whole report.
@@ -275,6 +279,7 @@ fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
             ci95: wilson_interval(t.sensor_correct, t.sensor_readings),
         }),
         online: t.online.report(),
+        sequential: None,
     }
 }
 
@@ -291,6 +296,23 @@ pub fn build(header: &StudyHeader, tallies: &[PointTally]) -> McReport {
             .map(|(j, t)| point_report(header, j, t))
             .collect(),
     }
+}
+
+/// The report of a sequential run (`--precision`): each point's result with how it stopped
+/// (`stops`, in point order).
+pub fn with_sequential(mut r: McReport, stops: &[super::sequential::Sequential]) -> McReport {
+    for (p, s) in r.results.iter_mut().zip(stops) {
+        p.sequential = Some(*s);
+    }
+    r
+}
+
+/// The header of a sequential run: its regenerating command asks for the same `precision`.
+pub fn with_precision(mut header: StudyHeader, precision: f64) -> StudyHeader {
+    header
+        .command
+        .push_str(&format!(" --precision {precision}"));
+    header
 }
 
 /// The report as pretty JSON with a final newline.
@@ -334,6 +356,11 @@ pub fn table(r: &McReport) -> String {
         head.push("sensor readings".into());
         head.push("sensor accuracy % [95% CI]".into());
     }
+    let sequential = r.results.iter().any(|p| p.sequential.is_some());
+    if sequential {
+        head.push("success % [95% CS]".into());
+        head.push("stopped on".into());
+    }
     let mut s = format!("| {} |\n|{}\n", head.join(" | "), "---|".repeat(head.len()));
     for p in &r.results {
         let mut row: Vec<String> = r
@@ -369,6 +396,15 @@ pub fn table(r: &McReport) -> String {
                 "–".to_string()
             });
         }
+        if let Some(q) = p.sequential.filter(|_| sequential) {
+            row.push(format!(
+                "{:.1}% [{:.1}, {:.1}]",
+                100.0 * p.success_rate,
+                100.0 * q.confidence_sequence[0],
+                100.0 * q.confidence_sequence[1]
+            ));
+            row.push(q.stopped.name().to_string());
+        }
         s.push_str(&format!("| {} |\n", row.join(" | ")));
     }
     s
@@ -396,6 +432,18 @@ pub fn markdown(r: &McReport, figure: &str) -> String {
         h.study_hash,
         h.pinfeed_version
     ));
+    if let Some(q) = r.results.iter().find_map(|p| p.sequential) {
+        s.push_str(&format!(
+            "Sampling was sequential (`--precision {}`): each point ran blocks of {} samples until the \
+             half-width of the 95% confidence sequence of its success rate (CS; Robbins' beta-binomial \
+             mixture, valid however the stop is chosen) was at most {}, or its {} samples were spent \
+             (`stopped on`: precision or cap).\n\n",
+            q.precision,
+            q.block,
+            q.precision,
+            h.samples_per_point
+        ));
+    }
     s.push_str("Uncertain parameters:\n\n");
     for u in &h.uncertain {
         s.push_str(&format!("- {u}\n"));

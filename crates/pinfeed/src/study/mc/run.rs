@@ -69,8 +69,17 @@ pub fn run_range_with_threads(
     threads: Option<usize>,
     tick: &(dyn Fn() + Sync),
 ) -> Result<BTreeMap<usize, PointTally>, StudyError> {
+    with_threads(threads, || run_range(study, range, tick))
+}
+
+/// Run `work` on a pool of `threads` threads, so that every [`run_range`] inside it runs there
+/// (None: on rayon's global pool, all cores).
+pub fn with_threads<R: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> Result<R, StudyError> + Send,
+) -> Result<R, StudyError> {
     match threads {
-        None => run_range(study, range, tick),
+        None => work(),
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
@@ -79,7 +88,7 @@ pub fn run_range_with_threads(
                     threads: n,
                     reason: e.to_string(),
                 })?;
-            pool.install(|| run_range(study, range, tick))
+            pool.install(work)
         }
     }
 }

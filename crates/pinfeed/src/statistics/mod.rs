@@ -1,5 +1,17 @@
 //! Small statistics shared by the layers that report rates: the line's success rate, Monte Carlo
-//! studies, sensor accuracies.
+//! studies, sensor accuracies; and output analysis (docs/output-analysis.md): where a series'
+//! warm-up ends ([`mser5`]), an interval for the mean of a correlated series ([`batch_means()`]),
+//! and an interval for a rate that may be watched after every sample ([`confidence_sequence()`]).
+
+pub mod batch_means;
+pub mod confidence_sequence;
+pub mod mser;
+pub mod quantiles;
+
+pub use batch_means::{batch_means, BatchMeans};
+pub use confidence_sequence::{confidence_sequence, precise_enough};
+pub use mser::{mser5, Mser, MserVerdict};
+pub use quantiles::{normal_quantile, t_quantile};
 
 /// The 50th, 90th and 99th percentiles (s) of a latency histogram recorded in whole µs, each
 /// clamped into [`min`, `max`] (s), the smallest and largest latencies it summarises: an HDR
@@ -40,6 +52,27 @@ pub fn wilson_lower_one_sided(k: u64, n: u64) -> f64 {
     let centre = p + z2 / (2.0 * n);
     let half = z * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
     ((centre - half) / (1.0 + z2 / n)).max(0.0)
+}
+
+/// Series the output-analysis tests share.
+#[cfg(test)]
+pub(crate) mod testing {
+    use rand_distr::{Distribution, StandardNormal};
+
+    /// `n` observations of the AR(1) series xₜ = φ·xₜ₋₁ + σεₜ (ε standard normal, σ = `sd`)
+    /// started in its stationary law, mean 0, from random stream (53, `seed`).
+    pub fn ar1(seed: u64, phi: f64, n: usize, sd: f64) -> Vec<f64> {
+        let mut rng = crate::random::stream(53, seed);
+        let mut z = || -> f64 { StandardNormal.sample(&mut rng) };
+        let mut x = sd * z() / (1.0 - phi * phi).sqrt();
+        (0..n)
+            .map(|_| {
+                let now = x;
+                x = phi * x + sd * z();
+                now
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]
