@@ -47,7 +47,7 @@ pub(super) fn arrival(
         None => fresh_part(scene, opts.seed, index, metrics)?,
     };
     if let Some(lp) = belt.closed_loop.as_mut() {
-        lp.open_entry(t);
+        lp.open_entry(index, t);
     }
     metrics.arrival(t);
     schedule_next(scene, opts, belt, t, index);

@@ -161,6 +161,8 @@ pub(super) struct LoopState {
     /// Entry number → (part, passes before this one); only with a return path (else the entry
     /// number is the part and every pass the first).
     entries: BTreeMap<u64, (u64, u32)>,
+    /// When each part still in the system first arrived (s), by part.
+    born: BTreeMap<u64, f64>,
     next_entry: u64,
     /// Parts off the belt between passes, by part.
     off_belt: BTreeMap<u64, Returning>,
@@ -198,6 +200,8 @@ struct LoopStats {
     last_new_arrival: f64,
     /// Deliveries (all, in the goal) before the latest new arrival: the steady window's counts.
     delivered_at_last_arrival: (u64, u64),
+    /// Every delivery: its time and the part's time in the system (first arrival to delivery).
+    deliveries: Vec<(f64, f64)>,
 }
 
 impl LoopStats {
@@ -225,14 +229,16 @@ impl LoopState {
         let headway = match feed.arrival {
             Arrival::Periodic { headway } | Arrival::Poisson { headway } => headway,
         };
-        // About 200 bins over the feed's span: enough batches for MSER-5.
-        let bin_s = headway * (parts as f64 / 200.0).ceil().max(1.0);
+        // About 1000 bins over the feed's span: MSER-5's batches of five bins then place a
+        // warm-up to within 0.5% of the span.
+        let bin_s = headway * (parts as f64 / 1000.0).ceil().max(1.0);
         LoopState {
             gate: cl.gate.clone(),
             recirculation: cl.recirculation.clone(),
             seed,
             busy_until: f64::NEG_INFINITY,
             entries: BTreeMap::new(),
+            born: BTreeMap::new(),
             next_entry: 0,
             off_belt: BTreeMap::new(),
             buffer: VecDeque::new(),
@@ -271,12 +277,14 @@ impl LoopState {
     /// A new part `part` arrives at the merge at `t`.
     pub(super) fn new_part(&mut self, part: u64, t: f64) {
         self.stats.arrival(t);
+        self.born.insert(part, t);
         self.new_waiting.push_back((part, t));
     }
 
     /// An open line's entry (no return path): part `part` enters as itself.
-    pub(super) fn open_entry(&mut self, t: f64) {
+    pub(super) fn open_entry(&mut self, part: u64, t: f64) {
         self.stats.arrival(t);
+        self.born.insert(part, t);
         self.stats.passes += 1;
     }
 
@@ -403,10 +411,12 @@ impl LoopState {
         self.entries.remove(&entry);
         let Some(r) = &self.recirculation else {
             self.stats.fates.rejected += 1;
+            self.born.remove(&part);
             return;
         };
         if pass + 1 >= r.max_passes {
             self.stats.fates.scrapped_max_passes += 1;
+            self.born.remove(&part);
             return;
         }
         let transit = r
@@ -444,6 +454,7 @@ impl LoopState {
             }
             WhenFull::Drop => {
                 self.off_belt.remove(&part);
+                self.born.remove(&part);
                 self.stats.fates.scrapped_full += 1;
                 self.levels(t, -1, 0);
             }
@@ -452,8 +463,9 @@ impl LoopState {
 
     /// Entry `entry` left the line at `t` with `outcome` (not through the gate).
     pub(super) fn finished(&mut self, entry: u64, t: f64, outcome: super::PartOutcome) {
-        let (_, pass) = self.identity(entry);
+        let (part, pass) = self.identity(entry);
         self.entries.remove(&entry);
+        let born = self.born.remove(&part).unwrap_or(t);
         let s = &mut self.stats;
         if !outcome.exited() {
             s.fates.lost += 1;
@@ -470,6 +482,7 @@ impl LoopState {
             s.passes_of_delivered.resize(k + 1, 0);
         }
         s.passes_of_delivered[k] += 1;
+        s.deliveries.push((t, t - born));
         s.first_delivery.get_or_insert(t);
         s.last_delivery = t;
         let bin = (t / s.bin_s).floor().max(0.0) as usize;
@@ -486,6 +499,41 @@ impl LoopState {
         self.stats.gate.acted
     }
 
+    /// MSER-5 on the deliveries per bin, then batch means (see [`OutputAnalysis`]).
+    fn output_analysis(&self) -> OutputAnalysis {
+        use crate::statistics::MserVerdict;
+        let s = &self.stats;
+        let steady_bins =
+            ((s.last_new_arrival / s.bin_s).floor() as usize).min(s.delivered_bins.len());
+        let series = |bins: &[u64]| -> Vec<f64> {
+            bins[..steady_bins.min(bins.len())]
+                .iter()
+                .map(|&n| n as f64)
+                .collect()
+        };
+        let delivered = series(&s.delivered_bins);
+        let m = crate::statistics::mser5(&delivered);
+        let cut = m.truncation.min(delivered.len());
+        let warm_up_s = cut as f64 * s.bin_s;
+        let per_min = 60.0 / s.bin_s;
+        let oriented = series(&s.ok_bins);
+        let times: Vec<f64> = (s.deliveries.iter())
+            .filter(|&&(t, _)| t >= warm_up_s && t < s.last_new_arrival)
+            .map(|&(_, st)| st)
+            .collect();
+        OutputAnalysis {
+            warm_up_s,
+            warm_up_verdict: match m.verdict {
+                MserVerdict::Reliable => "reliable",
+                MserVerdict::TooShort => "too_short",
+                MserVerdict::AtSearchEdge => "at_search_edge",
+            },
+            delivered_per_min: SteadyMean::of(&delivered[cut..], per_min),
+            oriented_per_min: SteadyMean::of(&oriented[cut.min(oriented.len())..], per_min),
+            system_time_s: SteadyMean::of(&times, 1.0),
+        }
+    }
+
     /// Check conservation at the end of a run of `parts` new parts: every part has a fate and
     /// nothing waits.
     pub(super) fn assert_conserved(&self, parts: u64) {
@@ -496,6 +544,7 @@ impl LoopState {
             "parts left waiting at the merge after the last event"
         );
         assert!(self.off_belt.is_empty(), "parts left on the return path");
+        assert!(self.born.is_empty(), "parts left without a fate");
         assert_eq!(
             s.fates.total(),
             parts,
@@ -570,6 +619,7 @@ impl LoopState {
                 new: merge_mean(s.merge_wait_new_s, s.merge_new),
                 returning: merge_mean(s.merge_wait_return_s, s.merge_returns),
             },
+            output_analysis: self.output_analysis(),
             series: Series {
                 bin_s: s.bin_s,
                 delivered: s.delivered_bins.clone(),
@@ -654,6 +704,52 @@ pub struct LoopSummary {
     pub buffer: LevelSummary,
     /// Mean waits at the merge.
     pub merge_wait_s: MergeWait,
+    /// Warm-up and the steady rates' and system time's intervals (MSER-5, batch means).
+    pub output_analysis: OutputAnalysis,
     /// Deliveries over time.
     pub series: Series,
+}
+
+/// A steady-state mean and its 95% batch-means interval.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SteadyMean {
+    /// The mean over the kept observations.
+    pub mean: f64,
+    /// Its 95% interval (Student t over the batch means).
+    pub ci95: [f64; 2],
+    /// Batches the interval was formed from.
+    pub batches: usize,
+}
+
+impl SteadyMean {
+    fn of(series: &[f64], scale: f64) -> Option<SteadyMean> {
+        let b = crate::statistics::batch_means(series, OUTPUT_BATCHES);
+        (b.batches >= 2).then(|| SteadyMean {
+            mean: b.mean * scale,
+            ci95: [b.ci95[0] * scale, b.ci95[1] * scale],
+            batches: b.batches,
+        })
+    }
+}
+
+/// Batches of the batch-means intervals (Law & Kelton recommend 10 to 30).
+const OUTPUT_BATCHES: usize = 20;
+
+/// The loop's output analysis: the warm-up MSER-5 finds in the deliveries per bin (up to the
+/// last new arrival: the drain after it is not steady), and over the bins after it the delivered
+/// and oriented rates with batch-means intervals; the system time (first arrival to delivery) of
+/// the parts delivered after the warm-up, likewise.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutputAnalysis {
+    /// The warm-up MSER-5 truncates (s from the first arrival).
+    pub warm_up_s: f64,
+    /// `reliable`, `too_short` (fewer than 10 batches of five bins) or `at_search_edge` (the
+    /// minimum is at half the series: run longer).
+    pub warm_up_verdict: &'static str,
+    /// Delivered parts per minute after the warm-up.
+    pub delivered_per_min: Option<SteadyMean>,
+    /// Delivered parts in the goal per minute after the warm-up.
+    pub oriented_per_min: Option<SteadyMean>,
+    /// Time in the system of the parts delivered after the warm-up (s).
+    pub system_time_s: Option<SteadyMean>,
 }

@@ -203,6 +203,20 @@ pub fn loop_table(o: &mut String, l: &crate::engine::closed_loop::LoopSummary) {
         "  merge wait              new {:.3} s, returning {:.3} s",
         l.merge_wait_s.new, l.merge_wait_s.returning
     );
+    let oa = &l.output_analysis;
+    let steady = |m: &Option<crate::engine::closed_loop::SteadyMean>, d: usize| match m {
+        Some(m) => format!("{:.d$} ({:.d$}–{:.d$})", m.mean, m.ci95[0], m.ci95[1]),
+        None => "n/a".into(),
+    };
+    let _ = writeln!(
+        o,
+        "  steady state            warm-up {:.1} s (MSER-5, {}); delivered {} / in goal {} parts/min; time in system {} s (95% batch means)",
+        oa.warm_up_s,
+        oa.warm_up_verdict.replace('_', " "),
+        steady(&oa.delivered_per_min, 2),
+        steady(&oa.oriented_per_min, 2),
+        steady(&oa.system_time_s, 1)
+    );
     let window = match l.steady_window_s {
         Some([a, b]) => format!("  (window {a:.1}–{b:.1} s)"),
         None => String::new(),

@@ -363,12 +363,7 @@ fn gate(
         ));
     }
     if reject_on == RejectOn::Contact {
-        if ro.accept.is_some() || ro.unknown.is_some() {
-            let k = if ro.accept.is_some() {
-                "accept"
-            } else {
-                "unknown"
-            };
+        if let Some(k) = decision_key(ro) {
             return Err(c.err(
                 &path(k),
                 "does not apply with reject_on = \"contact\": any touch rejects the part",
@@ -397,12 +392,7 @@ fn gate(
         });
     }
     let Some(by) = &ro.decided_by else {
-        if ro.accept.is_some() || ro.unknown.is_some() {
-            let k = if ro.accept.is_some() {
-                "accept"
-            } else {
-                "unknown"
-            };
+        if let Some(k) = decision_key(ro) {
             return Err(c.err(
                 &path(k),
                 "applies only with decided_by (the sensor pin whose decision commands the gate)",
@@ -477,6 +467,17 @@ fn gate(
         actuation,
         busy,
     })
+}
+
+/// The first of the keys that only a gate commanded by a decision takes, if given.
+fn decision_key(ro: &RawObstacle) -> Option<&'static str> {
+    if ro.accept.is_some() {
+        Some("accept")
+    } else if ro.unknown.is_some() {
+        Some("unknown")
+    } else {
+        None
+    }
 }
 
 fn compile_recirculation(
