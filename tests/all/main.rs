@@ -60,6 +60,7 @@ mod map_fence;
 mod map_tier;
 mod maps;
 mod mc;
+mod mc_loop;
 mod mc_obstacles;
 mod mc_precision;
 mod mc_sensing;

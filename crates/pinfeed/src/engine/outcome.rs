@@ -30,6 +30,10 @@ pub enum PartOutcome {
     Jam,
     /// The contact model could not finish the push.
     Solver,
+    /// Taken off by a closed loop's gate and never delivered: scrapped on its last pass or at a
+    /// full buffer, or rejected by a gate with no return path. Only a Monte Carlo sample of a
+    /// closed loop ends so; on the line the loop's `fates` count these parts.
+    Rejected,
 }
 
 impl PartOutcome {
@@ -44,6 +48,19 @@ impl PartOutcome {
         PartOutcome::Solver,
     ];
 
+    /// Every class, [`PartOutcome::ALL`] and then `rejected` (a Monte Carlo sample of a closed
+    /// loop).
+    pub const EVERY: [PartOutcome; 8] = [
+        PartOutcome::Success,
+        PartOutcome::WrongOrientation,
+        PartOutcome::Collision,
+        PartOutcome::MultiContact,
+        PartOutcome::OffBelt,
+        PartOutcome::Jam,
+        PartOutcome::Solver,
+        PartOutcome::Rejected,
+    ];
+
     /// The class's name in outputs (`success`, `wrong_orientation`, `collision`, `multi_contact`, `off_belt`, `jam`, `solver`).
     pub fn name(self) -> &'static str {
         match self {
@@ -54,6 +71,7 @@ impl PartOutcome {
             PartOutcome::OffBelt => "off_belt",
             PartOutcome::Jam => "jam",
             PartOutcome::Solver => "solver",
+            PartOutcome::Rejected => "rejected",
         }
     }
 
@@ -80,12 +98,23 @@ pub struct OutcomeCounts {
     pub jam: u64,
     /// Parts whose push the contact model could not finish.
     pub solver: u64,
+    /// Monte Carlo samples of a closed loop that the gate took off for good (absent when 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub rejected: u64,
+}
+
+fn is_zero(k: &u64) -> bool {
+    *k == 0
 }
 
 impl OutcomeCounts {
     /// Count one part of class `o`.
     pub fn add(&mut self, o: PartOutcome) {
         *self.get_mut(o) += 1;
+    }
+    /// Count `n` parts of class `o`.
+    pub fn add_n(&mut self, o: PartOutcome, n: u64) {
+        *self.get_mut(o) += n;
     }
     /// The count of class `o`.
     pub fn get(&self, o: PartOutcome) -> u64 {
@@ -97,6 +126,7 @@ impl OutcomeCounts {
             PartOutcome::OffBelt => self.off_belt,
             PartOutcome::Jam => self.jam,
             PartOutcome::Solver => self.solver,
+            PartOutcome::Rejected => self.rejected,
         }
     }
     fn get_mut(&mut self, o: PartOutcome) -> &mut u64 {
@@ -108,11 +138,12 @@ impl OutcomeCounts {
             PartOutcome::OffBelt => &mut self.off_belt,
             PartOutcome::Jam => &mut self.jam,
             PartOutcome::Solver => &mut self.solver,
+            PartOutcome::Rejected => &mut self.rejected,
         }
     }
     /// All parts counted, over every class.
     pub fn total(&self) -> u64 {
-        PartOutcome::ALL.iter().map(|&o| self.get(o)).sum()
+        PartOutcome::EVERY.iter().map(|&o| self.get(o)).sum()
     }
 }
 

@@ -49,7 +49,7 @@ pub fn draw_part(
 ) -> Result<PartDraw, crate::mechanics::PartModelError> {
     let mut rng = stream(seed, index);
     let gap = draw_gap(scene, &mut rng);
-    let theta = draw_orientation(scene, &mut rng);
+    let theta = draw_orientation(&scene.feed.orientation, &mut rng);
     let y = draw_lateral(&scene.feed.lateral, &mut rng);
     let model = match scene.part.support {
         SupportKind::Uniform => None,
@@ -71,16 +71,23 @@ pub fn draw_part(
 /// part keeps its support: a warped part stays warped).
 pub fn draw_reentry(scene: &Scene, seed: u64, part: u64, pass: u32) -> (f64, f64) {
     let mut rng = crate::random::substream(seed, REENTRY_PURPOSE + u64::from(pass), part);
-    let theta = draw_orientation(scene, &mut rng);
-    (theta, draw_lateral(&scene.feed.lateral, &mut rng))
+    let own = (scene.closed_loop.as_ref())
+        .and_then(|cl| cl.recirculation.as_ref())
+        .and_then(|r| r.reentry.as_ref());
+    let (orientation, lateral) = match own {
+        Some((o, l)) => (o, l),
+        None => (&scene.feed.orientation, &scene.feed.lateral),
+    };
+    let theta = draw_orientation(orientation, &mut rng);
+    (theta, draw_lateral(lateral, &mut rng))
 }
 
 /// The purposes of [`crate::random::substream`] from this one up are the re-entries' (one per
 /// pass).
 const REENTRY_PURPOSE: u64 = 0x5245_0000;
 
-fn draw_orientation(scene: &Scene, rng: &mut ChaCha8Rng) -> f64 {
-    match &scene.feed.orientation {
+fn draw_orientation(orientation: &Orientation, rng: &mut ChaCha8Rng) -> f64 {
+    match orientation {
         Orientation::Uniform => std::f64::consts::TAU * rng.random::<f64>(),
         Orientation::Stable {
             thetas_rad: thetas,

@@ -31,6 +31,7 @@ pub fn outcome_colour(o: PartOutcome) -> RGBColor {
         PartOutcome::OffBelt => RGBColor(120, 80, 40),
         PartOutcome::Jam => RGBColor(0, 0, 0),
         PartOutcome::Solver => RGBColor(120, 120, 120),
+        PartOutcome::Rejected => RGBColor(60, 110, 200),
     }
 }
 

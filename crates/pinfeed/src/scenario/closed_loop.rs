@@ -154,6 +154,10 @@ pub struct Recirculation {
     pub max_passes: u32,
     /// Least time between two entries at the merge (s).
     pub merge_gap: LoopTime,
+    /// How a returning part's pose is drawn: orientation and lateral offset (None: as the
+    /// scene's feed draws them). A Monte Carlo sample, whose feed is one fixed pose, sets the
+    /// study's nominal feed here.
+    pub reentry: Option<(super::Orientation, super::Lateral)>,
 }
 
 /// A closed loop: the gate, and the return path if rejected parts go round again.
@@ -544,6 +548,7 @@ fn compile_recirculation(
         when_full,
         max_passes,
         merge_gap,
+        reentry: None,
     })
 }
 

@@ -205,6 +205,21 @@ pub struct PointReport {
     /// ([`super::sequential`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sequential: Option<super::sequential::Sequential>,
+    /// A closed loop's purity and passes; only when the line has a reject gate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<LoopShare>,
+}
+
+/// What a closed loop did with a point's samples (one part each, sent round until delivered or
+/// taken off for good).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LoopShare {
+    /// Parts delivered in the goal / parts delivered (success / (success + wrong orientation)).
+    pub purity: f64,
+    /// Its 95% Wilson interval.
+    pub purity_ci95: [f64; 2],
+    /// Passes per part, over the samples.
+    pub passes_per_part: f64,
 }
 
 /// The whole report.
@@ -230,8 +245,12 @@ pub const SAMPLE_MEANING: &str =
 fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
     let n = t.samples;
     let mut shares = BTreeMap::new();
-    for c in PartOutcome::ALL {
+    for c in PartOutcome::EVERY {
         let k = t.outcomes.get(c);
+        // `rejected` only on a closed loop (whose samples count passes).
+        if c == PartOutcome::Rejected && t.passes == 0 {
+            continue;
+        }
         shares.insert(
             c.name().to_string(),
             Share {
@@ -280,6 +299,14 @@ fn point_report(header: &StudyHeader, j: usize, t: &PointTally) -> PointReport {
         }),
         online: t.online.report(),
         sequential: None,
+        closed_loop: (t.passes > 0).then(|| {
+            let (ok, wrong) = (t.outcomes.success, t.outcomes.wrong_orientation);
+            LoopShare {
+                purity: ok as f64 / (ok + wrong).max(1) as f64,
+                purity_ci95: wilson_interval(ok, ok + wrong),
+                passes_per_part: t.passes as f64 / n.max(1) as f64,
+            }
+        }),
     }
 }
 
@@ -332,7 +359,7 @@ fn pct(s: &Share) -> String {
 /// The per-point table (Markdown; also what the terminal shows).
 pub fn table(r: &McReport) -> String {
     // Classes shown: success always, the others where any point has one.
-    let shown: Vec<PartOutcome> = PartOutcome::ALL
+    let shown: Vec<PartOutcome> = PartOutcome::EVERY
         .into_iter()
         .filter(|&c| c == PartOutcome::Success || r.results.iter().any(|p| p.outcomes.get(c) > 0))
         .collect();
@@ -360,6 +387,11 @@ pub fn table(r: &McReport) -> String {
     if sequential {
         head.push("success % [95% CS]".into());
         head.push("stopped on".into());
+    }
+    let looped = r.results.iter().any(|p| p.closed_loop.is_some());
+    if looped {
+        head.push("purity % [95% CI]".into());
+        head.push("passes/part".into());
     }
     let mut s = format!("| {} |\n|{}\n", head.join(" | "), "---|".repeat(head.len()));
     for p in &r.results {
@@ -404,6 +436,15 @@ pub fn table(r: &McReport) -> String {
                 100.0 * q.confidence_sequence[1]
             ));
             row.push(q.stopped.name().to_string());
+        }
+        if let Some(l) = p.closed_loop.filter(|_| looped) {
+            row.push(format!(
+                "{:.2}% [{:.2}, {:.2}]",
+                100.0 * l.purity,
+                100.0 * l.purity_ci95[0],
+                100.0 * l.purity_ci95[1]
+            ));
+            row.push(format!("{:.3}", l.passes_per_part));
         }
         s.push_str(&format!("| {} |\n", row.join(" | ")));
     }

@@ -98,6 +98,8 @@ pub struct SampleResult {
     pub sensor_correct: u32,
     /// The online controller's decision on the part (None without one, or without a decision).
     pub online: Option<super::online::OnlineSample>,
+    /// A closed loop: the passes the part made (None on an open line).
+    pub passes: Option<u32>,
 }
 
 /// The per-parameter random streams of one sample.
@@ -989,10 +991,18 @@ pub fn draw_scene(
         output: base.output.clone(),
         // One map per sample would cost far more than the sample's few exact contacts.
         map_tier: base.map_tier.filter(|_| p.varies_map_inputs().is_none()),
-        closed_loop: base.closed_loop.clone(),
+        // A returning part is drawn from the study's nominal feed (the sample's feed is its
+        // first entry's pose).
+        closed_loop: base.closed_loop.clone().map(|mut cl| {
+            if let Some(r) = cl.recirculation.as_mut() {
+                r.reentry = Some((base.feed.orientation.clone(), base.feed.lateral));
+            }
+            cl
+        }),
     };
     scene.feed = draw_entry(&scene, base, p, &mut st, &mut other)?;
-    let run_seed = if sensors(base).is_empty() {
+    // The run's seed draws the sensor readings and a closed loop's gate, returns and re-entries.
+    let run_seed = if sensors(base).is_empty() && base.closed_loop.is_none() {
         0
     } else {
         st.readings_seed
@@ -1137,25 +1147,29 @@ pub fn run_sample(
             source,
         }
     })?;
+    // On a closed loop the one part may pass several times: only its last pass ends in a class
+    // (the gate's takings do not), or none when the gate took it off for good (`rejected`).
     let outcome = PartOutcome::ALL
         .into_iter()
         .find(|&o| run.metrics.outcomes.get(o) == 1)
-        .expect("one part ends in exactly one class");
-    let record = &run.records[0];
-    let latency_us = outcome
-        .exited()
-        .then(|| ((record.end_s - record.arrival_s) * 1e6).round().max(1.0) as u64);
+        .unwrap_or(PartOutcome::Rejected);
+    let passes = run.summary.closed_loop.as_ref().map(|l| l.passes as u32);
+    let record = run.records.last();
+    let latency_us = record
+        .filter(|_| outcome.exited())
+        .map(|r| ((r.end_s - r.arrival_s) * 1e6).round().max(1.0) as u64);
     let sensed = |f: fn(&crate::engine::sensing::SensorStats) -> u64| {
         run.metrics.sensors.iter().map(f).sum::<u64>() as u32
     };
     Ok(SampleResult {
         outcome,
-        contacts: record.contacts,
+        contacts: record.map_or(0, |r| r.contacts),
         latency_us,
         shape_redraws: drawn.shape_redraws,
         other_redraws: drawn.other_redraws,
         sensor_readings: sensed(|s| s.readings),
         sensor_correct: sensed(|s| s.confusion.correct()),
         online: super::online::OnlineSample::of(&run),
+        passes,
     })
 }

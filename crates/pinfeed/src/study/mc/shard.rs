@@ -186,6 +186,9 @@ pub struct ShardPoint {
     /// An online controller's counts; left out without decisions.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub online: super::online::OnlineTally,
+    /// A closed loop: the passes its parts made, summed (left out on an open line).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub passes: u64,
 }
 
 fn is_zero<T: Default + PartialEq>(n: &T) -> bool {
@@ -255,8 +258,11 @@ impl ShardFile {
                 ShardPoint {
                     point,
                     samples: t.samples,
-                    outcomes: PartOutcome::ALL
+                    // Every class of a line; `rejected` (a closed loop's) only when it happened,
+                    // so that an open line's shard reads as before.
+                    outcomes: PartOutcome::EVERY
                         .iter()
+                        .filter(|&&c| c != PartOutcome::Rejected || t.outcomes.rejected > 0)
                         .map(|&c| (c.name().to_string(), t.outcomes.get(c)))
                         .collect(),
                     contacts: t.contacts,
@@ -266,6 +272,7 @@ impl ShardFile {
                     sensor_readings: t.sensor_readings,
                     sensor_correct: t.sensor_correct,
                     online: t.online.clone(),
+                    passes: t.passes,
                 }
             })
             .collect();
@@ -335,7 +342,7 @@ impl ShardPoint {
         let point = self.point;
         let mut outcomes = OutcomeCounts::default();
         for (name, &n) in &self.outcomes {
-            let c = PartOutcome::ALL
+            let c = PartOutcome::EVERY
                 .into_iter()
                 .find(|c| c.name() == name)
                 .ok_or_else(|| ShardPointError::UnknownOutcome(name.clone()))?;
@@ -385,6 +392,7 @@ impl ShardPoint {
             sensor_readings: self.sensor_readings,
             sensor_correct: self.sensor_correct,
             online: self.online.clone(),
+            passes: self.passes,
         })
     }
 }

@@ -30,6 +30,8 @@ pub struct PointTally {
     pub sensor_correct: u64,
     /// What an online controller decided and predicted (empty without one).
     pub online: OnlineTally,
+    /// A closed loop: the passes its parts made, summed (0 on an open line).
+    pub passes: u64,
 }
 
 /// An empty latency histogram: 1 µs to 10⁶ s, 3 significant digits.
@@ -50,6 +52,7 @@ impl Default for PointTally {
             sensor_readings: 0,
             sensor_correct: 0,
             online: OnlineTally::default(),
+            passes: 0,
         }
     }
 }
@@ -64,6 +67,7 @@ impl PointTally {
         self.other_redraws += r.other_redraws as u64;
         self.sensor_readings += r.sensor_readings as u64;
         self.sensor_correct += r.sensor_correct as u64;
+        self.passes += u64::from(r.passes.unwrap_or(0));
         if let Some(o) = &r.online {
             self.online.add(o, r.outcome == PartOutcome::Success);
         }
@@ -75,7 +79,7 @@ impl PointTally {
     /// Add another tally of the same point.
     pub fn merge(&mut self, o: &PointTally) -> Result<(), TallyMergeError> {
         self.samples += o.samples;
-        for c in PartOutcome::ALL {
+        for c in PartOutcome::EVERY {
             add_count(&mut self.outcomes, c, o.outcomes.get(c));
         }
         self.contacts += o.contacts;
@@ -84,6 +88,7 @@ impl PointTally {
         self.sensor_readings += o.sensor_readings;
         self.sensor_correct += o.sensor_correct;
         self.online.merge(&o.online);
+        self.passes += o.passes;
         self.latency_us.add(&o.latency_us).map_err(TallyMergeError)
     }
 }
@@ -96,13 +101,5 @@ pub struct TallyMergeError(pub AdditionError);
 
 /// Add `n` to the count of class `c`.
 pub fn add_count(counts: &mut OutcomeCounts, c: PartOutcome, n: u64) {
-    match c {
-        PartOutcome::Success => counts.success += n,
-        PartOutcome::WrongOrientation => counts.wrong_orientation += n,
-        PartOutcome::Collision => counts.collision += n,
-        PartOutcome::MultiContact => counts.multi_contact += n,
-        PartOutcome::OffBelt => counts.off_belt += n,
-        PartOutcome::Jam => counts.jam += n,
-        PartOutcome::Solver => counts.solver += n,
-    }
+    counts.add_n(c, n);
 }
