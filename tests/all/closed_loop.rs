@@ -365,3 +365,41 @@ fn mser5_finds_a_loops_warm_up_and_batch_means_cover_the_steady_rate() {
     assert!(found >= 36, "warm-up within 10% in {found} of 40");
     assert!(covered >= 36, "steady rate covered in {covered} of 40");
 }
+
+/// The series' return load per bin integrates to the run's time-average load, and `run` draws
+/// the loop over time (closed_loop.svg) for a closed loop only.
+#[test]
+fn the_loops_series_and_figure_are_consistent() {
+    let mut s = scene(
+        "reach = 0.03\nbusy = 0.0",
+        "[recirculation]\ntransit = 7.0\nmax_passes = 4\nmerge_gap = 0.3",
+    );
+    s.feed.parts = 3000;
+    let r = run_scene(&s);
+    let l = loop_of(&r);
+    let area: f64 = l.series.return_load.iter().sum::<f64>() * l.series.bin_s;
+    let mean = area / r.summary.simulated_time_s;
+    assert!(
+        (mean - l.return_load.mean).abs() <= 1e-9 * (1.0 + mean),
+        "{mean} vs {:?}",
+        l.return_load
+    );
+    let d = crate::support::fresh_dir("closed-loop-figure");
+    let out = |scenario: &str| {
+        crate::support::pinfeed_ok(&[
+            "run",
+            scenario,
+            "--parts",
+            "60",
+            "--out",
+            d.to_str().unwrap(),
+        ]);
+    };
+    let root = env!("CARGO_MANIFEST_DIR");
+    out(&format!("{root}/scenarios/tripoly1_loop.toml"));
+    let svg = std::fs::read_to_string(d.join("tripoly1_loop/closed_loop.svg")).unwrap();
+    assert!(svg.contains("purity") && svg.contains("waiting at the merge"));
+    out(&format!("{root}/scenarios/quickstart.toml"));
+    assert!(!d.join("quickstart/closed_loop.svg").exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -9,7 +9,7 @@
 //!   the gate's `y`, and the gate is not busy from its last action (it cannot act again for a
 //!   `busy` time drawn per action). Otherwise the part is delivered: success or wrong
 //!   orientation, as on an open line. A gate that loses the parts arriving while it is busy is
-//!   the M/G/1/1 loss system: with Poisson arrivals at rate λ it acts on λ/(1 + λE[S]) parts per
+//!   the M/G/1/1 loss system: with Poisson arrivals at rate λ it acts on λ/(1 + λ·E(S)) parts per
 //!   second whatever the distribution of S (Erlang's loss formula and its insensitivity;
 //!   Gudmundsson & Goldberg 1999 treat a feeder's stations as such queues).
 //! * **Return path.** Without `[recirculation]` a rejected part leaves the line (`rejected`).
@@ -20,7 +20,7 @@
 //! * **Merge.** Every entry (new or returning) passes the merge, a single server whose service is
 //!   the least gap between entries (`merge_gap`); returning parts go first, new parts wait in
 //!   the order they came. With Poisson arrivals and no returns it is an M/G/1 queue whose mean
-//!   wait is Pollaczek–Khinchine's λE[G²] / (2(1 − λE[G])).
+//!   wait is Pollaczek–Khinchine's λ·E(G²) / (2(1 − λ·E(G))).
 //!
 //! Identity: a part on the belt is known by its entry number (the order it entered in, which the
 //! dynamic pins serve by); the loop maps each entry to (part, pass). Pass 0 of part i is drawn
@@ -144,6 +144,23 @@ impl Level {
     }
 }
 
+/// Add the area of `level` over [a, b) to the bins of width `bin` it covers.
+fn spread(bins: &mut Vec<f64>, bin: f64, a: f64, b: f64, level: u64) {
+    if level == 0 || b <= a {
+        return;
+    }
+    let last = (b / bin).floor() as usize;
+    if bins.len() <= last {
+        bins.resize(last + 1, 0.0);
+    }
+    let mut k = (a / bin).floor() as usize;
+    while k <= last {
+        let (lo, hi) = (k as f64 * bin, (k + 1) as f64 * bin);
+        bins[k] += level as f64 * (hi.min(b) - lo.max(a)).max(0.0);
+        k += 1;
+    }
+}
+
 /// A part off the belt between passes: the passes it has made and its own support.
 struct Returning {
     passes: u32,
@@ -202,6 +219,9 @@ struct LoopStats {
     delivered_at_last_arrival: (u64, u64),
     /// Every delivery: its time and the part's time in the system (first arrival to delivery).
     deliveries: Vec<(f64, f64)>,
+    /// Area (part·s) of the return load and of the buffer per bin.
+    load_bins: Vec<f64>,
+    buffer_bins: Vec<f64>,
 }
 
 impl LoopStats {
@@ -264,6 +284,21 @@ impl LoopState {
     /// Move the levels' clocks to `t`, changing the return load and the buffer by the deltas.
     fn levels(&mut self, t: f64, load: i64, buffer: i64) {
         let dt = (t - self.last_t).max(0.0);
+        let s = &mut self.stats;
+        spread(
+            &mut s.load_bins,
+            s.bin_s,
+            self.last_t,
+            t,
+            self.return_load.now,
+        );
+        spread(
+            &mut s.buffer_bins,
+            s.bin_s,
+            self.last_t,
+            t,
+            self.buffer_level.now,
+        );
         self.return_load.add(dt, load);
         self.buffer_level.add(dt, buffer);
         self.last_t = self.last_t.max(t);
@@ -624,6 +659,8 @@ impl LoopState {
                 bin_s: s.bin_s,
                 delivered: s.delivered_bins.clone(),
                 oriented: s.ok_bins.clone(),
+                return_load: s.load_bins.iter().map(|a| a / s.bin_s).collect(),
+                buffer: s.buffer_bins.iter().map(|a| a / s.bin_s).collect(),
             },
         }
     }
@@ -665,6 +702,10 @@ pub struct Series {
     pub delivered: Vec<u64>,
     /// Parts delivered in the goal per bin.
     pub oriented: Vec<u64>,
+    /// Time-average parts on the return path per bin.
+    pub return_load: Vec<f64>,
+    /// Time-average parts waiting at the merge per bin.
+    pub buffer: Vec<f64>,
 }
 
 /// The closed loop's block of a run's summary.

@@ -17,6 +17,7 @@ pub mod plot_accuracy;
 pub mod plot_contact;
 pub(crate) mod plot_labels;
 pub mod plot_line;
+pub mod plot_loop;
 pub mod plot_map;
 pub mod plot_orientations;
 pub mod plot_part;

@@ -4,7 +4,7 @@
 
 use crate::engine::RunResult;
 use crate::output::Batch;
-use crate::report::{animate, parts_csv, plot_line, plot_orientations};
+use crate::report::{animate, parts_csv, plot_line, plot_loop, plot_orientations};
 use crate::report::{ReportError, ReportResult};
 use crate::scenario::Scene;
 use std::path::Path;
@@ -44,10 +44,11 @@ impl RunFiles<'_> {
 }
 
 /// The files `pinfeed run` writes into a run's folder.
-const RUN_FILES: [&str; 5] = [
+const RUN_FILES: [&str; 6] = [
     "summary.json",
     "parts.csv",
     "orientation_histogram.svg",
+    "closed_loop.svg",
     "events.json",
     "control.json",
 ];
@@ -82,6 +83,12 @@ pub fn write_run(
             .produce(&p, |tmp| {
                 plot_orientations::plot_orientation_histogram(scene, summary, tmp)
             })
+            .map_err(ReportError::writing(&p))?;
+    }
+    if let Some(l) = &summary.closed_loop {
+        let p = dir.join("closed_loop.svg");
+        batch
+            .produce(&p, |tmp| plot_loop::plot_loop(&summary.scenario, l, tmp))
             .map_err(ReportError::writing(&p))?;
     }
     if scene.effects.event_log {
@@ -131,6 +138,7 @@ pub fn write_run(
             .output
             .histogram_svg
             .then_some("orientation_histogram.svg"),
+        summary.closed_loop.as_ref().map(|_| "closed_loop.svg"),
         scene.effects.event_log.then_some("events.json"),
         (scene.effects.event_log && !result.control.is_empty()).then_some("control.json"),
     ]
