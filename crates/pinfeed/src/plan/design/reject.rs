@@ -817,3 +817,68 @@ pub fn design_reject(
     r.verification = Some(v);
     done(r, verdict, reason)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Parts flush on a rail at y = 0 (+y side out): the goal `goal_mm` wide, one other state
+    /// `other_mm` wide.
+    fn flush(goal_mm: f64, other_mm: f64) -> Vec<Exit> {
+        let mut v = Vec::new();
+        for k in 0..50 {
+            let jitter = k as f64 * 1e-6;
+            v.push(Exit {
+                theta_deg: 180.0,
+                lo: 0.0,
+                hi: goal_mm * 1e-3 + jitter,
+                goal: true,
+            });
+            v.push(Exit {
+                theta_deg: 45.0,
+                lo: 0.0,
+                hi: other_mm * 1e-3 + jitter,
+                goal: false,
+            });
+        }
+        v
+    }
+
+    #[test]
+    fn a_gauge_goes_halfway_between_the_goal_s_edge_and_the_others() {
+        let e = flush(30.0, 42.4);
+        let (side, g, o) = separate(&e, &states(&e)).unwrap();
+        assert_eq!(side, Side::Left);
+        assert!(
+            (g - 0.03).abs() < 1e-4 && (o - 0.0424).abs() < 1e-9,
+            "{g} {o}"
+        );
+    }
+
+    #[test]
+    fn widths_too_close_or_a_wider_goal_are_no_gauge_with_the_widths() {
+        let e = flush(30.0, 30.4);
+        let why = separate(&e, &states(&e)).unwrap_err();
+        assert!(
+            why.starts_with("no gauge separates the goal state: widths goal 30.0 mm")
+                && why.contains("other 30.4 mm"),
+            "{why}"
+        );
+        let e = flush(42.4, 30.0);
+        let why = separate(&e, &states(&e)).unwrap_err();
+        assert!(why.contains("not the narrowest"), "{why}");
+    }
+
+    #[test]
+    fn states_across_zero_degrees_are_one() {
+        let mk = |t: f64| Exit {
+            theta_deg: t,
+            lo: 0.0,
+            hi: 0.04,
+            goal: false,
+        };
+        let st = states(&[mk(358.5), mk(1.0), mk(2.0), mk(90.0)]);
+        assert_eq!(st.len(), 2);
+        assert_eq!(st[0].parts, 3);
+    }
+}
