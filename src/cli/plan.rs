@@ -209,7 +209,7 @@ pub struct PlanArgs {
     pub refine: usize,
     /// After the design, try a check station: a gauge pin that only the wrong states touch, a
     /// reject gate commanded by its touch and a return path, verified by running the loop under
-    /// the uncertainty (docs/commands.md#plan---reject).
+    /// the uncertainty (docs/commands.md, "A check station and a reject gate").
     #[arg(long)]
     pub reject: bool,
     /// With --reject: the required purity of the delivered parts, in (0, 1) [default: 0.995].
