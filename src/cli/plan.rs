@@ -1,7 +1,8 @@
 //! `pinfeed plan`: maps its arguments to [`pinfeed::plan::design`] (the design workflow: searches,
 //! line checks, refinement, the line's headway) and prints the result; writes the chosen design.
 //!
-//! Exit status: 0 confirmed (the line check holds the target); 3 a design was written but the
+//! Exit status: 0 confirmed (the line check holds the target, or with `--reject` the loop's
+//! purity); 3 a design was written but the
 //! line does not confirm it (or, with `--check-parts 0`, it was not checked); 4 no design (no
 //! obstacle improves on the feed; nothing written); 1 an error, or a time limit that left no
 //! confirmed design.
@@ -9,6 +10,7 @@
 use super::stdout::print_result;
 use anyhow::{anyhow, Context, Result};
 use clap::Args;
+use pinfeed::plan::design::reject::{self, RejectOptions, RejectVerdict};
 use pinfeed::plan::design::{
     self, DesignOptions, FenceSettings, Layout, Mode, Objective, Status, TailChoice,
     UncertaintyChoice,
@@ -205,6 +207,14 @@ pub struct PlanArgs {
     /// parts the line got wrong added to the particles (0: never).
     #[arg(long, default_value_t = 2)]
     pub refine: usize,
+    /// After the design, try a check station: a gauge pin that only the wrong states touch, a
+    /// reject gate commanded by its touch and a return path, verified by running the loop under
+    /// the uncertainty (docs/commands.md, "A check station and a reject gate").
+    #[arg(long)]
+    pub reject: bool,
+    /// With --reject: the required purity of the delivered parts, in (0, 1) [default: 0.995].
+    #[arg(long, requires = "reject", allow_hyphen_values = true)]
+    pub purity: Option<f64>,
     /// Worker threads (0: one per core).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -368,6 +378,15 @@ pub fn options_of(args: &PlanArgs, recorded: &str) -> Result<DesignOptions> {
         (None, None) => o.name,
     };
     o.command = recorded.to_string();
+    o.reject = args.reject.then(|| {
+        RejectOptions::new(
+            args.purity.unwrap_or(reject::DEFAULT_PURITY),
+            args.check_parts,
+        )
+    });
+    if let Some(r) = &o.reject {
+        r.check().map_err(|e| flagged(e.into()))?;
+    }
     Ok(o)
 }
 
@@ -413,6 +432,13 @@ pub fn run(args: &PlanArgs, recorded: &str) -> Result<()> {
         summary::text(&o, &d, &files)
     };
     print_result(&out)?;
+    // A confirmed loop is the design's answer whatever the open line holds.
+    if d.reject
+        .as_ref()
+        .is_some_and(|r| r.verdict == RejectVerdict::Confirmed)
+    {
+        return Ok(());
+    }
     match (d.status, &d.limit) {
         (Status::Confirmed, _) => Ok(()),
         (status, Some(limit)) => Err(anyhow!(

@@ -71,6 +71,7 @@ mod plan_certificate;
 mod plan_fences;
 mod plan_goal;
 mod plan_margins;
+mod plan_reject;
 mod plan_sensing;
 mod plan_tails;
 mod plan_uncertain;

@@ -2,6 +2,7 @@
 //! summary, the JSON document, and the design's files (scenario, policy, uncertainty study and
 //! drawing).
 
+use crate::plan::design::reject::RejectDesign;
 use crate::plan::design::{
     self, describe_obstacles, Candidate, Design, DesignOptions, Layout, Mode, Objective, Status,
 };
@@ -69,7 +70,9 @@ pub fn write_design(
         }
         draw_design(o, c, d, draw)?;
         files.push(draw.display().to_string());
-        if let Some(u) = &c.uncertain_check {
+        // A loop's scenario is not the open line the study was planned for.
+        let looped = d.reject.as_ref().is_some_and(|r| r.gauge.is_some());
+        if let Some(u) = c.uncertain_check.as_ref().filter(|_| !looped) {
             let file = scenario
                 .file_name()
                 .map_or("plan.toml".into(), |f| f.to_string_lossy().to_string());
@@ -149,8 +152,11 @@ pub struct PlanJson<'a> {
     pub problem: &'a Problem,
     /// What the planner optimised.
     pub objective: Objective,
-    /// The chosen design's scenario (TOML text).
+    /// The chosen design's scenario (TOML text; with `--reject` and a gauge, the loop's).
     pub scenario: Option<&'a str>,
+    /// `--reject`: the states, the gauge, the loop and its verification.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reject: Option<&'a RejectDesign>,
 }
 
 /// The JSON document of a design, `files` being the ones written.
@@ -184,6 +190,7 @@ pub fn json(o: &DesignOptions, d: &Design, files: Vec<String>) -> ReportResult<S
         problem: &o.problem,
         objective: o.objective,
         scenario: d.scenario_toml.as_deref(),
+        reject: d.reject.as_ref(),
     };
     Ok(crate::report::versioned::pretty(&doc)?)
 }
@@ -382,10 +389,111 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
             _ => format!("limit       {l}\n"),
         };
     }
+    if let Some(r) = &d.reject {
+        t += &reject_lines(r);
+    }
     t += &format!("time        {:.1} s\n", d.elapsed_s);
     if !files.is_empty() {
         t += &format!("wrote       {}\n", files.join(", "));
     }
+    t
+}
+
+/// The `--reject` block: the states the line leaves, the gauge, the loop, each friction's run
+/// and the verdict beside the open line.
+fn reject_lines(r: &RejectDesign) -> String {
+    let mut t = format!(
+        "reject      measured {} parts at μ {}{}: {} state(s) leave the line\n",
+        r.parts_per_friction * r.frictions.len() as u64,
+        r.frictions
+            .iter()
+            .map(|m| m.to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        if r.tripod { " on random tripods" } else { "" },
+        r.states.len()
+    );
+    for s in &r.states {
+        t += &format!(
+            "  {:<5} {:>7.1}°  share {:.3}  width {:5.1} mm  edges (mm) low {:+.1}…{:+.1}  high {:+.1}…{:+.1}\n",
+            if s.goal { "goal" } else { "other" },
+            s.orientation_deg,
+            s.share,
+            s.width_mm,
+            s.low_edge_m[0] * 1e3,
+            s.low_edge_m[2] * 1e3,
+            s.high_edge_m[0] * 1e3,
+            s.high_edge_m[2] * 1e3,
+        );
+    }
+    if let (Some(g), Some(l)) = (&r.gauge, &r.settings) {
+        t += &format!(
+            "  gauge      pin x {:.3} m  y {:+.2} mm  radius {:.1} mm ({:?} side: touched past {:+.2} mm)\n",
+            g.x_m,
+            g.y_m * 1e3,
+            g.radius_m * 1e3,
+            g.side,
+            g.touch_m * 1e3
+        );
+        t += &format!(
+            "  loop       gate at the belt's end (y {:+.1} mm ± {:.1} mm, reject_on contact); return uniform {}–{} s, buffer {}, max passes {}, merge gap {} s; feed headway {} s (planned yield per pass {:.3}); belt {:.3} × {:.3} m\n",
+            l.gate_y_m * 1e3,
+            l.gate_reach_m * 1e3,
+            l.transit_s.0,
+            l.transit_s.1,
+            l.buffer,
+            l.max_passes,
+            design::line::fmt_headway(l.merge_gap_s),
+            design::line::fmt_headway(l.feed_headway_s),
+            l.planned_yield,
+            l.belt_length_m,
+            l.belt_width_m
+        );
+    }
+    if let Some(v) = &r.verification {
+        for f in &v.runs {
+            t += &format!(
+                "  μ {:<5}    {} new: delivered {}, in goal {}, purity 95% CI {:.4}–{:.4}, yield per pass {:.3}, {:.2} passes per delivered, {:.2} delivered/min\n",
+                f.mu,
+                f.new_parts,
+                f.delivered,
+                f.in_goal,
+                f.purity_ci95[0],
+                f.purity_ci95[1],
+                f.yield_per_pass,
+                f.passes_per_delivered,
+                f.delivered_per_min.unwrap_or(0.0)
+            );
+        }
+        t += &format!(
+            "  loop       purity {:.4} (95% CI {:.4}–{:.4}) of {} delivered; yield per pass {:.3}; {:.2} passes per delivered part; {:.2} delivered / {:.2} oriented parts per minute ({:.1} s)\n",
+            v.purity,
+            v.purity_ci95[0],
+            v.purity_ci95[1],
+            v.delivered,
+            v.yield_per_pass,
+            v.passes_per_delivered,
+            v.delivered_per_min,
+            v.oriented_per_min,
+            v.elapsed_s
+        );
+    }
+    t += &format!(
+        "  open line  {:.2} oriented parts per minute at purity {:.4}{}\n",
+        r.open_oriented_per_min,
+        r.open_purity,
+        if r.open_purity < r.purity_target {
+            format!(" (below {}: none at the required purity)", r.purity_target)
+        } else {
+            String::new()
+        }
+    );
+    t += &format!(
+        "  verdict    {} — {} ({:.1} s)\n",
+        r.verdict.word(),
+        r.reason,
+        r.elapsed_s
+    );
     t
 }
 

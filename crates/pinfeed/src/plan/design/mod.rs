@@ -25,6 +25,7 @@
 //! not fit runs fewer parts and says how many).
 
 pub mod line;
+pub mod reject;
 pub mod survey;
 
 pub use super::check::{Uncertainty, UncertaintySet};
@@ -190,6 +191,9 @@ pub struct DesignOptions {
     pub name: String,
     /// The command line that asked for it (written into the scenario's header).
     pub command: String,
+    /// `--reject`: after the design, try a gauge pin, a reject gate and a return path around the
+    /// chosen line ([`reject`]); None: the open line only.
+    pub reject: Option<reject::RejectOptions>,
 }
 
 impl DesignOptions {
@@ -213,6 +217,7 @@ impl DesignOptions {
             uncertainty: UncertaintyChoice::Default,
             command,
             name,
+            reject: None,
         }
     }
 }
@@ -753,6 +758,10 @@ pub struct Design {
     /// The chosen design's policy file, if any: (file name, text).
     #[serde(skip)]
     pub policy_toml: Option<(String, String)>,
+    /// `--reject`: the gauge, gate and return path tried around the chosen line, verified; when
+    /// a gauge was placed, `scenario_toml` is the loop's scenario.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reject: Option<reject::RejectDesign>,
 }
 
 impl Design {
@@ -901,6 +910,9 @@ pub fn check_goal(o: &DesignOptions) -> Result<(), DesignError> {
         ));
     }
     fence_options(o, p.mu_c)?;
+    if let Some(r) = &o.reject {
+        r.check()?;
+    }
     Ok(())
 }
 
@@ -1065,6 +1077,7 @@ pub fn design(
         });
         w.run_mode(mode, now + share)?;
     }
+    let w_line_runs = w.line_runs;
     let mut design = w.finish(started)?;
     if let Some(c) = &certificate {
         let ruled_out = design
@@ -1080,6 +1093,24 @@ pub fn design(
         }
     }
     design.certificate = certificate;
+    if let Some(ro) = o.reject {
+        progress(&Progress {
+            mode: None,
+            round: 0,
+            stage: "reject: measuring the exit states, verifying the loop".into(),
+            candidates: design.candidates.len(),
+            line_runs: w_line_runs,
+        });
+        let r = reject::design_reject(o, design.chosen(), ro)?;
+        if let (Some(body), Some(c)) = (r.loop_toml(), design.chosen()) {
+            let mut lines = r.header_lines();
+            lines.extend(header_lines(o, c, design.status));
+            let file = format!("{}.toml", o.name);
+            design.scenario_toml = Some(emit::header(&lines, &file) + &body);
+        }
+        design.reject = Some(r);
+        design.elapsed_s = started.elapsed().as_secs_f64();
+    }
     Ok(design)
 }
 
@@ -1806,6 +1837,7 @@ impl Work<'_> {
             elapsed_s: started.elapsed().as_secs_f64(),
             scenario_toml,
             policy_toml,
+            reject: None,
         })
     }
 
