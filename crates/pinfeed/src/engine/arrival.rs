@@ -5,12 +5,12 @@
 use super::controller::Control;
 use super::event_queue::EventKind;
 use super::line::Entry;
-use super::metrics::Metrics;
 use super::online_decide::online_arrival;
 use super::part_stream::{arrival_gap, draw_part, draw_reentry, PartDraw};
 use super::plan::ride_on;
 use super::results::{EngineError, RunOptions};
-use super::state::{ActivePart, Belt};
+use super::state::{ActivePart, Belt, Sinks};
+use super::trace::TraceKind;
 use crate::geometry::Pose;
 use crate::scenario::{Arrival, Scene};
 
@@ -23,15 +23,16 @@ pub(super) fn arrival(
     entry: Option<Entry>,
     control: Option<&Control>,
     belt: &mut Belt,
-    metrics: &mut Metrics,
+    sinks: &mut Sinks,
     t: f64,
     index: u64,
 ) -> Result<(), EngineError> {
     if let Some(lp) = belt.closed_loop.as_mut().filter(|l| l.merges()) {
         lp.new_part(index, t);
         schedule_next(scene, opts, belt, t, index);
-        return merge(scene, opts, control, belt, metrics, t);
+        return merge(scene, opts, control, belt, sinks, t);
     }
+    let metrics = &mut sinks.metrics;
     let mut x0 = 0.0;
     let d = match entry {
         Some(e) => {
@@ -52,7 +53,19 @@ pub(super) fn arrival(
     metrics.arrival(t);
     schedule_next(scene, opts, belt, t, index);
     let pose = Pose::new(x0, d.y, d.theta_rad);
-    enter(scene, opts, control, belt, metrics, t, index, pose, d.model);
+    let arrived = TraceKind::Arrival { part: index, pose };
+    sinks.note(t, Some(index), arrived);
+    enter(
+        scene,
+        opts,
+        control,
+        belt,
+        &mut sinks.metrics,
+        t,
+        index,
+        pose,
+        d.model,
+    );
     Ok(())
 }
 
@@ -61,7 +74,7 @@ fn fresh_part(
     scene: &Scene,
     seed: u64,
     index: u64,
-    metrics: &mut Metrics,
+    metrics: &mut super::metrics::Metrics,
 ) -> Result<PartDraw, EngineError> {
     let d =
         draw_part(scene, seed, index).map_err(|reason| EngineError::PartDraw { index, reason })?;
@@ -91,9 +104,10 @@ pub(super) fn merge(
     opts: &RunOptions,
     control: Option<&Control>,
     belt: &mut Belt,
-    metrics: &mut Metrics,
+    sinks: &mut Sinks,
     t: f64,
 ) -> Result<(), EngineError> {
+    let metrics = &mut sinks.metrics;
     let Some(lp) = belt.closed_loop.as_mut() else {
         return Ok(());
     };
@@ -112,7 +126,23 @@ pub(super) fn merge(
     };
     metrics.arrival(t);
     let pose = Pose::new(0.0, y, theta);
-    enter(scene, opts, control, belt, metrics, t, e.entry, pose, model);
+    let (part, pass) = (e.part, e.pass);
+    let entered = match pass {
+        0 => TraceKind::Arrival { part, pose },
+        _ => TraceKind::Reentry { part, pass, pose },
+    };
+    sinks.note(t, Some(e.entry), entered);
+    enter(
+        scene,
+        opts,
+        control,
+        belt,
+        &mut sinks.metrics,
+        t,
+        e.entry,
+        pose,
+        model,
+    );
     Ok(())
 }
 
@@ -124,7 +154,7 @@ fn enter(
     opts: &RunOptions,
     control: Option<&Control>,
     belt: &mut Belt,
-    metrics: &mut Metrics,
+    metrics: &mut super::metrics::Metrics,
     t: f64,
     id: u64,
     pose: Pose,
@@ -143,7 +173,7 @@ mod tests {
 
     /// Part 0 of a run of `parts` (the first one's path sampled) arrives at time 0 as `entry`
     /// says on the quickstart line (periodic feed, 4 s headway).
-    fn arrive(parts: u64) -> (Belt, Metrics) {
+    fn arrive(parts: u64) -> (Belt, super::super::metrics::Metrics) {
         let path = &crate::project_path("scenarios/quickstart.toml");
         let scene = crate::scenario::load(path).unwrap();
         let opts = RunOptions {
@@ -158,19 +188,19 @@ mod tests {
             model: None,
         };
         let mut belt = Belt::new();
-        let mut metrics = Metrics::new(vec![String::new(); scene.obstacles.len()], 1.0);
+        let mut sinks = Sinks::for_scene(&scene, false, None);
         arrival(
             &scene,
             &opts,
             Some(entry),
             None,
             &mut belt,
-            &mut metrics,
+            &mut sinks,
             0.0,
             0,
         )
         .unwrap();
-        (belt, metrics)
+        (belt, sinks.metrics)
     }
 
     /// The part enters at the entry's pose with its path started and is counted in; its first
