@@ -528,4 +528,26 @@ mod tests {
         assert_eq!(fed.sinks.metrics.exits, 1);
         assert_eq!(fed.sinks.metrics.latency_us.len(), 1);
     }
+
+    /// Untraced, the run keeps no trace buffer (noting an event is one branch, nothing
+    /// allocated); traced, every event reaches the sink and the buffer is left empty.
+    #[test]
+    fn only_a_traced_run_notes_events() {
+        let scene = quickstart();
+        let opts = RunOptions {
+            parts: 20,
+            ..RunOptions::from_scene(&scene)
+        };
+        let plain = simulate(&scene, &opts, &mut |_| {}, None, None, None).unwrap();
+        assert!(plain.sinks.trace.is_none());
+        let mut seen = Vec::new();
+        let sink: &mut dyn FnMut(&TraceEvent) = &mut |e| seen.push(*e);
+        let traced = simulate(&scene, &opts, &mut |_| {}, None, None, Some(sink)).unwrap();
+        assert_eq!(traced.sinks.trace.as_deref(), Some(&[][..]));
+        let arrivals = seen
+            .iter()
+            .filter(|e| matches!(e.kind, TraceKind::Arrival { .. }));
+        assert_eq!(arrivals.count(), 20);
+        assert_eq!(plain.sinks.metrics.work, traced.sinks.metrics.work);
+    }
 }
