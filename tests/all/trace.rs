@@ -154,3 +154,33 @@ fn an_unwritable_trace_is_refused_naming_it() {
     );
     assert!(!d.join("quickstart").exists(), "nothing is run");
 }
+
+/// The trace and the `sequential` line the documents show are what the commands write.
+#[test]
+fn the_documented_examples_are_what_the_commands_write() {
+    let d = fresh_dir("trace-docs");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let outputs = std::fs::read_to_string(root.join("docs/outputs.md")).unwrap();
+    let block = outputs
+        .split("--parts 3 --trace loop.jsonl`:\n\n```\n")
+        .nth(1)
+        .unwrap();
+    let shown: Vec<&str> = block.split("\n```").next().unwrap().lines().collect();
+    let trace = d.join("loop.jsonl");
+    let loop_args = ["run", "tripoly1_loop", "--parts", "3", "--quiet"];
+    pinfeed_ok(&[&loop_args[..], &["--out", s(&d), "--trace", s(&trace)]].concat());
+    let written = std::fs::read_to_string(&trace).unwrap();
+    assert_eq!(shown, written.lines().take(shown.len()).collect::<Vec<_>>());
+    let commands = std::fs::read_to_string(root.join("docs/commands.md")).unwrap();
+    let out = pinfeed_ok(&["run", "quickstart", "--precision", "0.05", "--out", s(&d)]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let line = text.lines().find(|l| l.starts_with("sequential")).unwrap();
+    assert!(commands.contains(&format!("```\n{line}\n```")), "{line}");
+    let json = std::fs::read_to_string(d.join("quickstart/summary.json")).unwrap();
+    let v: Value = serde_json::from_str(&json).unwrap();
+    let block = serde_json::to_string_pretty(&v["sequential"]).unwrap();
+    assert!(
+        outputs.contains(&format!("\"sequential\": {block}\n```")),
+        "{block}"
+    );
+}
