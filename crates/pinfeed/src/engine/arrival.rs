@@ -50,19 +50,16 @@ pub(super) fn arrival(
     if let Some(lp) = belt.closed_loop.as_mut() {
         lp.open_entry(index, t);
     }
-    metrics.arrival(t);
     schedule_next(scene, opts, belt, t, index);
     let pose = Pose::new(x0, d.y, d.theta_rad);
-    let arrived = TraceKind::Arrival { part: index, pose };
-    sinks.note(t, Some(index), arrived);
     enter(
         scene,
         opts,
         control,
         belt,
-        &mut sinks.metrics,
+        sinks,
         t,
-        index,
+        (index, index, 0),
         pose,
         d.model,
     );
@@ -124,47 +121,38 @@ pub(super) fn merge(
             (d.theta_rad, d.y, d.model)
         }
     };
-    metrics.arrival(t);
     let pose = Pose::new(0.0, y, theta);
-    let (part, pass) = (e.part, e.pass);
-    let entered = match pass {
-        0 => TraceKind::Arrival { part, pose },
-        _ => TraceKind::Reentry { part, pass, pose },
-    };
-    sinks.note(t, Some(e.entry), entered);
-    enter(
-        scene,
-        opts,
-        control,
-        belt,
-        &mut sinks.metrics,
-        t,
-        e.entry,
-        pose,
-        model,
-    );
+    let id = (e.entry, e.part, e.pass);
+    enter(scene, opts, control, belt, sinks, t, id, pose, model);
     Ok(())
 }
 
-/// Entry `id` goes on the belt at `t` at world pose `pose` with its own support `model` (if
-/// any): its first event is planned and its motion checked against the other parts.
+/// Entry `entry` (part `part` on its pass `pass`, 0 for its first) goes on the belt at `t` at
+/// world pose `pose` with its own support `model` (if any): it is counted in and traced, its
+/// first event is planned and its motion checked against the other parts.
 #[allow(clippy::too_many_arguments)]
 fn enter(
     scene: &Scene,
     opts: &RunOptions,
     control: Option<&Control>,
     belt: &mut Belt,
-    metrics: &mut super::metrics::Metrics,
+    sinks: &mut Sinks,
     t: f64,
-    id: u64,
+    (entry, part, pass): (u64, u64, u32),
     pose: Pose,
     model: Option<crate::mechanics::PartModel>,
 ) {
-    let sampled = (id as usize) < opts.sample_paths;
-    let mut part = ActivePart::entering(t, pose, model, sampled);
-    let work = &mut metrics.work;
-    online_arrival(scene, control, &mut belt.queue, t, id, &mut part);
-    ride_on(scene, control, belt, work, id, part, t);
+    sinks.metrics.arrival(t);
+    let entered = match pass {
+        0 => TraceKind::Arrival { part, pose },
+        _ => TraceKind::Reentry { part, pass, pose },
+    };
+    sinks.note(t, Some(entry), entered);
+    let sampled = (entry as usize) < opts.sample_paths;
+    let mut item = ActivePart::entering(t, pose, model, sampled);
+    let work = &mut sinks.metrics.work;
+    online_arrival(scene, control, &mut belt.queue, t, entry, &mut item);
+    ride_on(scene, control, belt, work, entry, item, t);
 }
 
 #[cfg(test)]

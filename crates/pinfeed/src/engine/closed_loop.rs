@@ -9,7 +9,7 @@
 //!   the gate's `y`, and the gate is not busy from its last action (it cannot act again for a
 //!   `busy` time drawn per action). Otherwise the part is delivered: success or wrong
 //!   orientation, as on an open line. A gate that loses the parts arriving while it is busy is
-//!   the M/G/1/1 loss system: with Poisson arrivals at rate λ it acts on λ/(1 + λE[S]) parts per
+//!   the M/G/1/1 loss system: with Poisson arrivals at rate λ it acts on λ/(1 + λE\[S\]) parts per
 //!   second whatever the distribution of S (Erlang's loss formula and its insensitivity;
 //!   Gudmundsson & Goldberg 1999 treat a feeder's stations as such queues).
 //! * **Return path.** Without `[recirculation]` a rejected part leaves the line (`rejected`).
@@ -20,7 +20,7 @@
 //! * **Merge.** Every entry (new or returning) passes the merge, a single server whose service is
 //!   the least gap between entries (`merge_gap`); returning parts go first, new parts wait in
 //!   the order they came. With Poisson arrivals and no returns it is an M/G/1 queue whose mean
-//!   wait is Pollaczek–Khinchine's λE[G²] / (2(1 − λE[G])).
+//!   wait is Pollaczek–Khinchine's λE\[G²\] / (2(1 − λE\[G\])).
 //!
 //! Identity: a part on the belt is known by its entry number (the order it entered in, which the
 //! dynamic pins serve by); the loop maps each entry to (part, pass). Pass 0 of part i is drawn

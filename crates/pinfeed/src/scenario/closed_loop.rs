@@ -72,7 +72,7 @@ impl LoopTime {
             LoopTime::Exponential { mean } => mean,
         }
     }
-    /// The second moment E[S²] (s²), for the Pollaczek–Khinchine formula.
+    /// The second moment E\[S²\] (s²), for the Pollaczek–Khinchine formula.
     pub fn second_moment(&self) -> f64 {
         match *self {
             LoopTime::Fixed(v) => v * v,
