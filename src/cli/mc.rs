@@ -43,8 +43,8 @@ pub struct McArgs {
     pub precision: Option<f64>,
 }
 
-/// `--precision E`: a number in (0, 0.5).
-fn parse_precision(text: &str) -> Result<f64, String> {
+/// `--precision E`: a number in (0, 0.5) (`mc` and `run`).
+pub(crate) fn parse_precision(text: &str) -> Result<f64, String> {
     let e: f64 = text
         .parse()
         .map_err(|_| format!("--precision must be a number in (0, 0.5), got '{text}'"))?;

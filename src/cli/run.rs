@@ -7,7 +7,8 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use pinfeed::engine::{self, RunOptions};
+use pinfeed::engine::sequential::Precision;
+use pinfeed::engine::{self, trace, RunOptions};
 use pinfeed::report::line_table;
 use pinfeed::report::run_folder::{write_run, RunFiles};
 use std::path::PathBuf;
@@ -53,6 +54,15 @@ pub struct RunArgs {
     /// $XDG_CACHE_HOME/pinfeed/maps or ~/.cache/pinfeed/maps).
     #[arg(long, value_name = "DIR", env = "PINFEED_CACHE")]
     pub cache_dir: Option<PathBuf>,
+    /// Feed parts until the 95% confidence sequence of the success rate (on a closed loop, the
+    /// purity) is at most ±E wide, checked after every finished part; [feed] parts (or --parts)
+    /// is the cap. E in (0, 0.5). The summary gets a `sequential` block (docs/output-analysis.md).
+    #[arg(long, value_name = "E", value_parser = super::mc::parse_precision)]
+    pub precision: Option<f64>,
+    /// Write every event of the run (arrivals, contacts, readings, decisions, the gate's rejects,
+    /// returns, exits and losses) to this file as JSON lines (docs/outputs.md#event-trace).
+    #[arg(long, value_name = "FILE.jsonl")]
+    pub trace: Option<PathBuf>,
 }
 
 pub fn run(args: &RunArgs) -> Result<()> {
@@ -67,6 +77,9 @@ pub fn run(args: &RunArgs) -> Result<()> {
     }
     if let Some(s) = args.seed {
         opts.seed = s;
+    }
+    if let Some(e) = args.precision {
+        opts.stop = Some(Precision::new(e).map_err(anyhow::Error::msg)?);
     }
     if let Some(x) = args.animate_speed.filter(|_| args.animate.is_some()) {
         if !(x.is_finite() && x > 0.0 && x <= 1e6) {
@@ -85,8 +98,12 @@ pub fn run(args: &RunArgs) -> Result<()> {
     let bar = super::progress::bar(opts.parts, "parts", args.quiet);
     let maps = super::contact_map::prepare_maps(&scene, args.cache_dir.as_deref(), args.quiet);
     let started = Instant::now();
-    let result = engine::run(&scene, &opts, &mut |done| bar.set_position(done))
-        .with_context(|| format!("running {}", args.scenario.display()))?;
+    let progress = &mut |done| bar.set_position(done);
+    let result = match &args.trace {
+        Some(path) => trace::run_to_file(&scene, &opts, progress, path).map_err(anyhow::Error::new),
+        None => engine::run(&scene, &opts, progress).map_err(anyhow::Error::new),
+    }
+    .with_context(|| format!("running {}", args.scenario.display()))?;
     let wall = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let maps = maps + &super::contact_map::persist_maps(&scene);
@@ -108,6 +125,13 @@ pub fn run(args: &RunArgs) -> Result<()> {
         text = json;
     } else if !args.quiet {
         text.push_str(&line_table::table(summary));
+        if let Some(s) = &summary.sequential {
+            let [lo, hi] = s.confidence_sequence;
+            text.push_str(&format!(
+                "sequential                {} in [{:.4}, {:.4}] (95% CS, ±{:.4} asked): stopped on {} after {} parts\n",
+                s.rate, lo, hi, s.precision, s.stopped.name(), s.parts
+            ));
+        }
         let parts_per_s = summary.parts_in as f64 / wall.max(1e-9);
         let contacts_per_s = summary.work.contact_solves as f64 / wall.max(1e-9);
         text.push_str(&format!(

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 /// A belt with no obstacle: a square part fed at a uniformly random orientation never turns, so it
 /// ends within `tolerance` degrees of 0° or 180° with probability exactly 2·2t/360.
-fn bare_scenario(tolerance: f64, orientation: &str) -> String {
+pub fn bare_scenario(tolerance: f64, orientation: &str) -> String {
     format!(
         r#"name = "bare"
 seed = 1

@@ -5,12 +5,12 @@
 use super::controller::Control;
 use super::event_queue::EventKind;
 use super::line::Entry;
-use super::metrics::Metrics;
 use super::online_decide::online_arrival;
 use super::part_stream::{arrival_gap, draw_part, draw_reentry, PartDraw};
 use super::plan::ride_on;
 use super::results::{EngineError, RunOptions};
-use super::state::{ActivePart, Belt};
+use super::state::{ActivePart, Belt, Sinks};
+use super::trace::TraceKind;
 use crate::geometry::Pose;
 use crate::scenario::{Arrival, Scene};
 
@@ -23,15 +23,16 @@ pub(super) fn arrival(
     entry: Option<Entry>,
     control: Option<&Control>,
     belt: &mut Belt,
-    metrics: &mut Metrics,
+    sinks: &mut Sinks,
     t: f64,
     index: u64,
 ) -> Result<(), EngineError> {
     if let Some(lp) = belt.closed_loop.as_mut().filter(|l| l.merges()) {
         lp.new_part(index, t);
         schedule_next(scene, opts, belt, t, index);
-        return merge(scene, opts, control, belt, metrics, t);
+        return merge(scene, opts, control, belt, sinks, t);
     }
+    let metrics = &mut sinks.metrics;
     let mut x0 = 0.0;
     let d = match entry {
         Some(e) => {
@@ -49,10 +50,19 @@ pub(super) fn arrival(
     if let Some(lp) = belt.closed_loop.as_mut() {
         lp.open_entry(index, t);
     }
-    metrics.arrival(t);
     schedule_next(scene, opts, belt, t, index);
     let pose = Pose::new(x0, d.y, d.theta_rad);
-    enter(scene, opts, control, belt, metrics, t, index, pose, d.model);
+    enter(
+        scene,
+        opts,
+        control,
+        belt,
+        sinks,
+        t,
+        (index, index, 0),
+        pose,
+        d.model,
+    );
     Ok(())
 }
 
@@ -61,7 +71,7 @@ fn fresh_part(
     scene: &Scene,
     seed: u64,
     index: u64,
-    metrics: &mut Metrics,
+    metrics: &mut super::metrics::Metrics,
 ) -> Result<PartDraw, EngineError> {
     let d =
         draw_part(scene, seed, index).map_err(|reason| EngineError::PartDraw { index, reason })?;
@@ -91,9 +101,10 @@ pub(super) fn merge(
     opts: &RunOptions,
     control: Option<&Control>,
     belt: &mut Belt,
-    metrics: &mut Metrics,
+    sinks: &mut Sinks,
     t: f64,
 ) -> Result<(), EngineError> {
+    let metrics = &mut sinks.metrics;
     let Some(lp) = belt.closed_loop.as_mut() else {
         return Ok(());
     };
@@ -110,31 +121,38 @@ pub(super) fn merge(
             (d.theta_rad, d.y, d.model)
         }
     };
-    metrics.arrival(t);
     let pose = Pose::new(0.0, y, theta);
-    enter(scene, opts, control, belt, metrics, t, e.entry, pose, model);
+    let id = (e.entry, e.part, e.pass);
+    enter(scene, opts, control, belt, sinks, t, id, pose, model);
     Ok(())
 }
 
-/// Entry `id` goes on the belt at `t` at world pose `pose` with its own support `model` (if
-/// any): its first event is planned and its motion checked against the other parts.
+/// Entry `entry` (part `part` on its pass `pass`, 0 for its first) goes on the belt at `t` at
+/// world pose `pose` with its own support `model` (if any): it is counted in and traced, its
+/// first event is planned and its motion checked against the other parts.
 #[allow(clippy::too_many_arguments)]
 fn enter(
     scene: &Scene,
     opts: &RunOptions,
     control: Option<&Control>,
     belt: &mut Belt,
-    metrics: &mut Metrics,
+    sinks: &mut Sinks,
     t: f64,
-    id: u64,
+    (entry, part, pass): (u64, u64, u32),
     pose: Pose,
     model: Option<crate::mechanics::PartModel>,
 ) {
-    let sampled = (id as usize) < opts.sample_paths;
-    let mut part = ActivePart::entering(t, pose, model, sampled);
-    let work = &mut metrics.work;
-    online_arrival(scene, control, &mut belt.queue, t, id, &mut part);
-    ride_on(scene, control, belt, work, id, part, t);
+    sinks.metrics.arrival(t);
+    let entered = match pass {
+        0 => TraceKind::Arrival { part, pose },
+        _ => TraceKind::Reentry { part, pass, pose },
+    };
+    sinks.note(t, Some(entry), entered);
+    let sampled = (entry as usize) < opts.sample_paths;
+    let mut item = ActivePart::entering(t, pose, model, sampled);
+    let work = &mut sinks.metrics.work;
+    online_arrival(scene, control, &mut belt.queue, t, entry, &mut item);
+    ride_on(scene, control, belt, work, entry, item, t);
 }
 
 #[cfg(test)]
@@ -143,7 +161,7 @@ mod tests {
 
     /// Part 0 of a run of `parts` (the first one's path sampled) arrives at time 0 as `entry`
     /// says on the quickstart line (periodic feed, 4 s headway).
-    fn arrive(parts: u64) -> (Belt, Metrics) {
+    fn arrive(parts: u64) -> (Belt, super::super::metrics::Metrics) {
         let path = &crate::project_path("scenarios/quickstart.toml");
         let scene = crate::scenario::load(path).unwrap();
         let opts = RunOptions {
@@ -158,19 +176,19 @@ mod tests {
             model: None,
         };
         let mut belt = Belt::new();
-        let mut metrics = Metrics::new(vec![String::new(); scene.obstacles.len()], 1.0);
+        let mut sinks = Sinks::for_scene(&scene, false, None);
         arrival(
             &scene,
             &opts,
             Some(entry),
             None,
             &mut belt,
-            &mut metrics,
+            &mut sinks,
             0.0,
             0,
         )
         .unwrap();
-        (belt, metrics)
+        (belt, sinks.metrics)
     }
 
     /// The part enters at the entry's pose with its path started and is counted in; its first

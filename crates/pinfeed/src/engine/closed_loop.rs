@@ -529,6 +529,12 @@ impl LoopState {
         s.ok_bins[bin] += u64::from(ok);
     }
 
+    /// The purity's counts: (delivered in the goal, delivered).
+    pub(super) fn purity_counts(&self) -> (u64, u64) {
+        let f = &self.stats.fates;
+        (f.delivered_ok, f.delivered())
+    }
+
     /// Passes the gate took off the belt (entries that did not end in an outcome class).
     pub(super) fn diverted(&self) -> u64 {
         self.stats.gate.acted

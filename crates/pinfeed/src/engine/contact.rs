@@ -25,6 +25,7 @@ use super::reading::sense;
 use super::results::CapturedPush;
 use super::sensing::SensedPass;
 use super::state::{ActivePart, Belt, Sinks, Touch};
+use super::trace::TraceKind;
 use crate::geometry::{Pose, Vec2};
 use crate::mechanics::{
     ContactOutcome, ContactSettings, ContactStatus, PartModel, PinPath, SolveFailure,
@@ -95,6 +96,12 @@ pub(super) fn contact_begin(
     let model = part.model.as_ref().unwrap_or(&scene.part.model);
     sinks.metrics.work.contact_solves += 1;
     sinks.metrics.work.model_evaluations += out.evaluations;
+    let obstacle = j as u32;
+    let touched = match out.contact || matches!(out.status, ContactStatus::PinInsidePart) {
+        true => TraceKind::ContactBegin { obstacle },
+        false => TraceKind::Graze { obstacle },
+    };
+    sinks.note(t, Some(index), touched);
     if matches!(out.status, ContactStatus::PinInsidePart) {
         belt.active.insert(index, part);
         let end = (PartOutcome::MultiContact, Cause::PinInsidePart);
@@ -110,6 +117,15 @@ pub(super) fn contact_begin(
     if let Some(sensor) = sensor {
         let pass = (&out, knots.samples.as_slice());
         let (decision, sensed) = sense(scene, seed, sinks, touch, sensor, pass, pose.theta_rad);
+        let hypothesis = match sensed.classification.decision {
+            Decision::Hypothesis(h) => Some(h as u32),
+            Decision::Unknown => None,
+        };
+        let read = TraceKind::Reading {
+            obstacle,
+            hypothesis,
+        };
+        sinks.note(t, Some(index), read);
         part.sensed.push(decision);
         reading = Some(sensed);
     }

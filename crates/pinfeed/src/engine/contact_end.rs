@@ -9,6 +9,7 @@ use super::motion::{Motion, Stop};
 use super::outcome::{Cause, PartOutcome};
 use super::plan::ride_on;
 use super::state::{Belt, Sinks, Touch};
+use super::trace::TraceKind;
 use crate::geometry::Pose;
 use crate::scenario::Scene;
 
@@ -29,6 +30,8 @@ pub(super) fn contact_end(
         unreachable!("contact end for a free part");
     };
     sinks.metrics.obstacles[j].busy_s += (plan.t_end - plan.t_begin).max(0.0);
+    let obstacle = j as u32;
+    sinks.note(t, Some(index), TraceKind::ContactEnd { obstacle });
     if let Some(stop) = plan.stop.clone() {
         belt.active.insert(index, part);
         let end = match stop {

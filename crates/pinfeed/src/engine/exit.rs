@@ -6,6 +6,7 @@ use super::controller::Control;
 use super::outcome::{Cause, PartOutcome};
 use super::results::{PartRecord, SamplePath};
 use super::state::{ActivePart, Belt, Sinks};
+use super::trace::TraceKind;
 use crate::geometry::wrap_deg;
 use crate::scenario::{Obstacle, Scene};
 
@@ -65,6 +66,15 @@ pub(super) fn finish(
     }
     let pose = part.motion.world_pose(t, scene.belt.speed);
     let theta_deg = wrap_deg(pose.theta_rad.to_degrees());
+    let end = match outcome.exited() {
+        true => TraceKind::Exit { outcome, pose },
+        false => TraceKind::Loss {
+            outcome,
+            cause,
+            pose,
+        },
+    };
+    sinks.note(t, Some(index), end);
     sinks.last_end = Some((outcome, pose));
     sinks
         .metrics
@@ -113,6 +123,8 @@ fn divert(scene: &Scene, belt: &mut Belt, sinks: &mut Sinks, index: u64, t: f64)
         return;
     };
     count_untouched(scene, sinks, &part, scene.belt.length);
+    let pose = part.motion.world_pose(t, scene.belt.speed);
+    sinks.note(t, Some(index), TraceKind::Reject { pose });
     let lp = belt.closed_loop.as_mut().expect("a gate");
     lp.rejected(index, t, part.model.take(), &mut belt.queue);
     belt.finished += 1;

@@ -52,8 +52,10 @@ use super::exit::{exit, finish};
 use super::online_decide::{decide_online, unread};
 use super::outcome::{Cause, PartOutcome};
 use super::results::{CapturedPush, EngineError, PartRecord, RunOptions, RunResult};
+use super::sequential::SequentialStop;
 use super::serve::serve;
 use super::state::{Belt, Sinks, Touch};
+use super::trace::{TraceEvent, TraceKind};
 use crate::geometry::Pose;
 use crate::mechanics::PartModel;
 use crate::scenario::Scene;
@@ -99,6 +101,7 @@ fn one_part(scene: &Scene, keep_records: bool) -> RunOptions {
         sample_paths: 0,
         keep_records,
         online: None,
+        stop: None,
     }
 }
 
@@ -117,6 +120,7 @@ pub fn run_entry(
         &mut |_| {},
         capture.then(Vec::new),
         Some(entry),
+        None,
     )?;
     let record = r.records.pop().expect("one part, one record");
     Ok((record, captured))
@@ -138,7 +142,7 @@ pub struct SingleRun {
 /// left (see [`SingleRun`]).
 pub fn run_single(scene: &Scene, entry: Entry) -> Result<SingleRun, EngineError> {
     let opts = one_part(scene, false);
-    let line = simulate(scene, &opts, &mut |_| {}, None, Some(entry))?;
+    let line = simulate(scene, &opts, &mut |_| {}, None, Some(entry), None)?;
     let (outcome, pose) = line.sinks.last_end.expect("one part, one end");
     Ok(SingleRun {
         outcome,
@@ -185,7 +189,17 @@ fn run_with(
     progress: &mut dyn FnMut(u64),
     captured: Option<Vec<CapturedPush>>,
 ) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
-    run_inner(scene, opts, progress, captured, None)
+    run_inner(scene, opts, progress, captured, None, None)
+}
+
+/// [`run`], handing every trace event to `trace` ([`super::trace::run_traced`]).
+pub(super) fn run_with_trace(
+    scene: &Scene,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(u64),
+    trace: &mut dyn FnMut(&TraceEvent),
+) -> Result<RunResult, EngineError> {
+    run_inner(scene, opts, progress, None, None, Some(trace)).map(|(r, _)| r)
 }
 
 fn run_inner(
@@ -194,10 +208,19 @@ fn run_inner(
     progress: &mut dyn FnMut(u64),
     captured: Option<Vec<CapturedPush>>,
     entry: Option<Entry>,
+    trace: Option<&mut dyn FnMut(&TraceEvent)>,
 ) -> Result<(RunResult, Vec<CapturedPush>), EngineError> {
-    let line = simulate(scene, opts, progress, captured, entry)?;
+    let line = simulate(scene, opts, progress, captured, entry, trace)?;
     let closed_loop =
         (line.belt.closed_loop.as_ref()).map(|l| l.summary(line.sinks.metrics.last_event));
+    let sequential = line.belt.stop.as_ref().map(|s| {
+        let (k, n) = line.rate_counts();
+        let rate = match line.belt.closed_loop {
+            Some(_) => "purity",
+            None => "success_rate",
+        };
+        s.summary(rate, line.belt.fed, k, n)
+    });
     let (sinks, mut control) = (line.sinks, line.control);
     let fidelity = match scene.map_tier {
         Some(_) => "map",
@@ -205,6 +228,7 @@ fn run_inner(
     };
     let mut summary = sinks.metrics.summary(&scene.name, opts.seed, fidelity);
     summary.closed_loop = closed_loop;
+    summary.sequential = sequential;
     let mut control_log = Vec::new();
     if let Some(c) = control.as_mut() {
         summary.controller = Some(c.finish(summary.simulated_time_s));
@@ -228,6 +252,7 @@ fn simulate<'a>(
     progress: &mut dyn FnMut(u64),
     captured: Option<Vec<CapturedPush>>,
     entry: Option<Entry>,
+    mut trace: Option<&mut dyn FnMut(&TraceEvent)>,
 ) -> Result<Line<'a>, EngineError> {
     let online = match &opts.online {
         Some(m) => Some(m.clone()),
@@ -252,6 +277,10 @@ fn simulate<'a>(
     if line.entry.is_none() {
         line.belt.closed_loop = (scene.closed_loop.as_ref())
             .map(|cl| LoopState::new(cl, &scene.feed, opts.seed, opts.parts));
+        line.belt.stop = opts.stop.map(SequentialStop::new);
+    }
+    if trace.is_some() {
+        line.sinks.trace = Some(Vec::new());
     }
     if opts.parts > 0 {
         line.belt
@@ -269,7 +298,12 @@ fn simulate<'a>(
         let Some(ev) = line.belt.queue.pop() else {
             break;
         };
+        let t = ev.time;
         line.handle(ev)?;
+        line.check_precision(t);
+        if let (Some(buffer), Some(sink)) = (line.sinks.trace.as_mut(), trace.as_mut()) {
+            buffer.drain(..).for_each(|e| sink(&e));
+        }
         if line.belt.finished % 256 == 0 {
             progress(line.belt.finished);
         }
@@ -286,14 +320,43 @@ fn simulate<'a>(
         metrics.parts_in,
         "conservation: every part that enters ends in exactly one class or at the gate"
     );
+    let fed = line.belt.fed;
+    assert!(
+        fed == opts.parts || line.belt.feed_stopped(),
+        "the feed sends its parts unless the precision rule stopped it"
+    );
     match &line.belt.closed_loop {
-        Some(l) => l.assert_conserved(opts.parts),
-        None => assert_eq!(metrics.parts_in, opts.parts),
+        Some(l) => l.assert_conserved(fed),
+        None => assert_eq!(metrics.parts_in, fed),
     }
     Ok(line)
 }
 
 impl Line<'_> {
+    /// The watched rate's (successes, trials): on an open line successes / parts finished, on a
+    /// closed loop delivered in the goal / delivered.
+    fn rate_counts(&self) -> (u64, u64) {
+        match &self.belt.closed_loop {
+            Some(l) => l.purity_counts(),
+            None => {
+                let o = &self.sinks.metrics.outcomes;
+                (o.get(PartOutcome::Success), o.total())
+            }
+        }
+    }
+
+    /// `run --precision`: after an event at `t`, check the rule if the trials changed; when it
+    /// holds the feed stops (noted in the trace).
+    fn check_precision(&mut self, t: f64) {
+        if self.belt.stop.is_none() {
+            return;
+        }
+        let (k, n) = self.rate_counts();
+        if self.belt.stop.as_mut().is_some_and(|s| s.check(k, n)) {
+            self.sinks.note(t, None, TraceKind::FeedStop { trials: n });
+        }
+    }
+
     /// Dispatch event `ev` to its stage; then, with a controller, serve the dynamic pins (a part
     /// that moved on may have freed one for the next command).
     fn handle(&mut self, ev: Event) -> Result<(), EngineError> {
@@ -311,6 +374,13 @@ impl Line<'_> {
             sinks.metrics.work.stale_events += 1;
             return Ok(());
         }
+        if matches!(ev.kind, EventKind::Arrival { .. }) {
+            if belt.feed_stopped() {
+                // `run --precision` met: the arrival scheduled before is dropped unprocessed.
+                return Ok(());
+            }
+            belt.fed += 1;
+        }
         sinks.metrics.work.events += 1;
         sinks.metrics.last_event = sinks.metrics.last_event.max(ev.time);
         if scene.effects.event_log {
@@ -325,8 +395,7 @@ impl Line<'_> {
         match ev.kind {
             EventKind::Arrival { part } => {
                 let control = control.as_ref();
-                let metrics = &mut sinks.metrics;
-                arrival(scene, opts, entry.take(), control, belt, metrics, t, part)?
+                arrival(scene, opts, entry.take(), control, belt, sinks, t, part)?
             }
             EventKind::ContactBegin { part, obstacle } => {
                 let (maps, control) = (maps.as_ref(), control.as_mut());
@@ -339,6 +408,8 @@ impl Line<'_> {
             EventKind::Exit { part } => exit(scene, control.as_mut(), belt, sinks, t, part),
             EventKind::Collision { first, second } => {
                 if belt.active.contains_key(&first) && belt.active.contains_key(&second) {
+                    let other = TraceKind::Collision { other: second };
+                    sinks.note(t, Some(first), other);
                     let end = (PartOutcome::Collision, Cause::None);
                     finish(scene, control.as_mut(), belt, sinks, first, t, end);
                     finish(scene, control.as_mut(), belt, sinks, second, t, end);
@@ -349,6 +420,15 @@ impl Line<'_> {
                 obstacle,
                 hypothesis,
             } => {
+                let h = (hypothesis != u32::MAX).then_some(hypothesis);
+                sinks.note(
+                    t,
+                    Some(part),
+                    TraceKind::Decision {
+                        obstacle,
+                        hypothesis: h,
+                    },
+                );
                 let work = &mut sinks.metrics.work;
                 if let Some(c) = control.as_mut() {
                     let taken = if c.online_model().is_some() {
@@ -368,15 +448,14 @@ impl Line<'_> {
                 if let Some(lp) = belt.closed_loop.as_mut() {
                     lp.returned(part, t);
                 }
-                let control = control.as_ref();
-                merge(scene, opts, control, belt, &mut sinks.metrics, t)?
+                sinks.note(t, None, TraceKind::Return { part });
+                merge(scene, opts, control.as_ref(), belt, sinks, t)?
             }
             EventKind::MergeFree => {
                 if let Some(lp) = belt.closed_loop.as_mut() {
                     lp.merge_freed();
                 }
-                let control = control.as_ref();
-                merge(scene, opts, control, belt, &mut sinks.metrics, t)?
+                merge(scene, opts, control.as_ref(), belt, sinks, t)?
             }
             EventKind::Unread { part, obstacle } => {
                 unread(scene, control.as_mut(), belt, t, part, obstacle as usize)
@@ -442,11 +521,33 @@ mod tests {
     fn only_a_fed_line_records_latencies() {
         let scene = quickstart();
         let opts = one_part(&scene, false);
-        let entered = simulate(&scene, &opts, &mut |_| {}, None, Some(entry(1.0))).unwrap();
+        let entered = simulate(&scene, &opts, &mut |_| {}, None, Some(entry(1.0)), None).unwrap();
         assert_eq!(entered.sinks.metrics.exits, 1);
         assert!(entered.sinks.metrics.latency_us.is_empty());
-        let fed = simulate(&scene, &opts, &mut |_| {}, None, None).unwrap();
+        let fed = simulate(&scene, &opts, &mut |_| {}, None, None, None).unwrap();
         assert_eq!(fed.sinks.metrics.exits, 1);
         assert_eq!(fed.sinks.metrics.latency_us.len(), 1);
+    }
+
+    /// Untraced, the run keeps no trace buffer (noting an event is one branch, nothing
+    /// allocated); traced, every event reaches the sink and the buffer is left empty.
+    #[test]
+    fn only_a_traced_run_notes_events() {
+        let scene = quickstart();
+        let opts = RunOptions {
+            parts: 20,
+            ..RunOptions::from_scene(&scene)
+        };
+        let plain = simulate(&scene, &opts, &mut |_| {}, None, None, None).unwrap();
+        assert!(plain.sinks.trace.is_none());
+        let mut seen = Vec::new();
+        let sink: &mut dyn FnMut(&TraceEvent) = &mut |e| seen.push(*e);
+        let traced = simulate(&scene, &opts, &mut |_| {}, None, None, Some(sink)).unwrap();
+        assert_eq!(traced.sinks.trace.as_deref(), Some(&[][..]));
+        let arrivals = seen
+            .iter()
+            .filter(|e| matches!(e.kind, TraceKind::Arrival { .. }));
+        assert_eq!(arrivals.count(), 20);
+        assert_eq!(plain.sinks.metrics.work, traced.sinks.metrics.work);
     }
 }

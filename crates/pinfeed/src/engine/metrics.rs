@@ -411,6 +411,10 @@ pub struct Summary {
     /// The closed loop: gate, return path and merge (absent from the JSON on an open line).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub closed_loop: Option<super::closed_loop::LoopSummary>,
+    /// `run --precision`: the rule, where the feed stopped and the rate's confidence sequence
+    /// (absent from the JSON without it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sequential: Option<super::sequential::SequentialSummary>,
 }
 
 pub use crate::statistics::wilson_interval;
@@ -495,6 +499,7 @@ impl Metrics {
             sensors: self.sensors.clone(),
             controller: None,
             closed_loop: None,
+            sequential: None,
         }
     }
 }

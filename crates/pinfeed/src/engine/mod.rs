@@ -18,7 +18,9 @@
 //! * [`controller`]: the controller's state (the dynamic pins' timelines and command queues) and
 //!   what it reports; `actuator`: a dynamic pin's timeline; [`online`]: the online controller's
 //!   model;
-//! * [`sensing`]: a sensor pin's reading and classification of one pass.
+//! * [`sensing`]: a sensor pin's reading and classification of one pass;
+//! * [`sequential`]: `run --precision`, the rule that stops the feed once the rate is known;
+//! * [`trace`]: the event trace (`run --trace`), noted as the stages go.
 //!
 //! The event loop ([`mod@line`]) dispatches each event to its stage; each stage is a function
 //! whose signature names the pieces of the run state it reads and writes. In the order a part
@@ -66,8 +68,10 @@ pub mod prepare;
 mod reading;
 pub mod results;
 pub mod sensing;
+pub mod sequential;
 mod serve;
 mod state;
+pub mod trace;
 
 pub use line::{run, run_capturing, run_entry, run_single, Entry, SingleRun};
 pub use metrics::Summary;

@@ -28,6 +28,9 @@ pub struct RunOptions {
     /// that changes a scene before running it (its physics, feed or seed) passes the model of the
     /// scene as written, which the controller was designed with.
     pub online: Option<super::prepare::OnlineHandle>,
+    /// `run --precision`: stop feeding new parts once the rate is known to this precision
+    /// ([`super::sequential`]); `parts` is then the cap. None: feed `parts` parts.
+    pub stop: Option<super::sequential::Precision>,
 }
 
 impl RunOptions {
@@ -39,6 +42,7 @@ impl RunOptions {
             sample_paths: 0,
             keep_records: false,
             online: None,
+            stop: None,
         }
     }
 }

@@ -8,6 +8,8 @@ use super::motion::Motion;
 use super::outcome::PartOutcome;
 use super::results::{CapturedPush, PartRecord, SamplePath};
 use super::sensing::{SensedDecision, SensorStats};
+use super::sequential::SequentialStop;
+use super::trace::{TraceEvent, TraceKind};
 use crate::geometry::Pose;
 use crate::mechanics::PartModel;
 use crate::scenario::{Obstacle, PinObstacle, Scene};
@@ -83,6 +85,10 @@ pub(super) struct Belt {
     pub(super) finished: u64,
     /// A closed loop's gate, return path and merge (None: an open line).
     pub(super) closed_loop: Option<super::closed_loop::LoopState>,
+    /// New parts fed so far (arrivals processed).
+    pub(super) fed: u64,
+    /// `run --precision`: the rule that stops the feed (None: the feed runs to its parts).
+    pub(super) stop: Option<SequentialStop>,
 }
 
 impl Belt {
@@ -93,7 +99,14 @@ impl Belt {
             active: BTreeMap::new(),
             finished: 0,
             closed_loop: None,
+            fed: 0,
+            stop: None,
         }
+    }
+
+    /// Has `run --precision`'s rule stopped the feed?
+    pub(super) fn feed_stopped(&self) -> bool {
+        self.stop.as_ref().is_some_and(SequentialStop::stopped)
     }
 
     /// Is event `kind` (taken off the queue with sequence number `seq`) stale: planned before a
@@ -122,6 +135,8 @@ pub(super) struct Sinks {
     pub(super) last_end: Option<(PartOutcome, Pose)>,
     /// Sensor pins (obstacle index, index into `metrics.sensors`); empty in a passive scene.
     pub(super) sensor_pins: Vec<(usize, usize)>,
+    /// The trace's events not yet handed on, when the run is traced ([`super::trace`]).
+    pub(super) trace: Option<Vec<TraceEvent>>,
 }
 
 impl Sinks {
@@ -158,6 +173,15 @@ impl Sinks {
             captured,
             last_end: None,
             sensor_pins,
+            trace: None,
+        }
+    }
+
+    /// Note `kind` at `t` of `entry` in the trace, when the run is traced (else nothing).
+    #[inline]
+    pub(super) fn note(&mut self, t: f64, entry: Option<u64>, kind: TraceKind) {
+        if let Some(trace) = self.trace.as_mut() {
+            trace.push(TraceEvent { t, entry, kind });
         }
     }
 }

@@ -124,6 +124,41 @@ pub fn precise_enough(k: u64, n: u64, alpha: f64, half_width: f64) -> bool {
     0.5 * (high - low) <= half_width
 }
 
+/// One minus the confidence of the sequences the sequential runs stop on (95%): `mc --precision`
+/// and `run --precision`.
+pub const ALPHA: f64 = 0.05;
+
+/// Why a sequential run stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stop {
+    /// The confidence sequence's half-width reached the precision asked for.
+    Precision,
+    /// The samples or parts allowed (the cap) were spent first.
+    Cap,
+}
+
+impl Stop {
+    /// `precision` or `cap`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stop::Precision => "precision",
+            Stop::Cap => "cap",
+        }
+    }
+}
+
+/// Check a `--precision` value: a half-width of a rate, in (0, 0.5).
+pub fn check_precision(e: f64) -> Result<f64, String> {
+    if e > 0.0 && e < 0.5 {
+        Ok(e)
+    } else {
+        Err(format!(
+            "--precision must lie in (0, 0.5) (the half-width of the success rate's 95% confidence sequence), got {e}"
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

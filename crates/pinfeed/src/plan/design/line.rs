@@ -99,6 +99,7 @@ impl<'a> Line<'a> {
             sample_paths: 0,
             keep_records: records,
             online: None,
+            stop: None,
         };
         let started = Instant::now();
         let res = run(scene, &opts, &mut |_| {})?;
@@ -248,6 +249,7 @@ mod tests {
                 sample_paths: 0,
                 keep_records: true,
                 online: None,
+                stop: None,
             };
             let fresh = run(&built, &opts, &mut |_| {}).unwrap();
             assert_eq!(format!("{:?}", res.summary), format!("{:?}", fresh.summary));

@@ -609,6 +609,7 @@ fn measure(
                 sample_paths: 0,
                 keep_records: true,
                 online: None,
+                stop: None,
             };
             let res = run(&s, &opts, &mut |_| {}).map_err(LineError::from)?;
             let mut out = Vec::new();

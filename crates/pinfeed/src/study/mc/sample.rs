@@ -1139,6 +1139,7 @@ pub fn run_sample(
         sample_paths: 0,
         keep_records: true,
         online: online.cloned(),
+        stop: None,
     };
     let run = engine::run(&drawn.scene, &opts, &mut |_| {}).map_err(|source| {
         super::StudyError::Engine {

@@ -19,30 +19,12 @@ use super::{Study, StudyError};
 use crate::statistics::confidence_sequence;
 use serde::Serialize;
 
+// The rule's confidence, its stop reasons and the check of E are shared with `run --precision`
+// (the engine's sequential stop), so they live in the statistics layer below both.
+pub use crate::statistics::confidence_sequence::{check_precision, Stop, ALPHA};
+
 /// Samples per point between two checks of the precision.
 pub const BLOCK: u64 = 1000;
-/// One minus the confidence of the sequence (95%).
-pub const ALPHA: f64 = 0.05;
-
-/// Why a point stopped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Stop {
-    /// The confidence sequence's half-width reached the precision asked for.
-    Precision,
-    /// The study's samples per point (the cap) were spent first.
-    Cap,
-}
-
-impl Stop {
-    /// `precision` or `cap`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stop::Precision => "precision",
-            Stop::Cap => "cap",
-        }
-    }
-}
 
 /// How a point's sequential run ended (in the report, per point, beside its samples).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -57,17 +39,6 @@ pub struct Sequential {
     pub half_width: f64,
     /// Why the point stopped.
     pub stopped: Stop,
-}
-
-/// Check a `--precision` value: a half-width of a rate, in (0, 0.5).
-pub fn check_precision(e: f64) -> Result<f64, String> {
-    if e > 0.0 && e < 0.5 {
-        Ok(e)
-    } else {
-        Err(format!(
-            "--precision must lie in (0, 0.5) (the half-width of the success rate's 95% confidence sequence), got {e}"
-        ))
-    }
 }
 
 /// Whether a point with `successes` in `samples`, checked every `block` samples, stops: on

@@ -817,6 +817,7 @@ pub fn run_scene(scene: &Scene) -> CaseReport {
         sample_paths: 1,
         keep_records: true,
         online: None,
+        stop: None,
     };
     match engine::run(scene, &opts, &mut |_| {}) {
         Err(e) => engine_error(&e),
