@@ -382,17 +382,33 @@ impl LoopState {
     }
 
     /// Entry `entry` reaches the gate at `t` at lateral offset `y` with the gate's call on it
-    /// (None: its sensor never read it): does the gate take it off?
+    /// (None: its sensor never read it) and the online controller's predicted success for it (if
+    /// it decided one): does the gate take it off?
     pub(super) fn gate_takes(
         &mut self,
         entry: u64,
         t: f64,
         y: f64,
         call: Option<GateCall>,
+        predicted: Option<f64>,
     ) -> bool {
         let g = &self.gate;
         let counts = &mut self.stats.gate;
-        let call = match (g.decided_by, call) {
+        let belief = predicted
+            .filter(|_| g.reject_on == RejectOn::Belief)
+            .map(|p| GateCall {
+                reject: p < g.min_success,
+                ready_at: t,
+            });
+        let call = match (g.decided_by, belief.or(call)) {
+            (None, Some(c)) => c,
+            (None, None) if g.reject_on == RejectOn::Belief => {
+                counts.unread += 1;
+                GateCall {
+                    reject: g.unknown_rejects,
+                    ready_at: t,
+                }
+            }
             (None, _) => GateCall {
                 reject: true,
                 ready_at: t,

@@ -164,7 +164,8 @@ pub(super) fn contact_begin(
                 let label = part.sensed.last().and_then(|d| d.label.as_deref());
                 part.gate_call = Some(g.call(label, plan.t_end));
             }
-            RejectOn::Decision => {}
+            // No pin commands a gate on the belief (it has no `decided_by`).
+            RejectOn::Decision | RejectOn::Belief => {}
         }
     }
     if let Some(sensed) = reading {

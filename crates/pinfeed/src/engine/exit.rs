@@ -24,9 +24,9 @@ pub(super) fn exit(
         return;
     };
     let pose = part.motion.world_pose(t, scene.belt.speed);
-    let call = part.gate_call;
+    let (call, predicted) = (part.gate_call, part.predicted);
     if let Some(lp) = belt.closed_loop.as_mut() {
-        if lp.gate_takes(index, t, pose.y, call) {
+        if lp.gate_takes(index, t, pose.y, call, predicted) {
             divert(scene, belt, sinks, index, t);
             return;
         }

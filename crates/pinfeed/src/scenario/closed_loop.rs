@@ -115,6 +115,9 @@ pub enum RejectOn {
     /// Any touch of its pin (a contact switch, or a light barrier across the lane): a part that
     /// does not touch the pin passes.
     Contact,
+    /// The online controller's belief: a part whose predicted success (at its decision) is
+    /// below `min_success` is taken off; one without a decision is `unknown`.
+    Belief,
 }
 
 /// The reject gate at the belt's end.
@@ -127,6 +130,8 @@ pub struct RejectGate {
     pub decided_by: Option<usize>,
     /// What takes a part off.
     pub reject_on: RejectOn,
+    /// With [`RejectOn::Belief`]: the least predicted success that passes.
+    pub min_success: f64,
     /// The labels of the sensor's hypotheses that pass.
     pub accept: Vec<String>,
     /// Does an `unknown` decision reject the part?
@@ -233,7 +238,8 @@ fn time(c: &Checker, path: &str, t: &RawTime) -> R<LoopTime> {
 }
 
 /// The keys a reject gate takes.
-const GATE_KEYS: &str = "y, reach, decided_by, reject_on, accept, unknown, actuation, busy";
+const GATE_KEYS: &str =
+    "y, reach, decided_by, reject_on, min_success, accept, unknown, actuation, busy";
 
 /// The gate and return path of a scene: the reject gate of `raw` (if any) and `[recirculation]`.
 /// `obstacles` are the compiled pins and fences, `sensors` their sensor pins' drafts.
@@ -247,6 +253,7 @@ pub(super) fn compile(
     belt: &Belt,
     part: &PartSpec,
     goal: &Goal,
+    online: bool,
 ) -> R<Option<ClosedLoop>> {
     let gates: Vec<usize> = (0..raw.len())
         .filter(|&i| raw[i].kind == ObstacleKind::RejectGate)
@@ -272,7 +279,7 @@ pub(super) fn compile(
             "a reject gate stands at the belt's end: list it after every pin and fence",
         ));
     }
-    let gate = gate(c, i, &raw[i], obstacles, sensors, belt, goal)?;
+    let gate = gate(c, i, &raw[i], obstacles, sensors, belt, goal, online)?;
     let recirculation = match recirculation {
         Some(rr) => Some(compile_recirculation(c, rr, belt, part)?),
         None => None,
@@ -283,6 +290,7 @@ pub(super) fn compile(
     }))
 }
 
+#[allow(clippy::too_many_arguments)]
 fn gate(
     c: &Checker,
     i: usize,
@@ -291,6 +299,7 @@ fn gate(
     sensors: &[SensorDraft],
     belt: &Belt,
     goal: &Goal,
+    online: bool,
 ) -> R<RejectGate> {
     let path = |k: &str| format!("obstacles[{i}].{k}");
     if ro.x.is_some() {
@@ -353,13 +362,57 @@ fn gate(
     let reject_on = match ro.reject_on.as_deref() {
         None | Some("decision") => RejectOn::Decision,
         Some("contact") => RejectOn::Contact,
+        Some("belief") => RejectOn::Belief,
         Some(other) => {
             return Err(c.err(
                 &path("reject_on"),
-                format!("must be \"decision\" or \"contact\", got \"{other}\""),
+                format!("must be \"decision\", \"contact\" or \"belief\", got \"{other}\""),
             ))
         }
     };
+    let min_success = match ro.min_success {
+        Some(_) if reject_on != RejectOn::Belief => {
+            return Err(c.err(
+                &path("min_success"),
+                "applies only with reject_on = \"belief\"",
+            ))
+        }
+        Some(m) => c.within(&path("min_success"), m, 0.0, 1.0, "predicted success")?,
+        None => 0.5,
+    };
+    // The gate without a pin; the pin-commanded gates below fill in theirs.
+    let pinless = RejectGate {
+        name,
+        decided_by: None,
+        reject_on,
+        min_success,
+        accept: Vec::new(),
+        unknown_rejects,
+        y,
+        reach,
+        actuation,
+        busy,
+    };
+    if reject_on == RejectOn::Belief {
+        if !online {
+            return Err(c.err(
+                &path("reject_on"),
+                "\"belief\" needs the online controller ([controller] mode = \"online\"), whose belief predicts each part's success",
+            ));
+        }
+        if let Some(k) = ro
+            .decided_by
+            .as_ref()
+            .map(|_| "decided_by")
+            .or(ro.accept.as_ref().map(|_| "accept"))
+        {
+            return Err(c.err(
+                &path(k),
+                "does not apply with reject_on = \"belief\": the online controller's prediction decides",
+            ));
+        }
+        return Ok(pinless);
+    }
     if ro.reject_on.is_some() && ro.decided_by.is_none() {
         return Err(c.err(
             &path("reject_on"),
@@ -384,15 +437,9 @@ fn gate(
             ));
         };
         return Ok(RejectGate {
-            name,
             decided_by: Some(j),
-            reject_on,
-            accept: Vec::new(),
             unknown_rejects: true,
-            y,
-            reach,
-            actuation,
-            busy,
+            ..pinless
         });
     }
     let Some(by) = &ro.decided_by else {
@@ -402,17 +449,7 @@ fn gate(
                 "applies only with decided_by (the sensor pin whose decision commands the gate)",
             ));
         }
-        return Ok(RejectGate {
-            name,
-            decided_by: None,
-            reject_on,
-            accept: Vec::new(),
-            unknown_rejects,
-            y,
-            reach,
-            actuation,
-            busy,
-        });
+        return Ok(pinless);
     };
     let Some(sensor) = sensors.iter().find(|s| s.name == by.as_str()) else {
         let names: Vec<&str> = sensors.iter().map(|s| s.name.as_str()).collect();
@@ -461,15 +498,9 @@ fn gate(
         },
     };
     Ok(RejectGate {
-        name,
         decided_by: Some(j),
-        reject_on,
         accept,
-        unknown_rejects,
-        y,
-        reach,
-        actuation,
-        busy,
+        ..pinless
     })
 }
 

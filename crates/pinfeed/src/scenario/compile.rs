@@ -76,6 +76,10 @@ pub fn compile(
         &belt,
         &part,
         &goal,
+        matches!(
+            controller.as_ref().map(|c| &c.mode),
+            Some(super::dynamic::ControlMode::Online(_))
+        ),
     )?;
     let mut scene = Scene {
         name,

@@ -137,6 +137,7 @@ pub(super) fn only_keys(c: &Checker, i: usize, ro: &RawObstacle, kind: &str, tak
         ("lower_time", ro.lower_time.is_some()),
         ("decided_by", ro.decided_by.is_some()),
         ("reject_on", ro.reject_on.is_some()),
+        ("min_success", ro.min_success.is_some()),
         ("accept", ro.accept.is_some()),
         ("unknown", ro.unknown.is_some()),
         ("reach", ro.reach.is_some()),

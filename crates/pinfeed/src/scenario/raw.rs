@@ -277,9 +277,13 @@ pub struct RawObstacle {
     /// Reject gate: the sensor pin whose decision commands it (default: none, the gate takes
     /// every part it can).
     pub decided_by: Option<String>,
-    /// Reject gate: what takes a part off: `decision` (default: its sensor pin's decision) or
-    /// `contact` (the part touched the `decided_by` pin: a contact switch).
+    /// Reject gate: what takes a part off: `decision` (default: its sensor pin's decision),
+    /// `contact` (the part touched the `decided_by` pin: a contact switch) or `belief` (the online
+    /// controller's predicted success is below `min_success`).
     pub reject_on: Option<String>,
+    /// Reject gate with `reject_on = "belief"`: the least predicted success that passes (default
+    /// 0.5).
+    pub min_success: Option<f64>,
     /// Reject gate: the sensor's hypotheses that pass (default: those in the goal).
     pub accept: Option<Vec<String>>,
     /// Reject gate: what an `unknown` decision does: `reject` (default) or `pass`.
