@@ -348,11 +348,16 @@ pub fn json(r: &McReport) -> String {
 }
 
 fn pct(s: &Share) -> String {
+    pct_in(s.rate, s.ci95, 1)
+}
+
+/// A rate and its interval in per cent with `d` decimals: `97.5% [96.1, 98.4]`.
+fn pct_in(rate: f64, ci: [f64; 2], d: usize) -> String {
     format!(
-        "{:.1}% [{:.1}, {:.1}]",
-        100.0 * s.rate,
-        100.0 * s.ci95[0],
-        100.0 * s.ci95[1]
+        "{:.d$}% [{:.d$}, {:.d$}]",
+        100.0 * rate,
+        100.0 * ci[0],
+        100.0 * ci[1]
     )
 }
 
@@ -418,32 +423,17 @@ pub fn table(r: &McReport) -> String {
         if let Some(sn) = p.sensor.filter(|_| sensing) {
             row.push(sn.readings.to_string());
             row.push(if sn.readings > 0 {
-                format!(
-                    "{:.1}% [{:.1}, {:.1}]",
-                    100.0 * sn.accuracy,
-                    100.0 * sn.ci95[0],
-                    100.0 * sn.ci95[1]
-                )
+                pct_in(sn.accuracy, sn.ci95, 1)
             } else {
                 "–".to_string()
             });
         }
         if let Some(q) = p.sequential.filter(|_| sequential) {
-            row.push(format!(
-                "{:.1}% [{:.1}, {:.1}]",
-                100.0 * p.success_rate,
-                100.0 * q.confidence_sequence[0],
-                100.0 * q.confidence_sequence[1]
-            ));
+            row.push(pct_in(p.success_rate, q.confidence_sequence, 1));
             row.push(q.stopped.name().to_string());
         }
         if let Some(l) = p.closed_loop.filter(|_| looped) {
-            row.push(format!(
-                "{:.2}% [{:.2}, {:.2}]",
-                100.0 * l.purity,
-                100.0 * l.purity_ci95[0],
-                100.0 * l.purity_ci95[1]
-            ));
+            row.push(pct_in(l.purity, l.purity_ci95, 2));
             row.push(format!("{:.3}", l.passes_per_part));
         }
         s.push_str(&format!("| {} |\n", row.join(" | ")));
