@@ -363,13 +363,19 @@ fn a_fence_plan_is_drawn_to_scale_at_its_angles() {
             "fence at {a}° drawn at {drawn:.1}°"
         );
     }
-    // One scale on both axes: px per mm from the belt view's x ticks (those just below its y
-    // ticks; the orientation sets' axes follow further down) equals that from its y ticks.
+    // One scale on both axes: px per mm from the belt view's x ticks (the first row of them
+    // below its y ticks; the orientation sets' axes follow further down) equals that from its y
+    // ticks.
     let ys = ticks(&boxes, "end");
     let bottom = ys.iter().map(|t| t.1.y1).fold(f64::MIN, f64::max);
-    let xs: Vec<(f64, TextBox)> = ticks(&boxes, "middle")
+    let below: Vec<(f64, TextBox)> = ticks(&boxes, "middle")
         .into_iter()
-        .filter(|t| t.1.y0 < bottom + 30.0)
+        .filter(|t| t.1.y0 > bottom - 12.0)
+        .collect();
+    let row = below.iter().map(|t| t.1.y0).fold(f64::MAX, f64::min);
+    let xs: Vec<(f64, TextBox)> = below
+        .into_iter()
+        .filter(|t| (t.1.y0 - row).abs() < 1.0)
         .collect();
     assert!(xs.len() >= 3 && ys.len() >= 3, "{xs:?} {ys:?}");
     let per =

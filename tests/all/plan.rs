@@ -317,9 +317,11 @@ fn best_effort_is_the_shortest_plan_with_the_most_parts_in_one_window() {
     assert_eq!((plan.window.inside, plan.steps.len()), brute);
 }
 
+/// The search finds a sensorless pin line for tripoly1 within eight pins that the nominal line
+/// holds; its verdict under the default uncertainty may go either way (exit 0 or 3).
 #[test]
 fn tripoly1_sensorless_plan_to_one_set_up_to_depth_8() {
-    let v = plan_ok(&[
+    let (code, v) = plan_json(&[
         "plan",
         "--part",
         "tripoly1",
@@ -329,6 +331,7 @@ fn tripoly1_sensorless_plan_to_one_set_up_to_depth_8() {
         "500",
         "--json",
     ]);
+    assert!(matches!(code, 0 | 3), "{}", v["message"]);
     assert_eq!(v["chosen"]["search"]["result"], "found", "{}", v["message"]);
     let pins = v["chosen"]["layout"]["sequence"]["steps"]
         .as_array()

@@ -142,6 +142,12 @@ impl OutcomeCounts {
             PartOutcome::Rejected => &mut self.rejected,
         }
     }
+    /// Add every count of `o` to this one's.
+    pub fn absorb(&mut self, o: &OutcomeCounts) {
+        for k in PartOutcome::EVERY {
+            self.add_n(k, o.get(k));
+        }
+    }
     /// All parts counted, over every class.
     pub fn total(&self) -> u64 {
         PartOutcome::EVERY.iter().map(|&o| self.get(o)).sum()

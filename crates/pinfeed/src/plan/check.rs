@@ -157,6 +157,11 @@ impl Uncertainty {
         range_of(&self.perturbations.fence_mu_f)
     }
 
+    /// The range of the fences' angle error (degrees) the search's particles plan against.
+    pub fn fences_angle(&self) -> Option<(f64, f64)> {
+        range_of(&self.perturbations.fence_angle)
+    }
+
     /// Does each part rest on a random tripod?
     pub fn tripod(&self) -> bool {
         self.perturbations.support == SupportChoice::Tripod
@@ -270,11 +275,25 @@ pub fn check_uncertain(
     seed: u64,
     samples: u64,
 ) -> Result<(crate::engine::OutcomeCounts, u64), StudyError> {
-    let study = Study::of_scene("design", scene.clone(), seed, samples, perturbations)?;
+    check_uncertain_from(scene, perturbations, seed, 0, samples)
+}
+
+/// Samples `from..to` of the study [`check_uncertain`] runs with `to` samples: as a study's
+/// shards, the counts of `0..m` and `m..n` add up to those of `0..n` (a check that wants more
+/// samples runs only the new ones).
+pub fn check_uncertain_from(
+    scene: &Scene,
+    perturbations: Perturbations,
+    seed: u64,
+    from: u64,
+    to: u64,
+) -> Result<(crate::engine::OutcomeCounts, u64), StudyError> {
+    let study = Study::of_scene("design", scene.clone(), seed, to, perturbations)?;
     let n = study.total_samples();
-    let tallies = crate::study::mc::run::run_range(&study, 0..n, &|| {})?;
+    let from = from.min(n);
+    let tallies = crate::study::mc::run::run_range(&study, from..n, &|| {})?;
     let outcomes = tallies.into_values().next().map(|t| t.outcomes);
-    Ok((outcomes.unwrap_or_default(), n))
+    Ok((outcomes.unwrap_or_default(), n - from))
 }
 
 #[cfg(test)]
@@ -389,5 +408,26 @@ mod tests {
         );
         let ok = Uncertainty::from_file(Path::new("my.toml"), "").unwrap();
         assert!(ok.is_nominal());
+    }
+
+    /// A check that wants more samples runs only the new ones: the counts of samples 0..m and
+    /// m..n add up to those of 0..n, as a study's shards do.
+    #[test]
+    fn an_uncertain_check_grows_by_its_new_samples_only() {
+        let scene =
+            crate::scenario::load(&crate::project_path("scenarios/tripoly2_fences.toml")).unwrap();
+        let p = Uncertainty::custom(Some((0.3, 0.7)), true, false)
+            .for_line(&["fence"])
+            .unwrap();
+        let (whole, n) = check_uncertain(&scene, p.clone(), 5, 240).unwrap();
+        let (mut parts, m) = check_uncertain_from(&scene, p.clone(), 5, 0, 90).unwrap();
+        let (rest, k) = check_uncertain_from(&scene, p, 5, 90, 240).unwrap();
+        parts.absorb(&rest);
+        assert_eq!((n, m + k), (240, 240));
+        assert_eq!(parts, whole);
+        assert!(
+            whole.success > 0 && whole.success < 240,
+            "{whole:?}: a mixed line"
+        );
     }
 }

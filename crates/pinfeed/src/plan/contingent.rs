@@ -248,7 +248,6 @@ pub fn branch_states(planner: &Planner) -> Result<Vec<State>, PlanError> {
             "the part has fewer than two stable states: there is nothing to sense",
         ));
     }
-    let robust = p.is_robust();
     let per = p.jitter_samples * p.offset_samples;
     let mut out = vec![Vec::new(); c.stable_deg.len()];
     for (i, (t, y)) in feed_samples(p, c)
@@ -257,7 +256,7 @@ pub fn branch_states(planner: &Planner) -> Result<Vec<State>, PlanError> {
         .enumerate()
     {
         out[i / per].push(Particle {
-            sample: if robust { i as u32 } else { 0 },
+            sample: planner.transition.sample_of(i),
             theta_q: theta_quanta(t, p.theta_quantum_deg, c.theta_steps),
             y_q: y_quanta(y, p.y_quantum_m),
             weight: 1,

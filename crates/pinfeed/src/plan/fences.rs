@@ -136,6 +136,19 @@ type FenceKey = (u32, i32, u16, i32, i32, i32);
 /// touched, lag behind the belt m).
 type FenceOutcome = Option<(f64, f64, bool, f64)>;
 
+/// The memo key of particle `p`'s pass by fence `ai` from `y0q` to `y1q` (quanta) with tail
+/// `rq`: its sample's fence twin ([`Transition::fence_sample`]), ends relative to the particle.
+fn fence_key(tr: &Transition, p: &Particle, ai: u16, y0q: i32, y1q: i32, rq: i32) -> FenceKey {
+    (
+        tr.fence_sample(p.sample),
+        p.theta_q,
+        ai,
+        y0q - p.y_q,
+        y1q - p.y_q,
+        rq,
+    )
+}
+
 /// Fence transitions with their memo.
 pub struct FenceTransition {
     /// The fence planner's settings.
@@ -166,16 +179,19 @@ impl FenceTransition {
         let q = problem.y_quantum_m;
         let a = tr.radius();
         let theta_deg = theta_q as f64 * problem.theta_quantum_deg;
-        let angle = self.options.angles_deg[ai as usize].to_radians();
+        let nominal = self.options.angles_deg[ai as usize].to_radians();
+        let (y0, y1) = (d0 as f64 * q, d1 as f64 * q);
+        let length = (y1 - y0).abs() / nominal.sin().abs();
+        // The sample's error in the fence's angle turns the fence, its length kept, about its
+        // upstream end (as a study's `fence_angle` does): its far end moves across the belt.
+        let angle = nominal + phys.fence_angle_deg.to_radians();
         let e = Vec2::from_angle(angle);
         let mut n = e.perp();
         if n.x > 0.0 {
             n = -n;
         }
-        let (y0, y1) = (d0 as f64 * q, d1 as f64 * q);
         // The line 1.01a upstream of the centroid, through the upstream end at lateral y0.
         let x0 = (1.01 * a + y0 * n.y) / (-n.x);
-        let length = (y1 - y0).abs() / angle.sin().abs();
         let spec = FenceSpec {
             start: Vec2::new(x0, y0),
             angle_rad: angle,
@@ -248,20 +264,29 @@ impl FenceTransition {
         let ymin = state.particles.iter().map(|p| p.y_q).min().unwrap() as f64 * q;
         let ymax = state.particles.iter().map(|p| p.y_q).max().unwrap() as f64 * q;
         let over = self.options.overhang_a * a;
+        // Planned against an error in the fences' angles, a fence reaches past the parts by as
+        // much more as the largest error turns its far end back: L·cos α·δ, with L at least the
+        // parts' spread plus their reach both sides.
+        let turn = problem
+            .fence_angle_range
+            .map_or(0.0, |(lo, hi)| lo.abs().max(hi.abs()).to_radians());
         // (angle index, y0 quanta, y1 quanta, tail radius quanta, interval lo, hi)
         let mut cands = Vec::new();
         for (ai, &deg) in self.options.angles_deg.iter().enumerate() {
+            let alpha = deg.to_radians().abs();
+            let span = ymax - ymin + 2.0 * (a + gap) + over;
+            let back = span / alpha.sin() * alpha.cos() * turn;
             let (y0, y1, lo, hi) = if deg > 0.0 {
                 (
                     (ymin - a - gap) / q,
-                    (ymax + a + gap + over) / q,
+                    (ymax + a + gap + over + back) / q,
                     -half,
                     ymin - a,
                 )
             } else {
                 (
                     (ymax + a + gap) / q,
-                    (ymin - a - gap - over) / q,
+                    (ymin - a - gap - over - back) / q,
                     ymax + a,
                     half,
                 )
@@ -290,7 +315,7 @@ impl FenceTransition {
         let mut missing: Vec<FenceKey> = Vec::new();
         for &(ai, y0q, y1q, rq, _, _) in &cands {
             for p in &state.particles {
-                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q, rq);
+                let k = fence_key(tr, p, ai, y0q, y1q, rq);
                 if !self.memo.contains_key(&k) {
                     missing.push(k);
                 }
@@ -320,7 +345,7 @@ impl FenceTransition {
             let mut parts = Vec::with_capacity(state.particles.len());
             let mut max_lag: f64 = 0.0;
             for p in &state.particles {
-                let k = (p.sample, p.theta_q, ai, y0q - p.y_q, y1q - p.y_q, rq);
+                let k = fence_key(tr, p, ai, y0q, y1q, rq);
                 match self.memo[&k] {
                     None => lost += p.weight,
                     Some((_, _, false, _)) => parts.push(*p),
@@ -543,6 +568,85 @@ mod tests {
         assert!(
             s_hi - s_lo > 4.0 * (t_hi - t_lo),
             "straight {s_lo}°…{s_hi}°"
+        );
+    }
+
+    /// Planned against an error δ in the fences' angles, a fence reaches past the parts by
+    /// L·cos α·δ more (the error turns its far end back by that much), and a sample's pass is
+    /// the fence turned by the sample's error about its upstream end, its length kept, as a
+    /// study's `fence_angle` turns it.
+    #[test]
+    fn an_angle_error_turns_the_fence_about_its_upstream_end() {
+        let mut p = Problem::new("tripoly2");
+        let compiled = p.compile().unwrap();
+        let fence_at = |p: &Problem, deg: f64| {
+            let tr = Transition::new(p, &compiled, 150).unwrap();
+            let state = crate::plan::particles::initial_state(p, &compiled, |i| tr.sample_of(i));
+            let mut ft = FenceTransition::new(FenceOptions::grid(0.5, 5.0, 60.0));
+            let acts = ft.actions(&state, &tr, p, compiled.theta_steps);
+            acts.into_iter()
+                .find_map(|(a, _)| match a {
+                    Action::Fence(f) if f.angle_deg == deg && f.tail_radius_m.is_none() => Some(f),
+                    _ => None,
+                })
+                .unwrap()
+        };
+        let plain = fence_at(&p, 15.0);
+        p.fence_angle_range = Some((-0.5, 0.5));
+        let turned = fence_at(&p, 15.0);
+        assert_eq!(plain.y0_m, turned.y0_m);
+        let alpha = 15f64.to_radians();
+        let back = (plain.y1_m - plain.y0_m) / alpha.sin() * alpha.cos() * 0.5f64.to_radians();
+        let more = turned.y1_m - plain.y1_m;
+        assert!(
+            (more - back).abs() <= p.y_quantum_m,
+            "{more} against {back}"
+        );
+
+        // The pass of a sample with an error of +0.5° is the fence at 15.5° from the same
+        // upstream end with the 15° fence's length.
+        let tr = Transition::new(&p, &compiled, 150).unwrap();
+        let k = (0..150u32)
+            .find(|&k| tr.samples[k as usize].fence_angle_deg == 0.5)
+            .unwrap();
+        let mut options = FenceOptions::grid(0.5, 5.0, 60.0);
+        options.angles_deg = vec![15.0];
+        let ft = FenceTransition::new(options);
+        let a = tr.radius();
+        let q = p.y_quantum_m;
+        let (d0, d1) = ((-1.5 * a / q).round() as i32, (1.5 * a / q).round() as i32);
+        let got = ft.pass(&tr, &p, (k, 40, 0, d0, d1, 0)).unwrap();
+        let length = (d1 - d0) as f64 * q / alpha.sin();
+        let turned = alpha + 0.5f64.to_radians();
+        let n = {
+            let n = Vec2::from_angle(turned).perp();
+            if n.x > 0.0 {
+                -n
+            } else {
+                n
+            }
+        };
+        let y0 = d0 as f64 * q;
+        let spec = FenceSpec {
+            start: Vec2::new((1.01 * a + y0 * n.y) / (-n.x), y0),
+            angle_rad: turned,
+            length,
+            mu_f: tr.samples[k as usize].mu_f.unwrap_or(0.5),
+            tail_radius: None,
+        };
+        let settings = ContactSettings {
+            fidelity: Fidelity::Exact,
+            mu_c: tr.samples[k as usize].mu_c,
+            tol: p.contact_tol.min(FENCE_TOL),
+            ..ContactSettings::default()
+        };
+        let pose = Pose::new(0.0, 0.0, (40.0 * p.theta_quantum_deg).to_radians());
+        let out = push_fence(&tr.samples[k as usize].model, pose, &spec, &settings, None);
+        assert!(out.contact);
+        assert_eq!(got.1, out.pose_final.y);
+        assert_eq!(
+            got.0,
+            wrap_deg(40.0 * p.theta_quantum_deg + out.rotation_rad.to_degrees())
         );
     }
 }

@@ -12,9 +12,14 @@
 //!   coordinate, drawn per obstacle and part) and every fence's angle by ±e degrees, for e in
 //!   [`PLACEMENT_MM`], until a step fails; the margin is the largest e that held.
 //!
-//! A step *holds* when its success rate is at least the design's target — the verdict's own rule,
-//! at the step's sample count. Whatever the design was planned against (random tripods, a μc
-//! range) stays in every step; a friction step fixes μ to its value.
+//! A step runs its parts in blocks ([`FIRST_BLOCK`] parts, then as many again as it has run, up to
+//! its cap) and stops as soon as its 95% Wilson interval lies wholly on one side of the design's
+//! target: it *holds* when the interval lies at or above it, fails when the interval lies below;
+//! at the cap it holds when its success rate is at least the target — the verdict's own rule. A
+//! step far from the target is decided by its first block (500 parts without a failure hold a
+//! target of 0.99), one near it runs every part of the cap. Whatever the design was planned
+//! against (random tripods, a μc range) stays in every step; a friction step fixes μ to its
+//! value.
 
 use crate::mechanics::support::SupportChoice;
 use crate::random::distribution::Distribution;
@@ -31,6 +36,34 @@ pub const MU_STEP: f64 = 0.05;
 pub const MU_REACH: f64 = 0.3;
 /// The placement errors tried (± mm on positions; the same number in degrees on fence angles).
 pub const PLACEMENT_MM: [f64; 4] = [0.25, 0.5, 1.0, 2.0];
+/// The parts of a step's first block.
+pub const FIRST_BLOCK: u64 = 500;
+
+/// The seed of a step's block `k`: the design's seed for the first, then a stream of their own.
+fn block_seed(seed: u64, k: u64) -> u64 {
+    use rand::Rng;
+    if k == 0 {
+        seed
+    } else {
+        crate::random::substream(seed, 0x6d61_7267, k).next_u64()
+    }
+}
+
+/// Is a step of `success` of `n` parts decided against `target` with `cap` parts at most:
+/// Some(holds) once the 95% Wilson interval lies wholly on one side of the target or the cap is
+/// reached (then: the rate at least the target), None while more parts are to be run.
+pub fn step_decided(success: u64, n: u64, target: f64, cap: u64) -> Option<bool> {
+    let [lo, hi] = wilson_interval(success, n);
+    if n >= cap {
+        Some(success as f64 >= target * n as f64)
+    } else if lo >= target {
+        Some(true)
+    } else if hi < target {
+        Some(false)
+    } else {
+        None
+    }
+}
 
 /// One step of a sweep: the line under one shift of its physics.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -76,6 +109,20 @@ pub struct Margins {
 }
 
 impl Margins {
+    /// The parts its steps ran: "500" or "500–2000".
+    pub fn parts_per_step(&self) -> String {
+        let n = self
+            .friction
+            .iter()
+            .chain(&self.placement)
+            .map(|s| s.samples);
+        match (n.clone().min(), n.max()) {
+            (Some(lo), Some(hi)) if lo < hi => format!("{lo}–{hi}"),
+            (Some(lo), _) => lo.to_string(),
+            _ => "0".into(),
+        }
+    }
+
     /// "holds for μ 0.45–0.60 (pins; fences μf 0.45–0.60) and placement ±0.5 mm / ±0.5°".
     pub fn describe(&self) -> String {
         let mu = match self.mu_holds {
@@ -154,15 +201,28 @@ pub fn measure(
     });
     let mu0 = scene.part.mu_c;
     let run = |p: Perturbations, at: f64| -> Result<Step, StudyError> {
-        let (counts, n) = super::check::check_uncertain(scene, p, seed, samples)?;
-        let rate = counts.success as f64 / n.max(1) as f64;
+        // Blocks of parts, each from a stream of its own, until the step is decided.
+        let (mut success, mut n, mut block) = (0u64, 0u64, 0u64);
+        let holds = loop {
+            let more = (if n == 0 { FIRST_BLOCK } else { n })
+                .min(samples - n)
+                .max(1);
+            let (counts, m) =
+                super::check::check_uncertain(scene, p.clone(), block_seed(seed, block), more)?;
+            success += counts.success;
+            n += m;
+            block += 1;
+            if let Some(h) = step_decided(success, n, target, samples.max(1)) {
+                break h;
+            }
+        };
         Ok(Step {
             at,
             samples: n,
-            success: counts.success,
-            success_rate: rate,
-            ci95: wilson_interval(counts.success, n),
-            holds: rate >= target,
+            success,
+            success_rate: success as f64 / n.max(1) as f64,
+            ci95: wilson_interval(success, n),
+            holds,
         })
     };
     let mut cut_short = false;
@@ -267,6 +327,24 @@ pub fn measure(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A step stops as soon as its interval lies on one side of the target, and at its cap
+    /// goes by the rate: 500 parts without a failure hold 0.99 (Wilson's lower end 0.9924), 495
+    /// of 500 do not decide it, 480 of 500 fail it; at the cap, 1980 of 2000 hold 0.99 and 1979
+    /// do not.
+    #[test]
+    fn a_step_is_decided_once_its_interval_clears_the_target() {
+        assert_eq!(step_decided(500, 500, 0.99, 2000), Some(true));
+        assert_eq!(step_decided(499, 500, 0.99, 2000), None);
+        assert_eq!(step_decided(495, 500, 0.99, 2000), None);
+        assert_eq!(step_decided(480, 500, 0.99, 2000), Some(false));
+        assert_eq!(step_decided(1980, 2000, 0.99, 2000), Some(true));
+        assert_eq!(step_decided(1979, 2000, 0.99, 2000), Some(false));
+        // The interval's ends decide, not the rate: 998 of 1000 (rate above 0.99) is not yet a
+        // hold at 0.995 (lower end 0.9928).
+        assert_eq!(step_decided(998, 1000, 0.995, 2000), None);
+        assert_eq!(step_decided(0, 1, 0.5, 1), Some(false));
+    }
 
     /// The margins say where the sweep ended: at a failing step (a closed end), or still holding
     /// at its reach (an open end, "or lower"/"or higher"), never that it "stopped holding".

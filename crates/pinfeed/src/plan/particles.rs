@@ -143,14 +143,18 @@ pub fn y_quanta(y: f64, quantum: f64) -> i32 {
     (y / quantum).round() as i32
 }
 
-/// The initial state: the feed's particles, rounded; feed sample i carries physics sample i when
-/// `robust` (else 0).
-pub fn initial_state(problem: &Problem, compiled: &Compiled, robust: bool) -> State {
+/// The initial state: the feed's particles, rounded; feed sample i carries physics sample
+/// `sample_of(i)` ([`super::transition::Transition::sample_of`]).
+pub fn initial_state(
+    problem: &Problem,
+    compiled: &Compiled,
+    sample_of: impl Fn(usize) -> u32,
+) -> State {
     let parts = feed_samples(problem, compiled)
         .into_iter()
         .enumerate()
         .map(|(i, (t, y))| Particle {
-            sample: if robust { i as u32 } else { 0 },
+            sample: sample_of(i),
             theta_q: theta_quanta(t, problem.theta_quantum_deg, compiled.theta_steps),
             y_q: y_quanta(y, problem.y_quantum_m),
             weight: 1,

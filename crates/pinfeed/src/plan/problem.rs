@@ -86,6 +86,9 @@ pub struct Problem {
     /// Robust against the fences' μf: each particle draws its own fence μf uniformly in this
     /// range (None: the fence planner's own μf).
     pub mu_f_range: Option<(f64, f64)>,
+    /// Robust against the fences' angle error (degrees, added to every fence's angle): the
+    /// particles plan against its ends and middle (None: fences at their angles).
+    pub fence_angle_range: Option<(f64, f64)>,
     /// Robustness: each particle carries its own random tripod support.
     pub tripod: bool,
     /// Pin radius (m; 0 = point pin).
@@ -152,6 +155,7 @@ impl Problem {
             mu_c: 0.5,
             mu_c_range: None,
             mu_f_range: None,
+            fence_angle_range: None,
             tripod: false,
             pin_radius_m: 0.002,
             belt_width_m: 0.1,
@@ -306,13 +310,26 @@ impl Problem {
                 }
             }
         }
+        if let Some((lo, hi)) = self.fence_angle_range {
+            if !(lo.is_finite() && hi.is_finite() && -10.0 <= lo && lo <= hi && hi <= 10.0) {
+                return Err(PlanError::input(
+                    "fence_angle_range",
+                    format!("{lo}:{hi}"),
+                    "must be LO:HI degrees with −10 ≤ LO ≤ HI ≤ 10 (an error in a fence's angle)",
+                ));
+            }
+        }
         Ok(())
     }
 
     /// Is the problem robust against uncertain physics (a friction range at the pins or the
-    /// fences, or tripods)? Then every feed sample carries its own physics sample.
+    /// fences, an error in the fences' angles, or tripods)? Then the particles carry physics
+    /// samples ([`super::transition::Transition::new`]).
     pub fn is_robust(&self) -> bool {
-        self.tripod || self.mu_c_range.is_some() || self.mu_f_range.is_some()
+        self.tripod
+            || self.mu_c_range.is_some()
+            || self.mu_f_range.is_some()
+            || self.fence_angle_range.is_some()
     }
 
     /// Check the line's settings against the part's size `a` (m): pin radius, belt width (and

@@ -183,9 +183,8 @@ impl Planner {
     pub fn new(problem: &Problem) -> Result<Planner, PlanError> {
         let compiled = problem.compile()?;
         let n = super::particles::feed_samples(problem, &compiled).len();
-        let robust = problem.is_robust();
         let transition = Transition::new(problem, &compiled, n)?;
-        let initial = initial_state(problem, &compiled, robust);
+        let initial = initial_state(problem, &compiled, |i| transition.sample_of(i));
         Ok(Planner {
             problem: problem.clone(),
             compiled,

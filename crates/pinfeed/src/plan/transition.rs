@@ -47,6 +47,9 @@ pub struct PhysicsSample {
     /// Fence–part friction of this sample, when the problem is robust against it
     /// ([`Problem::mu_f_range`]; None: the fence planner's own μf).
     pub mu_f: Option<f64>,
+    /// Error added to every fence's angle in this sample (degrees;
+    /// [`Problem::fence_angle_range`]).
+    pub fence_angle_deg: f64,
 }
 
 /// The outcome of one pass, as the planner keeps it.
@@ -89,6 +92,11 @@ pub struct Transition {
     pub reach_q: i32,
     /// The physics samples the particles draw from (one without robustness options).
     pub samples: Vec<PhysicsSample>,
+    /// Per sample, the first sample with the same fence passes ([`Transition::fence_sample`]).
+    fence_twins: Vec<u32>,
+    /// Per sample, the first sample with the same pin passes (model and μc): the memo's and
+    /// the columns' keys are theirs.
+    pin_twins: Vec<u32>,
     memo: HashMap<PassKey, PassOutcome>,
     columns: HashMap<(u32, i32), Arc<Vec<u32>>>,
     /// Work done so far.
@@ -101,6 +109,21 @@ pub struct Transition {
 
 /// Stream of the physics samples (each particle's own μc and tripod).
 const PHYSICS_STREAM: u64 = 0x7068_7973;
+
+/// How many frictions of a range a robust search on one support plans against.
+pub const FRICTION_LEVELS: usize = 9;
+
+/// `k` values evenly spaced over a range from end to end, which a robust search on one support
+/// plans against (`nominal` alone without a range).
+fn levels(range: Option<(f64, f64)>, nominal: f64, k: usize) -> Vec<f64> {
+    match range {
+        Some((lo, hi)) if hi > lo => (0..k)
+            .map(|j| lo + (hi - lo) * j as f64 / (k - 1) as f64)
+            .collect(),
+        Some((lo, _)) => vec![lo],
+        None => vec![nominal],
+    }
+}
 
 impl Transition {
     /// The physics samples: one (nominal) for all particles, or one per feed sample (`n`) drawn
@@ -135,7 +158,27 @@ impl Transition {
             }
         };
         let mut draws = Vec::new();
-        if robust {
+        if robust && !problem.tripod {
+            // On one support only the frictions and the fences' angle error vary: each feed
+            // sample takes its values from a grid over each range (FRICTION_LEVELS values from
+            // end to end, the angle error's ends and middle), the grids' values in turn. The
+            // passes depend on the grid point, not on the particle, so particles in the same
+            // state share them (the pins' and the fences' memos key the grid point), and the
+            // grid's ends are each range's worst cases.
+            let cs = levels(problem.mu_c_range, problem.mu_c, FRICTION_LEVELS);
+            let fs = levels(problem.mu_f_range, f64::NAN, FRICTION_LEVELS);
+            let angles = levels(problem.fence_angle_range, 0.0, 3);
+            for i in 0..n {
+                let (a, rest) = (i % angles.len(), i / angles.len());
+                let mu_f = fs[rest % fs.len()];
+                draws.push((
+                    cs[i % cs.len()],
+                    None,
+                    (!mu_f.is_nan()).then_some(mu_f),
+                    angles[a],
+                ));
+            }
+        } else if robust {
             for i in 0..n {
                 let mut rng = crate::random::stream(problem.seed ^ PHYSICS_STREAM, i as u64);
                 let mu_c = match problem.mu_c_range {
@@ -154,7 +197,10 @@ impl Transition {
                 let mu_f = problem
                     .mu_f_range
                     .map(|(lo, hi)| lo + (hi - lo) * rng.random::<f64>());
-                draws.push((mu_c, tripod, mu_f));
+                let angle = problem
+                    .fence_angle_range
+                    .map_or(0.0, |(lo, hi)| lo + (hi - lo) * rng.random::<f64>());
+                draws.push((mu_c, tripod, mu_f, angle));
             }
         }
         // The uniform model's μc values: the nominal one, and every draw on uniform pressure.
@@ -171,9 +217,10 @@ impl Transition {
                 mu_c: problem.mu_c,
                 support: Support::Uniform,
                 mu_f: None,
+                fence_angle_deg: 0.0,
             });
         } else {
-            for (mu_c, tripod, mu_f) in draws {
+            for (mu_c, tripod, mu_f, fence_angle_deg) in draws {
                 let (model, support) = match tripod {
                     Some(s) => (
                         Arc::new(tabled(
@@ -189,9 +236,24 @@ impl Transition {
                     mu_c,
                     support,
                     mu_f,
+                    fence_angle_deg,
                 });
             }
         }
+        let twins = |same: &dyn Fn(&PhysicsSample, &PhysicsSample) -> bool| -> Vec<u32> {
+            samples
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    samples[..i]
+                        .iter()
+                        .position(|t| Arc::ptr_eq(&t.model, &s.model) && same(t, s))
+                        .unwrap_or(i) as u32
+                })
+                .collect()
+        };
+        let fence_twins = twins(&|t, s| t.mu_f == s.mu_f && t.fence_angle_deg == s.fence_angle_deg);
+        let pin_twins = twins(&|t, s| t.mu_c == s.mu_c);
         let reach_q =
             ((compiled.radius + problem.pin_radius_m) / problem.y_quantum_m).floor() as i32;
         Ok(Transition {
@@ -206,12 +268,30 @@ impl Transition {
             coarse: problem.coarse,
             reach_q,
             samples,
+            fence_twins,
+            pin_twins,
             memo: HashMap::new(),
             columns: HashMap::new(),
             counters: PushCounters::default(),
             deadline: problem.deadline,
             expired: AtomicBool::new(false),
         })
+    }
+
+    /// The first physics sample whose fence passes are those of `sample`: the same contact
+    /// model, fence friction and angle error (a fence pass does not read the pins' μc).
+    pub fn fence_sample(&self, sample: u32) -> u32 {
+        self.fence_twins[sample as usize]
+    }
+
+    /// `key` with its sample replaced by the first one with the same pin passes.
+    fn pin_key(&self, key: PassKey) -> PassKey {
+        (self.pin_twins[key.0 as usize], key.1, key.2)
+    }
+
+    /// The physics sample feed sample `i` carries: the samples in turn.
+    pub fn sample_of(&self, i: usize) -> u32 {
+        (i % self.samples.len().max(1)) as u32
     }
 
     /// The part's radius a (m).
@@ -331,11 +411,12 @@ impl Transition {
     /// Make sure every key has an outcome in the memo (missing ones computed in parallel).
     pub fn ensure(&mut self, keys: &[PassKey]) {
         let mut missing: Vec<PassKey> = Vec::new();
-        for k in keys {
-            if self.memo.contains_key(k) {
+        for &k in keys {
+            let k = self.pin_key(k);
+            if self.memo.contains_key(&k) {
                 self.counters.memo_hits += 1;
             } else {
-                missing.push(*k);
+                missing.push(k);
             }
         }
         missing.sort_unstable();
@@ -351,7 +432,7 @@ impl Transition {
 
     /// The memoised outcome (call [`Transition::ensure`] first).
     pub fn outcome(&self, key: PassKey) -> Option<&PassOutcome> {
-        self.memo.get(&key)
+        self.memo.get(&self.pin_key(key))
     }
 
     /// Signature of column (sample, θ) at offset index i (offset i − reach), computing it (and
@@ -426,8 +507,8 @@ impl Transition {
     pub fn ensure_columns(&mut self, cols: &[(u32, i32)]) {
         let mut missing: Vec<(u32, i32)> = cols
             .iter()
+            .map(|&(s, t)| (self.pin_twins[s as usize], t))
             .filter(|c| !self.columns.contains_key(c))
-            .copied()
             .collect();
         missing.sort_unstable();
         missing.dedup();
@@ -450,7 +531,7 @@ impl Transition {
 
     /// The signature column of (sample, θ) (call [`Transition::ensure_columns`] first).
     pub fn column_of(&self, sample: u32, theta_q: i32) -> Arc<Vec<u32>> {
-        self.columns[&(sample, theta_q)].clone()
+        self.columns[&(self.pin_twins[sample as usize], theta_q)].clone()
     }
 
     /// The state after a pin at `pin_q` (quanta); every touched particle's pass must be in the
@@ -465,7 +546,7 @@ impl Transition {
                 parts.push(*p);
                 continue;
             }
-            let Some(&o) = self.memo.get(&(p.sample, p.theta_q, dy)) else {
+            let Some(&o) = self.outcome((p.sample, p.theta_q, dy)) else {
                 lost += p.weight;
                 continue;
             };
@@ -562,5 +643,73 @@ mod tests {
         q.mu_f_range = Some((0.4, 0.6));
         assert!(q.is_robust());
         assert_eq!(Transition::new(&q, &compiled, 4).unwrap().samples.len(), 4);
+    }
+
+    /// On one support a robust search plans against a grid over each range — nine frictions
+    /// from end to end, the angle error's ends and middle — the grid's points in turn, and
+    /// particles at the same grid point share their passes: a pin pass per pin friction, a
+    /// fence pass per fence friction and angle error.
+    #[test]
+    fn on_one_support_the_samples_are_a_grid_whose_points_share_their_passes() {
+        let mut p = Problem::new("tripoly2");
+        p.mu_c_range = Some((0.4, 0.6));
+        p.mu_f_range = Some((0.35, 0.65));
+        p.fence_angle_range = Some((-0.5, 0.5));
+        let compiled = p.compile().unwrap();
+        let mut t = Transition::new(&p, &compiled, 150).unwrap();
+        assert_eq!(t.samples.len(), 150);
+        let distinct = |f: &dyn Fn(&PhysicsSample) -> f64| {
+            let mut v: Vec<f64> = t.samples.iter().map(f).collect();
+            v.sort_by(f64::total_cmp);
+            v.dedup();
+            v
+        };
+        let mu_c = distinct(&|s| s.mu_c);
+        assert_eq!(mu_c.len(), FRICTION_LEVELS);
+        assert_eq!((mu_c[0], mu_c[8]), (0.4, 0.6));
+        assert!((mu_c[4] - 0.5).abs() < 1e-12);
+        let mu_f = distinct(&|s| s.mu_f.unwrap());
+        assert_eq!(
+            (mu_f.len(), mu_f[0], mu_f[8]),
+            (FRICTION_LEVELS, 0.35, 0.65)
+        );
+        assert_eq!(distinct(&|s| s.fence_angle_deg), vec![-0.5, 0.0, 0.5]);
+        // Every (fence friction, angle) pair is planned against.
+        let mut pairs: Vec<(u64, u64)> = t
+            .samples
+            .iter()
+            .map(|s| (s.mu_f.unwrap().to_bits(), s.fence_angle_deg.to_bits()))
+            .collect();
+        pairs.sort_unstable();
+        pairs.dedup();
+        assert_eq!(pairs.len(), 27);
+        let fence_twins: std::collections::BTreeSet<u32> =
+            (0..150).map(|i| t.fence_sample(i)).collect();
+        assert_eq!(fence_twins.len(), 27);
+        for i in 0..150u32 {
+            let (s, f) = (
+                &t.samples[i as usize],
+                &t.samples[t.fence_sample(i) as usize],
+            );
+            assert!(t.fence_sample(i) <= i);
+            assert_eq!((s.mu_f, s.fence_angle_deg), (f.mu_f, f.fence_angle_deg));
+        }
+        // One pin pass per pin friction for 150 particles at one orientation and offset.
+        let keys: Vec<PassKey> = (0..150).map(|i| (i, 0, 0)).collect();
+        t.ensure(&keys);
+        assert_eq!(t.counters.computed, FRICTION_LEVELS as u64);
+        for i in 0..150 {
+            let o = t.outcome((i, 0, 0)).expect("served");
+            let mut q = p.clone();
+            q.mu_c_range = None;
+            q.mu_c = t.samples[i as usize].mu_c;
+            let alone = Transition::new(&q, &compiled, 1).unwrap().pass((0, 0, 0));
+            assert_eq!(o.signature, alone.signature, "sample {i}");
+            assert!((o.theta_deg - alone.theta_deg).abs() < 1e-6, "sample {i}");
+        }
+        // On random tripods every sample stays its own.
+        p.tripod = true;
+        let r = Transition::new(&p, &compiled, 20).unwrap();
+        assert!((0..20).all(|i| r.fence_sample(i) == i && r.pin_twins[i as usize] == i));
     }
 }

@@ -344,7 +344,7 @@ pub fn text(o: &DesignOptions, d: &Design, files: &[String]) -> String {
             t += &format!(
                 "margins     {} — {} parts a step, each held to the target {}\n",
                 m.describe(),
-                m.friction.first().map_or(0, |s| s.samples),
+                m.parts_per_step(),
                 m.target
             );
         }

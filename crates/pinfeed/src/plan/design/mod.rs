@@ -286,6 +286,7 @@ impl DesignOptions {
         }
         o.problem.mu_c_range = u.pins_friction();
         o.problem.mu_f_range = u.fences_friction();
+        o.problem.fence_angle_range = u.fences_angle();
         o.problem.tripod = u.tripod();
         o.uncertainty = UncertaintyChoice::Given(Box::new(u));
         o
@@ -950,6 +951,12 @@ fn fence_options(o: &DesignOptions, mu_c: f64) -> Result<FenceOptions, DesignErr
     // range's highest μf.
     let jam_mu_f = o.problem.mu_f_range.map_or(mu_f, |(_, hi)| hi.max(mu_f));
     let mut opts = FenceOptions::grid(jam_mu_f, f.angle_step_deg, f.max_angle_deg);
+    // Robust against an error in the fences' angles, every fence stays below the jam limit
+    // turned by the largest error.
+    if let Some((lo, hi)) = o.problem.fence_angle_range {
+        let jam = 90.0 - jam_mu_f.atan().to_degrees() - lo.abs().max(hi.abs());
+        opts.angles_deg.retain(|a| a.abs() < jam - 1e-9);
+    }
     opts.mu_f = mu_f;
     opts.overhang_a = f.overhang_a;
     opts.tail_max_a = match f.tails {
@@ -1689,8 +1696,10 @@ impl Work<'_> {
             // clearly breaks (the 95% interval below the target) is decided there; otherwise the
             // samples double up to the check's, and beyond it (to 8×) while the interval holds
             // the target.
+            // Each step runs only the samples it adds (the study's samples are its shards').
             let scene = on_line.scene(h)?;
             let mut samples = o.screen_parts.clamp(1, parts);
+            let (mut outcomes, mut n, mut spent) = (OutcomeCounts::default(), 0u64, 0.0);
             loop {
                 self.tell(
                     Some(mode),
@@ -1698,11 +1707,20 @@ impl Work<'_> {
                     format!("line check under the planned uncertainty ({samples} samples)"),
                 );
                 let started = Instant::now();
-                let (outcomes, n) =
-                    super::check::check_uncertain(scene, perturbations.clone(), seed, samples)
-                        .map_err(|e| input("uncertain", "", e))?;
+                let (more, m) = super::check::check_uncertain_from(
+                    scene,
+                    perturbations.clone(),
+                    seed,
+                    n,
+                    samples,
+                )
+                .map_err(|e| input("uncertain", "", e))?;
+                outcomes.absorb(&more);
+                n += m;
+                spent += started.elapsed().as_secs_f64();
                 self.line_runs += 1;
-                let u = LineCheck::of(&outcomes, n, h, started);
+                let mut u = LineCheck::of(&outcomes, n, h, started);
+                u.elapsed_s = spent;
                 let fails = u.ci95[1] < target;
                 let next = if samples < parts {
                     (2 * samples).min(parts)
@@ -1853,7 +1871,7 @@ impl Work<'_> {
         self.tell(
             Some(c.mode),
             c.round,
-            format!("margins: friction and placement sweeps ({samples} parts a step)"),
+            format!("margins: friction and placement sweeps (up to {samples} parts a step)"),
         );
         let kinds: Vec<&str> = c.obstacles.iter().map(|o| o.kind.name()).collect();
         let base = o.planned().for_line(&kinds);
@@ -2097,7 +2115,7 @@ pub fn header_lines(o: &DesignOptions, c: &Candidate, status: Status) -> Vec<Str
     if let Some(m) = &c.margins {
         l.push(format!(
             "Margins (`pinfeed plan` swept them on the line, {} parts a step): {}.",
-            m.friction.first().map_or(0, |s| s.samples),
+            m.parts_per_step(),
             m.describe()
         ));
     }
