@@ -335,15 +335,15 @@ pub(crate) fn first_touch_chain(
     best
 }
 
-/// How near an end (relative to the fence's length) a vertex on the line at the current travel
+/// How near an end (normalised units: the part's a) a vertex on the line at the current travel
 /// counts as at the end: above the landing error of an event at any tolerance the contact model
 /// takes (at most 10⁻²·tol, tol ≤ 10⁻³).
 const END_LANDING: f64 = 1e-5;
 
 /// The first touch of the hull (vertices `world`) on the straight line of fence piece `f`, strictly
 /// between its ends (`joined`: its upstream end is the previous piece's arc). Travel may be
-/// negative (the caller filters). A vertex that meets the line now (within [`END_LANDING`]·length
-/// of travel `s_from`) within as much of an end lies at that end: the event that put it there (a
+/// negative (the caller filters). A vertex that meets the line now (within [`END_LANDING`] of
+/// travel `s_from`) within as much of an end lies at that end: the event that put it there (a
 /// pivot about the end letting go as the edge's far vertex reaches it) lands within that of the
 /// end, and taking it for a touch of the line would start a contact the part is leaving (the
 /// end's own cast decides whether it strikes).
@@ -368,8 +368,8 @@ fn line_touch(
         // Strictly inside: a vertex meeting the line exactly at an end meets that end, which the
         // point-pin cast handles (this keeps the decision at a fence end unambiguous). An end
         // joined to an arc is the arc's, whose cast meets it.
-        let now = (t - s_from).abs() <= END_LANDING * f.len.max(1.0);
-        let end_tol = if now { END_LANDING } else { 1e-9 } * f.len.max(1.0);
+        let now = (t - s_from).abs() <= END_LANDING;
+        let end_tol = if now { END_LANDING } else { 0.0 }.max(1e-9 * f.len.max(1.0));
         let lo = if joined { 0.0 } else { end_tol };
         let hi = if f.tail.is_some() {
             f.len
