@@ -115,6 +115,80 @@ impl ContactFrame {
         }
     }
 
+    /// The frame of the given feature (a vertex or an edge on the pin) at configuration `q`, the
+    /// feature's circle or line extended beyond its own region: the frame a sustained contact
+    /// keeps until [`ContactFrame::region`] says another feature touches.
+    pub fn pin_feature(
+        poly: &Polygon,
+        q: [f64; 3],
+        pin: &FixedPin,
+        kind: ContactKind,
+    ) -> ContactFrame {
+        let x = Vec2::new(q[0], q[1]);
+        match kind {
+            ContactKind::EdgeOnPin(k) => {
+                let n = poly.inward_normal(k).rotate(q[2]);
+                let e0 = world_point(q, poly.vertex(k));
+                let depth = (e0 - pin.centre).dot(n);
+                let point = pin.centre + n * depth;
+                ContactFrame {
+                    kind,
+                    gap: depth - pin.radius,
+                    point,
+                    normal: n,
+                    rho: point - x,
+                    pin_from_centroid: pin.centre - x,
+                    reach: depth,
+                }
+            }
+            ContactKind::VertexOnPin(i) | ContactKind::VertexOnLine(i) => {
+                let point = world_point(q, poly.vertex(i));
+                let d = point - pin.centre;
+                let reach = d.norm();
+                ContactFrame {
+                    kind: ContactKind::VertexOnPin(i),
+                    gap: reach - pin.radius,
+                    point,
+                    normal: d.normalized(),
+                    rho: point - x,
+                    pin_from_centroid: Vec2::ZERO,
+                    reach,
+                }
+            }
+        }
+    }
+
+    /// How far (length) the pin's centre lies inside the region where this feature is the part's
+    /// nearest to it, and the feature beyond the region's nearer side: for an edge, the distance
+    /// of the foot of the centre from the edge's nearer end (then that end's vertex); for a
+    /// vertex, the least distance of the centre past the normal lines of its two edges (then that
+    /// edge). Negative once another feature is the nearer.
+    pub fn region(&self, poly: &Polygon, q: [f64; 3], pin: &FixedPin) -> (f64, ContactKind) {
+        let local = (pin.centre - Vec2::new(q[0], q[1])).rotate(-q[2]);
+        let m = poly.len();
+        match self.kind {
+            ContactKind::EdgeOnPin(k) => {
+                let (a, len) = (poly.vertex(k), poly.edge_len(k));
+                let s = (local - a).dot(poly.edge_dir(k));
+                if s < len - s {
+                    (s, ContactKind::VertexOnPin(k))
+                } else {
+                    (len - s, ContactKind::VertexOnPin((k + 1) % m))
+                }
+            }
+            ContactKind::VertexOnPin(i) | ContactKind::VertexOnLine(i) => {
+                let d = local - poly.vertex(i);
+                let before = d.dot(poly.edge_dir(i + m - 1));
+                let after = -d.dot(poly.edge_dir(i));
+                if before < after {
+                    (before, ContactKind::EdgeOnPin((i + m - 1) % m))
+                } else {
+                    (after, ContactKind::EdgeOnPin(i))
+                }
+            }
+        }
+    }
+
     /// The frame of vertex `i` of `poly` at configuration `q` against the straight line through
     /// `on_line` with unit normal `line_normal` pointing to the part's side.
     pub fn line(

@@ -6,7 +6,8 @@
 //! * **free**: M q̈ = F_s(ξ_rel) + F_g, support friction ([`super::friction`]) and gravity;
 //! * **carried**: at rest on the surface (ξ_rel = 0), moving with it, while static friction
 //!   holds gravity ([`Surface::holds_against_gravity`]); entered when the relative speed
-//!   √(|v − V_s|² + k²ω²) (k the radius of gyration) falls to `rest_fraction`·V_ref, where the
+//!   √(|v − V_s|² + k²ω²) (k the radius of gyration) falls to max(`rest_fraction`, 10·tol)·V_ref
+//!   (above the integration's noise in the velocities), where the
 //!   relative twist is then set to zero;
 //! * **stick** / **slide ±** in contact with the pin: M q̈ = F + J_nᵀ λn + J_tᵀ λt with the
 //!   contact's normal acceleration held at zero (and, sticking, its tangential one), λt = ∓μc λn
@@ -133,7 +134,7 @@ pub struct DynamicParams {
     /// Mode switches allowed per contact before [`DynamicStatus::ModeChatter`], ≥ 1.
     pub max_switches: u32,
     /// Relative speed, in units of V_ref, below which a part that friction can hold is carried
-    /// by the surface; in (0, 0.1].
+    /// by the surface (at least 10·tol is used); in (0, 0.1].
     pub rest_fraction: f64,
     /// Closing speed, in units of V_ref, below which an impact is plastic; in [0, 0.1].
     pub zeno_fraction: f64,
@@ -368,6 +369,8 @@ struct Sim<'a> {
     v_ref: f64,
     a: f64,
     evals: u64,
+    /// The feature in contact (while a contact lasts).
+    feature: ContactKind,
 }
 
 impl Sim<'_> {
@@ -387,10 +390,14 @@ impl Sim<'_> {
         self.part.body.inverse_mass_times([f.x, f.y, mo])
     }
 
+    /// The frame of the feature in contact at `y`.
+    fn frame(&self, y: &[f64; 6]) -> ContactFrame {
+        ContactFrame::pin_feature(&self.part.poly, [y[0], y[1], y[2]], self.pin, self.feature)
+    }
+
     fn pieces(&mut self, y: &[f64; 6]) -> Pieces {
-        let q = [y[0], y[1], y[2]];
         let qd = [y[3], y[4], y[5]];
-        let frame = ContactFrame::pin(&self.part.poly, q, self.pin);
+        let frame = self.frame(y);
         let qdd0 = self.free_accel(y);
         let (jn, jt) = frame.jacobian();
         let (bn, bt) = frame.bias(qd);
@@ -537,6 +544,12 @@ impl Sim<'_> {
         ContactFrame::pin(&self.part.poly, [y[0], y[1], y[2]], self.pin).gap
     }
 
+    /// The relative speed below which a part friction can hold is carried: `rest_fraction`·V_ref,
+    /// and at least 10·tol·V_ref, above the integration's own noise in the velocities.
+    fn rest_speed(&self) -> f64 {
+        self.params.rest_fraction.max(10.0 * self.params.tol) * self.v_ref
+    }
+
     fn rel_speed(&self, y: &[f64; 6]) -> f64 {
         let k = self.part.body.radius_of_gyration();
         let dv = Vec2::new(y[3], y[4]) - self.surface.velocity;
@@ -545,7 +558,7 @@ impl Sim<'_> {
 
     /// The event functions of `mode` at state `y` with rates `r` (+∞: unused). A crossing from
     /// ≥ 0 to < 0 is an event.
-    fn events(&self, y: &[f64; 6], r: &Rates, mode: Mode) -> [f64; 3] {
+    fn events(&self, y: &[f64; 6], r: &Rates, mode: Mode) -> [f64; 4] {
         let inf = f64::INFINITY;
         let mu = self.params.mu_c;
         // The gap fires a hair inside contact, so that a part leaving the pin with zero gap
@@ -554,16 +567,27 @@ impl Sim<'_> {
         match mode {
             Mode::Free => {
                 let rest = if self.surface.holds_against_gravity() {
-                    self.rel_speed(y) - self.params.rest_fraction * self.v_ref
+                    self.rel_speed(y) - self.rest_speed()
                 } else {
                     inf
                 };
-                [gap(), rest, inf]
+                [gap(), rest, inf, inf]
             }
-            Mode::Carried => [gap(), inf, inf],
-            Mode::Slide(s) => [r.lam_n, s * r.u_t, r.den - PAINLEVE_MARGIN],
-            Mode::Stick => [r.lam_n, mu * r.lam_n - r.lam_t, mu * r.lam_n + r.lam_t],
+            Mode::Carried => [gap(), inf, inf, inf],
+            Mode::Slide(s) => [r.lam_n, s * r.u_t, r.den - PAINLEVE_MARGIN, self.region(y)],
+            Mode::Stick => [
+                r.lam_n,
+                mu * r.lam_n - r.lam_t,
+                mu * r.lam_n + r.lam_t,
+                self.region(y),
+            ],
         }
+    }
+
+    /// The contact feature's region function (≥ 0 while it is the feature touching).
+    fn region(&self, y: &[f64; 6]) -> f64 {
+        let q = [y[0], y[1], y[2]];
+        self.frame(y).region(&self.part.poly, q, self.pin).0
     }
 
     /// The largest distance any point of the part moves from `y0` to `y1`, bounded above.
@@ -626,7 +650,7 @@ impl Sim<'_> {
                 Err(Trouble::NonFinite) => return Err(DynamicStatus::NonFinite { t }),
                 Err(Trouble::Painleve) => {
                     self.project(y, false);
-                    let frame = ContactFrame::pin(&self.part.poly, [y[0], y[1], y[2]], self.pin);
+                    let frame = self.frame(y);
                     let qd = [y[3], y[4], y[5]];
                     let u = frame.velocity(qd);
                     let body = self.part.body;
@@ -659,11 +683,10 @@ impl Sim<'_> {
     /// Project `y` onto the contact: gap 0, u_n = 0 (and u_t = 0 when sticking). Returns the
     /// corrections (|gap|/a, |u|/V_ref).
     fn project(&self, y: &mut [f64; 6], stick: bool) -> (f64, f64) {
-        let q = [y[0], y[1], y[2]];
-        let f = ContactFrame::pin(&self.part.poly, q, self.pin);
+        let f = self.frame(y);
         y[0] -= f.gap * f.normal.x;
         y[1] -= f.gap * f.normal.y;
-        let f2 = ContactFrame::pin(&self.part.poly, [y[0], y[1], y[2]], self.pin);
+        let f2 = self.frame(y);
         let qd = [y[3], y[4], y[5]];
         let (un, ut) = f2.velocity(qd);
         let [ann, ant, att] = f2.delassus(&self.part.body);
@@ -730,6 +753,7 @@ pub fn simulate_pin_contact(
         v_ref,
         a,
         evals: 0,
+        feature: ContactKind::VertexOnPin(0),
     };
     let mut out = DynamicOutcome {
         status: DynamicStatus::TimeLimit,
@@ -778,7 +802,7 @@ pub fn simulate_pin_contact(
             }
             if mode == Mode::Free
                 && surface.holds_against_gravity()
-                && sim.rel_speed(&y) < params.rest_fraction * v_ref
+                && sim.rel_speed(&y) < sim.rest_speed()
             {
                 // Slow enough to be held (entered so, e.g. leaving the pin while moving with the
                 // surface): carried from here.
@@ -828,7 +852,7 @@ pub fn simulate_pin_contact(
                 continue;
             }
             let e1 = sim.events(&y1, &r1, mode);
-            let crossed: Vec<usize> = (0..3).filter(|&i| e0[i] >= 0.0 && e1[i] < 0.0).collect();
+            let crossed: Vec<usize> = (0..4).filter(|&i| e0[i] >= 0.0 && e1[i] < 0.0).collect();
             let grow = if norm > 0.0 {
                 (0.9 * norm.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
             } else {
@@ -923,6 +947,23 @@ pub fn simulate_pin_contact(
                 (Mode::Stick | Mode::Slide(_), 0) => {
                     close(&mut open, &mut out, t, ContactEnd::Separated);
                     Ok(Mode::Free)
+                }
+                (Mode::Stick | Mode::Slide(_), 3) => {
+                    // The contact passes to the neighbouring feature (continuous in the pose).
+                    let q = [y[0], y[1], y[2]];
+                    let (_, next) = sim.frame(&y).region(&sim.part.poly, q, pin);
+                    match next {
+                        ContactKind::VertexOnPin(i) if !sim.part.poly.vertex_is_convex(i) => {
+                            Err(DynamicStatus::MultiContact { t })
+                        }
+                        _ => {
+                            sim.feature = next;
+                            match open.as_mut() {
+                                Some(log) => sim.settle(&mut y, t, log),
+                                None => sim.choose_mode(&y).map_err(|e| trouble(e, t)),
+                            }
+                        }
+                    }
                 }
                 (Mode::Slide(_), _) => match open.as_mut() {
                     Some(log) => sim.settle(&mut y, t, log),
@@ -1051,7 +1092,7 @@ fn carried_end(sim: &Sim, y: &[f64; 6]) -> Option<DynamicStatus> {
 fn second_touch(sim: &Sim, y: &[f64; 6], t: f64) -> Option<DynamicStatus> {
     let poly = &sim.part.poly;
     let local = (sim.pin.centre - Vec2::new(y[0], y[1])).rotate(-y[2]);
-    let f = ContactFrame::pin(poly, [y[0], y[1], y[2]], sim.pin);
+    let f = sim.frame(y);
     let c = (f.point - Vec2::new(y[0], y[1])).rotate(-y[2]);
     for j in 0..poly.len() {
         let (p0, p1) = poly.edge(j);
@@ -1076,9 +1117,10 @@ fn touch(
     out: &mut DynamicOutcome,
 ) -> Result<Mode, DynamicStatus> {
     let frame = ContactFrame::pin(&sim.part.poly, [y[0], y[1], y[2]], sim.pin);
+    sim.feature = frame.kind;
     y[0] -= frame.gap * frame.normal.x;
     y[1] -= frame.gap * frame.normal.y;
-    let frame = ContactFrame::pin(&sim.part.poly, [y[0], y[1], y[2]], sim.pin);
+    let frame = sim.frame(y);
     let qd = [y[3], y[4], y[5]];
     let u = frame.velocity(qd);
     let tiny = 1e-9 * sim.v_ref;

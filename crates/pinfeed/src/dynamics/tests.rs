@@ -284,7 +284,8 @@ fn a_part_launched_uphill_stops_where_the_closed_form_says_and_rests() {
         out.state.q[0]
     );
     // The part is set at rest once its speed falls to rest_fraction·V_ref (V_ref = v0).
-    let snap = DynamicParams::default().rest_fraction * v0 / dec;
+    let d = DynamicParams::default();
+    let snap = d.rest_fraction.max(10.0 * d.tol) * v0 / dec;
     assert!(
         (out.time - v0 / dec).abs() < snap + 1e-9,
         "{} vs {}",
@@ -695,27 +696,35 @@ fn at_a_slow_belt_the_dynamic_tier_reduces_to_the_quasi_static_one() {
     assert!(unsettled.len() <= 10, "{unsettled:#?}");
 }
 
-/// Measurements for the record (run with `--ignored --nocapture`): the quasi-static agreement
-/// against belt speed, and the convergence of a pass under halving tolerances.
-/// Measurements for the record (run with `--ignored --nocapture`): the quasi-static agreement
-/// against belt speed, and the convergence of a pass under halving tolerances.
 #[test]
-#[ignore]
-fn debug_one() {
+fn final_states_converge_as_the_tolerance_falls() {
+    // A pass with bounces (e = 0.4), a plastic touch, a slide and a flight off a vertex, at belt
+    // speed 0.5 √(μs g a): the final orientation and position against a run at tol 1e-11. The
+    // error falls about in proportion to the tolerance (a factor 1.9 to 2.4 per halving below
+    // tol 3e-6; the measurement test prints the series).
     let p = part("tripoly2", &Support::Uniform);
     let v = 0.5 * (0.3 * 9.81 * p.polygon().radius()).sqrt();
-    for tol in [1e-4, 1e-11] {
-        let (out, _) = belt_pass(&p, 40.0, -0.3, 0.4, v, 0.4, tol);
-        println!(
-            "tol {tol} status {:?} t {} steps {} rej {} ev {} state {:?}",
-            out.status, out.time, out.steps, out.rejected, out.event_iterations, out.state
-        );
-        for c in &out.contacts {
-            println!("  {:?} {} {} steps {} rej {} ev {} sw {} slide {} stick {} tang {} end {:?} gapc {:e} vc {:e}", c.kind, c.t_start, c.t_end, c.steps, c.rejected, c.event_iterations, c.switches, c.slide_steps, c.stick_steps, c.tangential_impacts.len(), c.end, c.max_gap_correction, c.max_velocity_correction);
-        }
-    }
+    let run = |tol: f64| belt_pass(&p, 40.0, -0.3, 0.4, v, 0.4, tol).0;
+    let reference = run(1e-11);
+    assert_eq!(reference.status, DynamicStatus::Settled);
+    let err = |tol: f64| {
+        let out = run(tol);
+        assert_eq!(out.status, DynamicStatus::Settled, "tol {tol}");
+        let dq: Vec<f64> = (0..3)
+            .map(|i| (out.state.q[i] - reference.state.q[i]).abs())
+            .collect();
+        (dq[2], dq[0].max(dq[1]))
+    };
+    let (coarse, fine) = (err(1e-5), err(1e-7));
+    assert!(coarse.0 < 1e-5 && coarse.1 < 1e-3, "{coarse:?}");
+    assert!(
+        fine.0 < coarse.0 / 10.0 && fine.1 < coarse.1 / 10.0,
+        "{coarse:?} {fine:?}"
+    );
 }
 
+/// Measurements for the record (run with `--ignored --nocapture`): the quasi-static agreement
+/// against belt speed, and the convergence of a pass under halving tolerances.
 #[test]
 #[ignore]
 fn measure_quasi_static_agreement_and_convergence() {
@@ -739,9 +748,12 @@ fn measure_quasi_static_agreement_and_convergence() {
         let err = (out.state.q[2] - reference.state.q[2]).abs();
         let errx = (out.state.q[0] - reference.state.q[0]).abs();
         println!(
-            "tol {tol:.3e}: θ error {err:.3e} rad, x error {errx:.3e}, steps {}",
-            out.steps
+            "tol {tol:.3e}: θ error {err:.3e} rad, x error {errx:.3e}, steps {}, {:?}, t {}",
+            out.steps, out.status, out.time
         );
+        if out.status != DynamicStatus::Settled {
+            println!("{:?}", out.contacts.last());
+        }
         tol /= 2.0;
     }
 }
