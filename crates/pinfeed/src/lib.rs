@@ -16,6 +16,7 @@
 //! | [`random`], [`statistics`], [`input`], [`output`], [`progress`] | seeded streams, intervals, bounded file reads, whole-or-nothing file writes, progress callbacks |
 //! | [`geometry`] | polygons, named parts, stable states, first contact |
 //! | [`mechanics`] | the contact model: limit surfaces, one pin or fence pass |
+//! | [`dynamics`] | the dynamic tier: a part with inertia, impacts and sustained contact with a pin |
 //! | [`maps`] | configuration maps θ0 → θf, their bands, ensembles, the map tier |
 //! | [`contact_case`] | one fully specified pass, as `pinfeed contact` runs it, batches of them, and the maps of a case as `pinfeed map` computes them ([`contact_case::maps::run`]) |
 //! | [`sensing`] | force/torque readings, classifiers, sense experiments |
@@ -32,6 +33,7 @@
 //! run, a plan and a sensing evaluation written against this API.
 
 pub mod contact_case;
+pub mod dynamics;
 pub mod engine;
 pub mod geometry;
 pub mod input;
