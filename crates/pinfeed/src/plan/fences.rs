@@ -271,10 +271,10 @@ impl FenceTransition {
             .fence_angle_range
             .map_or(0.0, |(lo, hi)| lo.abs().max(hi.abs()).to_radians());
         // (angle index, y0 quanta, y1 quanta, tail radius quanta, interval lo, hi)
+        let span = ymax - ymin + 2.0 * (a + gap) + over;
         let mut cands = Vec::new();
         for (ai, &deg) in self.options.angles_deg.iter().enumerate() {
             let alpha = deg.to_radians().abs();
-            let span = ymax - ymin + 2.0 * (a + gap) + over;
             let back = span / alpha.sin() * alpha.cos() * turn;
             let (y0, y1, lo, hi) = if deg > 0.0 {
                 (

@@ -126,8 +126,11 @@ fn levels(range: Option<(f64, f64)>, nominal: f64, k: usize) -> Vec<f64> {
 }
 
 impl Transition {
-    /// The physics samples: one (nominal) for all particles, or one per feed sample (`n`) drawn
-    /// from the seed when the problem asks for robustness.
+    /// The physics samples: one (nominal) for all particles, or one per feed sample (`n`) when
+    /// the problem asks for robustness — on one support a point of the grid over its ranges
+    /// ([`FRICTION_LEVELS`] frictions per range, three angle errors; μc and the angle error
+    /// advance together, so not every (μc, μf) pair occurs), on random tripods a draw from the
+    /// seed.
     pub fn new(problem: &Problem, compiled: &Compiled, n: usize) -> Result<Transition, PlanError> {
         let part_err = |reason: crate::mechanics::PartModelError| PlanError::Part {
             part: problem.part.clone(),
